@@ -1,0 +1,122 @@
+//! Closed-form references: Goldsmith's Hertz impact, the linear-spring
+//! contact, and the founding paper's adequacy factor (its Eq. 15).
+
+use crate::error::{non_negative, positive, within, Error, Result};
+
+/// Goldsmith's constant in `Tc = 2.9432 delta_max / v`, as printed.
+pub const GOLDSMITH_CONSTANT: f64 = 2.9432;
+/// The same constant exactly: `2 * (2/5) * B(2/5, 1/2)`.
+pub const HERTZ_DURATION_CONSTANT: f64 = 2.943_275_184_324_705;
+
+/// `K* = (m + M) / (m M)`, 1/kg.
+fn inverse_effective_mass(impact_mass: f64, main_mass: f64) -> Result<f64> {
+    let m = positive("impact_mass", impact_mass)?;
+    let big = positive("main_mass", main_mass)?;
+    Ok((m + big) / (m * big))
+}
+
+/// Maximum indentation of a Hertz impact between two free bodies, m:
+/// `delta_max = (5 v^2 / (4 K* K_hz))^(2/5)`.
+pub fn goldsmith_max_indentation(
+    impact_mass: f64,
+    main_mass: f64,
+    hertz_stiffness: f64,
+    approach_speed: f64,
+) -> Result<f64> {
+    let k_star = inverse_effective_mass(impact_mass, main_mass)?;
+    let k = positive("hertz_stiffness", hertz_stiffness)?;
+    let v = positive("approach_speed", approach_speed)?;
+    Ok((5.0 * v * v / (4.0 * k_star * k)).powf(0.4))
+}
+
+/// Goldsmith's Hertz contact duration, s:
+/// `Tc = 2.9432 / v^0.2 * (5 / (4 K* K_hz))^(2/5)`. With `exact_constant`
+/// the constant is `2.943275...` (the closed-form value of the integral)
+/// instead of Goldsmith's printed 2.9432.
+pub fn goldsmith_contact_duration(
+    impact_mass: f64,
+    main_mass: f64,
+    hertz_stiffness: f64,
+    approach_speed: f64,
+    exact_constant: bool,
+) -> Result<f64> {
+    let delta_max =
+        goldsmith_max_indentation(impact_mass, main_mass, hertz_stiffness, approach_speed)?;
+    let constant = if exact_constant {
+        HERTZ_DURATION_CONSTANT
+    } else {
+        GOLDSMITH_CONSTANT
+    };
+    Ok(constant * delta_max / approach_speed)
+}
+
+/// Contact duration of a linear spring `k1` with a damper `c1` between two
+/// free bodies (half a damped period), s:
+/// `Tc = 2 m M pi / (sqrt(m + M) sqrt(4 m M k1 - c1^2 (m + M)))`.
+pub fn linear_contact_duration(
+    impact_mass: f64,
+    main_mass: f64,
+    stiffness: f64,
+    damping: f64,
+) -> Result<f64> {
+    let m = positive("impact_mass", impact_mass)?;
+    let big = positive("main_mass", main_mass)?;
+    let k1 = positive("stiffness", stiffness)?;
+    let c1 = non_negative("damping", damping)?;
+    let discriminant = 4.0 * m * big * k1 - c1 * c1 * (m + big);
+    if discriminant <= 0.0 {
+        return Err(Error::Inconsistent(format!(
+            "damping {c1} N s/m is at or above critical for stiffness {k1} N/m: the contact does not oscillate"
+        )));
+    }
+    Ok(2.0 * m * big * std::f64::consts::PI / ((m + big).sqrt() * discriminant.sqrt()))
+}
+
+/// The paper's adequacy factor (Eq. 15), percent:
+/// `A = ((1 - error/max_error) wf1 + (1 - cpu_time/max_cpu_time) (1 - wf1)) * 100`.
+pub fn adequacy(
+    error: f64,
+    max_error: f64,
+    cpu_time: f64,
+    max_cpu_time: f64,
+    error_weight: f64,
+) -> Result<f64> {
+    let error = non_negative("error", error)?;
+    let max_error = positive("max_error", max_error)?;
+    let cpu_time = non_negative("cpu_time", cpu_time)?;
+    let max_cpu_time = positive("max_cpu_time", max_cpu_time)?;
+    let wf1 = within("error_weight", error_weight, 0.0, 1.0, false, "in [0, 1]")?;
+    Ok(((1.0 - error / max_error) * wf1 + (1.0 - cpu_time / max_cpu_time) * (1.0 - wf1)) * 100.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_constant_matches_the_integral() {
+        // 2 * int_0^1 dx / sqrt(1 - x^(5/2)), by the substitution x = 1 - s^2
+        // (which removes the end singularity) and a fine midpoint rule.
+        let n = 200_000;
+        let h = 1.0 / n as f64;
+        let mut sum = 0.0;
+        for i in 0..n {
+            let s = (i as f64 + 0.5) * h;
+            let x: f64 = 1.0 - s * s;
+            sum += 2.0 * s / (1.0 - x.powf(2.5)).sqrt() * h;
+        }
+        assert!(
+            (2.0 * sum - HERTZ_DURATION_CONSTANT).abs() < 1e-8,
+            "{}",
+            2.0 * sum
+        );
+    }
+
+    #[test]
+    fn table1_values() {
+        let tc = goldsmith_contact_duration(0.25, 1.0, 3000.0, 0.1, false).unwrap();
+        assert!((tc - 0.1089).abs() < 5e-5, "{tc}");
+        let tl = linear_contact_duration(0.25, 1.0, 49.05, 0.01).unwrap();
+        assert!((tl - 0.2006).abs() < 5e-5, "{tl}");
+    }
+}

@@ -1,0 +1,23 @@
+//! vibroimpact-core: impact dampers and vibro-impact systems.
+//!
+//! Pure Rust, no Python: the two-mass impact damper ([`ImpactDamper`]),
+//! compliant contact laws ([`contact`]), fixed-step integrators
+//! ([`integrators`]) driven by one generic kernel ([`run::integrate`]) that
+//! keeps a thinned history and a table of located contacts, and closed-form
+//! references ([`closed_forms`], [`beam`], [`materials`]). SI units throughout.
+
+pub mod beam;
+pub mod closed_forms;
+pub mod contact;
+pub mod error;
+mod hermite;
+pub mod integrators;
+pub mod materials;
+pub mod model;
+pub mod run;
+pub mod system;
+
+pub use contact::{Contact, ContactLaw, LawKind};
+pub use error::{Error, Result};
+pub use run::{simulate, ContactRecord, ContactTiming, History, Method, Settings, Solution};
+pub use system::{ImpactDamper, State};

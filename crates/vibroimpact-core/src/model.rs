@@ -1,0 +1,151 @@
+//! The equations of motion in the plain-data form the kernels use.
+
+use crate::contact::ContactLaw;
+use crate::system::{ImpactDamper, State};
+
+/// A force on the main mass that depends on time only (N). The hook for
+/// excitations; `Free` is the unforced system.
+pub trait Excitation: Copy + Send + Sync {
+    /// True when the force is identically zero, so that energy can only
+    /// decrease and an increase betrays a numerical blow-up.
+    const IS_FREE: bool;
+    fn main_force(&self, time: f64) -> f64;
+}
+
+/// No external force.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Free;
+
+impl Excitation for Free {
+    const IS_FREE: bool = true;
+    #[inline(always)]
+    fn main_force(&self, _time: f64) -> f64 {
+        0.0
+    }
+}
+
+/// What the contact does in one state.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactState {
+    /// +1 when the impact mass presses on the wall at `y - w = +d`, -1 for
+    /// the wall at `-d`.
+    pub side: f64,
+    /// `|y - w| - d`, m; > 0 in contact.
+    pub indentation: f64,
+    /// Rate of indentation, m/s.
+    pub rate: f64,
+    /// The law's force (clamped at zero), N.
+    pub law_force: f64,
+    /// Law force plus the contact damper `c1 * rate`, N; pushes apart when > 0.
+    pub total_force: f64,
+}
+
+/// The impact damper with its contact law and excitation, ready to integrate.
+#[derive(Debug, Clone, Copy)]
+pub struct Model<L: ContactLaw, X: Excitation> {
+    pub main_mass: f64,
+    pub impact_mass: f64,
+    pub stiffness: f64,
+    pub damping: f64,
+    pub clearance: f64,
+    pub contact_damping: f64,
+    pub law: L,
+    pub excitation: X,
+}
+
+impl<L: ContactLaw, X: Excitation> Model<L, X> {
+    pub fn new(system: &ImpactDamper, law: L, contact_damping: f64, excitation: X) -> Self {
+        Self {
+            main_mass: system.main_mass,
+            impact_mass: system.impact_mass,
+            stiffness: system.stiffness,
+            damping: system.damping,
+            clearance: system.clearance,
+            contact_damping,
+            law,
+            excitation,
+        }
+    }
+
+    /// Which wall the impact mass is at or heading for, and its signed gap
+    /// function `side * (y - w) - d` (> 0 in contact).
+    #[inline(always)]
+    pub fn side(&self, s: &State) -> f64 {
+        let u = s.relative_displacement();
+        if u > 0.0 || (u == 0.0 && s.relative_velocity() >= 0.0) {
+            1.0
+        } else {
+            -1.0
+        }
+    }
+
+    /// The contact in state `s` (zero forces when not in contact).
+    #[inline(always)]
+    pub fn contact(&self, s: &State, approach_rate: f64) -> ContactState {
+        let side = self.side(s);
+        let indentation = side * s.relative_displacement() - self.clearance;
+        let rate = side * s.relative_velocity();
+        if indentation > 0.0 {
+            let law_force = self.law.force(indentation, rate, approach_rate);
+            ContactState {
+                side,
+                indentation,
+                rate,
+                law_force,
+                total_force: law_force + self.contact_damping * rate,
+            }
+        } else {
+            ContactState {
+                side,
+                indentation,
+                rate,
+                law_force: 0.0,
+                total_force: 0.0,
+            }
+        }
+    }
+
+    /// Accelerations `(w'', y'')` in m/s^2.
+    #[inline(always)]
+    pub fn accelerations(&self, time: f64, s: &State, approach_rate: f64) -> (f64, f64) {
+        let mut main_force = self.excitation.main_force(time)
+            - self.damping * s.main_velocity
+            - self.stiffness * s.main_displacement;
+        let mut impact_force = 0.0;
+        let u = s.relative_displacement();
+        // Cheap test first: the full contact evaluation only when touching.
+        if u.abs() > self.clearance {
+            let c = self.contact(s, approach_rate);
+            main_force += c.side * c.total_force;
+            impact_force -= c.side * c.total_force;
+        }
+        (main_force / self.main_mass, impact_force / self.impact_mass)
+    }
+
+    /// Mechanical energy: kinetic, main spring and elastic contact energy, J.
+    #[inline]
+    pub fn energy(&self, s: &State) -> f64 {
+        let side = self.side(s);
+        let indentation = side * s.relative_displacement() - self.clearance;
+        let contact = if indentation > 0.0 {
+            self.law.potential(indentation)
+        } else {
+            0.0
+        };
+        0.5 * (self.main_mass * s.main_velocity * s.main_velocity
+            + self.impact_mass * s.impact_velocity * s.impact_velocity
+            + self.stiffness * s.main_displacement * s.main_displacement)
+            + contact
+    }
+
+    /// Power dissipated in the contact (W): the law's non-elastic part plus
+    /// the contact damper.
+    #[inline]
+    pub fn contact_dissipation(&self, c: &ContactState) -> f64 {
+        if c.indentation > 0.0 {
+            (c.total_force - self.law.elastic_force(c.indentation)) * c.rate
+        } else {
+            0.0
+        }
+    }
+}
