@@ -1,1 +1,674 @@
+//! `vibroimpact._core`: the Python face of vibroimpact-core. It only converts
+//! arguments and results, releases the GIL around integration and maps each
+//! core error to its own Python exception.
 
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyArithmeticError, PyKeyboardInterrupt, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use vibroimpact_core as core;
+use vibroimpact_core::{beam, closed_forms, materials};
+
+create_exception!(
+    _core,
+    InvalidInputError,
+    PyValueError,
+    "An input is outside what the model allows; the message names the field."
+);
+create_exception!(
+    _core,
+    NumericalBlowUpError,
+    PyArithmeticError,
+    "The integration blew up (non-finite state or energy created from nothing)."
+);
+
+fn to_py(err: core::Error) -> PyErr {
+    match err {
+        core::Error::NumericalBlowUp { .. } => NumericalBlowUpError::new_err(err.to_string()),
+        core::Error::Interrupted { .. } => PyKeyboardInterrupt::new_err(err.to_string()),
+        _ => InvalidInputError::new_err(err.to_string()),
+    }
+}
+
+/// A whole number >= `min` from a Python int, as an InvalidInputError otherwise.
+fn whole(field: &str, value: i64, min: i64) -> PyResult<u64> {
+    if value < min {
+        Err(InvalidInputError::new_err(format!(
+            "{field} must be a whole number >= {min}, got {value}"
+        )))
+    } else {
+        Ok(value as u64)
+    }
+}
+
+/// The two-mass impact damper (SI units).
+///
+/// A main mass ``main_mass`` (M, kg) on a spring ``stiffness`` (K, N/m) and
+/// damper ``damping`` (C, N s/m) carries an enclosure in which the impact mass
+/// ``impact_mass`` (m, kg) moves freely with ``clearance`` (d, m) on each side.
+#[pyclass(frozen, eq, module = "vibroimpact._core")]
+#[derive(Clone, PartialEq)]
+struct ImpactDamper(core::ImpactDamper);
+
+#[pymethods]
+impl ImpactDamper {
+    #[new]
+    #[pyo3(signature = (main_mass, stiffness, impact_mass, clearance, damping = 0.0))]
+    fn new(
+        main_mass: f64,
+        stiffness: f64,
+        impact_mass: f64,
+        clearance: f64,
+        damping: f64,
+    ) -> PyResult<Self> {
+        core::ImpactDamper::new(main_mass, stiffness, damping, impact_mass, clearance)
+            .map(Self)
+            .map_err(to_py)
+    }
+    /// M, kg.
+    #[getter]
+    fn main_mass(&self) -> f64 {
+        self.0.main_mass
+    }
+    /// K, N/m.
+    #[getter]
+    fn stiffness(&self) -> f64 {
+        self.0.stiffness
+    }
+    /// m, kg.
+    #[getter]
+    fn impact_mass(&self) -> f64 {
+        self.0.impact_mass
+    }
+    /// d, m (on each side).
+    #[getter]
+    fn clearance(&self) -> f64 {
+        self.0.clearance
+    }
+    /// C, N s/m.
+    #[getter]
+    fn damping(&self) -> f64 {
+        self.0.damping
+    }
+    /// ``m M / (m + M)``, kg.
+    #[getter]
+    fn effective_mass(&self) -> f64 {
+        self.0.effective_mass()
+    }
+    fn __getnewargs__(&self) -> (f64, f64, f64, f64, f64) {
+        let s = &self.0;
+        (s.main_mass, s.stiffness, s.impact_mass, s.clearance, s.damping)
+    }
+    fn __repr__(&self) -> String {
+        let s = &self.0;
+        format!(
+            "ImpactDamper(main_mass={:?}, stiffness={:?}, impact_mass={:?}, clearance={:?}, damping={:?})",
+            s.main_mass, s.stiffness, s.impact_mass, s.clearance, s.damping
+        )
+    }
+}
+
+/// A compliant contact law and the contact damper.
+///
+/// ``law`` is ``"hertz"`` (F = k delta^1.5), ``"hyster-hertz"``
+/// (Lankarani-Nikravesh, F = k delta^1.5 (1 + 3/4 (1 - e^2) delta'/delta'_minus),
+/// needs ``restitution`` e in (0, 1]) or ``"linear"`` (F = k delta). ``stiffness``
+/// is in N/m^1.5 for the Hertz laws and N/m for ``"linear"``. ``damping`` (c1,
+/// N s/m) is a linear damper on the relative velocity acting only in contact.
+/// The law's force never pulls the bodies together: it is clamped at zero.
+#[pyclass(frozen, eq, module = "vibroimpact._core")]
+#[derive(Clone, PartialEq)]
+struct Contact(core::Contact);
+
+#[pymethods]
+impl Contact {
+    #[new]
+    #[pyo3(signature = (law, stiffness, damping = 0.0, restitution = None))]
+    fn new(law: &str, stiffness: f64, damping: f64, restitution: Option<f64>) -> PyResult<Self> {
+        let kind = core::LawKind::parse(law).map_err(to_py)?;
+        core::Contact::new(kind, stiffness, restitution, damping)
+            .map(Self)
+            .map_err(to_py)
+    }
+    /// The law's name.
+    #[getter]
+    fn law(&self) -> &'static str {
+        self.0.law.name()
+    }
+    /// K_hz (N/m^1.5) or k1 (N/m).
+    #[getter]
+    fn stiffness(&self) -> f64 {
+        self.0.stiffness
+    }
+    /// c1, N s/m.
+    #[getter]
+    fn damping(&self) -> f64 {
+        self.0.damping
+    }
+    /// e for "hyster-hertz", None otherwise.
+    #[getter]
+    fn restitution(&self) -> Option<f64> {
+        (self.0.law == core::LawKind::HysterHertz).then_some(self.0.restitution)
+    }
+    /// The law's force (N, clamped at zero; without the contact damper) at
+    /// ``indentation`` (m), indentation ``rate`` (m/s) and the rate at the
+    /// onset of the contact ``approach_rate`` (m/s).
+    #[pyo3(signature = (indentation, rate = 0.0, approach_rate = 1.0))]
+    fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
+        self.0.law_force(indentation, rate, approach_rate)
+    }
+    fn __getnewargs__(&self) -> (&'static str, f64, f64, Option<f64>) {
+        (self.law(), self.0.stiffness, self.0.damping, self.restitution())
+    }
+    fn __repr__(&self) -> String {
+        let restitution = match self.restitution() {
+            Some(e) => format!(", restitution={e:?}"),
+            None => String::new(),
+        };
+        format!(
+            "Contact(law={:?}, stiffness={:?}, damping={:?}{restitution})",
+            self.law(),
+            self.0.stiffness,
+            self.0.damping
+        )
+    }
+}
+
+/// Initial displacements (m) and velocities (m/s) of the main mass (w) and
+/// the impact mass (y).
+#[pyclass(frozen, eq, module = "vibroimpact._core")]
+#[derive(Clone, PartialEq)]
+struct InitialState(core::State);
+
+#[pymethods]
+impl InitialState {
+    #[new]
+    #[pyo3(signature = (main_displacement = 0.0, main_velocity = 0.0, impact_displacement = 0.0, impact_velocity = 0.0))]
+    fn new(
+        main_displacement: f64,
+        main_velocity: f64,
+        impact_displacement: f64,
+        impact_velocity: f64,
+    ) -> PyResult<Self> {
+        core::State::new(
+            main_displacement,
+            main_velocity,
+            impact_displacement,
+            impact_velocity,
+        )
+        .map(Self)
+        .map_err(to_py)
+    }
+    /// w, m.
+    #[getter]
+    fn main_displacement(&self) -> f64 {
+        self.0.main_displacement
+    }
+    /// w', m/s.
+    #[getter]
+    fn main_velocity(&self) -> f64 {
+        self.0.main_velocity
+    }
+    /// y, m.
+    #[getter]
+    fn impact_displacement(&self) -> f64 {
+        self.0.impact_displacement
+    }
+    /// y', m/s.
+    #[getter]
+    fn impact_velocity(&self) -> f64 {
+        self.0.impact_velocity
+    }
+    fn __getnewargs__(&self) -> (f64, f64, f64, f64) {
+        let s = &self.0;
+        (
+            s.main_displacement,
+            s.main_velocity,
+            s.impact_displacement,
+            s.impact_velocity,
+        )
+    }
+    fn __repr__(&self) -> String {
+        let s = &self.0;
+        format!(
+            "InitialState(main_displacement={:?}, main_velocity={:?}, impact_displacement={:?}, impact_velocity={:?})",
+            s.main_displacement, s.main_velocity, s.impact_displacement, s.impact_velocity
+        )
+    }
+}
+
+/// The contacts of a run, one entry per contact, as NumPy arrays in SI units.
+/// A contact still open at the end of the run has NaN ``separation``,
+/// ``duration`` and ``rebound_speed``.
+#[pyclass(frozen, module = "vibroimpact._core")]
+struct ContactTable {
+    /// Onset, s.
+    #[pyo3(get)]
+    onset: Py<PyArray1<f64>>,
+    /// Separation, s.
+    #[pyo3(get)]
+    separation: Py<PyArray1<f64>>,
+    /// Duration, s.
+    #[pyo3(get)]
+    duration: Py<PyArray1<f64>>,
+    /// Maximum indentation, m.
+    #[pyo3(get)]
+    max_indentation: Py<PyArray1<f64>>,
+    /// Relative normal speed at onset, m/s.
+    #[pyo3(get)]
+    approach_speed: Py<PyArray1<f64>>,
+    /// Relative normal speed at separation, m/s.
+    #[pyo3(get)]
+    rebound_speed: Py<PyArray1<f64>>,
+    /// Energy dissipated by the contact (law hysteresis and contact damper), J.
+    #[pyo3(get)]
+    energy_dissipated: Py<PyArray1<f64>>,
+    records: Vec<core::ContactRecord>,
+}
+
+const CONTACT_COLUMNS: [&str; 7] = [
+    "onset",
+    "separation",
+    "duration",
+    "max_indentation",
+    "approach_speed",
+    "rebound_speed",
+    "energy_dissipated",
+];
+
+fn record_values(r: &core::ContactRecord) -> [f64; 7] {
+    [
+        r.onset,
+        r.separation,
+        r.duration,
+        r.max_indentation,
+        r.approach_speed,
+        r.rebound_speed,
+        r.energy_dissipated,
+    ]
+}
+
+#[pymethods]
+impl ContactTable {
+    /// Column names, in order.
+    #[classattr]
+    fn columns() -> [&'static str; 7] {
+        CONTACT_COLUMNS
+    }
+    fn __len__(&self) -> usize {
+        self.records.len()
+    }
+    /// One dict per contact, keyed by the column names.
+    fn to_dicts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for r in &self.records {
+            let d = PyDict::new(py);
+            for (name, value) in CONTACT_COLUMNS.iter().zip(record_values(r)) {
+                d.set_item(name, value)?;
+            }
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+    fn __repr__(&self) -> String {
+        format!("ContactTable({} contacts)", self.records.len())
+    }
+}
+
+/// What ``simulate`` returns: the time history (NumPy arrays, SI units), the
+/// table of contacts and the run's statistics.
+#[pyclass(frozen, module = "vibroimpact._core")]
+struct Solution {
+    /// Time of each kept step, s.
+    #[pyo3(get)]
+    t: Py<PyArray1<f64>>,
+    /// w, m.
+    #[pyo3(get)]
+    main_displacement: Py<PyArray1<f64>>,
+    /// w', m/s.
+    #[pyo3(get)]
+    main_velocity: Py<PyArray1<f64>>,
+    /// y, m.
+    #[pyo3(get)]
+    impact_displacement: Py<PyArray1<f64>>,
+    /// y', m/s.
+    #[pyo3(get)]
+    impact_velocity: Py<PyArray1<f64>>,
+    /// Force between the bodies (law + contact damper), N; > 0 pushes apart.
+    #[pyo3(get)]
+    contact_force: Py<PyArray1<f64>>,
+    /// The contacts.
+    #[pyo3(get)]
+    contacts: Py<ContactTable>,
+    /// Steps taken.
+    #[pyo3(get)]
+    steps: u64,
+    /// Force (right-hand-side) evaluations.
+    #[pyo3(get)]
+    rhs_evaluations: u64,
+    /// Time reached, s (t_end rounded up to a whole number of steps).
+    #[pyo3(get)]
+    final_time: f64,
+    /// Method name.
+    #[pyo3(get)]
+    method: &'static str,
+}
+
+#[pymethods]
+impl Solution {
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "Solution(method={:?}, steps={}, rows={}, contacts={})",
+            self.method,
+            self.steps,
+            self.t.bind(py).len().unwrap_or(0),
+            self.contacts.bind(py).get().records.len()
+        )
+    }
+}
+
+fn array(py: Python<'_>, v: Vec<f64>) -> Py<PyArray1<f64>> {
+    v.into_pyarray(py).unbind()
+}
+
+fn settings(
+    dt: f64,
+    t_end: f64,
+    method: &str,
+    every: i64,
+    contact_timing: &str,
+    beta: f64,
+    gamma: f64,
+) -> PyResult<core::Settings> {
+    let parsed = core::Method::parse(method, beta, gamma).map_err(to_py)?;
+    let timing = core::ContactTiming::parse(contact_timing).map_err(to_py)?;
+    let every = whole("every", every, 1)?;
+    core::Settings::new(parsed, dt, t_end, every, timing).map_err(to_py)
+}
+
+/// Check solver settings as ``simulate`` would, without running; raises
+/// ``InvalidInputError`` naming the offending field.
+#[pyfunction]
+#[pyo3(signature = (*, dt, t_end, method = "newmark", every = 1, contact_timing = "located", beta = 0.25, gamma = 0.5))]
+fn check_solver(
+    dt: f64,
+    t_end: f64,
+    method: &str,
+    every: i64,
+    contact_timing: &str,
+    beta: f64,
+    gamma: f64,
+) -> PyResult<()> {
+    settings(dt, t_end, method, every, contact_timing, beta, gamma).map(|_| ())
+}
+
+/// Integrate the impact damper from ``initial`` to ``t_end`` (s) with step
+/// ``dt`` (s).
+///
+/// ``method`` is ``"newmark"`` (the founding paper's Newmark-beta with the
+/// contact force lagged one step; ``beta``, ``gamma`` default 1/4, 1/2) or
+/// ``"rk4"`` (classical Runge-Kutta). ``every`` keeps every N-th step in the
+/// history. ``contact_timing`` is ``"located"`` (onset and separation found
+/// inside the step) or ``"step-count"`` (the paper's: whole steps).
+/// The GIL is released while integrating; Ctrl-C interrupts.
+#[pyfunction]
+#[pyo3(signature = (system, contact, initial, *, dt, t_end, method = "newmark", every = 1, contact_timing = "located", beta = 0.25, gamma = 0.5))]
+#[allow(clippy::too_many_arguments)]
+fn simulate(
+    py: Python<'_>,
+    system: &ImpactDamper,
+    contact: &Contact,
+    initial: &InitialState,
+    dt: f64,
+    t_end: f64,
+    method: &str,
+    every: i64,
+    contact_timing: &str,
+    beta: f64,
+    gamma: f64,
+) -> PyResult<Solution> {
+    let settings = settings(dt, t_end, method, every, contact_timing, beta, gamma)?;
+    let parsed = settings.method;
+    let (sys, con, init) = (system.0, contact.0, initial.0);
+    let mut signal: Option<PyErr> = None;
+    let result = py.detach(|| {
+        core::simulate(&sys, &con, &init, &settings, &mut || {
+            match Python::attach(|py| py.check_signals()) {
+                Ok(()) => false,
+                Err(e) => {
+                    signal = Some(e);
+                    true
+                }
+            }
+        })
+    });
+    let sol = match result {
+        Ok(sol) => sol,
+        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
+            return Err(signal.take().expect("checked"))
+        }
+        Err(e) => return Err(to_py(e)),
+    };
+    let records = sol.contacts;
+    let column = |f: fn(&core::ContactRecord) -> f64| -> Vec<f64> { records.iter().map(f).collect() };
+    let table = ContactTable {
+        onset: array(py, column(|r| r.onset)),
+        separation: array(py, column(|r| r.separation)),
+        duration: array(py, column(|r| r.duration)),
+        max_indentation: array(py, column(|r| r.max_indentation)),
+        approach_speed: array(py, column(|r| r.approach_speed)),
+        rebound_speed: array(py, column(|r| r.rebound_speed)),
+        energy_dissipated: array(py, column(|r| r.energy_dissipated)),
+        records,
+    };
+    let h = sol.history;
+    Ok(Solution {
+        t: array(py, h.time),
+        main_displacement: array(py, h.main_displacement),
+        main_velocity: array(py, h.main_velocity),
+        impact_displacement: array(py, h.impact_displacement),
+        impact_velocity: array(py, h.impact_velocity),
+        contact_force: array(py, h.contact_force),
+        contacts: Py::new(py, table)?,
+        steps: sol.steps,
+        rhs_evaluations: sol.rhs_evaluations,
+        final_time: sol.final_time,
+        method: match parsed {
+            core::Method::Newmark { .. } => "newmark",
+            core::Method::Rk4 => "rk4",
+        },
+    })
+}
+
+/// Hertz stiffness K_hz (N/m^1.5) of a sphere (``radius`` m, ``youngs_modulus``
+/// Pa, ``poisson_ratio``) on a flat, or on a second sphere of ``other_radius``
+/// (m), made of (``other_youngs_modulus`` Pa, ``other_poisson_ratio``):
+/// ``K_hz = (4/3) E* sqrt(R)``, ``1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2``,
+/// ``R = r1 r2 / (r1 + r2)``.
+#[pyfunction]
+#[pyo3(signature = (radius, youngs_modulus, poisson_ratio, other_youngs_modulus, other_poisson_ratio, other_radius = None))]
+fn hertz_stiffness(
+    radius: f64,
+    youngs_modulus: f64,
+    poisson_ratio: f64,
+    other_youngs_modulus: f64,
+    other_poisson_ratio: f64,
+    other_radius: Option<f64>,
+) -> PyResult<f64> {
+    let a = materials::Material::new(youngs_modulus, poisson_ratio).map_err(to_py)?;
+    let b = materials::Material::new(other_youngs_modulus, other_poisson_ratio).map_err(|e| {
+        // Name the second body's fields as the caller wrote them.
+        InvalidInputError::new_err(format!("other_{e}"))
+    })?;
+    materials::hertz_stiffness(radius, &a, &b, other_radius).map_err(to_py)
+}
+
+/// One cantilever mode reduced to a single degree of freedom (see
+/// ``cantilever_mode``). Stiffnesses in N/m, masses in kg, frequency in rad/s.
+#[pyclass(frozen, get_all, module = "vibroimpact._core")]
+struct BeamMode {
+    mode: u32,
+    beta_l: f64,
+    angular_frequency: f64,
+    modal_stiffness: f64,
+    modal_mass: f64,
+    position: f64,
+    shape_at_position: f64,
+    stiffness_at_position: f64,
+    mass_at_position: f64,
+}
+
+#[pymethods]
+impl BeamMode {
+    fn __repr__(&self) -> String {
+        format!(
+            "BeamMode(mode={}, beta_l={:.6}, modal_stiffness={:.6e}, modal_mass={:.6e}, position={:?}, stiffness_at_position={:.6e}, mass_at_position={:.6e})",
+            self.mode, self.beta_l, self.modal_stiffness, self.modal_mass, self.position,
+            self.stiffness_at_position, self.mass_at_position
+        )
+    }
+}
+
+/// Reduce mode ``mode`` of a cantilever (``length`` m, ``youngs_modulus`` Pa,
+/// ``second_moment`` m^4, ``density`` kg/m^3, ``area`` m^2) to one degree of
+/// freedom by the Ritz method on its mode shape, normalised so that
+/// ``int_0^L phi^2 dx = L``. Gives the paper's modal values
+/// (``(b L)^4 E I / L^3``, ``rho A L``) and the values referred to
+/// ``position`` (m from the clamp; the tip by default), where the enclosure sits.
+#[pyfunction]
+#[pyo3(signature = (length, youngs_modulus, second_moment, density, area, mode = 1, position = None))]
+fn cantilever_mode(
+    length: f64,
+    youngs_modulus: f64,
+    second_moment: f64,
+    density: f64,
+    area: f64,
+    mode: i64,
+    position: Option<f64>,
+) -> PyResult<BeamMode> {
+    let mode = whole("mode", mode, 1)?.min(u32::MAX as u64) as u32;
+    let b = beam::cantilever_mode(
+        length,
+        youngs_modulus,
+        second_moment,
+        density,
+        area,
+        mode,
+        position,
+    )
+    .map_err(to_py)?;
+    Ok(BeamMode {
+        mode: b.mode,
+        beta_l: b.beta_l,
+        angular_frequency: b.angular_frequency,
+        modal_stiffness: b.modal_stiffness,
+        modal_mass: b.modal_mass,
+        position: b.position,
+        shape_at_position: b.shape_at_position,
+        stiffness_at_position: b.stiffness_at_position,
+        mass_at_position: b.mass_at_position,
+    })
+}
+
+/// The root ``b_i L`` of ``cos(x) cosh(x) + 1 = 0`` for mode ``mode`` >= 1.
+#[pyfunction]
+fn cantilever_root(mode: i64) -> PyResult<f64> {
+    let mode = whole("mode", mode, 1)?.min(u32::MAX as u64) as u32;
+    beam::cantilever_root(mode).map_err(to_py)
+}
+
+/// Normalised mode shape ``phi(x)`` (``int_0^L phi^2 dx = L``) of mode
+/// ``mode`` of a cantilever of ``length`` (m), at ``x`` (m from the clamp).
+#[pyfunction]
+fn cantilever_mode_shape(length: f64, mode: i64, x: f64) -> PyResult<f64> {
+    let mode = whole("mode", mode, 1)?.min(u32::MAX as u64) as u32;
+    beam::cantilever_mode_shape(length, mode, x).map_err(to_py)
+}
+
+/// Goldsmith's Hertz contact duration (s) of two free bodies meeting at
+/// ``approach_speed`` (m/s): ``2.9432 / v^0.2 (5 / (4 K* K_hz))^(2/5)`` with
+/// ``K* = (m + M)/(m M)``. ``exact_constant`` uses 2.943275... instead of 2.9432.
+#[pyfunction]
+#[pyo3(signature = (impact_mass, main_mass, hertz_stiffness, approach_speed, exact_constant = false))]
+fn goldsmith_contact_duration(
+    impact_mass: f64,
+    main_mass: f64,
+    hertz_stiffness: f64,
+    approach_speed: f64,
+    exact_constant: bool,
+) -> PyResult<f64> {
+    closed_forms::goldsmith_contact_duration(
+        impact_mass,
+        main_mass,
+        hertz_stiffness,
+        approach_speed,
+        exact_constant,
+    )
+    .map_err(to_py)
+}
+
+/// Goldsmith's maximum Hertz indentation (m): ``(5 v^2 / (4 K* K_hz))^(2/5)``.
+#[pyfunction]
+fn goldsmith_max_indentation(
+    impact_mass: f64,
+    main_mass: f64,
+    hertz_stiffness: f64,
+    approach_speed: f64,
+) -> PyResult<f64> {
+    closed_forms::goldsmith_max_indentation(impact_mass, main_mass, hertz_stiffness, approach_speed)
+        .map_err(to_py)
+}
+
+/// Contact duration (s) of a linear spring ``stiffness`` (N/m) with a damper
+/// ``damping`` (N s/m) between two free bodies: half a damped period.
+#[pyfunction]
+#[pyo3(signature = (impact_mass, main_mass, stiffness, damping = 0.0))]
+fn linear_contact_duration(
+    impact_mass: f64,
+    main_mass: f64,
+    stiffness: f64,
+    damping: f64,
+) -> PyResult<f64> {
+    closed_forms::linear_contact_duration(impact_mass, main_mass, stiffness, damping)
+        .map_err(to_py)
+}
+
+/// The founding paper's adequacy factor (Eq. 15), percent:
+/// ``((1 - error/max_error) wf1 + (1 - cpu_time/max_cpu_time)(1 - wf1)) * 100``
+/// with ``wf1 = error_weight``.
+#[pyfunction]
+fn adequacy(
+    error: f64,
+    max_error: f64,
+    cpu_time: f64,
+    max_cpu_time: f64,
+    error_weight: f64,
+) -> PyResult<f64> {
+    closed_forms::adequacy(error, max_error, cpu_time, max_cpu_time, error_weight).map_err(to_py)
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("InvalidInputError", py.get_type::<InvalidInputError>())?;
+    m.add("NumericalBlowUpError", py.get_type::<NumericalBlowUpError>())?;
+    m.add_class::<ImpactDamper>()?;
+    m.add_class::<Contact>()?;
+    m.add_class::<InitialState>()?;
+    m.add_class::<Solution>()?;
+    m.add_class::<ContactTable>()?;
+    m.add_class::<BeamMode>()?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(check_solver, m)?)?;
+    m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
+    m.add_function(wrap_pyfunction!(cantilever_mode, m)?)?;
+    m.add_function(wrap_pyfunction!(cantilever_root, m)?)?;
+    m.add_function(wrap_pyfunction!(cantilever_mode_shape, m)?)?;
+    m.add_function(wrap_pyfunction!(goldsmith_contact_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(goldsmith_max_indentation, m)?)?;
+    m.add_function(wrap_pyfunction!(linear_contact_duration, m)?)?;
+    m.add_function(wrap_pyfunction!(adequacy, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,63 @@
+"""vibroimpact: fast, verified simulation of impact dampers and vibro-impact systems.
+
+A main structure (one mode: mass ``M``, spring ``K``, damper ``C``) carries an
+enclosure in which a loose impact mass ``m`` rattles with a clearance ``d`` on
+each side. Contacts follow compliant laws (Hertz, Lankarani-Nikravesh
+"Hyster-Hertz", linear) with a contact damper ``c1``. SI units throughout.
+
+>>> import vibroimpact as vi
+>>> system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, damping=0.01,
+...                          impact_mass=0.25, clearance=0.01)
+>>> contact = vi.Contact("hertz", stiffness=3000.0, damping=0.01)
+>>> start = vi.InitialState(impact_displacement=0.01, impact_velocity=0.1)
+>>> sol = vi.simulate(system, contact, start, method="rk4", dt=1e-4, t_end=0.2)
+>>> round(float(sol.contacts.duration[0]), 5)
+0.10898
+"""
+
+from vibroimpact._core import (
+    BeamMode,
+    Contact,
+    ContactTable,
+    ImpactDamper,
+    InitialState,
+    InvalidInputError,
+    NumericalBlowUpError,
+    Solution,
+    __version__,
+    adequacy,
+    cantilever_mode,
+    cantilever_mode_shape,
+    cantilever_root,
+    goldsmith_contact_duration,
+    goldsmith_max_indentation,
+    hertz_stiffness,
+    linear_contact_duration,
+    simulate,
+)
+from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
+
+__all__ = [
+    "BeamMode",
+    "Contact",
+    "ContactTable",
+    "ImpactDamper",
+    "InitialState",
+    "InvalidInputError",
+    "NumericalBlowUpError",
+    "Scenario",
+    "ScenarioError",
+    "Solution",
+    "__version__",
+    "adequacy",
+    "cantilever_mode",
+    "cantilever_mode_shape",
+    "cantilever_root",
+    "goldsmith_contact_duration",
+    "goldsmith_max_indentation",
+    "hertz_stiffness",
+    "linear_contact_duration",
+    "load_scenario",
+    "parse_scenario",
+    "simulate",
+]

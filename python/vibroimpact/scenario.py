@@ -1,0 +1,230 @@
+"""TOML scenarios: one run of the impact damper described in a file.
+
+Every key is checked: unknown or mistyped keys, wrong types and out-of-range
+values raise :class:`ScenarioError` (a ``ValueError``) naming the file, the
+section and the key. See ``examples/`` and the README for the format.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from vibroimpact._core import (
+    Contact,
+    ImpactDamper,
+    InitialState,
+    InvalidInputError,
+    Solution,
+    check_solver,
+    simulate,
+)
+
+
+class ScenarioError(InvalidInputError):
+    """A scenario file that cannot be read or does not describe a valid run."""
+
+
+_NUMBER = "number"
+_TEXT = "string"
+_WHOLE = "whole number"
+
+# section -> key -> (type, default; a default of _REQUIRED means the key must be given)
+_REQUIRED = object()
+_SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
+    "system": {
+        "main_mass": (_NUMBER, _REQUIRED),
+        "stiffness": (_NUMBER, _REQUIRED),
+        "damping": (_NUMBER, 0.0),
+        "impact_mass": (_NUMBER, _REQUIRED),
+        "clearance": (_NUMBER, _REQUIRED),
+    },
+    "contact": {
+        "law": (_TEXT, _REQUIRED),
+        "stiffness": (_NUMBER, _REQUIRED),
+        "restitution": (_NUMBER, None),
+        "damping": (_NUMBER, 0.0),
+    },
+    "initial": {
+        "main_displacement": (_NUMBER, 0.0),
+        "main_velocity": (_NUMBER, 0.0),
+        "impact_displacement": (_NUMBER, 0.0),
+        "impact_velocity": (_NUMBER, 0.0),
+    },
+    "solver": {
+        "method": (_TEXT, "newmark"),
+        "dt": (_NUMBER, _REQUIRED),
+        "t_end": (_NUMBER, _REQUIRED),
+        "beta": (_NUMBER, 0.25),
+        "gamma": (_NUMBER, 0.5),
+        "contact_timing": (_TEXT, "located"),
+    },
+    "output": {
+        "every": (_WHOLE, 1),
+    },
+}
+_REQUIRED_SECTIONS = ("system", "contact", "solver")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated run: the system, its contact, the initial state and the solver settings.
+
+    Times in s, ``every`` keeps every N-th step of the history.
+    """
+
+    system: ImpactDamper
+    contact: Contact
+    initial: InitialState
+    method: str = "newmark"
+    dt: float = 1e-4
+    t_end: float = 0.3
+    beta: float = 0.25
+    gamma: float = 0.5
+    contact_timing: str = "located"
+    every: int = 1
+
+    def run(self) -> Solution:
+        """Integrate the scenario (see :func:`vibroimpact.simulate`)."""
+        return simulate(
+            self.system,
+            self.contact,
+            self.initial,
+            dt=self.dt,
+            t_end=self.t_end,
+            method=self.method,
+            every=self.every,
+            contact_timing=self.contact_timing,
+            beta=self.beta,
+            gamma=self.gamma,
+        )
+
+
+def paper_collision(
+    restitution: float | None = None, method: str = "newmark", dt: float = 1e-4
+) -> Scenario:
+    """The founding paper's Table 1 system at the onset of a 0.1 m/s collision.
+
+    ``M = 1 kg, K = 1 N/m, C = 0.01 N s/m, m = 0.25 kg, c1 = 0.01 N s/m,
+    K_hz = 3000 N/m^1.5``, clearance 0.01 m; Hertz contact, or Hyster-Hertz
+    with ``restitution``. Runs 0.3 s.
+    """
+    law = "hertz" if restitution is None else "hyster-hertz"
+    return Scenario(
+        system=ImpactDamper(
+            main_mass=1.0, stiffness=1.0, damping=0.01, impact_mass=0.25, clearance=0.01
+        ),
+        contact=Contact(law, stiffness=3000.0, damping=0.01, restitution=restitution),
+        initial=InitialState(impact_displacement=0.01, impact_velocity=0.1),
+        method=method,
+        dt=dt,
+        t_end=0.3,
+    )
+
+
+def _fail(source: str, where: str, message: str) -> ScenarioError:
+    return ScenarioError(f"{source}: {where}{message}")
+
+
+def _check_type(source: str, section: str, key: str, kind: str, value: Any) -> Any:
+    where = f"[{section}] {key}: "
+    if kind == _NUMBER:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise _fail(source, where, f"must be a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise _fail(source, where, f"must be a finite number, got {value}")
+        return value
+    if kind == _WHOLE:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise _fail(source, where, f"must be a whole number, got {value!r}")
+        return value
+    if not isinstance(value, str):
+        raise _fail(source, where, f"must be a string, got {value!r}")
+    return value
+
+
+def _unknown(source: str, where: str, key: str, allowed: list[str]) -> ScenarioError:
+    close = difflib.get_close_matches(key, allowed, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return _fail(source, where, f"unknown key {key!r} (allowed: {', '.join(allowed)}){hint}")
+
+
+def _sections(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
+    sections: dict[str, dict[str, Any]] = {}
+    for name, table in data.items():
+        if name not in _SCHEMA:
+            raise _unknown(source, "", name, list(_SCHEMA))
+        if not isinstance(table, dict):
+            raise _fail(source, "", f"{name!r} must be a table ([{name}]), got {table!r}")
+        schema = _SCHEMA[name]
+        values: dict[str, Any] = {}
+        for key, value in table.items():
+            if key not in schema:
+                raise _unknown(source, f"[{name}] ", key, list(schema))
+            values[key] = _check_type(source, name, key, schema[key][0], value)
+        sections[name] = values
+    for name in _REQUIRED_SECTIONS:
+        if name not in sections:
+            raise _fail(source, "", f"missing section [{name}]")
+    for name, schema in _SCHEMA.items():
+        values = sections.setdefault(name, {})
+        for key, (_, default) in schema.items():
+            if key not in values:
+                if default is _REQUIRED:
+                    raise _fail(source, f"[{name}] ", f"missing key {key!r}")
+                values[key] = default
+    return sections
+
+
+def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
+    """Build a :class:`Scenario` from TOML text; ``source`` names it in errors."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ScenarioError(f"{source}: invalid TOML: {err}") from None
+    s = _sections(data, source)
+
+    def build(section: str, make: Any) -> Any:
+        try:
+            return make(**s[section])
+        except InvalidInputError as err:
+            raise _fail(source, f"[{section}] ", str(err)) from None
+
+    system = build("system", ImpactDamper)
+    contact = build("contact", Contact)
+    initial = build("initial", InitialState)
+    scenario = Scenario(system, contact, initial, **s["solver"], **s["output"])
+    _validate_solver(scenario, source)
+    return scenario
+
+
+def _validate_solver(scenario: Scenario, source: str) -> None:
+    try:
+        check_solver(
+            dt=scenario.dt,
+            t_end=scenario.t_end,
+            method=scenario.method,
+            every=scenario.every,
+            contact_timing=scenario.contact_timing,
+            beta=scenario.beta,
+            gamma=scenario.gamma,
+        )
+    except InvalidInputError as err:
+        section = "output" if str(err).startswith("every") else "solver"
+        raise _fail(source, f"[{section}] ", str(err)) from None
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a TOML scenario file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
+        raise ScenarioError(f"cannot read scenario {str(path)!r}: {reason}") from None
+    return parse_scenario(text, str(path))
