@@ -286,7 +286,15 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                     };
                     let (_, slope) = hermite::eval(g0, g1, m0, m1, theta);
                     let rate = slope / dt;
-                    let onset = if located { t + theta * dt } else { t1 };
+                    // Counting steps, a sample exactly at the wall (|y - w| = d) is
+                    // already touching, as in the paper's |y - w| >= d.
+                    let onset = if located {
+                        t + theta * dt
+                    } else if g0 >= 0.0 {
+                        t
+                    } else {
+                        t1
+                    };
                     let c = model.contact(&s1, rate);
                     let p_onset = c1 * rate * rate;
                     let p1 = model.contact_dissipation(&c);
