@@ -15,6 +15,9 @@ each side. Contacts follow compliant laws (Hertz, Lankarani-Nikravesh
 0.10898
 """
 
+# Imported here, not on the first result array inside a (timed) run.
+import numpy as _numpy  # noqa: F401
+
 from vibroimpact._core import (
     BeamMode,
     Contact,

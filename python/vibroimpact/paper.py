@@ -79,7 +79,9 @@ class Row:
     error_vs_exact_percent: float
 
 
-def timed(run: Callable[[], Solution], min_repeats: int = 7, budget: float = 0.05) -> tuple[Solution, float]:
+def timed(
+    run: Callable[[], Solution], min_repeats: int = 7, budget: float = 0.05
+) -> tuple[Solution, float]:
     """Run repeatedly; return the last solution and the median CPU time (s)."""
     times: list[float] = []
     spent = 0.0
@@ -138,7 +140,9 @@ def rebound_ratio_exact(restitution: float) -> float:
 
 def rebound_ratio_simulated(restitution: float) -> float:
     """Rebound/approach speed of two free bodies under the Hyster-Hertz law."""
-    system = ImpactDamper(main_mass=MAIN_MASS, stiffness=0.0, impact_mass=IMPACT_MASS, clearance=0.01)
+    system = ImpactDamper(
+        main_mass=MAIN_MASS, stiffness=0.0, impact_mass=IMPACT_MASS, clearance=0.01
+    )
     contact = Contact("hyster-hertz", stiffness=HERTZ_STIFFNESS, restitution=restitution)
     start = InitialState(impact_displacement=0.01, impact_velocity=APPROACH_SPEED)
     sol = simulate(system, contact, start, method="rk4", dt=1e-5, t_end=0.3, every=1_000_000)
@@ -146,11 +150,19 @@ def rebound_ratio_simulated(restitution: float) -> float:
 
 
 def table2(goldsmith: float, exact: float) -> list[Row]:
-    linear = linear_contact_duration(IMPACT_MASS, MAIN_MASS, PAPER_LINEAR_STIFFNESS, CONTACT_DAMPING)
+    linear = linear_contact_duration(
+        IMPACT_MASS, MAIN_MASS, PAPER_LINEAR_STIFFNESS, CONTACT_DAMPING
+    )
     rows = [
         Row("goldsmith (theoretical)", None, goldsmith, None, 0.0, pct(goldsmith, exact)),
-        Row(f"linear model k1={PAPER_LINEAR_STIFFNESS}", None, linear, None,
-            pct(linear, goldsmith), pct(linear, exact)),
+        Row(
+            f"linear model k1={PAPER_LINEAR_STIFFNESS}",
+            None,
+            linear,
+            None,
+            pct(linear, goldsmith),
+            pct(linear, exact),
+        ),
     ]
     for timing in ("step-count", "located"):
         for method in ("newmark", "rk4"):
@@ -158,20 +170,27 @@ def table2(goldsmith: float, exact: float) -> list[Row]:
                 scenario = collision(method, dt, timing)
                 sol, cpu = timed(scenario.run)
                 tc = first_duration(sol)
-                rows.append(Row(f"{method} ({timing})", dt, tc, cpu, pct(tc, goldsmith), pct(tc, exact)))
+                rows.append(
+                    Row(f"{method} ({timing})", dt, tc, cpu, pct(tc, goldsmith), pct(tc, exact))
+                )
     return rows
 
 
 def table3(rows: list[Row], basis: str) -> list[tuple[str, float, list[float]]]:
     """Eq. 15 over the numerical rows, with maxima taken over those rows."""
     numerical = [r for r in rows if r.dt is not None and r.cpu_time is not None]
-    err = (lambda r: r.error_vs_exact_percent) if basis == "exact" else (lambda r: r.error_percent)
+
+    def err(r: Row) -> float:
+        return r.error_vs_exact_percent if basis == "exact" else r.error_percent
+
     max_err = max(err(r) for r in numerical)
     max_cpu = max(r.cpu_time for r in numerical if r.cpu_time is not None)
     out = []
     for r in numerical:
         assert r.dt is not None and r.cpu_time is not None
-        out.append((r.method, r.dt, [adequacy(err(r), max_err, r.cpu_time, max_cpu, w) for w in WEIGHTS]))
+        out.append(
+            (r.method, r.dt, [adequacy(err(r), max_err, r.cpu_time, max_cpu, w) for w in WEIGHTS])
+        )
     return out
 
 
@@ -189,10 +208,27 @@ def fmt(x: float | None, spec: str) -> str:
 def write_table2(path: Path, rows: list[Row]) -> None:
     with path.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
-        w.writerow(["method", "dt", "contact_duration", "cpu_time", "error_percent", "error_vs_exact_percent"])
+        w.writerow(
+            [
+                "method",
+                "dt",
+                "contact_duration",
+                "cpu_time",
+                "error_percent",
+                "error_vs_exact_percent",
+            ]
+        )
         for r in rows:
-            w.writerow([r.method, fmt(r.dt, "g"), repr(r.contact_duration), fmt(r.cpu_time, ".6e"),
-                        f"{r.error_percent:.6f}", f"{r.error_vs_exact_percent:.6f}"])
+            w.writerow(
+                [
+                    r.method,
+                    fmt(r.dt, "g"),
+                    repr(r.contact_duration),
+                    fmt(r.cpu_time, ".6e"),
+                    f"{r.error_percent:.6f}",
+                    f"{r.error_vs_exact_percent:.6f}",
+                ]
+            )
 
 
 def write_table3(path: Path, blocks: dict[str, list[tuple[str, float, list[float]]]]) -> None:
@@ -206,13 +242,19 @@ def write_table3(path: Path, blocks: dict[str, list[tuple[str, float, list[float
 
 def print_tables(rows: list[Row], blocks: dict[str, list[tuple[str, float, list[float]]]]) -> None:
     print("Table 2: contact duration of the Table 1 collision (v = 0.1 m/s)")
-    print(f"{'method':<28}{'dt (s)':>9}{'Tc (s)':>12}{'CPU (s)':>12}{'err %':>10}{'vs exact %':>12}")
+    print(
+        f"{'method':<28}{'dt (s)':>9}{'Tc (s)':>12}{'CPU (s)':>12}{'err %':>10}{'vs exact %':>12}"
+    )
     for r in rows:
-        print(f"{r.method:<28}{fmt(r.dt, 'g'):>9}{r.contact_duration:>12.7f}"
-              f"{fmt(r.cpu_time, '.3e'):>12}{r.error_percent:>10.4f}{r.error_vs_exact_percent:>12.5f}")
+        print(
+            f"{r.method:<28}{fmt(r.dt, 'g'):>9}{r.contact_duration:>12.7f}"
+            f"{fmt(r.cpu_time, '.3e'):>12}{r.error_percent:>10.4f}{r.error_vs_exact_percent:>12.5f}"
+        )
     for basis, block in blocks.items():
-        print(f"\nTable 3: adequacy (%), errors against {basis}; columns WF1 = "
-              + ", ".join(f"{x:.1f}" for x in WEIGHTS))
+        print(
+            f"\nTable 3: adequacy (%), errors against {basis}; columns WF1 = "
+            + ", ".join(f"{x:.1f}" for x in WEIGHTS)
+        )
         for method, dt, values in block:
             print(f"{method:<28}{dt:>9g}" + "".join(f"{v:>8.2f}" for v in values))
 
@@ -236,15 +278,22 @@ def findings(rows: list[Row]) -> Findings:
     hyster = []
     for method in ("rk4", "newmark"):
         for timing in ("step-count", "located"):
-            hyster.append((method, timing, first_duration(collision(method, 1e-4, timing, 0.9).run())))
-    restitution = [(e, rebound_ratio_exact(e), rebound_ratio_simulated(e)) for e in (0.9, 0.7, 0.5, 0.01)]
+            hyster.append(
+                (method, timing, first_duration(collision(method, 1e-4, timing, 0.9).run()))
+            )
+    restitution = [
+        (e, rebound_ratio_exact(e), rebound_ratio_simulated(e)) for e in (0.9, 0.7, 0.5, 0.01)
+    ]
     goldsmith = rows[0].contact_duration
     beam = cantilever_mode(length=1.0, youngs_modulus=1.0, second_moment=1.0, density=1.0, area=1.0)
     return Findings(
         goldsmith=goldsmith,
         goldsmith_exact_constant=goldsmith_contact_duration(
-            IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED, exact_constant=True),
-        max_indentation=goldsmith_max_indentation(IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED),
+            IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED, exact_constant=True
+        ),
+        max_indentation=goldsmith_max_indentation(
+            IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED
+        ),
         exact=exact_duration(),
         exact_hyster=exact_duration(0.9),
         hyster_rows=hyster,
@@ -285,6 +334,8 @@ def run_paper(out: Path) -> int:
     fig4(out / "fig4.png")
     elapsed = time.perf_counter() - started
     write_report(out / "report.md", rows, blocks, found, elapsed, platform.platform())
-    print(f"\nwrote table2.csv, table3.csv, fig1.png, fig3.png, fig4.png and report.md to {out}/ "
-          f"in {elapsed:.1f} s")
+    print(
+        f"\nwrote table2.csv, table3.csv, fig1.png, fig3.png, fig4.png and report.md to {out}/ "
+        f"in {elapsed:.1f} s"
+    )
     return 0

@@ -12,13 +12,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from vibroimpact._core import Contact, Solution  # noqa: E402
+from vibroimpact._core import Contact, Solution, goldsmith_max_indentation  # noqa: E402
 from vibroimpact.paper import (  # noqa: E402
     CONTACT_DAMPING,
     HERTZ_STIFFNESS,
     PAPER_LINEAR_STIFFNESS,
     collision,
-    goldsmith_max_indentation,
 )
 
 
@@ -54,8 +53,11 @@ def fig1(path: Path) -> None:
         sol = _history("rk4", 1e-5, None if e == 1.0 else e)
         p = _contact_phase(sol)
         b.plot(p["indentation"] * 1e3, p["law_force"], label=f"e = {e:g}")
-    b.set(xlabel="indentation (mm)", ylabel="law force (N)",
-          title="(b) Hyster-Hertz, Table 1 collision (RK4)")
+    b.set(
+        xlabel="indentation (mm)",
+        ylabel="law force (N)",
+        title="(b) Hyster-Hertz, Table 1 collision (RK4)",
+    )
     b.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -68,13 +70,24 @@ def fig3(path: Path, equal_duration_stiffness: float) -> None:
     dmax = goldsmith_max_indentation(0.25, 1.0, HERTZ_STIFFNESS, 0.1)
     delta = np.linspace(0.0, 1.1 * dmax, 200)
     ax.plot(delta * 1e3, HERTZ_STIFFNESS * delta**1.5, label="Hertz, K_hz = 3000 N/m^1.5")
-    ax.plot(delta * 1e3, PAPER_LINEAR_STIFFNESS * delta, "--",
-            label=f"paper's linear, k1 = {PAPER_LINEAR_STIFFNESS} N/m")
-    ax.plot(delta * 1e3, equal_duration_stiffness * delta, ":",
-            label=f"equal-duration linear, k1 = {equal_duration_stiffness:.1f} N/m")
+    ax.plot(
+        delta * 1e3,
+        PAPER_LINEAR_STIFFNESS * delta,
+        "--",
+        label=f"paper's linear, k1 = {PAPER_LINEAR_STIFFNESS} N/m",
+    )
+    ax.plot(
+        delta * 1e3,
+        equal_duration_stiffness * delta,
+        ":",
+        label=f"equal-duration linear, k1 = {equal_duration_stiffness:.1f} N/m",
+    )
     ax.axvline(dmax * 1e3, color="grey", lw=0.8)
-    ax.set(xlabel="indentation (mm)", ylabel="contact force (N)",
-           title="Hertz contact and its linear approximations")
+    ax.set(
+        xlabel="indentation (mm)",
+        ylabel="contact force (N)",
+        title="Hertz contact and its linear approximations",
+    )
     ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -87,13 +100,25 @@ def fig4(path: Path) -> None:
     for e, colour in ((None, "C0"), (0.9, "C3")):
         label = "elastic" if e is None else f"e = {e}"
         ref = _contact_phase(_history("rk4", 1e-5, e))
-        ax.plot(ref["t"], ref["relative"] * 1e3, color=colour, label=f"{label}: reference (RK4, 1e-5 s)")
+        ax.plot(
+            ref["t"], ref["relative"] * 1e3, color=colour, label=f"{label}: reference (RK4, 1e-5 s)"
+        )
         coarse = _contact_phase(_history("newmark", 1e-3, e))
-        ax.plot(coarse["t"][::4], coarse["relative"][::4] * 1e3, "o", ms=3, color=colour,
-                mfc="none", label=f"{label}: paper's Newmark, 1e-3 s")
+        ax.plot(
+            coarse["t"][::4],
+            coarse["relative"][::4] * 1e3,
+            "o",
+            ms=3,
+            color=colour,
+            mfc="none",
+            label=f"{label}: paper's Newmark, 1e-3 s",
+        )
     ax.axhline(10.0, color="grey", lw=0.8)
-    ax.set(xlabel="time (s)", ylabel="y - w (mm)",
-           title="Relative displacement through one contact (clearance 10 mm)")
+    ax.set(
+        xlabel="time (s)",
+        ylabel="y - w (mm)",
+        title="Relative displacement through one contact (clearance 10 mm)",
+    )
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

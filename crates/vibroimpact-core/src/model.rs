@@ -51,6 +51,11 @@ pub struct Model<L: ContactLaw, X: Excitation> {
     pub contact_damping: f64,
     pub law: L,
     pub excitation: X,
+    /// `1 / main_mass` and `1 / impact_mass`: multiplications in the hot loop.
+    inverse_main_mass: f64,
+    inverse_impact_mass: f64,
+    damping_per_mass: f64,
+    stiffness_per_mass: f64,
 }
 
 impl<L: ContactLaw, X: Excitation> Model<L, X> {
@@ -64,6 +69,10 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
             contact_damping,
             law,
             excitation,
+            inverse_main_mass: 1.0 / system.main_mass,
+            inverse_impact_mass: 1.0 / system.impact_mass,
+            damping_per_mass: system.damping / system.main_mass,
+            stiffness_per_mass: system.stiffness / system.main_mass,
         }
     }
 
@@ -108,18 +117,25 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
     /// Accelerations `(w'', y'')` in m/s^2.
     #[inline(always)]
     pub fn accelerations(&self, time: f64, s: &State, approach_rate: f64) -> (f64, f64) {
-        let mut main_force = self.excitation.main_force(time)
-            - self.damping * s.main_velocity
-            - self.stiffness * s.main_displacement;
-        let mut impact_force = 0.0;
+        // Per-unit-mass coefficients keep the dependency chain of each RK
+        // stage short (one multiply and one fused add).
+        let mut main = -(self.damping_per_mass * s.main_velocity
+            + self.stiffness_per_mass * s.main_displacement);
+        if !X::IS_FREE {
+            main += self.excitation.main_force(time) * self.inverse_main_mass;
+        }
         let u = s.relative_displacement();
         // Cheap test first: the full contact evaluation only when touching.
         if u.abs() > self.clearance {
             let c = self.contact(s, approach_rate);
-            main_force += c.side * c.total_force;
-            impact_force -= c.side * c.total_force;
+            let push = c.side * c.total_force;
+            (
+                main + push * self.inverse_main_mass,
+                -push * self.inverse_impact_mass,
+            )
+        } else {
+            (main, 0.0)
         }
-        (main_force / self.main_mass, impact_force / self.impact_mass)
     }
 
     /// Mechanical energy: kinetic, main spring and elastic contact energy, J.

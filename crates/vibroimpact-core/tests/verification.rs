@@ -1,9 +1,7 @@
 //! Verification against closed forms, conservation laws and the
 //! high-accuracy reference values of the founding-paper page.
 
-use vibroimpact_core::closed_forms::{
-    goldsmith_contact_duration, goldsmith_max_indentation, HERTZ_DURATION_CONSTANT,
-};
+use vibroimpact_core::closed_forms::{goldsmith_contact_duration, goldsmith_max_indentation};
 use vibroimpact_core::model::{Free, Model};
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, Solution, State,
@@ -58,8 +56,6 @@ fn pure_hertz_matches_goldsmith() {
         c.max_indentation
     );
     assert!(rel(c.rebound_speed, 0.1) < 1e-9);
-    // Goldsmith's printed constant is 2.9432 against the exact 2.943275...
-    assert!(HERTZ_DURATION_CONSTANT > 2.9432);
 }
 
 #[test]
@@ -195,7 +191,10 @@ fn energy_is_conserved_without_losses() {
     let rk = [drift(Method::Rk4, 1e-4), drift(Method::Rk4, 1e-5)];
     // Second order only: a fixed step straddles each contact onset, where the
     // force is not smooth (event location is issue 3's work).
-    assert!(rk[0] < 1e-7 && rk[1] < 1e-9 && rk[1] < rk[0] / 50.0, "{rk:?}");
+    assert!(
+        rk[0] < 1e-7 && rk[1] < 1e-9 && rk[1] < rk[0] / 50.0,
+        "{rk:?}"
+    );
     let coarse = drift(NEWMARK, 1e-4);
     let fine = drift(NEWMARK, 1e-5);
     assert!(fine < 0.12 * coarse, "{coarse} {fine}");

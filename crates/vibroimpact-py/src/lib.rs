@@ -98,7 +98,13 @@ impl ImpactDamper {
     }
     fn __getnewargs__(&self) -> (f64, f64, f64, f64, f64) {
         let s = &self.0;
-        (s.main_mass, s.stiffness, s.impact_mass, s.clearance, s.damping)
+        (
+            s.main_mass,
+            s.stiffness,
+            s.impact_mass,
+            s.clearance,
+            s.damping,
+        )
     }
     fn __repr__(&self) -> String {
         let s = &self.0;
@@ -159,7 +165,12 @@ impl Contact {
         self.0.law_force(indentation, rate, approach_rate)
     }
     fn __getnewargs__(&self) -> (&'static str, f64, f64, Option<f64>) {
-        (self.law(), self.0.stiffness, self.0.damping, self.restitution())
+        (
+            self.law(),
+            self.0.stiffness,
+            self.0.damping,
+            self.restitution(),
+        )
     }
     fn __repr__(&self) -> String {
         let restitution = match self.restitution() {
@@ -433,15 +444,19 @@ fn simulate(
     let (sys, con, init) = (system.0, contact.0, initial.0);
     let mut signal: Option<PyErr> = None;
     let result = py.detach(|| {
-        core::simulate(&sys, &con, &init, &settings, &mut || {
-            match Python::attach(|py| py.check_signals()) {
+        core::simulate(
+            &sys,
+            &con,
+            &init,
+            &settings,
+            &mut || match Python::attach(|py| py.check_signals()) {
                 Ok(()) => false,
                 Err(e) => {
                     signal = Some(e);
                     true
                 }
-            }
-        })
+            },
+        )
     });
     let sol = match result {
         Ok(sol) => sol,
@@ -451,7 +466,8 @@ fn simulate(
         Err(e) => return Err(to_py(e)),
     };
     let records = sol.contacts;
-    let column = |f: fn(&core::ContactRecord) -> f64| -> Vec<f64> { records.iter().map(f).collect() };
+    let column =
+        |f: fn(&core::ContactRecord) -> f64| -> Vec<f64> { records.iter().map(f).collect() };
     let table = ContactTable {
         onset: array(py, column(|r| r.onset)),
         separation: array(py, column(|r| r.separation)),
@@ -630,8 +646,7 @@ fn linear_contact_duration(
     stiffness: f64,
     damping: f64,
 ) -> PyResult<f64> {
-    closed_forms::linear_contact_duration(impact_mass, main_mass, stiffness, damping)
-        .map_err(to_py)
+    closed_forms::linear_contact_duration(impact_mass, main_mass, stiffness, damping).map_err(to_py)
 }
 
 /// The founding paper's adequacy factor (Eq. 15), percent:
@@ -652,7 +667,10 @@ fn adequacy(
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("InvalidInputError", py.get_type::<InvalidInputError>())?;
-    m.add("NumericalBlowUpError", py.get_type::<NumericalBlowUpError>())?;
+    m.add(
+        "NumericalBlowUpError",
+        py.get_type::<NumericalBlowUpError>(),
+    )?;
     m.add_class::<ImpactDamper>()?;
     m.add_class::<Contact>()?;
     m.add_class::<InitialState>()?;

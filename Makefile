@@ -1,0 +1,29 @@
+# Verbs for a newcomer. `make test` is the README's test command.
+.PHONY: help install test lint bench paper
+help:
+	@echo "make install  - pip install the package with its test tools"
+	@echo "make test     - every test, Rust and Python (what .ci/run runs)"
+	@echo "make lint     - cargo fmt/clippy, ruff, mypy, stubtest"
+	@echo "make bench    - throughput and call overhead benchmarks"
+	@echo "make paper    - reproduce the founding paper into paper-results/"
+
+install:
+	pip install ".[test]"
+
+test:
+	pip install ".[test]" && cargo test --workspace && python -m pytest
+
+lint:
+	cargo fmt --all --check
+	cargo clippy --workspace --all-targets -- -D warnings
+	ruff format --check python tests benchmarks
+	ruff check python tests benchmarks
+	mypy
+	python -m mypy.stubtest vibroimpact._core
+
+bench:
+	python benchmarks/bench_steps.py
+	cargo run --release -p vibroimpact-core --example throughput
+
+paper:
+	vibroimpact paper

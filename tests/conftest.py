@@ -1,0 +1,135 @@
+"""Shared fixtures: the founding paper's Table 1 system at the onset of a collision.
+
+Table 1 (Afsharfard & Farshidianfar 2012): M = 1 kg, K = 1 N/m, C = 0.01 N s/m,
+m = 0.25 kg, c1 = 0.01 N s/m, K_hz = 3000 N/m^1.5; clearance 0.01 m and the
+approach speed 0.1 m/s implied by the paper's Tc = 0.1089 s. The run starts at
+contact onset: w = w' = 0, y - w = d, y' = 0.1 m/s.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+import vibroimpact as vi
+
+MAIN_MASS = 1.0
+STIFFNESS = 1.0
+DAMPING = 0.01
+IMPACT_MASS = 0.25
+CLEARANCE = 0.01
+HERTZ_STIFFNESS = 3000.0
+CONTACT_DAMPING = 0.01
+APPROACH_SPEED = 0.1
+
+# A complete scenario for the Table 1 collision, every key of the format given.
+TABLE1_TOML = """\
+# The founding paper's Table 1 collision.
+[system]
+main_mass = 1.0
+stiffness = 1.0
+damping = 0.01
+impact_mass = 0.25
+clearance = 0.01
+
+[contact]
+law = "hertz"
+stiffness = 3000.0
+damping = 0.01
+
+[initial]
+main_displacement = 0.0
+main_velocity = 0.0
+impact_displacement = 0.01
+impact_velocity = 0.1
+
+[solver]
+method = "rk4"
+dt = 1e-4
+t_end = 0.2
+beta = 0.25
+gamma = 0.5
+contact_timing = "located"
+
+[output]
+every = 7
+"""
+
+
+@pytest.fixture
+def table1_system() -> vi.ImpactDamper:
+    return vi.ImpactDamper(
+        main_mass=MAIN_MASS,
+        stiffness=STIFFNESS,
+        damping=DAMPING,
+        impact_mass=IMPACT_MASS,
+        clearance=CLEARANCE,
+    )
+
+
+@pytest.fixture
+def free_system() -> vi.ImpactDamper:
+    """The Table 1 masses and clearance with no spring or damper: two free bodies."""
+    return vi.ImpactDamper(
+        main_mass=MAIN_MASS, stiffness=0.0, impact_mass=IMPACT_MASS, clearance=CLEARANCE
+    )
+
+
+@pytest.fixture
+def hertz_contact() -> vi.Contact:
+    return vi.Contact("hertz", stiffness=HERTZ_STIFFNESS, damping=CONTACT_DAMPING)
+
+
+@pytest.fixture
+def hyster_contact() -> vi.Contact:
+    """Hyster-Hertz with e = 0.9, the paper's lossy case."""
+    return vi.Contact(
+        "hyster-hertz", stiffness=HERTZ_STIFFNESS, damping=CONTACT_DAMPING, restitution=0.9
+    )
+
+
+@pytest.fixture
+def onset_state() -> vi.InitialState:
+    """Contact onset: y - w = d, the impact mass approaching at 0.1 m/s."""
+    return vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED)
+
+
+@pytest.fixture
+def table1_toml() -> str:
+    return TABLE1_TOML
+
+
+@pytest.fixture
+def write_scenario(tmp_path: Path) -> Callable[[str, str], Path]:
+    """Write TOML text to a file in a temporary folder and return its path."""
+
+    def write(text: str, name: str = "scenario.toml") -> Path:
+        path = tmp_path / name
+        path.write_text(text, encoding="utf-8")
+        return path
+
+    return write
+
+
+@pytest.fixture
+def run_cli(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess[str]]:
+    """Run ``python -m vibroimpact ARGS`` in a temporary folder."""
+
+    def run(*args: str, timeout: float = 120.0) -> subprocess.CompletedProcess[str]:
+        env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONWARNINGS": "error"}
+        return subprocess.run(
+            [sys.executable, "-m", "vibroimpact", *args],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            env=env,
+            timeout=timeout,
+            check=False,
+        )
+
+    return run

@@ -1,0 +1,732 @@
+"""Physics of vibroimpact against independent values.
+
+The references are closed forms recomputed here from their formulas, conservation
+laws, the reference page's published high-accuracy values
+(/work/shared/reference/paper-model.md) and a test-only oracle: SciPy's adaptive
+DOP853 integrating the same model at rtol 1e-12 with the separation instant located
+as an event.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import pytest
+from conftest import (
+    APPROACH_SPEED,
+    CLEARANCE,
+    CONTACT_DAMPING,
+    DAMPING,
+    HERTZ_STIFFNESS,
+    IMPACT_MASS,
+    MAIN_MASS,
+    STIFFNESS,
+)
+from scipy.integrate import quad, solve_ivp
+from scipy.optimize import brentq
+
+import vibroimpact as vi
+
+# Goldsmith's constant exactly: Tc v / delta_max = 2 int_0^1 dx / sqrt(1 - x^(5/2))
+# = 2 (2/5) B(2/5, 1/2).
+GOLDSMITH_EXACT = 2 * (2 / 5) * math.gamma(2 / 5) * math.gamma(1 / 2) / math.gamma(9 / 10)
+GOLDSMITH_PRINTED = 2.9432
+
+# The reference page's adaptive-RK8 values (Tc s, delta_max m, rebound/approach).
+REF_PURE_HERTZ = (0.1089327, 3.70107e-3, 1.0000)
+REF_TABLE1_ELASTIC = (0.1089819, 3.69668e-3, 0.99635)
+REF_TABLE1_HYSTER = (0.1100637, 3.56654e-3, 0.90985)
+
+
+# --------------------------------------------------------------------------- oracle
+
+
+@dataclass(frozen=True)
+class Oracle:
+    duration: float
+    max_indentation: float
+    rebound_ratio: float
+    contact: object  # OdeSolution over [0, duration]
+    free: object | None  # OdeSolution over [duration, t_free]
+
+
+@lru_cache(maxsize=None)
+def oracle(
+    main_mass: float,
+    stiffness: float,
+    damping: float,
+    impact_mass: float,
+    clearance: float,
+    law: str,
+    law_stiffness: float,
+    contact_damping: float,
+    restitution: float | None = None,
+    approach: float = APPROACH_SPEED,
+    t_free: float | None = None,
+) -> Oracle:
+    """One collision from onset (w = w' = 0, y - w = d, y' = approach) by DOP853.
+
+    Law force clamped at zero; c1 a linear damper on the relative velocity while the
+    indentation is positive (not clamped). Optionally continues in free flight to
+    ``t_free`` and checks that no other contact happens by then.
+    """
+    alpha = 0.75 * (1.0 - restitution**2) if law == "hyster-hertz" else 0.0
+
+    def law_force(delta: float, rate: float) -> float:
+        if law == "linear":
+            return law_stiffness * delta
+        return max(law_stiffness * delta**1.5 * (1.0 + alpha * rate / approach), 0.0)
+
+    def rhs(_t: float, s: np.ndarray) -> list[float]:
+        w, wd, y, yd = s
+        delta = (y - w) - clearance
+        rate = yd - wd
+        force = law_force(delta, rate) + contact_damping * rate if delta > 0 else 0.0
+        return [wd, (force - damping * wd - stiffness * w) / main_mass, yd, -force / impact_mass]
+
+    def separation(_t: float, s: np.ndarray) -> float:
+        return (s[2] - s[0]) - clearance
+
+    separation.terminal = True  # type: ignore[attr-defined]
+    separation.direction = -1  # type: ignore[attr-defined]
+
+    def deepest(_t: float, s: np.ndarray) -> float:
+        return s[3] - s[1]
+
+    deepest.direction = -1  # type: ignore[attr-defined]
+
+    sol = solve_ivp(
+        rhs,
+        (0.0, 10.0),
+        [0.0, 0.0, clearance, approach],
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-15,
+        events=[separation, deepest],
+        dense_output=True,
+    )
+    assert sol.status == 1, "the oracle's contact did not end"
+    t_sep = float(sol.t_events[0][0])
+    s_sep = sol.y_events[0][0]
+    s_deep = sol.y_events[1][0]
+    rebound = -(s_sep[3] - s_sep[1])
+
+    free = None
+    if t_free is not None:
+
+        def free_rhs(_t: float, s: np.ndarray) -> list[float]:
+            w, wd, _y, yd = s
+            return [wd, (-damping * wd - stiffness * w) / main_mass, yd, 0.0]
+
+        def touch(_t: float, s: np.ndarray) -> float:
+            return abs(s[2] - s[0]) - clearance
+
+        touch.terminal = True  # type: ignore[attr-defined]
+        touch.direction = 1  # type: ignore[attr-defined]
+        free_sol = solve_ivp(
+            free_rhs,
+            (t_sep, t_free),
+            s_sep,
+            method="DOP853",
+            rtol=1e-12,
+            atol=1e-15,
+            events=touch,
+            dense_output=True,
+        )
+        assert free_sol.status == 0, "a second contact in the oracle's free flight"
+        free = free_sol.sol
+
+    return Oracle(
+        duration=t_sep,
+        max_indentation=float(s_deep[2] - s_deep[0] - clearance),
+        rebound_ratio=float(rebound / approach),
+        contact=sol.sol,
+        free=free,
+    )
+
+
+def table1_oracle(restitution: float | None = None, t_free: float | None = None) -> Oracle:
+    law = "hertz" if restitution is None else "hyster-hertz"
+    return oracle(
+        MAIN_MASS,
+        STIFFNESS,
+        DAMPING,
+        IMPACT_MASS,
+        CLEARANCE,
+        law,
+        HERTZ_STIFFNESS,
+        CONTACT_DAMPING,
+        restitution,
+        t_free=t_free,
+    )
+
+
+def first_contact(sol: vi.Solution) -> tuple[float, float, float]:
+    c = sol.contacts
+    assert len(c) >= 1
+    assert np.isfinite(c.duration[0])
+    return (
+        float(c.duration[0]),
+        float(c.max_indentation[0]),
+        float(c.rebound_speed[0] / c.approach_speed[0]),
+    )
+
+
+def goldsmith(
+    m: float, big_m: float, k_hz: float, v: float, constant: float
+) -> tuple[float, float]:
+    """Goldsmith's (Tc, delta_max) for two free bodies, from the reference page's formulas."""
+    k_star = (m + big_m) / (m * big_m)
+    delta_max = (5.0 * v * v / (4.0 * k_star * k_hz)) ** 0.4
+    tc = constant / v**0.2 * (5.0 / (4.0 * k_star * k_hz)) ** 0.4
+    return tc, delta_max
+
+
+def energy(sol: vi.Solution, system: vi.ImpactDamper, contact: vi.Contact) -> np.ndarray:
+    """Kinetic + main-spring + elastic contact energy at each kept sample, J."""
+    w, wd = sol.main_displacement, sol.main_velocity
+    y, yd = sol.impact_displacement, sol.impact_velocity
+    delta = np.maximum(np.abs(y - w) - system.clearance, 0.0)
+    if contact.law == "linear":
+        potential = 0.5 * contact.stiffness * delta**2
+    else:
+        potential = 0.4 * contact.stiffness * delta**2.5
+    return (
+        0.5 * system.main_mass * wd**2
+        + 0.5 * system.impact_mass * yd**2
+        + 0.5 * system.stiffness * w**2
+        + potential
+    )
+
+
+# ------------------------------------------------------------------- oracle sanity
+
+
+def test_goldsmith_constant_is_the_integral() -> None:
+    integral, _ = quad(lambda s: 2 * s / math.sqrt(1 - (1 - s * s) ** 2.5), 0, 1, epsabs=1e-14)
+    assert 2 * integral == pytest.approx(GOLDSMITH_EXACT, rel=1e-10)
+    assert GOLDSMITH_EXACT == pytest.approx(GOLDSMITH_PRINTED, rel=5e-5)
+
+
+def test_oracle_reproduces_the_reference_page() -> None:
+    """The test's own oracle agrees with the published adaptive-RK8 values."""
+    pure = oracle(MAIN_MASS, 0.0, 0.0, IMPACT_MASS, CLEARANCE, "hertz", HERTZ_STIFFNESS, 0.0)
+    for got, ref in [
+        (pure, REF_PURE_HERTZ),
+        (table1_oracle(), REF_TABLE1_ELASTIC),
+        (table1_oracle(0.9), REF_TABLE1_HYSTER),
+    ]:
+        assert got.duration == pytest.approx(ref[0], abs=6e-8)
+        assert got.max_indentation == pytest.approx(ref[1], abs=6e-9)
+        assert got.rebound_ratio == pytest.approx(ref[2], abs=6e-5)
+
+
+# ---------------------------------------------------------------- pure Hertz impact
+
+
+@pytest.mark.parametrize(
+    ("m", "big_m", "k_hz", "v"),
+    [(IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED), (0.5, 2.0, 1.0e5, 0.3)],
+)
+def test_pure_hertz_matches_goldsmith(m: float, big_m: float, k_hz: float, v: float) -> None:
+    tc, delta_max = goldsmith(m, big_m, k_hz, v, GOLDSMITH_EXACT)
+    system = vi.ImpactDamper(main_mass=big_m, stiffness=0.0, impact_mass=m, clearance=CLEARANCE)
+    contact = vi.Contact("hertz", stiffness=k_hz)
+    start = vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=v)
+    dt = tc / 1000
+    sol = vi.simulate(system, contact, start, method="rk4", dt=dt, t_end=1.5 * tc)
+    duration, indentation, ratio = first_contact(sol)
+    assert duration == pytest.approx(tc, rel=1e-6)
+    assert indentation == pytest.approx(delta_max, rel=2e-6)
+    assert ratio == pytest.approx(1.0, abs=1e-6)
+    assert sol.contacts.approach_speed[0] == pytest.approx(v, rel=1e-12)
+
+
+def test_pure_hertz_reference_value(free_system: vi.ImpactDamper) -> None:
+    contact = vi.Contact("hertz", stiffness=HERTZ_STIFFNESS)
+    start = vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED)
+    sol = vi.simulate(free_system, contact, start, method="rk4", dt=1e-4, t_end=0.15)
+    duration, indentation, _ = first_contact(sol)
+    assert duration == pytest.approx(REF_PURE_HERTZ[0], rel=1e-6)
+    assert indentation == pytest.approx(REF_PURE_HERTZ[1], rel=3e-6)
+
+
+@pytest.mark.parametrize(
+    ("m", "big_m", "k_hz", "v"),
+    [(IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED), (0.5, 2.0, 1.0e5, 0.3)],
+)
+def test_goldsmith_closed_forms(m: float, big_m: float, k_hz: float, v: float) -> None:
+    tc_exact, delta_max = goldsmith(m, big_m, k_hz, v, GOLDSMITH_EXACT)
+    tc_printed, _ = goldsmith(m, big_m, k_hz, v, GOLDSMITH_PRINTED)
+    assert vi.goldsmith_contact_duration(m, big_m, k_hz, v) == pytest.approx(tc_printed, rel=1e-12)
+    got_exact = vi.goldsmith_contact_duration(m, big_m, k_hz, v, exact_constant=True)
+    assert got_exact == pytest.approx(tc_exact, rel=1e-12)
+    assert vi.goldsmith_max_indentation(m, big_m, k_hz, v) == pytest.approx(delta_max, rel=1e-12)
+
+
+def test_goldsmith_reproduces_the_papers_theoretical_duration() -> None:
+    tc = vi.goldsmith_contact_duration(IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED)
+    assert round(tc, 4) == 0.1089
+
+
+# ------------------------------------------------------------------ Table 1 collision
+
+
+@pytest.mark.parametrize(
+    ("restitution", "reference"), [(None, REF_TABLE1_ELASTIC), (0.9, REF_TABLE1_HYSTER)]
+)
+def test_table1_rk4_matches_reference_and_oracle(
+    table1_system: vi.ImpactDamper,
+    onset_state: vi.InitialState,
+    restitution: float | None,
+    reference: tuple[float, float, float],
+) -> None:
+    law = "hertz" if restitution is None else "hyster-hertz"
+    contact = vi.Contact(
+        law, stiffness=HERTZ_STIFFNESS, damping=CONTACT_DAMPING, restitution=restitution
+    )
+    sol = vi.simulate(table1_system, contact, onset_state, method="rk4", dt=1e-4, t_end=0.15)
+    duration, indentation, ratio = first_contact(sol)
+    # Against the page (rounded to the printed digits).
+    assert duration == pytest.approx(reference[0], rel=1e-6)
+    assert indentation == pytest.approx(reference[1], rel=3e-6)
+    assert ratio == pytest.approx(reference[2], abs=1e-5)
+    # Against the oracle (full precision).
+    exact = table1_oracle(restitution)
+    assert duration == pytest.approx(exact.duration, rel=1e-6)
+    assert indentation == pytest.approx(exact.max_indentation, rel=2e-6)
+    assert ratio == pytest.approx(exact.rebound_ratio, rel=5e-6)
+    assert sol.contacts.onset[0] == 0.0
+    assert sol.contacts.separation[0] == pytest.approx(exact.duration, rel=1e-6)
+
+
+def test_lossy_contact_lasts_one_percent_longer(
+    table1_system: vi.ImpactDamper,
+    hertz_contact: vi.Contact,
+    hyster_contact: vi.Contact,
+    onset_state: vi.InitialState,
+) -> None:
+    """The page's finding: e = 0.9 lengthens the contact by 1.0 %, not the paper's 0.4 %."""
+    runs = [
+        vi.simulate(table1_system, c, onset_state, method="rk4", dt=1e-4, t_end=0.15)
+        for c in (hertz_contact, hyster_contact)
+    ]
+    ratio = first_contact(runs[1])[0] / first_contact(runs[0])[0]
+    assert ratio == pytest.approx(table1_oracle(0.9).duration / table1_oracle().duration, rel=2e-6)
+    assert ratio - 1.0 == pytest.approx(0.0099, abs=0.0002)
+
+
+def test_table1_newmark_is_first_order(
+    table1_system: vi.ImpactDamper, hertz_contact: vi.Contact, onset_state: vi.InitialState
+) -> None:
+    exact = table1_oracle().duration
+    errors = []
+    for dt in (1e-3, 1e-4, 1e-5):
+        sol = vi.simulate(
+            table1_system, hertz_contact, onset_state, method="newmark", dt=dt, t_end=0.15
+        )
+        errors.append(abs(first_contact(sol)[0] / exact - 1.0))
+    # The reference page: about 0.47 % at dt = 1e-3 (the force lags one step).
+    assert errors[0] == pytest.approx(0.0047, abs=0.0005)
+    orders = [math.log10(errors[i] / errors[i + 1]) for i in range(2)]
+    for p in orders:
+        assert 0.85 < p < 1.15, orders
+
+
+def test_table1_newmark_rebound_and_indentation_converge(
+    table1_system: vi.ImpactDamper, hyster_contact: vi.Contact, onset_state: vi.InitialState
+) -> None:
+    exact = table1_oracle(0.9)
+    sol = vi.simulate(
+        table1_system, hyster_contact, onset_state, method="newmark", dt=1e-5, t_end=0.15
+    )
+    duration, indentation, ratio = first_contact(sol)
+    assert duration == pytest.approx(exact.duration, rel=2e-4)
+    assert indentation == pytest.approx(exact.max_indentation, rel=5e-4)
+    assert ratio == pytest.approx(exact.rebound_ratio, rel=2e-3)
+
+
+def test_rk4_time_history_matches_dense_oracle(
+    table1_system: vi.ImpactDamper, hertz_contact: vi.Contact, onset_state: vi.InitialState
+) -> None:
+    """The whole history (contact, then free flight to 0.2 s) against DOP853's dense output."""
+    t_end = 0.2
+    exact = table1_oracle(t_free=t_end)
+    sol = vi.simulate(table1_system, hertz_contact, onset_state, method="rk4", dt=1e-4, t_end=t_end)
+    t = sol.t
+    assert len(t) == 2001
+    np.testing.assert_allclose(t, np.arange(2001) * 1e-4, rtol=0, atol=1e-15)
+    inside = t <= exact.duration
+    ref = np.hstack([exact.contact(t[inside]), exact.free(t[~inside])])
+    relative = sol.impact_displacement - sol.main_displacement
+    assert np.max(np.abs(relative - (ref[2] - ref[0]))) < 1e-8
+    assert np.max(np.abs((sol.impact_velocity - sol.main_velocity) - (ref[3] - ref[1]))) < 1e-6
+    assert np.max(np.abs(sol.main_displacement - ref[0])) < 1e-8
+    assert np.max(np.abs(sol.impact_velocity - ref[3])) < 1e-6
+    # The reported force: law + damper in contact, exactly zero outside.
+    delta = ref[2] - ref[0] - CLEARANCE
+    rate = ref[3] - ref[1]
+    force = np.where(delta > 0, HERTZ_STIFFNESS * np.maximum(delta, 0) ** 1.5 + 0.01 * rate, 0.0)
+    sample_delta = relative - CLEARANCE
+    clear = sample_delta <= 0
+    assert np.all(sol.contact_force[clear] == 0.0)
+    assert np.max(np.abs(sol.contact_force - force)[~clear]) < 1e-5 * np.max(force)
+
+
+# ------------------------------------------------------------------ conservation laws
+
+
+@pytest.mark.parametrize("method", ["rk4", "newmark"])
+@pytest.mark.parametrize(
+    ("law", "stiffness", "restitution"),
+    [("hertz", 3000.0, None), ("hyster-hertz", 3000.0, 0.6), ("linear", 49.05, None)],
+)
+def test_momentum_conserved_without_spring(
+    free_system: vi.ImpactDamper,
+    method: str,
+    law: str,
+    stiffness: float,
+    restitution: float | None,
+) -> None:
+    """K = C = 0: only internal forces, so M w' + m y' is constant to round-off."""
+    contact = vi.Contact(law, stiffness=stiffness, damping=0.05, restitution=restitution)
+    start = vi.InitialState(main_velocity=-0.03, impact_displacement=0.005, impact_velocity=0.07)
+    sol = vi.simulate(free_system, contact, start, method=method, dt=1e-4, t_end=2.0)
+    assert len(sol.contacts) >= 3  # several contacts on both walls
+    momentum = MAIN_MASS * sol.main_velocity + IMPACT_MASS * sol.impact_velocity
+    p0 = MAIN_MASS * -0.03 + IMPACT_MASS * 0.07
+    assert np.max(np.abs(momentum - p0)) < 1e-14
+    # The centre of mass moves uniformly.
+    centre = MAIN_MASS * sol.main_displacement + IMPACT_MASS * sol.impact_displacement
+    expected = IMPACT_MASS * 0.005 + p0 * sol.t
+    assert np.max(np.abs(centre - expected)) < 1e-12
+
+
+@pytest.mark.parametrize(
+    "contact",
+    [
+        vi.Contact("hertz", stiffness=HERTZ_STIFFNESS),
+        vi.Contact("hyster-hertz", stiffness=HERTZ_STIFFNESS, restitution=1.0),
+    ],
+    ids=["hertz", "hyster-hertz-e1"],
+)
+def test_rk4_conserves_energy_over_many_contacts(contact: vi.Contact) -> None:
+    system = vi.ImpactDamper(
+        main_mass=MAIN_MASS, stiffness=STIFFNESS, impact_mass=IMPACT_MASS, clearance=CLEARANCE
+    )
+    start = vi.InitialState(main_displacement=0.002, impact_velocity=0.1)
+    sol = vi.simulate(system, contact, start, method="rk4", dt=1e-4, t_end=3.0)
+    assert len(sol.contacts) >= 8
+    e = energy(sol, system, contact)
+    assert np.max(np.abs(e / e[0] - 1.0)) < 1e-6
+    assert np.all(np.abs(sol.contacts.energy_dissipated) < 1e-12 * e[0])
+
+
+@pytest.mark.parametrize("restitution", [0.99, 0.9, 0.7, 0.5, 0.2, 0.01])
+def test_hyster_hertz_rebound_obeys_exact_relation(
+    free_system: vi.ImpactDamper, restitution: float
+) -> None:
+    """alpha (1 + e*) = ln((1 + alpha) / (1 - alpha e*)), alpha = 3/4 (1 - e^2)."""
+    alpha = 0.75 * (1 - restitution**2)
+    expected = brentq(
+        lambda x: alpha * (1 + x) - math.log((1 + alpha) / (1 - alpha * x)), 0.0, 1.0, xtol=1e-15
+    )
+    contact = vi.Contact("hyster-hertz", stiffness=HERTZ_STIFFNESS, restitution=restitution)
+    start = vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED)
+    sol = vi.simulate(free_system, contact, start, method="rk4", dt=1e-4, t_end=0.15)
+    assert first_contact(sol)[2] == pytest.approx(expected, rel=1e-7)
+    # The law never reaches the requested restitution (page: >= 0.663 even for e -> 0).
+    assert expected > 0.66
+    if restitution < 0.99:
+        assert expected > restitution
+
+
+@pytest.mark.parametrize(
+    ("m", "big_m", "k_hz", "v", "restitution"),
+    [(1.0, 1.0, 1.0e6, 1.0, 0.5), (0.01, 3.0, 50.0, 0.02, 0.8)],
+)
+def test_hyster_hertz_rebound_independent_of_masses_and_stiffness(
+    m: float, big_m: float, k_hz: float, v: float, restitution: float
+) -> None:
+    alpha = 0.75 * (1 - restitution**2)
+    expected = brentq(
+        lambda x: alpha * (1 + x) - math.log((1 + alpha) / (1 - alpha * x)), 0.0, 1.0, xtol=1e-15
+    )
+    system = vi.ImpactDamper(main_mass=big_m, stiffness=0.0, impact_mass=m, clearance=0.001)
+    contact = vi.Contact("hyster-hertz", stiffness=k_hz, restitution=restitution)
+    start = vi.InitialState(main_velocity=-v, impact_displacement=0.001)
+    tc, _ = goldsmith(m, big_m, k_hz, v, GOLDSMITH_EXACT)
+    sol = vi.simulate(system, contact, start, method="rk4", dt=tc / 2000, t_end=1.5 * tc)
+    assert first_contact(sol)[2] == pytest.approx(expected, rel=1e-7)
+
+
+@pytest.mark.parametrize("method", ["rk4", "newmark"])
+@pytest.mark.parametrize(
+    "contact",
+    [
+        vi.Contact("hyster-hertz", stiffness=HERTZ_STIFFNESS, restitution=0.7),
+        vi.Contact("hyster-hertz", stiffness=HERTZ_STIFFNESS, restitution=0.5, damping=0.05),
+        vi.Contact("hertz", stiffness=HERTZ_STIFFNESS, damping=0.2),
+        vi.Contact("linear", stiffness=49.05, damping=0.2),
+    ],
+    ids=["hh", "hh+c1", "hertz+c1", "linear+c1"],
+)
+def test_energy_dissipated_is_kinetic_energy_lost(
+    free_system: vi.ImpactDamper, contact: vi.Contact, method: str
+) -> None:
+    start = vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED)
+    dt = 1e-4 if method == "rk4" else 1e-5
+    sol = vi.simulate(free_system, contact, start, method=method, dt=dt, t_end=0.3)
+    assert len(sol.contacts) == 1 and np.isfinite(sol.contacts.duration[0])
+    kinetic = 0.5 * MAIN_MASS * sol.main_velocity**2 + 0.5 * IMPACT_MASS * sol.impact_velocity**2
+    lost = kinetic[0] - kinetic[-1]
+    assert lost > 0
+    rel = 1e-6 if method == "rk4" else 5e-3
+    assert sol.contacts.energy_dissipated[0] == pytest.approx(lost, rel=rel)
+    # And in terms of the relative speeds: 1/2 mu (v^2 - v'^2).
+    mu = MAIN_MASS * IMPACT_MASS / (MAIN_MASS + IMPACT_MASS)
+    v, v1 = sol.contacts.approach_speed[0], sol.contacts.rebound_speed[0]
+    assert 0.5 * mu * (v * v - v1 * v1) == pytest.approx(lost, rel=rel)
+
+
+# ------------------------------------------------------------------- contact timing
+
+
+@pytest.mark.parametrize("method", ["rk4", "newmark"])
+@pytest.mark.parametrize("dt", [1e-3, 1e-4])
+def test_step_count_timing_gives_whole_steps(
+    table1_system: vi.ImpactDamper, hertz_contact: vi.Contact, method: str, dt: float
+) -> None:
+    # Start in the middle of the enclosure: the onsets fall inside steps.
+    start = vi.InitialState(impact_velocity=0.07)
+    counted = vi.simulate(
+        table1_system,
+        hertz_contact,
+        start,
+        method=method,
+        dt=dt,
+        t_end=1.0,
+        contact_timing="step-count",
+    )
+    located = vi.simulate(table1_system, hertz_contact, start, method=method, dt=dt, t_end=1.0)
+    # The timing changes what is reported, not the trajectory.
+    np.testing.assert_array_equal(counted.impact_displacement, located.impact_displacement)
+    np.testing.assert_array_equal(counted.main_velocity, located.main_velocity)
+    a, b = counted.contacts, located.contacts
+    assert len(a) == len(b) >= 2
+    closed = np.isfinite(a.duration)
+    assert closed.sum() >= 2
+    for column in (a.onset, a.separation[closed], a.duration[closed]):
+        steps = column / dt
+        np.testing.assert_allclose(steps, np.round(steps), rtol=0, atol=1e-6)
+    # The first sample in (out of) contact is at most one step after the located instant.
+    assert np.all(a.onset - b.onset >= -1e-12) and np.all(a.onset - b.onset < dt)
+    lag = a.separation[closed] - b.separation[closed]
+    assert np.all(lag >= -1e-12) and np.all(lag < dt)
+    # The first onset: y - w reaches d at t = d / v exactly (free flight before it).
+    assert b.onset[0] == pytest.approx(CLEARANCE / 0.07, rel=1e-9 if method == "rk4" else 1e-6)
+    assert a.onset[0] == pytest.approx(math.ceil(CLEARANCE / 0.07 / dt) * dt, rel=1e-12)
+
+
+# ------------------------------------------------------------------------ linear law
+
+
+def linear_duration(m: float, big_m: float, k1: float, c1: float) -> float:
+    """The reference page's linear-model duration."""
+    return (
+        2
+        * m
+        * big_m
+        * math.pi
+        / (math.sqrt(m + big_m) * math.sqrt(4 * m * big_m * k1 - c1**2 * (m + big_m)))
+    )
+
+
+@pytest.mark.parametrize("c1", [0.0, 0.01, 0.5])
+def test_linear_law_duration(free_system: vi.ImpactDamper, c1: float) -> None:
+    k1 = 49.05
+    expected = linear_duration(IMPACT_MASS, MAIN_MASS, k1, c1)
+    # Half a damped period of the relative motion, written independently.
+    mu = IMPACT_MASS * MAIN_MASS / (IMPACT_MASS + MAIN_MASS)
+    assert expected == pytest.approx(math.pi / math.sqrt(k1 / mu - (c1 / (2 * mu)) ** 2), rel=1e-13)
+    assert vi.linear_contact_duration(IMPACT_MASS, MAIN_MASS, k1, c1) == pytest.approx(
+        expected, rel=1e-13
+    )
+    contact = vi.Contact("linear", stiffness=k1, damping=c1)
+    start = vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED)
+    sol = vi.simulate(free_system, contact, start, method="rk4", dt=1e-5, t_end=0.3)
+    assert first_contact(sol)[0] == pytest.approx(expected, rel=1e-9)
+    # Undamped: the maximum indentation is v / omega and the rebound is elastic.
+    if c1 == 0.0:
+        assert first_contact(sol)[1] == pytest.approx(APPROACH_SPEED * math.sqrt(mu / k1), rel=1e-9)
+        assert first_contact(sol)[2] == pytest.approx(1.0, rel=1e-9)
+    else:
+        decay = math.exp(-c1 / (2 * mu) * expected)
+        assert first_contact(sol)[2] == pytest.approx(decay, rel=1e-8)
+
+
+def test_linear_model_reproduces_the_papers_value() -> None:
+    """The paper's Table 2: linear model with k1 = 49.05 N/m lasts 0.2006 s."""
+    assert round(vi.linear_contact_duration(IMPACT_MASS, MAIN_MASS, 49.05, 0.01), 4) == 0.2006
+
+
+# ----------------------------------------------------------------------------- beam
+
+
+def cantilever_equation(x: float) -> float:
+    return math.cos(x) * math.cosh(x) + 1.0
+
+
+@pytest.mark.parametrize(("mode", "tabulated"), [(1, 1.875104), (2, 4.694091), (3, 7.854757)])
+def test_cantilever_roots(mode: int, tabulated: float) -> None:
+    root = vi.cantilever_root(mode)
+    assert root == pytest.approx(tabulated, abs=1e-6)
+    independent = brentq(
+        cantilever_equation, (mode - 1) * math.pi + 0.1, mode * math.pi, xtol=1e-14
+    )
+    assert root == pytest.approx(independent, rel=1e-12)
+
+
+def test_higher_cantilever_roots_tend_to_the_asymptote() -> None:
+    for mode in (4, 6, 10):
+        independent = brentq(
+            lambda x: math.cos(x) + 1.0 / math.cosh(x), (mode - 1) * math.pi, mode * math.pi
+        )
+        assert vi.cantilever_root(mode) == pytest.approx(independent, rel=1e-12)
+        assert vi.cantilever_root(mode) == pytest.approx((mode - 0.5) * math.pi, rel=1e-3)
+
+
+def page_mode_shape(beta_l: float, xi: np.ndarray) -> np.ndarray:
+    """The reference page's (unnormalised) mode shape at x / L = xi."""
+    z = beta_l * xi
+    sigma = (math.sin(beta_l) + math.sinh(beta_l)) / (math.cos(beta_l) + math.cosh(beta_l))
+    return np.sin(z) - np.sinh(z) - sigma * (np.cos(z) - np.cosh(z))
+
+
+def shape_samples(length: float, mode: int, x: np.ndarray) -> np.ndarray:
+    return np.array([vi.cantilever_mode_shape(length, mode, float(xi)) for xi in x])
+
+
+def test_cantilever_mode_constants() -> None:
+    length, e, i, rho, area = 0.7, 2.1e11, 3.0e-10, 7800.0, 1.2e-4
+    beam = vi.cantilever_mode(length, e, i, rho, area)
+    k = 12.362361 * e * i / length**3
+    big_m = rho * area * length
+    assert beam.modal_stiffness == pytest.approx(k, rel=1e-6)
+    root = brentq(cantilever_equation, 1.0, 3.0, xtol=1e-14)
+    assert beam.modal_stiffness == pytest.approx(root**4 * e * i / length**3, rel=1e-12)
+    assert beam.modal_mass == pytest.approx(big_m, rel=1e-12)
+    # The classical first natural frequency (b1 L)^2 sqrt(E I / (rho A L^4)).
+    assert beam.angular_frequency == pytest.approx(
+        root**2 * math.sqrt(e * i / (rho * area * length**4)), rel=1e-12
+    )
+    assert beam.position == length
+    assert abs(beam.shape_at_position) == pytest.approx(2.0, rel=1e-9)
+    assert abs(vi.cantilever_mode_shape(length, 1, length)) == pytest.approx(2.0, rel=1e-9)
+    assert beam.stiffness_at_position == pytest.approx(k / 4, rel=1e-6)
+    assert beam.mass_at_position == pytest.approx(big_m / 4, rel=1e-9)
+    # The page: K_tip = 3.0906 EI/L^3, close to the static tip stiffness 3 EI/L^3.
+    assert beam.stiffness_at_position == pytest.approx(3.0906 * e * i / length**3, rel=2e-5)
+
+
+def test_cantilever_mode_at_an_inner_position() -> None:
+    length = 2.0
+    beam = vi.cantilever_mode(length, 1.0, 1.0, 1.0, 1.0, position=0.5)
+    phi = vi.cantilever_mode_shape(length, 1, 0.5)
+    assert beam.shape_at_position == pytest.approx(phi, rel=1e-12)
+    assert beam.stiffness_at_position == pytest.approx(beam.modal_stiffness / phi**2, rel=1e-12)
+    assert beam.mass_at_position == pytest.approx(beam.modal_mass / phi**2, rel=1e-12)
+
+
+@pytest.mark.parametrize("mode", [1, 2, 3])
+def test_mode_shape_is_the_page_formula_normalised(mode: int) -> None:
+    length = 1.5
+    x = np.linspace(0.0, length, 4001)
+    ours = shape_samples(length, mode, x)
+    page = page_mode_shape(vi.cantilever_root(mode), x / length)
+    page *= math.sqrt(length / np.trapezoid(page**2, x))
+    sign = np.sign(ours[-1]) * np.sign(page[-1])
+    np.testing.assert_allclose(ours, sign * page, rtol=0, atol=1e-5)
+    assert ours[0] == pytest.approx(0.0, abs=1e-12)  # clamped end
+
+
+def test_mode_shapes_are_orthogonal() -> None:
+    length = 1.5
+    x = np.linspace(0.0, length, 4001)
+    shapes = [shape_samples(length, mode, x) for mode in (1, 2, 3)]
+    for i, a in enumerate(shapes):
+        for j, b in enumerate(shapes):
+            integral = np.trapezoid(a * b, x)
+            if i == j:
+                assert integral == pytest.approx(length, rel=1e-4)
+            else:
+                assert abs(integral) < 1e-4 * length
+
+
+# ------------------------------------------------------------------- Hertz stiffness
+
+
+@pytest.mark.parametrize(
+    ("r", "e1", "nu1", "e2", "nu2"),
+    [(0.01, 210e9, 0.3, 70e9, 0.33), (0.002, 3e9, 0.4, 200e9, 0.29), (0.05, 1e7, 0.49, 1e7, 0.0)],
+)
+def test_hertz_stiffness_matches_the_papers_form(
+    r: float, e1: float, nu1: float, e2: float, nu2: float
+) -> None:
+    paper = (
+        4
+        / (3 * math.pi)
+        * math.sqrt(r)
+        / ((1 - nu1**2) / (math.pi * e1) + (1 - nu2**2) / (math.pi * e2))
+    )
+    assert vi.hertz_stiffness(r, e1, nu1, e2, nu2) == pytest.approx(paper, rel=1e-13)
+    # Swapping the bodies changes nothing.
+    assert vi.hertz_stiffness(r, e2, nu2, e1, nu1) == pytest.approx(paper, rel=1e-13)
+
+
+def test_sphere_on_sphere_is_sphere_on_flat_with_effective_radius() -> None:
+    r1, r2 = 0.01, 0.03
+    effective = r1 * r2 / (r1 + r2)
+    two = vi.hertz_stiffness(r1, 210e9, 0.3, 70e9, 0.33, other_radius=r2)
+    flat = vi.hertz_stiffness(effective, 210e9, 0.3, 70e9, 0.33)
+    assert two == pytest.approx(flat, rel=1e-13)
+    swapped = vi.hertz_stiffness(r2, 70e9, 0.33, 210e9, 0.3, other_radius=r1)
+    assert swapped == pytest.approx(two, rel=1e-13)
+    # A very large second sphere tends to the flat.
+    big = vi.hertz_stiffness(r1, 210e9, 0.3, 70e9, 0.33, other_radius=1e9)
+    assert big == pytest.approx(vi.hertz_stiffness(r1, 210e9, 0.3, 70e9, 0.33), rel=1e-9)
+
+
+# ------------------------------------------------------------------------- adequacy
+
+PAPER_TABLE2 = [  # (method, dt, Tc, Tcpu, error %)
+    ("newmark", 1e-3, 0.1100, 0.0624, 1.01),
+    ("newmark", 1e-4, 0.1090, 0.2028, 0.09),
+    ("newmark", 2e-5, 0.1089, 2.5584, 0.00),
+    ("rk4", 1e-3, 0.1110, 0.0936, 1.93),
+    ("rk4", 1e-4, 0.1092, 0.1404, 0.27),
+    ("rk4", 2e-5, 0.1091, 0.3900, 0.18),
+]
+PAPER_TABLE3 = [
+    [97.56, 87.58, 77.60, 67.63, 57.65, 47.67],
+    [92.07, 92.73, 93.38, 94.03, 94.68, 95.34],
+    [0.00, 20.00, 40.00, 60.00, 80.00, 100.00],
+    [96.34, 77.07, 57.80, 38.54, 19.27, 0.00],
+    [94.51, 92.81, 91.11, 89.41, 87.71, 86.01],
+    [84.76, 85.94, 87.12, 88.31, 89.49, 90.67],
+]
+WEIGHTS = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
+
+
+def test_adequacy_reproduces_the_papers_table3() -> None:
+    max_err = max(row[4] for row in PAPER_TABLE2)
+    max_cpu = max(row[3] for row in PAPER_TABLE2)
+    for row, printed in zip(PAPER_TABLE2, PAPER_TABLE3, strict=True):
+        for wf1, value in zip(WEIGHTS, printed, strict=True):
+            got = vi.adequacy(row[4], max_err, row[3], max_cpu, wf1)
+            by_hand = ((1 - row[4] / max_err) * wf1 + (1 - row[3] / max_cpu) * (1 - wf1)) * 100
+            assert got == pytest.approx(by_hand, abs=1e-10)
+            assert got == pytest.approx(value, abs=0.01), (row, wf1)
