@@ -1,8 +1,9 @@
 """Throughput and call overhead of the core, driven from Python.
 
 Steps per second of both methods on the founding paper's Table 1 system
-(Hyster-Hertz contact, e = 0.9) over 1e7 steps (history thinned so that storage does not dominate), and the
-overhead of one ``simulate`` call of a single step. Prints medians.
+(Hyster-Hertz contact, e = 0.9) over 1e7 steps (history thinned so that
+storage does not dominate), and the overhead of one ``simulate`` call of a
+single step. Prints medians.
 
     python benchmarks/bench_steps.py [--steps N] [--repeats R]
 
@@ -61,7 +62,10 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=10_000_000, help="steps per run")
     parser.add_argument("--repeats", type=int, default=5, help="runs per median")
     args = parser.parse_args()
-    print(f"Table 1 system (e = 0.9), dt = 1e-4 s, {args.steps:.0e} steps, median of {args.repeats} runs")
+    print(
+        f"Table 1 system (e = 0.9), dt = 1e-4 s, {args.steps:.0e} steps, "
+        f"median of {args.repeats} runs"
+    )
     for method in ("newmark", "rk4"):
         rate, contacts = throughput(method, args.steps, args.repeats)
         goal = "meets" if rate >= 2e7 else "misses"

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pytest
+import vibroimpact as vi
 from conftest import (
     APPROACH_SPEED,
     CLEARANCE,
@@ -27,8 +28,6 @@ from conftest import (
 )
 from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
-
-import vibroimpact as vi
 
 # Goldsmith's constant exactly: Tc v / delta_max = 2 int_0^1 dx / sqrt(1 - x^(5/2))
 # = 2 (2/5) B(2/5, 1/2).
@@ -53,7 +52,7 @@ class Oracle:
     free: object | None  # OdeSolution over [duration, t_free]
 
 
-@lru_cache(maxsize=None)
+@cache
 def oracle(
     main_mass: float,
     stiffness: float,
