@@ -62,6 +62,7 @@ PAPER_HYSTER = {"rk4": 0.1103, "newmark": 0.1094}
 REFERENCE_ELASTIC = 0.1089819
 REFERENCE_HYSTER = 0.1100637
 REFERENCE_PURE_HERTZ = 0.1089327
+REFERENCE_REBOUND_RATIO = 0.99635
 
 METHOD_NAMES = {"newmark": "Newmark-beta", "rk4": "Runge-Kutta 4"}
 TIMING_NAMES = {"step-count": "steps counted", "located": "located"}
@@ -102,6 +103,10 @@ def first_duration(sol: Solution) -> float:
     if len(durations) == 0 or not math.isfinite(durations[0]):
         raise RuntimeError("the collision did not end within the run")
     return float(durations[0])
+
+
+def rebound_over_approach(sol: Solution) -> float:
+    return float(sol.contacts.rebound_speed[0] / sol.contacts.approach_speed[0])
 
 
 def collision(method: str, dt: float, timing: str, restitution: float | None = None) -> Scenario:
@@ -146,7 +151,7 @@ def rebound_ratio_simulated(restitution: float) -> float:
     contact = Contact("hyster-hertz", stiffness=HERTZ_STIFFNESS, restitution=restitution)
     start = InitialState(impact_displacement=0.01, impact_velocity=APPROACH_SPEED)
     sol = simulate(system, contact, start, method="rk4", dt=1e-5, t_end=0.3, every=1_000_000)
-    return float(sol.contacts.rebound_speed[0] / sol.contacts.approach_speed[0])
+    return rebound_over_approach(sol)
 
 
 def table2(goldsmith: float, exact: float) -> list[Row]:
@@ -272,6 +277,7 @@ class Findings:
     equal_k1: float
     beam_modal: float
     beam_tip: float
+    rebound_rows: list[tuple[str, float, float]]
 
 
 def findings(rows: list[Row]) -> Findings:
@@ -302,6 +308,11 @@ def findings(rows: list[Row]) -> Findings:
         equal_k1=equal_duration_stiffness(goldsmith),
         beam_modal=beam.modal_stiffness,
         beam_tip=beam.stiffness_at_position,
+        rebound_rows=[
+            (method, dt, rebound_over_approach(collision(method, dt, "located").run()))
+            for method in ("newmark", "rk4")
+            for dt in STEP_SIZES
+        ],
     )
 
 
