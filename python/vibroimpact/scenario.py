@@ -88,20 +88,21 @@ class Scenario:
     contact_timing: str = "located"
     every: int = 1
 
+    def solver_settings(self) -> dict[str, Any]:
+        """The keyword arguments of :func:`vibroimpact.simulate` this scenario sets."""
+        return {
+            "dt": self.dt,
+            "t_end": self.t_end,
+            "method": self.method,
+            "every": self.every,
+            "contact_timing": self.contact_timing,
+            "beta": self.beta,
+            "gamma": self.gamma,
+        }
+
     def run(self) -> Solution:
         """Integrate the scenario (see :func:`vibroimpact.simulate`)."""
-        return simulate(
-            self.system,
-            self.contact,
-            self.initial,
-            dt=self.dt,
-            t_end=self.t_end,
-            method=self.method,
-            every=self.every,
-            contact_timing=self.contact_timing,
-            beta=self.beta,
-            gamma=self.gamma,
-        )
+        return simulate(self.system, self.contact, self.initial, **self.solver_settings())
 
 
 def paper_collision(
@@ -205,15 +206,7 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
 
 def _validate_solver(scenario: Scenario, source: str) -> None:
     try:
-        check_solver(
-            dt=scenario.dt,
-            t_end=scenario.t_end,
-            method=scenario.method,
-            every=scenario.every,
-            contact_timing=scenario.contact_timing,
-            beta=scenario.beta,
-            gamma=scenario.gamma,
-        )
+        check_solver(**scenario.solver_settings())
     except InvalidInputError as err:
         section = "output" if str(err).startswith("every") else "solver"
         raise _fail(source, f"[{section}] ", str(err)) from None
