@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+
 import vibroimpact as vi
 
 MAIN_MASS = 1.0
