@@ -328,14 +328,25 @@ def test_repr_rebuilds_the_object() -> None:
         assert eval(repr(obj), namespace) == obj
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: the exceptions are created with module '_core' (not 'vibroimpact._core'), "
-    "so pickle cannot import them (breaks multiprocessing error propagation)",
-)
 def test_exceptions_pickle() -> None:
     with pytest.raises(vi.InvalidInputError) as err:
         vi.ImpactDamper(**{**SYSTEM, "main_mass": 0.0})
     copy = pickle.loads(pickle.dumps(err.value))
     assert type(copy) is vi.InvalidInputError
     assert str(copy) == str(err.value)
+
+
+def test_huge_whole_numbers_are_invalid_input_not_overflow() -> None:
+    system = vi.ImpactDamper(**SYSTEM)
+    contact = vi.Contact("hertz", stiffness=3000.0)
+    with pytest.raises(vi.InvalidInputError, match="every"):
+        vi.simulate(system, contact, vi.InitialState(), dt=1e-4, t_end=0.1, every=2**70)
+    with pytest.raises(vi.InvalidInputError, match="mode"):
+        vi.cantilever_root(2**40)
+
+
+def test_beta_and_gamma_are_checked_for_every_method() -> None:
+    system = vi.ImpactDamper(**SYSTEM)
+    contact = vi.Contact("hertz", stiffness=3000.0)
+    with pytest.raises(vi.InvalidInputError, match="beta"):
+        vi.simulate(system, contact, vi.InitialState(), dt=1e-4, t_end=0.1, method="rk4", beta=0.9)

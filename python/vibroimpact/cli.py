@@ -31,6 +31,10 @@ HISTORY_COLUMNS = (
 )
 
 
+# Energy growth (relative) above which `simulate` says the run gained energy.
+ENERGY_NOTE = 0.01
+
+
 class UsageError(Exception):
     """Bad input found by the CLI itself (exit status 2)."""
 
@@ -93,6 +97,7 @@ def run_summary(scenario: Scenario, sol: Solution, cpu_time: float) -> dict[str,
         "rhs_evaluations": sol.rhs_evaluations,
         "history_rows": len(sol.t),
         "cpu_time": cpu_time,
+        "energy_growth": _finite_or_none(sol.energy_growth),
         "contacts": [
             {key: _finite_or_none(value) for key, value in row.items()}
             for row in sol.contacts.to_dicts()
@@ -129,6 +134,11 @@ def _simulate(args: argparse.Namespace) -> int:
         f"{name}: {scenario.method}, dt = {scenario.dt:g} s, {sol.steps} steps "
         f"to t = {sol.final_time:g} s in {cpu_time * 1e3:.3f} ms"
     )
+    if sol.energy_growth > ENERGY_NOTE:
+        print(
+            f"note: the energy of this unforced system grew by {sol.energy_growth:.1%}; "
+            "that is numerical error: reduce dt or use a more accurate method"
+        )
     print(f"{len(sol.contacts)} contact(s)")
     if len(sol.contacts):
         header = (

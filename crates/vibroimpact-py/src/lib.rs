@@ -10,14 +10,15 @@ use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::{beam, closed_forms, materials};
 
+// The module path makes the exceptions picklable (e.g. from worker processes).
 create_exception!(
-    _core,
+    vibroimpact._core,
     InvalidInputError,
     PyValueError,
     "An input is outside what the model allows; the message names the field."
 );
 create_exception!(
-    _core,
+    vibroimpact._core,
     NumericalBlowUpError,
     PyArithmeticError,
     "The integration blew up (non-finite state or energy created from nothing)."
@@ -31,15 +32,34 @@ fn to_py(err: core::Error) -> PyErr {
     }
 }
 
-/// A whole number >= `min` from a Python int, as an InvalidInputError otherwise.
-fn whole(field: &str, value: i64, min: i64) -> PyResult<u64> {
-    if value < min {
-        Err(InvalidInputError::new_err(format!(
-            "{field} must be a whole number >= {min}, got {value}"
-        )))
-    } else {
-        Ok(value as u64)
+/// A whole number >= 1 from a Python int; one too large or too small for the
+/// core is an InvalidInputError naming the field, not an OverflowError.
+fn whole(field: &str, value: &Bound<'_, PyAny>) -> PyResult<u64> {
+    let invalid = || {
+        InvalidInputError::new_err(format!(
+            "{field} must be a whole number in [1, {}], got {value}",
+            i64::MAX
+        ))
+    };
+    match value.extract::<i64>() {
+        Ok(v) if v >= 1 => Ok(v as u64),
+        Ok(_) => Err(invalid()),
+        Err(err) if err.is_instance_of::<pyo3::exceptions::PyOverflowError>(value.py()) => {
+            Err(invalid())
+        }
+        Err(err) => Err(err),
     }
+}
+
+fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
+    whole("every", value)
+}
+
+fn mode_arg(value: &Bound<'_, PyAny>) -> PyResult<u32> {
+    let mode = whole("mode", value)?;
+    u32::try_from(mode).map_err(|_| {
+        InvalidInputError::new_err(format!("mode must be at most {}, got {mode}", u32::MAX))
+    })
 }
 
 /// The two-mass impact damper (SI units).
@@ -364,6 +384,11 @@ struct Solution {
     /// Method name.
     #[pyo3(get)]
     method: &'static str,
+    /// Largest relative growth of the mechanical energy of the unforced system,
+    /// ``max(E)/E(0) - 1`` (NaN if it starts at rest). Physically <= 0: a
+    /// positive value is numerical error (above 0.5 the run is refused).
+    #[pyo3(get)]
+    energy_growth: f64,
 }
 
 #[pymethods]
@@ -387,14 +412,13 @@ fn settings(
     dt: f64,
     t_end: f64,
     method: &str,
-    every: i64,
+    every: u64,
     contact_timing: &str,
     beta: f64,
     gamma: f64,
 ) -> PyResult<core::Settings> {
     let parsed = core::Method::parse(method, beta, gamma).map_err(to_py)?;
     let timing = core::ContactTiming::parse(contact_timing).map_err(to_py)?;
-    let every = whole("every", every, 1)?;
     core::Settings::new(parsed, dt, t_end, every, timing).map_err(to_py)
 }
 
@@ -406,7 +430,7 @@ fn check_solver(
     dt: f64,
     t_end: f64,
     method: &str,
-    every: i64,
+    #[pyo3(from_py_with = every_arg)] every: u64,
     contact_timing: &str,
     beta: f64,
     gamma: f64,
@@ -434,7 +458,7 @@ fn simulate(
     dt: f64,
     t_end: f64,
     method: &str,
-    every: i64,
+    #[pyo3(from_py_with = every_arg)] every: u64,
     contact_timing: &str,
     beta: f64,
     gamma: f64,
@@ -490,6 +514,7 @@ fn simulate(
         steps: sol.steps,
         rhs_evaluations: sol.rhs_evaluations,
         final_time: sol.final_time,
+        energy_growth: sol.energy_growth,
         method: match parsed {
             core::Method::Newmark { .. } => "newmark",
             core::Method::Rk4 => "rk4",
@@ -560,10 +585,9 @@ fn cantilever_mode(
     second_moment: f64,
     density: f64,
     area: f64,
-    mode: i64,
+    #[pyo3(from_py_with = mode_arg)] mode: u32,
     position: Option<f64>,
 ) -> PyResult<BeamMode> {
-    let mode = whole("mode", mode, 1)?.min(u32::MAX as u64) as u32;
     let b = beam::cantilever_mode(
         length,
         youngs_modulus,
@@ -589,16 +613,18 @@ fn cantilever_mode(
 
 /// The root ``b_i L`` of ``cos(x) cosh(x) + 1 = 0`` for mode ``mode`` >= 1.
 #[pyfunction]
-fn cantilever_root(mode: i64) -> PyResult<f64> {
-    let mode = whole("mode", mode, 1)?.min(u32::MAX as u64) as u32;
+fn cantilever_root(#[pyo3(from_py_with = mode_arg)] mode: u32) -> PyResult<f64> {
     beam::cantilever_root(mode).map_err(to_py)
 }
 
 /// Normalised mode shape ``phi(x)`` (``int_0^L phi^2 dx = L``) of mode
 /// ``mode`` of a cantilever of ``length`` (m), at ``x`` (m from the clamp).
 #[pyfunction]
-fn cantilever_mode_shape(length: f64, mode: i64, x: f64) -> PyResult<f64> {
-    let mode = whole("mode", mode, 1)?.min(u32::MAX as u64) as u32;
+fn cantilever_mode_shape(
+    length: f64,
+    #[pyo3(from_py_with = mode_arg)] mode: u32,
+    x: f64,
+) -> PyResult<f64> {
     beam::cantilever_mode_shape(length, mode, x).map_err(to_py)
 }
 
