@@ -18,6 +18,9 @@ pub trait ContactLaw: Copy + Send + Sync {
     fn elastic_force(&self, indentation: f64) -> f64;
     /// Elastic energy stored at `indentation`, J.
     fn potential(&self, indentation: f64) -> f64;
+    /// `(F, dF/d delta, dF/d delta')` for Newton iterations (zero slopes where
+    /// the force is clamped).
+    fn force_derivatives(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64, f64);
 }
 
 /// Hertz: `F = k delta^(3/2)`.
@@ -39,25 +42,94 @@ impl ContactLaw for Hertz {
     fn potential(&self, indentation: f64) -> f64 {
         0.4 * self.stiffness * indentation * indentation * indentation.sqrt()
     }
+    fn force_derivatives(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> (f64, f64, f64) {
+        let root = indentation.sqrt();
+        (self.stiffness * indentation * root, 1.5 * self.stiffness * root, 0.0)
+    }
 }
 
-/// Lankarani-Nikravesh ("Hyster-Hertz"):
-/// `F = k delta^(3/2) (1 + (3/4)(1 - e^2) delta' / delta'_minus)`.
+/// Hertz with hysteretic damping of the Lankarani-Nikravesh form:
+/// `F = k delta^(3/2) (1 + alpha delta' / delta'_minus)`.
+///
+/// "hyster-hertz" sets `alpha = (3/4)(1 - e^2)` (the founding paper's law,
+/// whose rebound is not `e`); "hertz-damped" solves `alpha` from the exact
+/// relation `alpha (1 + e) = ln((1 + alpha) / (1 - alpha e))`, so that two
+/// bodies alone separate at exactly `e` times their approach speed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HysterHertz {
     /// K_hz, N/m^1.5.
     pub stiffness: f64,
-    /// `(3/4)(1 - e^2)`, precomputed.
+    /// `alpha`, dimensionless.
     pub hysteresis: f64,
 }
 
 impl HysterHertz {
+    /// The founding paper's law: `alpha = (3/4)(1 - e^2)`.
     pub fn new(stiffness: f64, restitution: f64) -> Self {
         Self {
             stiffness,
             hysteresis: 0.75 * (1.0 - restitution * restitution),
         }
     }
+
+    /// The law whose rebound is exactly `restitution` (see [`exact_hysteresis`]).
+    pub fn exact(stiffness: f64, restitution: f64) -> Self {
+        Self {
+            stiffness,
+            hysteresis: exact_hysteresis(restitution),
+        }
+    }
+}
+
+/// The `alpha` for which a law `F = K delta^n (1 + alpha delta'/delta'_minus)`
+/// acting alone between two bodies gives the rebound/approach speed ratio
+/// `restitution` in (0, 1]: the root of
+/// `alpha (1 + e) - ln((1 + alpha)/(1 - alpha e)) = 0` in `(0, 1/e)`
+/// (0 for `e = 1`).
+pub fn exact_hysteresis(restitution: f64) -> f64 {
+    let e = restitution;
+    if e >= 1.0 {
+        return 0.0;
+    }
+    // f > 0 on (0, root) (f ~ alpha^2 (1 - e^2)/2 near 0) and f -> -inf at 1/e;
+    // log1p keeps f's sign right for small alpha.
+    let f = |a: f64| a * (1.0 + e) - ((a).ln_1p() - (-a * e).ln_1p());
+    let (mut lo, mut hi) = (0.0_f64, 1.0 / e);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if f(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The rebound/approach speed ratio that the law with hysteresis `alpha`
+/// gives two bodies alone: the root of the same relation in `e`.
+pub fn rebound_ratio(hysteresis: f64) -> f64 {
+    let a = hysteresis;
+    if a <= 0.0 {
+        return 1.0;
+    }
+    let f = |e: f64| a * (1.0 + e) - (a.ln_1p() - (-a * e).ln_1p());
+    let (mut lo, mut hi) = (0.0_f64, (1.0_f64).min(1.0 / a));
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if f(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// Below this approach rate (m/s) a contact is a graze and the damping term,
@@ -81,6 +153,23 @@ impl ContactLaw for HysterHertz {
     fn potential(&self, indentation: f64) -> f64 {
         0.4 * self.stiffness * indentation * indentation * indentation.sqrt()
     }
+    fn force_derivatives(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64, f64) {
+        let root = indentation.sqrt();
+        let elastic = self.stiffness * indentation * root;
+        let elastic_slope = 1.5 * self.stiffness * root;
+        if approach_rate <= GRAZING_RATE {
+            return (elastic, elastic_slope, 0.0);
+        }
+        let factor = 1.0 + self.hysteresis * rate / approach_rate;
+        if factor <= 0.0 {
+            return (0.0, 0.0, 0.0);
+        }
+        (
+            elastic * factor,
+            elastic_slope * factor,
+            elastic * self.hysteresis / approach_rate,
+        )
+    }
 }
 
 /// Linear spring: `F = k delta`.
@@ -102,6 +191,9 @@ impl ContactLaw for Linear {
     fn potential(&self, indentation: f64) -> f64 {
         0.5 * self.stiffness * indentation * indentation
     }
+    fn force_derivatives(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> (f64, f64, f64) {
+        (self.stiffness * indentation, self.stiffness, 0.0)
+    }
 }
 
 /// The named contact laws.
@@ -109,16 +201,18 @@ impl ContactLaw for Linear {
 pub enum LawKind {
     Hertz,
     HysterHertz,
+    HertzDamped,
     Linear,
 }
 
 impl LawKind {
-    pub const NAMES: &'static str = "\"hertz\", \"hyster-hertz\", \"linear\"";
+    pub const NAMES: &'static str = "\"hertz\", \"hyster-hertz\", \"hertz-damped\", \"linear\"";
 
     pub fn parse(name: &str) -> Result<Self> {
         match name {
             "hertz" => Ok(Self::Hertz),
             "hyster-hertz" => Ok(Self::HysterHertz),
+            "hertz-damped" => Ok(Self::HertzDamped),
             "linear" => Ok(Self::Linear),
             _ => Err(Error::UnknownChoice {
                 field: "law",
@@ -128,10 +222,16 @@ impl LawKind {
         }
     }
 
+    /// Whether the law takes a coefficient of restitution.
+    pub fn uses_restitution(self) -> bool {
+        matches!(self, Self::HysterHertz | Self::HertzDamped)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Self::Hertz => "hertz",
             Self::HysterHertz => "hyster-hertz",
+            Self::HertzDamped => "hertz-damped",
             Self::Linear => "linear",
         }
     }
@@ -144,7 +244,7 @@ pub struct Contact {
     pub law: LawKind,
     /// K_hz in N/m^1.5 for the Hertz laws, k1 in N/m for "linear".
     pub stiffness: f64,
-    /// e in (0, 1]; 1 for the laws that do not use it.
+    /// e in (0, 1] for the damped Hertz laws; 1 for the others.
     pub restitution: f64,
     /// c1, N s/m, acting on the relative velocity only while in contact.
     pub damping: f64,
@@ -185,25 +285,47 @@ impl Contact {
         })
     }
 
-    /// The law's force (N, clamped at zero), without the contact damper.
-    pub fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
-        if indentation <= 0.0 {
-            return 0.0;
-        }
+    /// The rebound/approach speed ratio two bodies alone get from the law
+    /// (without the contact damper): `e` for "hertz-damped", less than `e`
+    /// for "hyster-hertz" and never below 0.663.
+    pub fn effective_restitution(&self) -> f64 {
         match self.law {
-            LawKind::Hertz => Hertz {
-                stiffness: self.stiffness,
-            }
-            .force(indentation, rate, approach_rate),
-            LawKind::HysterHertz => HysterHertz::new(self.stiffness, self.restitution).force(
-                indentation,
-                rate,
-                approach_rate,
-            ),
-            LawKind::Linear => Linear {
-                stiffness: self.stiffness,
-            }
-            .force(indentation, rate, approach_rate),
+            LawKind::HysterHertz => rebound_ratio(0.75 * (1.0 - self.restitution * self.restitution)),
+            _ => self.restitution,
         }
     }
+
+    /// The law's force (N, clamped at zero), without the contact damper.
+    pub fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
+        struct Force(f64, f64, f64);
+        impl LawVisitor for Force {
+            type Output = f64;
+            fn visit<L: ContactLaw>(self, law: L) -> f64 {
+                if self.0 > 0.0 {
+                    law.force(self.0, self.1, self.2)
+                } else {
+                    0.0
+                }
+            }
+        }
+        self.visit(Force(indentation, rate, approach_rate))
+    }
+
+    /// Call `visitor` with the concrete law: the one place where the named
+    /// laws become types, so that kernels monomorphise over them.
+    pub fn visit<V: LawVisitor>(&self, visitor: V) -> V::Output {
+        let k = self.stiffness;
+        match self.law {
+            LawKind::Hertz => visitor.visit(Hertz { stiffness: k }),
+            LawKind::HysterHertz => visitor.visit(HysterHertz::new(k, self.restitution)),
+            LawKind::HertzDamped => visitor.visit(HysterHertz::exact(k, self.restitution)),
+            LawKind::Linear => visitor.visit(Linear { stiffness: k }),
+        }
+    }
+}
+
+/// Something to do with a concrete contact law (see [`Contact::visit`]).
+pub trait LawVisitor {
+    type Output;
+    fn visit<L: ContactLaw>(self, law: L) -> Self::Output;
 }

@@ -2,7 +2,7 @@
 //! thinned time history and builds the table of contacts, with contact
 //! instants located inside the step.
 
-use crate::contact::{Contact, ContactLaw, Hertz, HysterHertz, LawKind, Linear};
+use crate::contact::{Contact, ContactLaw, LawVisitor};
 use crate::error::{positive, within, Error, Result};
 use crate::hermite;
 use crate::integrators::{Integrator, Newmark, Rk4};
@@ -431,38 +431,25 @@ pub fn simulate(
     settings: &Settings,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> Result<Solution> {
-    let c1 = contact.damping;
-    match contact.law {
-        LawKind::Hertz => {
-            let law = Hertz {
-                stiffness: contact.stiffness,
-            };
-            with_method(
-                &Model::new(system, law, c1, Free),
-                initial,
-                settings,
-                interrupt,
-            )
-        }
-        LawKind::HysterHertz => {
-            let law = HysterHertz::new(contact.stiffness, contact.restitution);
-            with_method(
-                &Model::new(system, law, c1, Free),
-                initial,
-                settings,
-                interrupt,
-            )
-        }
-        LawKind::Linear => {
-            let law = Linear {
-                stiffness: contact.stiffness,
-            };
-            with_method(
-                &Model::new(system, law, c1, Free),
-                initial,
-                settings,
-                interrupt,
-            )
+    struct Run<'a> {
+        system: &'a ImpactDamper,
+        contact_damping: f64,
+        initial: &'a State,
+        settings: &'a Settings,
+        interrupt: &'a mut dyn FnMut() -> bool,
+    }
+    impl LawVisitor for Run<'_> {
+        type Output = Result<Solution>;
+        fn visit<L: ContactLaw>(self, law: L) -> Result<Solution> {
+            let model = Model::new(self.system, law, self.contact_damping, Free);
+            with_method(&model, self.initial, self.settings, self.interrupt)
         }
     }
+    contact.visit(Run {
+        system,
+        contact_damping: contact.damping,
+        initial,
+        settings,
+        interrupt,
+    })
 }
