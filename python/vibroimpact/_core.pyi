@@ -13,6 +13,8 @@ __all__ = [
     "InitialState",
     "InvalidInputError",
     "NumericalBlowUpError",
+    "RestitutionWarning",
+    "SimulationError",
     "Solution",
     "__version__",
     "adequacy",
@@ -33,6 +35,8 @@ _FloatArray = npt.NDArray[np.float64]
 
 class InvalidInputError(ValueError): ...
 class NumericalBlowUpError(ArithmeticError): ...
+class SimulationError(RuntimeError): ...
+class RestitutionWarning(UserWarning): ...
 
 @final
 class ImpactDamper:
@@ -75,6 +79,8 @@ class Contact:
     def damping(self) -> float: ...
     @property
     def restitution(self) -> float | None: ...
+    @property
+    def effective_restitution(self) -> float: ...
     def law_force(
         self, indentation: float, rate: float = 0.0, approach_rate: float = 1.0
     ) -> float: ...
@@ -115,6 +121,8 @@ class ContactTable:
     @property
     def rebound_speed(self) -> _FloatArray: ...
     @property
+    def restitution(self) -> _FloatArray: ...
+    @property
     def energy_dissipated(self) -> _FloatArray: ...
     def __len__(self) -> int: ...
     def to_dicts(self) -> list[dict[str, float]]: ...
@@ -145,6 +153,12 @@ class Solution:
     def method(self) -> str: ...
     @property
     def energy_growth(self) -> float: ...
+    @property
+    def stepping(self) -> str: ...
+    @property
+    def rejected_steps(self) -> int: ...
+    @property
+    def grazing_contacts(self) -> int: ...
 
 @final
 class BeamMode:
@@ -172,23 +186,33 @@ def simulate(
     contact: Contact,
     initial: InitialState,
     *,
-    dt: float,
     t_end: float,
+    dt: float | None = None,
     method: str = "newmark",
     every: int = 1,
     contact_timing: str = "located",
+    stepping: str | None = None,
     beta: float = 0.25,
     gamma: float = 0.5,
+    spectral_radius: float = 0.9,
+    rtol: float = 1e-8,
+    atol: float = 1e-12,
+    max_steps: int = 1_000_000_000,
 ) -> Solution: ...
 def check_solver(
     *,
-    dt: float,
     t_end: float,
+    dt: float | None = None,
     method: str = "newmark",
     every: int = 1,
     contact_timing: str = "located",
+    stepping: str | None = None,
     beta: float = 0.25,
     gamma: float = 0.5,
+    spectral_radius: float = 0.9,
+    rtol: float = 1e-8,
+    atol: float = 1e-12,
+    max_steps: int = 1_000_000_000,
 ) -> None: ...
 def hertz_stiffness(
     radius: float,

@@ -57,10 +57,15 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
     },
     "solver": {
         "method": (_TEXT, "newmark"),
-        "dt": (_NUMBER, _REQUIRED),
+        "dt": (_NUMBER, None),
         "t_end": (_NUMBER, _REQUIRED),
+        "stepping": (_TEXT, None),
         "beta": (_NUMBER, 0.25),
         "gamma": (_NUMBER, 0.5),
+        "spectral_radius": (_NUMBER, 0.9),
+        "rtol": (_NUMBER, 1e-8),
+        "atol": (_NUMBER, 1e-12),
+        "max_steps": (_WHOLE, 1_000_000_000),
         "contact_timing": (_TEXT, "located"),
     },
     "output": {
@@ -81,10 +86,15 @@ class Scenario:
     contact: Contact
     initial: InitialState
     method: str = "newmark"
-    dt: float = 1e-4
+    dt: float | None = 1e-4
     t_end: float = 0.3
+    stepping: str | None = None
     beta: float = 0.25
     gamma: float = 0.5
+    spectral_radius: float = 0.9
+    rtol: float = 1e-8
+    atol: float = 1e-12
+    max_steps: int = 1_000_000_000
     contact_timing: str = "located"
     every: int = 1
 
@@ -96,8 +106,13 @@ class Scenario:
             "method": self.method,
             "every": self.every,
             "contact_timing": self.contact_timing,
+            "stepping": self.stepping,
             "beta": self.beta,
             "gamma": self.gamma,
+            "spectral_radius": self.spectral_radius,
+            "rtol": self.rtol,
+            "atol": self.atol,
+            "max_steps": self.max_steps,
         }
 
     def run(self) -> Solution:
@@ -208,7 +223,7 @@ def _validate_solver(scenario: Scenario, source: str) -> None:
     try:
         check_solver(**scenario.solver_settings())
     except InvalidInputError as err:
-        section = "output" if str(err).startswith("every") else "solver"
+        section = "output" if str(err).startswith("every ") else "solver"
         raise _fail(source, f"[{section}] ", str(err)) from None
 
 

@@ -20,7 +20,8 @@ pub trait ContactLaw: Copy + Send + Sync {
     fn potential(&self, indentation: f64) -> f64;
     /// `(F, dF/d delta, dF/d delta')` for Newton iterations (zero slopes where
     /// the force is clamped).
-    fn force_derivatives(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64, f64);
+    fn force_derivatives(&self, indentation: f64, rate: f64, approach_rate: f64)
+        -> (f64, f64, f64);
 }
 
 /// Hertz: `F = k delta^(3/2)`.
@@ -42,9 +43,18 @@ impl ContactLaw for Hertz {
     fn potential(&self, indentation: f64) -> f64 {
         0.4 * self.stiffness * indentation * indentation * indentation.sqrt()
     }
-    fn force_derivatives(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> (f64, f64, f64) {
+    fn force_derivatives(
+        &self,
+        indentation: f64,
+        _rate: f64,
+        _approach_rate: f64,
+    ) -> (f64, f64, f64) {
         let root = indentation.sqrt();
-        (self.stiffness * indentation * root, 1.5 * self.stiffness * root, 0.0)
+        (
+            self.stiffness * indentation * root,
+            1.5 * self.stiffness * root,
+            0.0,
+        )
     }
 }
 
@@ -153,7 +163,12 @@ impl ContactLaw for HysterHertz {
     fn potential(&self, indentation: f64) -> f64 {
         0.4 * self.stiffness * indentation * indentation * indentation.sqrt()
     }
-    fn force_derivatives(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64, f64) {
+    fn force_derivatives(
+        &self,
+        indentation: f64,
+        rate: f64,
+        approach_rate: f64,
+    ) -> (f64, f64, f64) {
         let root = indentation.sqrt();
         let elastic = self.stiffness * indentation * root;
         let elastic_slope = 1.5 * self.stiffness * root;
@@ -191,7 +206,12 @@ impl ContactLaw for Linear {
     fn potential(&self, indentation: f64) -> f64 {
         0.5 * self.stiffness * indentation * indentation
     }
-    fn force_derivatives(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> (f64, f64, f64) {
+    fn force_derivatives(
+        &self,
+        indentation: f64,
+        _rate: f64,
+        _approach_rate: f64,
+    ) -> (f64, f64, f64) {
         (self.stiffness * indentation, self.stiffness, 0.0)
     }
 }
@@ -290,7 +310,9 @@ impl Contact {
     /// for "hyster-hertz" and never below 0.663.
     pub fn effective_restitution(&self) -> f64 {
         match self.law {
-            LawKind::HysterHertz => rebound_ratio(0.75 * (1.0 - self.restitution * self.restitution)),
+            LawKind::HysterHertz => {
+                rebound_ratio(0.75 * (1.0 - self.restitution * self.restitution))
+            }
             _ => self.restitution,
         }
     }

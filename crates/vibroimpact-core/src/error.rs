@@ -26,6 +26,25 @@ pub enum Error {
         "numerical blow-up at t = {time:.6e} s ({reason}); reduce dt or choose a more stable method"
     )]
     NumericalBlowUp { time: f64, reason: &'static str },
+    /// Newton's method did not converge within a step of an implicit method.
+    #[error("Newton iterations did not converge in the step from t = {time:.6e} s; reduce dt")]
+    NewtonFailed { time: f64 },
+    /// Contacts and separations follow each other ever faster.
+    #[error(
+        "chattering at t = {time:.6e} s: {events} contact changes in a row less than {interval:.1e} s apart \
+         (the impact mass is settling against a wall); the run was stopped there"
+    )]
+    Chattering {
+        time: f64,
+        events: u64,
+        interval: f64,
+    },
+    /// The adaptive step size fell to round-off.
+    #[error("step size {step:.3e} s too small at t = {time:.6e} s; loosen rtol/atol")]
+    StepSizeTooSmall { time: f64, step: f64 },
+    /// More steps than allowed.
+    #[error("maximum number of steps ({max_steps}) reached at t = {time:.6e} s; raise max_steps")]
+    TooManySteps { time: f64, max_steps: u64 },
     /// The caller asked to stop (for example Ctrl-C in Python).
     #[error("interrupted at t = {time:.6e} s")]
     Interrupted { time: f64 },

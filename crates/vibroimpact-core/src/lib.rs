@@ -10,14 +10,21 @@ pub mod beam;
 pub mod closed_forms;
 pub mod contact;
 pub mod error;
+pub mod events;
 mod hermite;
 pub mod integrators;
 pub mod materials;
 pub mod model;
 pub mod run;
+pub mod steppers;
 pub mod system;
+pub mod tableau;
 
 pub use contact::{Contact, ContactLaw, LawKind};
 pub use error::{Error, Result};
-pub use run::{simulate, ContactRecord, ContactTiming, History, Method, Settings, Solution};
+pub use run::{
+    simulate, ContactRecord, ContactTiming, History, Method, MethodOptions, Settings, Solution,
+    Stepping,
+};
+pub use steppers::Tolerances;
 pub use system::{ImpactDamper, State};

@@ -40,6 +40,20 @@ pub struct ContactState {
     pub total_force: f64,
 }
 
+/// The contact regime of the event-driven kernel: the contact force acts
+/// exactly while in `Contact` mode, so the right-hand side is smooth within a
+/// mode and every non-smooth instant is a located mode switch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Mode {
+    Free,
+    Contact {
+        /// +1 at the wall `y - w = +d`, -1 at `-d`.
+        side: f64,
+        /// Indentation rate at onset, m/s (latched for rate-dependent laws).
+        approach_rate: f64,
+    },
+}
+
 /// The impact damper with its contact law and excitation, ready to integrate.
 #[derive(Debug, Clone, Copy)]
 pub struct Model<L: ContactLaw, X: Excitation> {
@@ -135,6 +149,81 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
             )
         } else {
             (main, 0.0)
+        }
+    }
+
+    /// The contact against wall `side` in state `s`; the law's force is zero
+    /// where the indentation is not positive, the contact damper acts anyway
+    /// (the caller decides that the bodies are in contact).
+    #[inline(always)]
+    pub fn contact_at(&self, s: &State, side: f64, approach_rate: f64) -> ContactState {
+        let indentation = side * s.relative_displacement() - self.clearance;
+        let rate = side * s.relative_velocity();
+        let law_force = if indentation > 0.0 {
+            self.law.force(indentation, rate, approach_rate)
+        } else {
+            0.0
+        };
+        ContactState {
+            side,
+            indentation,
+            rate,
+            law_force,
+            total_force: law_force + self.contact_damping * rate,
+        }
+    }
+
+    /// Accelerations `(w'', y'')` (m/s^2) in a given mode.
+    #[inline(always)]
+    pub fn accelerations_in(&self, time: f64, s: &State, mode: Mode) -> (f64, f64) {
+        let (aw, ay, _) = self.rates_in(time, s, mode);
+        (aw, ay)
+    }
+
+    /// Accelerations (m/s^2) and the power dissipated by the contact (W) in a
+    /// given mode, from one evaluation of the contact.
+    #[inline(always)]
+    pub fn rates_in(&self, time: f64, s: &State, mode: Mode) -> (f64, f64, f64) {
+        let mut main = -(self.damping_per_mass * s.main_velocity
+            + self.stiffness_per_mass * s.main_displacement);
+        if !X::IS_FREE {
+            main += self.excitation.main_force(time) * self.inverse_main_mass;
+        }
+        match mode {
+            Mode::Free => (main, 0.0, 0.0),
+            Mode::Contact {
+                side,
+                approach_rate,
+            } => {
+                let c = self.contact_at(s, side, approach_rate);
+                let push = side * c.total_force;
+                let elastic = if c.indentation > 0.0 {
+                    self.law.elastic_force(c.indentation)
+                } else {
+                    0.0
+                };
+                (
+                    main + push * self.inverse_main_mass,
+                    -push * self.inverse_impact_mass,
+                    (c.total_force - elastic) * c.rate,
+                )
+            }
+        }
+    }
+
+    /// Power dissipated by the contact (W) in a given mode.
+    #[inline(always)]
+    pub fn dissipation_in(&self, s: &State, mode: Mode) -> f64 {
+        self.rates_in(0.0, s, mode).2
+    }
+
+    /// The external force on the main mass, N.
+    #[inline(always)]
+    pub fn external_force(&self, time: f64) -> f64 {
+        if X::IS_FREE {
+            0.0
+        } else {
+            self.excitation.main_force(time)
         }
     }
 

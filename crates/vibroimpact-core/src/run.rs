@@ -4,9 +4,11 @@
 
 use crate::contact::{Contact, ContactLaw, LawVisitor};
 use crate::error::{positive, within, Error, Result};
+use crate::events::integrate_events;
 use crate::hermite;
 use crate::integrators::{Integrator, Newmark, Rk4};
 use crate::model::{Excitation, Free, Model};
+use crate::steppers::{Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper, Tolerances};
 use crate::system::{ImpactDamper, State};
 
 /// How contact instants are reported.
@@ -35,28 +37,126 @@ impl ContactTiming {
     }
 }
 
+/// Options of the methods, by name; each method reads the ones it uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MethodOptions {
+    /// Newmark's beta, in [0, 0.5] (default 1/4).
+    pub beta: f64,
+    /// Newmark's gamma, in [0.5, 1] (default 1/2).
+    pub gamma: f64,
+    /// Generalised-alpha's spectral radius at infinite frequency, in [0, 1].
+    pub spectral_radius: f64,
+    /// Relative tolerance of the adaptive methods.
+    pub rtol: f64,
+    /// Absolute tolerance of the adaptive methods (m and m/s).
+    pub atol: f64,
+}
+
+impl Default for MethodOptions {
+    fn default() -> Self {
+        Self {
+            beta: 0.25,
+            gamma: 0.5,
+            spectral_radius: 0.9,
+            rtol: 1e-8,
+            atol: 1e-12,
+        }
+    }
+}
+
 /// The integration method.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// The paper's Newmark-beta with the contact force lagged one step.
     Newmark { beta: f64, gamma: f64 },
+    /// Newmark-beta with Newton iterations on the contact force.
+    NewmarkImplicit { beta: f64, gamma: f64 },
+    /// Chung-Hulbert generalised-alpha.
+    GeneralizedAlpha { spectral_radius: f64 },
     /// Classical fourth-order Runge-Kutta.
     Rk4,
+    /// Dormand-Prince 5(4), adaptive.
+    Dopri5(Tolerances),
+    /// DOP853, adaptive.
+    Dop853(Tolerances),
 }
 
 impl Method {
-    pub const NAMES: &'static str = "\"newmark\", \"rk4\"";
+    pub const NAMES: &'static str =
+        "\"newmark\", \"newmark-implicit\", \"generalized-alpha\", \"rk4\", \"dopri5\", \"dop853\"";
 
-    /// Method by name; `beta`, `gamma` apply to "newmark" only.
-    pub fn parse(name: &str, beta: f64, gamma: f64) -> Result<Self> {
-        // Checked whatever the method, so that a wrong value is never silently ignored.
-        let beta = within("beta", beta, 0.0, 0.5, false, "in [0, 0.5]")?;
-        let gamma = within("gamma", gamma, 0.5, 1.0, false, "in [0.5, 1]")?;
+    /// Method by name. Every option is checked whatever the method, so that
+    /// a wrong value is never silently ignored.
+    pub fn parse(name: &str, options: &MethodOptions) -> Result<Self> {
+        let beta = within("beta", options.beta, 0.0, 0.5, false, "in [0, 0.5]")?;
+        let gamma = within("gamma", options.gamma, 0.5, 1.0, false, "in [0.5, 1]")?;
+        let spectral_radius = within(
+            "spectral_radius",
+            options.spectral_radius,
+            0.0,
+            1.0,
+            false,
+            "in [0, 1]",
+        )?;
+        let tolerances = Tolerances {
+            rtol: within("rtol", options.rtol, 1e-15, 0.1, false, "in [1e-15, 0.1]")?,
+            atol: positive("atol", options.atol)?,
+        };
         match name {
             "newmark" => Ok(Self::Newmark { beta, gamma }),
+            "newmark-implicit" => Ok(Self::NewmarkImplicit { beta, gamma }),
+            "generalized-alpha" => Ok(Self::GeneralizedAlpha { spectral_radius }),
             "rk4" => Ok(Self::Rk4),
+            "dopri5" => Ok(Self::Dopri5(tolerances)),
+            "dop853" => Ok(Self::Dop853(tolerances)),
             _ => Err(Error::UnknownChoice {
                 field: "method",
+                allowed: Self::NAMES,
+                value: name.to_string(),
+            }),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Newmark { .. } => "newmark",
+            Self::NewmarkImplicit { .. } => "newmark-implicit",
+            Self::GeneralizedAlpha { .. } => "generalized-alpha",
+            Self::Rk4 => "rk4",
+            Self::Dopri5(_) => "dopri5",
+            Self::Dop853(_) => "dop853",
+        }
+    }
+
+    /// Whether the step size is adaptive (dt is then only the first step).
+    pub fn is_adaptive(&self) -> bool {
+        matches!(self, Self::Dopri5(_) | Self::Dop853(_))
+    }
+
+    /// The founding paper's two methods also run in its fixed stepping.
+    pub fn has_fixed_stepping(&self) -> bool {
+        matches!(self, Self::Newmark { .. } | Self::Rk4)
+    }
+}
+
+/// How steps meet contact events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stepping {
+    /// The founding paper's way: fixed steps that may straddle an onset or a
+    /// separation (contact instants then located or counted afterwards).
+    Fixed,
+    /// Events located to round-off, the step cut there and restarted.
+    Events,
+}
+
+impl Stepping {
+    pub const NAMES: &'static str = "\"fixed\", \"events\"";
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "fixed" => Ok(Self::Fixed),
+            "events" => Ok(Self::Events),
+            _ => Err(Error::UnknownChoice {
+                field: "stepping",
                 allowed: Self::NAMES,
                 value: name.to_string(),
             }),
@@ -71,24 +171,33 @@ pub const MAX_HISTORY_ROWS: u64 = 100_000_000;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
     pub method: Method,
-    /// Step, s (> 0).
-    pub dt: f64,
-    /// End time, s (> 0); rounded up to a whole number of steps.
+    /// Step, s (> 0): required by the fixed-step methods, the first step of
+    /// the adaptive ones (chosen automatically when None).
+    pub dt: Option<f64>,
+    /// End time, s (> 0); rounded up to a whole number of steps by the
+    /// fixed-step methods.
     pub t_end: f64,
     /// Keep every `every`-th step in the history (the last step always).
     pub every: u64,
     pub timing: ContactTiming,
+    pub stepping: Stepping,
+    /// Most steps (accepted and rejected) a run may take.
+    pub max_steps: u64,
 }
 
 impl Settings {
+    /// `stepping` None takes the method's default: "fixed" for the paper's
+    /// "newmark" and "rk4", "events" for the others (which have no other).
     pub fn new(
         method: Method,
-        dt: f64,
+        dt: Option<f64>,
         t_end: f64,
         every: u64,
         timing: ContactTiming,
+        stepping: Option<Stepping>,
+        max_steps: u64,
     ) -> Result<Self> {
-        let dt = positive("dt", dt)?;
+        let dt = dt.map(|dt| positive("dt", dt)).transpose()?;
         let t_end = positive("t_end", t_end)?;
         if every == 0 {
             return Err(Error::InvalidParameter {
@@ -97,28 +206,65 @@ impl Settings {
                 value: 0.0,
             });
         }
+        if max_steps == 0 {
+            return Err(Error::InvalidParameter {
+                field: "max_steps",
+                allowed: "a whole number >= 1",
+                value: 0.0,
+            });
+        }
+        if dt.is_none() && !method.is_adaptive() {
+            return Err(Error::Inconsistent(format!(
+                "dt is required for method {:?} (a step in s > 0)",
+                method.name()
+            )));
+        }
+        let default = if method.has_fixed_stepping() {
+            Stepping::Fixed
+        } else {
+            Stepping::Events
+        };
+        let stepping = stepping.unwrap_or(default);
+        if stepping == Stepping::Fixed && !method.has_fixed_stepping() {
+            return Err(Error::Inconsistent(format!(
+                "stepping \"fixed\" is the founding paper's, for methods \"newmark\" and \"rk4\" only, not {:?}",
+                method.name()
+            )));
+        }
+        if stepping == Stepping::Events && timing == ContactTiming::StepCount {
+            return Err(Error::Inconsistent(
+                "contact_timing \"step-count\" needs stepping \"fixed\": with events the contact instants are exact"
+                    .into(),
+            ));
+        }
         let settings = Self {
             method,
             dt,
             t_end,
             every,
             timing,
+            stepping,
+            max_steps,
         };
-        let rows = settings.steps() / every + 2;
-        if rows > MAX_HISTORY_ROWS {
-            return Err(Error::Inconsistent(format!(
-                "the history would keep {rows} rows (t_end / dt / every); at most {MAX_HISTORY_ROWS} \
-                 are allowed: raise every"
-            )));
+        if !method.is_adaptive() {
+            let rows = settings.steps() / every + 2;
+            if rows > MAX_HISTORY_ROWS {
+                return Err(Error::Inconsistent(format!(
+                    "the history would keep {rows} rows (t_end / dt / every); at most {MAX_HISTORY_ROWS} \
+                     are allowed: raise every"
+                )));
+            }
         }
         Ok(settings)
     }
 
-    /// Number of steps: `t_end / dt` rounded up (a relative 1e-9 of slack
-    /// keeps `0.3 / 1e-4` at 3000 despite rounding).
+    /// Number of fixed steps: `t_end / dt` rounded up (a relative 1e-9 of
+    /// slack keeps `0.3 / 1e-4` at 3000 despite rounding); 0 without dt.
     pub fn steps(&self) -> u64 {
-        let ratio = self.t_end / self.dt;
-        (ratio * (1.0 - 1e-9)).ceil().max(1.0) as u64
+        match self.dt {
+            Some(dt) => ((self.t_end / dt) * (1.0 - 1e-9)).ceil().max(1.0) as u64,
+            None => 0,
+        }
     }
 }
 
@@ -139,6 +285,8 @@ pub struct ContactRecord {
     pub approach_speed: f64,
     /// Separation speed at the end of the contact, m/s.
     pub rebound_speed: f64,
+    /// Effective restitution: `rebound_speed / approach_speed`.
+    pub restitution: f64,
     /// Work done by the contact's dissipative forces (law hysteresis and the
     /// contact damper), J.
     pub energy_dissipated: f64,
@@ -157,7 +305,7 @@ pub struct History {
 }
 
 impl History {
-    fn with_capacity(rows: usize) -> Self {
+    pub(crate) fn with_capacity(rows: usize) -> Self {
         Self {
             time: Vec::with_capacity(rows),
             main_displacement: Vec::with_capacity(rows),
@@ -169,7 +317,7 @@ impl History {
     }
 
     #[inline]
-    fn push(&mut self, time: f64, s: &State, force: f64) {
+    pub(crate) fn push(&mut self, time: f64, s: &State, force: f64) {
         self.time.push(time);
         self.main_displacement.push(s.main_displacement);
         self.main_velocity.push(s.main_velocity);
@@ -184,8 +332,12 @@ impl History {
 pub struct Solution {
     pub history: History,
     pub contacts: Vec<ContactRecord>,
-    /// Steps taken.
+    /// Steps taken (accepted).
     pub steps: u64,
+    /// Steps rejected by the error control of the adaptive methods.
+    pub rejected_steps: u64,
+    /// Touches shallower than round-off that were not treated as contacts.
+    pub grazing_contacts: u64,
     /// Right-hand-side (force) evaluations.
     pub rhs_evaluations: u64,
     pub final_time: f64,
@@ -223,7 +375,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
     rhs_per_step: u64,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> Result<Solution> {
-    let dt = settings.dt;
+    let dt = settings.dt.expect("fixed stepping has a step");
     let n_steps = settings.steps();
     let every = settings.every;
     let located = settings.timing == ContactTiming::Located;
@@ -346,6 +498,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                         max_indentation: oc.max_indentation,
                         approach_speed: oc.approach_speed,
                         rebound_speed: -rate,
+                        restitution: -rate / oc.approach_speed,
                         energy_dissipated: oc.dissipated + 0.5 * theta * dt * (p0 + p_sep),
                     });
                     open = None;
@@ -384,6 +537,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
             max_indentation: oc.max_indentation,
             approach_speed: oc.approach_speed,
             rebound_speed: f64::NAN,
+            restitution: f64::NAN,
             energy_dissipated: oc.dissipated,
         });
     }
@@ -392,6 +546,8 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
         history,
         contacts,
         steps: n_steps,
+        rejected_steps: 0,
+        grazing_contacts: 0,
         rhs_evaluations: n_steps * rhs_per_step,
         final_time: t0 + n_steps as f64 * dt,
         final_state: s,
@@ -409,8 +565,9 @@ fn with_method<L: ContactLaw>(
     settings: &Settings,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> Result<Solution> {
+    let events = settings.stepping == Stepping::Events;
     match settings.method {
-        Method::Newmark { beta, gamma } => integrate(
+        Method::Newmark { beta, gamma } if !events => integrate(
             model,
             &mut Newmark::new(beta, gamma),
             initial,
@@ -418,7 +575,34 @@ fn with_method<L: ContactLaw>(
             1,
             interrupt,
         ),
-        Method::Rk4 => integrate(model, &mut Rk4, initial, settings, 4, interrupt),
+        Method::Rk4 if !events => integrate(model, &mut Rk4, initial, settings, 4, interrupt),
+        Method::Newmark { beta, gamma } => {
+            let mut stepper = NewmarkFamily::newmark(beta, gamma, true);
+            integrate_events(model, &mut stepper, initial, settings, interrupt)
+        }
+        Method::NewmarkImplicit { beta, gamma } => {
+            let mut stepper = NewmarkFamily::newmark(beta, gamma, false);
+            integrate_events(model, &mut stepper, initial, settings, interrupt)
+        }
+        Method::GeneralizedAlpha { spectral_radius } => {
+            let mut stepper = NewmarkFamily::generalized_alpha(spectral_radius);
+            integrate_events(model, &mut stepper, initial, settings, interrupt)
+        }
+        Method::Rk4 => integrate_events(
+            model,
+            &mut Rk4Stepper::default(),
+            initial,
+            settings,
+            interrupt,
+        ),
+        Method::Dopri5(tolerances) => {
+            let mut stepper = Dopri5Stepper::new(tolerances);
+            integrate_events(model, &mut stepper, initial, settings, interrupt)
+        }
+        Method::Dop853(tolerances) => {
+            let mut stepper = Dop853Stepper::new(tolerances);
+            integrate_events(model, &mut stepper, initial, settings, interrupt)
+        }
     }
 }
 

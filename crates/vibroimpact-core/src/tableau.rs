@@ -71,8 +71,7 @@ pub const DOPRI5_E: [f64; 7] = [
 /// Differential Equations I", 2nd ed., and Hairer's dop853): twelve stages,
 /// eighth order, error estimated from embedded fifth- and third-order results.
 /// These are the published coefficients (decimal expansions of the rational
-/// values); the order test in `events.rs` checks them.
-
+/// values); the order tests check them.
 pub const DOP853_C: [f64; 12] = [
     0.0,
     0.05260015195876773,

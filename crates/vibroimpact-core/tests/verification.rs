@@ -34,7 +34,7 @@ fn run(
     t_end: f64,
     timing: ContactTiming,
 ) -> Solution {
-    let settings = Settings::new(method, dt, t_end, 1, timing).unwrap();
+    let settings = Settings::new(method, Some(dt), t_end, 1, timing, None, u64::MAX).unwrap();
     simulate(&sys.0, &sys.1, &sys.2, &settings, &mut || false).unwrap()
 }
 

@@ -4,7 +4,9 @@
 
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyArithmeticError, PyKeyboardInterrupt, PyValueError};
+use pyo3::exceptions::{
+    PyArithmeticError, PyKeyboardInterrupt, PyRuntimeError, PyUserWarning, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
@@ -24,11 +26,32 @@ create_exception!(
     "The integration blew up (non-finite state or energy created from nothing)."
 );
 
+create_exception!(
+    vibroimpact._core,
+    SimulationError,
+    PyRuntimeError,
+    "The run could not go on: chattering, Newton failure, step size at round-off, or too many steps."
+);
+create_exception!(
+    vibroimpact._core,
+    RestitutionWarning,
+    PyUserWarning,
+    "The contact law will not rebound at the restitution it was given."
+);
+
 fn to_py(err: core::Error) -> PyErr {
+    use core::Error as E;
+    let message = err.to_string();
     match err {
-        core::Error::NumericalBlowUp { .. } => NumericalBlowUpError::new_err(err.to_string()),
-        core::Error::Interrupted { .. } => PyKeyboardInterrupt::new_err(err.to_string()),
-        _ => InvalidInputError::new_err(err.to_string()),
+        E::NumericalBlowUp { .. } => NumericalBlowUpError::new_err(message),
+        E::Interrupted { .. } => PyKeyboardInterrupt::new_err(message),
+        E::NewtonFailed { .. }
+        | E::Chattering { .. }
+        | E::StepSizeTooSmall { .. }
+        | E::TooManySteps { .. } => SimulationError::new_err(message),
+        E::InvalidParameter { .. } | E::UnknownChoice { .. } | E::Inconsistent(_) => {
+            InvalidInputError::new_err(message)
+        }
     }
 }
 
@@ -53,6 +76,10 @@ fn whole(field: &str, value: &Bound<'_, PyAny>) -> PyResult<u64> {
 
 fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
     whole("every", value)
+}
+
+fn max_steps_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
+    whole("max_steps", value)
 }
 
 fn mode_arg(value: &Bound<'_, PyAny>) -> PyResult<u32> {
@@ -135,11 +162,17 @@ impl ImpactDamper {
     }
 }
 
+/// "hyster-hertz" warns below this restitution: its rebound is then far from e.
+const WARN_BELOW: f64 = 0.7;
+
 /// A compliant contact law and the contact damper.
 ///
 /// ``law`` is ``"hertz"`` (F = k delta^1.5), ``"hyster-hertz"``
 /// (Lankarani-Nikravesh, F = k delta^1.5 (1 + 3/4 (1 - e^2) delta'/delta'_minus),
-/// needs ``restitution`` e in (0, 1]) or ``"linear"`` (F = k delta). ``stiffness``
+/// needs ``restitution`` e in (0, 1]; it rebounds faster than e and warns with
+/// ``RestitutionWarning`` below 0.7), ``"hertz-damped"`` (the same form with
+/// the damping solved so that two bodies alone rebound at exactly e) or
+/// ``"linear"`` (F = k delta). ``stiffness``
 /// is in N/m^1.5 for the Hertz laws and N/m for ``"linear"``. ``damping`` (c1,
 /// N s/m) is a linear damper on the relative velocity acting only in contact.
 /// The law's force never pulls the bodies together: it is clamped at zero.
@@ -151,11 +184,34 @@ struct Contact(core::Contact);
 impl Contact {
     #[new]
     #[pyo3(signature = (law, stiffness, damping = 0.0, restitution = None))]
-    fn new(law: &str, stiffness: f64, damping: f64, restitution: Option<f64>) -> PyResult<Self> {
+    fn new(
+        py: Python<'_>,
+        law: &str,
+        stiffness: f64,
+        damping: f64,
+        restitution: Option<f64>,
+    ) -> PyResult<Self> {
         let kind = core::LawKind::parse(law).map_err(to_py)?;
-        core::Contact::new(kind, stiffness, restitution, damping)
-            .map(Self)
-            .map_err(to_py)
+        let contact = core::Contact::new(kind, stiffness, restitution, damping).map_err(to_py)?;
+        if kind == core::LawKind::HysterHertz && contact.restitution < WARN_BELOW {
+            let message = std::ffi::CString::new(format!(
+                "law \"hyster-hertz\" with restitution {} rebounds at {:.4} of the approach speed, \
+                 not {}; use law \"hertz-damped\" for a rebound of exactly e",
+                contact.restitution,
+                contact.effective_restitution(),
+                contact.restitution
+            ))
+            .expect("no NUL in the message");
+            PyErr::warn(py, &py.get_type::<RestitutionWarning>(), &message, 1)?;
+        }
+        Ok(Self(contact))
+    }
+    /// The rebound/approach speed ratio two bodies alone get from the law
+    /// (without the contact damper): e for "hertz-damped", more than e for
+    /// "hyster-hertz" (never below 0.663), 1 for "hertz" and "linear".
+    #[getter]
+    fn effective_restitution(&self) -> f64 {
+        self.0.effective_restitution()
     }
     /// The law's name.
     #[getter]
@@ -292,23 +348,27 @@ struct ContactTable {
     /// Relative normal speed at separation, m/s.
     #[pyo3(get)]
     rebound_speed: Py<PyArray1<f64>>,
+    /// Effective restitution: rebound_speed / approach_speed.
+    #[pyo3(get)]
+    restitution: Py<PyArray1<f64>>,
     /// Energy dissipated by the contact (law hysteresis and contact damper), J.
     #[pyo3(get)]
     energy_dissipated: Py<PyArray1<f64>>,
     records: Vec<core::ContactRecord>,
 }
 
-const CONTACT_COLUMNS: [&str; 7] = [
+const CONTACT_COLUMNS: [&str; 8] = [
     "onset",
     "separation",
     "duration",
     "max_indentation",
     "approach_speed",
     "rebound_speed",
+    "restitution",
     "energy_dissipated",
 ];
 
-fn record_values(r: &core::ContactRecord) -> [f64; 7] {
+fn record_values(r: &core::ContactRecord) -> [f64; 8] {
     [
         r.onset,
         r.separation,
@@ -316,6 +376,7 @@ fn record_values(r: &core::ContactRecord) -> [f64; 7] {
         r.max_indentation,
         r.approach_speed,
         r.rebound_speed,
+        r.restitution,
         r.energy_dissipated,
     ]
 }
@@ -324,7 +385,7 @@ fn record_values(r: &core::ContactRecord) -> [f64; 7] {
 impl ContactTable {
     /// Column names, in order.
     #[classattr]
-    fn columns() -> [&'static str; 7] {
+    fn columns() -> [&'static str; 8] {
         CONTACT_COLUMNS
     }
     fn __len__(&self) -> usize {
@@ -384,6 +445,15 @@ struct Solution {
     /// Method name.
     #[pyo3(get)]
     method: &'static str,
+    /// "fixed" or "events".
+    #[pyo3(get)]
+    stepping: &'static str,
+    /// Steps rejected by the error control (adaptive methods).
+    #[pyo3(get)]
+    rejected_steps: u64,
+    /// Touches shallower than round-off, not counted as contacts.
+    #[pyo3(get)]
+    grazing_contacts: u64,
     /// Largest relative growth of the mechanical energy of the unforced system,
     /// ``max(E)/E(0) - 1`` (NaN if it starts at rest). Physically <= 0: a
     /// positive value is numerical error (above 0.5 the run is refused).
@@ -408,62 +478,124 @@ fn array(py: Python<'_>, v: Vec<f64>) -> Py<PyArray1<f64>> {
     v.into_pyarray(py).unbind()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn settings(
-    dt: f64,
+    dt: Option<f64>,
     t_end: f64,
     method: &str,
     every: u64,
     contact_timing: &str,
+    stepping: Option<&str>,
     beta: f64,
     gamma: f64,
+    spectral_radius: f64,
+    rtol: f64,
+    atol: f64,
+    max_steps: u64,
 ) -> PyResult<core::Settings> {
-    let parsed = core::Method::parse(method, beta, gamma).map_err(to_py)?;
+    let options = core::MethodOptions {
+        beta,
+        gamma,
+        spectral_radius,
+        rtol,
+        atol,
+    };
+    let parsed = core::Method::parse(method, &options).map_err(to_py)?;
     let timing = core::ContactTiming::parse(contact_timing).map_err(to_py)?;
-    core::Settings::new(parsed, dt, t_end, every, timing).map_err(to_py)
+    let stepping = stepping
+        .map(core::Stepping::parse)
+        .transpose()
+        .map_err(to_py)?;
+    core::Settings::new(parsed, dt, t_end, every, timing, stepping, max_steps).map_err(to_py)
 }
 
 /// Check solver settings as ``simulate`` would, without running; raises
 /// ``InvalidInputError`` naming the offending field.
 #[pyfunction]
-#[pyo3(signature = (*, dt, t_end, method = "newmark", every = 1, contact_timing = "located", beta = 0.25, gamma = 0.5))]
+#[pyo3(signature = (*, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000))]
+#[allow(clippy::too_many_arguments)]
 fn check_solver(
-    dt: f64,
     t_end: f64,
+    dt: Option<f64>,
     method: &str,
     #[pyo3(from_py_with = every_arg)] every: u64,
     contact_timing: &str,
+    stepping: Option<&str>,
     beta: f64,
     gamma: f64,
+    spectral_radius: f64,
+    rtol: f64,
+    atol: f64,
+    #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
 ) -> PyResult<()> {
-    settings(dt, t_end, method, every, contact_timing, beta, gamma).map(|_| ())
+    settings(
+        dt,
+        t_end,
+        method,
+        every,
+        contact_timing,
+        stepping,
+        beta,
+        gamma,
+        spectral_radius,
+        rtol,
+        atol,
+        max_steps,
+    )
+    .map(|_| ())
 }
 
-/// Integrate the impact damper from ``initial`` to ``t_end`` (s) with step
-/// ``dt`` (s).
+/// Integrate the impact damper from ``initial`` to ``t_end`` (s).
 ///
-/// ``method`` is ``"newmark"`` (the founding paper's Newmark-beta with the
-/// contact force lagged one step; ``beta``, ``gamma`` default 1/4, 1/2) or
-/// ``"rk4"`` (classical Runge-Kutta). ``every`` keeps every N-th step in the
-/// history. ``contact_timing`` is ``"located"`` (onset and separation found
-/// inside the step) or ``"step-count"`` (the paper's: whole steps).
+/// ``method``: ``"newmark"`` (the founding paper's Newmark-beta, contact force
+/// lagged one step), ``"newmark-implicit"`` (Newton on the contact force;
+/// ``beta``, ``gamma`` default 1/4, 1/2), ``"generalized-alpha"``
+/// (Chung-Hulbert, ``spectral_radius`` in [0, 1]), ``"rk4"`` (classical
+/// Runge-Kutta): fixed step ``dt`` (s); ``"dopri5"``, ``"dop853"``: adaptive
+/// with ``rtol``, ``atol`` (``dt`` is then the first step, optional).
+///
+/// ``stepping``: ``"events"`` locates every contact onset and separation to
+/// round-off, cuts the step there and restarts; ``"fixed"`` is the founding
+/// paper's stepping, for ``"newmark"`` and ``"rk4"`` only (their default),
+/// whose contact instants are ``contact_timing`` ``"located"`` (interpolated
+/// inside the step) or ``"step-count"`` (whole steps). ``every`` keeps every
+/// N-th step in the history; ``max_steps`` bounds the work.
 /// The GIL is released while integrating; Ctrl-C interrupts.
 #[pyfunction]
-#[pyo3(signature = (system, contact, initial, *, dt, t_end, method = "newmark", every = 1, contact_timing = "located", beta = 0.25, gamma = 0.5))]
+#[pyo3(signature = (system, contact, initial, *, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000))]
 #[allow(clippy::too_many_arguments)]
 fn simulate(
     py: Python<'_>,
     system: &ImpactDamper,
     contact: &Contact,
     initial: &InitialState,
-    dt: f64,
     t_end: f64,
+    dt: Option<f64>,
     method: &str,
     #[pyo3(from_py_with = every_arg)] every: u64,
     contact_timing: &str,
+    stepping: Option<&str>,
     beta: f64,
     gamma: f64,
+    spectral_radius: f64,
+    rtol: f64,
+    atol: f64,
+    #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
 ) -> PyResult<Solution> {
-    let settings = settings(dt, t_end, method, every, contact_timing, beta, gamma)?;
+    let settings = settings(
+        dt,
+        t_end,
+        method,
+        every,
+        contact_timing,
+        stepping,
+        beta,
+        gamma,
+        spectral_radius,
+        rtol,
+        atol,
+        max_steps,
+    )?;
     let parsed = settings.method;
     let (sys, con, init) = (system.0, contact.0, initial.0);
     let mut signal: Option<PyErr> = None;
@@ -499,6 +631,7 @@ fn simulate(
         max_indentation: array(py, column(|r| r.max_indentation)),
         approach_speed: array(py, column(|r| r.approach_speed)),
         rebound_speed: array(py, column(|r| r.rebound_speed)),
+        restitution: array(py, column(|r| r.restitution)),
         energy_dissipated: array(py, column(|r| r.energy_dissipated)),
         records,
     };
@@ -515,10 +648,13 @@ fn simulate(
         rhs_evaluations: sol.rhs_evaluations,
         final_time: sol.final_time,
         energy_growth: sol.energy_growth,
-        method: match parsed {
-            core::Method::Newmark { .. } => "newmark",
-            core::Method::Rk4 => "rk4",
+        method: parsed.name(),
+        stepping: match settings.stepping {
+            core::Stepping::Fixed => "fixed",
+            core::Stepping::Events => "events",
         },
+        rejected_steps: sol.rejected_steps,
+        grazing_contacts: sol.grazing_contacts,
     })
 }
 
@@ -697,6 +833,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "NumericalBlowUpError",
         py.get_type::<NumericalBlowUpError>(),
     )?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    m.add("RestitutionWarning", py.get_type::<RestitutionWarning>())?;
     m.add_class::<ImpactDamper>()?;
     m.add_class::<Contact>()?;
     m.add_class::<InitialState>()?;

@@ -1,0 +1,570 @@
+//! Steppers of the event-driven kernel: each advances the state by one step
+//! within one contact mode, where the right-hand side is smooth.
+//!
+//! Explicit Runge-Kutta (classical RK4, Dormand-Prince 5(4), DOP853) and the
+//! Newmark family solved by Newton's method (implicit Newmark,
+//! generalised-alpha, and the founding paper's lagged Newmark).
+
+use crate::contact::ContactLaw;
+use crate::error::{Error, Result};
+use crate::model::{Excitation, Mode, Model};
+use crate::system::State;
+use crate::tableau::*;
+
+/// The integrated variables: `w, w', y, y'` and the energy the contact has
+/// dissipated so far (J), integrated by the method itself.
+pub type Vector = [f64; 5];
+
+#[inline(always)]
+pub fn to_vector(s: &State, dissipated: f64) -> Vector {
+    [
+        s.main_displacement,
+        s.main_velocity,
+        s.impact_displacement,
+        s.impact_velocity,
+        dissipated,
+    ]
+}
+
+#[inline(always)]
+pub fn to_state(v: &Vector) -> State {
+    State {
+        main_displacement: v[0],
+        main_velocity: v[1],
+        impact_displacement: v[2],
+        impact_velocity: v[3],
+    }
+}
+
+/// One attempted step.
+#[derive(Debug, Clone, Copy)]
+pub struct Attempt {
+    /// The end point, with the dissipated energy in the last slot.
+    pub end: Vector,
+    /// Scaled error estimate (accept when <= 1); 0 for fixed-step methods.
+    pub error: f64,
+}
+
+/// A method the event-driven kernel can drive.
+pub trait Stepper {
+    /// Whether the step size is controlled by an error estimate.
+    const ADAPTIVE: bool;
+    /// Order of the error estimate plus one, for the step-size controller.
+    const CONTROL_EXPONENT: f64;
+    /// Start, or restart after a mode switch: data carried from step to step
+    /// (accelerations, first-same-as-last stages) is rebuilt, because the
+    /// right-hand side jumps at a mode switch.
+    fn reset<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        mode: Mode,
+    );
+    /// Attempt a step `h` from `(time, y)`. May be called several times from
+    /// the same point (rejections, event location) before `accept`.
+    fn attempt<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<Attempt>;
+    /// The last attempt is the new current point.
+    fn accept(&mut self);
+    /// Right-hand-side evaluations so far.
+    fn evaluations(&self) -> u64;
+    /// Relative tolerance of an adaptive method (for its first step).
+    fn tolerance(&self) -> f64 {
+        1e-6
+    }
+}
+
+#[inline(always)]
+fn derivative<L: ContactLaw, X: Excitation>(
+    model: &Model<L, X>,
+    time: f64,
+    y: &Vector,
+    mode: Mode,
+) -> Vector {
+    let (aw, ay, power) = model.rates_in(time, &to_state(y), mode);
+    [y[1], aw, y[3], ay, power]
+}
+
+/// Runs the stages of an explicit tableau; `k[0]` must hold `f(time, y)`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn stages<const S: usize, L: ContactLaw, X: Excitation>(
+    model: &Model<L, X>,
+    time: f64,
+    y: &Vector,
+    h: f64,
+    mode: Mode,
+    c: &[f64; S],
+    a: &[[f64; S]; S],
+    k: &mut [Vector; S],
+) {
+    for i in 1..S {
+        // Sum the stage increments first, then scale once by h: fewer
+        // operations and a straight line the compiler can vectorise.
+        let mut sum = [0.0; 5];
+        for (aij, kj) in a[i].iter().zip(k.iter()).take(i) {
+            for n in 0..5 {
+                sum[n] += aij * kj[n];
+            }
+        }
+        let mut yi = *y;
+        for n in 0..5 {
+            yi[n] += h * sum[n];
+        }
+        k[i] = derivative(model, time + c[i] * h, &yi, mode);
+    }
+}
+
+#[inline(always)]
+fn combine<const S: usize>(y: &Vector, h: f64, b: &[f64; S], k: &[Vector; S]) -> Vector {
+    let mut sum = [0.0; 5];
+    for (bi, ki) in b.iter().zip(k.iter()) {
+        for n in 0..5 {
+            sum[n] += bi * ki[n];
+        }
+    }
+    let mut out = *y;
+    for n in 0..5 {
+        out[n] += h * sum[n];
+    }
+    out
+}
+
+/// Tolerances of the adaptive methods: `rtol` relative, `atol` absolute (in
+/// the units of each variable: m and m/s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    pub rtol: f64,
+    pub atol: f64,
+}
+
+impl Tolerances {
+    /// The weight of variable `n` in the error norm (the dissipated energy
+    /// is an output, not controlled).
+    #[inline(always)]
+    fn scale(&self, y: &Vector, end: &Vector, n: usize) -> f64 {
+        self.atol + self.rtol * y[n].abs().max(end[n].abs())
+    }
+}
+
+/// Classical fourth-order Runge-Kutta, fixed step.
+#[derive(Debug, Clone, Default)]
+pub struct Rk4Stepper {
+    evaluations: u64,
+}
+
+impl Stepper for Rk4Stepper {
+    const ADAPTIVE: bool = false;
+    const CONTROL_EXPONENT: f64 = 5.0;
+    fn reset<L: ContactLaw, X: Excitation>(
+        &mut self,
+        _: &Model<L, X>,
+        _: f64,
+        _: &Vector,
+        _: Mode,
+    ) {
+    }
+
+    #[inline(always)]
+    fn attempt<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<Attempt> {
+        let mut k = [[0.0; 5]; 4];
+        k[0] = derivative(model, time, y, mode);
+        stages(model, time, y, h, mode, &RK4_C, &RK4_A, &mut k);
+        self.evaluations += 4;
+        Ok(Attempt {
+            end: combine(y, h, &RK4_B, &k),
+            error: 0.0,
+        })
+    }
+
+    fn accept(&mut self) {}
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+}
+
+/// Dormand-Prince 5(4) with error control; first same as last.
+#[derive(Debug, Clone)]
+pub struct Dopri5Stepper {
+    tolerances: Tolerances,
+    /// `f` at the current point, valid after `reset` or `accept`.
+    start: Vector,
+    /// `f` at the end of the last attempt.
+    pending: Vector,
+    evaluations: u64,
+}
+
+impl Dopri5Stepper {
+    pub fn new(tolerances: Tolerances) -> Self {
+        Self {
+            tolerances,
+            start: [0.0; 5],
+            pending: [0.0; 5],
+            evaluations: 0,
+        }
+    }
+}
+
+impl Stepper for Dopri5Stepper {
+    const ADAPTIVE: bool = true;
+    const CONTROL_EXPONENT: f64 = 5.0;
+
+    fn reset<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        mode: Mode,
+    ) {
+        self.start = derivative(model, time, y, mode);
+        self.evaluations += 1;
+    }
+
+    fn attempt<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<Attempt> {
+        let mut k = [[0.0; 5]; 7];
+        k[0] = self.start;
+        stages(model, time, y, h, mode, &DOPRI5_C, &DOPRI5_A, &mut k);
+        self.evaluations += 6;
+        let end = combine(y, h, &DOPRI5_B, &k);
+        let mut sum = 0.0;
+        for n in 0..4 {
+            let e: f64 = DOPRI5_E
+                .iter()
+                .zip(k.iter())
+                .map(|(ei, ki)| ei * ki[n])
+                .sum();
+            let ratio = h * e / self.tolerances.scale(y, &end, n);
+            sum += ratio * ratio;
+        }
+        self.pending = k[6];
+        Ok(Attempt {
+            end,
+            error: (sum / 4.0).sqrt(),
+        })
+    }
+
+    fn accept(&mut self) {
+        self.start = self.pending;
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    fn tolerance(&self) -> f64 {
+        self.tolerances.rtol
+    }
+}
+
+/// DOP853 with its combined fifth/third-order error estimate.
+#[derive(Debug, Clone)]
+pub struct Dop853Stepper {
+    tolerances: Tolerances,
+    start: Vector,
+    pending: Vector,
+    evaluations: u64,
+}
+
+impl Dop853Stepper {
+    pub fn new(tolerances: Tolerances) -> Self {
+        Self {
+            tolerances,
+            start: [0.0; 5],
+            pending: [0.0; 5],
+            evaluations: 0,
+        }
+    }
+}
+
+impl Stepper for Dop853Stepper {
+    const ADAPTIVE: bool = true;
+    const CONTROL_EXPONENT: f64 = 8.0;
+
+    fn reset<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        mode: Mode,
+    ) {
+        self.start = derivative(model, time, y, mode);
+        self.evaluations += 1;
+    }
+
+    fn attempt<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<Attempt> {
+        let mut k = [[0.0; 5]; 12];
+        k[0] = self.start;
+        stages(model, time, y, h, mode, &DOP853_C, &DOP853_A, &mut k);
+        let end = combine(y, h, &DOP853_B, &k);
+        let last = derivative(model, time + h, &end, mode);
+        self.evaluations += 12;
+        let (mut err5, mut err3) = (0.0, 0.0);
+        for n in 0..4 {
+            let scale = self.tolerances.scale(y, &end, n);
+            let mut e5 = DOP853_E5[12] * last[n];
+            let mut e3 = DOP853_E3[12] * last[n];
+            for (i, ki) in k.iter().enumerate() {
+                e5 += DOP853_E5[i] * ki[n];
+                e3 += DOP853_E3[i] * ki[n];
+            }
+            err5 += (e5 / scale) * (e5 / scale);
+            err3 += (e3 / scale) * (e3 / scale);
+        }
+        let denominator = err5 + 0.01 * err3;
+        let error = if denominator > 0.0 {
+            h.abs() * err5 / (denominator * 4.0).sqrt()
+        } else {
+            0.0
+        };
+        self.pending = last;
+        Ok(Attempt { end, error })
+    }
+
+    fn accept(&mut self) {
+        self.start = self.pending;
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    fn tolerance(&self) -> f64 {
+        self.tolerances.rtol
+    }
+}
+
+/// The Newmark family on the two equations of motion, written for the new
+/// accelerations and solved by Newton's method:
+///
+/// `M a_(n+1-am) + C v_(n+1-af) + K x_(n+1-af) - f(t_(n+1-af), x, v) = 0`
+///
+/// with Newmark's `x_(n+1)`, `v_(n+1)` in `beta`, `gamma`. `am = af = 0` is
+/// Newmark-beta (average acceleration for 1/4, 1/2: second order, no
+/// numerical damping); Chung-Hulbert's generalised-alpha sets all four from
+/// the spectral radius at infinite frequency. With `lagged` the contact law's
+/// force is taken from the start of the step (the founding paper's method),
+/// leaving only the contact damper implicit.
+#[derive(Debug, Clone)]
+pub struct NewmarkFamily {
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub beta: f64,
+    pub gamma: f64,
+    pub lagged: bool,
+    /// Accelerations at the current point and at the end of the last attempt.
+    accel: (f64, f64),
+    pending: (f64, f64),
+    evaluations: u64,
+}
+
+/// Newton iterations allowed per step.
+const NEWTON_ITERATIONS: usize = 40;
+
+impl NewmarkFamily {
+    /// Newmark-beta solved implicitly (Newton on the contact force).
+    pub fn newmark(beta: f64, gamma: f64, lagged: bool) -> Self {
+        Self {
+            alpha_m: 0.0,
+            alpha_f: 0.0,
+            beta,
+            gamma,
+            lagged,
+            accel: (0.0, 0.0),
+            pending: (0.0, 0.0),
+            evaluations: 0,
+        }
+    }
+
+    /// Chung-Hulbert generalised-alpha with spectral radius `rho` in [0, 1]
+    /// at infinite frequency (1: no numerical damping).
+    pub fn generalized_alpha(rho: f64) -> Self {
+        let alpha_m = (2.0 * rho - 1.0) / (rho + 1.0);
+        let alpha_f = rho / (rho + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        let beta = 0.25 * (1.0 - alpha_m + alpha_f).powi(2);
+        Self {
+            alpha_m,
+            alpha_f,
+            beta,
+            gamma,
+            lagged: false,
+            accel: (0.0, 0.0),
+            pending: (0.0, 0.0),
+            evaluations: 0,
+        }
+    }
+}
+
+impl Stepper for NewmarkFamily {
+    const ADAPTIVE: bool = false;
+    const CONTROL_EXPONENT: f64 = 3.0;
+
+    fn reset<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        mode: Mode,
+    ) {
+        // After a jump the physical accelerations, not the algorithmic ones.
+        self.accel = model.accelerations_in(time, &to_state(y), mode);
+        self.evaluations += 1;
+    }
+
+    fn attempt<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<Attempt> {
+        let (am, af, beta, gamma) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
+        let (m_main, m_imp) = (model.main_mass, model.impact_mass);
+        let (a0w, a0y) = self.accel;
+        let s0 = to_state(y);
+        // Predictors: the parts of x_(n+1), v_(n+1) that do not depend on a_(n+1).
+        let xw = y[0] + h * y[1] + h * h * (0.5 - beta) * a0w;
+        let xy = y[2] + h * y[3] + h * h * (0.5 - beta) * a0y;
+        let vw = y[1] + h * (1.0 - gamma) * a0w;
+        let vy = y[3] + h * (1.0 - gamma) * a0y;
+        let (bx, gv) = (beta * h * h, gamma * h);
+        let force_ext =
+            (1.0 - af) * model.external_force(time + h) + af * model.external_force(time);
+        // The lagged law force: from the start of the step, not differentiated.
+        let lagged_force = match mode {
+            Mode::Contact {
+                side,
+                approach_rate,
+            } if self.lagged => model.contact_at(&s0, side, approach_rate).law_force,
+            _ => 0.0,
+        };
+        let (mut aw, mut ay) = (a0w, a0y);
+        let mut converged = false;
+        for _ in 0..NEWTON_ITERATIONS {
+            self.evaluations += 1;
+            let x1w = xw + bx * aw;
+            let x1y = xy + bx * ay;
+            let v1w = vw + gv * aw;
+            let v1y = vy + gv * ay;
+            let xfw = (1.0 - af) * x1w + af * y[0];
+            let xfy = (1.0 - af) * x1y + af * y[2];
+            let vfw = (1.0 - af) * v1w + af * y[1];
+            let vfy = (1.0 - af) * v1y + af * y[3];
+            // Contact force on the main mass (+side F) and its slopes in the
+            // indentation (F_d) and its rate (F_r).
+            let (push, f_d, f_r) = match mode {
+                Mode::Free => (0.0, 0.0, 0.0),
+                Mode::Contact {
+                    side,
+                    approach_rate,
+                } => {
+                    let indentation = side * (xfy - xfw) - model.clearance;
+                    let rate = side * (vfy - vfw);
+                    let c1 = model.contact_damping;
+                    if self.lagged {
+                        (side * (lagged_force + c1 * rate), 0.0, c1)
+                    } else if indentation > 0.0 {
+                        let (f, fd, fr) =
+                            model
+                                .law
+                                .force_derivatives(indentation, rate, approach_rate);
+                        (side * (f + c1 * rate), fd, fr + c1)
+                    } else {
+                        (side * c1 * rate, 0.0, c1)
+                    }
+                }
+            };
+            let amw = (1.0 - am) * aw + am * a0w;
+            let amy = (1.0 - am) * ay + am * a0y;
+            let rw = m_main * amw + model.damping * vfw + model.stiffness * xfw - force_ext - push;
+            let ry = m_imp * amy + push;
+            // Jacobian d(r)/d(a_(n+1)): symmetric 2x2.
+            let kx = (1.0 - af) * bx;
+            let cv = (1.0 - af) * gv;
+            let coupling = kx * f_d + cv * f_r;
+            let j11 = (1.0 - am) * m_main + kx * model.stiffness + cv * model.damping + coupling;
+            let j22 = (1.0 - am) * m_imp + coupling;
+            let j12 = -coupling;
+            let det = j11 * j22 - j12 * j12;
+            let daw = -(j22 * rw - j12 * ry) / det;
+            let day = -(-j12 * rw + j11 * ry) / det;
+            aw += daw;
+            ay += day;
+            // Round-off in the residual is relative to the largest force, so
+            // the tolerance is too (accelerations may cancel to near zero).
+            let forces = (model.stiffness * xfw)
+                .abs()
+                .max((model.damping * vfw).abs())
+                .max(push.abs())
+                .max(force_ext.abs());
+            let scale = aw
+                .abs()
+                .max(ay.abs())
+                .max(a0w.abs())
+                .max(a0y.abs())
+                .max(forces / m_main.min(m_imp));
+            if !(aw.is_finite() && ay.is_finite()) {
+                break;
+            }
+            if daw.abs().max(day.abs()) <= 1e-13 * scale || scale == 0.0 {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
+            return Err(Error::NewtonFailed { time });
+        }
+        let end_state = State {
+            main_displacement: xw + bx * aw,
+            main_velocity: vw + gv * aw,
+            impact_displacement: xy + bx * ay,
+            impact_velocity: vy + gv * ay,
+        };
+        // Dissipated energy by the trapezoidal rule, second order like the method.
+        let power0 = model.dissipation_in(&s0, mode);
+        let power1 = model.dissipation_in(&end_state, mode);
+        self.pending = (aw, ay);
+        Ok(Attempt {
+            end: to_vector(&end_state, y[4] + 0.5 * h * (power0 + power1)),
+            error: 0.0,
+        })
+    }
+
+    fn accept(&mut self) {
+        self.accel = self.pending;
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+}
