@@ -93,8 +93,11 @@ def run_summary(scenario: Scenario, sol: Solution, cpu_time: float) -> dict[str,
         "dt": scenario.dt,
         "t_end": scenario.t_end,
         "final_time": sol.final_time,
+        "stepping": sol.stepping,
         "steps": sol.steps,
+        "rejected_steps": sol.rejected_steps,
         "rhs_evaluations": sol.rhs_evaluations,
+        "grazing_contacts": sol.grazing_contacts,
         "history_rows": len(sol.t),
         "cpu_time": cpu_time,
         "energy_growth": _finite_or_none(sol.energy_growth),
@@ -130,8 +133,10 @@ def _simulate(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
         return 0
     name = str(args.scenario) if args.scenario else "the paper's Table 1 collision"
+    step = f"dt = {scenario.dt:g} s" if scenario.dt is not None else f"rtol = {scenario.rtol:g}"
     print(
-        f"{name}: {scenario.method}, dt = {scenario.dt:g} s, {sol.steps} steps "
+        f"{name}: {scenario.method} ({sol.stepping} stepping), {step}, {sol.steps} steps "
+        f"({sol.rejected_steps} rejected, {sol.rhs_evaluations} force evaluations) "
         f"to t = {sol.final_time:g} s in {cpu_time * 1e3:.3f} ms"
     )
     if sol.energy_growth > ENERGY_NOTE:
@@ -148,6 +153,7 @@ def _simulate(args: argparse.Namespace) -> int:
             "max indent. (m)",
             "approach (m/s)",
             "rebound (m/s)",
+            "restitution",
             "dissipated (J)",
         )
         print("  ".join(f"{h:>15}" for h in header))

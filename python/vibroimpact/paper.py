@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from vibroimpact import beyond
 from vibroimpact._core import (
     Contact,
     ImpactDamper,
@@ -120,8 +121,15 @@ def collision(method: str, dt: float, timing: str, restitution: float | None = N
 
 
 def exact_duration(restitution: float | None = None) -> float:
-    """The model's own contact duration, by RK4 with located instants at dt = 1e-5 s."""
-    return first_duration(collision("rk4", 1e-5, "located", restitution).run())
+    """The model's own contact duration (DOP853 at rtol 1e-13, events located)."""
+    return beyond.exact_duration(restitution)
+
+
+def exact_duration_rk4() -> float:
+    """The same by RK4 at dt = 1e-5 s with events: a second, independent method."""
+    system, contact, start = beyond.table1()
+    sol = simulate(system, contact, start, method="rk4", stepping="events", dt=1e-5, t_end=RUN_TIME)
+    return first_duration(sol)
 
 
 def pct(value: float, reference: float) -> float:
@@ -189,9 +197,9 @@ def table2(goldsmith: float, exact: float) -> list[Row]:
     return rows
 
 
-def table3(rows: list[Row], basis: str) -> list[tuple[str, float, list[float]]]:
+def table3(rows: list[Row], basis: str) -> list[tuple[str, float | None, list[float]]]:
     """Eq. 15 over the numerical rows, with maxima taken over those rows."""
-    numerical = [r for r in rows if r.dt is not None and r.cpu_time is not None]
+    numerical = [r for r in rows if r.cpu_time is not None]
 
     def err(r: Row) -> float:
         return r.error_vs_exact_percent if basis == "exact" else r.error_percent
@@ -200,7 +208,7 @@ def table3(rows: list[Row], basis: str) -> list[tuple[str, float, list[float]]]:
     max_cpu = max(r.cpu_time for r in numerical if r.cpu_time is not None)
     out = []
     for r in numerical:
-        assert r.dt is not None and r.cpu_time is not None
+        assert r.cpu_time is not None
         out.append(
             (r.method, r.dt, [adequacy(err(r), max_err, r.cpu_time, max_cpu, w) for w in WEIGHTS])
         )
@@ -244,16 +252,19 @@ def write_table2(path: Path, rows: list[Row]) -> None:
             )
 
 
-def write_table3(path: Path, blocks: dict[str, list[tuple[str, float, list[float]]]]) -> None:
+Block = list[tuple[str, float | None, list[float]]]
+
+
+def write_table3(path: Path, blocks: dict[str, Block]) -> None:
     with path.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(["method", "dt", "error_basis"] + [f"wf1_{x:.1f}" for x in WEIGHTS])
         for basis, rows in blocks.items():
             for method, dt, values in rows:
-                w.writerow([method, f"{dt:g}", basis] + [f"{v:.2f}" for v in values])
+                w.writerow([method, fmt(dt, "g"), basis] + [f"{v:.2f}" for v in values])
 
 
-def print_tables(rows: list[Row], blocks: dict[str, list[tuple[str, float, list[float]]]]) -> None:
+def print_tables(rows: list[Row], blocks: dict[str, Block]) -> None:
     print("Table 2: contact duration of the Table 1 collision (v = 0.1 m/s)")
     print(
         f"{'method':<28}{'dt (s)':>9}{'Tc (s)':>12}{'CPU (s)':>12}{'err %':>10}{'vs exact %':>12}"
@@ -269,7 +280,7 @@ def print_tables(rows: list[Row], blocks: dict[str, list[tuple[str, float, list[
             + ", ".join(f"{x:.1f}" for x in WEIGHTS)
         )
         for method, dt, values in block:
-            print(f"{method:<28}{dt:>9g}" + "".join(f"{v:>8.2f}" for v in values))
+            print(f"{method:<28}{fmt(dt, 'g'):>9}" + "".join(f"{v:>8.2f}" for v in values))
 
 
 @dataclass(frozen=True)
@@ -286,9 +297,14 @@ class Findings:
     beam_modal: float
     beam_tip: float
     rebound_rows: list[tuple[str, float, float]]
+    exact_rk4: float
+    study: list[beyond.StudyRun]
+    scipy_study: list[beyond.StudyRun]
 
 
-def findings(rows: list[Row]) -> Findings:
+def findings(
+    rows: list[Row], study: list[beyond.StudyRun], scipy_study: list[beyond.StudyRun]
+) -> Findings:
     hyster = []
     for method in ("rk4", "newmark"):
         for timing in ("step-count", "located"):
@@ -321,12 +337,15 @@ def findings(rows: list[Row]) -> Findings:
             for method in ("newmark", "rk4")
             for dt in STEP_SIZES
         ],
+        exact_rk4=exact_duration_rk4(),
+        study=study,
+        scipy_study=scipy_study,
     )
 
 
 def run_paper(out: Path) -> int:
     """Compute everything, write the files into ``out`` and print the tables."""
-    from vibroimpact.plots import fig1, fig3, fig4
+    from vibroimpact.plots import fig1, fig3, fig4, work_precision
     from vibroimpact.report import write_report
 
     started = time.perf_counter()
@@ -343,18 +362,39 @@ def run_paper(out: Path) -> int:
     goldsmith = goldsmith_contact_duration(IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED)
     exact = exact_duration()
     rows = table2(goldsmith, exact)
-    blocks = {"exact": table3(rows, "exact"), "goldsmith": table3(rows, "goldsmith")}
-    write_table2(out / "table2.csv", rows)
+    study = beyond.ours(exact)
+    scipy_study = beyond.scipy_runs(exact)
+    # The paper's two methods are in table 2 already; the study adds the others.
+    all_rows = rows + [
+        Row(
+            f"{r.label} ({r.setting})" if r.rtol is not None else r.label,
+            r.dt,
+            r.contact_duration,
+            r.cpu_time,
+            pct(r.contact_duration, goldsmith),
+            r.error * 100.0,
+        )
+        for r in study
+        if "paper" not in r.label
+    ]
+    blocks = {
+        "exact": table3(rows, "exact"),
+        "goldsmith": table3(rows, "goldsmith"),
+        "exact, all methods": table3(all_rows, "exact"),
+    }
+    write_table2(out / "table2.csv", all_rows)
     write_table3(out / "table3.csv", blocks)
-    print_tables(rows, blocks)
-    found = findings(rows)
+    print_tables(all_rows, blocks)
+    found = findings(rows, study, scipy_study)
     fig1(out / "fig1.png")
     fig3(out / "fig3.png", found.equal_k1)
     fig4(out / "fig4.png")
+    work_precision(out / "work_precision.png", study, scipy_study)
     elapsed = time.perf_counter() - started
     write_report(out / "report.md", rows, blocks, found, elapsed, platform.platform())
     print(
-        f"\nwrote table2.csv, table3.csv, fig1.png, fig3.png, fig4.png and report.md to {out}/ "
+        "\nwrote table2.csv, table3.csv, fig1.png, fig3.png, fig4.png, work_precision.png "
+        f"and report.md to {out}/ "
         f"in {elapsed:.1f} s"
     )
     return 0

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from vibroimpact._core import Contact, Solution, goldsmith_max_indentation  # noqa: E402
+from vibroimpact.beyond import StudyRun  # noqa: E402
 from vibroimpact.paper import (  # noqa: E402
     CONTACT_DAMPING,
     HERTZ_STIFFNESS,
@@ -120,6 +121,37 @@ def fig4(path: Path) -> None:
         title="Relative displacement through one contact (clearance 10 mm)",
     )
     ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def work_precision(path: Path, study: list[StudyRun], scipy_study: list[StudyRun]) -> None:
+    """Error of the contact duration against CPU time, a line per method (log-log)."""
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    labels = list(dict.fromkeys(r.label for r in study + scipy_study))
+    floor = 1e-16  # an exact hit would have no logarithm
+    for i, label in enumerate(labels):
+        runs = sorted(
+            (r for r in study + scipy_study if r.label == label), key=lambda r: r.cpu_time
+        )
+        style = "--" if label.startswith("scipy") else "-"
+        ax.loglog(
+            [r.cpu_time for r in runs],
+            [max(r.error, floor) for r in runs],
+            style,
+            marker="o",
+            ms=3,
+            color=f"C{i % 10}",
+            label=label,
+        )
+    ax.set(
+        xlabel="CPU time per collision (s, median)",
+        ylabel="relative error of the contact duration",
+        title="Table 1 collision: work against precision",
+    )
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
