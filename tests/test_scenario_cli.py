@@ -461,9 +461,11 @@ def test_paper_table2(paper_dir: tuple[Path, str]) -> None:
         "error_percent",
         "error_vs_exact_percent",
     ]
-    closed = [r for r in rows if r["dt"] == ""]
-    numerical = [r for r in rows if r["dt"] != ""]
+    # Closed forms have no CPU time (and no dt); adaptive runs have a CPU time but no dt.
+    closed = [r for r in rows if r["cpu_time"] == ""]
+    numerical = [r for r in rows if r["cpu_time"] != ""]
     assert len(closed) == 2 and len(numerical) >= 6
+    assert all(r["dt"] == "" for r in closed)
     assert all(r["cpu_time"] == "" for r in closed)
     assert all(float(r["cpu_time"]) > 0 for r in numerical)
     # The closed forms, recomputed: Goldsmith (printed constant) and the linear model.
@@ -480,21 +482,31 @@ def test_paper_table2(paper_dir: tuple[Path, str]) -> None:
             abs(tc / REF_DURATION - 1) * 100, abs=1e-4
         )
     for r in numerical:
-        dt, tc = float(r["dt"]), float(r["contact_duration"])
+        tc = float(r["contact_duration"])
         if "step-count" in r["method"]:
+            dt = float(r["dt"])
             assert tc / dt == pytest.approx(round(tc / dt), abs=1e-6)
-        if r["method"].startswith("rk4") and "step-count" not in r["method"]:
+        if r["method"] == "rk4 (located)":
             assert tc == pytest.approx(REF_DURATION, rel=2e-6)
+        if r["method"].startswith(("dopri5", "dop853")):
+            assert r["dt"] == "" and "rtol=" in r["method"]
 
 
 def test_paper_table3_is_eq15_of_table2(paper_dir: tuple[Path, str]) -> None:
-    table2 = [r for r in read_csv(paper_dir[0] / "table2.csv") if r["dt"] != ""]
+    numerical = [r for r in read_csv(paper_dir[0] / "table2.csv") if r["cpu_time"] != ""]
+    # The paper's two methods (as it ran them) and then every method.
+    paper_rows = [r for r in numerical if r["method"].endswith(("(step-count)", "(located)"))]
     table3 = read_csv(paper_dir[0] / "table3.csv")
     weights = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0]
     assert list(table3[0]) == ["method", "dt", "error_basis"] + [f"wf1_{w:.1f}" for w in weights]
-    columns = {"goldsmith": "error_percent", "exact": "error_vs_exact_percent"}
-    assert {r["error_basis"] for r in table3} == set(columns)
-    for basis, column in columns.items():
+    blocks = {
+        "goldsmith": ("error_percent", paper_rows),
+        "exact": ("error_vs_exact_percent", paper_rows),
+        "exact, all methods": ("error_vs_exact_percent", numerical),
+    }
+    assert {r["error_basis"] for r in table3} == set(blocks)
+    assert len(paper_rows) == 12 and len(numerical) > len(paper_rows)
+    for basis, (column, table2) in blocks.items():
         block = [r for r in table3 if r["error_basis"] == basis]
         assert [(r["method"], r["dt"]) for r in block] == [(r["method"], r["dt"]) for r in table2]
         # Maxima over the compared numerical runs (both methods, all steps).
@@ -510,8 +522,16 @@ def test_paper_table3_is_eq15_of_table2(paper_dir: tuple[Path, str]) -> None:
 def test_paper_report_lists_its_files(paper_dir: tuple[Path, str]) -> None:
     report = (paper_dir[0] / "report.md").read_text(encoding="utf-8")
     assert report.startswith("# ")
-    for name in ("table2.csv", "table3.csv", "fig1.png", "fig3.png", "fig4.png"):
+    for name in (
+        "table2.csv",
+        "table3.csv",
+        "fig1.png",
+        "fig3.png",
+        "fig4.png",
+        "work_precision.png",
+    ):
         assert name in report, name
+        assert (paper_dir[0] / name).stat().st_size > 0
 
 
 def test_paper_unwritable_out_exits_2(run_cli: RunCli, tmp_path: Path) -> None:

@@ -2,6 +2,8 @@
 //! arguments and results, releases the GIL around integration and maps each
 //! core error to its own Python exception.
 
+use std::sync::{Mutex, OnceLock};
+
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{
@@ -325,36 +327,33 @@ impl InitialState {
     }
 }
 
-/// The contacts of a run, one entry per contact, as NumPy arrays in SI units.
-/// A contact still open at the end of the run has NaN ``separation``,
-/// ``duration`` and ``rebound_speed``.
-#[pyclass(frozen, module = "vibroimpact._core")]
-struct ContactTable {
-    /// Onset, s.
-    #[pyo3(get)]
-    onset: Py<PyArray1<f64>>,
-    /// Separation, s.
-    #[pyo3(get)]
-    separation: Py<PyArray1<f64>>,
-    /// Duration, s.
-    #[pyo3(get)]
-    duration: Py<PyArray1<f64>>,
-    /// Maximum indentation, m.
-    #[pyo3(get)]
-    max_indentation: Py<PyArray1<f64>>,
-    /// Relative normal speed at onset, m/s.
-    #[pyo3(get)]
-    approach_speed: Py<PyArray1<f64>>,
-    /// Relative normal speed at separation, m/s.
-    #[pyo3(get)]
-    rebound_speed: Py<PyArray1<f64>>,
-    /// Effective restitution: rebound_speed / approach_speed.
-    #[pyo3(get)]
-    restitution: Py<PyArray1<f64>>,
-    /// Energy dissipated by the contact (law hysteresis and contact damper), J.
-    #[pyo3(get)]
-    energy_dissipated: Py<PyArray1<f64>>,
-    records: Vec<core::ContactRecord>,
+/// A column of results that becomes a NumPy array on first access (without
+/// a copy): a call pays only for the arrays it reads.
+struct Column {
+    data: Mutex<Option<Vec<f64>>>,
+    array: OnceLock<Py<PyArray1<f64>>>,
+}
+
+impl Column {
+    fn new(data: Vec<f64>) -> Self {
+        Self {
+            data: Mutex::new(Some(data)),
+            array: OnceLock::new(),
+        }
+    }
+
+    fn get(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.array
+            .get_or_init(|| {
+                let data = self
+                    .data
+                    .lock()
+                    .map(|mut d| d.take().unwrap_or_default())
+                    .unwrap_or_default();
+                data.into_pyarray(py).unbind()
+            })
+            .clone_ref(py)
+    }
 }
 
 const CONTACT_COLUMNS: [&str; 8] = [
@@ -381,12 +380,83 @@ fn record_values(r: &core::ContactRecord) -> [f64; 8] {
     ]
 }
 
+/// The contacts of a run, one entry per contact, as NumPy arrays in SI units.
+/// A contact still open at the end of the run has NaN ``separation``,
+/// ``duration``, ``rebound_speed`` and ``restitution``.
+#[pyclass(frozen, module = "vibroimpact._core")]
+struct ContactTable {
+    records: Vec<core::ContactRecord>,
+    columns: [OnceLock<Py<PyArray1<f64>>>; 8],
+}
+
+impl ContactTable {
+    fn new(records: Vec<core::ContactRecord>) -> Self {
+        Self {
+            records,
+            columns: Default::default(),
+        }
+    }
+
+    fn column(&self, py: Python<'_>, index: usize) -> Py<PyArray1<f64>> {
+        self.columns[index]
+            .get_or_init(|| {
+                let values: Vec<f64> = self
+                    .records
+                    .iter()
+                    .map(|r| record_values(r)[index])
+                    .collect();
+                values.into_pyarray(py).unbind()
+            })
+            .clone_ref(py)
+    }
+}
+
 #[pymethods]
 impl ContactTable {
     /// Column names, in order.
     #[classattr]
     fn columns() -> [&'static str; 8] {
         CONTACT_COLUMNS
+    }
+    /// Onset, s.
+    #[getter]
+    fn onset(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 0)
+    }
+    /// Separation, s.
+    #[getter]
+    fn separation(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 1)
+    }
+    /// Duration, s.
+    #[getter]
+    fn duration(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 2)
+    }
+    /// Maximum indentation, m.
+    #[getter]
+    fn max_indentation(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 3)
+    }
+    /// Relative normal speed at onset, m/s.
+    #[getter]
+    fn approach_speed(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 4)
+    }
+    /// Relative normal speed at separation, m/s.
+    #[getter]
+    fn rebound_speed(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 5)
+    }
+    /// Effective restitution: rebound_speed / approach_speed.
+    #[getter]
+    fn restitution(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 6)
+    }
+    /// Energy dissipated by the contact (law hysteresis and contact damper), J.
+    #[getter]
+    fn energy_dissipated(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 7)
     }
     fn __len__(&self) -> usize {
         self.records.len()
@@ -412,34 +482,25 @@ impl ContactTable {
 /// table of contacts and the run's statistics.
 #[pyclass(frozen, module = "vibroimpact._core")]
 struct Solution {
-    /// Time of each kept step, s.
-    #[pyo3(get)]
-    t: Py<PyArray1<f64>>,
-    /// w, m.
-    #[pyo3(get)]
-    main_displacement: Py<PyArray1<f64>>,
-    /// w', m/s.
-    #[pyo3(get)]
-    main_velocity: Py<PyArray1<f64>>,
-    /// y, m.
-    #[pyo3(get)]
-    impact_displacement: Py<PyArray1<f64>>,
-    /// y', m/s.
-    #[pyo3(get)]
-    impact_velocity: Py<PyArray1<f64>>,
-    /// Force between the bodies (law + contact damper), N; > 0 pushes apart.
-    #[pyo3(get)]
-    contact_force: Py<PyArray1<f64>>,
+    history: [Column; 6],
+    rows: usize,
     /// The contacts.
     #[pyo3(get)]
     contacts: Py<ContactTable>,
-    /// Steps taken.
+    /// Steps taken (accepted).
     #[pyo3(get)]
     steps: u64,
-    /// Force (right-hand-side) evaluations.
+    /// Steps rejected by the error control (adaptive methods).
+    #[pyo3(get)]
+    rejected_steps: u64,
+    /// Force (right-hand-side) evaluations, Newton iterations included.
     #[pyo3(get)]
     rhs_evaluations: u64,
-    /// Time reached, s (t_end rounded up to a whole number of steps).
+    /// Touches shallower than round-off, not counted as contacts.
+    #[pyo3(get)]
+    grazing_contacts: u64,
+    /// Time reached, s (t_end rounded up to a whole number of steps by the
+    /// fixed-step methods).
     #[pyo3(get)]
     final_time: f64,
     /// Method name.
@@ -448,12 +509,6 @@ struct Solution {
     /// "fixed" or "events".
     #[pyo3(get)]
     stepping: &'static str,
-    /// Steps rejected by the error control (adaptive methods).
-    #[pyo3(get)]
-    rejected_steps: u64,
-    /// Touches shallower than round-off, not counted as contacts.
-    #[pyo3(get)]
-    grazing_contacts: u64,
     /// Largest relative growth of the mechanical energy of the unforced system,
     /// ``max(E)/E(0) - 1`` (NaN if it starts at rest). Physically <= 0: a
     /// positive value is numerical error (above 0.5 the run is refused).
@@ -463,19 +518,46 @@ struct Solution {
 
 #[pymethods]
 impl Solution {
+    /// Time of each kept step, s.
+    #[getter]
+    fn t(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[0].get(py)
+    }
+    /// w, m.
+    #[getter]
+    fn main_displacement(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[1].get(py)
+    }
+    /// w', m/s.
+    #[getter]
+    fn main_velocity(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[2].get(py)
+    }
+    /// y, m.
+    #[getter]
+    fn impact_displacement(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[3].get(py)
+    }
+    /// y', m/s.
+    #[getter]
+    fn impact_velocity(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[4].get(py)
+    }
+    /// Force between the bodies (law + contact damper), N; > 0 pushes apart.
+    #[getter]
+    fn contact_force(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[5].get(py)
+    }
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
-            "Solution(method={:?}, steps={}, rows={}, contacts={})",
+            "Solution(method={:?}, stepping={:?}, steps={}, rows={}, contacts={})",
             self.method,
+            self.stepping,
             self.steps,
-            self.t.bind(py).len().unwrap_or(0),
+            self.rows,
             self.contacts.bind(py).get().records.len()
         )
     }
-}
-
-fn array(py: Python<'_>, v: Vec<f64>) -> Py<PyArray1<f64>> {
-    v.into_pyarray(py).unbind()
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -621,31 +703,22 @@ fn simulate(
         }
         Err(e) => return Err(to_py(e)),
     };
-    let records = sol.contacts;
-    let column =
-        |f: fn(&core::ContactRecord) -> f64| -> Vec<f64> { records.iter().map(f).collect() };
-    let table = ContactTable {
-        onset: array(py, column(|r| r.onset)),
-        separation: array(py, column(|r| r.separation)),
-        duration: array(py, column(|r| r.duration)),
-        max_indentation: array(py, column(|r| r.max_indentation)),
-        approach_speed: array(py, column(|r| r.approach_speed)),
-        rebound_speed: array(py, column(|r| r.rebound_speed)),
-        restitution: array(py, column(|r| r.restitution)),
-        energy_dissipated: array(py, column(|r| r.energy_dissipated)),
-        records,
-    };
     let h = sol.history;
     Ok(Solution {
-        t: array(py, h.time),
-        main_displacement: array(py, h.main_displacement),
-        main_velocity: array(py, h.main_velocity),
-        impact_displacement: array(py, h.impact_displacement),
-        impact_velocity: array(py, h.impact_velocity),
-        contact_force: array(py, h.contact_force),
-        contacts: Py::new(py, table)?,
+        rows: h.time.len(),
+        history: [
+            Column::new(h.time),
+            Column::new(h.main_displacement),
+            Column::new(h.main_velocity),
+            Column::new(h.impact_displacement),
+            Column::new(h.impact_velocity),
+            Column::new(h.contact_force),
+        ],
+        contacts: Py::new(py, ContactTable::new(sol.contacts))?,
         steps: sol.steps,
+        rejected_steps: sol.rejected_steps,
         rhs_evaluations: sol.rhs_evaluations,
+        grazing_contacts: sol.grazing_contacts,
         final_time: sol.final_time,
         energy_growth: sol.energy_growth,
         method: parsed.name(),
@@ -653,8 +726,6 @@ fn simulate(
             core::Stepping::Fixed => "fixed",
             core::Stepping::Events => "events",
         },
-        rejected_steps: sol.rejected_steps,
-        grazing_contacts: sol.grazing_contacts,
     })
 }
 
