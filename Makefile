@@ -23,6 +23,7 @@ lint:
 
 bench:
 	python benchmarks/bench_steps.py
+	python benchmarks/bench_scipy.py
 	cargo run --release -p vibroimpact-core --example throughput
 
 paper:

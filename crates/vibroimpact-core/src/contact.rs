@@ -16,6 +16,14 @@ pub trait ContactLaw: Copy + Send + Sync {
     fn force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64;
     /// The conservative (elastic) part of the force, N.
     fn elastic_force(&self, indentation: f64) -> f64;
+    /// `(force, elastic_force)` together (one square root for the Hertz laws).
+    #[inline(always)]
+    fn force_and_elastic(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64) {
+        (
+            self.force(indentation, rate, approach_rate),
+            self.elastic_force(indentation),
+        )
+    }
     /// Elastic energy stored at `indentation`, J.
     fn potential(&self, indentation: f64) -> f64;
     /// `(F, dF/d delta, dF/d delta')` for Newton iterations (zero slopes where
@@ -35,6 +43,11 @@ impl ContactLaw for Hertz {
     #[inline(always)]
     fn force(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> f64 {
         self.elastic_force(indentation)
+    }
+    #[inline(always)]
+    fn force_and_elastic(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> (f64, f64) {
+        let f = self.elastic_force(indentation);
+        (f, f)
     }
     #[inline(always)]
     fn elastic_force(&self, indentation: f64) -> f64 {
@@ -149,11 +162,18 @@ const GRAZING_RATE: f64 = 1e-12;
 impl ContactLaw for HysterHertz {
     #[inline(always)]
     fn force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
+        self.force_and_elastic(indentation, rate, approach_rate).0
+    }
+    #[inline(always)]
+    fn force_and_elastic(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64) {
         let elastic = self.elastic_force(indentation);
         if approach_rate > GRAZING_RATE {
-            (elastic * (1.0 + self.hysteresis * rate / approach_rate)).max(0.0)
+            (
+                (elastic * (1.0 + self.hysteresis * rate / approach_rate)).max(0.0),
+                elastic,
+            )
         } else {
-            elastic
+            (elastic, elastic)
         }
     }
     #[inline(always)]
@@ -280,22 +300,19 @@ impl Contact {
     ) -> Result<Self> {
         let stiffness = positive("stiffness", stiffness)?;
         let damping = non_negative("damping", damping)?;
-        let restitution = match (law, restitution) {
-            (LawKind::HysterHertz, Some(e)) => {
-                within("restitution", e, 0.0, 1.0, true, "in (0, 1]")?
-            }
-            (LawKind::HysterHertz, None) => {
-                return Err(Error::Inconsistent(
-                    "restitution is required for law \"hyster-hertz\" (a number in (0, 1])".into(),
-                ))
-            }
-            (_, Some(_)) => {
+        let restitution = match (law.uses_restitution(), restitution) {
+            (true, Some(e)) => within("restitution", e, 0.0, 1.0, true, "in (0, 1]")?,
+            (true, None) => {
                 return Err(Error::Inconsistent(format!(
-                    "restitution applies only to law \"hyster-hertz\", not {:?}",
+                    "restitution is required for law {:?} (a number in (0, 1])",
                     law.name()
                 )))
             }
-            (_, None) => 1.0,
+            (false, Some(_)) => return Err(Error::Inconsistent(format!(
+                "restitution applies only to laws \"hyster-hertz\" and \"hertz-damped\", not {:?}",
+                law.name()
+            ))),
+            (false, None) => 1.0,
         };
         Ok(Self {
             law,

@@ -222,7 +222,8 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
         }
         first = false;
         let g = gap(model, &attempt.end, side).0;
-        if new_side(g) {
+        // Exactly on the wall is the event itself: the new mode starts there.
+        if new_side(g) || g == 0.0 {
             hi = trial;
             g_hi = g;
             best = attempt;

@@ -195,17 +195,19 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
                 side,
                 approach_rate,
             } => {
-                let c = self.contact_at(s, side, approach_rate);
-                let push = side * c.total_force;
-                let elastic = if c.indentation > 0.0 {
-                    self.law.elastic_force(c.indentation)
+                let indentation = side * s.relative_displacement() - self.clearance;
+                let rate = side * s.relative_velocity();
+                let (law_force, elastic) = if indentation > 0.0 {
+                    self.law.force_and_elastic(indentation, rate, approach_rate)
                 } else {
-                    0.0
+                    (0.0, 0.0)
                 };
+                let total = law_force + self.contact_damping * rate;
+                let push = side * total;
                 (
                     main + push * self.inverse_main_mass,
                     -push * self.inverse_impact_mass,
-                    (c.total_force - elastic) * c.rate,
+                    (total - elastic) * rate,
                 )
             }
         }

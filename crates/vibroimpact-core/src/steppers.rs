@@ -108,14 +108,16 @@ fn stages<const S: usize, L: ContactLaw, X: Excitation>(
     for i in 1..S {
         // Sum the stage increments first, then scale once by h: fewer
         // operations and a straight line the compiler can vectorise.
-        let mut sum = [0.0; 5];
+        // The dissipated energy (slot 4) feeds no force: stage values of
+        // the four state variables suffice.
+        let mut sum = [0.0; 4];
         for (aij, kj) in a[i].iter().zip(k.iter()).take(i) {
-            for n in 0..5 {
+            for n in 0..4 {
                 sum[n] += aij * kj[n];
             }
         }
         let mut yi = *y;
-        for n in 0..5 {
+        for n in 0..4 {
             yi[n] += h * sum[n];
         }
         k[i] = derivative(model, time + c[i] * h, &yi, mode);
