@@ -308,10 +308,12 @@ impl Contact {
                     law.name()
                 )))
             }
-            (false, Some(_)) => return Err(Error::Inconsistent(format!(
+            (false, Some(_)) => {
+                return Err(Error::Inconsistent(format!(
                 "restitution applies only to laws \"hyster-hertz\" and \"hertz-damped\", not {:?}",
                 law.name()
-            ))),
+            )))
+            }
             (false, None) => 1.0,
         };
         Ok(Self {

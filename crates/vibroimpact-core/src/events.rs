@@ -252,6 +252,61 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
     Ok(Location::Cut(hi, best))
 }
 
+/// The largest indentation within the step `y -> y(taken)` of a contact on
+/// `side`, whose indentation rate changes sign in it: the rate's root, found
+/// by the Illinois method on the method's own steps. Leaves the stepper
+/// holding the full step again.
+#[allow(clippy::too_many_arguments)]
+fn peak_indentation<L: ContactLaw, X: Excitation, S: Stepper>(
+    model: &Model<L, X>,
+    stepper: &mut S,
+    time: f64,
+    y: &Vector,
+    end: &Vector,
+    taken: f64,
+    mode: Mode,
+    side: f64,
+) -> Result<f64> {
+    let (mut lo, mut hi) = (0.0, taken);
+    let (mut peak, mut r_hi) = gap(model, end, side);
+    let mut r_lo = gap(model, y, side).1;
+    let scale = 4.0 * f64::EPSILON * (y[1].abs() + y[3].abs());
+    let mut kept = 0i8;
+    for _ in 0..60 {
+        if hi - lo <= 4.0 * f64::EPSILON * (time.abs() + hi) {
+            break;
+        }
+        let mut trial = hi - r_hi * (hi - lo) / (r_hi - r_lo);
+        if !(trial > lo && trial < hi) {
+            trial = 0.5 * (lo + hi);
+        }
+        let attempt = stepper.attempt(model, time, y, trial, mode)?;
+        let (g, r) = gap(model, &attempt.end, side);
+        peak = peak.max(g);
+        if r.abs() <= scale {
+            break;
+        }
+        if r > 0.0 {
+            lo = trial;
+            r_lo = r;
+            if kept == -1 {
+                r_hi *= 0.5;
+            }
+            kept = -1;
+        } else {
+            hi = trial;
+            r_hi = r;
+            if kept == 1 {
+                r_lo *= 0.5;
+            }
+            kept = 1;
+        }
+    }
+    // The stepper's pending data must belong to the step that is kept.
+    stepper.attempt(model, time, y, taken, mode)?;
+    Ok(peak)
+}
+
 /// The time a contact at approach speed `speed` takes to store the relative
 /// kinetic energy elastically, `delta* / speed` (s): a fraction of the
 /// contact duration, used to start an adaptive method's steps after onset,
@@ -499,20 +554,19 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 reason: "the state is no longer finite",
             });
         }
-        stepper.accept();
-        // Maximum indentation inside a step taken in contact.
+        // Maximum indentation: where the indentation rate falls through zero
+        // inside a step taken in contact, found on the method's own solution.
         if let (Some(oc), Mode::Contact { side, .. }) = (open.as_mut(), step_mode) {
-            let (g0, r0) = gap(model, &y, side);
+            let (_, r0) = gap(model, &y, side);
             let (g1, r1) = gap(model, &end, side);
-            let (m0, m1) = (r0 * taken, r1 * taken);
-            if m0 > 0.0 && m1 <= 0.0 {
-                let theta = hermite::argmax(g0, g1, m0, m1);
-                oc.max_indentation = oc
-                    .max_indentation
-                    .max(hermite::eval(g0, g1, m0, m1, theta).0);
+            if r0 > 0.0 && r1 <= 0.0 {
+                let peak =
+                    peak_indentation(model, stepper, time, &y, &end, taken, step_mode, side)?;
+                oc.max_indentation = oc.max_indentation.max(peak);
             }
             oc.max_indentation = oc.max_indentation.max(g1);
         }
+        stepper.accept();
         time += taken;
         if fixed && !switched {
             grid_index += 1;
