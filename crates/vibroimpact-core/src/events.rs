@@ -11,7 +11,7 @@
 
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
-use crate::hermite;
+use crate::hermite::{self, Quintic};
 use crate::model::{Excitation, Mode, Model};
 use crate::run::{ContactRecord, History, Settings, Solution};
 use crate::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
@@ -21,6 +21,32 @@ use crate::system::State;
 #[inline(always)]
 fn gap<L: ContactLaw, X: Excitation>(model: &Model<L, X>, y: &Vector, side: f64) -> (f64, f64) {
     (side * (y[2] - y[0]) - model.clearance, side * (y[3] - y[1]))
+}
+
+/// The sixth-order interpolant of the gap of `side` over the step
+/// `y -> end` of length `h` taken in `mode` (accelerations at both ends).
+#[allow(clippy::too_many_arguments)]
+fn gap_quintic<L: ContactLaw, X: Excitation>(
+    model: &Model<L, X>,
+    time: f64,
+    y: &Vector,
+    end: &Vector,
+    h: f64,
+    mode: Mode,
+    side: f64,
+) -> Quintic {
+    let (g0, r0) = gap(model, y, side);
+    let (g1, r1) = gap(model, end, side);
+    let (aw0, ay0) = model.accelerations_in(time, &to_state(y), mode);
+    let (aw1, ay1) = model.accelerations_in(time + h, &to_state(end), mode);
+    Quintic {
+        g0,
+        g1,
+        m0: r0 * h,
+        m1: r1 * h,
+        c0: side * (ay0 - aw0) * h * h,
+        c1: side * (ay1 - aw1) * h * h,
+    }
 }
 
 /// What the check of one step found.
@@ -199,7 +225,14 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
     // Illinois: regula falsi that halves the retained end's value when the
     // same end is kept twice, so that both ends converge.
     let mut kept = 0i8;
-    let mut guess = crossing.guess * h;
+    // The first guess from the sixth-order interpolant of the whole step.
+    let mut guess = match crossing.after {
+        Some(_) => {
+            let quintic = gap_quintic(model, time, y, &full.end, h, mode, side);
+            h * quintic.root(lo / h, 1.0)
+        }
+        None => crossing.guess * h,
+    };
     let mut first = true;
     for _ in 0..100 {
         let width = hi - lo;
@@ -222,8 +255,9 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
         }
         first = false;
         let g = gap(model, &attempt.end, side).0;
-        // Exactly on the wall is the event itself: the new mode starts there.
-        if new_side(g) || g == 0.0 {
+        // On the wall to round-off is the event itself: the new mode starts
+        // there (its force is continuous in the gap, so either side will do).
+        if new_side(g) || g.abs() <= round_off {
             hi = trial;
             g_hi = g;
             best = attempt;
@@ -241,7 +275,7 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
             }
             kept = -1;
         }
-        if g == 0.0 {
+        if g.abs() <= round_off {
             break;
         }
     }
@@ -252,10 +286,11 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
     Ok(Location::Cut(hi, best))
 }
 
-/// The largest indentation within the step `y -> y(taken)` of a contact on
-/// `side`, whose indentation rate changes sign in it: the rate's root, found
-/// by the Illinois method on the method's own steps. Leaves the stepper
-/// holding the full step again.
+/// The largest indentation within the step `y -> end` (length `taken`) of a
+/// contact on `side` whose indentation rate changes sign in it: located on
+/// the step's sixth-order interpolant, then taken from the method's own step
+/// to that instant (the maximum is flat, so that is accurate to the method).
+/// Leaves the stepper holding the full step again.
 #[allow(clippy::too_many_arguments)]
 fn peak_indentation<L: ContactLaw, X: Excitation, S: Stepper>(
     model: &Model<L, X>,
@@ -267,44 +302,12 @@ fn peak_indentation<L: ContactLaw, X: Excitation, S: Stepper>(
     mode: Mode,
     side: f64,
 ) -> Result<f64> {
-    let (mut lo, mut hi) = (0.0, taken);
-    let (mut peak, mut r_hi) = gap(model, end, side);
-    let mut r_lo = gap(model, y, side).1;
-    let scale = 4.0 * f64::EPSILON * (y[1].abs() + y[3].abs());
-    let mut kept = 0i8;
-    for _ in 0..60 {
-        if hi - lo <= 4.0 * f64::EPSILON * (time.abs() + hi) {
-            break;
-        }
-        let mut trial = hi - r_hi * (hi - lo) / (r_hi - r_lo);
-        if !(trial > lo && trial < hi) {
-            trial = 0.5 * (lo + hi);
-        }
-        let attempt = stepper.attempt(model, time, y, trial, mode)?;
-        let (g, r) = gap(model, &attempt.end, side);
-        peak = peak.max(g);
-        if r.abs() <= scale {
-            break;
-        }
-        if r > 0.0 {
-            lo = trial;
-            r_lo = r;
-            if kept == -1 {
-                r_hi *= 0.5;
-            }
-            kept = -1;
-        } else {
-            hi = trial;
-            r_hi = r;
-            if kept == 1 {
-                r_lo *= 0.5;
-            }
-            kept = 1;
-        }
-    }
+    let quintic = gap_quintic(model, time, y, end, taken, mode, side);
+    let theta = quintic.argmax();
+    let probe = stepper.attempt(model, time, y, theta * taken, mode)?;
     // The stepper's pending data must belong to the step that is kept.
     stepper.attempt(model, time, y, taken, mode)?;
-    Ok(peak)
+    Ok(gap(model, &probe.end, side).0)
 }
 
 /// The time a contact at approach speed `speed` takes to store the relative

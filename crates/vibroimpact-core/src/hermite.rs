@@ -99,3 +99,152 @@ mod tests {
         assert!((a - 0.7).abs() < 1e-12, "{a}");
     }
 }
+
+/// The quintic Hermite interpolant on [0, 1] from values `g`, first
+/// derivatives `m` (times the step) and second derivatives `c` (times the
+/// step squared) at both ends: sixth-order accurate, for locating events and
+/// extrema inside a step when accelerations are known.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Quintic {
+    pub g0: f64,
+    pub g1: f64,
+    pub m0: f64,
+    pub m1: f64,
+    pub c0: f64,
+    pub c1: f64,
+}
+
+impl Quintic {
+    /// Value and slope (per unit theta) at `theta`.
+    pub(crate) fn eval(&self, theta: f64) -> (f64, f64) {
+        let t = theta;
+        let (t2, t3) = (t * t, t * t * t);
+        let (t4, t5) = (t3 * t, t3 * t2);
+        let h0 = 1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5;
+        let h1 = t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5;
+        let h2 = 0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5;
+        let h3 = 0.5 * t3 - t4 + 0.5 * t5;
+        let h4 = -4.0 * t3 + 7.0 * t4 - 3.0 * t5;
+        let h5 = 10.0 * t3 - 15.0 * t4 + 6.0 * t5;
+        let d0 = -30.0 * t2 + 60.0 * t3 - 30.0 * t4;
+        let d1 = 1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4;
+        let d2 = t - 4.5 * t2 + 6.0 * t3 - 2.5 * t4;
+        let d3 = 1.5 * t2 - 4.0 * t3 + 2.5 * t4;
+        let d4 = -12.0 * t2 + 28.0 * t3 - 15.0 * t4;
+        let d5 = 30.0 * t2 - 60.0 * t3 + 30.0 * t4;
+        let value =
+            self.g0 * h0 + self.m0 * h1 + self.c0 * h2 + self.c1 * h3 + self.m1 * h4 + self.g1 * h5;
+        let slope =
+            self.g0 * d0 + self.m0 * d1 + self.c0 * d2 + self.c1 * d3 + self.m1 * d4 + self.g1 * d5;
+        (value, slope)
+    }
+
+    /// A root in `[lo, hi]`, where the interpolant changes sign; Newton
+    /// safeguarded by bisection.
+    pub(crate) fn root(&self, mut lo: f64, mut hi: f64) -> f64 {
+        let g_lo = self.eval(lo).0;
+        if g_lo == 0.0 {
+            return lo;
+        }
+        let rising = g_lo < 0.0;
+        let mut theta = 0.5 * (lo + hi);
+        for _ in 0..100 {
+            let (value, slope) = self.eval(theta);
+            if value == 0.0 {
+                return theta;
+            }
+            if (value < 0.0) == rising {
+                lo = theta;
+            } else {
+                hi = theta;
+            }
+            let newton = theta - value / slope;
+            let next = if slope != 0.0 && newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if (next - theta).abs() <= 1e-16 {
+                return next;
+            }
+            theta = next;
+        }
+        theta
+    }
+
+    /// Where the slope falls through zero in `[0, 1]` (slope > 0 at 0 and
+    /// <= 0 at 1): the maximum over the step.
+    pub(crate) fn argmax(&self) -> f64 {
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            if self.eval(mid).1 > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
+
+#[cfg(test)]
+mod quintic_tests {
+    use super::Quintic;
+
+    #[test]
+    fn reproduces_a_quintic_and_finds_its_root_and_maximum() {
+        // p(t) = (t - 0.4)(t + 1)(t - 3)(t + 2)(t - 5), expanded by hand:
+        // a quintic, so the interpolant is exact and its root is 0.4.
+        let roots = [0.4, -1.0, 3.0, -2.0, 5.0];
+        let p = |t: f64| roots.iter().map(|r| t - r).product::<f64>();
+        let dp = |t: f64| {
+            (0..5)
+                .map(|i| {
+                    (0..5)
+                        .filter(|&j| j != i)
+                        .map(|j| t - roots[j])
+                        .product::<f64>()
+                })
+                .sum::<f64>()
+        };
+        let ddp = |t: f64| {
+            let mut sum = 0.0;
+            for i in 0..5 {
+                for j in 0..5 {
+                    if i != j {
+                        sum += (0..5)
+                            .filter(|&k| k != i && k != j)
+                            .map(|k| t - roots[k])
+                            .product::<f64>();
+                    }
+                }
+            }
+            sum
+        };
+        let q = Quintic {
+            g0: p(0.0),
+            g1: p(1.0),
+            m0: dp(0.0),
+            m1: dp(1.0),
+            c0: ddp(0.0),
+            c1: ddp(1.0),
+        };
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            assert!((q.eval(t).0 - p(t)).abs() < 1e-12, "{t}");
+            assert!((q.eval(t).1 - dp(t)).abs() < 1e-11, "{t}");
+        }
+        assert!((q.root(0.0, 1.0) - 0.4).abs() < 1e-14);
+        // r(t) = 1 - (t - 0.6)^2 (1 + t) peaks at 0.6.
+        let r = Quintic {
+            g0: 1.0 - 0.36,
+            g1: 1.0 - 0.16 * 2.0,
+            m0: 0.84,
+            m1: -1.76,
+            c0: -(2.0 * 1.0 + 4.0 * (0.0 - 0.6)),
+            c1: -(2.0 * 2.0 + 4.0 * (1.0 - 0.6)),
+        };
+        assert!((r.argmax() - 0.6).abs() < 1e-12, "{}", r.argmax());
+    }
+}

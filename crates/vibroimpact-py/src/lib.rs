@@ -230,10 +230,10 @@ impl Contact {
     fn damping(&self) -> f64 {
         self.0.damping
     }
-    /// e for "hyster-hertz", None otherwise.
+    /// e for "hyster-hertz" and "hertz-damped", None otherwise.
     #[getter]
     fn restitution(&self) -> Option<f64> {
-        (self.0.law == core::LawKind::HysterHertz).then_some(self.0.restitution)
+        self.0.law.uses_restitution().then_some(self.0.restitution)
     }
     /// The law's force (N, clamped at zero; without the contact damper) at
     /// ``indentation`` (m), indentation ``rate`` (m/s) and the rate at the
