@@ -239,14 +239,6 @@ def test_hertz_damped_rebound_with_the_implicit_methods(method: str, e: float) -
     assert one_contact(sol, 0.1).restitution[0] == pytest.approx(e, rel=1e-5)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=vi.SimulationError,
-    reason="bug: Newton fails on the hertz-damped law at low e even at 1000 steps per "
-    "contact: the factor 1 + alpha delta'/delta'_minus falls to 1 - alpha e at separation "
-    "(1.6e-8 for e = 0.05, 1.8e-4 for e = 0.1) and the force is clamped at zero just "
-    "beyond: a kink near which the Newton iteration does not converge",
-)
 @pytest.mark.parametrize(
     ("method", "e"),
     [("newmark-implicit", 0.05), ("generalized-alpha", 0.05), ("generalized-alpha", 0.1)],

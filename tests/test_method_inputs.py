@@ -384,11 +384,6 @@ def test_cli_text_reports_the_steps(
     assert f"{direct.rhs_evaluations} force evaluations" in first
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: the CLI catches InvalidInputError and NumericalBlowUpError but not "
-    "SimulationError, so max_steps, Newton failure or chattering end in a traceback",
-)
 def test_cli_simulation_error_is_one_line(
     run_cli: RunCli, table1_toml: str, write_scenario: WriteScenario
 ) -> None:

@@ -706,12 +706,6 @@ def test_adaptive_methods_graze_and_miss(method: str) -> None:
     assert (len(missed.contacts), missed.grazing_contacts) == (0, 0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: an interior touch is detected only through the cubic Hermite "
-    "interpolant of a step's end values; DOP853's steps (0.5 s here) miss a contact "
-    "1e-4 d (1e-6 m) deep at the default rtol (DOPRI5 finds it)",
-)
 def test_dop853_finds_a_shallow_contact() -> None:
     assert len(graze_run(1e-4, method="dopri5").contacts) == 1
     assert len(graze_run(1e-4, method="dop853").contacts) == 1
@@ -809,21 +803,12 @@ def test_max_steps_bounds_a_run(settings: dict[str, Any]) -> None:
     assert table1_run(max_steps=100_000, **settings).final_time >= 0.15
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: the fixed-stepping kernel (default of rk4 and newmark) ignores max_steps",
-)
 @pytest.mark.parametrize("method", ["rk4", "newmark"])
 def test_max_steps_bounds_fixed_stepping(method: str) -> None:
     with pytest.raises(vi.SimulationError, match="max_steps"):
         table1_run(method=method, dt=1e-4, max_steps=10)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug (off by one): a run that needs exactly max_steps steps raises at t_end "
-    "instead of returning",
-)
 def test_a_run_of_exactly_max_steps_completes() -> None:
     settings: dict[str, Any] = dict(method="rk4", dt=0.01, t_end=4.0, stepping="events")
     full = vi.simulate(SMOOTH_SYSTEM, SMOOTH_CONTACT, SMOOTH_START, **settings)
@@ -832,13 +817,6 @@ def test_a_run_of_exactly_max_steps_completes() -> None:
     assert sol.steps == 400
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: Newton's stopping test (|da| <= 1e-13 of the accelerations) is below the "
-    "round-off floor of the indentation computed from absolute positions: a last-bit flip "
-    "of x between iterations moves da by ~ulp(x) f'/m, so runs fail at random steps, more "
-    "often the farther the bodies are from the origin",
-)
 def test_newton_is_translation_invariant() -> None:
     """K = C = 0: shifting both bodies by 1 m to 1 km changes nothing physical. Each run
     is ten elastic contacts, each resolved by 200+ steps."""

@@ -1,7 +1,8 @@
 """The ``vibroimpact`` command (also ``python -m vibroimpact``).
 
 Exit status: 0 on success, 2 for bad input (arguments, scenario files,
-parameter values, unwritable output), 1 for a numerical blow-up, 130 when
+parameter values, unwritable output), 1 for a run that could not be completed
+(numerical blow-up, chattering, Newton failure, max_steps), 130 when
 interrupted. Errors are one line on stderr, never a traceback.
 """
 
@@ -18,7 +19,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from vibroimpact._core import InvalidInputError, NumericalBlowUpError, Solution, __version__
+from vibroimpact._core import (
+    InvalidInputError,
+    NumericalBlowUpError,
+    SimulationError,
+    Solution,
+    __version__,
+)
 from vibroimpact.scenario import Scenario, load_scenario, paper_collision
 
 HISTORY_COLUMNS = (
@@ -176,7 +183,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (InvalidInputError, UsageError) as err:
         print(f"vibroimpact: error: {err}", file=sys.stderr)
         return 2
-    except NumericalBlowUpError as err:
+    except (NumericalBlowUpError, SimulationError) as err:
+        # The input was valid but the run could not be completed.
         print(f"vibroimpact: error: {err}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

@@ -65,8 +65,10 @@ struct Crossing {
 
 /// Looks for a mode change in the step `y -> end` of length `h`.
 /// `graze_tolerance` (m): an interior touch shallower than that is a graze.
+#[allow(clippy::too_many_arguments)]
 fn find_crossing<L: ContactLaw, X: Excitation>(
     model: &Model<L, X>,
+    time: f64,
     y: &Vector,
     end: &Vector,
     h: f64,
@@ -95,10 +97,15 @@ fn find_crossing<L: ContactLaw, X: Excitation>(
                     })
                 } else if m0 > 0.0 && m1 < 0.0 {
                     // Both ends outside contact: touching and leaving within
-                    // the step shows as a positive interior maximum.
-                    let theta = hermite::argmax(g0, g1, m0, m1);
-                    let peak = hermite::eval(g0, g1, m0, m1, theta).0;
-                    if peak > graze_tolerance {
+                    // the step shows as a positive interior maximum. The
+                    // sixth-order interpolant finds it; where it and the cubic
+                    // disagree by more than its margin below the wall, the
+                    // maximum is probed with the method itself.
+                    let quintic = gap_quintic(model, time, y, end, h, mode, side);
+                    let theta = quintic.argmax();
+                    let peak = quintic.eval(theta).0;
+                    let cubic = hermite::eval(g0, g1, m0, m1, hermite::argmax(g0, g1, m0, m1)).0;
+                    if peak > graze_tolerance || peak + (peak - cubic).abs() > 0.0 {
                         Some(Crossing {
                             side,
                             before: 0.0,
@@ -174,6 +181,8 @@ enum Location {
     Cut(f64, Attempt),
     /// The interpolant's crossing was not there.
     Unconfirmed,
+    /// An interior touch shallower than the graze tolerance.
+    Graze,
     /// The step up to the event would fail the error control: retry shorter.
     Reject(f64),
 }
@@ -191,6 +200,7 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
     full: &Attempt,
     mode: Mode,
     crossing: Crossing,
+    graze_tolerance: f64,
 ) -> Result<Location> {
     let side = crossing.side;
     let onset = matches!(mode, Mode::Free);
@@ -219,6 +229,9 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
     let mut g_hi = gap(model, &best.end, side).0;
     if !new_side(g_hi) {
         return Ok(Location::Unconfirmed);
+    }
+    if crossing.after.is_none() && onset && g_hi <= graze_tolerance {
+        return Ok(Location::Graze);
     }
     // Whether the stepper's last attempt is the one at `hi`.
     let mut holds_hi = crossing.before == 0.0 || crossing.after.is_none();
@@ -480,6 +493,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
         // the error control only ever judges steps within one smooth mode.
         if let Some(crossing) = find_crossing(
             model,
+            time,
             &y,
             &attempt.end,
             length,
@@ -487,7 +501,17 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             graze_tolerance,
             &mut grazes,
         ) {
-            match locate(model, stepper, time, &y, length, &attempt, mode, crossing)? {
+            match locate(
+                model,
+                stepper,
+                time,
+                &y,
+                length,
+                &attempt,
+                mode,
+                crossing,
+                graze_tolerance,
+            )? {
                 Location::Cut(cut, cut_attempt) => {
                     taken = cut;
                     attempt = cut_attempt;
@@ -507,6 +531,10 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 }
                 // Not confirmed: the stepper must hold the full step again.
                 Location::Unconfirmed => {
+                    attempt = stepper.attempt(model, time, &y, length, mode)?
+                }
+                Location::Graze => {
+                    grazes += 1;
                     attempt = stepper.attempt(model, time, &y, length, mode)?
                 }
             }
@@ -643,7 +671,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 });
             }
         }
-        if accepted + rejected >= settings.max_steps {
+        if !done && accepted + rejected >= settings.max_steps {
             return Err(Error::TooManySteps {
                 time,
                 max_steps: settings.max_steps,

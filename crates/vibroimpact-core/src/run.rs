@@ -527,6 +527,12 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
         if step % INTERRUPT_INTERVAL == 0 && interrupt() {
             return Err(Error::Interrupted { time: t1 });
         }
+        if step == settings.max_steps && step < n_steps {
+            return Err(Error::TooManySteps {
+                time: t1,
+                max_steps: settings.max_steps,
+            });
+        }
     }
 
     if let Some(oc) = open {

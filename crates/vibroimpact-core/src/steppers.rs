@@ -470,18 +470,15 @@ impl Stepper for NewmarkFamily {
             } if self.lagged => model.contact_at(&s0, side, approach_rate).law_force,
             _ => 0.0,
         };
-        let (mut aw, mut ay) = (a0w, a0y);
-        let mut converged = false;
-        for _ in 0..NEWTON_ITERATIONS {
-            self.evaluations += 1;
-            let x1w = xw + bx * aw;
-            let x1y = xy + bx * ay;
-            let v1w = vw + gv * aw;
-            let v1y = vy + gv * ay;
-            let xfw = (1.0 - af) * x1w + af * y[0];
-            let xfy = (1.0 - af) * x1y + af * y[2];
-            let vfw = (1.0 - af) * v1w + af * y[1];
-            let vfy = (1.0 - af) * v1y + af * y[3];
+        let kx = (1.0 - af) * bx;
+        let cv = (1.0 - af) * gv;
+        // Residual of both equations at trial accelerations, with the slopes
+        // of the contact force (Jacobian) and the size of the forces in play.
+        let residual = |aw: f64, ay: f64| {
+            let xfw = (1.0 - af) * (xw + bx * aw) + af * y[0];
+            let xfy = (1.0 - af) * (xy + bx * ay) + af * y[2];
+            let vfw = (1.0 - af) * (vw + gv * aw) + af * y[1];
+            let vfy = (1.0 - af) * (vy + gv * ay) + af * y[3];
             // Contact force on the main mass (+side F) and its slopes in the
             // indentation (F_d) and its rate (F_r).
             let (push, f_d, f_r) = match mode {
@@ -510,35 +507,76 @@ impl Stepper for NewmarkFamily {
             let amy = (1.0 - am) * ay + am * a0y;
             let rw = m_main * amw + model.damping * vfw + model.stiffness * xfw - force_ext - push;
             let ry = m_imp * amy + push;
-            // Jacobian d(r)/d(a_(n+1)): symmetric 2x2.
-            let kx = (1.0 - af) * bx;
-            let cv = (1.0 - af) * gv;
             let coupling = kx * f_d + cv * f_r;
+            // Round-off in the residual: the terms' sizes, and the contact
+            // force's response to the last bits of the (absolute) positions
+            // and velocities from which the indentation is computed.
+            let noise = 4.0
+                * f64::EPSILON
+                * ((m_main * amw).abs()
+                    + (model.damping * vfw).abs()
+                    + (model.stiffness * xfw).abs()
+                    + force_ext.abs()
+                    + push.abs()
+                    + f_d * (xfw.abs() + xfy.abs())
+                    + f_r * (vfw.abs() + vfy.abs()));
+            (rw, ry, coupling, noise)
+        };
+        let norm = |rw: f64, ry: f64| rw.abs().max(ry.abs());
+        let (mut aw, mut ay) = (a0w, a0y);
+        let (mut rw, mut ry, mut coupling, mut noise) = residual(aw, ay);
+        self.evaluations += 1;
+        let mut converged = false;
+        for _ in 0..NEWTON_ITERATIONS {
+            // Jacobian d(r)/d(a_(n+1)): symmetric 2x2.
             let j11 = (1.0 - am) * m_main + kx * model.stiffness + cv * model.damping + coupling;
             let j22 = (1.0 - am) * m_imp + coupling;
             let j12 = -coupling;
             let det = j11 * j22 - j12 * j12;
             let daw = -(j22 * rw - j12 * ry) / det;
             let day = -(-j12 * rw + j11 * ry) / det;
-            aw += daw;
-            ay += day;
-            // Round-off in the residual is relative to the largest force, so
-            // the tolerance is too (accelerations may cancel to near zero).
-            let forces = (model.stiffness * xfw)
-                .abs()
-                .max((model.damping * vfw).abs())
-                .max(push.abs())
-                .max(force_ext.abs());
-            let scale = aw
-                .abs()
-                .max(ay.abs())
-                .max(a0w.abs())
-                .max(a0y.abs())
-                .max(forces / m_main.min(m_imp));
-            if !(aw.is_finite() && ay.is_finite()) {
+            if !(daw.is_finite() && day.is_finite()) {
                 break;
             }
-            if daw.abs().max(day.abs()) <= 1e-13 * scale || scale == 0.0 {
+            // Converged when the update can no longer change the new
+            // displacements or velocities (round-off), is relatively tiny, or
+            // is within the round-off of the residual itself.
+            let floor = noise / j11.min(j22);
+            let invisible = |da: f64, a: f64, x: f64, v: f64| {
+                let mut tol = (1e-13 * a.abs().max(a0w.abs()).max(a0y.abs())).max(floor);
+                let by_v = 4.0 * f64::EPSILON * v.abs() / gv;
+                let by_x = if bx > 0.0 {
+                    4.0 * f64::EPSILON * x.abs() / bx
+                } else {
+                    f64::INFINITY
+                };
+                tol = tol.max(by_v.min(by_x));
+                da.abs() <= tol
+            };
+            let done = invisible(daw, aw, xw + bx * aw, vw + gv * aw)
+                && invisible(day, ay, xy + bx * ay, vy + gv * ay);
+            // Backtracking: halve the update until the residual falls, which
+            // keeps Newton from cycling across the kink where a law's force is
+            // clamped at zero.
+            if done {
+                // The update is at round-off: take it without evaluating again.
+                (aw, ay) = (aw + daw, ay + day);
+                converged = true;
+                break;
+            }
+            let before = norm(rw, ry);
+            let mut lambda = 1.0;
+            loop {
+                let (cw, cy) = (aw + lambda * daw, ay + lambda * day);
+                let (nw, ny, nc, nn) = residual(cw, cy);
+                self.evaluations += 1;
+                if norm(nw, ny) < before || lambda < 1e-3 {
+                    (aw, ay, rw, ry, coupling, noise) = (cw, cy, nw, ny, nc, nn);
+                    break;
+                }
+                lambda *= 0.5;
+            }
+            if norm(rw, ry) == 0.0 {
                 converged = true;
                 break;
             }
