@@ -247,7 +247,7 @@ Most adequate by our numbers: {best_note}.
 6. **The Hyster-Hertz law does not deliver the restitution it is given.** For two bodies
    alone the rebound/approach ratio `e*` obeys `alpha (1 + e*) = ln((1 + alpha)/(1 - alpha e*))`
    with `alpha = 3/4 (1 - e^2)`, whatever the stiffness, masses or speed; it never falls below
-   0.663. Our simulations agree with the relation:
+   0.66296 (its limit as e -> 0). Our simulations agree with the relation:
 
 {restitution_md}
 

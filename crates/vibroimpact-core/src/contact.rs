@@ -325,8 +325,8 @@ impl Contact {
     }
 
     /// The rebound/approach speed ratio two bodies alone get from the law
-    /// (without the contact damper): `e` for "hertz-damped", less than `e`
-    /// for "hyster-hertz" and never below 0.663.
+    /// (without the contact damper): `e` for "hertz-damped", more than `e`
+    /// for "hyster-hertz" and never below 0.66296.
     pub fn effective_restitution(&self) -> f64 {
         match self.law {
             LawKind::HysterHertz => {

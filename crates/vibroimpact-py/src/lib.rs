@@ -210,7 +210,7 @@ impl Contact {
     }
     /// The rebound/approach speed ratio two bodies alone get from the law
     /// (without the contact damper): e for "hertz-damped", more than e for
-    /// "hyster-hertz" (never below 0.663), 1 for "hertz" and "linear".
+    /// "hyster-hertz" (never below 0.66296), 1 for "hertz" and "linear".
     #[getter]
     fn effective_restitution(&self) -> f64 {
         self.0.effective_restitution()
