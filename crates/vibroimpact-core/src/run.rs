@@ -365,6 +365,51 @@ const ENERGY_INTERVAL: u64 = 32;
 /// An unforced system whose energy grows by more than this factor has blown up.
 const ENERGY_GROWTH_LIMIT: f64 = 1.5;
 
+/// Watches the mechanical energy of an unforced system, which can only fall:
+/// growth by half is a numerical blow-up, and the largest growth is reported.
+pub(crate) struct EnergyWatch {
+    initial: f64,
+    largest: f64,
+    /// Only an unforced system is watched.
+    active: bool,
+}
+
+impl EnergyWatch {
+    pub(crate) fn new(initial: f64, active: bool) -> Self {
+        Self {
+            initial,
+            largest: initial,
+            active,
+        }
+    }
+
+    /// Whether to check at this many steps (every few steps, and at the end).
+    #[inline(always)]
+    pub(crate) fn due(&self, steps: u64, last: bool) -> bool {
+        self.active && (steps % ENERGY_INTERVAL == 0 || last)
+    }
+
+    pub(crate) fn check(&mut self, energy: f64, time: f64) -> Result<()> {
+        self.largest = self.largest.max(energy);
+        if energy > ENERGY_GROWTH_LIMIT * self.initial {
+            return Err(Error::NumericalBlowUp {
+                time,
+                reason: "the energy of the unforced system grew by more than 50 %",
+            });
+        }
+        Ok(())
+    }
+
+    /// `max(E) / E(0) - 1`; NaN when forced or starting at rest.
+    pub(crate) fn growth(&self) -> f64 {
+        if self.active && self.initial > 0.0 {
+            self.largest / self.initial - 1.0
+        } else {
+            f64::NAN
+        }
+    }
+}
+
 /// The generic kernel. `interrupt` is called every few tens of thousands of
 /// steps; returning true stops the run with `Error::Interrupted`.
 pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
@@ -403,8 +448,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
     } else {
         None
     };
-    let energy0 = model.energy(&s);
-    let mut max_energy = energy0;
+    let mut watch = EnergyWatch::new(model.energy(&s), X::IS_FREE);
     integrator.start(model, &s, t0, dt, approach);
     // A countdown, not `step % every`: an integer division per step would
     // cost more than a Newmark step.
@@ -514,15 +558,8 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
             let force = model.contact(&s, approach).total_force;
             history.push(t1, &s, force);
         }
-        if X::IS_FREE && (step % ENERGY_INTERVAL == 0 || step == n_steps) {
-            let energy = model.energy(&s);
-            max_energy = max_energy.max(energy);
-            if energy > ENERGY_GROWTH_LIMIT * energy0 {
-                return Err(Error::NumericalBlowUp {
-                    time: t1,
-                    reason: "the energy of the unforced system grew by more than 50 %",
-                });
-            }
+        if watch.due(step, step == n_steps) {
+            watch.check(model.energy(&s), t1)?;
         }
         if step % INTERRUPT_INTERVAL == 0 && interrupt() {
             return Err(Error::Interrupted { time: t1 });
@@ -557,11 +594,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
         rhs_evaluations: n_steps * rhs_per_step,
         final_time: t0 + n_steps as f64 * dt,
         final_state: s,
-        energy_growth: if X::IS_FREE && energy0 > 0.0 {
-            max_energy / energy0 - 1.0
-        } else {
-            f64::NAN
-        },
+        energy_growth: watch.growth(),
     })
 }
 

@@ -200,55 +200,45 @@ impl Stepper for Rk4Stepper {
     }
 }
 
-/// Dormand-Prince 5(4) with error control; first same as last.
-#[derive(Debug, Clone)]
-pub struct Dopri5Stepper {
-    tolerances: Tolerances,
-    /// `f` at the current point, valid after `reset` or `accept`.
-    start: Vector,
-    /// `f` at the end of the last attempt.
-    pending: Vector,
-    evaluations: u64,
-}
-
-impl Dopri5Stepper {
-    pub fn new(tolerances: Tolerances) -> Self {
-        Self {
-            tolerances,
-            start: [0.0; 5],
-            pending: [0.0; 5],
-            evaluations: 0,
-        }
-    }
-}
-
-impl Stepper for Dopri5Stepper {
-    const ADAPTIVE: bool = true;
-    const CONTROL_EXPONENT: f64 = 5.0;
-
-    fn reset<L: ContactLaw, X: Excitation>(
-        &mut self,
-        model: &Model<L, X>,
-        time: f64,
-        y: &Vector,
-        mode: Mode,
-    ) {
-        self.start = derivative(model, time, y, mode);
-        self.evaluations += 1;
-    }
-
-    fn attempt<L: ContactLaw, X: Excitation>(
-        &mut self,
+/// An embedded Runge-Kutta pair: one step from `f` at its start, giving the
+/// end point, the scaled error and `f` at the end (first same as last).
+pub trait EmbeddedPair {
+    /// Order of the error estimate plus one, for the step-size controller.
+    const CONTROL_EXPONENT: f64;
+    /// Right-hand-side evaluations per step (the start's excluded).
+    const EVALUATIONS: u64;
+    #[allow(clippy::too_many_arguments)]
+    fn step<L: ContactLaw, X: Excitation>(
         model: &Model<L, X>,
         time: f64,
         y: &Vector,
         h: f64,
         mode: Mode,
-    ) -> Result<Attempt> {
+        start: &Vector,
+        tolerances: &Tolerances,
+    ) -> (Vector, f64, Vector);
+}
+
+/// Dormand-Prince 5(4).
+#[derive(Debug, Clone, Copy)]
+pub struct Dopri5;
+
+impl EmbeddedPair for Dopri5 {
+    const CONTROL_EXPONENT: f64 = 5.0;
+    const EVALUATIONS: u64 = 6;
+
+    fn step<L: ContactLaw, X: Excitation>(
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+        start: &Vector,
+        tolerances: &Tolerances,
+    ) -> (Vector, f64, Vector) {
         let mut k = [[0.0; 5]; 7];
-        k[0] = self.start;
+        k[0] = *start;
         stages(model, time, y, h, mode, &DOPRI5_C, &DOPRI5_A, &mut k);
-        self.evaluations += 6;
         let end = combine(y, h, &DOPRI5_B, &k);
         let mut sum = 0.0;
         for n in 0..4 {
@@ -257,81 +247,38 @@ impl Stepper for Dopri5Stepper {
                 .zip(k.iter())
                 .map(|(ei, ki)| ei * ki[n])
                 .sum();
-            let ratio = h * e / self.tolerances.scale(y, &end, n);
+            let ratio = h * e / tolerances.scale(y, &end, n);
             sum += ratio * ratio;
         }
-        self.pending = k[6];
-        Ok(Attempt {
-            end,
-            error: (sum / 4.0).sqrt(),
-        })
-    }
-
-    fn accept(&mut self) {
-        self.start = self.pending;
-    }
-
-    fn evaluations(&self) -> u64 {
-        self.evaluations
-    }
-
-    fn tolerance(&self) -> f64 {
-        self.tolerances.rtol
+        (end, (sum / 4.0).sqrt(), k[6])
     }
 }
 
-/// DOP853 with its combined fifth/third-order error estimate.
-#[derive(Debug, Clone)]
-pub struct Dop853Stepper {
-    tolerances: Tolerances,
-    start: Vector,
-    pending: Vector,
-    evaluations: u64,
-}
+/// DOP853, with its combined fifth/third-order error estimate.
+#[derive(Debug, Clone, Copy)]
+pub struct Dop853;
 
-impl Dop853Stepper {
-    pub fn new(tolerances: Tolerances) -> Self {
-        Self {
-            tolerances,
-            start: [0.0; 5],
-            pending: [0.0; 5],
-            evaluations: 0,
-        }
-    }
-}
-
-impl Stepper for Dop853Stepper {
-    const ADAPTIVE: bool = true;
+impl EmbeddedPair for Dop853 {
     const CONTROL_EXPONENT: f64 = 8.0;
+    const EVALUATIONS: u64 = 12;
 
-    fn reset<L: ContactLaw, X: Excitation>(
-        &mut self,
-        model: &Model<L, X>,
-        time: f64,
-        y: &Vector,
-        mode: Mode,
-    ) {
-        self.start = derivative(model, time, y, mode);
-        self.evaluations += 1;
-    }
-
-    fn attempt<L: ContactLaw, X: Excitation>(
-        &mut self,
+    fn step<L: ContactLaw, X: Excitation>(
         model: &Model<L, X>,
         time: f64,
         y: &Vector,
         h: f64,
         mode: Mode,
-    ) -> Result<Attempt> {
+        start: &Vector,
+        tolerances: &Tolerances,
+    ) -> (Vector, f64, Vector) {
         let mut k = [[0.0; 5]; 12];
-        k[0] = self.start;
+        k[0] = *start;
         stages(model, time, y, h, mode, &DOP853_C, &DOP853_A, &mut k);
         let end = combine(y, h, &DOP853_B, &k);
         let last = derivative(model, time + h, &end, mode);
-        self.evaluations += 12;
         let (mut err5, mut err3) = (0.0, 0.0);
         for n in 0..4 {
-            let scale = self.tolerances.scale(y, &end, n);
+            let scale = tolerances.scale(y, &end, n);
             let mut e5 = DOP853_E5[12] * last[n];
             let mut e3 = DOP853_E3[12] * last[n];
             for (i, ki) in k.iter().enumerate() {
@@ -347,6 +294,64 @@ impl Stepper for Dop853Stepper {
         } else {
             0.0
         };
+        (end, error, last)
+    }
+}
+
+/// An embedded pair with error control, carrying `f` from step to step.
+#[derive(Debug, Clone)]
+pub struct Adaptive<P: EmbeddedPair> {
+    tolerances: Tolerances,
+    /// `f` at the current point, valid after `reset` or `accept`.
+    start: Vector,
+    /// `f` at the end of the last attempt.
+    pending: Vector,
+    evaluations: u64,
+    pair: std::marker::PhantomData<P>,
+}
+
+impl<P: EmbeddedPair> Adaptive<P> {
+    pub fn new(tolerances: Tolerances) -> Self {
+        Self {
+            tolerances,
+            start: [0.0; 5],
+            pending: [0.0; 5],
+            evaluations: 0,
+            pair: std::marker::PhantomData,
+        }
+    }
+}
+
+/// Dormand-Prince 5(4) with error control.
+pub type Dopri5Stepper = Adaptive<Dopri5>;
+/// DOP853 with error control.
+pub type Dop853Stepper = Adaptive<Dop853>;
+
+impl<P: EmbeddedPair> Stepper for Adaptive<P> {
+    const ADAPTIVE: bool = true;
+    const CONTROL_EXPONENT: f64 = P::CONTROL_EXPONENT;
+
+    fn reset<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        mode: Mode,
+    ) {
+        self.start = derivative(model, time, y, mode);
+        self.evaluations += 1;
+    }
+
+    fn attempt<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<Attempt> {
+        let (end, error, last) = P::step(model, time, y, h, mode, &self.start, &self.tolerances);
+        self.evaluations += P::EVALUATIONS;
         self.pending = last;
         Ok(Attempt { end, error })
     }
