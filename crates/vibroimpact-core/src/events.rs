@@ -63,8 +63,50 @@ struct Crossing {
     guess: f64,
 }
 
+/// Both ends of a free step outside contact, the gap's rate falling through
+/// zero: touching and leaving within the step shows as a positive interior
+/// maximum. The sixth-order interpolant finds it; where it and the cubic
+/// disagree by more than its margin below the wall, the maximum is probed
+/// with the method itself (by `locate`). Rare, so kept out of the hot loop.
+#[cold]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn interior_touch<L: ContactLaw, X: Excitation>(
+    model: &Model<L, X>,
+    time: f64,
+    y: &Vector,
+    end: &Vector,
+    h: f64,
+    mode: Mode,
+    side: f64,
+    graze_tolerance: f64,
+    grazes: &mut u64,
+) -> Option<Crossing> {
+    let (g0, r0) = gap(model, y, side);
+    let (g1, r1) = gap(model, end, side);
+    let (m0, m1) = (r0 * h, r1 * h);
+    let quintic = gap_quintic(model, time, y, end, h, mode, side);
+    let theta = quintic.argmax();
+    let peak = quintic.eval(theta).0;
+    let cubic = hermite::eval(g0, g1, m0, m1, hermite::argmax(g0, g1, m0, m1)).0;
+    if peak > graze_tolerance || peak + (peak - cubic).abs() > 0.0 {
+        Some(Crossing {
+            side,
+            before: 0.0,
+            after: None,
+            guess: theta,
+        })
+    } else {
+        if peak > 0.0 {
+            *grazes += 1;
+        }
+        None
+    }
+}
+
 /// Looks for a mode change in the step `y -> end` of length `h`.
 /// `graze_tolerance` (m): an interior touch shallower than that is a graze.
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn find_crossing<L: ContactLaw, X: Excitation>(
     model: &Model<L, X>,
@@ -96,28 +138,7 @@ fn find_crossing<L: ContactLaw, X: Excitation>(
                         guess,
                     })
                 } else if m0 > 0.0 && m1 < 0.0 {
-                    // Both ends outside contact: touching and leaving within
-                    // the step shows as a positive interior maximum. The
-                    // sixth-order interpolant finds it; where it and the cubic
-                    // disagree by more than its margin below the wall, the
-                    // maximum is probed with the method itself.
-                    let quintic = gap_quintic(model, time, y, end, h, mode, side);
-                    let theta = quintic.argmax();
-                    let peak = quintic.eval(theta).0;
-                    let cubic = hermite::eval(g0, g1, m0, m1, hermite::argmax(g0, g1, m0, m1)).0;
-                    if peak > graze_tolerance || peak + (peak - cubic).abs() > 0.0 {
-                        Some(Crossing {
-                            side,
-                            before: 0.0,
-                            after: None,
-                            guess: theta,
-                        })
-                    } else {
-                        if peak > 0.0 {
-                            *grazes += 1;
-                        }
-                        None
-                    }
+                    interior_touch(model, time, y, end, h, mode, side, graze_tolerance, grazes)
                 } else {
                     None
                 };

@@ -532,6 +532,9 @@ impl Stepper for NewmarkFamily {
         let (mut rw, mut ry, mut coupling, mut noise) = residual(aw, ay);
         self.evaluations += 1;
         let mut converged = false;
+        // Apart, and with the law's force lagged, the equations are linear in
+        // the new accelerations: one Newton update solves them exactly.
+        let linear = self.lagged || matches!(mode, Mode::Free);
         for _ in 0..NEWTON_ITERATIONS {
             // Jacobian d(r)/d(a_(n+1)): symmetric 2x2.
             let j11 = (1.0 - am) * m_main + kx * model.stiffness + cv * model.damping + coupling;
@@ -563,8 +566,8 @@ impl Stepper for NewmarkFamily {
             // Backtracking: halve the update until the residual falls, which
             // keeps Newton from cycling across the kink where a law's force is
             // clamped at zero.
-            if done {
-                // The update is at round-off: take it without evaluating again.
+            if done || linear {
+                // The update is at round-off, or exact: take it as it is.
                 (aw, ay) = (aw + daw, ay + day);
                 converged = true;
                 break;
