@@ -314,7 +314,7 @@ fn locate<L: ContactLaw, X: Excitation, S: Stepper>(
         }
     }
     // The stepper's pending data must belong to the step that is kept.
-    if !holds_hi {
+    if !holds_hi && S::CARRIES_DATA {
         best = stepper.attempt(model, time, y, hi, mode)?;
     }
     Ok(Location::Cut(hi, best))
@@ -340,7 +340,9 @@ fn peak_indentation<L: ContactLaw, X: Excitation, S: Stepper>(
     let theta = quintic.argmax();
     let probe = stepper.attempt(model, time, y, theta * taken, mode)?;
     // The stepper's pending data must belong to the step that is kept.
-    stepper.attempt(model, time, y, taken, mode)?;
+    if S::CARRIES_DATA {
+        stepper.attempt(model, time, y, taken, mode)?;
+    }
     Ok(gap(model, &probe.end, side).0)
 }
 
@@ -549,11 +551,15 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 }
                 // Not confirmed: the stepper must hold the full step again.
                 Location::Unconfirmed => {
-                    attempt = stepper.attempt(model, time, &y, length, mode)?
+                    if S::CARRIES_DATA {
+                        attempt = stepper.attempt(model, time, &y, length, mode)?
+                    }
                 }
                 Location::Graze => {
                     grazes += 1;
-                    attempt = stepper.attempt(model, time, &y, length, mode)?
+                    if S::CARRIES_DATA {
+                        attempt = stepper.attempt(model, time, &y, length, mode)?
+                    }
                 }
             }
         }

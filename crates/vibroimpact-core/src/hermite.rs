@@ -57,18 +57,52 @@ pub(crate) fn root(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
 }
 
 /// Where the cubic's slope falls from `m0 > 0` to `m1 <= 0`: its maximum
-/// over the step. Bisection on the slope (a quadratic).
+/// over the step. The slope is a quadratic in theta, with one root in [0, 1]
+/// where it changes sign; found by the Illinois method (a few evaluations,
+/// where bisection to round-off would take sixty).
 pub(crate) fn argmax(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
+    falling_root(|t| eval(g0, g1, m0, m1, t).1)
+}
+
+/// The root in [0, 1] of `slope`, positive at 0 and not positive at 1:
+/// regula falsi with the Illinois modification, to round-off.
+pub(crate) fn falling_root(slope: impl Fn(f64) -> f64) -> f64 {
     let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if eval(g0, g1, m0, m1, mid).1 > 0.0 {
-            lo = mid;
+    let (mut s_lo, mut s_hi) = (slope(lo), slope(hi));
+    if s_hi >= 0.0 {
+        return hi;
+    }
+    let (mut best, mut best_s) = (hi, s_hi.abs());
+    let mut kept = 0i8;
+    for _ in 0..200 {
+        let mut t = hi - s_hi * (hi - lo) / (s_hi - s_lo);
+        if !(t > lo && t < hi) {
+            t = 0.5 * (lo + hi);
+        }
+        let s = slope(t);
+        if s.abs() < best_s {
+            (best, best_s) = (t, s.abs());
+        }
+        if s > 0.0 {
+            lo = t;
+            s_lo = s;
+            if kept == -1 {
+                s_hi *= 0.5;
+            }
+            kept = -1;
         } else {
-            hi = mid;
+            hi = t;
+            s_hi = s;
+            if kept == 1 {
+                s_lo *= 0.5;
+            }
+            kept = 1;
+        }
+        if s == 0.0 || hi - lo <= 4.0 * f64::EPSILON {
+            break;
         }
     }
-    0.5 * (lo + hi)
+    best
 }
 
 #[cfg(test)]
@@ -175,16 +209,7 @@ impl Quintic {
     /// Where the slope falls through zero in `[0, 1]` (slope > 0 at 0 and
     /// <= 0 at 1): the maximum over the step.
     pub(crate) fn argmax(&self) -> f64 {
-        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-        for _ in 0..64 {
-            let mid = 0.5 * (lo + hi);
-            if self.eval(mid).1 > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        0.5 * (lo + hi)
+        falling_root(|t| self.eval(t).1)
     }
 }
 

@@ -51,6 +51,9 @@ pub trait Stepper {
     const ADAPTIVE: bool;
     /// Order of the error estimate plus one, for the step-size controller.
     const CONTROL_EXPONENT: f64;
+    /// Whether `accept` needs the last attempt to be the accepted step (it
+    /// carries data from it); a stateless stepper need not redo a step.
+    const CARRIES_DATA: bool = true;
     /// Start, or restart after a mode switch: data carried from step to step
     /// (accelerations, first-same-as-last stages) is rebuilt, because the
     /// right-hand side jumps at a mode switch.
@@ -165,6 +168,7 @@ pub struct Rk4Stepper {
 impl Stepper for Rk4Stepper {
     const ADAPTIVE: bool = false;
     const CONTROL_EXPONENT: f64 = 5.0;
+    const CARRIES_DATA: bool = false;
     fn reset<L: ContactLaw, X: Excitation>(
         &mut self,
         _: &Model<L, X>,
