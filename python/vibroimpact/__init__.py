@@ -3,7 +3,10 @@
 A main structure (one mode: mass ``M``, spring ``K``, damper ``C``) carries an
 enclosure in which a loose impact mass ``m`` rattles with a clearance ``d`` on
 each side. Contacts follow compliant laws (Hertz, Lankarani-Nikravesh
-"Hyster-Hertz", linear) with a contact damper ``c1``. SI units throughout.
+"Hyster-Hertz", "hertz-damped" with an exact restitution, linear) with a
+contact damper ``c1``. Methods: the founding paper's lagged Newmark-beta,
+implicit Newmark, generalised-alpha, RK4, and adaptive DOP5(4) and DOP853,
+with contact events located to round-off. SI units throughout.
 
 >>> import vibroimpact as vi
 >>> system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, damping=0.01,

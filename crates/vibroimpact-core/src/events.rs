@@ -394,6 +394,16 @@ const INTERRUPT_INTERVAL: u64 = 1 << 14;
 const CHATTER_FRACTION: f64 = 1e-12;
 const CHATTER_EVENTS: u64 = 16;
 
+/// Rebound over approach speed; NaN for a contact that did not start by an
+/// approach (one open at t = 0 with the bodies at rest or separating).
+pub(crate) fn restitution(rebound: f64, approach: f64) -> f64 {
+    if approach > 0.0 {
+        rebound / approach
+    } else {
+        f64::NAN
+    }
+}
+
 /// The mode of the initial state: in contact when indented, or exactly at a
 /// wall and moving into it.
 fn initial_mode<L: ContactLaw, X: Excitation>(model: &Model<L, X>, y: &Vector) -> Mode {
@@ -655,7 +665,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                             max_indentation: oc.max_indentation,
                             approach_speed: oc.approach_speed,
                             rebound_speed: rebound,
-                            restitution: rebound / oc.approach_speed,
+                            restitution: restitution(rebound, oc.approach_speed),
                             energy_dissipated: y[4] - oc.dissipated_at_onset,
                         });
                     }

@@ -542,7 +542,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                         max_indentation: oc.max_indentation,
                         approach_speed: oc.approach_speed,
                         rebound_speed: -rate,
-                        restitution: -rate / oc.approach_speed,
+                        restitution: crate::events::restitution(-rate, oc.approach_speed),
                         energy_dissipated: oc.dissipated + 0.5 * theta * dt * (p0 + p_sep),
                     });
                     open = None;
