@@ -841,3 +841,24 @@ def test_newton_is_translation_invariant() -> None:
                     continue
                 assert sol.contacts.onset[0] == pytest.approx(0.1, rel=1e-6)
     assert failures == []
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [{"method": "rk4", "dt": 1e-3, "stepping": "events"}, {"method": "dop853"}],
+    ids=["rk4", "dop853"],
+)
+def test_contacts_faster_than_the_time_resolution_stop_with_a_clear_error(
+    settings: dict[str, Any],
+) -> None:
+    """A 1 nm gap and an absurdly stiff contact (K_hz = 1e30 N/m^1.5): contacts and
+    flights of ~1e-13 s follow each other, below the run's time resolution. The run
+    must stop at once with a SimulationError (chattering, or a step at round-off),
+    never loop or hang."""
+    system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=1e-9)
+    contact = vi.Contact("hertz", stiffness=1e30)
+    start = vi.InitialState(impact_velocity=0.1)
+    with time_limit(20):
+        with pytest.raises(vi.SimulationError, match="chattering|too small") as err:
+            vi.simulate(system, contact, start, t_end=1.0, max_steps=10**7, **settings)
+    assert "\n" not in str(err.value)

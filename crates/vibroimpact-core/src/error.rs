@@ -31,8 +31,9 @@ pub enum Error {
     NewtonFailed { time: f64 },
     /// Contacts and separations follow each other ever faster.
     #[error(
-        "chattering at t = {time:.6e} s: {events} contact changes in a row less than {interval:.1e} s apart \
-         (the impact mass is settling against a wall); the run was stopped there"
+        "chattering at t = {time:.6e} s: {events} contact changes in a row less than {interval:.1e} s apart, \
+         below the run's time resolution (an impact mass settling against a wall, or a contact far too stiff \
+         for the clearance); the run was stopped there"
     )]
     Chattering {
         time: f64,
