@@ -1,14 +1,35 @@
-"""The extension's type stub matches the compiled module."""
+"""Code-quality gates that run with the tests: the extension's stub matches the
+compiled module, the Python sources pass ruff and mypy, the Rust sources are
+formatted."""
 
+import shutil
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*argv: str) -> None:
+    done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
 
 
 def test_stub_matches_the_extension_module() -> None:
-    done = subprocess.run(
-        [sys.executable, "-m", "mypy.stubtest", "vibroimpact._core"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert done.returncode == 0, done.stdout + done.stderr
+    run(sys.executable, "-m", "mypy.stubtest", "vibroimpact._core")
+
+
+def test_python_sources_pass_ruff() -> None:
+    run(sys.executable, "-m", "ruff", "check", "python", "tests", "benchmarks")
+    run(sys.executable, "-m", "ruff", "format", "--check", "python", "tests", "benchmarks")
+
+
+def test_python_package_passes_mypy_strict() -> None:
+    run(sys.executable, "-m", "mypy")
+
+
+@pytest.mark.skipif(shutil.which("cargo") is None, reason="needs cargo")
+def test_rust_sources_are_formatted() -> None:
+    run("cargo", "fmt", "--all", "--check")
