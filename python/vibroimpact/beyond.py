@@ -26,7 +26,7 @@ HERTZ_STIFFNESS, CONTACT_DAMPING, APPROACH_SPEED = 3000.0, 0.01, 0.1
 STUDY_TIME = 0.11
 
 STEP_SIZES = (4e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)
-TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
 # (label, method, stepping): the fixed-step runs.
 FIXED_RUNS = (
     ("newmark (paper)", "newmark", "fixed"),

@@ -578,7 +578,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             if rejects(error) {
                 rejected += 1;
                 let factor = if error.is_finite() {
-                    (0.9 * error.powf(-1.0 / S::CONTROL_EXPONENT)).clamp(0.1, 0.9)
+                    (0.9 * S::shrink(error)).clamp(0.1, 0.9)
                 } else {
                     0.1
                 };
@@ -597,7 +597,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             }
             let most = if just_rejected { 1.0 } else { 5.0 };
             let factor = if error > 0.0 {
-                (0.9 * error.powf(-1.0 / S::CONTROL_EXPONENT)).clamp(0.2, most)
+                (0.9 * S::shrink(error)).clamp(0.2, most)
             } else {
                 most
             };
