@@ -25,7 +25,7 @@ HERTZ_STIFFNESS, CONTACT_DAMPING, APPROACH_SPEED = 3000.0, 0.01, 0.1
 # Long enough for the contact (about 0.109 s) to end, short of the next one.
 STUDY_TIME = 0.11
 
-STEP_SIZES = (4e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)
+STEP_SIZES = (4e-3, 3e-3, 2.5e-3, 2.2e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4)
 TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12)
 # (label, method, stepping): the fixed-step runs.
 FIXED_RUNS = (
