@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from vibroimpact._core import Contact, ImpactDamper, InitialState, Solution, simulate
+from vibroimpact.scenario import paper_collision
 
 # Table 1 of the paper, at the onset of a 0.1 m/s collision (SI units).
 MAIN_MASS, STIFFNESS, DAMPING = 1.0, 1.0, 0.01
@@ -54,18 +55,8 @@ class StudyRun:
 
 def table1(restitution: float | None = None) -> tuple[ImpactDamper, Contact, InitialState]:
     """The Table 1 system, its contact (Hertz, or Hyster-Hertz with ``restitution``), onset."""
-    law = "hertz" if restitution is None else "hyster-hertz"
-    return (
-        ImpactDamper(
-            main_mass=MAIN_MASS,
-            stiffness=STIFFNESS,
-            damping=DAMPING,
-            impact_mass=IMPACT_MASS,
-            clearance=CLEARANCE,
-        ),
-        Contact(law, stiffness=HERTZ_STIFFNESS, damping=CONTACT_DAMPING, restitution=restitution),
-        InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED),
-    )
+    scenario = paper_collision(restitution)
+    return scenario.system, scenario.contact, scenario.initial
 
 
 def median_time(

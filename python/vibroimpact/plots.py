@@ -13,13 +13,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from vibroimpact._core import Contact, Solution, goldsmith_max_indentation  # noqa: E402
-from vibroimpact.beyond import StudyRun  # noqa: E402
-from vibroimpact.paper import (  # noqa: E402
+from vibroimpact.beyond import (  # noqa: E402
     CONTACT_DAMPING,
     HERTZ_STIFFNESS,
-    PAPER_LINEAR_STIFFNESS,
-    collision,
+    StudyRun,  # noqa: E402
 )
+from vibroimpact.paper import PAPER_LINEAR_STIFFNESS, collision  # noqa: E402
 
 
 def _contact_phase(sol: Solution, clearance: float = 0.01) -> dict[str, Any]:

@@ -82,13 +82,17 @@ fn interior_touch<L: ContactLaw, X: Excitation>(
     graze_tolerance: f64,
     grazes: &mut u64,
 ) -> Option<Crossing> {
-    let (g0, r0) = gap(model, y, side);
-    let (g1, r1) = gap(model, end, side);
-    let (m0, m1) = (r0 * h, r1 * h);
-    let quintic = gap_quintic(model, time, y, end, h, mode, side);
-    let theta = quintic.argmax();
-    let peak = quintic.eval(theta).0;
-    let cubic = hermite::eval(g0, g1, m0, m1, hermite::argmax(g0, g1, m0, m1)).0;
+    let q = gap_quintic(model, time, y, end, h, mode, side);
+    let theta = q.argmax();
+    let peak = q.eval(theta).0;
+    let cubic = hermite::eval(
+        q.g0,
+        q.g1,
+        q.m0,
+        q.m1,
+        hermite::argmax(q.g0, q.g1, q.m0, q.m1),
+    )
+    .0;
     if peak > graze_tolerance || peak + (peak - cubic).abs() > 0.0 {
         Some(Crossing {
             side,

@@ -105,25 +105,16 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
     /// The contact in state `s` (zero forces when not in contact).
     #[inline(always)]
     pub fn contact(&self, s: &State, approach_rate: f64) -> ContactState {
-        let side = self.side(s);
-        let indentation = side * s.relative_displacement() - self.clearance;
-        let rate = side * s.relative_velocity();
-        if indentation > 0.0 {
-            let law_force = self.law.force(indentation, rate, approach_rate);
-            ContactState {
-                side,
-                indentation,
-                rate,
-                law_force,
-                total_force: law_force + self.contact_damping * rate,
-            }
+        let c = self.contact_at(s, self.side(s), approach_rate);
+        if c.indentation > 0.0 {
+            c
         } else {
+            // Apart: by the sign of the indentation, no force at all (the
+            // fixed-step kernels have no contact mode to keep the damper on).
             ContactState {
-                side,
-                indentation,
-                rate,
                 law_force: 0.0,
                 total_force: 0.0,
+                ..c
             }
         }
     }
