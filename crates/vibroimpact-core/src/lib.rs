@@ -16,6 +16,7 @@ pub mod integrators;
 pub mod materials;
 pub mod model;
 pub mod run;
+pub mod signals;
 pub mod steppers;
 pub mod system;
 pub mod tableau;

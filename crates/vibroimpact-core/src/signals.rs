@@ -1,0 +1,428 @@
+//! Excitation signals: functions of time that scale a force (N) or a base
+//! acceleration (m/s^2). Deterministic ones are evaluated in closed form;
+//! random ones are generated once from a seed into samples that are then
+//! interpolated linearly, so a run reads them without allocating.
+//!
+//! The random generators use only IEEE-754 basic operations (+, -, *, /,
+//! sqrt), never the platform's `ln`, `exp` or `cos`, so the same seed gives
+//! the same signal bit for bit on every platform.
+
+use crate::error::{finite, non_negative, positive, Error, Result};
+
+/// Most samples a generated or recorded signal may hold (8 bytes each: 800 MB).
+pub const MAX_SIGNAL_SAMPLES: usize = 100_000_000;
+
+/// One harmonic, `amplitude cos(2 pi frequency t + phase)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Harmonic {
+    /// In the unit of the signal (N or m/s^2).
+    pub amplitude: f64,
+    /// Hz (>= 0).
+    pub frequency: f64,
+    /// rad.
+    pub phase: f64,
+}
+
+impl Harmonic {
+    /// Validated: every value finite, the frequency not negative.
+    pub fn new(amplitude: f64, frequency: f64, phase: f64) -> Result<Self> {
+        Ok(Self {
+            amplitude: finite("amplitude", amplitude)?,
+            frequency: non_negative("frequency", frequency)?,
+            phase: finite("phase", phase)?,
+        })
+    }
+
+    #[inline(always)]
+    fn value(&self, time: f64) -> f64 {
+        self.amplitude * (std::f64::consts::TAU * self.frequency * time + self.phase).cos()
+    }
+}
+
+/// How a swept sine's frequency moves from start to end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SweepLaw {
+    /// `f(t) = f0 + (f1 - f0) t / T`.
+    Linear,
+    /// `f(t) = f0 (f1 / f0)^(t / T)`: the same time per octave.
+    Logarithmic,
+}
+
+impl SweepLaw {
+    pub const NAMES: &'static str = "\"linear\", \"logarithmic\"";
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "linear" => Ok(Self::Linear),
+            "logarithmic" => Ok(Self::Logarithmic),
+            _ => Err(Error::UnknownChoice {
+                field: "sweep",
+                allowed: Self::NAMES,
+                value: name.to_string(),
+            }),
+        }
+    }
+}
+
+/// A signal of time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Signal {
+    /// One harmonic.
+    Harmonic(Harmonic),
+    /// A sum of harmonics.
+    Harmonics(Vec<Harmonic>),
+    /// `amplitude cos(theta(t) + phase)` whose instantaneous frequency
+    /// `theta'(t) / 2 pi` goes from `start_frequency` to `end_frequency` (Hz)
+    /// over `duration` (s), then stays at the end frequency (the phase is
+    /// continuous throughout).
+    Sweep {
+        amplitude: f64,
+        start_frequency: f64,
+        end_frequency: f64,
+        duration: f64,
+        law: SweepLaw,
+        phase: f64,
+    },
+    /// Values at increasing times, linearly interpolated, zero outside the
+    /// record (a recorded ground motion ends at rest).
+    Recorded { time: Vec<f64>, value: Vec<f64> },
+    /// Values every `interval` s from t = 0, linearly interpolated, zero
+    /// after the last sample (generated random signals).
+    Sampled { interval: f64, value: Vec<f64> },
+}
+
+impl Signal {
+    /// One harmonic, `amplitude cos(2 pi frequency t + phase)`.
+    pub fn harmonic(amplitude: f64, frequency: f64, phase: f64) -> Result<Self> {
+        Harmonic::new(amplitude, frequency, phase).map(Self::Harmonic)
+    }
+
+    /// A swept sine (see [`Signal::Sweep`]); a logarithmic sweep needs both
+    /// frequencies > 0.
+    pub fn sweep(
+        amplitude: f64,
+        start_frequency: f64,
+        end_frequency: f64,
+        duration: f64,
+        law: SweepLaw,
+        phase: f64,
+    ) -> Result<Self> {
+        let check = match law {
+            SweepLaw::Linear => non_negative,
+            SweepLaw::Logarithmic => positive,
+        };
+        Ok(Self::Sweep {
+            amplitude: finite("amplitude", amplitude)?,
+            start_frequency: check("start_frequency", start_frequency)?,
+            end_frequency: check("end_frequency", end_frequency)?,
+            duration: positive("duration", duration)?,
+            law,
+            phase: finite("phase", phase)?,
+        })
+    }
+
+    /// A recorded signal: `time` (s) strictly increasing, at least two
+    /// samples, `value` of the same length, both finite; values multiplied by
+    /// `scale`.
+    pub fn recorded(time: Vec<f64>, value: Vec<f64>, scale: f64) -> Result<Self> {
+        let scale = finite("scale", scale)?;
+        if time.len() != value.len() {
+            return Err(Error::Inconsistent(format!(
+                "a recorded signal needs as many values as times, got {} times and {} values",
+                time.len(),
+                value.len()
+            )));
+        }
+        if time.len() < 2 {
+            return Err(Error::Inconsistent(format!(
+                "a recorded signal needs at least 2 samples, got {}",
+                time.len()
+            )));
+        }
+        if time.len() > MAX_SIGNAL_SAMPLES {
+            return Err(Error::Inconsistent(format!(
+                "a recorded signal may hold at most {MAX_SIGNAL_SAMPLES} samples, got {}",
+                time.len()
+            )));
+        }
+        for (row, (&t, &v)) in time.iter().zip(&value).enumerate() {
+            if !t.is_finite() || !v.is_finite() {
+                return Err(Error::Inconsistent(format!(
+                    "a recorded signal must be finite: row {row} has time {t} and value {v}"
+                )));
+            }
+            if row > 0 && t <= time[row - 1] {
+                return Err(Error::Inconsistent(format!(
+                    "recorded times must increase strictly: row {row} has {t} s after {} s",
+                    time[row - 1]
+                )));
+            }
+        }
+        let value = value.into_iter().map(|v| v * scale).collect();
+        Ok(Self::Recorded { time, value })
+    }
+
+    /// Band-limited Gaussian white noise of two-sided power spectral density
+    /// `intensity` S0 (unit^2 per rad/s) up to `cutoff_frequency` (Hz), over
+    /// `duration` (s): independent samples of variance `2 S0 omega_c` every
+    /// `pi / omega_c` s (the Nyquist interval of the cutoff), linearly
+    /// interpolated. Its spectral density at low frequency is S0.
+    pub fn white_noise(
+        intensity: f64,
+        cutoff_frequency: f64,
+        duration: f64,
+        seed: u64,
+    ) -> Result<Self> {
+        let (interval, count) = noise_grid(intensity, cutoff_frequency, duration)?;
+        let cutoff = std::f64::consts::TAU * cutoff_frequency;
+        let deviation = (2.0 * intensity * cutoff).sqrt();
+        let mut gauss = Gaussian::new(seed);
+        let value = (0..count).map(|_| deviation * gauss.next()).collect();
+        Ok(Self::Sampled { interval, value })
+    }
+
+    /// The Kanai-Tajimi ground acceleration (m/s^2): band-limited white noise
+    /// of intensity S0 (see [`Signal::white_noise`]) filtered by the ground,
+    /// a damped oscillator of `ground_frequency` (Hz) and `ground_damping`,
+    /// whose absolute acceleration is the signal. Its spectral density is
+    /// `S0 (wg^4 + 4 zg^2 wg^2 w^2) / ((wg^2 - w^2)^2 + 4 zg^2 wg^2 w^2)`.
+    /// The filter starts at rest; the cutoff must exceed the ground frequency.
+    pub fn kanai_tajimi(
+        intensity: f64,
+        ground_frequency: f64,
+        ground_damping: f64,
+        cutoff_frequency: f64,
+        duration: f64,
+        seed: u64,
+    ) -> Result<Self> {
+        let ground = std::f64::consts::TAU * positive("ground_frequency", ground_frequency)?;
+        let zeta = positive("ground_damping", ground_damping)?;
+        if cutoff_frequency.is_finite() && cutoff_frequency <= ground_frequency {
+            return Err(Error::Inconsistent(format!(
+                "cutoff_frequency ({cutoff_frequency} Hz) must exceed ground_frequency ({ground_frequency} Hz)"
+            )));
+        }
+        let Self::Sampled { interval, value } =
+            Self::white_noise(intensity, cutoff_frequency, duration, seed)?
+        else {
+            unreachable!("white_noise returns samples")
+        };
+        // The filter x'' + 2 zg wg x' + wg^2 x = -w(t) by RK4 on sub-steps of
+        // at most 1/20 of the ground period's radian (basic operations only:
+        // the result is the same on every platform); w is linear in between.
+        let substeps = (20.0 * ground * interval).ceil().max(1.0) as usize;
+        let h = interval / substeps as f64;
+        let (a, b) = (2.0 * zeta * ground, ground * ground);
+        let rate = |x: f64, v: f64, w: f64| (v, -a * v - b * x - w);
+        let (mut x, mut v) = (0.0f64, 0.0f64);
+        let mut out = Vec::with_capacity(value.len());
+        out.push(0.0);
+        for pair in value.windows(2) {
+            let (w0, w1) = (pair[0], pair[1]);
+            for k in 0..substeps {
+                let at = |s: f64| w0 + (w1 - w0) * ((k as f64 + s) / substeps as f64);
+                let (wa, wm, wb) = (at(0.0), at(0.5), at(1.0));
+                let (k1x, k1v) = rate(x, v, wa);
+                let (k2x, k2v) = rate(x + 0.5 * h * k1x, v + 0.5 * h * k1v, wm);
+                let (k3x, k3v) = rate(x + 0.5 * h * k2x, v + 0.5 * h * k2v, wm);
+                let (k4x, k4v) = rate(x + h * k3x, v + h * k3v, wb);
+                x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+                v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+            }
+            // The ground's absolute acceleration x'' + w.
+            out.push(-a * v - b * x);
+        }
+        Ok(Self::Sampled {
+            interval,
+            value: out,
+        })
+    }
+
+    /// The signal's value at `time` (s).
+    #[inline]
+    pub fn value(&self, time: f64) -> f64 {
+        match self {
+            Self::Harmonic(h) => h.value(time),
+            Self::Harmonics(list) => list.iter().map(|h| h.value(time)).sum(),
+            Self::Sweep {
+                amplitude,
+                start_frequency,
+                end_frequency,
+                duration,
+                law,
+                phase,
+            } => {
+                amplitude
+                    * (sweep_phase(*start_frequency, *end_frequency, *duration, *law, time) + phase)
+                        .cos()
+            }
+            Self::Recorded { time: times, value } => {
+                let last = times.len() - 1;
+                if !(time >= times[0] && time <= times[last]) {
+                    return 0.0;
+                }
+                // The first sample after `time` (a binary search: the hot loop
+                // reads it once per stage).
+                let next = times.partition_point(|&t| t <= time).clamp(1, last);
+                let (t0, t1) = (times[next - 1], times[next]);
+                let (v0, v1) = (value[next - 1], value[next]);
+                v0 + (v1 - v0) * ((time - t0) / (t1 - t0))
+            }
+            Self::Sampled { interval, value } => {
+                let position = time / interval;
+                if position.is_nan() || position < 0.0 {
+                    return 0.0;
+                }
+                let index = position.floor();
+                let at = index as usize;
+                if at + 1 >= value.len() {
+                    return if at + 1 == value.len() && position == index {
+                        value[at]
+                    } else {
+                        0.0
+                    };
+                }
+                let fraction = position - index;
+                value[at] + (value[at + 1] - value[at]) * fraction
+            }
+        }
+    }
+}
+
+/// The phase `theta(t)` (rad) of a swept sine: the integral of
+/// `2 pi f(t)` from 0, continued at the end frequency after `duration`.
+fn sweep_phase(f0: f64, f1: f64, duration: f64, law: SweepLaw, time: f64) -> f64 {
+    let tau = std::f64::consts::TAU;
+    let during = time.min(duration);
+    let after = (time - duration).max(0.0);
+    let swept = match law {
+        SweepLaw::Linear => f0 * during + 0.5 * (f1 - f0) * during * during / duration,
+        SweepLaw::Logarithmic => {
+            let ratio = f1 / f0;
+            if (ratio - 1.0).abs() < 1e-12 {
+                f0 * during
+            } else {
+                // f0 T (r^(t/T) - 1) / ln r, with exp_m1 for accuracy near r = 1.
+                let log_ratio = ratio.ln();
+                f0 * duration * (log_ratio * during / duration).exp_m1() / log_ratio
+            }
+        }
+    };
+    tau * (swept + f1 * after)
+}
+
+/// The sample interval `pi / omega_c` (s) and the number of samples covering
+/// `duration` for a random signal, validated.
+fn noise_grid(intensity: f64, cutoff_frequency: f64, duration: f64) -> Result<(f64, usize)> {
+    non_negative("intensity", intensity)?;
+    let cutoff = positive("cutoff_frequency", cutoff_frequency)?;
+    let duration = positive("duration", duration)?;
+    let interval = 0.5 / cutoff;
+    let count = (duration / interval).ceil() + 1.0;
+    if count.is_nan() || count > MAX_SIGNAL_SAMPLES as f64 {
+        return Err(Error::Inconsistent(format!(
+            "a random signal of duration {duration} s and cutoff_frequency {cutoff} Hz needs {count:.3e} samples; \
+             at most {MAX_SIGNAL_SAMPLES} are allowed: lower the cutoff or the duration"
+        )));
+    }
+    Ok((interval, count as usize))
+}
+
+/// Standard normal numbers from a seed, the same on every platform:
+/// SplitMix64 uniforms and Marsaglia's polar method, with a logarithm of
+/// basic operations only.
+struct Gaussian {
+    state: u64,
+    spare: Option<f64>,
+}
+
+impl Gaussian {
+    fn new(seed: u64) -> Self {
+        Self {
+            state: seed,
+            spare: None,
+        }
+    }
+
+    /// SplitMix64 (Steele, Lea and Flood 2014).
+    fn next_u64(&mut self) -> u64 {
+        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in (-1, 1), 53 bits.
+    fn uniform(&mut self) -> f64 {
+        let unit = (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+        2.0 * unit - 1.0
+    }
+
+    fn next(&mut self) -> f64 {
+        if let Some(value) = self.spare.take() {
+            return value;
+        }
+        loop {
+            let (u, v) = (self.uniform(), self.uniform());
+            let s = u * u + v * v;
+            if s > 0.0 && s < 1.0 {
+                let factor = (-2.0 * portable_ln(s) / s).sqrt();
+                self.spare = Some(v * factor);
+                return u * factor;
+            }
+        }
+    }
+}
+
+/// Natural logarithm of a positive normal number with basic operations only:
+/// `x = m 2^k` with m in [1/sqrt 2, sqrt 2), then
+/// `ln m = 2 atanh z = 2 (z + z^3/3 + z^5/5 + ...)`, `z = (m - 1)/(m + 1)`,
+/// |z| <= 0.1716, so 14 terms reach round-off.
+fn portable_ln(x: f64) -> f64 {
+    debug_assert!(x > 0.0 && x.is_normal());
+    let bits = x.to_bits();
+    let mut exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let mut mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    if mantissa > std::f64::consts::SQRT_2 {
+        mantissa *= 0.5;
+        exponent += 1;
+    }
+    let z = (mantissa - 1.0) / (mantissa + 1.0);
+    let z2 = z * z;
+    let mut term = z;
+    let mut sum = 0.0;
+    for n in 0..14 {
+        sum += term / (2 * n + 1) as f64;
+        term *= z2;
+    }
+    2.0 * sum + exponent as f64 * std::f64::consts::LN_2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splitmix64_matches_its_reference_sequence() {
+        // The published outputs of SplitMix64 from seed 0.
+        let mut g = Gaussian::new(0);
+        assert_eq!(g.next_u64(), 0xE220_A839_7B1D_CDAF);
+        assert_eq!(g.next_u64(), 0x6E78_9E6A_A1B9_65F4);
+        assert_eq!(g.next_u64(), 0x06C4_5D18_8009_454F);
+    }
+
+    #[test]
+    fn portable_ln_matches_the_platform_to_round_off() {
+        let mut x = 1e-300;
+        while x < 1e300 {
+            for y in [x, x * 1.234567, x * 0.7, x * 1.41] {
+                let (ours, std) = (portable_ln(y), y.ln());
+                assert!(
+                    (ours - std).abs() <= 4.0 * f64::EPSILON * std.abs().max(1.0),
+                    "ln({y}) = {ours}, std {std}"
+                );
+            }
+            x *= 10.0;
+        }
+    }
+}
