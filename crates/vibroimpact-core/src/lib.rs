@@ -13,11 +13,13 @@ pub mod error;
 pub mod events;
 mod hermite;
 pub mod integrators;
+pub mod linalg;
 pub mod materials;
 pub mod model;
 pub mod run;
 pub mod signals;
 pub mod steppers;
+pub mod structure;
 pub mod system;
 pub mod tableau;
 

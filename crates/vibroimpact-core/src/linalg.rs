@@ -1,0 +1,182 @@
+//! Small dense symmetric matrices (row-major `n x n` slices): the checks a
+//! structure's matrices must pass and the factorisation its kernel uses.
+//! Sizes are a few tens of degrees of freedom, so plain loops are best.
+
+/// The largest absolute entry.
+pub fn max_abs(a: &[f64]) -> f64 {
+    a.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// The first pair `(i, j)`, `i < j`, whose entries differ by more than a
+/// relative 1e-12 of the largest entry; None when symmetric.
+pub fn asymmetry(a: &[f64], n: usize) -> Option<(usize, usize)> {
+    let tolerance = 1e-12 * max_abs(a);
+    for i in 0..n {
+        for j in i + 1..n {
+            if (a[i * n + j] - a[j * n + i]).abs() > tolerance {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
+/// Cholesky factor `L` (row-major, lower) of a symmetric positive definite
+/// matrix; None when a pivot is not positive beyond round-off.
+pub fn cholesky(a: &[f64], n: usize) -> Option<Vec<f64>> {
+    let scale = max_abs(a);
+    let mut l = vec![0.0; n * n];
+    for j in 0..n {
+        let mut diagonal = a[j * n + j];
+        for k in 0..j {
+            diagonal -= l[j * n + k] * l[j * n + k];
+        }
+        if diagonal.is_nan() || diagonal <= 1e-14 * scale {
+            return None;
+        }
+        let root = diagonal.sqrt();
+        l[j * n + j] = root;
+        for i in j + 1..n {
+            let mut sum = a[i * n + j];
+            for k in 0..j {
+                sum -= l[i * n + k] * l[j * n + k];
+            }
+            l[i * n + j] = sum / root;
+        }
+    }
+    Some(l)
+}
+
+/// The inverse of a symmetric positive definite matrix from its Cholesky
+/// factor, by solving `L L^T x = e_k` for each column.
+pub fn inverse_from_cholesky(l: &[f64], n: usize) -> Vec<f64> {
+    let mut inverse = vec![0.0; n * n];
+    let mut column = vec![0.0; n];
+    for k in 0..n {
+        column.iter_mut().for_each(|c| *c = 0.0);
+        column[k] = 1.0;
+        // Forward: L y = e_k.
+        for i in 0..n {
+            let mut sum = column[i];
+            for j in 0..i {
+                sum -= l[i * n + j] * column[j];
+            }
+            column[i] = sum / l[i * n + i];
+        }
+        // Backward: L^T x = y.
+        for i in (0..n).rev() {
+            let mut sum = column[i];
+            for j in i + 1..n {
+                sum -= l[j * n + i] * column[j];
+            }
+            column[i] = sum / l[i * n + i];
+        }
+        for i in 0..n {
+            inverse[i * n + k] = column[i];
+        }
+    }
+    inverse
+}
+
+/// Eigenvalues of a symmetric matrix by cyclic Jacobi rotations, ascending.
+/// Accurate to round-off relative to the largest eigenvalue.
+pub fn symmetric_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
+    let mut m = a.to_vec();
+    let scale = max_abs(a);
+    for _sweep in 0..100 {
+        let off: f64 = (0..n)
+            .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| m[i * n + j] * m[i * n + j])
+            .sum();
+        if off.sqrt() <= 1e-15 * scale || scale == 0.0 {
+            break;
+        }
+        for p in 0..n {
+            for q in p + 1..n {
+                let apq = m[p * n + q];
+                if apq == 0.0 {
+                    continue;
+                }
+                let (app, aqq) = (m[p * n + p], m[q * n + q]);
+                // The rotation that zeroes (p, q) (Golub and Van Loan, 8.5.2).
+                let theta = (aqq - app) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..n {
+                    let (akp, akq) = (m[k * n + p], m[k * n + q]);
+                    m[k * n + p] = c * akp - s * akq;
+                    m[k * n + q] = s * akp + c * akq;
+                }
+                for k in 0..n {
+                    let (apk, aqk) = (m[p * n + k], m[q * n + k]);
+                    m[p * n + k] = c * apk - s * aqk;
+                    m[q * n + k] = s * apk + c * aqk;
+                }
+            }
+        }
+    }
+    let mut values: Vec<f64> = (0..n).map(|i| m[i * n + i]).collect();
+    values.sort_by(f64::total_cmp);
+    values
+}
+
+/// `y = A x` for a row-major `rows x x.len()` matrix.
+#[inline]
+pub fn multiply(a: &[f64], x: &[f64], y: &mut [f64]) {
+    let n = x.len();
+    for (row, out) in y.iter_mut().enumerate() {
+        *out = a[row * n..(row + 1) * n]
+            .iter()
+            .zip(x)
+            .map(|(a, x)| a * x)
+            .sum();
+    }
+}
+
+/// `x^T A x` for a symmetric row-major matrix.
+pub fn quadratic_form(a: &[f64], x: &[f64]) -> f64 {
+    let n = x.len();
+    (0..n)
+        .map(|i| x[i] * (0..n).map(|j| a[i * n + j] * x[j]).sum::<f64>())
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eigenvalues_of_a_known_matrix() {
+        // The second-difference matrix tridiag(-1, 2, -1) of size n has
+        // eigenvalues 2 - 2 cos(k pi / (n + 1)), k = 1..n.
+        let n = 7;
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            a[i * n + i] = 2.0;
+            if i + 1 < n {
+                a[i * n + i + 1] = -1.0;
+                a[(i + 1) * n + i] = -1.0;
+            }
+        }
+        let values = symmetric_eigenvalues(&a, n);
+        for (k, v) in values.iter().enumerate() {
+            let exact = 2.0 - 2.0 * ((k + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
+            assert!((v - exact).abs() < 1e-14, "{v} vs {exact}");
+        }
+        let l = cholesky(&a, n).expect("positive definite");
+        let inverse = inverse_from_cholesky(&l, n);
+        // A A^-1 = I.
+        for i in 0..n {
+            for j in 0..n {
+                let p: f64 = (0..n).map(|k| a[i * n + k] * inverse[k * n + j]).sum();
+                let expected = if i == j { 1.0 } else { 0.0 };
+                assert!((p - expected).abs() < 1e-13);
+            }
+        }
+        // Singular (a free-free chain) and indefinite matrices have no factor.
+        assert!(cholesky(&[1.0, -1.0, -1.0, 1.0], 2).is_none());
+        assert!(cholesky(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
+    }
+}

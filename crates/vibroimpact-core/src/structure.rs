@@ -1,0 +1,170 @@
+//! The structure of a 0.2 system: generalised coordinates `q` with mass,
+//! stiffness and damping matrices (`M q'' + C q' + K q = f`), the points where
+//! dampers, stops and forces attach (each a row `h` with the point's
+//! displacement `h . q`), and the influence vector `r` of a rigid base motion
+//! (the structure's coordinates move by `r` per metre of base displacement).
+//!
+//! Kinds: one mass on a spring and damper; any symmetric matrices; and a
+//! cantilever in its modal coordinates, whose points are its mode shapes at a
+//! position along the beam (so a tip force enters each mode with the tip
+//! value of its shape, 2 in magnitude, by construction).
+
+use crate::error::{non_negative, positive, Error, Result};
+use crate::linalg;
+
+/// Most degrees of freedom a structure may have: its matrices are dense and
+/// every step multiplies them, so a larger model belongs in modal coordinates.
+pub const MAX_DOFS: usize = 200;
+
+#[derive(Debug, Clone, PartialEq)]
+enum Points {
+    /// A point is a coordinate index.
+    Indices,
+}
+
+/// A linear structure (SI units: kg, N/m, N s/m), validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Structure {
+    dofs: usize,
+    /// Row-major `dofs x dofs`.
+    mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    influence: Vec<f64>,
+    points: Points,
+}
+
+impl Structure {
+    /// One mass (kg) on a spring (N/m) and a damper (N s/m).
+    pub fn oscillator(mass: f64, stiffness: f64, damping: f64) -> Result<Self> {
+        Ok(Self {
+            dofs: 1,
+            mass: vec![positive("mass", mass)?],
+            stiffness: vec![non_negative("stiffness", stiffness)?],
+            damping: vec![non_negative("damping", damping)?],
+            influence: vec![1.0],
+            points: Points::Indices,
+        })
+    }
+
+    /// Any `n x n` matrices, given as rows: `mass` symmetric positive
+    /// definite, `stiffness` and `damping` symmetric positive semi-definite
+    /// (kg, N/m, N s/m). Every coordinate moves with the base (`r = 1`).
+    pub fn matrices(
+        mass: &[Vec<f64>],
+        stiffness: &[Vec<f64>],
+        damping: &[Vec<f64>],
+    ) -> Result<Self> {
+        let n = mass.len();
+        if n == 0 || n > MAX_DOFS {
+            return Err(Error::Inconsistent(format!(
+                "structure.mass must be an n x n matrix with 1 <= n <= {MAX_DOFS}, got {n} rows"
+            )));
+        }
+        let mass = square("mass", mass, n)?;
+        let stiffness = square("stiffness", stiffness, n)?;
+        let damping = square("damping", damping, n)?;
+        if linalg::cholesky(&mass, n).is_none() {
+            return Err(Error::Inconsistent(
+                "structure.mass must be positive definite (every mode needs mass): it is not"
+                    .into(),
+            ));
+        }
+        for (key, matrix) in [("stiffness", &stiffness), ("damping", &damping)] {
+            let values = linalg::symmetric_eigenvalues(matrix, n);
+            let lowest = values[0];
+            if lowest < -1e-12 * linalg::max_abs(&values) {
+                return Err(Error::Inconsistent(format!(
+                    "structure.{key} must be positive semi-definite (no mode that gains energy): \
+                     its lowest eigenvalue is {lowest:.6e}"
+                )));
+            }
+        }
+        Ok(Self {
+            dofs: n,
+            mass,
+            stiffness,
+            damping,
+            influence: vec![1.0; n],
+            points: Points::Indices,
+        })
+    }
+
+    /// Number of generalised coordinates.
+    pub fn dofs(&self) -> usize {
+        self.dofs
+    }
+
+    /// Mass matrix, row-major, kg.
+    pub fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Stiffness matrix, row-major, N/m.
+    pub fn stiffness(&self) -> &[f64] {
+        &self.stiffness
+    }
+
+    /// Damping matrix, row-major, N s/m.
+    pub fn damping(&self) -> &[f64] {
+        &self.damping
+    }
+
+    /// Influence vector of a rigid base displacement.
+    pub fn influence(&self) -> &[f64] {
+        &self.influence
+    }
+
+    /// The row `h` of the point `at` (a coordinate index for the oscillator
+    /// and matrices), whose displacement is `h . q`, m. `key` names the input
+    /// in the error (for example `"damper 1 at"`).
+    pub fn point(&self, key: &str, at: f64) -> Result<Vec<f64>> {
+        match self.points {
+            Points::Indices => {
+                let index = at as usize;
+                if !(at.is_finite() && at >= 0.0 && at.fract() == 0.0 && index < self.dofs) {
+                    return Err(Error::Inconsistent(format!(
+                        "{key} must be a coordinate index, a whole number in [0, {}], got {at}",
+                        self.dofs - 1
+                    )));
+                }
+                let mut row = vec![0.0; self.dofs];
+                row[index] = 1.0;
+                Ok(row)
+            }
+        }
+    }
+
+    /// Kinetic plus strain energy at displacements `q` (m) and velocities
+    /// `v` (m/s), J.
+    pub fn energy(&self, q: &[f64], v: &[f64]) -> f64 {
+        0.5 * (linalg::quadratic_form(&self.mass, v) + linalg::quadratic_form(&self.stiffness, q))
+    }
+}
+
+/// A square, finite, symmetric matrix from its rows, row-major.
+fn square(key: &str, rows: &[Vec<f64>], n: usize) -> Result<Vec<f64>> {
+    if rows.len() != n || rows.iter().any(|row| row.len() != n) {
+        let shape: Vec<usize> = rows.iter().map(Vec::len).collect();
+        return Err(Error::Inconsistent(format!(
+            "structure.{key} must be {n} x {n} like structure.mass, got rows of lengths {shape:?}"
+        )));
+    }
+    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+    if let Some(at) = flat.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Inconsistent(format!(
+            "structure.{key} must be finite: entry [{}][{}] is {}",
+            at / n,
+            at % n,
+            flat[at]
+        )));
+    }
+    if let Some((i, j)) = linalg::asymmetry(&flat, n) {
+        return Err(Error::Inconsistent(format!(
+            "structure.{key} must be symmetric: entry [{i}][{j}] = {} but [{j}][{i}] = {}",
+            flat[i * n + j],
+            flat[j * n + i]
+        )));
+    }
+    Ok(flat)
+}
