@@ -1,6 +1,8 @@
 //! Orders of the steppers on a smooth problem with a closed form, and every
 //! method's event-driven run of the Table 1 collision.
 
+mod common;
+
 use vibroimpact_core::contact::Hertz;
 use vibroimpact_core::model::{Free, Mode, Model};
 use vibroimpact_core::steppers::{
@@ -49,125 +51,129 @@ fn order<S: Stepper>(mut make: impl FnMut() -> S, steps: &[f64]) -> f64 {
 
 #[test]
 fn each_method_converges_at_its_order_on_a_smooth_problem() {
-    let loose = Tolerances {
-        rtol: 1e-3,
-        atol: 1e-6,
-    };
-    let cases: [(&str, f64, f64); 6] = [
-        ("rk4", order(Rk4Stepper::default, &[0.1, 0.05, 0.025]), 4.0),
-        (
-            "newmark-implicit",
-            order(
-                || NewmarkFamily::newmark(0.25, 0.5, false),
-                &[0.1, 0.05, 0.025],
+    common::timeout(60, || {
+        let loose = Tolerances {
+            rtol: 1e-3,
+            atol: 1e-6,
+        };
+        let cases: [(&str, f64, f64); 6] = [
+            ("rk4", order(Rk4Stepper::default, &[0.1, 0.05, 0.025]), 4.0),
+            (
+                "newmark-implicit",
+                order(
+                    || NewmarkFamily::newmark(0.25, 0.5, false),
+                    &[0.1, 0.05, 0.025],
+                ),
+                2.0,
             ),
-            2.0,
-        ),
-        (
-            "generalized-alpha",
-            order(
-                || NewmarkFamily::generalized_alpha(0.8),
-                &[0.1, 0.05, 0.025],
+            (
+                "generalized-alpha",
+                order(
+                    || NewmarkFamily::generalized_alpha(0.8),
+                    &[0.1, 0.05, 0.025],
+                ),
+                2.0,
             ),
-            2.0,
-        ),
-        (
-            "newmark (lagged, free flight)",
-            order(
-                || NewmarkFamily::newmark(0.25, 0.5, true),
-                &[0.1, 0.05, 0.025],
+            (
+                "newmark (lagged, free flight)",
+                order(
+                    || NewmarkFamily::newmark(0.25, 0.5, true),
+                    &[0.1, 0.05, 0.025],
+                ),
+                2.0,
             ),
-            2.0,
-        ),
-        (
-            "dopri5",
-            order(|| Dopri5Stepper::new(loose), &[0.1, 0.05, 0.025]),
-            5.0,
-        ),
-        (
-            "dop853",
-            order(|| Dop853Stepper::new(loose), &[0.4, 0.2, 0.1]),
-            8.0,
-        ),
-    ];
-    for (name, measured, theory) in cases {
-        assert!(
-            (measured - theory).abs() < 0.2,
-            "{name}: order {measured:.3}, expected {theory}"
-        );
-    }
+            (
+                "dopri5",
+                order(|| Dopri5Stepper::new(loose), &[0.1, 0.05, 0.025]),
+                5.0,
+            ),
+            (
+                "dop853",
+                order(|| Dop853Stepper::new(loose), &[0.4, 0.2, 0.1]),
+                8.0,
+            ),
+        ];
+        for (name, measured, theory) in cases {
+            assert!(
+                (measured - theory).abs() < 0.2,
+                "{name}: order {measured:.3}, expected {theory}"
+            );
+        }
+    });
 }
 
 #[test]
 fn every_method_with_events_converges_to_the_exact_collision() {
-    let system = ImpactDamper::new(1.0, 1.0, 0.01, 0.25, 0.01).unwrap();
-    let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
-    let start = State::new(0.0, 0.0, 0.01, 0.1).unwrap();
-    let run = |method: Method, dt: Option<f64>| {
-        let settings = Settings::new(
-            method,
-            dt,
-            0.15,
-            1_000_000,
-            ContactTiming::Located,
-            Some(Stepping::Events),
-            u64::MAX,
-        )
-        .unwrap();
-        simulate(&system, &contact, &start, &settings, &mut || false)
-            .unwrap()
-            .contacts[0]
-    };
-    let tight = Tolerances {
-        rtol: 1e-13,
-        atol: 1e-16,
-    };
-    let exact = run(Method::Dop853(tight), None);
-    // The reference page's independent value, printed to 7 digits.
-    assert!((exact.duration - 0.1089819).abs() < 1e-7);
-    let newmark = Method::NewmarkImplicit {
-        beta: 0.25,
-        gamma: 0.5,
-    };
-    let alpha = Method::GeneralizedAlpha {
-        spectral_radius: 0.8,
-    };
-    let cases = [
-        (Method::Rk4, Some(1e-3), 1e-6),
-        (Method::Rk4, Some(1e-4), 1e-9),
-        (newmark, Some(1e-4), 2e-6),
-        (alpha, Some(1e-4), 2e-6),
-        (
-            Method::Dopri5(Tolerances {
-                rtol: 1e-10,
-                atol: 1e-13,
-            }),
-            None,
-            1e-9,
-        ),
-        (
-            Method::Dop853(Tolerances {
-                rtol: 1e-10,
-                atol: 1e-13,
-            }),
-            None,
-            1e-10,
-        ),
-    ];
-    for (method, dt, tolerance) in cases {
-        let c = run(method, dt);
-        let error = (c.duration / exact.duration - 1.0).abs();
-        assert!(error < tolerance, "{method:?} dt {dt:?}: error {error:.2e}");
-        let peak = (c.max_indentation / exact.max_indentation - 1.0).abs();
-        assert!(
-            peak < 10.0 * tolerance,
-            "{method:?} dt {dt:?}: peak error {peak:.2e}"
-        );
-        assert!((c.restitution - exact.restitution).abs() < 10.0 * tolerance);
-    }
-    // Second order: ten times smaller step, a hundred times smaller error.
-    let coarse = (run(newmark, Some(1e-3)).duration / exact.duration - 1.0).abs();
-    let fine = (run(newmark, Some(1e-4)).duration / exact.duration - 1.0).abs();
-    let slope = (coarse / fine).log10();
-    assert!((slope - 2.0).abs() < 0.2, "newmark-implicit slope {slope}");
+    common::timeout(60, || {
+        let system = ImpactDamper::new(1.0, 1.0, 0.01, 0.25, 0.01).unwrap();
+        let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
+        let start = State::new(0.0, 0.0, 0.01, 0.1).unwrap();
+        let run = |method: Method, dt: Option<f64>| {
+            let settings = Settings::new(
+                method,
+                dt,
+                0.15,
+                1_000_000,
+                ContactTiming::Located,
+                Some(Stepping::Events),
+                u64::MAX,
+            )
+            .unwrap();
+            simulate(&system, &contact, &start, &settings, &mut || false)
+                .unwrap()
+                .contacts[0]
+        };
+        let tight = Tolerances {
+            rtol: 1e-13,
+            atol: 1e-16,
+        };
+        let exact = run(Method::Dop853(tight), None);
+        // The reference page's independent value, printed to 7 digits.
+        assert!((exact.duration - 0.1089819).abs() < 1e-7);
+        let newmark = Method::NewmarkImplicit {
+            beta: 0.25,
+            gamma: 0.5,
+        };
+        let alpha = Method::GeneralizedAlpha {
+            spectral_radius: 0.8,
+        };
+        let cases = [
+            (Method::Rk4, Some(1e-3), 1e-6),
+            (Method::Rk4, Some(1e-4), 1e-9),
+            (newmark, Some(1e-4), 2e-6),
+            (alpha, Some(1e-4), 2e-6),
+            (
+                Method::Dopri5(Tolerances {
+                    rtol: 1e-10,
+                    atol: 1e-13,
+                }),
+                None,
+                1e-9,
+            ),
+            (
+                Method::Dop853(Tolerances {
+                    rtol: 1e-10,
+                    atol: 1e-13,
+                }),
+                None,
+                1e-10,
+            ),
+        ];
+        for (method, dt, tolerance) in cases {
+            let c = run(method, dt);
+            let error = (c.duration / exact.duration - 1.0).abs();
+            assert!(error < tolerance, "{method:?} dt {dt:?}: error {error:.2e}");
+            let peak = (c.max_indentation / exact.max_indentation - 1.0).abs();
+            assert!(
+                peak < 10.0 * tolerance,
+                "{method:?} dt {dt:?}: peak error {peak:.2e}"
+            );
+            assert!((c.restitution - exact.restitution).abs() < 10.0 * tolerance);
+        }
+        // Second order: ten times smaller step, a hundred times smaller error.
+        let coarse = (run(newmark, Some(1e-3)).duration / exact.duration - 1.0).abs();
+        let fine = (run(newmark, Some(1e-4)).duration / exact.duration - 1.0).abs();
+        let slope = (coarse / fine).log10();
+        assert!((slope - 2.0).abs() < 0.2, "newmark-implicit slope {slope}");
+    });
 }
