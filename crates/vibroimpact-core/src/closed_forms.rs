@@ -8,6 +8,21 @@ pub const GOLDSMITH_CONSTANT: f64 = 2.9432;
 /// The same constant exactly: `2 * (2/5) * B(2/5, 1/2)`.
 pub const HERTZ_DURATION_CONSTANT: f64 = 2.943_275_184_324_705;
 
+/// A result `value` (the `what`, in `unit`) must be finite and > 0;
+/// otherwise `inputs` are out of floating-point range together.
+pub(crate) fn representable(what: &str, unit: &str, value: f64, inputs: &str) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::Inconsistent(format!(
+            "the {what} is {value:e} {unit}, out of floating-point range: {inputs} are too large or too small together"
+        )))
+    }
+}
+
+/// What the closed forms' results depend on.
+const INPUTS: &str = "the masses, stiffness and speed";
+
 /// `K* = (m + M) / (m M)`, 1/kg.
 fn inverse_effective_mass(impact_mass: f64, main_mass: f64) -> Result<f64> {
     let m = positive("impact_mass", impact_mass)?;
@@ -26,7 +41,12 @@ pub fn goldsmith_max_indentation(
     let k_star = inverse_effective_mass(impact_mass, main_mass)?;
     let k = positive("hertz_stiffness", hertz_stiffness)?;
     let v = positive("approach_speed", approach_speed)?;
-    Ok((5.0 * v * v / (4.0 * k_star * k)).powf(0.4))
+    representable(
+        "maximum indentation",
+        "m",
+        (5.0 * v * v / (4.0 * k_star * k)).powf(0.4),
+        INPUTS,
+    )
 }
 
 /// Goldsmith's Hertz contact duration, s:
@@ -47,7 +67,12 @@ pub fn goldsmith_contact_duration(
     } else {
         GOLDSMITH_CONSTANT
     };
-    Ok(constant * delta_max / approach_speed)
+    representable(
+        "contact duration",
+        "s",
+        constant * delta_max / approach_speed,
+        INPUTS,
+    )
 }
 
 /// Contact duration of a linear spring `k1` with a damper `c1` between two
@@ -64,12 +89,26 @@ pub fn linear_contact_duration(
     let k1 = positive("stiffness", stiffness)?;
     let c1 = non_negative("damping", damping)?;
     let discriminant = 4.0 * m * big * k1 - c1 * c1 * (m + big);
+    if discriminant.is_nan() {
+        // inf - inf: both terms overflow.
+        return representable(
+            "discriminant 4 m M k1 - c1^2 (m + M)",
+            "N kg^2/m",
+            discriminant,
+            INPUTS,
+        );
+    }
     if discriminant <= 0.0 {
         return Err(Error::Inconsistent(format!(
             "damping {c1} N s/m is at or above critical for stiffness {k1} N/m: the contact does not oscillate"
         )));
     }
-    Ok(2.0 * m * big * std::f64::consts::PI / ((m + big).sqrt() * discriminant.sqrt()))
+    representable(
+        "contact duration",
+        "s",
+        2.0 * m * big * std::f64::consts::PI / ((m + big).sqrt() * discriminant.sqrt()),
+        INPUTS,
+    )
 }
 
 /// The paper's adequacy factor (Eq. 15), percent:
@@ -86,12 +125,21 @@ pub fn adequacy(
     let cpu_time = non_negative("cpu_time", cpu_time)?;
     let max_cpu_time = positive("max_cpu_time", max_cpu_time)?;
     let wf1 = within("error_weight", error_weight, 0.0, 1.0, false, "in [0, 1]")?;
-    Ok(((1.0 - error / max_error) * wf1 + (1.0 - cpu_time / max_cpu_time) * (1.0 - wf1)) * 100.0)
+    let factor =
+        ((1.0 - error / max_error) * wf1 + (1.0 - cpu_time / max_cpu_time) * (1.0 - wf1)) * 100.0;
+    if factor.is_finite() {
+        Ok(factor)
+    } else {
+        Err(Error::Inconsistent(format!(
+            "the adequacy factor is {factor}: error / max_error or cpu_time / max_cpu_time is out of floating-point range"
+        )))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::tests::field;
 
     #[test]
     fn exact_constant_matches_the_integral() {
@@ -110,6 +158,48 @@ mod tests {
             "{}",
             2.0 * sum
         );
+    }
+
+    #[test]
+    fn every_argument_is_checked_and_named() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let duration = |m, big, k, v| goldsmith_contact_duration(m, big, k, v, true);
+            assert_eq!(field(duration(bad, 1.0, 1.0, 1.0)), "impact_mass");
+            assert_eq!(field(duration(1.0, bad, 1.0, 1.0)), "main_mass");
+            assert_eq!(field(duration(1.0, 1.0, bad, 1.0)), "hertz_stiffness");
+            assert_eq!(field(duration(1.0, 1.0, 1.0, bad)), "approach_speed");
+            let indentation = |m, big, k, v| goldsmith_max_indentation(m, big, k, v);
+            assert_eq!(field(indentation(bad, 1.0, 1.0, 1.0)), "impact_mass");
+            assert_eq!(field(indentation(1.0, 1.0, 1.0, bad)), "approach_speed");
+            let linear = |m, big, k, c| linear_contact_duration(m, big, k, c);
+            assert_eq!(field(linear(bad, 1.0, 1.0, 0.0)), "impact_mass");
+            assert_eq!(field(linear(1.0, bad, 1.0, 0.0)), "main_mass");
+            assert_eq!(field(linear(1.0, 1.0, bad, 0.0)), "stiffness");
+            assert_eq!(field(linear(1.0, 1.0, 1.0, bad)), "damping");
+            assert_eq!(field(adequacy(bad, 1.0, 1.0, 1.0, 0.5)), "error");
+            assert_eq!(field(adequacy(1.0, bad, 1.0, 1.0, 0.5)), "max_error");
+            assert_eq!(field(adequacy(1.0, 1.0, bad, 1.0, 0.5)), "cpu_time");
+            assert_eq!(field(adequacy(1.0, 1.0, 1.0, bad, 0.5)), "max_cpu_time");
+            assert_eq!(field(adequacy(1.0, 1.0, 1.0, 1.0, bad)), "error_weight");
+        }
+    }
+
+    #[test]
+    fn results_beyond_floating_point_are_errors() {
+        let out_of_range = |r: Result<f64>| match r {
+            Err(Error::Inconsistent(message)) => {
+                assert!(message.contains("out of floating-point range"), "{message}")
+            }
+            other => panic!("expected an out-of-range error, got {other:?}"),
+        };
+        // (5 v^2 / (4 K* K_hz))^0.4 overflows; the duration delta_max / v underflows to 0.
+        out_of_range(goldsmith_max_indentation(1e300, 1e300, 1e-300, 1e300));
+        out_of_range(goldsmith_contact_duration(
+            1e-300, 1e-300, 1e300, 1e300, false,
+        ));
+        // 4 m M k1 and c1^2 (m + M) both overflow (inf - inf).
+        out_of_range(linear_contact_duration(1e300, 1e300, 1e300, 1e300));
+        out_of_range(adequacy(1e308, 1e-308, 0.0, 1.0, 0.5));
     }
 
     #[test]

@@ -6,9 +6,14 @@
 //! law; it is a linear damper on the relative velocity that acts only while in
 //! contact, exactly as in the founding paper's equations of motion.
 
-use crate::error::{non_negative, positive, within, Error, Result};
+use crate::error::{finite, non_negative, positive, within, Error, Result};
 
 /// A contact law, generic so that the integration kernels monomorphise over it.
+///
+/// The laws below are the kernels' building blocks: their methods run in the
+/// inner loops on the kernels' own (finite) state and check nothing. Build
+/// them through a validated [`Contact`] ([`Contact::visit`]); the checked way
+/// to evaluate a law is [`Contact::law_force`].
 pub trait ContactLaw: Copy + Send + Sync {
     /// Force in N (>= 0) at indentation `indentation` > 0 (m), indentation
     /// rate `rate` (m/s, > 0 while approaching) and the rate latched at the
@@ -87,21 +92,49 @@ pub struct HysterHertz {
 }
 
 impl HysterHertz {
-    /// The founding paper's law: `alpha = (3/4)(1 - e^2)`.
-    pub fn new(stiffness: f64, restitution: f64) -> Self {
+    /// The founding paper's law: `alpha = (3/4)(1 - e^2)`, for `stiffness` > 0
+    /// (N/m^1.5) and `restitution` in (0, 1].
+    pub fn new(stiffness: f64, restitution: f64) -> Result<Self> {
+        Ok(Self::paper(
+            positive("stiffness", stiffness)?,
+            checked_restitution(restitution)?,
+        ))
+    }
+
+    /// The law whose rebound is exactly `restitution` in (0, 1] (see
+    /// [`exact_hysteresis`]), for `stiffness` > 0 (N/m^1.5).
+    pub fn exact(stiffness: f64, restitution: f64) -> Result<Self> {
+        Ok(Self::rebounding_at(
+            positive("stiffness", stiffness)?,
+            checked_restitution(restitution)?,
+        ))
+    }
+
+    /// [`HysterHertz::new`] for inputs already checked.
+    fn paper(stiffness: f64, restitution: f64) -> Self {
         Self {
             stiffness,
-            hysteresis: 0.75 * (1.0 - restitution * restitution),
+            hysteresis: paper_hysteresis(restitution),
         }
     }
 
-    /// The law whose rebound is exactly `restitution` (see [`exact_hysteresis`]).
-    pub fn exact(stiffness: f64, restitution: f64) -> Self {
+    /// [`HysterHertz::exact`] for inputs already checked.
+    fn rebounding_at(stiffness: f64, restitution: f64) -> Self {
         Self {
             stiffness,
-            hysteresis: exact_hysteresis(restitution),
+            hysteresis: hysteresis_for(restitution),
         }
     }
+}
+
+/// The founding paper's `alpha = (3/4)(1 - e^2)`.
+fn paper_hysteresis(restitution: f64) -> f64 {
+    0.75 * (1.0 - restitution * restitution)
+}
+
+/// A coefficient of restitution: in (0, 1].
+fn checked_restitution(restitution: f64) -> Result<f64> {
+    within("restitution", restitution, 0.0, 1.0, true, "in (0, 1]")
 }
 
 /// The `alpha` for which a law `F = K delta^n (1 + alpha delta'/delta'_minus)`
@@ -109,7 +142,12 @@ impl HysterHertz {
 /// `restitution` in (0, 1]: the root of
 /// `alpha (1 + e) - ln((1 + alpha)/(1 - alpha e)) = 0` in `(0, 1/e)`
 /// (0 for `e = 1`).
-pub fn exact_hysteresis(restitution: f64) -> f64 {
+pub fn exact_hysteresis(restitution: f64) -> Result<f64> {
+    Ok(hysteresis_for(checked_restitution(restitution)?))
+}
+
+/// [`exact_hysteresis`] for a restitution already checked.
+fn hysteresis_for(restitution: f64) -> f64 {
     let e = restitution;
     if e >= 1.0 {
         return 0.0;
@@ -133,8 +171,13 @@ pub fn exact_hysteresis(restitution: f64) -> f64 {
 }
 
 /// The rebound/approach speed ratio that the law with hysteresis `alpha`
-/// gives two bodies alone: the root of the same relation in `e`.
-pub fn rebound_ratio(hysteresis: f64) -> f64 {
+/// (finite, >= 0) gives two bodies alone: the root of the same relation in `e`.
+pub fn rebound_ratio(hysteresis: f64) -> Result<f64> {
+    Ok(ratio_for(non_negative("hysteresis", hysteresis)?))
+}
+
+/// [`rebound_ratio`] for a hysteresis already checked.
+fn ratio_for(hysteresis: f64) -> f64 {
     let a = hysteresis;
     if a <= 0.0 {
         return 1.0;
@@ -301,7 +344,7 @@ impl Contact {
         let stiffness = positive("stiffness", stiffness)?;
         let damping = non_negative("damping", damping)?;
         let restitution = match (law.uses_restitution(), restitution) {
-            (true, Some(e)) => within("restitution", e, 0.0, 1.0, true, "in (0, 1]")?,
+            (true, Some(e)) => checked_restitution(e)?,
             (true, None) => {
                 return Err(Error::Inconsistent(format!(
                     "restitution is required for law {:?} (a number in (0, 1])",
@@ -329,15 +372,16 @@ impl Contact {
     /// for "hyster-hertz" and never below 0.66296.
     pub fn effective_restitution(&self) -> f64 {
         match self.law {
-            LawKind::HysterHertz => {
-                rebound_ratio(0.75 * (1.0 - self.restitution * self.restitution))
-            }
+            LawKind::HysterHertz => ratio_for(paper_hysteresis(self.restitution)),
             _ => self.restitution,
         }
     }
 
-    /// The law's force (N, clamped at zero), without the contact damper.
-    pub fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
+    /// The law's force (N, clamped at zero), without the contact damper, at
+    /// `indentation` (m; none at or below 0), indentation `rate` (m/s, > 0
+    /// while approaching) and the rate latched at the onset `approach_rate`
+    /// (m/s), all finite.
+    pub fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> Result<f64> {
         struct Force(f64, f64, f64);
         impl LawVisitor for Force {
             type Output = f64;
@@ -349,7 +393,19 @@ impl Contact {
                 }
             }
         }
-        self.visit(Force(indentation, rate, approach_rate))
+        let indentation = finite("indentation", indentation)?;
+        let rate = finite("rate", rate)?;
+        let approach_rate = finite("approach_rate", approach_rate)?;
+        let force = self.visit(Force(indentation, rate, approach_rate));
+        if force.is_finite() {
+            Ok(force)
+        } else {
+            Err(Error::Inconsistent(format!(
+                "the {} force at indentation {indentation} m is out of floating-point range: \
+                 the indentation or rate is far beyond any contact",
+                self.law.name()
+            )))
+        }
     }
 
     /// Call `visitor` with the concrete law: the one place where the named
@@ -358,8 +414,8 @@ impl Contact {
         let k = self.stiffness;
         match self.law {
             LawKind::Hertz => visitor.visit(Hertz { stiffness: k }),
-            LawKind::HysterHertz => visitor.visit(HysterHertz::new(k, self.restitution)),
-            LawKind::HertzDamped => visitor.visit(HysterHertz::exact(k, self.restitution)),
+            LawKind::HysterHertz => visitor.visit(HysterHertz::paper(k, self.restitution)),
+            LawKind::HertzDamped => visitor.visit(HysterHertz::rebounding_at(k, self.restitution)),
             LawKind::Linear => visitor.visit(Linear { stiffness: k }),
         }
     }
@@ -369,4 +425,57 @@ impl Contact {
 pub trait LawVisitor {
     type Output;
     fn visit<L: ContactLaw>(self, law: L) -> Self::Output;
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    const NON_FINITE: [f64; 3] = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY];
+
+    /// The field an invalid-parameter error names (panics on anything else).
+    pub(crate) fn field<T: std::fmt::Debug>(result: Result<T>) -> &'static str {
+        match result {
+            Err(Error::InvalidParameter { field, .. }) => field,
+            other => panic!("expected an invalid parameter, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn law_force_refuses_non_finite_arguments() {
+        let contact = Contact::new(LawKind::HertzDamped, 3000.0, Some(0.5), 0.01).unwrap();
+        for bad in NON_FINITE {
+            assert_eq!(field(contact.law_force(bad, 0.0, 1.0)), "indentation");
+            assert_eq!(field(contact.law_force(1e-3, bad, 1.0)), "rate");
+            assert_eq!(field(contact.law_force(1e-3, 0.0, bad)), "approach_rate");
+        }
+        // A force beyond floating point is an error, not inf.
+        let err = contact.law_force(1e300, 0.0, 1.0).unwrap_err();
+        assert!(
+            err.to_string().contains("out of floating-point range"),
+            "{err}"
+        );
+        // Finite arguments still give the law: 3000 (1e-4)^1.5 N with no rate.
+        let force = contact.law_force(1e-4, 0.0, 1.0).unwrap();
+        assert!((force - 3000.0 * 1e-6).abs() < 1e-18, "{force}");
+    }
+
+    #[test]
+    fn helpers_refuse_values_outside_their_range() {
+        for bad in NON_FINITE.into_iter().chain([0.0, 1.5, -0.5]) {
+            assert_eq!(field(exact_hysteresis(bad)), "restitution");
+            assert_eq!(field(HysterHertz::new(1.0, bad)), "restitution");
+            assert_eq!(field(HysterHertz::exact(1.0, bad)), "restitution");
+            assert_eq!(field(HysterHertz::new(-bad.abs(), 0.5)), "stiffness");
+        }
+        for bad in NON_FINITE.into_iter().chain([-1e-3]) {
+            assert_eq!(field(rebound_ratio(bad)), "hysteresis");
+        }
+        // The checked helpers agree with the relation they solve:
+        // alpha (1 + e) = ln((1 + alpha) / (1 - alpha e)).
+        let alpha = exact_hysteresis(0.5).unwrap();
+        let residual = alpha * 1.5 - ((1.0 + alpha) / (1.0 - 0.5 * alpha)).ln();
+        assert!(residual.abs() < 1e-14, "{residual}");
+        assert!((rebound_ratio(alpha).unwrap() - 0.5).abs() < 1e-14);
+    }
 }

@@ -236,11 +236,14 @@ impl Contact {
         self.0.law.uses_restitution().then_some(self.0.restitution)
     }
     /// The law's force (N, clamped at zero; without the contact damper) at
-    /// ``indentation`` (m), indentation ``rate`` (m/s) and the rate at the
-    /// onset of the contact ``approach_rate`` (m/s).
+    /// ``indentation`` (m; none at or below 0), indentation ``rate`` (m/s, > 0
+    /// while approaching) and the rate at the onset of the contact
+    /// ``approach_rate`` (m/s), all finite.
     #[pyo3(signature = (indentation, rate = 0.0, approach_rate = 1.0))]
-    fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
-        self.0.law_force(indentation, rate, approach_rate)
+    fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> PyResult<f64> {
+        self.0
+            .law_force(indentation, rate, approach_rate)
+            .map_err(to_py)
     }
     fn __getnewargs__(&self) -> (&'static str, f64, f64, Option<f64>) {
         (
@@ -744,11 +747,15 @@ fn hertz_stiffness(
     other_poisson_ratio: f64,
     other_radius: Option<f64>,
 ) -> PyResult<f64> {
-    let a = materials::Material::new(youngs_modulus, poisson_ratio).map_err(to_py)?;
-    let b = materials::Material::new(other_youngs_modulus, other_poisson_ratio).map_err(|e| {
-        // Name the second body's fields as the caller wrote them.
-        InvalidInputError::new_err(format!("other_{e}"))
-    })?;
+    // Checked by the core, which names the second body's fields other_....
+    let a = materials::Material {
+        youngs_modulus,
+        poisson_ratio,
+    };
+    let b = materials::Material {
+        youngs_modulus: other_youngs_modulus,
+        poisson_ratio: other_poisson_ratio,
+    };
     materials::hertz_stiffness(radius, &a, &b, other_radius).map_err(to_py)
 }
 
@@ -824,15 +831,35 @@ fn cantilever_root(#[pyo3(from_py_with = mode_arg)] mode: u32) -> PyResult<f64> 
     beam::cantilever_root(mode).map_err(to_py)
 }
 
-/// Normalised mode shape ``phi(x)`` (``int_0^L phi^2 dx = L``) of mode
-/// ``mode`` of a cantilever of ``length`` (m), at ``x`` (m from the clamp).
+/// Which derivative of a mode shape: 0, 1, 2 or 3 (a huge int is invalid
+/// input, not an OverflowError).
+fn derivative_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    match value.extract::<i64>() {
+        Ok(k @ 0..=3) => Ok(k as usize),
+        Ok(_) => Err(InvalidInputError::new_err(format!(
+            "derivative must be 0, 1, 2 or 3, got {value}"
+        ))),
+        Err(err) if err.is_instance_of::<pyo3::exceptions::PyOverflowError>(value.py()) => Err(
+            InvalidInputError::new_err(format!("derivative must be 0, 1, 2 or 3, got {value}")),
+        ),
+        Err(err) => Err(err),
+    }
+}
+
+/// Normalised mode shape ``phi(x)`` (``int_0^L phi^2 dx = L``, ``|phi(L)| =
+/// 2``) of mode ``mode`` (any, exact to round-off) of a cantilever of
+/// ``length`` (m), at ``x`` (m from the clamp, in [0, length]); with
+/// ``derivative`` k = 1, 2 or 3 its k-th derivative in x (1/m^k).
 #[pyfunction]
+#[pyo3(signature = (length, mode, x, derivative = 0))]
 fn cantilever_mode_shape(
     length: f64,
     #[pyo3(from_py_with = mode_arg)] mode: u32,
     x: f64,
+    #[pyo3(from_py_with = derivative_arg)] derivative: usize,
 ) -> PyResult<f64> {
-    beam::cantilever_mode_shape(length, mode, x).map_err(to_py)
+    let values = beam::cantilever_mode_shape_derivatives(length, mode, x).map_err(to_py)?;
+    Ok(values[derivative])
 }
 
 /// Goldsmith's Hertz contact duration (s) of two free bodies meeting at
