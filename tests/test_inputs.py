@@ -242,17 +242,88 @@ def test_stiff_contact_with_large_step_raises(method: str, dt: float) -> None:
     assert isinstance(err.value, ArithmeticError)
 
 
-@pytest.mark.parametrize("method", ["rk4", "newmark"])
-@pytest.mark.parametrize("dt", [0.05, 0.02, 0.01, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5])
-@pytest.mark.parametrize("k_hz", [3e9, 3e7, 3e5])
-def test_a_run_either_raises_or_returns_a_sane_history(method: str, dt: float, k_hz: float) -> None:
-    """Across step sizes around stability: finite history, energy never grown past 50 %."""
+BLOW_UP_STEPS = [0.05, 0.02, 0.01, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5]
+BLOW_UP_STIFFNESSES = [3e9, 3e7, 3e5]
+
+
+def hertz_run(method: str, dt: float, k_hz: float) -> vi.Solution:
+    """An elastic Hertz contact (K_hz N/m^1.5) from onset at 0.1 m/s, C = c1 = 0."""
     system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01)
     contact = vi.Contact("hertz", stiffness=k_hz)
-    state = vi.InitialState(**STATE)
+    return vi.simulate(system, contact, vi.InitialState(**STATE), method=method, dt=dt, t_end=0.5)
+
+
+def hertz_energy(sol: vi.Solution, k_hz: float) -> np.ndarray:
+    """Kinetic + spring + Hertz potential (0.4 K_hz delta^2.5), J, computed here."""
+    w, wd, y, yd = (
+        sol.main_displacement,
+        sol.main_velocity,
+        sol.impact_displacement,
+        sol.impact_velocity,
+    )
+    delta = np.maximum(np.abs(y - w) - 0.01, 0.0)
+    return 0.5 * wd**2 + 0.5 * 0.25 * yd**2 + 0.5 * w**2 + 0.4 * k_hz * delta**2.5
+
+
+def contact_time(k_hz: float) -> float:
+    """Goldsmith's duration of the contact (two free bodies, the spring's effect on
+    a contact this short is negligible), s."""
+    return vi.goldsmith_contact_duration(0.25, 1.0, k_hz, 0.1)
+
+
+CASES = [
+    (method, dt, k_hz)
+    for method in ("rk4", "newmark")
+    for dt in BLOW_UP_STEPS
+    for k_hz in BLOW_UP_STIFFNESSES
+]
+
+
+@pytest.mark.parametrize(("method", "dt", "k_hz"), [c for c in CASES if c[1] > contact_time(c[2])])
+def test_a_step_longer_than_the_contact_raises(method: str, dt: float, k_hz: float) -> None:
+    """A fixed step longer than the whole contact cannot resolve it: the bodies
+    interpenetrate by far more than the contact allows and the run blows up; it must
+    say so, naming dt, rather than return a history."""
+    with pytest.raises(vi.NumericalBlowUpError, match="dt"):
+        hertz_run(method, dt, k_hz)
+
+
+@pytest.mark.parametrize(
+    ("dt", "k_hz"),
+    [(c[1], c[2]) for c in CASES if c[0] == "rk4" and c[1] <= contact_time(c[2]) / 10],
+)
+def test_rk4_resolving_the_contact_conserves_energy(dt: float, k_hz: float) -> None:
+    """Ten or more steps per contact: RK4 returns and its energy error (e = 1, C = 0:
+    none physically) stays below (dt / Tc)^2 / 5. Fixed steps straddle each onset
+    and separation, where the force has a kink, so the error falls at second order
+    in dt / Tc; the measured constant is at most 0.07 on these cases."""
+    sol = hertz_run("rk4", dt, k_hz)
+    assert len(sol.contacts) >= 2
+    energy = hertz_energy(sol, k_hz)
+    drift = float(np.max(np.abs(energy / energy[0] - 1)))
+    assert drift < (dt / contact_time(k_hz)) ** 2 / 5, drift
+
+
+@pytest.mark.parametrize(
+    ("method", "dt", "k_hz"),
+    [
+        c
+        for c in CASES
+        if c[1] <= contact_time(c[2]) and (c[0] == "newmark" or c[1] > contact_time(c[2]) / 10)
+    ],
+)
+def test_a_marginal_step_either_raises_or_returns_a_sane_history(
+    method: str, dt: float, k_hz: float
+) -> None:
+    """Between the two: RK4 with a few steps per contact, and the paper's Newmark
+    (whose lagged force gains energy at every contact). Either outcome is allowed, but
+    a returned history is finite and never holds more than 1.5 times the initial
+    energy at any kept row (the kernel checks only every few steps), and an error
+    names dt."""
     try:
-        sol = vi.simulate(system, contact, state, method=method, dt=dt, t_end=0.5)
-    except vi.NumericalBlowUpError:
+        sol = hertz_run(method, dt, k_hz)
+    except vi.NumericalBlowUpError as err:
+        assert "dt" in str(err)
         return
     columns = [
         sol.t,
@@ -264,9 +335,7 @@ def test_a_run_either_raises_or_returns_a_sane_history(method: str, dt: float, k
     ]
     for column in columns:
         assert np.all(np.isfinite(column))
-    w, wd, y, yd = columns[1:5]
-    delta = np.maximum(np.abs(y - w) - 0.01, 0.0)
-    energy = 0.5 * wd**2 + 0.5 * 0.25 * yd**2 + 0.5 * w**2 + 0.4 * k_hz * delta**2.5
+    energy = hertz_energy(sol, k_hz)
     assert np.max(energy) <= 1.5 * energy[0]
 
 
