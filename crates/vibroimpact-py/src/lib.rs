@@ -791,6 +791,7 @@ impl BeamMode {
 /// ``int_0^L phi^2 dx = L``. Gives the paper's modal values
 /// (``(b L)^4 E I / L^3``, ``rho A L``) and the values referred to
 /// ``position`` (m from the clamp; the tip by default), where the enclosure sits.
+/// Exact to round-off for any mode; a position at a node of the mode is refused.
 #[pyfunction]
 #[pyo3(signature = (length, youngs_modulus, second_moment, density, area, mode = 1, position = None))]
 fn cantilever_mode(
@@ -825,7 +826,8 @@ fn cantilever_mode(
     })
 }
 
-/// The root ``b_i L`` of ``cos(x) cosh(x) + 1 = 0`` for mode ``mode`` >= 1.
+/// The root ``b_i L`` of ``cos(x) cosh(x) + 1 = 0`` for mode ``mode`` >= 1
+/// (any mode, to round-off); ``omega_i = (b_i L)^2 sqrt(E I / (rho A L^4))``.
 #[pyfunction]
 fn cantilever_root(#[pyo3(from_py_with = mode_arg)] mode: u32) -> PyResult<f64> {
     beam::cantilever_root(mode).map_err(to_py)
