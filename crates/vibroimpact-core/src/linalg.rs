@@ -78,6 +78,19 @@ pub fn inverse_from_cholesky(l: &[f64], n: usize) -> Vec<f64> {
     inverse
 }
 
+/// The inverse of a lower-triangular matrix (row-major), lower-triangular.
+pub fn inverse_lower(l: &[f64], n: usize) -> Vec<f64> {
+    let mut inverse = vec![0.0; n * n];
+    for k in 0..n {
+        inverse[k * n + k] = 1.0 / l[k * n + k];
+        for i in k + 1..n {
+            let sum: f64 = (k..i).map(|j| l[i * n + j] * inverse[j * n + k]).sum();
+            inverse[i * n + k] = -sum / l[i * n + i];
+        }
+    }
+    inverse
+}
+
 /// Eigenvalues of a symmetric matrix by cyclic Jacobi rotations, ascending.
 /// Accurate to round-off relative to the largest eigenvalue.
 pub fn symmetric_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {

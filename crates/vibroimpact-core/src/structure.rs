@@ -9,7 +9,8 @@
 //! position along the beam (so a tip force enters each mode with the tip
 //! value of its shape, 2 in magnitude, by construction).
 
-use crate::error::{non_negative, positive, Error, Result};
+use crate::beam::CantileverShape;
+use crate::error::{non_negative, positive, within, Error, Result};
 use crate::linalg;
 
 /// Most degrees of freedom a structure may have: its matrices are dense and
@@ -20,6 +21,12 @@ pub const MAX_DOFS: usize = 200;
 enum Points {
     /// A point is a coordinate index.
     Indices,
+    /// A point is a position along a cantilever (m from the clamp); its row
+    /// is the mode shapes there.
+    Beam {
+        length: f64,
+        shapes: Vec<CantileverShape>,
+    },
 }
 
 /// A linear structure (SI units: kg, N/m, N s/m), validated.
@@ -90,6 +97,89 @@ impl Structure {
         })
     }
 
+    /// An Euler-Bernoulli cantilever (`length` m, `youngs_modulus` Pa,
+    /// `second_moment` m^4, `mass_per_length` kg/m) in the coordinates of its
+    /// first `modes` modes, each with the modal `damping_ratio`. With the
+    /// shapes normalised to `int_0^L phi_i^2 dx = L` (so `|phi_i(L)| = 2`):
+    /// `M = rho A L I`, `K_ii = (b_i L)^4 E I / L^3`, `C_ii = 2 zeta omega_i
+    /// M_ii`, `omega_i = (b_i L)^2 sqrt(E I / (rho A L^4))`, and a base motion
+    /// enters mode `i` with `r_i = (1/L) int_0^L phi_i dx = 2 sigma_i / (b_i L)`.
+    pub fn cantilever(
+        length: f64,
+        youngs_modulus: f64,
+        second_moment: f64,
+        mass_per_length: f64,
+        modes: u32,
+        damping_ratio: f64,
+    ) -> Result<Self> {
+        let length = positive("length", length)?;
+        let flexural =
+            positive("youngs_modulus", youngs_modulus)? * positive("second_moment", second_moment)?;
+        let mass_per_length = positive("mass_per_length", mass_per_length)?;
+        let zeta = within("damping_ratio", damping_ratio, 0.0, 1.0, false, "in [0, 1]")?;
+        let n = modes as usize;
+        if n == 0 || n > MAX_DOFS {
+            return Err(Error::Inconsistent(format!(
+                "structure.modes must be a whole number in [1, {MAX_DOFS}], got {modes}"
+            )));
+        }
+        let shapes = (1..=modes)
+            .map(CantileverShape::new)
+            .collect::<Result<Vec<_>>>()?;
+        let modal_mass = mass_per_length * length;
+        let mut mass = vec![0.0; n * n];
+        let mut stiffness = vec![0.0; n * n];
+        let mut damping = vec![0.0; n * n];
+        let mut influence = vec![0.0; n];
+        for (i, shape) in shapes.iter().enumerate() {
+            let b = shape.beta_l;
+            let k = b.powi(4) * flexural / length.powi(3);
+            let omega = (k / modal_mass).sqrt();
+            mass[i * n + i] = modal_mass;
+            stiffness[i * n + i] = k;
+            damping[i * n + i] = 2.0 * zeta * omega * modal_mass;
+            // sigma = (sinh b - sin b) / (cosh b + cos b), from e^-b (no overflow).
+            let e = (-b).exp();
+            let sigma = (1.0 - e * (2.0 * b.sin() + e)) / (1.0 + e * (2.0 * b.cos() + e));
+            influence[i] = 2.0 * sigma / b;
+        }
+        Ok(Self {
+            dofs: n,
+            mass,
+            stiffness,
+            damping,
+            influence,
+            points: Points::Beam { length, shapes },
+        })
+    }
+
+    /// Undamped natural angular frequencies (rad/s), ascending: the square
+    /// roots of the eigenvalues of `L^-1 K L^-T`, with `M = L L^T`.
+    pub fn natural_frequencies(&self) -> Vec<f64> {
+        let n = self.dofs;
+        let l = linalg::cholesky(&self.mass, n).expect("checked positive definite");
+        let inverse = linalg::inverse_lower(&l, n);
+        // B = L^-1 K, then A = B L^-T.
+        let mut b = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                b[i * n + j] = (0..=i)
+                    .map(|p| inverse[i * n + p] * self.stiffness[p * n + j])
+                    .sum();
+            }
+        }
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = (0..=j).map(|q| b[i * n + q] * inverse[j * n + q]).sum();
+            }
+        }
+        linalg::symmetric_eigenvalues(&a, n)
+            .into_iter()
+            .map(|v| v.max(0.0).sqrt())
+            .collect()
+    }
+
     /// Number of generalised coordinates.
     pub fn dofs(&self) -> usize {
         self.dofs
@@ -131,6 +221,14 @@ impl Structure {
                 let mut row = vec![0.0; self.dofs];
                 row[index] = 1.0;
                 Ok(row)
+            }
+            Points::Beam { length, ref shapes } => {
+                if !(at.is_finite() && (0.0..=length).contains(&at)) {
+                    return Err(Error::Inconsistent(format!(
+                        "{key} must be a position along the beam in [0, {length}] m, got {at}"
+                    )));
+                }
+                shapes.iter().map(|s| s.value(at / length)).collect()
             }
         }
     }
