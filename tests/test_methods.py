@@ -43,9 +43,6 @@ from conftest import (
 
 EPS = np.finfo(float).eps
 
-# The model's exact duration of the Table 1 collision (s), quoted in the issue.
-TABLE1_DURATION = 0.108981931757
-
 
 def log_slope(x: list[float] | np.ndarray, y: list[float] | np.ndarray) -> float:
     """Least-squares slope of log(y) against log(x)."""
@@ -272,10 +269,9 @@ def collision_errors(sol: vi.Solution, exact: Collision) -> tuple[float, float, 
     )
 
 
-def test_oracle_gives_the_quoted_duration() -> None:
+def test_oracle_reproduces_the_reference_page() -> None:
     exact = collision_oracle()
-    assert exact.duration == pytest.approx(TABLE1_DURATION, rel=1e-10)
-    # The reference page's independent check, to its printed digits.
+    # /work/shared/reference/paper-model.md, "Independent checks", to its printed digits.
     assert exact.duration == pytest.approx(0.1089819, abs=6e-8)
     assert exact.max_indentation == pytest.approx(3.69668e-3, abs=6e-9)
     assert exact.rebound_ratio == pytest.approx(0.99635, abs=6e-6)
@@ -324,7 +320,6 @@ def test_adaptive_methods_converge_on_the_table1_collision(method: str) -> None:
 def test_rk4_events_at_1e3_within_1e6_of_the_exact_duration() -> None:
     sol = table1_run(method="rk4", dt=1e-3, stepping="events")
     assert collision_errors(sol, collision_oracle())[0] < 1e-6
-    assert sol.contacts.duration[0] == pytest.approx(TABLE1_DURATION, rel=1e-6)
 
 
 def test_dop853_at_rtol_1e10_within_1e10_of_the_exact_duration() -> None:
@@ -385,22 +380,50 @@ RATTLE_START = vi.InitialState(main_displacement=0.05, impact_displacement=0.05)
 class Rattle:
     onsets: np.ndarray
     separations: np.ndarray
+    # Relative normal speeds at each onset and at each separation, m/s.
+    approach_speeds: np.ndarray
+    rebound_speeds: np.ndarray
 
 
-@cache
-def rattle_oracle() -> Rattle:
-    """The rattling run mode by mode with SciPy's DOP853 (rtol 1e-13).
+def mode_by_mode_oracle(
+    system: vi.ImpactDamper,
+    contact: vi.Contact,
+    start: vi.InitialState,
+    t_end: float,
+    max_flight_step: float = np.inf,
+) -> Rattle:
+    """A run with a hertz-damped contact, mode by mode with SciPy's DOP853 (rtol 1e-13).
 
     Free flight until |y - w| = d (event), then the contact (hertz-damped force
     with the approach rate latched at onset, clamped at zero, plus c1) until the
-    indentation returns to zero (event), and so on to the end.
+    indentation returns to zero (event), and so on to the end. SciPy sees an event
+    only as a sign change between its steps: flights shorter than its step need
+    `max_flight_step` (s) below them.
     """
-    alpha = exact_hysteresis(RATTLE_E)
-    k, c, m_main, m_imp, d = RATTLE_K, DAMPING, MAIN_MASS, IMPACT_MASS, CLEARANCE
+    assert contact.law == "hertz-damped" and contact.restitution is not None
+    alpha = exact_hysteresis(contact.restitution)
+    k, c, m_main, m_imp, d = (
+        system.stiffness,
+        system.damping,
+        system.main_mass,
+        system.impact_mass,
+        system.clearance,
+    )
+    k_hz, c1 = contact.stiffness, contact.damping
     options: dict[str, Any] = dict(method="DOP853", rtol=1e-13, atol=1e-16)
-    t, state = 0.0, np.array([0.05, 0.0, 0.05, 0.0])
+    t = 0.0
+    state = np.array(
+        [
+            start.main_displacement,
+            start.main_velocity,
+            start.impact_displacement,
+            start.impact_velocity,
+        ]
+    )
     onsets: list[float] = []
     separations: list[float] = []
+    approaches: list[float] = []
+    rebounds: list[float] = []
     while True:
 
         def free(_t: float, s: np.ndarray) -> list[float]:
@@ -415,7 +438,9 @@ def rattle_oracle() -> Rattle:
         for event in (upper, lower):
             event.terminal = True  # type: ignore[attr-defined]
             event.direction = 1  # type: ignore[attr-defined]
-        sol = solve_ivp(free, (t, RATTLE_T), state, events=[upper, lower], **options)
+        sol = solve_ivp(
+            free, (t, t_end), state, events=[upper, lower], max_step=max_flight_step, **options
+        )
         if sol.status == 0:
             break
         hit = 0 if len(sol.t_events[0]) else 1
@@ -423,13 +448,14 @@ def rattle_oracle() -> Rattle:
         t, state = float(sol.t_events[hit][0]), sol.y_events[hit][0]
         approach = side * (state[3] - state[1])
         onsets.append(t)
+        approaches.append(approach)
 
         def contact(
             _t: float, s: np.ndarray, side: float = side, v0: float = approach
         ) -> list[float]:
             delta, rate = side * (s[2] - s[0]) - d, side * (s[3] - s[1])
-            law = HERTZ_STIFFNESS * max(delta, 0.0) ** 1.5 * (1 + alpha * rate / v0)
-            push = side * (max(law, 0.0) + CONTACT_DAMPING * rate)
+            law = k_hz * max(delta, 0.0) ** 1.5 * (1 + alpha * rate / v0)
+            push = side * (max(law, 0.0) + c1 * rate)
             return [s[1], (push - c * s[1] - k * s[0]) / m_main, s[3], -push / m_imp]
 
         def apart(_t: float, s: np.ndarray, side: float = side) -> float:
@@ -437,12 +463,18 @@ def rattle_oracle() -> Rattle:
 
         apart.terminal = True  # type: ignore[attr-defined]
         apart.direction = -1  # type: ignore[attr-defined]
-        sol = solve_ivp(contact, (t, RATTLE_T), state, events=apart, **options)
+        sol = solve_ivp(contact, (t, t_end), state, events=apart, **options)
         if sol.status == 0:
             break
         t, state = float(sol.t_events[0][0]), sol.y_events[0][0]
         separations.append(t)
-    return Rattle(np.array(onsets), np.array(separations))
+        rebounds.append(-side * (state[3] - state[1]))
+    return Rattle(np.array(onsets), np.array(separations), np.array(approaches), np.array(rebounds))
+
+
+@cache
+def rattle_oracle() -> Rattle:
+    return mode_by_mode_oracle(RATTLE_SYSTEM, RATTLE_CONTACT, RATTLE_START, RATTLE_T)
 
 
 def test_rattle_oracle_rattles() -> None:
@@ -495,6 +527,34 @@ def test_located_events_match_the_oracle(settings: dict[str, Any], tolerance: fl
     np.testing.assert_allclose(
         sol.contact_force[onset_rows], CONTACT_DAMPING * c.approach_speed, rtol=1e-9, atol=1e-15
     )
+
+
+def test_fixed_stepping_latches_the_located_approach_rate() -> None:
+    """The paper's fixed stepping (RK4) on the rattling run: a step straddles each
+    onset, and the hertz-damped law's latched rate must be the located onset's, not
+    the rate at the start of that step (the main mass accelerates the gap in free
+    flight, so the two differ by up to ~1e-3). The rebound of a rate-dependent law
+    depends on the latched rate, so each contact's onset, approach and rebound are
+    checked against the oracle: with the located latch the errors are below 4e-7 (s
+    and m/s) at dt = 1e-4 s, falling with dt; with the provisional one 5e-5 s, 2e-4 s
+    and 9e-5 m/s."""
+    exact = rattle_oracle()
+    sol = vi.simulate(
+        RATTLE_SYSTEM,
+        RATTLE_CONTACT,
+        RATTLE_START,
+        t_end=RATTLE_T,
+        method="rk4",
+        dt=1e-4,
+        stepping="fixed",
+    )
+    c = sol.contacts
+    closed = np.isfinite(c.separation)
+    assert len(c) == len(exact.onsets) and closed.sum() == len(exact.separations)
+    np.testing.assert_allclose(c.onset, exact.onsets, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(c.separation[closed], exact.separations, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(c.approach_speed, exact.approach_speeds, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(c.rebound_speed[closed], exact.rebound_speeds, rtol=0, atol=1e-6)
 
 
 # ------------------------------------------------- d) energy
@@ -731,10 +791,11 @@ PRESSED_RUNS = [
 
 
 @cache
-def pressed_reference() -> vi.ContactTable:
-    return vi.simulate(
-        PRESSED_SYSTEM, PRESSED_CONTACT, PRESSED_START, t_end=0.3, method="dop853", rtol=1e-11
-    ).contacts
+def pressed_reference() -> Rattle:
+    # The flights shrink to about 1 ms: ten SciPy steps at least in each.
+    return mode_by_mode_oracle(
+        PRESSED_SYSTEM, PRESSED_CONTACT, PRESSED_START, 0.3, max_flight_step=1e-4
+    )
 
 
 @pytest.mark.parametrize("settings", PRESSED_RUNS, ids=[s["method"] for s in PRESSED_RUNS])
@@ -757,9 +818,14 @@ def test_bouncing_down_ends_in_persistent_contact_or_chattering_error(
     assert np.all(flights > 0) and np.all(np.diff(flights) < 0)
     assert c.duration[-1] > 50 * c.duration[0]
     reference = pressed_reference()
-    assert len(c) == len(reference)
-    np.testing.assert_allclose(c.onset, reference.onset, rtol=1e-4)
-    np.testing.assert_allclose(c.duration, reference.duration, rtol=1e-3)
+    assert len(c) == len(reference.onsets)
+    # Measured: onsets within 3e-6 and durations within 3e-5 (DOPRI5 at its default
+    # tolerance), the others closer.
+    np.testing.assert_allclose(c.onset, reference.onsets, rtol=1e-5)
+    closed = np.isfinite(c.separation)
+    np.testing.assert_allclose(
+        c.duration[closed], reference.separations - reference.onsets[: closed.sum()], rtol=1e-4
+    )
 
 
 def test_a_stiff_contact_may_fail_newton_but_says_so() -> None:
@@ -780,7 +846,7 @@ def test_a_stiff_contact_may_fail_newton_but_says_so() -> None:
         assert isinstance(err, RuntimeError)
         assert "Newton" in str(err) and "dt" in str(err)
         return
-    assert len(sol.contacts) == len(pressed_reference())
+    assert len(sol.contacts) == len(pressed_reference().onsets)
 
 
 @pytest.mark.parametrize(
