@@ -37,6 +37,7 @@ from vibroimpact._core import (
     cantilever_mode,
     cantilever_mode_shape,
     cantilever_root,
+    check_solver,
     goldsmith_contact_duration,
     goldsmith_max_indentation,
     hertz_stiffness,
@@ -44,6 +45,24 @@ from vibroimpact._core import (
     simulate,
 )
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
+
+
+def _equality_only(*classes: type) -> None:
+    """Leave the ordering comparisons out of ``help()`` of classes that only compare equal.
+
+    PyO3's ``#[pyclass(eq)]`` fills the one C slot of all six comparisons, and CPython
+    then lists a wrapper for each (``__lt__``, ...) although ordering returns
+    NotImplemented. Deleting the four ordering wrappers leaves them inherited from
+    ``object`` (help no longer shows them; ``<`` still raises TypeError), and ``==``
+    still reaches the binding through ``__eq__``.
+    """
+    for cls in classes:
+        for name in ("__lt__", "__le__", "__gt__", "__ge__"):
+            if name in vars(cls):
+                delattr(cls, name)
+
+
+_equality_only(ImpactDamper, Contact, InitialState)
 
 __all__ = [
     "BeamMode",
@@ -63,6 +82,7 @@ __all__ = [
     "cantilever_mode",
     "cantilever_mode_shape",
     "cantilever_root",
+    "check_solver",
     "goldsmith_contact_duration",
     "goldsmith_max_indentation",
     "hertz_stiffness",

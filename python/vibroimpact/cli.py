@@ -26,6 +26,7 @@ from vibroimpact._core import (
     Solution,
     __version__,
 )
+from vibroimpact.output import UsageError, written_whole
 from vibroimpact.scenario import Scenario, load_scenario, paper_collision
 
 HISTORY_COLUMNS = (
@@ -38,12 +39,30 @@ HISTORY_COLUMNS = (
 )
 
 
+# Headers of the text table of contacts, by column of `ContactTable.columns`.
+CONTACT_HEADERS = {
+    "onset": "onset (s)",
+    "separation": "separation (s)",
+    "duration": "duration (s)",
+    "max_indentation": "max indent. (m)",
+    "approach_speed": "approach (m/s)",
+    "rebound_speed": "rebound (m/s)",
+    "restitution": "restitution",
+    "energy_dissipated": "dissipated (J)",
+    "energy_change": "net change (J)",
+}
+# What the energy columns are: printed under the table, the same words as in the help.
+ENERGY_DISSIPATED_TEXT = (
+    "dissipated = work of the contact's dissipative forces (the law's hysteresis and the "
+    "contact damper c1) during the contact, J, not the net change of the system's energy"
+)
+ENERGY_CHANGE_TEXT = (
+    "net change = change of the system's mechanical energy over the contact, J "
+    "(negative: lost; positive: created by the method's numerical error)"
+)
+CONTACT_NOTES = {"energy_dissipated": ENERGY_DISSIPATED_TEXT, "energy_change": ENERGY_CHANGE_TEXT}
 # Energy growth (relative) above which `simulate` says the run gained energy.
 ENERGY_NOTE = 0.01
-
-
-class UsageError(Exception):
-    """Bad input found by the CLI itself (exit status 2)."""
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -58,9 +77,10 @@ def _parser() -> argparse.ArgumentParser:
         "paper",
         help="reproduce the founding paper's tables and figures, with a report",
         description=(
-            "Reproduce Afsharfard & Farshidianfar (2012): writes table2.csv, table3.csv, "
-            "fig1.png, fig3.png, fig4.png and report.md, and prints the tables. "
-            "CPU times are measured on this machine (medians of repeated runs)."
+            "Reproduce Afsharfard & Farshidianfar (2012): writes tables 2 and 3 (CSV), the "
+            "figures (PNG) and report.md, which lists every file written, and prints the "
+            "tables. CPU times are measured on this machine (medians of repeated runs). "
+            "Each file is written whole or not at all."
         ),
     )
     paper.add_argument(
@@ -75,16 +95,26 @@ def _parser() -> argparse.ArgumentParser:
         "simulate",
         help="run one scenario (TOML); without a file, the paper's Table 1 collision",
         description=(
-            "Run one scenario and print its contacts. Without SCENARIO, the founding "
-            "paper's Table 1 collision (Hertz, 0.1 m/s, Newmark-beta, dt = 1e-4 s, 0.3 s)."
+            "Run one scenario and print its contacts (SI units). Without SCENARIO, the "
+            "founding paper's Table 1 collision (Hertz, 0.1 m/s, Newmark-beta, dt = 1e-4 s, "
+            f"0.3 s). In the table of contacts, {ENERGY_DISSIPATED_TEXT}. A contact still "
+            "open at the end of the run shows 'open' for its separation, duration, rebound "
+            "and restitution (null in --json)."
         ),
     )
     simulate.add_argument("scenario", nargs="?", type=Path, help="scenario file (.toml)")
     simulate.add_argument(
-        "--out", type=Path, metavar="FILE.csv", help="write the time history to a CSV file"
+        "--out",
+        type=Path,
+        metavar="FILE.csv",
+        help="write the time history to a CSV file (whole or not at all: a run that fails "
+        "leaves an existing file as it was)",
     )
     simulate.add_argument(
-        "--json", action="store_true", help="print one JSON object (steps, contacts, ...)"
+        "--json",
+        action="store_true",
+        help="print one JSON object (steps, contacts, ...); a quantity not defined for a "
+        "contact still open at the end of the run is null",
     )
     return parser
 
@@ -116,16 +146,33 @@ def run_summary(scenario: Scenario, sol: Solution, cpu_time: float) -> dict[str,
 
 
 def write_history(path: Path, sol: Solution) -> None:
-    """Write the time history as CSV, one row per kept step."""
+    """Write the time history as CSV, one row per kept step, whole or not at all."""
     columns = [getattr(sol, name) for name, _ in HISTORY_COLUMNS]
-    try:
-        with path.open("w", newline="", encoding="utf-8") as f:
-            writer = csv.writer(f)
-            writer.writerow(name for name, _ in HISTORY_COLUMNS)
-            for row in zip(*columns, strict=True):
-                writer.writerow(repr(float(v)) for v in row)
-    except OSError as err:
-        raise UsageError(f"cannot write {str(path)!r}: {err.strerror or err}") from None
+    with written_whole(path) as f:
+        writer = csv.writer(f)
+        writer.writerow(name for name, _ in HISTORY_COLUMNS)
+        for row in zip(*columns, strict=True):
+            writer.writerow(repr(float(v)) for v in row)
+
+
+def contact_lines(sol: Solution) -> list[str]:
+    """The text table of contacts, then what its energy columns mean.
+
+    Columns come from ``ContactTable.columns``; a value left undefined because the
+    contact is still open at the end of the run (NaN in the table) reads ``open``.
+    """
+    columns = list(sol.contacts.columns)
+    lines = ["  ".join(f"{CONTACT_HEADERS.get(name, name):>15}" for name in columns)]
+    for row in sol.contacts.to_dicts():
+        still_open = not math.isfinite(row["separation"])
+        lines.append(
+            "  ".join(
+                f"{'open':>15}" if still_open and math.isnan(row[name]) else f"{row[name]:>15.7g}"
+                for name in columns
+            )
+        )
+    lines += [f"  {text}" for name, text in CONTACT_NOTES.items() if name in columns]
+    return lines
 
 
 def _simulate(args: argparse.Namespace) -> int:
@@ -153,19 +200,7 @@ def _simulate(args: argparse.Namespace) -> int:
         )
     print(f"{len(sol.contacts)} contact(s)")
     if len(sol.contacts):
-        header = (
-            "onset (s)",
-            "separation (s)",
-            "duration (s)",
-            "max indent. (m)",
-            "approach (m/s)",
-            "rebound (m/s)",
-            "restitution",
-            "dissipated (J)",
-        )
-        print("  ".join(f"{h:>15}" for h in header))
-        for row in sol.contacts.to_dicts():
-            print("  ".join(f"{v:>15.7g}" for v in row.values()))
+        print("\n".join(contact_lines(sol)))
     if args.out:
         print(f"history ({len(sol.t)} rows) written to {args.out}")
     return 0

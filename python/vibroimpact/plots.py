@@ -18,7 +18,18 @@ from vibroimpact.beyond import (  # noqa: E402
     HERTZ_STIFFNESS,
     StudyRun,  # noqa: E402
 )
+from vibroimpact.output import written_whole  # noqa: E402
 from vibroimpact.paper import PAPER_LINEAR_STIFFNESS, collision  # noqa: E402
+
+
+def _save(fig: Any, path: Path) -> None:
+    """Write the figure as PNG, whole or not at all, and free it."""
+    try:
+        fig.tight_layout()
+        with written_whole(path, binary=True) as f:
+            fig.savefig(f, format="png", dpi=110)
+    finally:
+        plt.close(fig)
 
 
 def _contact_phase(sol: Solution, clearance: float = 0.01) -> dict[str, Any]:
@@ -52,16 +63,39 @@ def fig1(path: Path) -> None:
     for e in (1.0, 0.9, 0.7, 0.5):
         sol = _history("rk4", 1e-5, None if e == 1.0 else e)
         p = _contact_phase(sol)
-        b.plot(p["indentation"] * 1e3, p["law_force"], label=f"e = {e:g}")
+        (line,) = b.plot(p["indentation"] * 1e3, p["law_force"], label=f"e = {e:g}")
+        loading, unloading = _loop_arrows(b, p["indentation"] * 1e3, p["law_force"], line)
+    # Name the branches once, on the widest loop (the last drawn, e = 0.5).
+    b.annotate("loading", xy=loading, xytext=(0.7, 0.33), arrowprops={"arrowstyle": "-"})
+    b.annotate("unloading", xy=unloading, xytext=(2.7, 0.07), arrowprops={"arrowstyle": "-"})
     b.set(
         xlabel="indentation (mm)",
         ylabel="law force (N)",
         title="(b) Hyster-Hertz, Table 1 collision (RK4)",
     )
-    b.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    b.legend(title="arrows: direction of travel", title_fontsize=8, loc="upper left")
+    _save(fig, path)
+
+
+def _loop_arrows(
+    ax: Any, indentation: Any, force: Any, line: Any
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Arrowheads along a loop's loading and unloading branches; the two points marked."""
+    inside = np.flatnonzero(np.isfinite(indentation))
+    deepest = inside[np.argmax(indentation[inside])]
+    marked = []
+    for branch in (inside[inside <= deepest], inside[inside >= deepest]):
+        # Where the branch passes 60 % of the deepest indentation, pointing the way it runs.
+        i = branch[np.argmin(np.abs(indentation[branch] - 0.6 * indentation[deepest]))]
+        j = min(i + len(branch) // 50, branch[-1])
+        ax.annotate(
+            "",
+            xy=(indentation[j], force[j]),
+            xytext=(indentation[i], force[i]),
+            arrowprops={"arrowstyle": "-|>", "color": line.get_color(), "mutation_scale": 14},
+        )
+        marked.append((float(indentation[i]), float(force[i])))
+    return marked[0], marked[1]
 
 
 def fig3(path: Path, equal_duration_stiffness: float) -> None:
@@ -82,16 +116,19 @@ def fig3(path: Path, equal_duration_stiffness: float) -> None:
         ":",
         label=f"equal-duration linear, k1 = {equal_duration_stiffness:.1f} N/m",
     )
-    ax.axvline(dmax * 1e3, color="grey", lw=0.8)
+    ax.axvline(
+        dmax * 1e3,
+        color="grey",
+        lw=0.8,
+        label=f"Goldsmith's maximum indentation, {dmax * 1e3:.2f} mm (v = 0.1 m/s)",
+    )
     ax.set(
         xlabel="indentation (mm)",
         ylabel="contact force (N)",
         title="Hertz contact and its linear approximations",
     )
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def fig4(path: Path) -> None:
@@ -111,28 +148,41 @@ def fig4(path: Path) -> None:
             ms=3,
             color=colour,
             mfc="none",
-            label=f"{label}: paper's Newmark, 1e-3 s",
+            label=f"{label}: paper's Newmark, 1e-3 s (every 4th step shown)",
         )
-    ax.axhline(10.0, color="grey", lw=0.8)
+    ax.axhline(10.0, color="grey", lw=0.8, label="clearance: in contact above it")
     ax.set(
         xlabel="time (s)",
         ylabel="y - w (mm)",
         title="Relative displacement through one contact (clearance 10 mm)",
     )
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
+
+
+def _varies(runs: list[StudyRun]) -> str:
+    """The setting that varies along a line of runs and its range, e.g. ``dt = 4e-3 to 1e-4 s``."""
+
+    def short(x: float) -> str:
+        return f"{x:.0e}".replace("e-0", "e-")
+
+    steps = [r.dt for r in runs if r.dt is not None]
+    if steps:
+        return f"dt = {short(max(steps))} to {short(min(steps))} s"
+    tolerances = [r.rtol for r in runs if r.rtol is not None]
+    return f"rtol = {short(max(tolerances))} to {short(min(tolerances))}"
 
 
 def work_precision(path: Path, study: list[StudyRun], scipy_study: list[StudyRun]) -> None:
-    """Error of the contact duration against CPU time, a line per method (log-log)."""
-    fig, ax = plt.subplots(figsize=(8, 5.5))
+    """Error of the contact duration against CPU time, a line per method (log-log),
+    through its runs from the largest step or tolerance to the smallest."""
+    fig, ax = plt.subplots(figsize=(8, 7))
     labels = list(dict.fromkeys(r.label for r in study + scipy_study))
     floor = 1e-16  # an exact hit would have no logarithm
     for i, label in enumerate(labels):
         runs = sorted(
-            (r for r in study + scipy_study if r.label == label), key=lambda r: r.cpu_time
+            (r for r in study + scipy_study if r.label == label),
+            key=lambda r: -(r.dt if r.dt is not None else r.rtol or 0.0),
         )
         style = "--" if label.startswith("scipy") else "-"
         ax.loglog(
@@ -142,7 +192,7 @@ def work_precision(path: Path, study: list[StudyRun], scipy_study: list[StudyRun
             marker="o",
             ms=3,
             color=f"C{i % 10}",
-            label=label,
+            label=f"{label}: {_varies(runs)}",
         )
     ax.set(
         xlabel="CPU time per collision (s, median)",
@@ -150,7 +200,12 @@ def work_precision(path: Path, study: list[StudyRun], scipy_study: list[StudyRun
         title="Table 1 collision: work against precision",
     )
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    ax.legend(
+        fontsize=7,
+        ncol=2,
+        title="method: its step dt or tolerance rtol along the line, from largest to smallest",
+        title_fontsize=7,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.1),
+    )
+    _save(fig, path)

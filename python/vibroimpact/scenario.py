@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import reprlib
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,16 @@ class ScenarioError(InvalidInputError):
 _NUMBER = "number"
 _TEXT = "string"
 _WHOLE = "whole number"
+# TOML integers are 64-bit: "If an integer cannot be represented losslessly, an
+# error must be thrown" (TOML 1.0). Python's parser reads any size, so we check.
+_TOML_INTEGERS = range(-(2**63), 2**63)
+# A scenario is a few kB; a cap keeps a wrong path (a disk image, /dev/zero)
+# from filling the memory before the parser refuses it.
+MAX_SCENARIO_BYTES = 16 * 2**20
+# Values quoted in error messages are cut short: an error is one line.
+_SHORT = reprlib.Repr()
+_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxdict = 2, 4, 4
+_SHORT.maxstring, _SHORT.maxlong, _SHORT.maxother = 40, 24, 40
 
 # section -> key -> (type, default; a default of _REQUIRED means the key must be given)
 _REQUIRED = object()
@@ -148,19 +159,27 @@ def _fail(source: str, where: str, message: str) -> ScenarioError:
 
 def _check_type(source: str, section: str, key: str, kind: str, value: Any) -> Any:
     where = f"[{section}] {key}: "
+    shown = _SHORT.repr(value)
+    if isinstance(value, int) and not isinstance(value, bool) and value not in _TOML_INTEGERS:
+        raise _fail(
+            source,
+            where,
+            f"an integer of {len(str(abs(value)))} digits ({shown}) is outside TOML's "
+            "64-bit integers; write it as a float (e.g. 1e30)",
+        )
     if kind == _NUMBER:
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise _fail(source, where, f"must be a number, got {value!r}")
+            raise _fail(source, where, f"must be a number, got {shown}")
         value = float(value)
         if not math.isfinite(value):
             raise _fail(source, where, f"must be a finite number, got {value}")
         return value
     if kind == _WHOLE:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise _fail(source, where, f"must be a whole number, got {value!r}")
+            raise _fail(source, where, f"must be a whole number, got {shown}")
         return value
     if not isinstance(value, str):
-        raise _fail(source, where, f"must be a string, got {value!r}")
+        raise _fail(source, where, f"must be a string, got {shown}")
     return value
 
 
@@ -176,7 +195,9 @@ def _sections(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
         if name not in _SCHEMA:
             raise _unknown(source, "", name, list(_SCHEMA))
         if not isinstance(table, dict):
-            raise _fail(source, "", f"{name!r} must be a table ([{name}]), got {table!r}")
+            raise _fail(
+                source, "", f"{name!r} must be a table ([{name}]), got {_SHORT.repr(table)}"
+            )
         schema = _SCHEMA[name]
         values: dict[str, Any] = {}
         for key, value in table.items():
@@ -201,8 +222,16 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
     """Build a :class:`Scenario` from TOML text; ``source`` names it in errors."""
     try:
         data = tomllib.loads(text)
+    except RecursionError:
+        # The parser recurses once per level of nested arrays or inline tables.
+        raise ScenarioError(f"{source}: invalid TOML: values nested too deeply") from None
     except tomllib.TOMLDecodeError as err:
         raise ScenarioError(f"{source}: invalid TOML: {err}") from None
+    except ValueError as err:
+        # The parser's int() refusing a number of thousands of digits; what follows the
+        # colon advises on a Python setting, no help to the author of a scenario.
+        reason = str(err).split(":")[0]
+        raise ScenarioError(f"{source}: invalid TOML: a value it cannot read ({reason})") from None
     s = _sections(data, source)
 
     def build(section: str, make: Any) -> Any:
@@ -228,10 +257,17 @@ def _validate_solver(scenario: Scenario, source: str) -> None:
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a TOML scenario file."""
+    """Read and validate a TOML scenario file (UTF-8, at most ``MAX_SCENARIO_BYTES``)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as f:
+            data = f.read(MAX_SCENARIO_BYTES + 1)
+        if len(data) > MAX_SCENARIO_BYTES:
+            raise ScenarioError(
+                f"cannot read scenario {str(path)!r}: larger than "
+                f"{MAX_SCENARIO_BYTES // 2**20} MiB; is it a scenario (TOML text)?"
+            )
+        text = data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as err:
         reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
         raise ScenarioError(f"cannot read scenario {str(path)!r}: {reason}") from None
