@@ -434,12 +434,22 @@ def test_the_work_precision_comparison_with_scipy_is_there(paper_run: tuple[Path
     )
 
 
-def test_a_missing_scipy_is_said_not_silently_left_out(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_missing_scipy_is_said_not_silently_left_out(
+    quick_paper: None,
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     monkeypatch.setitem(sys.modules, "scipy", None)  # import scipy now raises ImportError
     monkeypatch.setitem(sys.modules, "scipy.integrate", None)
     message = beyond.scipy_missing()
     assert message is not None and "pip install scipy" in message
     assert beyond.scipy_runs(0.1) == []
+    status, out, _ = run_main(capsys, "paper", "--out", str(tmp_path))
+    assert status == 0
+    assert f"note: {message}" in out.splitlines()
+    report = (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert message in report and "scipy RK45" not in report
 
 
 # --------------------------------------------------------------------- figures
