@@ -27,6 +27,7 @@ from vibroimpact._core import (
     __version__,
 )
 from vibroimpact.output import UsageError, written_whole
+from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, load_scenario, paper_collision
 
 HISTORY_COLUMNS = (
@@ -53,11 +54,11 @@ CONTACT_HEADERS = {
 }
 # What the energy columns are: printed under the table, the same words as in the help.
 ENERGY_DISSIPATED_TEXT = (
-    "dissipated = work of the contact's dissipative forces (the law's hysteresis and the "
-    "contact damper c1) during the contact, J, not the net change of the system's energy"
+    "dissipated (J) = work of the contact's dissipative forces (the law's hysteresis and "
+    "the contact damper c1) during the contact; it is not the net change of the energy"
 )
 ENERGY_CHANGE_TEXT = (
-    "net change = change of the system's mechanical energy over the contact, J "
+    "net change (J) = change of the system's mechanical energy over the contact "
     "(negative: lost; positive: created by the method's numerical error)"
 )
 CONTACT_NOTES = {"energy_dissipated": ENERGY_DISSIPATED_TEXT, "energy_change": ENERGY_CHANGE_TEXT}
@@ -211,8 +212,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         if args.command == "paper":
-            from vibroimpact.paper import run_paper
-
             return run_paper(args.out)
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
