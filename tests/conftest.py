@@ -120,7 +120,9 @@ def write_scenario(tmp_path: Path) -> Callable[[str, str], Path]:
 def run_cli(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess[str]]:
     """Run ``python -m vibroimpact ARGS`` in a temporary folder."""
 
-    def run(*args: str, timeout: float = 120.0) -> subprocess.CompletedProcess[str]:
+    # Below pytest's per-test limit (60 s, pyproject.toml), so that a hung command
+    # fails this test alone with its own message.
+    def run(*args: str, timeout: float = 50.0) -> subprocess.CompletedProcess[str]:
         env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONWARNINGS": "error"}
         return subprocess.run(
             [sys.executable, "-m", "vibroimpact", *args],
