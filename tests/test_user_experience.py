@@ -325,6 +325,12 @@ def test_written_whole_lets_other_errors_through_and_writes_new_files(tmp_path: 
     assert stat.S_IMODE(fresh.stat().st_mode) == 0o666 & ~umask  # as open() would give
     with pytest.raises(UsageError, match="cannot write"), written_whole(tmp_path / "no" / "c"):
         pass
+    # Through a symbolic link: the file it points to is written, the link stays.
+    link = tmp_path / "link.txt"
+    link.symlink_to(path)
+    with written_whole(link) as f:
+        f.write("through the link")
+    assert link.is_symlink() and path.read_text(encoding="utf-8") == "through the link"
 
 
 def _single_run(run: Callable[[], Any], min_repeats: int = 5, budget: float = 0.02) -> Any:

@@ -32,6 +32,9 @@ def written_whole(path: Path, binary: bool = False) -> Iterator[IO[Any]]:
     naming it; other errors propagate unchanged.
     """
     temporary = None
+    if path.is_symlink():
+        # Write the file the link points to, as open() would, and keep the link.
+        path = path.resolve()
     try:
         descriptor, temporary = _create_beside(path)
         file: IO[Any] = (
