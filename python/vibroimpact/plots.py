@@ -19,7 +19,7 @@ from vibroimpact.beyond import (  # noqa: E402
     StudyRun,  # noqa: E402
 )
 from vibroimpact.output import written_whole  # noqa: E402
-from vibroimpact.paper import PAPER_LINEAR_STIFFNESS, collision  # noqa: E402
+from vibroimpact.paper_data import PAPER_LINEAR_STIFFNESS, collision  # noqa: E402
 
 
 def _save(fig: Any, path: Path) -> None:

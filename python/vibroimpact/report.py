@@ -5,7 +5,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from vibroimpact.beyond import cheapest, scipy_missing
 from vibroimpact.output import written_whole
+from vibroimpact.paper_data import (
+    PAPER_HYSTER,
+    PAPER_TABLE2,
+    PAPER_TABLE3,
+    REFERENCE_ELASTIC,
+    REFERENCE_HYSTER,
+    REFERENCE_REBOUND_RATIO,
+    STEP_SIZES,
+    WEIGHTS,
+    paper_table3_recomputed,
+)
 
 if TYPE_CHECKING:
     from vibroimpact.paper import Findings, Row
@@ -34,19 +46,6 @@ def write_report(
 ) -> None:
     """Write the report to ``path`` (whole or not at all); ``files`` are the names of
     every file the job writes, this report included."""
-    from vibroimpact.beyond import scipy_missing
-    from vibroimpact.paper import (
-        PAPER_HYSTER,
-        PAPER_TABLE2,
-        PAPER_TABLE3,
-        REFERENCE_ELASTIC,
-        REFERENCE_HYSTER,
-        REFERENCE_REBOUND_RATIO,
-        STEP_SIZES,
-        WEIGHTS,
-        paper_table3_recomputed,
-    )
-
     exact, gold = found.exact, found.goldsmith
     t2 = []
     for method, dt, tc, cpu, err in PAPER_TABLE2:
@@ -306,8 +305,6 @@ Most adequate by our numbers: {best_note}.
 
 
 def _beyond_section(found: Findings, rows: list[Row]) -> str:
-    from vibroimpact.beyond import cheapest
-
     study, scipy_study = found.study, found.scipy_study
     body = [
         [
