@@ -421,6 +421,66 @@ impl Contact {
     }
 }
 
+/// Any of the laws, chosen at run time: for systems whose pairs each have
+/// their own law (one branch per evaluation, which the predictor learns).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyLaw {
+    Hertz(Hertz),
+    HysterHertz(HysterHertz),
+    Linear(Linear),
+}
+
+impl Contact {
+    /// The law as a run-time choice (see [`AnyLaw`]).
+    pub fn any_law(&self) -> AnyLaw {
+        let k = self.stiffness;
+        match self.law {
+            LawKind::Hertz => AnyLaw::Hertz(Hertz { stiffness: k }),
+            LawKind::HysterHertz => AnyLaw::HysterHertz(HysterHertz::paper(k, self.restitution)),
+            LawKind::HertzDamped => {
+                AnyLaw::HysterHertz(HysterHertz::rebounding_at(k, self.restitution))
+            }
+            LawKind::Linear => AnyLaw::Linear(Linear { stiffness: k }),
+        }
+    }
+}
+
+macro_rules! delegate {
+    ($self:ident, $law:ident => $call:expr) => {
+        match $self {
+            AnyLaw::Hertz($law) => $call,
+            AnyLaw::HysterHertz($law) => $call,
+            AnyLaw::Linear($law) => $call,
+        }
+    };
+}
+
+impl ContactLaw for AnyLaw {
+    #[inline(always)]
+    fn force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
+        delegate!(self, law => law.force(indentation, rate, approach_rate))
+    }
+    #[inline(always)]
+    fn elastic_force(&self, indentation: f64) -> f64 {
+        delegate!(self, law => law.elastic_force(indentation))
+    }
+    #[inline(always)]
+    fn force_and_elastic(&self, indentation: f64, rate: f64, approach_rate: f64) -> (f64, f64) {
+        delegate!(self, law => law.force_and_elastic(indentation, rate, approach_rate))
+    }
+    fn potential(&self, indentation: f64) -> f64 {
+        delegate!(self, law => law.potential(indentation))
+    }
+    fn force_derivatives(
+        &self,
+        indentation: f64,
+        rate: f64,
+        approach_rate: f64,
+    ) -> (f64, f64, f64) {
+        delegate!(self, law => law.force_derivatives(indentation, rate, approach_rate))
+    }
+}
+
 /// Something to do with a concrete contact law (see [`Contact::visit`]).
 pub trait LawVisitor {
     type Output;

@@ -6,6 +6,7 @@
 //! keeps a thinned history and a table of located contacts, and closed-form
 //! references ([`closed_forms`], [`beam`], [`materials`]). SI units throughout.
 
+pub mod assembly;
 pub mod beam;
 pub mod closed_forms;
 pub mod contact;
@@ -21,6 +22,8 @@ pub mod signals;
 pub mod steppers;
 pub mod structure;
 pub mod system;
+pub mod system_events;
+pub mod system_steppers;
 pub mod tableau;
 
 pub use contact::{Contact, ContactLaw, LawKind};

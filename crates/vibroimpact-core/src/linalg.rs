@@ -148,6 +148,40 @@ pub fn multiply(a: &[f64], x: &[f64], y: &mut [f64]) {
     }
 }
 
+/// `a . b`.
+#[inline(always)]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// Solves `A x = b` in place (`b` becomes `x`) by Gaussian elimination with
+/// partial pivoting; `A` (row-major, `n x n`) is overwritten.
+pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
+            .unwrap_or(col);
+        if pivot != col {
+            for c in 0..n {
+                a.swap(col * n + c, pivot * n + c);
+            }
+            b.swap(col, pivot);
+        }
+        let diagonal = a[col * n + col];
+        for row in col + 1..n {
+            let factor = a[row * n + col] / diagonal;
+            for c in col..n {
+                a[row * n + c] -= factor * a[col * n + c];
+            }
+            b[row] -= factor * b[col];
+        }
+    }
+    for row in (0..n).rev() {
+        let sum: f64 = (row + 1..n).map(|c| a[row * n + c] * b[c]).sum();
+        b[row] = (b[row] - sum) / a[row * n + row];
+    }
+}
+
 /// `x^T A x` for a symmetric row-major matrix.
 pub fn quadratic_form(a: &[f64], x: &[f64]) -> f64 {
     let n = x.len();

@@ -1,0 +1,621 @@
+//! A 0.2 system: a structure, loose masses (dampers) rattling against its
+//! points, stops fixed to the base, gravity and excitations; assembled into
+//! the plain data the kernel integrates.
+//!
+//! Coordinates `x = (q, z)`: the structure's `q` (n) and the dampers'
+//! displacements `z` (k), all relative to the base. Each wall of a pair is an
+//! interaction with a gap `g = offset + h . x` (open while `g > 0`), as
+//! Siconos writes `y = H q + b`; its contact force `lambda >= 0` acts along
+//! `h^T`, so it accelerates the coordinates by `M^-1 h^T lambda`.
+//! Gravity along -x and any base acceleration act on every mass as an
+//! inertial load `-M r a(t)` (`r`: the influence vector, 1 for each damper).
+
+use crate::contact::{AnyLaw, Contact, ContactLaw};
+use crate::error::{finite, non_negative, positive, within, Error, Result};
+use crate::linalg;
+use crate::signals::Signal;
+use crate::structure::Structure;
+
+/// What happens when a gap closes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PairLaw {
+    /// A compliant contact law with its contact damper.
+    Compliant(Contact),
+    /// An instantaneous impact with Newton's restitution `e` in [0, 1]:
+    /// the relative normal speed after is `e` times the one before.
+    Rigid { restitution: f64 },
+}
+
+impl PairLaw {
+    /// Newton's rigid law, `restitution` in [0, 1].
+    pub fn rigid(restitution: f64) -> Result<Self> {
+        Ok(Self::Rigid {
+            restitution: within("restitution", restitution, 0.0, 1.0, false, "in [0, 1]")?,
+        })
+    }
+}
+
+/// A loose mass rattling against a point of the structure, between a lower
+/// and an upper wall: free while `-lower_clearance < z - h.q < upper_clearance`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Damper {
+    /// kg (> 0).
+    pub mass: f64,
+    /// The point (a coordinate index, or m along a cantilever).
+    pub at: f64,
+    /// m (>= 0).
+    pub lower_clearance: f64,
+    /// m (>= 0).
+    pub upper_clearance: f64,
+    pub law: PairLaw,
+}
+
+/// Which way a stop limits its point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The point stays at or below `+gap`.
+    Upper,
+    /// The point stays at or above `-gap`.
+    Lower,
+}
+
+impl Side {
+    pub const NAMES: &'static str = "\"upper\", \"lower\"";
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "upper" => Ok(Self::Upper),
+            "lower" => Ok(Self::Lower),
+            _ => Err(Error::UnknownChoice {
+                field: "side",
+                allowed: Self::NAMES,
+                value: name.to_string(),
+            }),
+        }
+    }
+}
+
+/// A stop fixed to the base that a point of the structure hits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stop {
+    pub at: f64,
+    pub side: Side,
+    /// m (>= 0).
+    pub gap: f64,
+    pub law: PairLaw,
+}
+
+/// Where an excitation acts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Load {
+    /// A force (N) at a point of the structure.
+    Force { at: f64 },
+    /// A base (support) acceleration (m/s^2): every coordinate is relative
+    /// to the base, and stops move with it.
+    Base,
+}
+
+/// An excitation: a signal applied as a force or a base acceleration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Excitation {
+    pub load: Load,
+    pub signal: Signal,
+}
+
+/// Everything a run needs to know about the system.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SystemSpec {
+    pub structure: Structure,
+    pub dampers: Vec<Damper>,
+    pub stops: Vec<Stop>,
+    /// m/s^2 (>= 0), along -x.
+    pub gravity: f64,
+    pub excitations: Vec<Excitation>,
+}
+
+/// The law of one interaction, ready for the kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InteractionLaw {
+    Compliant { law: AnyLaw, damping: f64 },
+    Rigid { restitution: f64 },
+}
+
+/// One wall of a pair: a gap `offset + h . x` and its law.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Interaction {
+    /// Index into [`Assembly::pairs`].
+    pub pair: usize,
+    /// Over all coordinates `x` (dense, length `dim`).
+    pub h: Vec<f64>,
+    pub offset: f64,
+    /// `M^-1 h^T`: the acceleration per newton of contact force.
+    pub push: Vec<f64>,
+    /// `h M^-1 h^T`, 1/kg: the inverse of the effective mass at the gap.
+    pub inverse_mass: f64,
+    pub law: InteractionLaw,
+}
+
+/// A force excitation, ready for the kernel.
+#[derive(Debug, Clone, PartialEq)]
+struct ForceLoad {
+    /// The point's row over `q`.
+    row: Vec<f64>,
+    /// `M^-1 row^T`.
+    push: Vec<f64>,
+    signal: Signal,
+}
+
+/// The system in the kernel's plain data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assembly {
+    /// Structure coordinates.
+    pub n: usize,
+    /// Dampers.
+    pub k: usize,
+    /// All coordinates, `n + k`.
+    pub dim: usize,
+    mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    /// `M^-1 K` and `M^-1 C` of the structure.
+    minv_k: Vec<f64>,
+    minv_c: Vec<f64>,
+    damper_mass: Vec<f64>,
+    /// `r`, and `M r` (for the work of base loads).
+    influence: Vec<f64>,
+    mass_influence: Vec<f64>,
+    gravity: f64,
+    forces: Vec<ForceLoad>,
+    base: Vec<Signal>,
+    pub interactions: Vec<Interaction>,
+    /// Pair names, as the contact table gives them ("damper 0", "stop 1").
+    pub pairs: Vec<String>,
+}
+
+/// Accumulators after the coordinates and velocities in the state vector:
+/// the viscous loss, the input work, then each interaction's contact loss
+/// (so that overlapping contacts of different pairs keep their own).
+pub const VISCOUS: usize = 0;
+pub const INPUT: usize = 1;
+pub const CONTACT: usize = 2;
+
+/// What one interaction is doing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Mode {
+    Open,
+    /// A compliant contact, with the indentation rate latched at its onset.
+    Compliant {
+        approach_rate: f64,
+    },
+    /// A rigid pair moving together after a chattering sequence: the gap
+    /// and its rate stay zero, held by a constraint force.
+    Sticking,
+}
+
+impl Assembly {
+    /// Assemble and check a system. Errors name the input (`damper 1 at`).
+    pub fn new(spec: &SystemSpec) -> Result<Self> {
+        let s = &spec.structure;
+        let (n, k) = (s.dofs(), spec.dampers.len());
+        let dim = n + k;
+        let l = linalg::cholesky(s.mass(), n).expect("a structure's mass is positive definite");
+        let minv = linalg::inverse_from_cholesky(&l, n);
+        let product = |a: &[f64]| {
+            let mut out = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..n {
+                    out[i * n + j] = (0..n).map(|p| minv[i * n + p] * a[p * n + j]).sum();
+                }
+            }
+            out
+        };
+        let minv_k = product(s.stiffness());
+        let minv_c = product(s.damping());
+        let mut mass_influence = vec![0.0; n];
+        linalg::multiply(s.mass(), s.influence(), &mut mass_influence);
+        let gravity = non_negative("gravity", spec.gravity)?;
+
+        let mut damper_mass = Vec::with_capacity(k);
+        let mut interactions = Vec::new();
+        let mut pairs = Vec::new();
+        let full_push = |h: &[f64]| {
+            let mut push = vec![0.0; dim];
+            linalg::multiply(&minv, &h[..n], &mut push[..n]);
+            for j in 0..k {
+                push[n + j] = h[n + j] / spec.dampers[j].mass;
+            }
+            push
+        };
+        for (j, d) in spec.dampers.iter().enumerate() {
+            let name = format!("damper {j}");
+            damper_mass.push(positive_named(&name, "mass", d.mass)?);
+            let lower = non_negative_named(&name, "lower_clearance", d.lower_clearance)?;
+            let upper = non_negative_named(&name, "upper_clearance", d.upper_clearance)?;
+            let point = s.point(&format!("{name} at"), d.at)?;
+            let law = interaction_law(&name, &d.law)?;
+            let pair = pairs.len();
+            pairs.push(name);
+            // Relative displacement u = z_j - point . q; upper wall: g = upper - u,
+            // lower wall: g = lower + u.
+            for (sign, offset) in [(-1.0, upper), (1.0, lower)] {
+                let mut h = vec![0.0; dim];
+                for i in 0..n {
+                    h[i] = -sign * point[i];
+                }
+                h[n + j] = sign;
+                interactions.push(Interaction {
+                    pair,
+                    push: vec![],
+                    inverse_mass: 0.0,
+                    h,
+                    offset,
+                    law,
+                });
+            }
+        }
+        for (j, stop) in spec.stops.iter().enumerate() {
+            let name = format!("stop {j}");
+            let gap = non_negative_named(&name, "gap", stop.gap)?;
+            let point = s.point(&format!("{name} at"), stop.at)?;
+            let law = interaction_law(&name, &stop.law)?;
+            let sign = match stop.side {
+                Side::Upper => -1.0,
+                Side::Lower => 1.0,
+            };
+            let mut h = vec![0.0; dim];
+            for i in 0..n {
+                h[i] = sign * point[i];
+            }
+            let pair = pairs.len();
+            pairs.push(name);
+            interactions.push(Interaction {
+                pair,
+                push: vec![],
+                inverse_mass: 0.0,
+                h,
+                offset: gap,
+                law,
+            });
+        }
+        for interaction in &mut interactions {
+            interaction.push = full_push(&interaction.h);
+            interaction.inverse_mass = linalg::dot(&interaction.h, &interaction.push);
+            if interaction.inverse_mass.is_nan() || interaction.inverse_mass <= 0.0 {
+                return Err(Error::Inconsistent(format!(
+                    "{} acts at a point that does not move (every mode has a node there): \
+                     move it",
+                    pairs[interaction.pair]
+                )));
+            }
+        }
+        let mut forces = Vec::new();
+        let mut base = Vec::new();
+        for (j, excitation) in spec.excitations.iter().enumerate() {
+            match excitation.load {
+                Load::Force { at } => {
+                    let row = s.point(&format!("excitation {j} at"), at)?;
+                    let mut push = vec![0.0; n];
+                    linalg::multiply(&minv, &row, &mut push);
+                    forces.push(ForceLoad {
+                        row,
+                        push,
+                        signal: excitation.signal.clone(),
+                    });
+                }
+                Load::Base => base.push(excitation.signal.clone()),
+            }
+        }
+        Ok(Self {
+            n,
+            k,
+            dim,
+            mass: s.mass().to_vec(),
+            stiffness: s.stiffness().to_vec(),
+            damping: s.damping().to_vec(),
+            minv_k,
+            minv_c,
+            damper_mass,
+            influence: s.influence().to_vec(),
+            mass_influence,
+            gravity,
+            forces,
+            base,
+            interactions,
+            pairs,
+        })
+    }
+
+    /// Length of the state vector: `x`, `v` and the accumulators.
+    pub fn state_len(&self) -> usize {
+        2 * self.dim + CONTACT + self.interactions.len()
+    }
+
+    /// Whether nothing forces the system (energy can then only fall).
+    pub fn is_free(&self) -> bool {
+        self.forces.is_empty() && self.base.is_empty()
+    }
+
+    /// The gap of interaction `i` and its rate at state `y`.
+    #[inline(always)]
+    pub fn gap(&self, i: usize, y: &[f64]) -> (f64, f64) {
+        let it = &self.interactions[i];
+        let d = self.dim;
+        (
+            it.offset + linalg::dot(&it.h, &y[..d]),
+            linalg::dot(&it.h, &y[d..2 * d]),
+        )
+    }
+
+    /// The base acceleration from the excitations alone (m/s^2).
+    #[inline(always)]
+    fn base_signal(&self, time: f64) -> f64 {
+        self.base.iter().map(|s| s.value(time)).sum()
+    }
+
+    /// The derivative of the state `y` at `time` in `modes` into `out`; the
+    /// constraint forces of sticking interactions are solved for on the way
+    /// (`scratch` holds them). Allocates nothing.
+    pub fn rates(
+        &self,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+    ) {
+        let (n, d) = (self.n, self.dim);
+        let (x, v) = (&y[..d], &y[d..2 * d]);
+        out[..d].copy_from_slice(v);
+        let base = self.base_signal(time);
+        let inertial = base + self.gravity;
+        let (acc, rest) = out[d..].split_at_mut(d);
+        for (i, a) in acc[..n].iter_mut().enumerate() {
+            let row = i * n..(i + 1) * n;
+            *a = -linalg::dot(&self.minv_k[row.clone()], &x[..n])
+                - linalg::dot(&self.minv_c[row], &v[..n])
+                - self.influence[i] * inertial;
+        }
+        for a in acc[n..].iter_mut() {
+            *a = -inertial;
+        }
+        let mut input = 0.0;
+        for f in &self.forces {
+            let value = f.signal.value(time);
+            for (a, p) in acc[..n].iter_mut().zip(&f.push) {
+                *a += p * value;
+            }
+            input += value * linalg::dot(&f.row, &v[..n]);
+        }
+        if base != 0.0 {
+            // The work of the inertial load -M r a of the base signals.
+            let momentum = linalg::dot(&self.mass_influence, &v[..n])
+                + self
+                    .damper_mass
+                    .iter()
+                    .zip(&v[n..])
+                    .map(|(m, v)| m * v)
+                    .sum::<f64>();
+            input -= base * momentum;
+        }
+        let mut sticking = 0;
+        let (head, losses) = rest.split_at_mut(CONTACT);
+        for (i, (it, mode)) in self.interactions.iter().zip(modes).enumerate() {
+            losses[i] = 0.0;
+            match (*mode, it.law) {
+                (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
+                    let indentation = -(it.offset + linalg::dot(&it.h, x));
+                    let rate = -linalg::dot(&it.h, v);
+                    let (force, elastic) = if indentation > 0.0 {
+                        law.force_and_elastic(indentation, rate, approach_rate)
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    let total = force + damping * rate;
+                    for (a, p) in acc.iter_mut().zip(&it.push) {
+                        *a += p * total;
+                    }
+                    losses[i] = (total - elastic) * rate;
+                }
+                (Mode::Sticking, _) => {
+                    scratch.sticking[sticking] = i;
+                    sticking += 1;
+                }
+                _ => {}
+            }
+        }
+        if sticking > 0 {
+            self.constraint_forces(
+                &scratch.sticking[..sticking],
+                acc,
+                &mut scratch.matrix,
+                &mut scratch.forces,
+            );
+            for (s, &i) in scratch.sticking[..sticking].iter().enumerate() {
+                let lambda = scratch.forces[s];
+                for (a, p) in acc.iter_mut().zip(&self.interactions[i].push) {
+                    *a += p * lambda;
+                }
+            }
+            scratch.count = sticking;
+        } else {
+            scratch.count = 0;
+        }
+        head[VISCOUS] = linalg::quadratic_form(&self.damping, &v[..n]);
+        head[INPUT] = input;
+    }
+
+    /// The forces `lambda` of the sticking interactions `active` that keep
+    /// their gaps' accelerations at zero: `W lambda = -H a`, `W = H M^-1
+    /// H^T`, by Gaussian elimination with partial pivoting (a few rows).
+    fn constraint_forces(
+        &self,
+        active: &[usize],
+        acc: &[f64],
+        matrix: &mut [f64],
+        forces: &mut [f64],
+    ) {
+        let m = active.len();
+        for (r, &i) in active.iter().enumerate() {
+            for (c, &j) in active.iter().enumerate() {
+                matrix[r * m + c] =
+                    linalg::dot(&self.interactions[i].h, &self.interactions[j].push);
+            }
+            forces[r] = -linalg::dot(&self.interactions[i].h, acc);
+        }
+        linalg::solve_in_place(&mut matrix[..m * m], &mut forces[..m], m);
+    }
+
+    /// Stored energy: kinetic, strain, gravity's potential and the elastic
+    /// energy of compliant contacts, J.
+    pub fn energy(&self, y: &[f64], modes: &[Mode]) -> f64 {
+        self.energy_terms(y, modes).0
+    }
+
+    /// The stored energy and the sum of its terms' magnitudes (J): the
+    /// scale against which a balance residual is judged (gravity's
+    /// potential can cancel the kinetic energy exactly).
+    pub fn energy_terms(&self, y: &[f64], modes: &[Mode]) -> (f64, f64) {
+        let (n, d) = (self.n, self.dim);
+        let (x, v) = (&y[..d], &y[d..2 * d]);
+        let kinetic = 0.5 * linalg::quadratic_form(&self.mass, &v[..n])
+            + self
+                .damper_mass
+                .iter()
+                .zip(&v[n..])
+                .map(|(m, v)| 0.5 * m * v * v)
+                .sum::<f64>();
+        let strain = 0.5 * linalg::quadratic_form(&self.stiffness, &x[..n]);
+        let gravity = self.gravity
+            * (linalg::dot(&self.mass_influence, &x[..n])
+                + self
+                    .damper_mass
+                    .iter()
+                    .zip(&x[n..])
+                    .map(|(m, z)| m * z)
+                    .sum::<f64>());
+        let mut contact = 0.0;
+        for (it, mode) in self.interactions.iter().zip(modes) {
+            if let (Mode::Compliant { .. }, InteractionLaw::Compliant { law, .. }) = (mode, it.law)
+            {
+                let indentation = -(it.offset + linalg::dot(&it.h, x));
+                if indentation > 0.0 {
+                    contact += law.potential(indentation);
+                }
+            }
+        }
+        (
+            kinetic + strain + gravity + contact,
+            kinetic + strain + gravity.abs() + contact,
+        )
+    }
+
+    /// A rigid impact on interaction `i`: Newton's law with momentum
+    /// conserved, `v+ = v- - (1 + e) (h . v-) M^-1 h^T / (h M^-1 h^T)`.
+    /// Returns the energy it takes, J.
+    pub fn impact(&self, i: usize, y: &mut [f64], restitution: f64) -> f64 {
+        let it = &self.interactions[i];
+        let d = self.dim;
+        let rate = linalg::dot(&it.h, &y[d..2 * d]);
+        let impulse = -(1.0 + restitution) * rate / it.inverse_mass;
+        for (v, p) in y[d..2 * d].iter_mut().zip(&it.push) {
+            *v += p * impulse;
+        }
+        0.5 * (1.0 - restitution * restitution) * rate * rate / it.inverse_mass
+    }
+}
+
+/// Work space of [`Assembly::rates`], allocated once per run.
+#[derive(Debug, Clone)]
+pub struct Scratch {
+    sticking: Vec<usize>,
+    matrix: Vec<f64>,
+    /// Constraint forces of the sticking interactions (N), after `rates`.
+    pub forces: Vec<f64>,
+    /// How many interactions were sticking in the last `rates`.
+    pub count: usize,
+}
+
+impl Scratch {
+    pub fn new(assembly: &Assembly) -> Self {
+        let m = assembly.interactions.len().max(1);
+        Self {
+            sticking: vec![0; m],
+            matrix: vec![0.0; m * m],
+            forces: vec![0.0; m],
+            count: 0,
+        }
+    }
+
+    /// The constraint force of interaction `i` in the last `rates` (N), or
+    /// None when it was not sticking.
+    pub fn force_of(&self, i: usize) -> Option<f64> {
+        self.sticking[..self.count]
+            .iter()
+            .position(|&j| j == i)
+            .map(|s| self.forces[s])
+    }
+}
+
+fn interaction_law(name: &str, law: &PairLaw) -> Result<InteractionLaw> {
+    Ok(match *law {
+        PairLaw::Compliant(contact) => InteractionLaw::Compliant {
+            law: contact.any_law(),
+            damping: contact.damping,
+        },
+        PairLaw::Rigid { restitution } => {
+            if !(0.0..=1.0).contains(&restitution) {
+                return Err(Error::Inconsistent(format!(
+                    "{name} restitution must be in [0, 1], got {restitution}"
+                )));
+            }
+            InteractionLaw::Rigid { restitution }
+        }
+    })
+}
+
+fn positive_named(name: &str, key: &'static str, value: f64) -> Result<f64> {
+    positive(key, value).map_err(|e| Error::Inconsistent(format!("{name} {e}")))
+}
+
+fn non_negative_named(name: &str, key: &'static str, value: f64) -> Result<f64> {
+    non_negative(key, value).map_err(|e| Error::Inconsistent(format!("{name} {e}")))
+}
+
+/// The initial state vector from the four arrays of `[initial]` (zeros where
+/// empty), checked against the system's sizes and finite.
+pub fn initial_state(
+    assembly: &Assembly,
+    structure_displacement: &[f64],
+    structure_velocity: &[f64],
+    damper_displacement: &[f64],
+    damper_velocity: &[f64],
+) -> Result<Vec<f64>> {
+    let (n, k, d) = (assembly.n, assembly.k, assembly.dim);
+    let mut y = vec![0.0; assembly.state_len()];
+    for (key, values, size, at) in [
+        ("structure_displacement", structure_displacement, n, 0),
+        ("structure_velocity", structure_velocity, n, d),
+        ("damper_displacement", damper_displacement, k, n),
+        ("damper_velocity", damper_velocity, k, d + n),
+    ] {
+        if !values.is_empty() && values.len() != size {
+            return Err(Error::Inconsistent(format!(
+                "initial.{key} must have {size} values (or none), got {}",
+                values.len()
+            )));
+        }
+        for (slot, &value) in y[at..at + values.len()].iter_mut().zip(values) {
+            *slot = finite(key, value)?;
+        }
+    }
+    for i in 0..assembly.interactions.len() {
+        let (gap, _) = assembly.gap(i, &y);
+        if gap < 0.0 {
+            return Err(Error::Inconsistent(format!(
+                "initial state: {} starts {:.6e} m inside its wall; start every pair apart or just touching",
+                assembly.pairs[assembly.interactions[i].pair],
+                -gap
+            )));
+        }
+    }
+    Ok(y)
+}

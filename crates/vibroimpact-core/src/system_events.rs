@@ -1,0 +1,956 @@
+//! The event-driven kernel for any [`Assembly`]: every interaction's gap is
+//! watched at once, the earliest event in a step is located on the method's
+//! own solution (the step length that ends on it, by the Illinois method),
+//! the step is cut there and the method restarted.
+//!
+//! Events: a gap closing (a compliant contact starts, or a rigid impact
+//! applies Newton's law with momentum conserved), a compliant contact
+//! opening, and a sticking pair's constraint force reaching zero (release).
+//! After a rigid impact whose remaining chattering sequence would finish
+//! within the run's time resolution, the sequence is summed: with the
+//! relative acceleration `a` pressing the pair together and rebound speed
+//! `u`, the flights `2 u e^n / |a|` add up to `2 u / (|a| (1 - e))`, after
+//! which the pair sticks (exact for a constant `a`, such as a ball on a
+//! floor). Simultaneous impacts are applied one after the other in the
+//! order of the interactions (dampers, then stops).
+
+use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
+
+/// The contact-loss accumulator of interaction `i` in a state vector.
+#[inline(always)]
+fn loss_slot(system: &Assembly, i: usize) -> usize {
+    2 * system.dim + CONTACT + i
+}
+use crate::error::{Error, Result};
+use crate::hermite;
+use crate::system_steppers::ExplicitRk;
+
+/// How to run and what to keep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunOptions {
+    /// Step (s): fixed for RK4, the first step of the adaptive methods.
+    pub dt: Option<f64>,
+    /// End time, s.
+    pub t_end: f64,
+    /// Keep every `every`-th step (and the last).
+    pub every: u64,
+    /// Keep no history at all when false (constant memory but the contacts).
+    pub keep_history: bool,
+    /// Most steps (accepted and rejected).
+    pub max_steps: u64,
+    /// Most history rows plus contacts a run may keep.
+    pub max_rows: u64,
+    /// Largest energy-balance residual, relative to the energies in play.
+    pub energy_tolerance: f64,
+}
+
+/// What kind of contact a record is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactKind {
+    /// A compliant contact, from onset to separation.
+    Compliant,
+    /// A rigid impact: zero duration.
+    Impact,
+    /// A rigid pair moving together, from the accumulation instant of its
+    /// chattering sequence to its release.
+    Sticking,
+}
+
+impl ContactKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Compliant => "compliant",
+            Self::Impact => "impact",
+            Self::Sticking => "sticking",
+        }
+    }
+}
+
+/// One contact of one pair. Speeds are relative normal speeds (m/s, > 0);
+/// NaN separation, duration and rebound for a contact still open at the end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairContact {
+    /// Index into [`Assembly::pairs`].
+    pub pair: usize,
+    pub kind: ContactKind,
+    /// s.
+    pub onset: f64,
+    /// s.
+    pub separation: f64,
+    /// s.
+    pub duration: f64,
+    /// m (0 for rigid pairs).
+    pub max_indentation: f64,
+    pub approach_speed: f64,
+    pub rebound_speed: f64,
+    /// rebound over approach speed.
+    pub restitution: f64,
+    /// Energy taken by the contact's dissipative forces or by the impacts, J.
+    pub energy_dissipated: f64,
+}
+
+/// Where the energy went, J: `stored_end - stored_start = input_work -
+/// dissipated + residual`, the residual being numerical error.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EnergyBalance {
+    pub input_work: f64,
+    /// Viscous, contact and impact losses together.
+    pub dissipated: f64,
+    pub viscous: f64,
+    pub contact: f64,
+    pub impact: f64,
+    pub stored_start: f64,
+    pub stored_end: f64,
+    pub residual: f64,
+}
+
+/// What a run returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SystemSolution {
+    /// Times of the kept rows, s.
+    pub time: Vec<f64>,
+    /// Kept rows of `x` then `v` (`2 dim` values each).
+    pub states: Vec<f64>,
+    pub contacts: Vec<PairContact>,
+    /// `x` then `v` at the end.
+    pub final_state: Vec<f64>,
+    pub final_time: f64,
+    pub energy: EnergyBalance,
+    pub steps: u64,
+    pub rejected_steps: u64,
+    pub rhs_evaluations: u64,
+    pub grazing_contacts: u64,
+}
+
+/// A contact being followed.
+#[derive(Debug, Clone, Copy)]
+struct Open {
+    kind: ContactKind,
+    onset: f64,
+    approach_speed: f64,
+    max_indentation: f64,
+    /// The contact-loss accumulator at onset (compliant), or the loss so far.
+    dissipated: f64,
+}
+
+/// Whether the error control rejects a step (a NaN error too).
+#[inline(always)]
+fn rejects(error: f64) -> bool {
+    error.is_nan() || error > 1.0
+}
+
+impl Open {
+    /// The record of this contact ending at `separation` (NaN: still open)
+    /// with relative `rebound` speed (m/s) and `dissipated` energy (J).
+    fn close(&self, pair: usize, separation: f64, rebound: f64, dissipated: f64) -> PairContact {
+        let restitution = match self.kind {
+            // A sticking pair does not rebound.
+            ContactKind::Sticking if separation.is_finite() => 0.0,
+            _ if self.approach_speed > 0.0 => rebound / self.approach_speed,
+            _ => f64::NAN,
+        };
+        PairContact {
+            pair,
+            kind: self.kind,
+            onset: self.onset,
+            separation,
+            // Still open: NaN (f64::max would turn it into 0).
+            duration: if separation.is_nan() {
+                f64::NAN
+            } else {
+                (separation - self.onset).max(0.0)
+            },
+            max_indentation: self.max_indentation,
+            approach_speed: self.approach_speed,
+            rebound_speed: rebound,
+            restitution,
+            energy_dissipated: dissipated,
+        }
+    }
+}
+
+/// The value whose sign change is interaction `i`'s event: positive on the
+/// side it is on now (open: the gap; compliant contact: the indentation;
+/// sticking: the constraint force).
+#[allow(clippy::too_many_arguments)]
+fn event_value(
+    system: &Assembly,
+    i: usize,
+    mode: Mode,
+    time: f64,
+    y: &[f64],
+    modes: &[Mode],
+    scratch: &mut Scratch,
+    work: &mut [f64],
+) -> f64 {
+    match mode {
+        Mode::Open => system.gap(i, y).0,
+        Mode::Compliant { .. } => -system.gap(i, y).0,
+        Mode::Sticking => {
+            system.rates(time, y, modes, scratch, work);
+            scratch.force_of(i).unwrap_or(0.0)
+        }
+    }
+}
+
+/// An event found in a step: interaction `i`, first guessed at the fraction
+/// `guess` of the step; `interior` when both ends are on the old side.
+#[derive(Debug, Clone, Copy)]
+struct Crossing {
+    i: usize,
+    guess: f64,
+    interior: bool,
+    /// A fraction of the step on the old side (0: the start), for a value
+    /// that starts on the wall (just after an event) and moves away first.
+    before: f64,
+}
+
+/// The earliest event in the step `y -> end` of length `h`, from the end
+/// values and, for gaps, the cubic Hermite interpolant (an interior touch or
+/// separation deeper than `graze` m counts; a shallower one is a graze).
+#[allow(clippy::too_many_arguments)]
+fn find_crossing(
+    system: &Assembly,
+    time: f64,
+    y: &[f64],
+    end: &[f64],
+    h: f64,
+    modes: &[Mode],
+    graze: f64,
+    grazes: &mut u64,
+    scratch: &mut Scratch,
+    work: &mut [f64],
+) -> Option<Crossing> {
+    let mut best: Option<Crossing> = None;
+    let mut consider = |c: Crossing| {
+        if best.is_none_or(|b| c.guess < b.guess) {
+            best = Some(c);
+        }
+    };
+    for (i, &mode) in modes.iter().enumerate() {
+        let sign = match mode {
+            Mode::Open => 1.0,
+            Mode::Compliant { .. } => -1.0,
+            Mode::Sticking => {
+                let value = event_value(system, i, mode, time + h, end, modes, scratch, work);
+                if value < 0.0 {
+                    consider(Crossing {
+                        i,
+                        guess: 1.0,
+                        interior: false,
+                        before: 0.0,
+                    });
+                }
+                continue;
+            }
+        };
+        let (g0, r0) = system.gap(i, y);
+        let (g1, r1) = system.gap(i, end);
+        let (v0, v1, m0, m1) = (sign * g0, sign * g1, sign * r0 * h, sign * r1 * h);
+        if v1 < 0.0 {
+            // On the wall at the start (to round-off, just after an event)
+            // and moving away: the crossing is the later one, after the
+            // interpolant's maximum.
+            let before = if v0 <= graze && m0 > 0.0 && m1 < 0.0 {
+                hermite::argmax(v0, v1, m0, m1)
+            } else {
+                0.0
+            };
+            let top = hermite::eval(v0, v1, m0, m1, before).0;
+            let guess = if top > 0.0 {
+                before + (1.0 - before) * top / (top - v1)
+            } else {
+                before
+            };
+            consider(Crossing {
+                i,
+                guess,
+                interior: false,
+                before,
+            });
+        } else if m0 < 0.0 && m1 > 0.0 {
+            // The value falls then rises within the step: a dip below zero?
+            let theta = hermite::argmax(-v0, -v1, -m0, -m1);
+            let low = hermite::eval(v0, v1, m0, m1, theta).0;
+            if low < -graze {
+                consider(Crossing {
+                    i,
+                    guess: theta,
+                    interior: true,
+                    before: 0.0,
+                });
+            } else if low < 0.0 {
+                *grazes += 1;
+            }
+        }
+    }
+    best
+}
+
+/// What locating an event found.
+enum Location {
+    /// The step length ending on the event; the attempt is in `best`.
+    Cut(f64),
+    /// The interpolant's dip was not there.
+    Unconfirmed,
+    /// The step up to (about) the event fails the error control.
+    Reject(f64),
+}
+
+/// Buffers of the location.
+struct Buffers {
+    probe: Vec<f64>,
+    best: Vec<f64>,
+    work: Vec<f64>,
+}
+
+/// Locates interaction `c.i`'s event in the step of length `h` whose end is
+/// `full`: Illinois on the step length, to round-off in time or in value.
+#[allow(clippy::too_many_arguments)]
+fn locate(
+    system: &Assembly,
+    stepper: &mut ExplicitRk,
+    time: f64,
+    y: &[f64],
+    h: f64,
+    full: &[f64],
+    modes: &[Mode],
+    c: Crossing,
+    scratch: &mut Scratch,
+    buffers: &mut Buffers,
+) -> Location {
+    let mode = modes[c.i];
+    let d = system.dim;
+    let round_off = 8.0
+        * f64::EPSILON
+        * (system.interactions[c.i].offset.abs()
+            + system.interactions[c.i]
+                .h
+                .iter()
+                .zip(&y[..d])
+                .map(|(h, x)| (h * x).abs())
+                .sum::<f64>());
+    let value = |end: &[f64], at: f64, scratch: &mut Scratch, work: &mut [f64]| {
+        event_value(system, c.i, mode, at, end, modes, scratch, work)
+    };
+    let (mut lo, mut v_lo) = (0.0, value(y, time, scratch, &mut buffers.work));
+    if c.before > 0.0 {
+        let length = c.before * h;
+        stepper.attempt(system, time, y, length, modes, scratch, &mut buffers.probe);
+        let v = value(&buffers.probe, time + length, scratch, &mut buffers.work);
+        // Where the interpolant was wrong about the old side, start from 0.
+        if v > 0.0 {
+            (lo, v_lo) = (length, v);
+        }
+    }
+    let (mut hi, mut v_hi);
+    if c.interior {
+        hi = c.guess * h;
+        let error = stepper.attempt(system, time, y, hi, modes, scratch, &mut buffers.best);
+        if stepper.is_adaptive() && rejects(error) {
+            return Location::Reject(hi);
+        }
+        v_hi = value(&buffers.best, time + hi, scratch, &mut buffers.work);
+        if v_hi >= 0.0 {
+            return Location::Unconfirmed;
+        }
+    } else {
+        hi = h;
+        buffers.best.copy_from_slice(full);
+        v_hi = value(full, time + h, scratch, &mut buffers.work);
+    }
+    if v_lo < 0.0 {
+        // Starting on the wall to round-off: the event is the start.
+        v_lo = 0.0;
+    }
+    let mut guess = if c.interior { f64::NAN } else { c.guess * h };
+    let mut kept = 0i8;
+    let mut first = true;
+    for _ in 0..200 {
+        let width = hi - lo;
+        if width <= 4.0 * f64::EPSILON * (time.abs() + hi) || v_hi.abs() <= round_off {
+            break;
+        }
+        let mut trial = if guess > lo && guess < hi {
+            guess
+        } else {
+            hi - v_hi * width / (v_hi - v_lo)
+        };
+        if !(trial > lo && trial < hi) {
+            trial = 0.5 * (lo + hi);
+        }
+        guess = f64::NAN;
+        let error = stepper.attempt(system, time, y, trial, modes, scratch, &mut buffers.probe);
+        if stepper.is_adaptive() && first && rejects(error) {
+            return Location::Reject(trial);
+        }
+        first = false;
+        let v = value(&buffers.probe, time + trial, scratch, &mut buffers.work);
+        if v < 0.0 || v.abs() <= round_off {
+            hi = trial;
+            v_hi = v;
+            std::mem::swap(&mut buffers.best, &mut buffers.probe);
+            if kept == 1 {
+                v_lo *= 0.5;
+            }
+            kept = 1;
+        } else {
+            lo = trial;
+            v_lo = v;
+            if kept == -1 {
+                v_hi *= 0.5;
+            }
+            kept = -1;
+        }
+        if v.abs() <= round_off {
+            break;
+        }
+    }
+    Location::Cut(hi)
+}
+
+/// Chattering of compliant contacts: this many mode changes in a row, each
+/// closer than a fraction of the run, stop it.
+const CHATTER_EVENTS: u64 = 16;
+const CHATTER_FRACTION: f64 = 1e-12;
+/// How often (steps) the energy balance is checked and the caller asked
+/// whether to stop.
+const ENERGY_INTERVAL: u64 = 32;
+const INTERRUPT_INTERVAL: u64 = 1 << 14;
+
+/// Integrates `system` from `initial` (see [`crate::assembly::initial_state`]).
+pub fn integrate_system(
+    system: &Assembly,
+    stepper: &mut ExplicitRk,
+    initial: &[f64],
+    options: &RunOptions,
+    interrupt: &mut dyn FnMut() -> bool,
+) -> Result<SystemSolution> {
+    let len = system.state_len();
+    let d = system.dim;
+    let count = system.interactions.len();
+    let adaptive = stepper.is_adaptive();
+    let t_end = options.t_end;
+    let dt = options.dt.unwrap_or(f64::NAN);
+    if !adaptive && (dt.is_nan() || dt <= 0.0) {
+        return Err(Error::Inconsistent(format!(
+            "dt is required for method {:?} (a step in s > 0)",
+            stepper.name()
+        )));
+    }
+    let graze = 1e-12
+        * system
+            .interactions
+            .iter()
+            .map(|it| it.offset.abs())
+            .fold(1e-9, f64::max);
+    // The time resolution below which a chattering sequence is summed.
+    let resolution = if adaptive { 1e-6 * t_end } else { dt };
+    let chatter_interval = CHATTER_FRACTION * t_end;
+
+    let mut y = initial.to_vec();
+    let mut end = vec![0.0; len];
+    let mut full = vec![0.0; len];
+    let mut buffers = Buffers {
+        probe: vec![0.0; len],
+        best: vec![0.0; len],
+        work: vec![0.0; len],
+    };
+    let mut scratch = Scratch::new(system);
+    let mut modes = vec![Mode::Open; count];
+    let mut open: Vec<Option<Open>> = vec![None; count];
+    let (stored_start, start_scale) = system.energy_terms(&y, &modes);
+    let mut impact_loss = 0.0;
+    let mut contacts: Vec<PairContact> = Vec::new();
+    let row = 2 * d;
+    let mut time_rows: Vec<f64> = Vec::new();
+    let mut states: Vec<f64> = Vec::new();
+    let keep = |time: f64, y: &[f64], time_rows: &mut Vec<f64>, states: &mut Vec<f64>| {
+        time_rows.push(time);
+        states.extend_from_slice(&y[..row]);
+    };
+    if options.keep_history {
+        keep(0.0, &y, &mut time_rows, &mut states);
+    }
+    let mut time = 0.0;
+    let mut h = options.dt.unwrap_or(1e-6 * t_end);
+    let mut grid: u64 = 0;
+    let (mut accepted, mut rejected, mut grazes) = (0u64, 0u64, 0u64);
+    let mut until_kept = options.every;
+    let (mut last_event, mut close_events) = (f64::NEG_INFINITY, 0u64);
+    let mut just_rejected = false;
+
+    while time < t_end {
+        let mut length = if adaptive {
+            h.min(t_end - time)
+        } else {
+            (grid + 1) as f64 * dt - time
+        };
+        if !adaptive && length <= 0.0 {
+            grid += 1;
+            continue;
+        }
+        if adaptive && (t_end - time - length) < 1e-3 * length {
+            length = t_end - time;
+        }
+        let error = stepper.attempt(system, time, &y, length, &modes, &mut scratch, &mut end);
+        let mut taken = length;
+        let mut switched: Option<usize> = None;
+        let mut last_attempt_kept = true;
+        let mut crossing = find_crossing(
+            system,
+            time,
+            &y,
+            &end,
+            length,
+            &modes,
+            graze,
+            &mut grazes,
+            &mut scratch,
+            &mut buffers.work,
+        );
+        // An event inside the step: locate it; another interaction that
+        // turns out to have crossed before it is located in its turn.
+        let mut rounds = 0;
+        while let Some(c) = crossing {
+            rounds += 1;
+            full.copy_from_slice(&end);
+            match locate(
+                system,
+                stepper,
+                time,
+                &y,
+                taken,
+                &full,
+                &modes,
+                c,
+                &mut scratch,
+                &mut buffers,
+            ) {
+                Location::Cut(cut) => {
+                    taken = cut;
+                    switched = Some(c.i);
+                    last_attempt_kept = false;
+                    end.copy_from_slice(&buffers.best);
+                }
+                Location::Unconfirmed => {
+                    last_attempt_kept = false;
+                    if switched.is_none() {
+                        crossing = None;
+                        continue;
+                    }
+                }
+                Location::Reject(shorter) => {
+                    rejected += 1;
+                    h = 0.9 * shorter;
+                    just_rejected = true;
+                    switched = None;
+                    crossing = None;
+                    taken = f64::NAN;
+                    continue;
+                }
+            }
+            crossing = None;
+            if rounds > count {
+                break;
+            }
+            // Another interaction on its new side at the cut came first.
+            for (j, &mode) in modes.iter().enumerate() {
+                if Some(j) == switched {
+                    continue;
+                }
+                let v = event_value(
+                    system,
+                    j,
+                    mode,
+                    time + taken,
+                    &end,
+                    &modes,
+                    &mut scratch,
+                    &mut buffers.work,
+                );
+                if v < 0.0 {
+                    crossing = Some(Crossing {
+                        i: j,
+                        guess: 1.0,
+                        interior: false,
+                        before: 0.0,
+                    });
+                    break;
+                }
+            }
+        }
+        if taken.is_nan() {
+            continue;
+        }
+        if adaptive && switched.is_none() {
+            if rejects(error) {
+                rejected += 1;
+                let factor = if error.is_finite() {
+                    (0.9 * stepper.shrink(error)).clamp(0.1, 0.9)
+                } else {
+                    0.1
+                };
+                h = taken * factor;
+                just_rejected = true;
+                if h <= 16.0 * f64::EPSILON * time.abs().max(t_end) {
+                    return Err(Error::StepSizeTooSmall { time, step: h });
+                }
+                if accepted + rejected >= options.max_steps {
+                    return Err(Error::TooManySteps {
+                        time,
+                        max_steps: options.max_steps,
+                    });
+                }
+                continue;
+            }
+            let most = if just_rejected { 1.0 } else { 5.0 };
+            let factor = if error > 0.0 {
+                (0.9 * stepper.shrink(error)).clamp(0.2, most)
+            } else {
+                most
+            };
+            h = taken * factor;
+            just_rejected = false;
+        }
+        if end[..row].iter().any(|v| !v.is_finite()) {
+            return Err(Error::NumericalBlowUp {
+                time: time + taken,
+                reason: "the state is no longer finite",
+            });
+        }
+        // Deepest indentation of each compliant contact within the step.
+        for (i, record) in open.iter_mut().enumerate() {
+            if let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), modes[i]) {
+                let (g0, r0) = system.gap(i, &y);
+                let (g1, r1) = system.gap(i, &end);
+                let (m0, m1) = (r0 * taken, r1 * taken);
+                let mut deepest = -g1;
+                if m0 < 0.0 && m1 > 0.0 {
+                    let theta = hermite::argmax(-g0, -g1, -m0, -m1);
+                    deepest = deepest.max(hermite::eval(-g0, -g1, -m0, -m1, theta).0);
+                }
+                oc.max_indentation = oc.max_indentation.max(deepest);
+            }
+        }
+        if last_attempt_kept {
+            stepper.accept();
+        } else {
+            stepper.reset();
+        }
+        time += taken;
+        if !adaptive && (switched.is_none() || (grid + 1) as f64 * dt - time <= 0.0) {
+            grid += 1;
+        }
+        y.copy_from_slice(&end);
+        accepted += 1;
+
+        if switched.is_some() {
+            // Every interaction on its wall at this instant switches.
+            let mut any = false;
+            for i in 0..count {
+                let v = event_value(
+                    system,
+                    i,
+                    modes[i],
+                    time,
+                    &y,
+                    &modes,
+                    &mut scratch,
+                    &mut buffers.work,
+                );
+                let located = Some(i) == switched;
+                if !(located || v < 0.0) {
+                    continue;
+                }
+                any = true;
+                switch(
+                    system,
+                    i,
+                    time,
+                    &mut y,
+                    &mut modes,
+                    &mut open,
+                    &mut contacts,
+                    &mut impact_loss,
+                    &mut grazes,
+                    resolution,
+                    &mut scratch,
+                    &mut buffers.work,
+                );
+            }
+            if any {
+                settle_sticking(
+                    system,
+                    time,
+                    &mut y,
+                    &mut modes,
+                    &mut open,
+                    &mut contacts,
+                    &mut impact_loss,
+                );
+                stepper.reset();
+                if adaptive {
+                    h = h.min(1e-3 * t_end).max(1e-9 * t_end);
+                }
+                if time - last_event < chatter_interval {
+                    close_events += 1;
+                    if close_events >= CHATTER_EVENTS {
+                        return Err(Error::Chattering {
+                            time,
+                            events: close_events,
+                            interval: chatter_interval,
+                        });
+                    }
+                } else {
+                    close_events = 0;
+                }
+                last_event = time;
+            }
+        }
+
+        let done = time >= t_end;
+        until_kept -= 1;
+        if options.keep_history && (until_kept == 0 || done) {
+            until_kept = options.every;
+            keep(time, &y, &mut time_rows, &mut states);
+        }
+        if (time_rows.len() + contacts.len()) as u64 > options.max_rows {
+            return Err(Error::Inconsistent(format!(
+                "the run kept {} history rows and {} contacts by t = {time:.6e} s, more than the cap of {}: \
+                 raise every, keep no history, shorten t_end or raise the cap",
+                time_rows.len(),
+                contacts.len(),
+                options.max_rows
+            )));
+        }
+        if accepted % ENERGY_INTERVAL == 0 || done {
+            check_balance(
+                system,
+                &y,
+                &modes,
+                stored_start,
+                start_scale,
+                impact_loss,
+                options,
+                time,
+            )?;
+        }
+        if !done && accepted + rejected >= options.max_steps {
+            return Err(Error::TooManySteps {
+                time,
+                max_steps: options.max_steps,
+            });
+        }
+        if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
+            return Err(Error::Interrupted { time });
+        }
+    }
+
+    for (i, record) in open.iter().enumerate() {
+        if let Some(oc) = record {
+            let dissipated = match oc.kind {
+                ContactKind::Compliant => y[loss_slot(system, i)] - oc.dissipated,
+                _ => oc.dissipated,
+            };
+            contacts.push(oc.close(system.interactions[i].pair, f64::NAN, f64::NAN, dissipated));
+        }
+    }
+    contacts.sort_by(|a, b| a.onset.total_cmp(&b.onset));
+    let energy = balance(system, &y, &modes, stored_start, impact_loss);
+    Ok(SystemSolution {
+        time: time_rows,
+        states,
+        contacts,
+        final_state: y[..row].to_vec(),
+        final_time: time,
+        energy,
+        steps: accepted,
+        rejected_steps: rejected,
+        rhs_evaluations: stepper.evaluations(),
+        grazing_contacts: grazes,
+    })
+}
+
+/// The energy balance at state `y`.
+fn balance(
+    system: &Assembly,
+    y: &[f64],
+    modes: &[Mode],
+    stored_start: f64,
+    impact: f64,
+) -> EnergyBalance {
+    let at = 2 * system.dim;
+    let (viscous, input_work) = (y[at + VISCOUS], y[at + INPUT]);
+    let contact: f64 = y[at + CONTACT..].iter().sum();
+    let stored_end = system.energy(y, modes);
+    let dissipated = viscous + contact + impact;
+    EnergyBalance {
+        input_work,
+        dissipated,
+        viscous,
+        contact,
+        impact,
+        stored_start,
+        stored_end,
+        residual: stored_end - stored_start - input_work + dissipated,
+    }
+}
+
+/// Energy cannot be created: a residual beyond the tolerance, relative to the
+/// energies in play, is a numerical failure, not a result.
+#[allow(clippy::too_many_arguments)]
+fn check_balance(
+    system: &Assembly,
+    y: &[f64],
+    modes: &[Mode],
+    stored_start: f64,
+    start_scale: f64,
+    impact: f64,
+    options: &RunOptions,
+    time: f64,
+) -> Result<()> {
+    let b = balance(system, y, modes, stored_start, impact);
+    let scale =
+        start_scale + system.energy_terms(y, modes).1 + b.input_work.abs() + b.dissipated.abs();
+    if b.residual.abs() > options.energy_tolerance * scale || !b.residual.is_finite() {
+        return Err(Error::NumericalBlowUp {
+            time,
+            reason:
+                "the energy balance does not close (stored - start - input + dissipated is beyond \
+                     energy_tolerance of the energies in play): reduce dt or tighten rtol/atol",
+        });
+    }
+    Ok(())
+}
+
+/// Switch interaction `i` at `time`: start or end a contact, apply an
+/// impact, start or end sticking.
+#[allow(clippy::too_many_arguments)]
+fn switch(
+    system: &Assembly,
+    i: usize,
+    time: f64,
+    y: &mut [f64],
+    modes: &mut [Mode],
+    open: &mut [Option<Open>],
+    contacts: &mut Vec<PairContact>,
+    impact_loss: &mut f64,
+    grazes: &mut u64,
+    resolution: f64,
+    scratch: &mut Scratch,
+    work: &mut [f64],
+) {
+    let it = &system.interactions[i];
+    let row = 2 * system.dim;
+    let (_, rate) = system.gap(i, y);
+    match (modes[i], it.law) {
+        (Mode::Open, InteractionLaw::Compliant { .. }) => {
+            let approach = -rate;
+            modes[i] = Mode::Compliant {
+                approach_rate: approach,
+            };
+            open[i] = Some(Open {
+                kind: ContactKind::Compliant,
+                onset: time,
+                approach_speed: approach,
+                max_indentation: 0.0,
+                dissipated: y[loss_slot(system, i)],
+            });
+        }
+        (Mode::Compliant { .. }, _) => {
+            modes[i] = Mode::Open;
+            if let Some(oc) = open[i].take() {
+                let dissipated = y[loss_slot(system, i)] - oc.dissipated;
+                contacts.push(oc.close(it.pair, time, rate, dissipated));
+            }
+        }
+        (Mode::Open, InteractionLaw::Rigid { restitution }) => {
+            let approach = -rate;
+            let speed_scale = y[system.dim..row]
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) {
+                let loss = system.impact(i, y, restitution);
+                *impact_loss += loss;
+                contacts.push(PairContact {
+                    pair: it.pair,
+                    kind: ContactKind::Impact,
+                    onset: time,
+                    separation: time,
+                    duration: 0.0,
+                    max_indentation: 0.0,
+                    approach_speed: approach,
+                    rebound_speed: restitution * approach,
+                    restitution,
+                    energy_dissipated: loss,
+                });
+            } else {
+                *grazes += 1;
+            }
+            // Would the rest of a chattering sequence finish within the
+            // run's resolution? Then sum it and stick.
+            let rebound = system.gap(i, y).1;
+            system.rates(time, y, modes, scratch, work);
+            let d = system.dim;
+            let pressing = crate::linalg::dot(&it.h, &work[d..2 * d]);
+            if pressing < 0.0 && restitution < 1.0 {
+                let remaining = 2.0 * rebound.max(0.0) / (-pressing * (1.0 - restitution));
+                if remaining <= resolution {
+                    let loss = system.impact(i, y, 0.0);
+                    *impact_loss += loss;
+                    modes[i] = Mode::Sticking;
+                    open[i] = Some(Open {
+                        kind: ContactKind::Sticking,
+                        onset: time + remaining,
+                        approach_speed: rebound.max(0.0),
+                        max_indentation: 0.0,
+                        dissipated: loss,
+                    });
+                }
+            }
+        }
+        (Mode::Sticking, _) => {
+            modes[i] = Mode::Open;
+            if let Some(oc) = open[i].take() {
+                contacts.push(oc.close(it.pair, time, 0.0, oc.dissipated));
+            }
+        }
+    }
+}
+
+/// After an impact elsewhere, a sticking pair whose gap now closes is held
+/// (a plastic impact keeps it stuck) and one whose gap now opens is
+/// released: the sequential answer to what is, exactly, a complementarity
+/// problem among the pairs.
+fn settle_sticking(
+    system: &Assembly,
+    time: f64,
+    y: &mut [f64],
+    modes: &mut [Mode],
+    open: &mut [Option<Open>],
+    contacts: &mut Vec<PairContact>,
+    impact_loss: &mut f64,
+) {
+    let d = system.dim;
+    let speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let tiny = 1e-9 * speed_scale;
+    for i in 0..modes.len() {
+        if modes[i] != Mode::Sticking {
+            continue;
+        }
+        let (_, rate) = system.gap(i, y);
+        if rate < -tiny {
+            let loss = system.impact(i, y, 0.0);
+            *impact_loss += loss;
+            if let Some(oc) = open[i].as_mut() {
+                oc.dissipated += loss;
+            }
+        } else if rate > tiny {
+            modes[i] = Mode::Open;
+            if let Some(oc) = open[i].take() {
+                contacts.push(oc.close(system.interactions[i].pair, time, 0.0, oc.dissipated));
+            }
+        }
+    }
+}
