@@ -8,11 +8,14 @@ contact onset: w = w' = 0, y - w = d, y' = 0.1 m/s.
 
 from __future__ import annotations
 
+import inspect
 import os
+import resource
 import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -116,6 +119,16 @@ def write_scenario(tmp_path: Path) -> Callable[[str, str], Path]:
     return write
 
 
+# Address space of a command run by a test, bytes: a run whose history grows without
+# bound fails there with an allocation error instead of taking the machine's memory.
+SUBPROCESS_MEMORY = 2 << 30
+
+
+def limit_memory() -> None:
+    """For subprocess.run(preexec_fn=...): cap the child's address space."""
+    resource.setrlimit(resource.RLIMIT_AS, (SUBPROCESS_MEMORY, SUBPROCESS_MEMORY))
+
+
 @pytest.fixture
 def run_cli(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess[str]]:
     """Run ``python -m vibroimpact ARGS`` in a temporary folder."""
@@ -132,6 +145,34 @@ def run_cli(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess[str]]:
             env=env,
             timeout=timeout,
             check=False,
+            preexec_fn=limit_memory,
         )
 
     return run
+
+
+# Runs in the tests are bounded: a kernel whose steps collapse (a wrong error estimate,
+# a Butcher coefficient off) must fail in seconds with SimulationError, not fill memory
+# with an adaptive run's history until the machine gives out (it did: 8 GB in 60 s with
+# one DOP853 weight changed). The largest run in the suite takes 3e5 steps.
+TEST_MAX_STEPS = 2_000_000
+
+
+@pytest.fixture(autouse=True)
+def bounded_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Runs through vi.simulate or a scenario take at most TEST_MAX_STEPS steps, unless
+    the test sets max_steps itself."""
+    unbounded = vi.simulate
+    # The defaults of simulate and of a scenario: a test that sets neither.
+    defaults = (
+        inspect.signature(unbounded).parameters["max_steps"].default,
+        vi.scenario.Scenario.max_steps,
+    )
+
+    def simulate(*args: Any, **kwargs: Any) -> vi.Solution:
+        if kwargs.get("max_steps", defaults[0]) in defaults:
+            kwargs["max_steps"] = TEST_MAX_STEPS
+        return unbounded(*args, **kwargs)
+
+    monkeypatch.setattr(vi, "simulate", simulate)
+    monkeypatch.setattr(vi.scenario, "simulate", simulate)

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
+from conftest import limit_memory
 from vibroimpact.cli import main
 
 REPO = Path(__file__).resolve().parent.parent
@@ -427,8 +428,10 @@ def paper_dir(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
         capture_output=True,
         text=True,
         env=env,
-        timeout=300,
+        # Below pytest's 60 s per test; it takes about 4 s.
+        timeout=50,
         check=False,
+        preexec_fn=limit_memory,
     )
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
