@@ -239,12 +239,14 @@ fn hyster_hertz_rebound_ratio_follows_the_exact_relation() {
             let c = run(sys, Method::Rk4, 1e-5, 0.3, ContactTiming::Located).contacts[0];
             let ratio = c.rebound_speed / c.approach_speed;
             let exact = exact_rebound_ratio(alpha);
-            assert!((ratio - exact).abs() < 1e-8, "e = {e}: {ratio} vs {exact}");
+            // Measured: 3e-12 at dt = 1e-5 s (the onset at t = 0, the
+            // separation located on the step's Hermite cubic).
+            assert!((ratio - exact).abs() < 1e-10, "e = {e}: {ratio} vs {exact}");
             // The energy the contact reports dissipating is the kinetic energy lost.
             let m_eff = 0.2;
             let lost = 0.5 * m_eff * (c.approach_speed.powi(2) - c.rebound_speed.powi(2));
             assert!(
-                rel(c.energy_dissipated, lost) < 1e-6,
+                rel(c.energy_dissipated, lost) < 1e-9,
                 "{} vs {lost}",
                 c.energy_dissipated
             );
