@@ -45,6 +45,7 @@ from vibroimpact._core import (
     simulate,
 )
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
+from vibroimpact.system import simulate_system
 
 
 def _equality_only(*classes: type) -> None:
@@ -90,4 +91,5 @@ __all__ = [
     "load_scenario",
     "parse_scenario",
     "simulate",
+    "simulate_system",
 ]

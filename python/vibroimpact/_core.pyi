@@ -1,6 +1,6 @@
 """Type stub of the compiled extension ``vibroimpact._core`` (checked by mypy.stubtest)."""
 
-from typing import ClassVar, final
+from typing import Any, ClassVar, final
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,7 @@ __all__ = [
     "hertz_stiffness",
     "linear_contact_duration",
     "simulate",
+    "simulate_system",
 ]
 
 __version__: str
@@ -181,6 +182,21 @@ class BeamMode:
     @property
     def mass_at_position(self) -> float: ...
 
+def simulate_system(
+    spec: dict[str, Any],
+    initial: list[list[float]],
+    *,
+    method: str,
+    t_end: float,
+    dt: float | None,
+    rtol: float,
+    atol: float,
+    every: int,
+    history: bool,
+    max_steps: int,
+    max_rows: int,
+    energy_tolerance: float,
+) -> dict[str, Any]: ...
 def simulate(
     system: ImpactDamper,
     contact: Contact,

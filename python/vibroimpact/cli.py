@@ -28,7 +28,13 @@ from vibroimpact._core import (
 )
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.paper import run_paper
-from vibroimpact.scenario import Scenario, load_scenario, paper_collision
+from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
+from vibroimpact.system_scenario import (
+    SystemScenario,
+    system_lines,
+    system_summary,
+    write_system_history,
+)
 
 HISTORY_COLUMNS = (
     ("t", "time, s"),
@@ -176,8 +182,28 @@ def contact_lines(sol: Solution) -> list[str]:
     return lines
 
 
+def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
+    start = time.perf_counter()
+    try:
+        sol = scenario.run()
+    except InvalidInputError as err:
+        raise ScenarioError(str(err)) from None
+    cpu_time = time.perf_counter() - start
+    if args.out:
+        write_system_history(args.out, sol)
+    if args.json:
+        print(json.dumps(system_summary(scenario, sol, cpu_time)))
+        return 0
+    print("\n".join(system_lines(str(args.scenario), sol, cpu_time)))
+    if args.out:
+        print(f"history ({len(sol.t)} rows) written to {args.out}")
+    return 0
+
+
 def _simulate(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario) if args.scenario else paper_collision()
+    if isinstance(scenario, SystemScenario):
+        return _simulate_system(args, scenario)
     start = time.perf_counter()
     sol = scenario.run()
     cpu_time = time.perf_counter() - start

@@ -24,6 +24,7 @@ from vibroimpact._core import (
     check_solver,
     simulate,
 )
+from vibroimpact.system_scenario import SystemScenario, system_scenario
 
 
 class ScenarioError(InvalidInputError):
@@ -218,8 +219,16 @@ def _sections(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
     return sections
 
 
-def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
-    """Build a :class:`Scenario` from TOML text; ``source`` names it in errors."""
+def parse_scenario(
+    text: str, source: str = "<scenario>", base_dir: Path | None = None
+) -> Scenario | SystemScenario:
+    """Build a scenario from TOML text; ``source`` names it in errors.
+
+    A file with a ``[structure]`` section describes a 0.2 system
+    (:class:`~vibroimpact.system_scenario.SystemScenario`; recorded signals' files
+    are read relative to ``base_dir``); one with ``[system]`` and ``[contact]``,
+    the two-mass impact damper (:class:`Scenario`).
+    """
     try:
         data = tomllib.loads(text)
     except RecursionError:
@@ -232,6 +241,11 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
         # colon advises on a Python setting, no help to the author of a scenario.
         reason = str(err).split(":")[0]
         raise ScenarioError(f"{source}: invalid TOML: a value it cannot read ({reason})") from None
+    if "structure" in data:
+        try:
+            return system_scenario(data, source, base_dir)
+        except InvalidInputError as err:
+            raise ScenarioError(str(err)) from None
     s = _sections(data, source)
 
     def build(section: str, make: Any) -> Any:
@@ -256,7 +270,7 @@ def _validate_solver(scenario: Scenario, source: str) -> None:
         raise _fail(source, f"[{section}] ", str(err)) from None
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path) -> Scenario | SystemScenario:
     """Read and validate a TOML scenario file (UTF-8, at most ``MAX_SCENARIO_BYTES``)."""
     path = Path(path)
     try:
@@ -271,4 +285,4 @@ def load_scenario(path: str | Path) -> Scenario:
     except (OSError, UnicodeDecodeError) as err:
         reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
         raise ScenarioError(f"cannot read scenario {str(path)!r}: {reason}") from None
-    return parse_scenario(text, str(path))
+    return parse_scenario(text, str(path), path.parent)

@@ -14,6 +14,8 @@ use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::{beam, closed_forms, materials};
 
+mod system;
+
 // The module path makes the exceptions picklable (e.g. from worker processes).
 create_exception!(
     vibroimpact._core,
@@ -942,6 +944,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ContactTable>()?;
     m.add_class::<BeamMode>()?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(system::simulate_system, m)?)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_mode, m)?)?;

@@ -1,0 +1,374 @@
+//! The binding of the 0.2 engine: a system described by plain Python data
+//! (the sections of a TOML scenario, already checked for unknown keys and
+//! types by `vibroimpact.system`), integrated with the GIL released, and the
+//! results returned as flat NumPy arrays for the Python side to shape.
+
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use vibroimpact_core as core;
+use vibroimpact_core::assembly::{
+    initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+};
+use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
+use vibroimpact_core::structure::Structure;
+use vibroimpact_core::system_events::{integrate_system, RunOptions};
+use vibroimpact_core::system_steppers::ExplicitRk;
+
+use crate::{to_py, InvalidInputError};
+
+/// `where key` must be present: the Python side fills defaults, so a missing
+/// key is a bug of the caller's dict, reported as bad input all the same.
+fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    place: &str,
+    key: &str,
+) -> PyResult<T> {
+    match d.get_item(key)? {
+        Some(value) => value.extract::<T>().map_err(|_| {
+            InvalidInputError::new_err(format!("{place}.{key} has the wrong type: {value}"))
+        }),
+        None => Err(InvalidInputError::new_err(format!(
+            "{place}.{key} is required"
+        ))),
+    }
+}
+
+fn optional<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    place: &str,
+    key: &str,
+) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        Some(value) if !value.is_none() => get(d, place, key).map(Some),
+        _ => Ok(None),
+    }
+}
+
+/// A core error about `place` (a section or list entry), prefixed with it.
+fn named(place: &str) -> impl Fn(core::Error) -> PyErr + '_ {
+    move |e| match e {
+        core::Error::InvalidParameter { .. } | core::Error::UnknownChoice { .. } => {
+            InvalidInputError::new_err(format!("{place}.{e}"))
+        }
+        other => to_py(other),
+    }
+}
+
+fn structure(d: &Bound<'_, PyDict>) -> PyResult<Structure> {
+    let place = "structure";
+    let kind: String = get(d, place, "kind")?;
+    match kind.as_str() {
+        "oscillator" => Structure::oscillator(
+            get(d, place, "mass")?,
+            get(d, place, "stiffness")?,
+            get(d, place, "damping")?,
+        ),
+        "matrices" => Structure::matrices(
+            &get::<Vec<Vec<f64>>>(d, place, "mass")?,
+            &get::<Vec<Vec<f64>>>(d, place, "stiffness")?,
+            &get::<Vec<Vec<f64>>>(d, place, "damping")?,
+        ),
+        "cantilever" => Structure::cantilever(
+            get(d, place, "length")?,
+            get(d, place, "youngs_modulus")?,
+            get(d, place, "second_moment")?,
+            get(d, place, "mass_per_length")?,
+            get(d, place, "modes")?,
+            get(d, place, "damping_ratio")?,
+        ),
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "structure.kind must be one of \"oscillator\", \"matrices\", \"cantilever\", got {other:?}"
+            )))
+        }
+    }
+    .map_err(named(place))
+}
+
+/// A pair's law from its `law`, `stiffness`, `restitution`, `damping`.
+fn pair_law(d: &Bound<'_, PyDict>, place: &str) -> PyResult<PairLaw> {
+    let law: String = get(d, place, "law")?;
+    let restitution: Option<f64> = optional(d, place, "restitution")?;
+    if law == "rigid" {
+        let e = restitution.ok_or_else(|| {
+            InvalidInputError::new_err(format!(
+                "{place}.restitution is required for law \"rigid\" (a number in [0, 1])"
+            ))
+        })?;
+        return PairLaw::rigid(e).map_err(named(place));
+    }
+    let kind = core::LawKind::parse(&law).map_err(|_| {
+        InvalidInputError::new_err(format!(
+            "{place}.law must be one of \"rigid\", {}, got {law:?}",
+            core::LawKind::NAMES
+        ))
+    })?;
+    let stiffness: f64 = optional(d, place, "stiffness")?.ok_or_else(|| {
+        InvalidInputError::new_err(format!(
+            "{place}.stiffness is required for law {law:?} (N/m^1.5, or N/m for \"linear\")"
+        ))
+    })?;
+    let damping: f64 = optional(d, place, "damping")?.unwrap_or(0.0);
+    core::Contact::new(kind, stiffness, restitution, damping)
+        .map(PairLaw::Compliant)
+        .map_err(named(place))
+}
+
+fn signal(d: &Bound<'_, PyDict>, place: &str, t_end: f64) -> PyResult<Signal> {
+    let kind: String = get(d, place, "signal")?;
+    let number = |key: &str| get::<f64>(d, place, key);
+    let duration = || Ok::<f64, PyErr>(optional::<f64>(d, place, "duration")?.unwrap_or(t_end));
+    match kind.as_str() {
+        "harmonic" => Signal::harmonic(
+            number("amplitude")?,
+            number("frequency")?,
+            optional(d, place, "phase")?.unwrap_or(0.0),
+        ),
+        "sweep" => {
+            let law: String = optional(d, place, "sweep")?.unwrap_or_else(|| "linear".into());
+            Signal::sweep(
+                number("amplitude")?,
+                number("start_frequency")?,
+                number("end_frequency")?,
+                duration()?,
+                SweepLaw::parse(&law).map_err(named(place))?,
+                optional(d, place, "phase")?.unwrap_or(0.0),
+            )
+        }
+        "harmonics" => {
+            let amplitudes: Vec<f64> = get(d, place, "amplitudes")?;
+            let frequencies: Vec<f64> = get(d, place, "frequencies")?;
+            let phases: Vec<f64> =
+                optional(d, place, "phases")?.unwrap_or_else(|| vec![0.0; amplitudes.len()]);
+            if frequencies.len() != amplitudes.len() || phases.len() != amplitudes.len() {
+                return Err(InvalidInputError::new_err(format!(
+                    "{place}: amplitudes, frequencies and phases must have the same length, got {}, {} and {}",
+                    amplitudes.len(),
+                    frequencies.len(),
+                    phases.len()
+                )));
+            }
+            amplitudes
+                .iter()
+                .zip(&frequencies)
+                .zip(&phases)
+                .map(|((&a, &f), &p)| Harmonic::new(a, f, p))
+                .collect::<core::Result<Vec<_>>>()
+                .map(Signal::Harmonics)
+        }
+        "recorded" => Signal::recorded(
+            get(d, place, "time")?,
+            get(d, place, "value")?,
+            optional(d, place, "scale")?.unwrap_or(1.0),
+        ),
+        "white-noise" => Signal::white_noise(
+            number("intensity")?,
+            number("cutoff_frequency")?,
+            duration()?,
+            get(d, place, "seed")?,
+        ),
+        "kanai-tajimi" => Signal::kanai_tajimi(
+            number("intensity")?,
+            number("ground_frequency")?,
+            number("ground_damping")?,
+            number("cutoff_frequency")?,
+            duration()?,
+            get(d, place, "seed")?,
+        ),
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "{place}.signal must be one of \"harmonic\", \"sweep\", \"harmonics\", \"recorded\", \
+                 \"white-noise\", \"kanai-tajimi\", got {other:?}"
+            )))
+        }
+    }
+    .map_err(named(place))
+}
+
+fn entries<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    match d.get_item(key)? {
+        Some(list) => list
+            .cast::<PyList>()
+            .map_err(|_| InvalidInputError::new_err(format!("{key} must be a list of tables")))?
+            .iter()
+            .map(|item| {
+                item.cast_into::<PyDict>()
+                    .map_err(|_| InvalidInputError::new_err(format!("each {key} must be a table")))
+            })
+            .collect(),
+        None => Ok(vec![]),
+    }
+}
+
+/// The system from its sections; signals without a duration last `t_end`.
+fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
+    let structure_dict = spec
+        .get_item("structure")?
+        .ok_or_else(|| InvalidInputError::new_err("[structure] is required"))?
+        .cast_into::<PyDict>()
+        .map_err(|_| InvalidInputError::new_err("structure must be a table"))?;
+    let mut dampers = Vec::new();
+    for (j, d) in entries(spec, "damper")?.iter().enumerate() {
+        let place = format!("damper {j}");
+        dampers.push(Damper {
+            mass: get(d, &place, "mass")?,
+            at: get(d, &place, "at")?,
+            lower_clearance: get(d, &place, "lower_clearance")?,
+            upper_clearance: get(d, &place, "upper_clearance")?,
+            law: pair_law(d, &place)?,
+        });
+    }
+    let mut stops = Vec::new();
+    for (j, d) in entries(spec, "stop")?.iter().enumerate() {
+        let place = format!("stop {j}");
+        let side: String = get(d, &place, "side")?;
+        stops.push(Stop {
+            at: get(d, &place, "at")?,
+            side: Side::parse(&side).map_err(named(&place))?,
+            gap: get(d, &place, "gap")?,
+            law: pair_law(d, &place)?,
+        });
+    }
+    let mut excitations = Vec::new();
+    for (j, d) in entries(spec, "excitation")?.iter().enumerate() {
+        let place = format!("excitation {j}");
+        let kind: String = get(d, &place, "kind")?;
+        let load = match kind.as_str() {
+            "force" => Load::Force {
+                at: get(d, &place, "at")?,
+            },
+            "base" => Load::Base,
+            other => {
+                return Err(InvalidInputError::new_err(format!(
+                    "{place}.kind must be \"force\" or \"base\", got {other:?}"
+                )))
+            }
+        };
+        excitations.push(Excitation {
+            load,
+            signal: signal(d, &place, t_end)?,
+        });
+    }
+    Ok(SystemSpec {
+        structure: structure(&structure_dict)?,
+        dampers,
+        stops,
+        gravity: optional(spec, "system", "gravity")?.unwrap_or(0.0),
+        excitations,
+    })
+}
+
+/// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
+/// dict of flat arrays that the Python side shapes.
+#[pyfunction]
+#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, every, history, max_steps, max_rows, energy_tolerance))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_system<'py>(
+    py: Python<'py>,
+    spec: &Bound<'py, PyDict>,
+    initial: [Vec<f64>; 4],
+    method: &str,
+    t_end: f64,
+    dt: Option<f64>,
+    rtol: f64,
+    atol: f64,
+    every: u64,
+    history: bool,
+    max_steps: u64,
+    max_rows: u64,
+    energy_tolerance: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let system_spec = system_spec(spec, t_end)?;
+    let system = Assembly::new(&system_spec).map_err(to_py)?;
+    let y0 = initial_state(&system, &initial[0], &initial[1], &initial[2], &initial[3])
+        .map_err(to_py)?;
+    let len = system.state_len();
+    let mut stepper = match method {
+        "rk4" => ExplicitRk::rk4(len),
+        "dopri5" => ExplicitRk::dopri5(len, rtol, atol),
+        "dop853" => ExplicitRk::dop853(len, rtol, atol),
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "method must be one of \"rk4\", \"dopri5\", \"dop853\" for a [structure] system \
+                 (the Newmark family follows), got {other:?}"
+            )))
+        }
+    };
+    let options = RunOptions {
+        dt,
+        t_end,
+        every,
+        keep_history: history,
+        max_steps,
+        max_rows,
+        energy_tolerance,
+    };
+    let mut signal: Option<PyErr> = None;
+    let result = py.detach(|| {
+        integrate_system(
+            &system,
+            &mut stepper,
+            &y0,
+            &options,
+            &mut || match Python::attach(|py| py.check_signals()) {
+                Ok(()) => false,
+                Err(e) => {
+                    signal = Some(e);
+                    true
+                }
+            },
+        )
+    });
+    let sol = match result {
+        Ok(sol) => sol,
+        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
+            return Err(signal.take().expect("checked"))
+        }
+        Err(e) => return Err(to_py(e)),
+    };
+    let out = PyDict::new(py);
+    out.set_item("n", system.n)?;
+    out.set_item("k", system.k)?;
+    out.set_item("pairs", system.pairs.clone())?;
+    out.set_item("time", sol.time.into_pyarray(py))?;
+    out.set_item("states", sol.states.into_pyarray(py))?;
+    out.set_item("final_state", sol.final_state.into_pyarray(py))?;
+    out.set_item("final_time", sol.final_time)?;
+    let columns = PyDict::new(py);
+    let c = &sol.contacts;
+    let column = |f: fn(&core::system_events::PairContact) -> f64| {
+        c.iter().map(f).collect::<Vec<f64>>().into_pyarray(py)
+    };
+    columns.set_item("pair", c.iter().map(|r| r.pair).collect::<Vec<usize>>())?;
+    columns.set_item("kind", c.iter().map(|r| r.kind.name()).collect::<Vec<_>>())?;
+    columns.set_item("onset", column(|r| r.onset))?;
+    columns.set_item("separation", column(|r| r.separation))?;
+    columns.set_item("duration", column(|r| r.duration))?;
+    columns.set_item("max_indentation", column(|r| r.max_indentation))?;
+    columns.set_item("approach_speed", column(|r| r.approach_speed))?;
+    columns.set_item("rebound_speed", column(|r| r.rebound_speed))?;
+    columns.set_item("restitution", column(|r| r.restitution))?;
+    columns.set_item("energy_dissipated", column(|r| r.energy_dissipated))?;
+    out.set_item("contacts", columns)?;
+    let e = sol.energy;
+    let energy = PyDict::new(py);
+    for (key, value) in [
+        ("input_work", e.input_work),
+        ("dissipated", e.dissipated),
+        ("viscous", e.viscous),
+        ("contact", e.contact),
+        ("impact", e.impact),
+        ("stored_start", e.stored_start),
+        ("stored_end", e.stored_end),
+        ("residual", e.residual),
+    ] {
+        energy.set_item(key, value)?;
+    }
+    out.set_item("energy", energy)?;
+    out.set_item("steps", sol.steps)?;
+    out.set_item("rejected_steps", sol.rejected_steps)?;
+    out.set_item("rhs_evaluations", sol.rhs_evaluations)?;
+    out.set_item("grazing_contacts", sol.grazing_contacts)?;
+    Ok(out)
+}

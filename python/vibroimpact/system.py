@@ -1,0 +1,587 @@
+"""vibroimpact 0.2 systems: any structure, several dampers and stops, excitations, rigid impacts.
+
+A system is described by the same sections as a TOML scenario (SI units):
+
+- ``structure``: ``kind = "oscillator"`` (``mass``, ``stiffness``, ``damping``),
+  ``"matrices"`` (``mass``, ``stiffness``, ``damping`` as n x n arrays of rows; M
+  symmetric positive definite, K and C symmetric positive semi-definite) or
+  ``"cantilever"`` (``length``, ``youngs_modulus``, ``second_moment``,
+  ``mass_per_length``, ``modes``, ``damping_ratio``; modal coordinates).
+- ``damper`` (a list): a loose mass (``mass``, kg) rattling against the point ``at``
+  (a coordinate index, or m along a cantilever) with ``clearance`` on each side or
+  ``lower_clearance`` and ``upper_clearance`` (m), and a ``law``.
+- ``stop`` (a list): the point ``at`` hits a stop fixed to the base; ``side = "upper"``
+  keeps it at or below ``+gap``, ``"lower"`` at or above ``-gap`` (m); a ``law``.
+- Laws: ``"rigid"`` (Newton's restitution ``restitution`` in [0, 1], located
+  instantaneous impacts, chattering summed to its accumulation instant, then
+  sticking) or a compliant law of :class:`vibroimpact.Contact` (``stiffness``,
+  ``restitution``, ``damping``).
+- ``gravity``: ``acceleration`` (m/s^2, along -x; 9.81 when the section is empty).
+- ``excitation`` (a list, summed): ``kind = "force"`` at a point ``at`` (N) or
+  ``"base"`` (a support acceleration, m/s^2: every coordinate is relative to the
+  base, and stops move with it), with a ``signal``: ``"harmonic"`` (``amplitude *
+  cos(2 pi frequency t + phase)``, Hz, rad), ``"sweep"`` (``start_frequency``,
+  ``end_frequency``, ``duration``, ``sweep = "linear" | "logarithmic"``),
+  ``"harmonics"`` (``amplitudes``, ``frequencies``, ``phases``), ``"recorded"``
+  (``file``, a CSV of time and value, or ``time`` and ``value`` arrays; linear
+  interpolation, ``scale``, zero outside the record), ``"white-noise"`` (two-sided
+  ``intensity`` S0 per rad/s up to ``cutoff_frequency``, ``seed``) and
+  ``"kanai-tajimi"`` (also ``ground_frequency``, ``ground_damping``); random signals
+  are the same bit for bit for the same seed on every platform.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact._core import Contact, InvalidInputError
+from vibroimpact._core import simulate_system as _simulate_system
+
+__all__ = [
+    "PreparedRun",
+    "SystemContacts",
+    "SystemSolution",
+    "prepare_system",
+    "simulate_system",
+    "SYSTEM_SOLVER_DEFAULTS",
+]
+
+_NUMBER, _TEXT, _WHOLE, _NUMBERS, _MATRIX = "number", "string", "whole number", "array", "matrix"
+_REQ = object()
+
+# The keys of each section: (type, default; _REQ where required, None where optional).
+_STRUCTURE: dict[str, dict[str, tuple[str, Any]]] = {
+    "oscillator": {
+        "mass": (_NUMBER, _REQ),
+        "stiffness": (_NUMBER, _REQ),
+        "damping": (_NUMBER, 0.0),
+    },
+    "matrices": {"mass": (_MATRIX, _REQ), "stiffness": (_MATRIX, _REQ), "damping": (_MATRIX, None)},
+    "cantilever": {
+        "length": (_NUMBER, _REQ),
+        "youngs_modulus": (_NUMBER, _REQ),
+        "second_moment": (_NUMBER, _REQ),
+        "mass_per_length": (_NUMBER, _REQ),
+        "modes": (_WHOLE, _REQ),
+        "damping_ratio": (_NUMBER, 0.0),
+    },
+}
+_LAW: dict[str, tuple[str, Any]] = {
+    "law": (_TEXT, _REQ),
+    "stiffness": (_NUMBER, None),
+    "restitution": (_NUMBER, None),
+    "damping": (_NUMBER, 0.0),
+}
+_DAMPER = {
+    "mass": (_NUMBER, _REQ),
+    "at": (_NUMBER, _REQ),
+    "clearance": (_NUMBER, None),
+    "lower_clearance": (_NUMBER, None),
+    "upper_clearance": (_NUMBER, None),
+    **_LAW,
+}
+_STOP = {"at": (_NUMBER, _REQ), "side": (_TEXT, _REQ), "gap": (_NUMBER, _REQ), **_LAW}
+_GRAVITY = {"acceleration": (_NUMBER, 9.81)}
+_EXCITATION = {
+    "kind": (_TEXT, _REQ),
+    "at": (_NUMBER, None),
+    "signal": (_TEXT, _REQ),
+    "amplitude": (_NUMBER, None),
+    "frequency": (_NUMBER, None),
+    "phase": (_NUMBER, None),
+    "start_frequency": (_NUMBER, None),
+    "end_frequency": (_NUMBER, None),
+    "duration": (_NUMBER, None),
+    "sweep": (_TEXT, None),
+    "amplitudes": (_NUMBERS, None),
+    "frequencies": (_NUMBERS, None),
+    "phases": (_NUMBERS, None),
+    "file": (_TEXT, None),
+    "time": (_NUMBERS, None),
+    "value": (_NUMBERS, None),
+    "scale": (_NUMBER, None),
+    "intensity": (_NUMBER, None),
+    "cutoff_frequency": (_NUMBER, None),
+    "ground_frequency": (_NUMBER, None),
+    "ground_damping": (_NUMBER, None),
+    "seed": (_WHOLE, None),
+}
+_INITIAL = {
+    "structure_displacement": (_NUMBERS, ()),
+    "structure_velocity": (_NUMBERS, ()),
+    "damper_displacement": (_NUMBERS, ()),
+    "damper_velocity": (_NUMBERS, ()),
+}
+#: The solver settings of a 0.2 run and their defaults (the one place they live).
+SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
+    "method": "rk4",
+    "dt": None,
+    "rtol": 1e-8,
+    "atol": 1e-12,
+    "max_steps": 1_000_000_000,
+    "energy_tolerance": 1e-2,
+    "max_rows": 20_000_000,
+}
+_SOLVER = {
+    "method": (_TEXT, SYSTEM_SOLVER_DEFAULTS["method"]),
+    "dt": (_NUMBER, None),
+    "t_end": (_NUMBER, _REQ),
+    "rtol": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["rtol"]),
+    "atol": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["atol"]),
+    "max_steps": (_WHOLE, SYSTEM_SOLVER_DEFAULTS["max_steps"]),
+    "energy_tolerance": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["energy_tolerance"]),
+    "max_rows": (_WHOLE, SYSTEM_SOLVER_DEFAULTS["max_rows"]),
+}
+_OUTPUT = {"every": (_WHOLE, 1), "history": ("boolean", True)}
+_INT64 = range(-(2**63), 2**63)
+_METHODS = ("rk4", "dopri5", "dop853")
+_SIDES = ("upper", "lower")
+_LOADS = ("force", "base")
+_SIGNALS = ("harmonic", "sweep", "harmonics", "recorded", "white-noise", "kanai-tajimi")
+_SWEEPS = ("linear", "logarithmic")
+
+
+def _choice(where: str, key: str, value: Any, choices: Sequence[str]) -> None:
+    if value not in choices:
+        listed = ", ".join(f'"{c}"' for c in choices)
+        raise _fail(where, f'{key} must be one of {listed}, got "{value}"')
+
+
+def _check_law(where: str, d: Mapping[str, Any]) -> None:
+    """A pair's law: "rigid" with a restitution in [0, 1], or a compliant law that
+    :class:`vibroimpact.Contact` accepts with the same values."""
+    if d["law"] == "rigid":
+        e = d["restitution"]
+        if e is None or not 0.0 <= e <= 1.0:
+            raise _fail(where, f'law "rigid" needs restitution in [0, 1], got {e}')
+        return
+    try:
+        Contact(
+            d["law"],
+            stiffness=1.0 if d["stiffness"] is None else d["stiffness"],
+            damping=d["damping"],
+            restitution=d["restitution"],
+        )
+    except InvalidInputError as err:
+        message = str(err).replace("law must be one of ", 'law must be one of "rigid", ')
+        raise _fail(where, message) from None
+    if d["stiffness"] is None:
+        raise _fail(where, f'law {d["law"]!r} needs a stiffness (N/m^1.5, N/m for "linear")')
+
+
+def _fail(where: str, message: str) -> InvalidInputError:
+    return InvalidInputError(f"{where}{message}")
+
+
+def _value(where: str, kind: str, value: Any) -> Any:
+    """``value`` checked as ``kind``: numbers finite, whole numbers in 64 bits."""
+    if kind == _NUMBER:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise _fail(where, f"must be a number, got {value!r:.60}")
+        if isinstance(value, int) and value not in _INT64:
+            raise _fail(where, "is an integer beyond 64 bits; write it as a float (e.g. 1e30)")
+        number = float(value)
+        if not math.isfinite(number):
+            raise _fail(where, f"must be a finite number, got {number}")
+        return number
+    if kind == _WHOLE:
+        if isinstance(value, bool) or not isinstance(value, int) or value not in range(2**63):
+            raise _fail(where, f"must be a whole number >= 0 in 64 bits, got {value!r:.60}")
+        return value
+    if kind == _TEXT:
+        if not isinstance(value, str):
+            raise _fail(where, f"must be a string, got {value!r:.60}")
+        return value
+    if kind == "boolean":
+        if not isinstance(value, bool):
+            raise _fail(where, f"must be true or false, got {value!r:.60}")
+        return value
+    if kind == _NUMBERS:
+        if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+            raise _fail(where, f"must be an array of numbers, got {value!r:.60}")
+        return [_value(f"{where[:-2]}[{i}]: ", _NUMBER, v) for i, v in enumerate(value)]
+    # _MATRIX: an array of rows.
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise _fail(where, f"must be an array of rows (n x n), got {value!r:.60}")
+    return [_value(f"{where[:-2]}[{i}]: ", _NUMBERS, row) for i, row in enumerate(value)]
+
+
+def _table(where: str, table: Any, schema: Mapping[str, tuple[str, Any]]) -> dict[str, Any]:
+    """A table checked against ``schema``: unknown keys refused (with a suggestion),
+    types checked, defaults filled, required keys demanded."""
+    if not isinstance(table, Mapping):
+        raise _fail(where, f"must be a table, got {table!r:.60}")
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        if key not in schema:
+            close = difflib.get_close_matches(str(key), list(schema), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise _fail(where, f"unknown key {key!r} (allowed: {', '.join(schema)}){hint}")
+        out[key] = _value(f"{where}{key}: ", schema[key][0], value)
+    for key, (_, default) in schema.items():
+        if key not in out:
+            if default is _REQ:
+                raise _fail(where, f"missing key {key!r}")
+            out[key] = default
+    return out
+
+
+def _list(name: str, value: Any) -> list[Any]:
+    if isinstance(value, Mapping):
+        return [value]
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence):
+        raise _fail("", f"{name} must be a list of tables ([[{name}]]), got {value!r:.60}")
+    return list(value)
+
+
+def _read_record(path: Path, where: str) -> tuple[list[float], list[float]]:
+    """Time and value columns of a CSV file (lines starting with # and a header
+    line are skipped)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
+        raise _fail(where, f"cannot read {str(path)!r}: {reason}") from None
+    times: list[float] = []
+    values: list[float] = []
+    first = True
+    for number, line in enumerate(text.splitlines(), start=1):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        cells = [c.strip() for c in line.replace(";", ",").split(",")]
+        header, first = first, False
+        if len(cells) < 2:
+            raise _fail(where, f"{path.name} line {number}: needs time and value, got {line!r:.60}")
+        try:
+            times.append(float(cells[0]))
+            values.append(float(cells[1]))
+        except ValueError:
+            if header:  # the first line may name the columns
+                continue
+            raise _fail(
+                where, f"{path.name} line {number}: not two numbers: {line!r:.60}"
+            ) from None
+    return times, values
+
+
+def system_spec(
+    structure: Any,
+    damper: Any = (),
+    stop: Any = (),
+    gravity: Any = None,
+    excitation: Any = (),
+    base_dir: Path | None = None,
+) -> dict[str, Any]:
+    """The sections of a system, checked and with their defaults filled (see the module
+    docstring); errors name the section and key."""
+    if not isinstance(structure, Mapping):
+        raise _fail("", f"[structure] must be a table, got {structure!r:.60}")
+    kind = structure.get("kind")
+    if kind not in _STRUCTURE:
+        listed = ", ".join(f'"{k}"' for k in _STRUCTURE)
+        raise _fail("[structure] ", f'kind must be one of {listed}, got "{kind}"')
+    schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[kind]}
+    spec: dict[str, Any] = {"structure": _table("[structure] ", structure, schema)}
+    if kind == "matrices" and spec["structure"]["damping"] is None:
+        size = len(spec["structure"]["mass"])
+        spec["structure"]["damping"] = [[0.0] * size for _ in range(size)]
+    dampers = []
+    for j, table in enumerate(_list("damper", damper)):
+        d = _table(f"[[damper]] {j}: ", table, _DAMPER)
+        both = d["clearance"]
+        for side in ("lower_clearance", "upper_clearance"):
+            if d[side] is None:
+                if both is None:
+                    raise _fail(
+                        f"[[damper]] {j}: ",
+                        "give clearance (each side) or lower_clearance and upper_clearance",
+                    )
+                d[side] = both
+            elif both is not None:
+                raise _fail(f"[[damper]] {j}: ", f"give clearance or {side}, not both")
+        del d["clearance"]
+        _check_law(f"[[damper]] {j}: ", d)
+        dampers.append(d)
+    spec["damper"] = dampers
+    stops = []
+    for j, table in enumerate(_list("stop", stop)):
+        d = _table(f"[[stop]] {j}: ", table, _STOP)
+        _choice(f"[[stop]] {j}: ", "side", d["side"], _SIDES)
+        _check_law(f"[[stop]] {j}: ", d)
+        stops.append(d)
+    spec["stop"] = stops
+    if gravity is None:
+        spec["gravity"] = {"acceleration": 0.0}
+    elif isinstance(gravity, int | float) and not isinstance(gravity, bool):
+        spec["gravity"] = {"acceleration": _value("gravity: ", _NUMBER, gravity)}
+    else:
+        spec["gravity"] = _table("[gravity] ", gravity, _GRAVITY)
+    excitations = []
+    for j, table in enumerate(_list("excitation", excitation)):
+        where = f"[[excitation]] {j}: "
+        e = _table(where, table, _EXCITATION)
+        _choice(where, "kind", e["kind"], _LOADS)
+        _choice(where, "signal", e["signal"], _SIGNALS)
+        if e["sweep"] is not None:
+            _choice(where, "sweep", e["sweep"], _SWEEPS)
+        if e["kind"] == "force" and e["at"] is None:
+            raise _fail(where, 'kind "force" needs the point it acts at: at')
+        if e["file"] is not None:
+            if e["time"] is not None or e["value"] is not None:
+                raise _fail(where, "give file or time and value, not both")
+            path = Path(e["file"])
+            if base_dir is not None and not path.is_absolute():
+                path = base_dir / path
+            e["time"], e["value"] = _read_record(path, where)
+        excitations.append({k: v for k, v in e.items() if v is not None and k != "file"})
+    spec["excitation"] = excitations
+    return spec
+
+
+@dataclass(frozen=True)
+class SystemContacts:
+    """The contacts of a 0.2 run, one entry per contact, as NumPy arrays (SI units).
+
+    ``pair`` names the pair ("damper 0", "stop 1"); ``kind`` is "compliant",
+    "impact" (a rigid impact: zero duration) or "sticking" (a rigid pair moving
+    together from the accumulation instant of its chattering sequence to its
+    release). ``energy_dissipated`` is the work of the contact's dissipative
+    forces, or the kinetic energy an impact takes (J). A contact still open at the
+    end has NaN ``separation``, ``duration``, ``rebound_speed`` and ``restitution``.
+    """
+
+    pair: list[str]
+    kind: list[str]
+    onset: np.ndarray
+    separation: np.ndarray
+    duration: np.ndarray
+    max_indentation: np.ndarray
+    approach_speed: np.ndarray
+    rebound_speed: np.ndarray
+    restitution: np.ndarray
+    energy_dissipated: np.ndarray
+
+    columns = (
+        "pair",
+        "kind",
+        "onset",
+        "separation",
+        "duration",
+        "max_indentation",
+        "approach_speed",
+        "rebound_speed",
+        "restitution",
+        "energy_dissipated",
+    )
+
+    def __len__(self) -> int:
+        return len(self.pair)
+
+    def to_dicts(self) -> list[dict[str, Any]]:
+        """One dict per contact, keyed by the column names."""
+        return [
+            {name: _plain(getattr(self, name)[i]) for name in self.columns}
+            for i in range(len(self))
+        ]
+
+
+def _plain(x: Any) -> Any:
+    return x if isinstance(x, str) else float(x)
+
+
+@dataclass(frozen=True)
+class SystemSolution:
+    """What :func:`simulate_system` returns.
+
+    History arrays have one row per kept step: ``structure_displacement`` (m, rows
+    x n), ``structure_velocity``, ``damper_displacement`` (rows x k),
+    ``damper_velocity``; all relative to the base. ``energy`` (J): ``input_work``,
+    ``dissipated`` (``viscous`` + ``contact`` + ``impact``), ``stored_start``,
+    ``stored_end`` and ``residual`` = stored_end - stored_start - input_work +
+    dissipated (numerical error; checked against ``energy_tolerance``).
+    """
+
+    t: np.ndarray
+    structure_displacement: np.ndarray
+    structure_velocity: np.ndarray
+    damper_displacement: np.ndarray
+    damper_velocity: np.ndarray
+    contacts: SystemContacts
+    final_state: dict[str, np.ndarray]
+    final_time: float
+    energy: dict[str, float]
+    steps: int
+    rejected_steps: int
+    rhs_evaluations: int
+    grazing_contacts: int
+    method: str
+    pairs: list[str] = field(default_factory=list)
+
+
+def simulate_system(
+    structure: Mapping[str, Any],
+    *,
+    damper: Any = (),
+    stop: Any = (),
+    gravity: Any = None,
+    excitation: Any = (),
+    initial: Mapping[str, Any] | None = None,
+    t_end: float,
+    method: str = SYSTEM_SOLVER_DEFAULTS["method"],
+    dt: float | None = None,
+    rtol: float = SYSTEM_SOLVER_DEFAULTS["rtol"],
+    atol: float = SYSTEM_SOLVER_DEFAULTS["atol"],
+    every: int = 1,
+    history: bool = True,
+    max_steps: int = SYSTEM_SOLVER_DEFAULTS["max_steps"],
+    energy_tolerance: float = SYSTEM_SOLVER_DEFAULTS["energy_tolerance"],
+    max_rows: int = SYSTEM_SOLVER_DEFAULTS["max_rows"],
+    base_dir: Path | None = None,
+) -> SystemSolution:
+    """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
+
+    The sections are those of a TOML scenario (see the module docstring), as dicts
+    (``damper``, ``stop`` and ``excitation`` as lists of dicts). ``initial`` holds
+    ``structure_displacement``, ``structure_velocity``, ``damper_displacement``,
+    ``damper_velocity`` (arrays, SI; zeros where left out). ``method``: ``"rk4"``
+    (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``). Every
+    event (contact onset, separation, rigid impact, release) is located to
+    round-off. ``every`` keeps every N-th step; ``history=False`` keeps none (the
+    contacts and the final state only). A run stops with a clear error past
+    ``max_steps`` steps, past ``max_rows`` history rows and contacts, or when its
+    energy balance is off by more than ``energy_tolerance`` of the energies in play.
+    The GIL is released while integrating; Ctrl-C interrupts.
+    """
+    run = prepare_system(
+        structure,
+        damper=damper,
+        stop=stop,
+        gravity=gravity,
+        excitation=excitation,
+        initial=initial,
+        solver={
+            "method": method,
+            "t_end": t_end,
+            "rtol": rtol,
+            "atol": atol,
+            "max_steps": max_steps,
+            "energy_tolerance": energy_tolerance,
+            "max_rows": max_rows,
+            **({} if dt is None else {"dt": dt}),
+        },
+        output={"every": every, "history": history},
+        base_dir=base_dir,
+    )
+    return run.run()
+
+
+@dataclass(frozen=True)
+class PreparedRun:
+    """A checked 0.2 run, ready to integrate (see :func:`prepare_system`)."""
+
+    spec: dict[str, Any]
+    initial: dict[str, list[float]]
+    solver: dict[str, Any]
+    output: dict[str, Any]
+
+    def run(self) -> SystemSolution:
+        """Integrate it."""
+        spec, init, solver, output = self.spec, self.initial, self.solver, self.output
+        raw = _simulate_system(
+            {**spec, "gravity": spec["gravity"]["acceleration"]},
+            [init[k] for k in _INITIAL],
+            method=solver["method"],
+            t_end=solver["t_end"],
+            dt=solver["dt"],
+            rtol=solver["rtol"],
+            atol=solver["atol"],
+            every=output["every"],
+            history=output["history"],
+            max_steps=solver["max_steps"],
+            max_rows=solver["max_rows"],
+            energy_tolerance=solver["energy_tolerance"],
+        )
+        return _solution(raw, solver["method"])
+
+
+def prepare_system(
+    structure: Any,
+    *,
+    damper: Any = (),
+    stop: Any = (),
+    gravity: Any = None,
+    excitation: Any = (),
+    initial: Any = None,
+    solver: Mapping[str, Any],
+    output: Mapping[str, Any] | None = None,
+    base_dir: Path | None = None,
+) -> PreparedRun:
+    """Check every section of a 0.2 run (the sections of a TOML scenario, as dicts)
+    and fill their defaults; errors name the section and key."""
+    spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
+    init = _table("[initial] ", initial or {}, _INITIAL)
+    solver = _table("[solver] ", solver, _SOLVER)
+    output = _table("[output] ", output or {}, _OUTPUT)
+    _choice("[solver] ", "method", solver["method"], _METHODS)
+    for key in ("t_end", "rtol", "atol", "energy_tolerance"):
+        if not solver[key] > 0:
+            raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
+    if solver["dt"] is not None and not solver["dt"] > 0:
+        raise _fail("[solver] dt: ", f"must be > 0, got {solver['dt']}")
+    if solver["method"] == "rk4" and solver["dt"] is None:
+        raise _fail("[solver] dt: ", 'is required for method "rk4" (a step in s > 0)')
+    if solver["method"] == "rk4" and solver["t_end"] / solver["dt"] > solver["max_steps"]:
+        raise _fail(
+            "[solver] ",
+            f"t_end / dt = {solver['t_end'] / solver['dt']:.3e} steps exceeds max_steps "
+            f"({solver['max_steps']}): raise dt or max_steps, or shorten t_end",
+        )
+    for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
+        value = (output if section == "output" else solver)[key]
+        if value < 1:
+            raise _fail(f"[{section}] {key}: ", f"must be >= 1, got {value}")
+    return PreparedRun(spec, init, solver, output)
+
+
+def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
+    n, k = raw["n"], raw["k"]
+    width = 2 * (n + k)
+    states = raw["states"].reshape(-1, width)
+    final = raw["final_state"]
+    c = raw["contacts"]
+    pairs = list(raw["pairs"])
+    contacts = SystemContacts(
+        pair=[pairs[p] for p in c["pair"]],
+        kind=list(c["kind"]),
+        **{name: c[name] for name in SystemContacts.columns[2:]},
+    )
+    return SystemSolution(
+        t=raw["time"],
+        structure_displacement=states[:, :n],
+        damper_displacement=states[:, n : n + k],
+        structure_velocity=states[:, n + k : 2 * n + k],
+        damper_velocity=states[:, 2 * n + k :],
+        contacts=contacts,
+        final_state={
+            "structure_displacement": final[:n],
+            "structure_velocity": final[n + k : 2 * n + k],
+            "damper_displacement": final[n : n + k],
+            "damper_velocity": final[2 * n + k :],
+        },
+        final_time=raw["final_time"],
+        energy=dict(raw["energy"]),
+        steps=raw["steps"],
+        rejected_steps=raw["rejected_steps"],
+        rhs_evaluations=raw["rhs_evaluations"],
+        grazing_contacts=raw["grazing_contacts"],
+        method=method,
+        pairs=pairs,
+    )

@@ -1,0 +1,160 @@
+"""TOML scenarios of 0.2 systems (a ``[structure]`` section) and what the command line
+prints and writes for them.
+
+Sections: ``[structure]`` and ``[solver]`` (required), ``[[damper]]``, ``[[stop]]``,
+``[gravity]``, ``[[excitation]]``, ``[initial]``, ``[output]``; see
+:mod:`vibroimpact.system` and the README. Every key is checked: an unknown key, a
+wrong type or a bad value is an error naming the file, the section and the key.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.output import written_whole
+from vibroimpact.system import PreparedRun, SystemSolution, prepare_system
+
+SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
+
+
+@dataclass(frozen=True)
+class SystemScenario:
+    """A checked 0.2 scenario (see :func:`vibroimpact.system.prepare_system`)."""
+
+    source: str
+    prepared: PreparedRun
+
+    @property
+    def solver(self) -> dict[str, Any]:
+        return dict(self.prepared.solver)
+
+    def run(self) -> SystemSolution:
+        """Integrate the scenario; errors name the file."""
+        try:
+            return self.prepared.run()
+        except InvalidInputError as err:
+            raise InvalidInputError(f"{self.source}: {err}") from None
+
+
+def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) -> SystemScenario:
+    """A 0.2 scenario from parsed TOML, every section checked; errors name the file,
+    the section and the key."""
+    for name in data:
+        if name not in SECTIONS:
+            raise InvalidInputError(
+                f"{source}: unknown section [{name}] (allowed with [structure]: "
+                f"{', '.join(SECTIONS)})"
+            )
+    if "solver" not in data:
+        raise InvalidInputError(f"{source}: missing section [solver]")
+    try:
+        prepared = prepare_system(
+            data["structure"],
+            damper=data.get("damper", ()),
+            stop=data.get("stop", ()),
+            gravity=data.get("gravity"),
+            excitation=data.get("excitation", ()),
+            initial=data.get("initial"),
+            solver=data["solver"],
+            output=data.get("output"),
+            base_dir=base_dir,
+        )
+    except InvalidInputError as err:
+        raise InvalidInputError(f"{source}: {err}") from None
+    return SystemScenario(source, prepared)
+
+
+def _finite_or_none(x: float) -> float | None:
+    return x if math.isfinite(x) else None
+
+
+def system_summary(
+    scenario: SystemScenario, sol: SystemSolution, cpu_time: float
+) -> dict[str, Any]:
+    """The JSON-ready summary of a run (SI units): settings, statistics, the final state,
+    the energy balance and the contacts with the pair each belongs to."""
+    solver = scenario.solver
+    return {
+        "method": sol.method,
+        "dt": solver.get("dt"),
+        "t_end": solver.get("t_end"),
+        "final_time": sol.final_time,
+        "steps": sol.steps,
+        "rejected_steps": sol.rejected_steps,
+        "rhs_evaluations": sol.rhs_evaluations,
+        "grazing_contacts": sol.grazing_contacts,
+        "history_rows": len(sol.t),
+        "cpu_time": cpu_time,
+        "final_state": {key: [float(v) for v in value] for key, value in sol.final_state.items()},
+        "energy": dict(sol.energy),
+        "contacts": [
+            {k: (v if isinstance(v, str) else _finite_or_none(v)) for k, v in row.items()}
+            for row in sol.contacts.to_dicts()
+        ],
+    }
+
+
+def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
+    """The CSV columns: ``t``, then each coordinate's displacement and velocity."""
+    columns: list[tuple[str, Any]] = [("t", sol.t)]
+    for name in (
+        "structure_displacement",
+        "structure_velocity",
+        "damper_displacement",
+        "damper_velocity",
+    ):
+        array = getattr(sol, name)
+        columns += [(f"{name}_{i}", array[:, i]) for i in range(array.shape[1])]
+    return columns
+
+
+def write_system_history(path: Path, sol: SystemSolution) -> None:
+    """Write the history as CSV, whole or not at all."""
+    columns = history_columns(sol)
+    with written_whole(path) as f:
+        writer = csv.writer(f)
+        writer.writerow(name for name, _ in columns)
+        for row in zip(*(values for _, values in columns), strict=True):
+            writer.writerow(repr(float(v)) for v in row)
+
+
+def system_lines(name: str, sol: SystemSolution, cpu_time: float) -> list[str]:
+    """What ``vibroimpact simulate`` prints for a 0.2 run."""
+    e = sol.energy
+    lines = [
+        f"{name}: {sol.method}, {sol.steps} steps ({sol.rejected_steps} rejected, "
+        f"{sol.rhs_evaluations} force evaluations) to t = {sol.final_time:g} s in "
+        f"{cpu_time * 1e3:.3f} ms",
+        f"energy (J): stored {e['stored_start']:.6g} -> {e['stored_end']:.6g}, input work "
+        f"{e['input_work']:.6g}, dissipated {e['dissipated']:.6g} (viscous {e['viscous']:.6g}, "
+        f"contact {e['contact']:.6g}, impacts {e['impact']:.6g}), residual {e['residual']:.3g}",
+        f"{len(sol.contacts)} contact(s)",
+    ]
+    if len(sol.contacts):
+        head = [
+            "pair",
+            "kind",
+            "onset",
+            "duration",
+            "approach_speed",
+            "restitution",
+            "energy_dissipated",
+        ]
+        lines.append("  ".join(f"{h:>17}" for h in head))
+        for row in sol.contacts.to_dicts():
+            cells = []
+            for h in head:
+                value = row[h]
+                if isinstance(value, str):
+                    cells.append(f"{value:>17}")
+                elif math.isnan(value):
+                    cells.append(f"{'open':>17}")
+                else:
+                    cells.append(f"{value:>17.7g}")
+            lines.append("  ".join(cells))
+    return lines

@@ -1,0 +1,297 @@
+"""0.2 systems from Python, TOML and the command line: results against closed forms
+and a SciPy oracle, the names the outside checks use (--json, --out), and bad
+scenarios refused with exit status 2 naming the key."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from vibroimpact.system import simulate_system
+
+ROOT = Path(__file__).resolve().parents[1]
+BALL = {"kind": "oscillator", "mass": 0.2, "stiffness": 0.0}
+FLOOR = {"at": 0, "side": "lower", "gap": 1.0, "law": "rigid", "restitution": 0.8}
+
+
+def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "vibroimpact", *args],
+        capture_output=True,
+        text=True,
+        timeout=50,
+        cwd=cwd,
+    )
+
+
+def test_bouncing_ball_accumulates_at_the_zeno_time_and_rests() -> None:
+    # t_inf = t1 (1 + e) / (1 - e), t1 = sqrt(2 h / g); all of m g h lost in impacts.
+    g, h, e = 9.81, 1.0, 0.8
+    t_inf = math.sqrt(2 * h / g) * (1 + e) / (1 - e)
+    for method, dt in (("rk4", 1e-3), ("dop853", None)):
+        sol = simulate_system(
+            BALL, stop=[FLOOR], gravity={}, t_end=6.0, method=method, dt=dt, history=False
+        )
+        assert len(sol.t) == 0
+        kinds = sol.contacts.kind
+        assert kinds[-1] == "sticking" and set(kinds[:-1]) == {"impact"}
+        assert sol.contacts.onset[-1] == pytest.approx(t_inf, abs=1e-8)
+        assert sol.final_state["structure_displacement"][0] == pytest.approx(-h, abs=1e-9)
+        assert sol.energy["impact"] == pytest.approx(0.2 * g * h, rel=1e-12)
+        assert abs(sol.energy["residual"]) < 1e-12
+
+
+def test_base_excited_oscillator_matches_its_steady_state() -> None:
+    # m x'' + c x' + k x = -m a0 cos(w t), started on Re(X e^(i w t)).
+    m, k, c, a0, f = 0.5, 200.0, 0.4, 3.0, 2.2
+    w = 2 * math.pi * f
+    x = -m * a0 / (k - m * w * w + 1j * c * w)
+    sol = simulate_system(
+        {"kind": "oscillator", "mass": m, "stiffness": k, "damping": c},
+        excitation=[{"kind": "base", "signal": "harmonic", "amplitude": a0, "frequency": f}],
+        initial={"structure_displacement": [x.real], "structure_velocity": [-w * x.imag]},
+        t_end=1.0,
+        method="dop853",
+        rtol=1e-12,
+        atol=1e-15,
+    )
+    exact = (x * np.exp(1j * w * sol.t)).real
+    assert np.max(np.abs(sol.structure_displacement[:, 0] - exact)) < 1e-10 * abs(x)
+
+
+def test_rattling_damper_matches_a_scipy_event_oracle() -> None:
+    """A harmonically forced oscillator with a loose mass and rigid walls, against
+    solve_ivp with terminal events and the impact map written out here."""
+    scipy = pytest.importorskip("scipy.integrate")
+    M, K, C, m, d, e, F, f = 1.0, 40.0, 0.2, 0.15, 0.01, 0.7, 2.0, 1.3
+    w = 2 * math.pi * f
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        return [y[1], (F * math.cos(w * t) - C * y[1] - K * y[0]) / M, y[3], 0.0]
+
+    def upper(t: float, y: np.ndarray) -> float:
+        return d - (y[2] - y[0])
+
+    def lower(t: float, y: np.ndarray) -> float:
+        return d + (y[2] - y[0])
+
+    for event in (upper, lower):
+        event.terminal = True  # type: ignore[attr-defined]
+        event.direction = -1  # type: ignore[attr-defined]
+    t, y, impacts = 0.0, np.array([0.0, 0.0, 0.0, 0.0]), []
+    while t < 2.0 and len(impacts) < 12:
+        r = scipy.solve_ivp(rhs, (t, 2.0), y, events=(upper, lower), rtol=1e-12, atol=1e-14)
+        t, y = r.t[-1], r.y[:, -1].copy()
+        if r.status == 1:
+            # Newton's law on the relative velocity, momentum conserved.
+            after = -e * (y[3] - y[1])
+            momentum = M * y[1] + m * y[3]
+            y[1] = (momentum - m * after) / (M + m)
+            y[3] = y[1] + after
+            impacts.append(t)
+    sol = simulate_system(
+        {"kind": "oscillator", "mass": M, "stiffness": K, "damping": C},
+        damper=[{"mass": m, "at": 0, "clearance": d, "law": "rigid", "restitution": e}],
+        excitation=[
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": F, "frequency": f}
+        ],
+        t_end=2.0,
+        method="dop853",
+        rtol=1e-12,
+        atol=1e-15,
+    )
+    onsets, kinds = sol.contacts.onset, sol.contacts.kind
+    ours = [c for c, kind in zip(onsets, kinds, strict=True) if kind == "impact"]
+    assert len(impacts) >= 4
+    np.testing.assert_allclose(ours[: len(impacts)], impacts, atol=1e-8)
+
+
+def test_momentum_through_rigid_impacts_of_a_free_pair() -> None:
+    sol = simulate_system(
+        {"kind": "matrices", "mass": [[1.5]], "stiffness": [[0.0]]},
+        damper=[{"mass": 0.4, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.6}],
+        initial={"structure_velocity": [0.3], "damper_velocity": [-0.5]},
+        t_end=0.5,
+        method="rk4",
+        dt=1e-3,
+    )
+    momentum = 1.5 * sol.structure_velocity[:, 0] + 0.4 * sol.damper_velocity[:, 0]
+    assert np.ptp(momentum) < 1e-13
+    assert len(sol.contacts) >= 3
+    np.testing.assert_allclose(sol.contacts.restitution, 0.6, rtol=1e-12)
+
+
+def test_recorded_file_reproduces_the_harmonic_it_samples(tmp_path: Path) -> None:
+    # A CSV sampling 2 cos(2 pi 3 t) every 1e-4 s: linear interpolation errs by
+    # at most A (2 pi f dt)^2 / 8 = 9e-7 N, so the responses agree to ~1e-6 relative.
+    times = np.arange(0.0, 1.0 + 1e-4, 1e-4)
+    rows = "\n".join(f"{float(t)!r},{2 * math.cos(2 * math.pi * 3 * t)!r}" for t in times)
+    (tmp_path / "force.csv").write_text("time,force\n" + rows + "\n")
+    structure = {"kind": "oscillator", "mass": 1.0, "stiffness": 100.0, "damping": 0.5}
+    recorded = {"kind": "force", "at": 0, "signal": "recorded", "file": "force.csv"}
+    harmonic = {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 2.0, "frequency": 3.0}
+    a = simulate_system(
+        structure, excitation=[recorded], t_end=1.0, method="rk4", dt=1e-4, base_dir=tmp_path
+    )
+    b = simulate_system(structure, excitation=[harmonic], t_end=1.0, method="rk4", dt=1e-4)
+    scale = np.max(np.abs(b.structure_displacement))
+    assert np.max(np.abs(a.structure_displacement - b.structure_displacement)) < 1e-6 * scale
+
+
+SCENARIO = """
+[structure]
+kind = "matrices"
+mass = [[1.0, 0.0], [0.0, 0.5]]
+stiffness = [[300.0, -100.0], [-100.0, 100.0]]
+
+[[damper]]
+mass = 0.05
+at = 1
+clearance = 0.002
+law = "rigid"
+restitution = 0.5
+
+[[stop]]
+at = 0
+side = "upper"
+gap = 0.004
+law = "hertz-damped"
+stiffness = 1e8
+restitution = 0.7
+
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = 1.5
+frequency = 2.5
+
+[initial]
+structure_displacement = [0.001, 0.0]
+
+[solver]
+method = "dopri5"
+t_end = 1.0
+"""
+
+
+def test_cli_json_and_out_use_the_names_of_the_issue(tmp_path: Path) -> None:
+    path = tmp_path / "run.toml"
+    path.write_text(SCENARIO)
+    done = cli("simulate", str(path), "--json", "--out", str(tmp_path / "h.csv"))
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert set(out["final_state"]) == {
+        "structure_displacement",
+        "structure_velocity",
+        "damper_displacement",
+        "damper_velocity",
+    }
+    assert len(out["final_state"]["structure_displacement"]) == 2
+    assert len(out["final_state"]["damper_velocity"]) == 1
+    energy = out["energy"]
+    for key in ("input_work", "dissipated", "stored_start", "stored_end", "residual"):
+        assert isinstance(energy[key], float)
+    balance = (
+        energy["stored_end"] - energy["stored_start"] - energy["input_work"] + energy["dissipated"]
+    )
+    assert balance == pytest.approx(energy["residual"], abs=1e-15)
+    assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
+    pairs = {c["pair"] for c in out["contacts"]}
+    assert pairs <= {"damper 0", "stop 0"} and "damper 0" in pairs
+    for c in out["contacts"]:
+        if c["kind"] == "impact":
+            assert c["duration"] == 0.0 and c["onset"] == c["separation"]
+    header = (tmp_path / "h.csv").read_text().splitlines()[0].split(",")
+    assert header == [
+        "t",
+        "structure_displacement_0",
+        "structure_displacement_1",
+        "structure_velocity_0",
+        "structure_velocity_1",
+        "damper_displacement_0",
+        "damper_velocity_0",
+    ]
+
+
+BAD = [
+    ('kind = "matrices"', 'kind = "truss"', 'kind must be one of "oscillator"'),
+    ("[-100.0, 100.0]]", "[-90.0, 100.0]]", "structure.stiffness must be symmetric"),
+    ("[[300.0, -100.0]", "[[-300.0, -100.0]", "structure.stiffness must be positive semi-definite"),
+    (
+        "mass = [[1.0, 0.0], [0.0, 0.5]]",
+        "mass = [[1.0, 0.0], [0.0, -0.5]]",
+        "structure.mass must be positive definite",
+    ),
+    ("at = 1\n", "at = 2\n", "damper 0 at must be a coordinate index"),
+    ('side = "upper"', 'side = "above"', 'side must be one of "upper", "lower"'),
+    ('law = "rigid"', 'law = "glue"', 'law must be one of "rigid"'),
+    ("restitution = 0.5", "restitution = 1.5", "restitution in [0, 1]"),
+    ('signal = "harmonic"', 'signal = "chirp"', 'signal must be one of "harmonic"'),
+    (
+        "structure_displacement = [0.001, 0.0]",
+        "structure_displacement = [0.001]",
+        "initial.structure_displacement must have 2 values",
+    ),
+    (
+        "structure_displacement = [0.001, 0.0]",
+        "structure_displacement = [0.0, 0.01]",
+        "damper 0 starts",
+    ),
+    ("clearance = 0.002", "clearence = 0.002", "did you mean 'clearance'"),
+    ('method = "dopri5"', 'method = "newmark"', 'method must be one of "rk4"'),
+]
+
+
+@pytest.mark.parametrize(("old", "new", "message"), BAD, ids=[m for _, _, m in BAD])
+def test_bad_system_scenarios_exit_2_naming_the_key(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    assert old in SCENARIO
+    path = tmp_path / "bad.toml"
+    path.write_text(SCENARIO.replace(old, new, 1))
+    done = cli("simulate", str(path))
+    assert done.returncode == 2, (done.stdout, done.stderr)
+    assert message in done.stderr and "Traceback" not in done.stderr
+    assert done.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("rows", "message"),
+    [
+        ("0.0,1.0\n0.0,2.0\n", "increase strictly"),
+        ("0.0,1.0\n", "at least 2"),
+        ("0.0,1.0\nx,y\n", "not two numbers"),
+    ],
+)
+def test_bad_recorded_series_exit_2(tmp_path: Path, rows: str, message: str) -> None:
+    (tmp_path / "ground.csv").write_text(rows)
+    text = SCENARIO.replace(
+        'signal = "harmonic"\namplitude = 1.5\nfrequency = 2.5',
+        'signal = "recorded"\nfile = "ground.csv"',
+    )
+    (tmp_path / "run.toml").write_text(text)
+    done = cli("simulate", "run.toml", cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    assert message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_examples_of_systems_run() -> None:
+    for name in ("bouncing_ball.toml", "beam_two_dampers.toml"):
+        done = cli("simulate", str(ROOT / "examples" / name), "--json")
+        assert done.returncode == 0, done.stderr
+        out = json.loads(done.stdout)
+        assert abs(out["energy"]["residual"]) < 1e-6 * max(
+            out["energy"]["dissipated"], out["energy"]["input_work"]
+        )
+
+
+def test_simulate_system_is_exported() -> None:
+    assert vi.simulate_system is simulate_system
