@@ -72,6 +72,16 @@ SOLVER = {
 }
 
 
+def _simulate_system(**kwargs: Any) -> Any:
+    # The public function; the binding's own is called by it with checked values.
+    return vi.simulate_system(
+        {"kind": "oscillator", "mass": 1.0, "stiffness": 10.0},
+        damper=[{"mass": 0.1, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.5}],
+        method="rk4",
+        **kwargs,
+    )
+
+
 def _simulate(**kwargs: Any) -> Any:
     return vi.simulate(
         vi.ImpactDamper(**SYSTEM),
@@ -103,6 +113,10 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
         },
     ),
     "simulate": (_simulate, SOLVER),
+    "simulate_system": (
+        _simulate_system,
+        {"t_end": 1e-2, "dt": 1e-3, "rtol": 1e-8, "atol": 1e-12, "energy_tolerance": 1e-2},
+    ),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (
         vi.hertz_stiffness,
