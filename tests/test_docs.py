@@ -30,7 +30,7 @@ def test_package_docstring_examples_pass() -> None:
 def test_readme_python_snippet_runs_and_its_comment_is_true(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    (code,) = blocks("python")
+    code = blocks("python")[0]
     namespace: dict[str, object] = {}
     exec(compile(code, "README.md", "exec"), namespace)
     printed = capsys.readouterr().out.splitlines()
@@ -62,6 +62,27 @@ def test_readme_scenario_block_is_a_valid_scenario() -> None:
     toml = next(b for b in blocks("toml") if "[system]" in b)
     scenario = vibroimpact.parse_scenario(toml, "README.md")
     assert scenario.contact.law == "hyster-hertz" and scenario.every == 1
+
+
+def test_readme_system_snippet_runs_and_its_comments_are_true(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code = next(b for b in blocks("python") if "simulate_system" in b)
+    exec(compile(code, "README.md", "exec"), {})
+    kind, onset = capsys.readouterr().out.splitlines()[0].split()
+    # The ball's accumulation time t1 (1 + e) / (1 - e), t1 = sqrt(2 h / g).
+    assert kind == "sticking"
+    assert abs(float(onset) - (2 / 9.81) ** 0.5 * 1.8 / 0.2) < 1e-8
+
+
+def test_readme_system_scenario_block_runs() -> None:
+    toml = next(b for b in blocks("toml") if "[structure]" in b)
+    scenario = vibroimpact.parse_scenario(toml, "README.md")
+    sol = scenario.run()
+    assert {"damper 0", "stop 0"} >= set(sol.contacts.pair) and len(sol.contacts) > 0
+    e = sol.energy
+    scale = abs(e["input_work"]) + e["dissipated"] + abs(e["stored_start"]) + abs(e["stored_end"])
+    assert abs(e["residual"]) < 1e-6 * scale
 
 
 def test_readme_test_command_is_what_ci_runs() -> None:
