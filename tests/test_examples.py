@@ -22,7 +22,9 @@ EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 # The README's scenario block documents the format the same way.
 README_SCENARIOS = [
-    b for b in re.findall(r"```toml\n(.*?)```", README, flags=re.S) if "[system]" in b
+    b
+    for b in re.findall(r"```toml\n(.*?)```", README, flags=re.S)
+    if "[system]" in b or "[structure]" in b
 ]
 NOT_A_CHOICE = "not-a-choice"
 QUOTED = re.compile(r'"([^"]*)"')
