@@ -160,6 +160,8 @@ pub struct Assembly {
     minv_k: Vec<f64>,
     minv_c: Vec<f64>,
     damper_mass: Vec<f64>,
+    /// Whether M, K and C are all diagonal (modal coordinates).
+    diagonal: bool,
     /// `r`, and `M r` (for the work of base loads).
     influence: Vec<f64>,
     mass_influence: Vec<f64>,
@@ -314,6 +316,9 @@ impl Assembly {
             minv_k,
             minv_c,
             damper_mass,
+            diagonal: [s.mass(), s.stiffness(), s.damping()]
+                .iter()
+                .all(|a| (0..n * n).all(|p| p % (n + 1) == 0 || a[p] == 0.0)),
             influence: s.influence().to_vec(),
             mass_influence,
             gravity,
@@ -345,12 +350,6 @@ impl Assembly {
         )
     }
 
-    /// The base acceleration from the excitations alone (m/s^2).
-    #[inline(always)]
-    fn base_signal(&self, time: f64) -> f64 {
-        self.base.iter().map(|s| s.value(time)).sum()
-    }
-
     /// The derivative of the state `y` at `time` in `modes` into `out`; the
     /// constraint forces of sticking interactions are solved for on the way
     /// (`scratch` holds them). Allocates nothing.
@@ -365,21 +364,34 @@ impl Assembly {
         let (n, d) = (self.n, self.dim);
         let (x, v) = (&y[..d], &y[d..2 * d]);
         out[..d].copy_from_slice(v);
-        let base = self.base_signal(time);
+        let mut base = 0.0;
+        for (signal, cache) in self.base.iter().zip(&mut scratch.base_values) {
+            base += cache.value(signal, time);
+        }
         let inertial = base + self.gravity;
         let (acc, rest) = out[d..].split_at_mut(d);
-        for (i, a) in acc[..n].iter_mut().enumerate() {
-            let row = i * n..(i + 1) * n;
-            *a = -linalg::dot(&self.minv_k[row.clone()], &x[..n])
-                - linalg::dot(&self.minv_c[row], &v[..n])
-                - self.influence[i] * inertial;
-        }
+        let viscous = if self.diagonal {
+            // Modal coordinates: the matrices are diagonal.
+            for i in 0..n {
+                let (k, c) = (self.minv_k[i * n + i], self.minv_c[i * n + i]);
+                acc[i] = -(k * x[i] + c * v[i]) - self.influence[i] * inertial;
+            }
+            (0..n).map(|i| self.damping[i * n + i] * v[i] * v[i]).sum()
+        } else {
+            for (i, a) in acc[..n].iter_mut().enumerate() {
+                let row = i * n..(i + 1) * n;
+                *a = -linalg::dot(&self.minv_k[row.clone()], &x[..n])
+                    - linalg::dot(&self.minv_c[row], &v[..n])
+                    - self.influence[i] * inertial;
+            }
+            linalg::quadratic_form(&self.damping, &v[..n])
+        };
         for a in acc[n..].iter_mut() {
             *a = -inertial;
         }
         let mut input = 0.0;
-        for f in &self.forces {
-            let value = f.signal.value(time);
+        for (f, cache) in self.forces.iter().zip(&mut scratch.force_values) {
+            let value = cache.value(&f.signal, time);
             for (a, p) in acc[..n].iter_mut().zip(&f.push) {
                 *a += p * value;
             }
@@ -439,7 +451,7 @@ impl Assembly {
         } else {
             scratch.count = 0;
         }
-        head[VISCOUS] = linalg::quadratic_form(&self.damping, &v[..n]);
+        head[VISCOUS] = viscous;
         head[INPUT] = input;
     }
 
@@ -523,9 +535,31 @@ impl Assembly {
     }
 }
 
+/// The last value of a signal: Runge-Kutta stages share times (RK4's two
+/// midpoints, a step's end and the next one's start), and a harmonic's
+/// cosine is the costliest part of a small system's right-hand side.
+#[derive(Debug, Clone, Copy)]
+struct Cached {
+    time: f64,
+    value: f64,
+}
+
+impl Cached {
+    #[inline(always)]
+    fn value(&mut self, signal: &Signal, time: f64) -> f64 {
+        if time.to_bits() != self.time.to_bits() {
+            self.time = time;
+            self.value = signal.value(time);
+        }
+        self.value
+    }
+}
+
 /// Work space of [`Assembly::rates`], allocated once per run.
 #[derive(Debug, Clone)]
 pub struct Scratch {
+    force_values: Vec<Cached>,
+    base_values: Vec<Cached>,
     sticking: Vec<usize>,
     matrix: Vec<f64>,
     /// Constraint forces of the sticking interactions (N), after `rates`.
@@ -537,7 +571,13 @@ pub struct Scratch {
 impl Scratch {
     pub fn new(assembly: &Assembly) -> Self {
         let m = assembly.interactions.len().max(1);
+        let empty = Cached {
+            time: f64::NAN,
+            value: 0.0,
+        };
         Self {
+            force_values: vec![empty; assembly.forces.len()],
+            base_values: vec![empty; assembly.base.len()],
             sticking: vec![0; m],
             matrix: vec![0.0; m * m],
             forces: vec![0.0; m],
