@@ -301,3 +301,65 @@ def test_examples_of_systems_run() -> None:
 
 def test_simulate_system_is_exported() -> None:
     assert vi.simulate_system is simulate_system
+
+
+def test_masri_caughey_two_impacts_per_cycle_steady_state() -> None:
+    """Masri and Caughey (1966), restated in shared/reference/forced-oracles.md: the
+    symmetric orbit of a harmonically forced undamped primary with a loose mass, two
+    rigid impacts per forcing period. Started on the orbit just after an impact on
+    the upper wall, the run must stay on it: impacts every half period, the primary's
+    motion x(tau) of the closed form, the same approach speed at every impact."""
+    M, K, F0, m, e = 1.0, 100.0, 1.0, 0.1, 0.6
+    wn, xst, mu = math.sqrt(K / M), F0 / K, m / M
+    r, d = 0.8, 2.0  # forcing over natural frequency; clearance over static deflection
+    w, clearance = r * wn, d * xst
+    P = 1 / (1 - r * r)
+    a1 = 1 + (2 * mu * r / math.pi) * math.tan(math.pi / (2 * r))
+    b1 = (2 / math.pi) * (1 - e) * (1 + mu) / (1 + e)
+    root = math.sqrt((a1 * d) ** 2 - (a1 * a1 + b1 * b1) * (d * d - 4 * P * P))
+    q = (a1 * d + root) / (2 * (a1 * a1 + b1 * b1))
+    phi = math.atan2(b1 * q, a1 * q - d / 2)
+    amplitude = 2 * mu * r * q / math.pi / math.cos(math.pi / (2 * r))
+
+    def primary(tau: np.ndarray) -> np.ndarray:
+        return P * np.cos(r * tau + phi) + amplitude * np.sin(tau - math.pi / (2 * r))
+
+    def primary_rate(tau: float) -> float:
+        return -P * r * math.sin(r * tau + phi) + amplitude * math.cos(tau - math.pi / (2 * r))
+
+    # Admissible: the ball stays inside the container between impacts.
+    tau = np.linspace(0, math.pi / r, 2001)
+    ball = q - 2 * r * q / math.pi * tau
+    assert np.max(np.abs(ball - primary(tau))) <= d / 2 * (1 + 1e-12)
+    sol = simulate_system(
+        {"kind": "oscillator", "mass": M, "stiffness": K},
+        damper=[{"mass": m, "at": 0, "clearance": clearance / 2, "law": "rigid", "restitution": e}],
+        excitation=[
+            {
+                "kind": "force",
+                "at": 0,
+                "signal": "harmonic",
+                "amplitude": F0,
+                "frequency": w / (2 * math.pi),
+                "phase": phi,
+            }
+        ],
+        initial={
+            "structure_displacement": [xst * float(primary(np.array(0.0)))],
+            "structure_velocity": [wn * xst * primary_rate(0.0)],
+            "damper_displacement": [xst * q],
+            "damper_velocity": [wn * xst * (-2 * r * q / math.pi)],
+        },
+        t_end=6 * math.pi / w,
+        method="dop853",
+        rtol=1e-12,
+        atol=1e-15,
+    )
+    half = math.pi / w
+    np.testing.assert_allclose(sol.contacts.onset, half * np.arange(1, 6), rtol=1e-11)
+    approach = wn * xst * abs(-2 * r * q / math.pi - primary_rate(math.pi / r))
+    np.testing.assert_allclose(sol.contacts.approach_speed, approach, rtol=1e-9)
+    scaled = wn * sol.t
+    k = np.floor(scaled / (math.pi / r))
+    exact = xst * np.where(k % 2 == 0, 1.0, -1.0) * primary(scaled - k * math.pi / r)
+    assert np.max(np.abs(sol.structure_displacement[:, 0] - exact)) < 1e-9 * np.max(np.abs(exact))
