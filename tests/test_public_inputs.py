@@ -115,7 +115,16 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
     "simulate": (_simulate, SOLVER),
     "simulate_system": (
         _simulate_system,
-        {"t_end": 1e-2, "dt": 1e-3, "rtol": 1e-8, "atol": 1e-12, "energy_tolerance": 1e-2},
+        {
+            "t_end": 1e-2,
+            "dt": 1e-3,
+            "rtol": 1e-8,
+            "atol": 1e-12,
+            "beta": 0.25,
+            "gamma": 0.5,
+            "spectral_radius": 0.9,
+            "energy_tolerance": 1e-2,
+        },
     ),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (

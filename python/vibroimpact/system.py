@@ -128,6 +128,9 @@ SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
     "max_steps": 1_000_000_000,
     "energy_tolerance": 1e-2,
     "max_rows": 20_000_000,
+    "beta": 0.25,
+    "gamma": 0.5,
+    "spectral_radius": 0.9,
 }
 _SOLVER = {
     "method": (_TEXT, SYSTEM_SOLVER_DEFAULTS["method"]),
@@ -138,10 +141,14 @@ _SOLVER = {
     "max_steps": (_WHOLE, SYSTEM_SOLVER_DEFAULTS["max_steps"]),
     "energy_tolerance": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["energy_tolerance"]),
     "max_rows": (_WHOLE, SYSTEM_SOLVER_DEFAULTS["max_rows"]),
+    "beta": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["beta"]),
+    "gamma": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["gamma"]),
+    "spectral_radius": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["spectral_radius"]),
 }
 _OUTPUT = {"every": (_WHOLE, 1), "history": ("boolean", True)}
 _INT64 = range(-(2**63), 2**63)
-_METHODS = ("rk4", "dopri5", "dop853")
+_METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha")
+_FIXED_STEP = ("rk4", "newmark-implicit", "generalized-alpha")
 _SIDES = ("upper", "lower")
 _LOADS = ("force", "base")
 _SIGNALS = ("harmonic", "sweep", "harmonics", "recorded", "white-noise", "kanai-tajimi")
@@ -439,6 +446,9 @@ def simulate_system(
     dt: float | None = None,
     rtol: float = SYSTEM_SOLVER_DEFAULTS["rtol"],
     atol: float = SYSTEM_SOLVER_DEFAULTS["atol"],
+    beta: float = SYSTEM_SOLVER_DEFAULTS["beta"],
+    gamma: float = SYSTEM_SOLVER_DEFAULTS["gamma"],
+    spectral_radius: float = SYSTEM_SOLVER_DEFAULTS["spectral_radius"],
     every: int = 1,
     history: bool = True,
     max_steps: int = SYSTEM_SOLVER_DEFAULTS["max_steps"],
@@ -452,7 +462,9 @@ def simulate_system(
     (``damper``, ``stop`` and ``excitation`` as lists of dicts). ``initial`` holds
     ``structure_displacement``, ``structure_velocity``, ``damper_displacement``,
     ``damper_velocity`` (arrays, SI; zeros where left out). ``method``: ``"rk4"``
-    (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``). Every
+    (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``),
+    ``"newmark-implicit"`` (``beta``, ``gamma``) or ``"generalized-alpha"``
+    (``spectral_radius``), implicit with Newton's method, fixed step ``dt``. Every
     event (contact onset, separation, rigid impact, release) is located to
     round-off. ``every`` keeps every N-th step; ``history=False`` keeps none (the
     contacts and the final state only). A run stops with a clear error past
@@ -475,6 +487,9 @@ def simulate_system(
             "max_steps": max_steps,
             "energy_tolerance": energy_tolerance,
             "max_rows": max_rows,
+            "beta": beta,
+            "gamma": gamma,
+            "spectral_radius": spectral_radius,
             **({} if dt is None else {"dt": dt}),
         },
         output={"every": every, "history": history},
@@ -503,6 +518,9 @@ class PreparedRun:
             dt=solver["dt"],
             rtol=solver["rtol"],
             atol=solver["atol"],
+            beta=solver["beta"],
+            gamma=solver["gamma"],
+            spectral_radius=solver["spectral_radius"],
             every=output["every"],
             history=output["history"],
             max_steps=solver["max_steps"],
@@ -536,9 +554,15 @@ def prepare_system(
             raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
     if solver["dt"] is not None and not solver["dt"] > 0:
         raise _fail("[solver] dt: ", f"must be > 0, got {solver['dt']}")
-    if solver["method"] == "rk4" and solver["dt"] is None:
-        raise _fail("[solver] dt: ", 'is required for method "rk4" (a step in s > 0)')
-    if solver["method"] == "rk4" and solver["t_end"] / solver["dt"] > solver["max_steps"]:
+    fixed = solver["method"] in _FIXED_STEP
+    if fixed and solver["dt"] is None:
+        raise _fail(
+            "[solver] dt: ", f"is required for method {solver['method']!r} (a step in s > 0)"
+        )
+    for key, low, high in (("beta", 0.0, 0.5), ("gamma", 0.5, 1.0), ("spectral_radius", 0.0, 1.0)):
+        if not low <= solver[key] <= high:
+            raise _fail(f"[solver] {key}: ", f"must be in [{low}, {high}], got {solver[key]}")
+    if fixed and solver["t_end"] / solver["dt"] > solver["max_steps"]:
         raise _fail(
             "[solver] ",
             f"t_end / dt = {solver['t_end'] / solver['dt']:.3e} steps exceeds max_steps "

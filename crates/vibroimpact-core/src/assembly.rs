@@ -455,6 +455,86 @@ impl Assembly {
         head[INPUT] = input;
     }
 
+    /// The Jacobians of the accelerations (the middle `dim` rates) with
+    /// respect to the coordinates `x` and the velocities `v` at state `y`, as
+    /// row-major `dim x dim` matrices, for Newton's method: the structure's
+    /// `-M^-1 K` and `-M^-1 C`, the compliant contacts' slopes along
+    /// `M^-1 h^T h`, and sticking pairs' constraints projected out.
+    pub fn acceleration_jacobian(
+        &self,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        dadx: &mut [f64],
+        dadv: &mut [f64],
+    ) {
+        let (n, d) = (self.n, self.dim);
+        let (x, v) = (&y[..d], &y[d..2 * d]);
+        dadx.iter_mut().for_each(|a| *a = 0.0);
+        dadv.iter_mut().for_each(|a| *a = 0.0);
+        for i in 0..n {
+            for j in 0..n {
+                dadx[i * d + j] = -self.minv_k[i * n + j];
+                dadv[i * d + j] = -self.minv_c[i * n + j];
+            }
+        }
+        let mut sticking = 0;
+        for (i, (it, mode)) in self.interactions.iter().zip(modes).enumerate() {
+            match (*mode, it.law) {
+                (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
+                    let indentation = -(it.offset + linalg::dot(&it.h, x));
+                    let rate = -linalg::dot(&it.h, v);
+                    let (_, by_indentation, by_rate) = if indentation > 0.0 {
+                        law.force_derivatives(indentation, rate, approach_rate)
+                    } else {
+                        (0.0, 0.0, 0.0)
+                    };
+                    // lambda(delta, delta'), delta = -(b + h.x): d/dx = -lambda_delta h.
+                    for (r, p) in it.push.iter().enumerate() {
+                        for (c, h) in it.h.iter().enumerate() {
+                            dadx[r * d + c] -= p * by_indentation * h;
+                            dadv[r * d + c] -= p * (by_rate + damping) * h;
+                        }
+                    }
+                }
+                (Mode::Sticking, _) => {
+                    scratch.sticking[sticking] = i;
+                    sticking += 1;
+                }
+                _ => {}
+            }
+        }
+        if sticking == 0 {
+            return;
+        }
+        // The constraint force -W^-1 H a makes the accelerations P a with
+        // P = I - Push W^-1 H: project each column of both Jacobians.
+        let active = &scratch.sticking[..sticking];
+        for matrix in [&mut *dadx, &mut *dadv] {
+            for c in 0..d {
+                for (r, &i) in active.iter().enumerate() {
+                    for (q, &j) in active.iter().enumerate() {
+                        scratch.matrix[r * sticking + q] =
+                            linalg::dot(&self.interactions[i].h, &self.interactions[j].push);
+                    }
+                    scratch.forces[r] = (0..d)
+                        .map(|k| self.interactions[i].h[k] * matrix[k * d + c])
+                        .sum();
+                }
+                linalg::solve_in_place(
+                    &mut scratch.matrix[..sticking * sticking],
+                    &mut scratch.forces[..sticking],
+                    sticking,
+                );
+                for (r, &i) in active.iter().enumerate() {
+                    for k in 0..d {
+                        matrix[k * d + c] -= self.interactions[i].push[k] * scratch.forces[r];
+                    }
+                }
+            }
+        }
+    }
+
     /// The forces `lambda` of the sticking interactions `active` that keep
     /// their gaps' accelerations at zero: `W lambda = -H a`, `W = H M^-1
     /// H^T`, by Gaussian elimination with partial pivoting (a few rows).

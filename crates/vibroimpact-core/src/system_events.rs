@@ -23,7 +23,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 }
 use crate::error::{Error, Result};
 use crate::hermite;
-use crate::system_steppers::ExplicitRk;
+use crate::system_steppers::SystemStepper;
 
 /// How to run and what to keep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -307,9 +307,9 @@ struct Buffers {
 /// Locates interaction `c.i`'s event in the step of length `h` whose end is
 /// `full`: Illinois on the step length, to round-off in time or in value.
 #[allow(clippy::too_many_arguments)]
-fn locate(
+fn locate<S: SystemStepper>(
     system: &Assembly,
-    stepper: &mut ExplicitRk,
+    stepper: &mut S,
     time: f64,
     y: &[f64],
     h: f64,
@@ -318,7 +318,7 @@ fn locate(
     c: Crossing,
     scratch: &mut Scratch,
     buffers: &mut Buffers,
-) -> Location {
+) -> Result<Location> {
     let mode = modes[c.i];
     let d = system.dim;
     let round_off = 8.0
@@ -336,7 +336,7 @@ fn locate(
     let (mut lo, mut v_lo) = (0.0, value(y, time, scratch, &mut buffers.work));
     if c.before > 0.0 {
         let length = c.before * h;
-        stepper.attempt(system, time, y, length, modes, scratch, &mut buffers.probe);
+        stepper.attempt(system, time, y, length, modes, scratch, &mut buffers.probe)?;
         let v = value(&buffers.probe, time + length, scratch, &mut buffers.work);
         // Where the interpolant was wrong about the old side, start from 0.
         if v > 0.0 {
@@ -346,13 +346,13 @@ fn locate(
     let (mut hi, mut v_hi);
     if c.interior {
         hi = c.guess * h;
-        let error = stepper.attempt(system, time, y, hi, modes, scratch, &mut buffers.best);
+        let error = stepper.attempt(system, time, y, hi, modes, scratch, &mut buffers.best)?;
         if stepper.is_adaptive() && rejects(error) {
-            return Location::Reject(hi);
+            return Ok(Location::Reject(hi));
         }
         v_hi = value(&buffers.best, time + hi, scratch, &mut buffers.work);
         if v_hi >= 0.0 {
-            return Location::Unconfirmed;
+            return Ok(Location::Unconfirmed);
         }
     } else {
         hi = h;
@@ -380,9 +380,9 @@ fn locate(
             trial = 0.5 * (lo + hi);
         }
         guess = f64::NAN;
-        let error = stepper.attempt(system, time, y, trial, modes, scratch, &mut buffers.probe);
+        let error = stepper.attempt(system, time, y, trial, modes, scratch, &mut buffers.probe)?;
         if stepper.is_adaptive() && first && rejects(error) {
-            return Location::Reject(trial);
+            return Ok(Location::Reject(trial));
         }
         first = false;
         let v = value(&buffers.probe, time + trial, scratch, &mut buffers.work);
@@ -406,7 +406,7 @@ fn locate(
             break;
         }
     }
-    Location::Cut(hi)
+    Ok(Location::Cut(hi))
 }
 
 /// Chattering of compliant contacts: this many mode changes in a row, each
@@ -419,9 +419,9 @@ const ENERGY_INTERVAL: u64 = 32;
 const INTERRUPT_INTERVAL: u64 = 1 << 14;
 
 /// Integrates `system` from `initial` (see [`crate::assembly::initial_state`]).
-pub fn integrate_system(
+pub fn integrate_system<S: SystemStepper>(
     system: &Assembly,
-    stepper: &mut ExplicitRk,
+    stepper: &mut S,
     initial: &[f64],
     options: &RunOptions,
     interrupt: &mut dyn FnMut() -> bool,
@@ -493,7 +493,7 @@ pub fn integrate_system(
         if adaptive && (t_end - time - length) < 1e-3 * length {
             length = t_end - time;
         }
-        let error = stepper.attempt(system, time, &y, length, &modes, &mut scratch, &mut end);
+        let error = stepper.attempt(system, time, &y, length, &modes, &mut scratch, &mut end)?;
         let mut taken = length;
         let mut switched: Option<usize> = None;
         let mut last_attempt_kept = true;
@@ -526,7 +526,7 @@ pub fn integrate_system(
                 c,
                 &mut scratch,
                 &mut buffers,
-            ) {
+            )? {
                 Location::Cut(cut) => {
                     taken = cut;
                     switched = Some(c.i);

@@ -13,7 +13,7 @@ use vibroimpact_core::assembly::{
 use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, RunOptions};
-use vibroimpact_core::system_steppers::ExplicitRk;
+use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 
 use crate::{to_py, InvalidInputError};
 
@@ -259,10 +259,43 @@ fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
     })
 }
 
+/// Integrate with the GIL released, checking for Ctrl-C now and then.
+fn run<S: SystemStepper + Send>(
+    py: Python<'_>,
+    system: &Assembly,
+    stepper: &mut S,
+    y0: &[f64],
+    options: &RunOptions,
+) -> PyResult<core::system_events::SystemSolution> {
+    let mut signal: Option<PyErr> = None;
+    let result = py.detach(|| {
+        integrate_system(
+            system,
+            stepper,
+            y0,
+            options,
+            &mut || match Python::attach(|py| py.check_signals()) {
+                Ok(()) => false,
+                Err(e) => {
+                    signal = Some(e);
+                    true
+                }
+            },
+        )
+    });
+    match result {
+        Ok(sol) => Ok(sol),
+        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
+            Err(signal.take().expect("checked"))
+        }
+        Err(e) => Err(to_py(e)),
+    }
+}
+
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
 /// dict of flat arrays that the Python side shapes.
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, every, history, max_steps, max_rows, energy_tolerance))]
+#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, every, history, max_steps, max_rows, energy_tolerance))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_system<'py>(
     py: Python<'py>,
@@ -273,6 +306,9 @@ pub fn simulate_system<'py>(
     dt: Option<f64>,
     rtol: f64,
     atol: f64,
+    beta: f64,
+    gamma: f64,
+    spectral_radius: f64,
     every: u64,
     history: bool,
     max_steps: u64,
@@ -284,17 +320,6 @@ pub fn simulate_system<'py>(
     let y0 = initial_state(&system, &initial[0], &initial[1], &initial[2], &initial[3])
         .map_err(to_py)?;
     let len = system.state_len();
-    let mut stepper = match method {
-        "rk4" => ExplicitRk::rk4(len),
-        "dopri5" => ExplicitRk::dopri5(len, rtol, atol),
-        "dop853" => ExplicitRk::dop853(len, rtol, atol),
-        other => {
-            return Err(InvalidInputError::new_err(format!(
-                "method must be one of \"rk4\", \"dopri5\", \"dop853\" for a [structure] system \
-                 (the Newmark family follows), got {other:?}"
-            )))
-        }
-    };
     let options = RunOptions {
         dt,
         t_end,
@@ -304,29 +329,38 @@ pub fn simulate_system<'py>(
         max_rows,
         energy_tolerance,
     };
-    let mut signal: Option<PyErr> = None;
-    let result = py.detach(|| {
-        integrate_system(
+    let result = match method {
+        "rk4" => run(py, &system, &mut ExplicitRk::rk4(len), &y0, &options),
+        "dopri5" => run(
+            py,
             &system,
-            &mut stepper,
+            &mut ExplicitRk::dopri5(len, rtol, atol),
             &y0,
             &options,
-            &mut || match Python::attach(|py| py.check_signals()) {
-                Ok(()) => false,
-                Err(e) => {
-                    signal = Some(e);
-                    true
-                }
-            },
-        )
-    });
-    let sol = match result {
-        Ok(sol) => sol,
-        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
-            return Err(signal.take().expect("checked"))
+        ),
+        "dop853" => run(
+            py,
+            &system,
+            &mut ExplicitRk::dop853(len, rtol, atol),
+            &y0,
+            &options,
+        ),
+        "newmark-implicit" => {
+            let mut stepper = NewmarkFamily::newmark(&system, beta, gamma);
+            run(py, &system, &mut stepper, &y0, &options)
         }
-        Err(e) => return Err(to_py(e)),
+        "generalized-alpha" => {
+            let mut stepper = NewmarkFamily::generalized_alpha(&system, spectral_radius);
+            run(py, &system, &mut stepper, &y0, &options)
+        }
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
+                 \"generalized-alpha\" for a [structure] system, got {other:?}"
+            )))
+        }
     };
+    let sol = result?;
     let out = PyDict::new(py);
     out.set_item("n", system.n)?;
     out.set_item("k", system.k)?;
