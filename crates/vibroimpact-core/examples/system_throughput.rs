@@ -135,10 +135,11 @@ fn main() {
         };
         let (t, sol) = time_runs(11, &forced, make, &options(dt, 200.0));
         println!(
-            "forced damper with rigid impacts, 1000 periods, {name}: {:.2} ms per run ({} impacts, {} steps)",
+            "forced damper with rigid impacts, 1000 periods, {name}: {:.2} ms per run ({} impacts, {} steps, {} evaluations)",
             t * 1e3,
             sol.contacts.len(),
-            sol.steps
+            sol.steps,
+            sol.rhs_evaluations
         );
     }
 }

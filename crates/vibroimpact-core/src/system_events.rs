@@ -386,6 +386,17 @@ fn locate<S: SystemStepper>(
         }
         first = false;
         let v = value(&buffers.probe, time + trial, scratch, &mut buffers.work);
+        // Newton's step on the step length from the value's rate at the
+        // trial's end (a gap's rate is in the state): near the event it
+        // converges in one or two steps where regula falsi would creep.
+        let slope = match mode {
+            Mode::Open => system.gap(c.i, &buffers.probe).1,
+            Mode::Compliant { .. } => -system.gap(c.i, &buffers.probe).1,
+            Mode::Sticking => f64::NAN,
+        };
+        if slope != 0.0 {
+            guess = trial - v / slope;
+        }
         if v < 0.0 || v.abs() <= round_off {
             hi = trial;
             v_hi = v;
