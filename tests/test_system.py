@@ -388,3 +388,21 @@ def test_implicit_methods_take_systems_at_second_order(method: str) -> None:
 
     order = math.log2(error(1e-3) / error(5e-4))
     assert abs(order - 2) < 0.05, order
+
+
+def test_long_adaptive_runs_stop_at_the_row_cap_and_history_off_keeps_none() -> None:
+    """An undamped rattler to t_end = 1e12 s would fill the memory: it stops at max_rows
+    with a message naming the keys to change; with history=False only the contacts count."""
+    rattler = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 100.0},
+        "damper": [{"mass": 0.1, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.9}],
+        "initial": {"damper_velocity": [1.0]},
+        "method": "dop853",
+    }
+    with pytest.raises(vi.InvalidInputError, match="max_rows = 2000") as err:
+        simulate_system(**rattler, t_end=1e12, max_rows=2000)
+    assert "history = false" in str(err.value) and "\n" not in str(err.value)
+    sol = simulate_system(**rattler, t_end=50.0, history=False)
+    assert len(sol.t) == 0 and len(sol.contacts) > 0
+    with_history = simulate_system(**rattler, t_end=50.0)
+    np.testing.assert_array_equal(sol.contacts.onset, with_history.contacts.onset)

@@ -169,6 +169,9 @@ pub struct Assembly {
     forces: Vec<ForceLoad>,
     base: Vec<Signal>,
     pub interactions: Vec<Interaction>,
+    /// The structure's longest natural period (s; infinite without a
+    /// spring): the time scale of the run's resolution.
+    pub longest_period: f64,
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
 }
@@ -325,6 +328,11 @@ impl Assembly {
             forces,
             base,
             interactions,
+            longest_period: s
+                .natural_frequencies()
+                .into_iter()
+                .find(|w| *w > 0.0)
+                .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w),
             pairs,
         })
     }

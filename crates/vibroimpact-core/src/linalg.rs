@@ -155,8 +155,11 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Solves `A x = b` in place (`b` becomes `x`) by Gaussian elimination with
-/// partial pivoting; `A` (row-major, `n x n`) is overwritten.
+/// partial pivoting; `A` (row-major, `n x n`) is overwritten. A singular `A`
+/// (dependent rows, such as two constraints on the same gap) gives the
+/// dependent unknowns 0: the least-effort solution of a consistent system.
 pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
+    let scale = max_abs(a);
     for col in 0..n {
         let pivot = (col..n)
             .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
@@ -168,6 +171,9 @@ pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
             b.swap(col, pivot);
         }
         let diagonal = a[col * n + col];
+        if diagonal.abs() <= 1e-13 * scale {
+            continue;
+        }
         for row in col + 1..n {
             let factor = a[row * n + col] / diagonal;
             for c in col..n {
@@ -177,8 +183,13 @@ pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
         }
     }
     for row in (0..n).rev() {
+        let diagonal = a[row * n + row];
+        if diagonal.abs() <= 1e-13 * scale {
+            b[row] = 0.0;
+            continue;
+        }
         let sum: f64 = (row + 1..n).map(|c| a[row * n + c] * b[c]).sum();
-        b[row] = (b[row] - sum) / a[row * n + row];
+        b[row] = (b[row] - sum) / diagonal;
     }
 }
 

@@ -289,8 +289,9 @@ fn find_crossing(
 
 /// What locating an event found.
 enum Location {
-    /// The step length ending on the event; the attempt is in `best`.
-    Cut(f64),
+    /// The step length ending on the event and its scaled error; the
+    /// attempt is in `best`.
+    Cut(f64, f64),
     /// The interpolant's dip was not there.
     Unconfirmed,
     /// The step up to (about) the event fails the error control.
@@ -314,6 +315,7 @@ fn locate<S: SystemStepper>(
     y: &[f64],
     h: f64,
     full: &[f64],
+    full_error: f64,
     modes: &[Mode],
     c: Crossing,
     scratch: &mut Scratch,
@@ -343,11 +345,11 @@ fn locate<S: SystemStepper>(
             (lo, v_lo) = (length, v);
         }
     }
-    let (mut hi, mut v_hi);
+    let (mut hi, mut v_hi, mut best_error);
     if c.interior {
         hi = c.guess * h;
-        let error = stepper.attempt(system, time, y, hi, modes, scratch, &mut buffers.best)?;
-        if stepper.is_adaptive() && rejects(error) {
+        best_error = stepper.attempt(system, time, y, hi, modes, scratch, &mut buffers.best)?;
+        if stepper.is_adaptive() && rejects(best_error) {
             return Ok(Location::Reject(hi));
         }
         v_hi = value(&buffers.best, time + hi, scratch, &mut buffers.work);
@@ -356,6 +358,7 @@ fn locate<S: SystemStepper>(
         }
     } else {
         hi = h;
+        best_error = full_error;
         buffers.best.copy_from_slice(full);
         v_hi = value(full, time + h, scratch, &mut buffers.work);
     }
@@ -400,6 +403,7 @@ fn locate<S: SystemStepper>(
         if v < 0.0 || v.abs() <= round_off {
             hi = trial;
             v_hi = v;
+            best_error = error;
             std::mem::swap(&mut buffers.best, &mut buffers.probe);
             if kept == 1 {
                 v_lo *= 0.5;
@@ -417,13 +421,13 @@ fn locate<S: SystemStepper>(
             break;
         }
     }
-    Ok(Location::Cut(hi))
+    Ok(Location::Cut(hi, best_error))
 }
 
 /// Chattering of compliant contacts: this many mode changes in a row, each
-/// closer than a fraction of the run, stop it.
+/// closer than the time's round-off can resolve, stop it.
 const CHATTER_EVENTS: u64 = 16;
-const CHATTER_FRACTION: f64 = 1e-12;
+const CHATTER_ULPS: f64 = 1e3;
 /// How often (steps) the energy balance is checked and the caller asked
 /// whether to stop.
 const ENERGY_INTERVAL: u64 = 32;
@@ -456,8 +460,17 @@ pub fn integrate_system<S: SystemStepper>(
             .map(|it| it.offset.abs())
             .fold(1e-9, f64::max);
     // The time resolution below which a chattering sequence is summed.
-    let resolution = if adaptive { 1e-6 * t_end } else { dt };
-    let chatter_interval = CHATTER_FRACTION * t_end;
+    // The time below which a chattering sequence is summed: the step, or a
+    // millionth of the structure's longest period (of the run, without one).
+    let resolution = if adaptive {
+        1e-6 * t_end.min(system.longest_period)
+    } else {
+        dt
+    };
+    // Events closer than a thousand units of round-off of the time itself
+    // cannot be told apart.
+    let time_scale = t_end.min(system.longest_period);
+    let chatter_interval = |time: f64| CHATTER_ULPS * f64::EPSILON * time.abs().max(time_scale);
 
     let mut y = initial.to_vec();
     let mut end = vec![0.0; len];
@@ -505,6 +518,7 @@ pub fn integrate_system<S: SystemStepper>(
             length = t_end - time;
         }
         let error = stepper.attempt(system, time, &y, length, &modes, &mut scratch, &mut end)?;
+        let mut full_error = error;
         let mut taken = length;
         let mut switched: Option<usize> = None;
         let mut last_attempt_kept = true;
@@ -533,13 +547,26 @@ pub fn integrate_system<S: SystemStepper>(
                 &y,
                 taken,
                 &full,
+                full_error,
                 &modes,
                 c,
                 &mut scratch,
                 &mut buffers,
             )? {
-                Location::Cut(cut) => {
+                // A step that straddled an event may have been accepted for
+                // an error measured across it; the cut step must pass too.
+                Location::Cut(cut, cut_error) if adaptive && rejects(cut_error) => {
+                    rejected += 1;
+                    h = 0.5 * cut;
+                    just_rejected = true;
+                    switched = None;
+                    crossing = None;
+                    taken = f64::NAN;
+                    continue;
+                }
+                Location::Cut(cut, cut_error) => {
                     taken = cut;
+                    full_error = cut_error;
                     switched = Some(c.i);
                     last_attempt_kept = false;
                     end.copy_from_slice(&buffers.best);
@@ -674,8 +701,7 @@ pub fn integrate_system<S: SystemStepper>(
                 if !(located || v < 0.0) {
                     continue;
                 }
-                any = true;
-                switch(
+                any |= switch(
                     system,
                     i,
                     time,
@@ -702,15 +728,15 @@ pub fn integrate_system<S: SystemStepper>(
                 );
                 stepper.reset();
                 if adaptive {
-                    h = h.min(1e-3 * t_end).max(1e-9 * t_end);
+                    h = h.min(1e-3 * t_end);
                 }
-                if time - last_event < chatter_interval {
+                if time - last_event < chatter_interval(time) {
                     close_events += 1;
                     if close_events >= CHATTER_EVENTS {
                         return Err(Error::Chattering {
                             time,
                             events: close_events,
-                            interval: chatter_interval,
+                            interval: chatter_interval(time),
                         });
                     }
                 } else {
@@ -728,8 +754,8 @@ pub fn integrate_system<S: SystemStepper>(
         }
         if (time_rows.len() + contacts.len()) as u64 > options.max_rows {
             return Err(Error::Inconsistent(format!(
-                "the run kept {} history rows and {} contacts by t = {time:.6e} s, more than the cap of {}: \
-                 raise every, keep no history, shorten t_end or raise the cap",
+                "the run kept {} history rows and {} contacts by t = {time:.6e} s, more than max_rows = {}: \
+                 raise every, set history = false, shorten t_end or raise max_rows",
                 time_rows.len(),
                 contacts.len(),
                 options.max_rows
@@ -851,7 +877,7 @@ fn switch(
     resolution: f64,
     scratch: &mut Scratch,
     work: &mut [f64],
-) {
+) -> bool {
     let it = &system.interactions[i];
     let row = 2 * system.dim;
     let (_, rate) = system.gap(i, y);
@@ -896,6 +922,10 @@ fn switch(
                     restitution,
                     energy_dissipated: loss,
                 });
+            } else if -approach > 1e-9 * speed_scale {
+                // Located on the wall but leaving it (the start of a step
+                // just after an impact): no event.
+                return false;
             } else {
                 *grazes += 1;
             }
@@ -906,8 +936,20 @@ fn switch(
             let d = system.dim;
             let pressing = crate::linalg::dot(&it.h, &work[d..2 * d]);
             if pressing < 0.0 && restitution < 1.0 {
-                let remaining = 2.0 * rebound.max(0.0) / (-pressing * (1.0 - restitution));
-                if remaining <= resolution {
+                let rebound = rebound.max(0.0);
+                let remaining = 2.0 * rebound / (-pressing * (1.0 - restitution));
+                // The sequence is summed once it would finish within the
+                // step (fixed-step methods), or once its flights rise less
+                // than 1e-9 of the gap's scale: below that the positions'
+                // round-off decides the impacts, not the dynamics.
+                let height = rebound * rebound / (-2.0 * pressing);
+                let scale = it.offset.abs()
+                    + it.h
+                        .iter()
+                        .zip(&y[..system.dim])
+                        .map(|(h, x)| (h * x).abs())
+                        .sum::<f64>();
+                if remaining <= resolution || height <= 1e-9 * scale {
                     let loss = system.impact(i, y, 0.0);
                     *impact_loss += loss;
                     modes[i] = Mode::Sticking;
@@ -928,6 +970,7 @@ fn switch(
             }
         }
     }
+    true
 }
 
 /// After an impact elsewhere, a sticking pair whose gap now closes is held
