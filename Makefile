@@ -22,6 +22,8 @@ lint:
 	python -m mypy.stubtest vibroimpact._core
 
 bench:
+	python benchmarks/bench_system.py
+	cargo run --release -p vibroimpact-core --example system_throughput
 	python benchmarks/bench_steps.py
 	python benchmarks/bench_scipy.py
 	cargo run --release -p vibroimpact-core --example throughput
