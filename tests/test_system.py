@@ -406,3 +406,18 @@ def test_long_adaptive_runs_stop_at_the_row_cap_and_history_off_keeps_none() -> 
     assert len(sol.t) == 0 and len(sol.contacts) > 0
     with_history = simulate_system(**rattler, t_end=50.0)
     np.testing.assert_array_equal(sol.contacts.onset, with_history.contacts.onset)
+
+
+def test_fixed_step_history_beyond_the_cap_is_refused_before_running() -> None:
+    osc = {"kind": "oscillator", "mass": 1.0, "stiffness": 100.0}
+    with pytest.raises(vi.InvalidInputError, match=r"t_end / dt / every.*max_rows = 1000"):
+        simulate_system(osc, t_end=1.0, dt=1e-4, method="rk4", max_rows=1000)
+    # The same run keeping every 20th step, or no history, fits.
+    assert (
+        len(simulate_system(osc, t_end=1.0, dt=1e-4, method="rk4", max_rows=1000, every=20).t)
+        == 501
+    )
+    assert (
+        len(simulate_system(osc, t_end=1.0, dt=1e-4, method="rk4", max_rows=1000, history=False).t)
+        == 0
+    )

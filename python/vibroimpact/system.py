@@ -568,6 +568,17 @@ def prepare_system(
             f"t_end / dt = {solver['t_end'] / solver['dt']:.3e} steps exceeds max_steps "
             f"({solver['max_steps']}): raise dt or max_steps, or shorten t_end",
         )
+    if fixed and output["history"]:
+        # The history of a fixed-step run is known before it starts: refuse it
+        # up front rather than stop at the cap.
+        rows = solver["t_end"] / solver["dt"] / max(output["every"], 1) + 2
+        if rows > solver["max_rows"]:
+            raise _fail(
+                "[solver] ",
+                f"the history would keep {rows:.3e} rows (t_end / dt / every), more than "
+                f"max_rows = {solver['max_rows']}: raise every, set history = false, "
+                "shorten t_end or raise max_rows",
+            )
     for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
         value = (output if section == "output" else solver)[key]
         if value < 1:
