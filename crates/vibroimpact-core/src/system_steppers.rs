@@ -186,15 +186,17 @@ impl SystemStepper for ExplicitRk {
             self.evaluations += 1;
             self.start_valid = true;
         }
+        let len = y.len();
         for i in 1..s {
-            self.point.copy_from_slice(y);
-            for j in 0..i {
-                let weight = self.a[i * s + j];
-                if weight != 0.0 {
-                    for (p, k) in self.point.iter_mut().zip(&self.k[j]) {
-                        *p += h * weight * k;
-                    }
+            // One pass: y + h sum_j a_ij k_j (no copy first, no zero weights).
+            let row = &self.a[i * s..i * s + i];
+            let (done, _) = self.k.split_at(i);
+            for n in 0..len {
+                let mut sum = 0.0;
+                for (weight, k) in row.iter().zip(done) {
+                    sum += weight * k[n];
                 }
+                self.point[n] = y[n] + h * sum;
             }
             system.rates(
                 time + self.c[i] * h,
@@ -205,13 +207,12 @@ impl SystemStepper for ExplicitRk {
             );
             self.evaluations += 1;
         }
-        out.copy_from_slice(y);
-        for (j, bj) in self.b.iter().enumerate() {
-            if *bj != 0.0 {
-                for (o, k) in out.iter_mut().zip(&self.k[j]) {
-                    *o += h * bj * k;
-                }
+        for n in 0..len {
+            let mut sum = 0.0;
+            for (weight, k) in self.b.iter().zip(&self.k) {
+                sum += weight * k[n];
             }
+            out[n] = y[n] + h * sum;
         }
         let coordinates = 2 * system.dim;
         let scale = |n: usize| self.atol + self.rtol * y[n].abs().max(out[n].abs());
