@@ -14,8 +14,9 @@ import vibroimpact as vi
 system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01)
 contact = vi.Contact("hertz", stiffness=3000.0)
 print("started", flush=True)
-vi.simulate(system, contact, vi.InitialState(main_displacement=0.05), method="rk4",
-            dt=1e-6, t_end=1e4, every=10**9)
+start = vi.InitialState(main_displacement=0.05, impact_displacement=0.05)  # released together
+vi.simulate(system, contact, start, method="rk4",
+            dt=1e-6, t_end=1e4, every=10**9, max_steps=10**11)
 """
 
 

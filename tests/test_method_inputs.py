@@ -144,7 +144,8 @@ def test_fixed_stepping_error_names_the_methods_that_have_it() -> None:
 def test_limits_are_accepted(settings: dict[str, Any]) -> None:
     sol = vi.simulate(SYSTEM, CONTACT, START, t_end=0.01, **settings)
     assert sol.final_time == pytest.approx(0.01, rel=1e-12)
-    check_solver(t_end=0.01, max_steps=1, **settings)
+    # Ten steps: a fixed step's count beyond max_steps is refused up front.
+    check_solver(t_end=0.01, max_steps=10, **settings)
 
 
 @pytest.mark.parametrize(
@@ -267,10 +268,9 @@ def test_new_solver_keys_reach_the_run(table1_toml: str) -> None:
     )
     assert got.contacts.to_dicts() == want.contacts.to_dicts()
     assert (got.steps, got.rhs_evaluations) == (want.steps, want.rhs_evaluations)
-    # A smaller step budget is enforced.
-    small = vi.parse_scenario(with_solver(table1_toml, solver.replace("5000", "100")))
-    with pytest.raises(vi.SimulationError, match="max_steps"):
-        small.run()
+    # A smaller step budget is enforced: 2000 fixed steps are refused before the run.
+    with pytest.raises(vi.InvalidInputError, match="max_steps"):
+        vi.parse_scenario(with_solver(table1_toml, solver.replace("5000", "100")))
 
 
 @pytest.mark.parametrize(

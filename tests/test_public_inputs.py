@@ -69,6 +69,7 @@ SOLVER = {
     "spectral_radius": 0.9,
     "rtol": 1e-8,
     "atol": 1e-12,
+    "energy_tolerance": 0.05,
 }
 
 

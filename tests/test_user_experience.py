@@ -572,7 +572,7 @@ def test_a_contact_open_at_the_end_reads_open_and_null(
     path.write_text(table1_toml.replace("t_end = 0.2", "t_end = 0.05"), encoding="utf-8")
     (row,) = vi.load_scenario(path).run().contacts.to_dicts()
     undefined = {name for name, value in row.items() if math.isnan(value)}
-    assert undefined == {"separation", "duration", "rebound_speed", "restitution"}
+    assert undefined == {"separation", "duration", "rebound_speed", "restitution", "energy_change"}
 
     status, out, _ = run_main(capsys, "simulate", str(path))
     assert status == 0

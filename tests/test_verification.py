@@ -348,7 +348,13 @@ def test_table1_newmark_is_first_order(
     errors = []
     for dt in (1e-3, 1e-4, 1e-5):
         sol = vi.simulate(
-            table1_system, hertz_contact, onset_state, method="newmark", dt=dt, t_end=0.15
+            table1_system,
+            hertz_contact,
+            onset_state,
+            method="newmark",
+            dt=dt,
+            t_end=0.15,
+            energy_tolerance=1.0,  # at dt = 1e-3 it creates energy, refused by default
         )
         errors.append(abs(first_contact(sol)[0] / exact - 1.0))
     # The reference page: about 0.47 % at dt = 1e-3 (the force lags one step).
@@ -620,6 +626,8 @@ def test_step_count_timing_gives_whole_steps(
 ) -> None:
     # Start in the middle of the enclosure: the onsets fall inside steps.
     start = vi.InitialState(impact_velocity=0.07)
+    # The lagged Newmark at dt = 1e-3 creates more energy than the default check allows.
+    loose = {"energy_tolerance": 0.5}
     counted = vi.simulate(
         table1_system,
         hertz_contact,
@@ -628,8 +636,11 @@ def test_step_count_timing_gives_whole_steps(
         dt=dt,
         t_end=1.0,
         contact_timing="step-count",
+        **loose,
     )
-    located = vi.simulate(table1_system, hertz_contact, start, method=method, dt=dt, t_end=1.0)
+    located = vi.simulate(
+        table1_system, hertz_contact, start, method=method, dt=dt, t_end=1.0, **loose
+    )
     # The timing changes what is reported, not the trajectory.
     np.testing.assert_array_equal(counted.impact_displacement, located.impact_displacement)
     np.testing.assert_array_equal(counted.main_velocity, located.main_velocity)
@@ -889,7 +900,9 @@ def test_energy_growth_reports_the_energy_the_method_creates() -> None:
         return float(energy.max() / energy[0] - 1.0)
 
     # The paper's lagged Newmark gains energy at every contact; RK4 barely changes it.
-    lagged = vi.simulate(system, contact, start, method="newmark", dt=1e-3, t_end=1.0)
+    lagged = vi.simulate(
+        system, contact, start, method="newmark", dt=1e-3, t_end=1.0, energy_tolerance=1.0
+    )
     exact = growth_from_history(lagged)
     assert exact > 0.05
     # Checked every 32 steps, so it may miss the very peak but never exceeds it.

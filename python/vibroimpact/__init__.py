@@ -22,9 +22,12 @@ with contact events located to round-off. SI units throughout.
 import numpy as _numpy  # noqa: F401
 
 from vibroimpact._core import (
+    DEFAULT_ENERGY_TOLERANCE,
+    DEFAULT_MAX_ROWS,
     BeamMode,
     Contact,
     ContactTable,
+    EnergyBalanceError,
     ImpactDamper,
     InitialState,
     InvalidInputError,
@@ -66,9 +69,12 @@ def _equality_only(*classes: type) -> None:
 _equality_only(ImpactDamper, Contact, InitialState)
 
 __all__ = [
+    "DEFAULT_ENERGY_TOLERANCE",
+    "DEFAULT_MAX_ROWS",
     "BeamMode",
     "Contact",
     "ContactTable",
+    "EnergyBalanceError",
     "ImpactDamper",
     "InitialState",
     "InvalidInputError",

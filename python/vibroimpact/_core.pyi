@@ -6,9 +6,12 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "DEFAULT_ENERGY_TOLERANCE",
+    "DEFAULT_MAX_ROWS",
     "BeamMode",
     "Contact",
     "ContactTable",
+    "EnergyBalanceError",
     "ImpactDamper",
     "InitialState",
     "InvalidInputError",
@@ -31,11 +34,14 @@ __all__ = [
 ]
 
 __version__: str
+DEFAULT_MAX_ROWS: int
+DEFAULT_ENERGY_TOLERANCE: float
 
 _FloatArray = npt.NDArray[np.float64]
 
 class InvalidInputError(ValueError): ...
 class NumericalBlowUpError(ArithmeticError): ...
+class EnergyBalanceError(NumericalBlowUpError): ...
 class SimulationError(RuntimeError): ...
 class RestitutionWarning(UserWarning): ...
 
@@ -125,6 +131,8 @@ class ContactTable:
     def restitution(self) -> _FloatArray: ...
     @property
     def energy_dissipated(self) -> _FloatArray: ...
+    @property
+    def energy_change(self) -> _FloatArray: ...
     def __len__(self) -> int: ...
     def to_dicts(self) -> list[dict[str, float]]: ...
 
@@ -154,6 +162,10 @@ class Solution:
     def method(self) -> str: ...
     @property
     def energy_growth(self) -> float: ...
+    @property
+    def energy_residual(self) -> float: ...
+    @property
+    def final_state(self) -> InitialState: ...
     @property
     def stepping(self) -> str: ...
     @property
@@ -217,6 +229,9 @@ def simulate(
     rtol: float = 1e-8,
     atol: float = 1e-12,
     max_steps: int = 1_000_000_000,
+    max_rows: int | None = None,
+    energy_tolerance: float | None = None,
+    history: bool = True,
 ) -> Solution: ...
 def check_solver(
     *,
@@ -232,6 +247,9 @@ def check_solver(
     rtol: float = 1e-8,
     atol: float = 1e-12,
     max_steps: int = 1_000_000_000,
+    max_rows: int | None = None,
+    energy_tolerance: float | None = None,
+    history: bool = True,
 ) -> None: ...
 def hertz_stiffness(
     radius: float,

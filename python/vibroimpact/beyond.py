@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from vibroimpact._core import Contact, ImpactDamper, InitialState, Solution, simulate
+from vibroimpact.paper_data import PAPER_METHOD_LIMITS
 from vibroimpact.scenario import paper_collision
 
 # Table 1 of the paper, at the onset of a 0.1 m/s collision (SI units).
@@ -112,8 +113,11 @@ def ours(exact: float) -> list[StudyRun]:
         )
 
     for label, method, stepping in FIXED_RUNS:
+        limits = PAPER_METHOD_LIMITS if method == "newmark" else {}
         for dt in STEP_SIZES:
-            measure(label, f"dt={dt:g}", dt, None, method=method, dt=dt, stepping=stepping)
+            measure(
+                label, f"dt={dt:g}", dt, None, method=method, dt=dt, stepping=stepping, **limits
+            )
     for method in ADAPTIVE_RUNS:
         for rtol in TOLERANCES:
             measure(

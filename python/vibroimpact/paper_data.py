@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import replace
+from typing import Any
 
 from vibroimpact._core import RestitutionWarning, adequacy
 from vibroimpact.scenario import Scenario, paper_collision
@@ -18,6 +19,12 @@ PAPER_LINEAR_STIFFNESS = 49.05  # N/m, the paper's k1
 STEP_SIZES = (1e-3, 1e-4, 2e-5)
 WEIGHTS = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
 RUN_TIME = 0.15  # s: the collision lasts about 0.109 s
+# The founding paper's lagged Newmark creates energy at every contact (its rebound exceeds the
+# approach speed; at dt = 4e-3 s the energy balance misses by 41 % of the energy in play), which
+# vibroimpact refuses by default (energy_tolerance 5 %). Showing that error is the point of
+# reproducing the paper, so its runs, and only they, loosen the check to 50 %, the energy
+# growth that vibroimpact has always stopped as a blow-up (report.md says so).
+PAPER_METHOD_LIMITS: dict[str, Any] = {"energy_tolerance": 0.5}
 
 # The paper's printed Table 2: (method, dt, Tc, Tcpu, error %).
 PAPER_TABLE2 = [
@@ -50,7 +57,8 @@ def collision(method: str, dt: float, timing: str, restitution: float | None = N
         # The paper's law at low e is shown on purpose (figure 1b).
         warnings.simplefilter("ignore", RestitutionWarning)
         base = paper_collision(restitution=restitution, method=method, dt=dt)
-    return replace(base, t_end=RUN_TIME, contact_timing=timing, every=1_000_000)
+    limits = PAPER_METHOD_LIMITS if method == "newmark" else {}
+    return replace(base, t_end=RUN_TIME, contact_timing=timing, every=1_000_000, **limits)
 
 
 def paper_table3_recomputed() -> list[list[float]]:

@@ -8,6 +8,7 @@ section and the key. See ``examples/`` and the README for the format.
 from __future__ import annotations
 
 import difflib
+import inspect
 import math
 import reprlib
 import tomllib
@@ -34,6 +35,7 @@ class ScenarioError(InvalidInputError):
 _NUMBER = "number"
 _TEXT = "string"
 _WHOLE = "whole number"
+_BOOLEAN = "boolean"
 # TOML integers are 64-bit: "If an integer cannot be represented losslessly, an
 # error must be thrown" (TOML 1.0). Python's parser reads any size, so we check.
 _TOML_INTEGERS = range(-(2**63), 2**63)
@@ -44,6 +46,12 @@ MAX_SCENARIO_BYTES = 4 * 2**20
 _SHORT = reprlib.Repr()
 _SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxdict = 2, 4, 4
 _SHORT.maxstring, _SHORT.maxlong, _SHORT.maxother = 40, 24, 40
+
+# The solver's and the output's defaults are simulate's own (one source: its signature); a
+# default of None leaves the choice to the core (max_rows, energy_tolerance).
+_DEFAULTS: dict[str, Any] = {
+    name: parameter.default for name, parameter in inspect.signature(simulate).parameters.items()
+}
 
 # section -> key -> (type, default; a default of _REQUIRED means the key must be given)
 _REQUIRED = object()
@@ -68,20 +76,23 @@ _SCHEMA: dict[str, dict[str, tuple[str, Any]]] = {
         "impact_velocity": (_NUMBER, 0.0),
     },
     "solver": {
-        "method": (_TEXT, "newmark"),
-        "dt": (_NUMBER, None),
+        "method": (_TEXT, _DEFAULTS["method"]),
+        "dt": (_NUMBER, _DEFAULTS["dt"]),
         "t_end": (_NUMBER, _REQUIRED),
-        "stepping": (_TEXT, None),
-        "beta": (_NUMBER, 0.25),
-        "gamma": (_NUMBER, 0.5),
-        "spectral_radius": (_NUMBER, 0.9),
-        "rtol": (_NUMBER, 1e-8),
-        "atol": (_NUMBER, 1e-12),
-        "max_steps": (_WHOLE, 1_000_000_000),
-        "contact_timing": (_TEXT, "located"),
+        "stepping": (_TEXT, _DEFAULTS["stepping"]),
+        "beta": (_NUMBER, _DEFAULTS["beta"]),
+        "gamma": (_NUMBER, _DEFAULTS["gamma"]),
+        "spectral_radius": (_NUMBER, _DEFAULTS["spectral_radius"]),
+        "rtol": (_NUMBER, _DEFAULTS["rtol"]),
+        "atol": (_NUMBER, _DEFAULTS["atol"]),
+        "max_steps": (_WHOLE, _DEFAULTS["max_steps"]),
+        "contact_timing": (_TEXT, _DEFAULTS["contact_timing"]),
+        "energy_tolerance": (_NUMBER, _DEFAULTS["energy_tolerance"]),
+        "max_rows": (_WHOLE, _DEFAULTS["max_rows"]),
     },
     "output": {
-        "every": (_WHOLE, 1),
+        "every": (_WHOLE, _DEFAULTS["every"]),
+        "history": (_BOOLEAN, _DEFAULTS["history"]),
     },
 }
 _REQUIRED_SECTIONS = ("system", "contact", "solver")
@@ -91,7 +102,9 @@ _REQUIRED_SECTIONS = ("system", "contact", "solver")
 class Scenario:
     """A validated run: the system, its contact, the initial state and the solver settings.
 
-    Times in s, ``every`` keeps every N-th step of the history.
+    Times in s, ``every`` keeps every N-th step of the history (``history`` False keeps
+    none); ``max_rows`` and ``energy_tolerance`` bound the run (None: the core's
+    defaults, see :func:`vibroimpact.simulate`).
     """
 
     system: ImpactDamper
@@ -109,6 +122,9 @@ class Scenario:
     max_steps: int = 1_000_000_000
     contact_timing: str = "located"
     every: int = 1
+    energy_tolerance: float | None = _DEFAULTS["energy_tolerance"]
+    history: bool = _DEFAULTS["history"]
+    max_rows: int | None = _DEFAULTS["max_rows"]
 
     def solver_settings(self) -> dict[str, Any]:
         """The keyword arguments of :func:`vibroimpact.simulate` this scenario sets."""
@@ -125,6 +141,9 @@ class Scenario:
             "rtol": self.rtol,
             "atol": self.atol,
             "max_steps": self.max_steps,
+            "energy_tolerance": self.energy_tolerance,
+            "history": self.history,
+            "max_rows": self.max_rows,
         }
 
     def run(self) -> Solution:
@@ -178,6 +197,10 @@ def _check_type(source: str, section: str, key: str, kind: str, value: Any) -> A
     if kind == _WHOLE:
         if isinstance(value, bool) or not isinstance(value, int):
             raise _fail(source, where, f"must be a whole number, got {shown}")
+        return value
+    if kind == _BOOLEAN:
+        if not isinstance(value, bool):
+            raise _fail(source, where, f"must be true or false, got {shown}")
         return value
     if not isinstance(value, str):
         raise _fail(source, where, f"must be a string, got {shown}")

@@ -41,7 +41,10 @@ pub enum Error {
         interval: f64,
     },
     /// The adaptive step size fell to round-off.
-    #[error("step size {step:.3e} s too small at t = {time:.6e} s; loosen rtol/atol")]
+    #[error(
+        "step size {step:.3e} s too small at t = {time:.6e} s (at the round-off of the run's times, \
+         which reach t_end); loosen rtol/atol or shorten t_end"
+    )]
     StepSizeTooSmall { time: f64, step: f64 },
     /// More steps than allowed.
     #[error("maximum number of steps ({max_steps}) reached at t = {time:.6e} s; raise max_steps")]
@@ -49,6 +52,62 @@ pub enum Error {
     /// The caller asked to stop (for example Ctrl-C in Python).
     #[error("interrupted at t = {time:.6e} s")]
     Interrupted { time: f64 },
+    /// The history rows plus contacts a run keeps reached `max_rows`.
+    #[error(
+        "the run kept {rows} history rows and {contacts} contacts by t = {time:.6e} s, reaching \
+         max_rows = {max_rows}: {advice}"
+    )]
+    RowLimit {
+        time: f64,
+        max_rows: u64,
+        rows: u64,
+        contacts: u64,
+        /// What to change.
+        advice: &'static str,
+    },
+    /// The energy balance does not close: stored energy plus the work of the
+    /// dissipative forces minus the external work differs from the energy at
+    /// the start by more than `tolerance` times the energy in play.
+    #[error(
+        "energy balance violated at t = {time:.6e} s: stored energy + dissipated work - external work \
+         differs from the energy at the start by {residual:.3e} J, {ratio:.2e} of the energy in play \
+         ({scale:.3e} J), more than energy_tolerance = {tolerance:e}; the result would be physically \
+         impossible: reduce dt, choose another method (e.g. \"dop853\") or tighten rtol/atol \
+         (raise energy_tolerance only to accept it)",
+        ratio = .residual.abs() / .scale
+    )]
+    EnergyBalance {
+        time: f64,
+        residual: f64,
+        scale: f64,
+        tolerance: f64,
+    },
+    /// A contact whose energy balance does not close: over the contact the
+    /// system's energy change plus the work of the contact's dissipative
+    /// forces plus that of the main damper, minus the external work, is not
+    /// zero to within `tolerance` of the energy in play. Positive, the
+    /// contact created energy, which no contact can.
+    #[error(
+        "the contact from t = {onset:.6e} s to {separation:.6e} s does not balance its energy: the \
+         system's energy changed by {change:.3e} J, the contact dissipated {dissipated:.3e} J and the \
+         main damper and external force account for {work:.3e} J; these must sum to zero, but leave \
+         {residual:.3e} J ({ratio:.2e} of the energy in play, {scale:.3e} J; rebound/approach speed \
+         {restitution:.4}; a positive residual is energy the contact created), more than \
+         energy_tolerance = {tolerance:e}; reduce dt, choose another method (e.g. \"dop853\") or \
+         tighten rtol/atol (raise energy_tolerance only to accept it)",
+        residual = .change + .work + .dissipated,
+        ratio = (.change + .work + .dissipated).abs() / .scale
+    )]
+    ContactEnergy {
+        onset: f64,
+        separation: f64,
+        change: f64,
+        dissipated: f64,
+        work: f64,
+        scale: f64,
+        restitution: f64,
+        tolerance: f64,
+    },
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

@@ -13,7 +13,10 @@ use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
 use crate::hermite::{self, Quintic};
 use crate::model::{Excitation, Mode, Model};
-use crate::run::{ContactRecord, EnergyWatch, History, Settings, Solution};
+use crate::run::{
+    check_start, external_work, open_record, speed_squared_integral, ContactRecord, EnergyLedger,
+    Records, Settings, Solution,
+};
 use crate::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
 use crate::system::State;
 
@@ -389,10 +392,16 @@ struct Open {
     onset: f64,
     approach_speed: f64,
     max_indentation: f64,
-    dissipated_at_onset: f64,
+    /// The non-conservative work at onset, J.
+    losses_at_onset: f64,
+    /// Mechanical energy at onset, J.
+    energy: f64,
+    /// `work_in_contact` at onset, J.
+    work: f64,
 }
 
-/// Interrupt and energy checks, as in the fixed-step kernel.
+/// How often (in accepted steps) the kernel asks whether to stop; a power of
+/// two, a multiple of the energy check's interval.
 const INTERRUPT_INTERVAL: u64 = 1 << 14;
 /// Mode changes in a row closer than this fraction of the run make chattering.
 const CHATTER_FRACTION: f64 = 1e-12;
@@ -432,6 +441,8 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
     settings: &Settings,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> Result<Solution> {
+    settings.check_steps()?;
+    check_start(model, initial)?;
     let fixed = !S::ADAPTIVE;
     let t0 = 0.0;
     let grid_steps = settings.steps();
@@ -448,6 +459,13 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
     let mut y = to_vector(initial, 0.0);
     let mut time = t0;
     let mut mode = initial_mode(model, &y);
+    let energy = model.energy(initial);
+    let mut ledger = EnergyLedger::new(energy, X::IS_FREE, settings.energy_tolerance);
+    // The method integrates the non-conservative work (y[4]): the main
+    // damper's less the external force's apart, the contact's in contact.
+    // The damper's and the external force's work in contact are summed here
+    // (J), so that y[4] gains exactly each contact's dissipation.
+    let mut work_in_contact = 0.0;
     let mut open = match mode {
         Mode::Contact {
             side,
@@ -457,18 +475,19 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             onset: t0,
             approach_speed: approach_rate,
             max_indentation: gap(model, &y, model.side(initial)).0,
-            dissipated_at_onset: 0.0,
+            losses_at_onset: 0.0,
+            energy,
+            work: 0.0,
         }),
         Mode::Free => None,
     };
     stepper.reset(model, time, &y, mode);
 
-    let rows = if fixed {
-        (grid_steps / every + 2) as usize
-    } else {
-        64
-    };
-    let mut history = History::with_capacity(rows);
+    let rows = if fixed { grid_steps / every + 2 } else { 64 };
+    if fixed {
+        settings.check_rows(rows)?;
+    }
+    let mut records = Records::new(settings, rows);
     let force = |y: &Vector, mode: Mode| match mode {
         Mode::Free => 0.0,
         Mode::Contact {
@@ -480,10 +499,8 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 .total_force
         }
     };
-    history.push(time, initial, force(&y, mode));
-    let mut contacts: Vec<ContactRecord> = Vec::with_capacity(16);
+    records.keep(time, initial, force(&y, mode))?;
 
-    let mut watch = EnergyWatch::new(model.energy(initial), X::IS_FREE);
     let mut h = match settings.dt {
         Some(dt) => dt,
         None => {
@@ -636,6 +653,12 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             oc.max_indentation = oc.max_indentation.max(g1);
         }
         stepper.accept();
+        let (start, stop) = (to_state(&y), to_state(&end));
+        if let Mode::Contact { .. } = step_mode {
+            work_in_contact += model.damping * speed_squared_integral(taken, &start, &stop)
+                - external_work(model, time, taken, &start, &stop);
+        }
+        ledger.external_step(model, time, taken, &start, &stop);
         time += taken;
         if fixed && !switched {
             grid_index += 1;
@@ -656,13 +679,16 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                         onset: time,
                         approach_speed: approach_rate,
                         max_indentation: gap(model, &y, side).0.max(0.0),
-                        dissipated_at_onset: y[4],
+                        losses_at_onset: y[4],
+                        energy: model.energy(&stop),
+                        work: work_in_contact,
                     });
                 }
                 Mode::Free => {
                     if let Some(oc) = open.take() {
                         let rebound = -(oc.side * (y[3] - y[1]));
-                        contacts.push(ContactRecord {
+                        let work = work_in_contact - oc.work;
+                        let record = ContactRecord {
                             onset: oc.onset,
                             separation: time,
                             duration: time - oc.onset,
@@ -670,8 +696,11 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                             approach_speed: oc.approach_speed,
                             rebound_speed: rebound,
                             restitution: restitution(rebound, oc.approach_speed),
-                            energy_dissipated: y[4] - oc.dissipated_at_onset,
-                        });
+                            energy_dissipated: y[4] - oc.losses_at_onset,
+                            energy_change: model.energy(&stop) - oc.energy,
+                        };
+                        ledger.check_contact(&record, oc.energy, work)?;
+                        records.contact(record, time)?;
                     }
                 }
             }
@@ -695,12 +724,22 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
         }
         until_kept -= 1;
         let done = time >= t_end;
-        if until_kept == 0 || done {
-            until_kept = every;
-            history.push(time, &to_state(&y), force(&y, mode));
-        }
-        if watch.due(accepted, done) {
-            watch.check(model.energy(&to_state(&y)), time)?;
+        // The rare work, behind one test: a history row, the energy check,
+        // the question whether to stop (its interval a multiple of the
+        // energy check's).
+        if until_kept == 0 || ledger.due(accepted, done) {
+            if until_kept == 0 || done {
+                until_kept = every;
+                if records.keeps_history() {
+                    records.keep(time, &stop, force(&y, mode))?;
+                }
+            }
+            if ledger.due(accepted, done) {
+                ledger.check(model.energy(&stop), y[4] + work_in_contact, time)?;
+                if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
+                    return Err(Error::Interrupted { time });
+                }
+            }
         }
         if !done && accepted + rejected >= settings.max_steps {
             return Err(Error::TooManySteps {
@@ -708,33 +747,24 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 max_steps: settings.max_steps,
             });
         }
-        if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
-            return Err(Error::Interrupted { time });
-        }
     }
 
     if let Some(oc) = open {
-        contacts.push(ContactRecord {
-            onset: oc.onset,
-            separation: f64::NAN,
-            duration: f64::NAN,
-            max_indentation: oc.max_indentation,
-            approach_speed: oc.approach_speed,
-            rebound_speed: f64::NAN,
-            restitution: f64::NAN,
-            energy_dissipated: y[4] - oc.dissipated_at_onset,
-        });
+        let dissipated = y[4] - oc.losses_at_onset;
+        let record = open_record(oc.onset, oc.approach_speed, oc.max_indentation, dissipated);
+        records.contact(record, time)?;
     }
     Ok(Solution {
-        history,
-        contacts,
+        history: records.history,
+        contacts: records.contacts,
         steps: accepted,
         rejected_steps: rejected,
         grazing_contacts: grazes,
         rhs_evaluations: stepper.evaluations(),
         final_time: time,
         final_state: to_state(&y),
-        energy_growth: watch.growth(),
+        energy_growth: ledger.growth(),
+        energy_residual: ledger.residual(),
     })
 }
 

@@ -5,6 +5,8 @@
 //! ([`integrators`]) driven by one generic kernel ([`run::integrate`]) that
 //! keeps a thinned history and a table of located contacts, and closed-form
 //! references ([`closed_forms`], [`beam`], [`materials`]). SI units throughout.
+//! Every run is bounded in steps and memory and checks its energy balance
+//! (see [`run::simulate`]).
 
 pub mod assembly;
 pub mod beam;
@@ -30,7 +32,7 @@ pub use contact::{Contact, ContactLaw, LawKind};
 pub use error::{Error, Result};
 pub use run::{
     simulate, ContactRecord, ContactTiming, History, Method, MethodOptions, Settings, Solution,
-    Stepping,
+    Stepping, DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
 };
 pub use steppers::Tolerances;
 pub use system::{ImpactDamper, State};

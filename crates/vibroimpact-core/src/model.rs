@@ -171,17 +171,27 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
         (aw, ay)
     }
 
-    /// Accelerations (m/s^2) and the power dissipated by the contact (W) in a
-    /// given mode, from one evaluation of the contact.
+    /// Accelerations (m/s^2) and the non-conservative power (W) in a given
+    /// mode, from one evaluation of the contact. Apart: the power the main
+    /// damper takes from the system less what the external force gives it.
+    /// In contact: the power the contact's dissipative forces take (the
+    /// damper's and the external force's there are summed by the kernel, so
+    /// that the method integrates each contact's own dissipation alone).
     #[inline(always)]
     pub fn rates_in(&self, time: f64, s: &State, mode: Mode) -> (f64, f64, f64) {
         let mut main = -(self.damping_per_mass * s.main_velocity
             + self.stiffness_per_mass * s.main_displacement);
+        let mut force = 0.0;
         if !X::IS_FREE {
-            main += self.excitation.main_force(time) * self.inverse_main_mass;
+            force = self.excitation.main_force(time);
+            main += force * self.inverse_main_mass;
         }
         match mode {
-            Mode::Free => (main, 0.0, 0.0),
+            Mode::Free => (
+                main,
+                0.0,
+                (self.damping * s.main_velocity - force) * s.main_velocity,
+            ),
             Mode::Contact {
                 side,
                 approach_rate,
@@ -204,10 +214,11 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
         }
     }
 
-    /// Power dissipated by the contact (W) in a given mode.
+    /// The non-conservative power (W) at `time` in a given mode (see
+    /// [`Model::rates_in`]).
     #[inline(always)]
-    pub fn dissipation_in(&self, s: &State, mode: Mode) -> f64 {
-        self.rates_in(0.0, s, mode).2
+    pub fn losses_in(&self, time: f64, s: &State, mode: Mode) -> f64 {
+        self.rates_in(time, s, mode).2
     }
 
     /// The external force on the main mass, N.

@@ -11,8 +11,10 @@ use crate::model::{Excitation, Mode, Model};
 use crate::system::State;
 use crate::tableau::*;
 
-/// The integrated variables: `w, w', y, y'` and the energy the contact has
-/// dissipated so far (J), integrated by the method itself.
+/// The integrated variables: `w, w', y, y'` and the non-conservative work so
+/// far (J: apart, what the main damper took less what the external force
+/// gave; in contact, what the contact's dissipative forces took; see
+/// [`Model::rates_in`]), integrated by the method itself.
 pub type Vector = [f64; 5];
 
 #[inline(always)]
@@ -39,7 +41,7 @@ pub fn to_state(v: &Vector) -> State {
 /// One attempted step.
 #[derive(Debug, Clone, Copy)]
 pub struct Attempt {
-    /// The end point, with the dissipated energy in the last slot.
+    /// The end point, with the non-conservative work in the last slot.
     pub end: Vector,
     /// Scaled error estimate (accept when <= 1); 0 for fixed-step methods.
     pub error: f64,
@@ -101,7 +103,7 @@ fn derivative<L: ContactLaw, X: Excitation>(
 }
 
 /// `y + h * sum(w * k)` over the four state variables (and, with `all`,
-/// the dissipated energy too), for literal weight lists: the
+/// the non-conservative work too), for literal weight lists: the
 /// compiler unrolls and constant-folds these where it would not a loop.
 macro_rules! stage_point {
     ($y:expr, $h:expr; $($w:expr, $k:expr);+) => {{
@@ -147,7 +149,7 @@ fn stages<const S: usize, L: ContactLaw, X: Excitation>(
     for i in 1..S {
         // Sum the stage increments first, then scale once by h: fewer
         // operations and a straight line the compiler can vectorise.
-        // The dissipated energy (slot 4) feeds no force: stage values of
+        // The non-conservative work (slot 4) feeds no force: stage values of
         // the four state variables suffice.
         let mut sum = [0.0; 4];
         for (aij, kj) in a[i].iter().zip(k.iter()).take(i) {
@@ -187,7 +189,7 @@ pub struct Tolerances {
 }
 
 impl Tolerances {
-    /// The weight of variable `n` in the error norm (the dissipated energy
+    /// The weight of variable `n` in the error norm (the non-conservative work
     /// is an output, not controlled).
     #[inline(always)]
     fn scale(&self, y: &Vector, end: &Vector, n: usize) -> f64 {
@@ -510,6 +512,10 @@ pub struct NewmarkFamily {
     /// Accelerations at the current point and at the end of the last attempt.
     accel: (f64, f64),
     pending: (f64, f64),
+    /// Non-conservative power at the current point and at the end of the
+    /// last attempt (W), for the trapezoidal rule on it.
+    losses: f64,
+    pending_losses: f64,
     evaluations: u64,
 }
 
@@ -527,6 +533,8 @@ impl NewmarkFamily {
             lagged,
             accel: (0.0, 0.0),
             pending: (0.0, 0.0),
+            losses: 0.0,
+            pending_losses: 0.0,
             evaluations: 0,
         }
     }
@@ -546,6 +554,8 @@ impl NewmarkFamily {
             lagged: false,
             accel: (0.0, 0.0),
             pending: (0.0, 0.0),
+            losses: 0.0,
+            pending_losses: 0.0,
             evaluations: 0,
         }
     }
@@ -563,7 +573,8 @@ impl Stepper for NewmarkFamily {
         mode: Mode,
     ) {
         // After a jump the physical accelerations, not the algorithmic ones.
-        self.accel = model.accelerations_in(time, &to_state(y), mode);
+        let (aw, ay, losses) = model.rates_in(time, &to_state(y), mode);
+        (self.accel, self.losses) = ((aw, ay), losses);
         self.evaluations += 1;
     }
 
@@ -718,18 +729,20 @@ impl Stepper for NewmarkFamily {
             impact_displacement: xy + bx * ay,
             impact_velocity: vy + gv * ay,
         };
-        // Dissipated energy by the trapezoidal rule, second order like the method.
-        let power0 = model.dissipation_in(&s0, mode);
-        let power1 = model.dissipation_in(&end_state, mode);
+        // Non-conservative work by the trapezoidal rule, second order like the
+        // method (the power at the start carried from the step before).
+        let power1 = model.losses_in(time + h, &end_state, mode);
         self.pending = (aw, ay);
+        self.pending_losses = power1;
         Ok(Attempt {
-            end: to_vector(&end_state, y[4] + 0.5 * h * (power0 + power1)),
+            end: to_vector(&end_state, y[4] + 0.5 * h * (self.losses + power1)),
             error: 0.0,
         })
     }
 
     fn accept(&mut self) {
         self.accel = self.pending;
+        self.losses = self.pending_losses;
     }
 
     fn evaluations(&self) -> u64 {

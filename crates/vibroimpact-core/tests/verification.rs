@@ -36,7 +36,12 @@ fn run(
     t_end: f64,
     timing: ContactTiming,
 ) -> Solution {
-    let settings = Settings::new(method, Some(dt), t_end, 1, timing, None, u64::MAX).unwrap();
+    // The paper's lagged Newmark creates energy at every contact, which is refused by
+    // default (issue 7); these tests are about other properties.
+    let loose = matches!(method, Method::Newmark { .. }).then_some(0.5);
+    let settings = Settings::new(method, Some(dt), t_end, 1, timing, None, u64::MAX)
+        .and_then(|s| s.with_limits(true, None, loose))
+        .unwrap();
     simulate(&sys.0, &sys.1, &sys.2, &settings, &mut || false).unwrap()
 }
 

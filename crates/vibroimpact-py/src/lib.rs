@@ -32,6 +32,14 @@ create_exception!(
 
 create_exception!(
     vibroimpact._core,
+    EnergyBalanceError,
+    NumericalBlowUpError,
+    "The result would be physically impossible: its energy balance does not close, or a contact \
+     created energy (beyond energy_tolerance)."
+);
+
+create_exception!(
+    vibroimpact._core,
     SimulationError,
     PyRuntimeError,
     "The run could not go on: chattering, Newton failure, step size at round-off, or too many steps."
@@ -48,11 +56,13 @@ fn to_py(err: core::Error) -> PyErr {
     let message = err.to_string();
     match err {
         E::NumericalBlowUp { .. } => NumericalBlowUpError::new_err(message),
+        E::EnergyBalance { .. } | E::ContactEnergy { .. } => EnergyBalanceError::new_err(message),
         E::Interrupted { .. } => PyKeyboardInterrupt::new_err(message),
         E::NewtonFailed { .. }
         | E::Chattering { .. }
         | E::StepSizeTooSmall { .. }
-        | E::TooManySteps { .. } => SimulationError::new_err(message),
+        | E::TooManySteps { .. }
+        | E::RowLimit { .. } => SimulationError::new_err(message),
         E::InvalidParameter { .. } | E::UnknownChoice { .. } | E::Inconsistent(_) => {
             InvalidInputError::new_err(message)
         }
@@ -78,12 +88,48 @@ fn whole(field: &str, value: &Bound<'_, PyAny>) -> PyResult<u64> {
     }
 }
 
+/// A float argument (the `from_py_with` of every float parameter). A Python
+/// int beyond the range of a float (`10**400`) becomes an infinity of its
+/// sign, as a float computation beyond the range would, instead of an
+/// OverflowError: the core then refuses it like any non-finite value, in an
+/// InvalidInputError that names the field.
+fn real(value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    match value.extract::<f64>() {
+        Ok(v) => Ok(v),
+        Err(err) if err.is_instance_of::<pyo3::exceptions::PyOverflowError>(value.py()) => {
+            Ok(if value.lt(0)? {
+                f64::NEG_INFINITY
+            } else {
+                f64::INFINITY
+            })
+        }
+        Err(err) => Err(err),
+    }
+}
+
+/// [`real`] for a parameter that may be None.
+fn real_or_none(value: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    if value.is_none() {
+        Ok(None)
+    } else {
+        real(value).map(Some)
+    }
+}
+
 fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
     whole("every", value)
 }
 
 fn max_steps_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
     whole("max_steps", value)
+}
+
+fn max_rows_arg(value: &Bound<'_, PyAny>) -> PyResult<Option<u64>> {
+    if value.is_none() {
+        Ok(None)
+    } else {
+        whole("max_rows", value).map(Some)
+    }
 }
 
 fn mode_arg(value: &Bound<'_, PyAny>) -> PyResult<u32> {
@@ -107,11 +153,11 @@ impl ImpactDamper {
     #[new]
     #[pyo3(signature = (main_mass, stiffness, impact_mass, clearance, damping = 0.0))]
     fn new(
-        main_mass: f64,
-        stiffness: f64,
-        impact_mass: f64,
-        clearance: f64,
-        damping: f64,
+        #[pyo3(from_py_with = real)] main_mass: f64,
+        #[pyo3(from_py_with = real)] stiffness: f64,
+        #[pyo3(from_py_with = real)] impact_mass: f64,
+        #[pyo3(from_py_with = real)] clearance: f64,
+        #[pyo3(from_py_with = real)] damping: f64,
     ) -> PyResult<Self> {
         core::ImpactDamper::new(main_mass, stiffness, damping, impact_mass, clearance)
             .map(Self)
@@ -191,9 +237,9 @@ impl Contact {
     fn new(
         py: Python<'_>,
         law: &str,
-        stiffness: f64,
-        damping: f64,
-        restitution: Option<f64>,
+        #[pyo3(from_py_with = real)] stiffness: f64,
+        #[pyo3(from_py_with = real)] damping: f64,
+        #[pyo3(from_py_with = real_or_none)] restitution: Option<f64>,
     ) -> PyResult<Self> {
         let kind = core::LawKind::parse(law).map_err(to_py)?;
         let contact = core::Contact::new(kind, stiffness, restitution, damping).map_err(to_py)?;
@@ -242,7 +288,12 @@ impl Contact {
     /// while approaching) and the rate at the onset of the contact
     /// ``approach_rate`` (m/s), all finite.
     #[pyo3(signature = (indentation, rate = 0.0, approach_rate = 1.0))]
-    fn law_force(&self, indentation: f64, rate: f64, approach_rate: f64) -> PyResult<f64> {
+    fn law_force(
+        &self,
+        #[pyo3(from_py_with = real)] indentation: f64,
+        #[pyo3(from_py_with = real)] rate: f64,
+        #[pyo3(from_py_with = real)] approach_rate: f64,
+    ) -> PyResult<f64> {
         self.0
             .law_force(indentation, rate, approach_rate)
             .map_err(to_py)
@@ -280,10 +331,10 @@ impl InitialState {
     #[new]
     #[pyo3(signature = (main_displacement = 0.0, main_velocity = 0.0, impact_displacement = 0.0, impact_velocity = 0.0))]
     fn new(
-        main_displacement: f64,
-        main_velocity: f64,
-        impact_displacement: f64,
-        impact_velocity: f64,
+        #[pyo3(from_py_with = real)] main_displacement: f64,
+        #[pyo3(from_py_with = real)] main_velocity: f64,
+        #[pyo3(from_py_with = real)] impact_displacement: f64,
+        #[pyo3(from_py_with = real)] impact_velocity: f64,
     ) -> PyResult<Self> {
         core::State::new(
             main_displacement,
@@ -361,7 +412,7 @@ impl Column {
     }
 }
 
-const CONTACT_COLUMNS: [&str; 8] = [
+const CONTACT_COLUMNS: [&str; 9] = [
     "onset",
     "separation",
     "duration",
@@ -370,9 +421,10 @@ const CONTACT_COLUMNS: [&str; 8] = [
     "rebound_speed",
     "restitution",
     "energy_dissipated",
+    "energy_change",
 ];
 
-fn record_values(r: &core::ContactRecord) -> [f64; 8] {
+fn record_values(r: &core::ContactRecord) -> [f64; 9] {
     [
         r.onset,
         r.separation,
@@ -382,16 +434,17 @@ fn record_values(r: &core::ContactRecord) -> [f64; 8] {
         r.rebound_speed,
         r.restitution,
         r.energy_dissipated,
+        r.energy_change,
     ]
 }
 
 /// The contacts of a run, one entry per contact, as NumPy arrays in SI units.
 /// A contact still open at the end of the run has NaN ``separation``,
-/// ``duration``, ``rebound_speed`` and ``restitution``.
+/// ``duration``, ``rebound_speed``, ``restitution`` and ``energy_change``.
 #[pyclass(frozen, module = "vibroimpact._core")]
 struct ContactTable {
     records: Vec<core::ContactRecord>,
-    columns: [OnceLock<Py<PyArray1<f64>>>; 8],
+    columns: [OnceLock<Py<PyArray1<f64>>>; 9],
 }
 
 impl ContactTable {
@@ -420,7 +473,7 @@ impl ContactTable {
 impl ContactTable {
     /// Column names, in order.
     #[classattr]
-    fn columns() -> [&'static str; 8] {
+    fn columns() -> [&'static str; 9] {
         CONTACT_COLUMNS
     }
     /// Onset, s.
@@ -458,10 +511,22 @@ impl ContactTable {
     fn restitution(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
         self.column(py, 6)
     }
-    /// Energy dissipated by the contact (law hysteresis and contact damper), J.
+    /// Work done during the contact by the contact's dissipative forces (the
+    /// law's hysteresis and the contact damper c1), J, >= 0: the integral of
+    /// ``(F - F_elastic) * delta'`` over the contact. The main damper C is not
+    /// in it.
     #[getter]
     fn energy_dissipated(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
         self.column(py, 7)
+    }
+    /// Net change of the whole system's mechanical energy over the contact
+    /// (kinetic energy of both masses, main spring and contact elastic energy;
+    /// at separation minus at onset), J. With no main damper it is
+    /// ``-energy_dissipated``; with one, the damper's work during the contact
+    /// is in it too. NaN for a contact still open at the end.
+    #[getter]
+    fn energy_change(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 8)
     }
     fn __len__(&self) -> usize {
         self.records.len()
@@ -519,6 +584,15 @@ struct Solution {
     /// positive value is numerical error (above 0.5 the run is refused).
     #[pyo3(get)]
     energy_growth: f64,
+    /// Largest residual of the energy balance found by the run's checks
+    /// (stored energy + dissipated work - external work - energy at the
+    /// start), relative to the energy in play; NaN for a system at rest. The
+    /// run is refused when it exceeds ``energy_tolerance``.
+    #[pyo3(get)]
+    energy_residual: f64,
+    /// The state at ``final_time``.
+    #[pyo3(get)]
+    final_state: InitialState,
 }
 
 #[pymethods]
@@ -579,6 +653,9 @@ fn settings(
     rtol: f64,
     atol: f64,
     max_steps: u64,
+    max_rows: Option<u64>,
+    energy_tolerance: Option<f64>,
+    history: bool,
 ) -> PyResult<core::Settings> {
     let options = core::MethodOptions {
         beta,
@@ -593,27 +670,32 @@ fn settings(
         .map(core::Stepping::parse)
         .transpose()
         .map_err(to_py)?;
-    core::Settings::new(parsed, dt, t_end, every, timing, stepping, max_steps).map_err(to_py)
+    core::Settings::new(parsed, dt, t_end, every, timing, stepping, max_steps)
+        .and_then(|s| s.with_limits(history, max_rows, energy_tolerance))
+        .map_err(to_py)
 }
 
 /// Check solver settings as ``simulate`` would, without running; raises
 /// ``InvalidInputError`` naming the offending field.
 #[pyfunction]
-#[pyo3(signature = (*, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000))]
+#[pyo3(signature = (*, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000, max_rows = None, energy_tolerance = None, history = true))]
 #[allow(clippy::too_many_arguments)]
 fn check_solver(
-    t_end: f64,
-    dt: Option<f64>,
+    #[pyo3(from_py_with = real)] t_end: f64,
+    #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
     method: &str,
     #[pyo3(from_py_with = every_arg)] every: u64,
     contact_timing: &str,
     stepping: Option<&str>,
-    beta: f64,
-    gamma: f64,
-    spectral_radius: f64,
-    rtol: f64,
-    atol: f64,
+    #[pyo3(from_py_with = real)] beta: f64,
+    #[pyo3(from_py_with = real)] gamma: f64,
+    #[pyo3(from_py_with = real)] spectral_radius: f64,
+    #[pyo3(from_py_with = real)] rtol: f64,
+    #[pyo3(from_py_with = real)] atol: f64,
     #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
+    #[pyo3(from_py_with = real_or_none)] energy_tolerance: Option<f64>,
+    history: bool,
 ) -> PyResult<()> {
     settings(
         dt,
@@ -628,6 +710,9 @@ fn check_solver(
         rtol,
         atol,
         max_steps,
+        max_rows,
+        energy_tolerance,
+        history,
     )
     .map(|_| ())
 }
@@ -647,27 +732,41 @@ fn check_solver(
 /// whose contact instants are ``contact_timing`` ``"located"`` (interpolated
 /// inside the step) or ``"step-count"`` (whole steps). ``every`` keeps every
 /// N-th step in the history; ``max_steps`` bounds the work.
+///
+/// Limits: ``max_rows`` bounds the history rows plus contacts a run keeps
+/// (None: ``DEFAULT_MAX_ROWS``, 2e7; a row is 48 bytes, a contact 72): a
+/// fixed-step history beyond it is refused before the run, any other run
+/// stops at it with a ``SimulationError``; ``history=False`` keeps no history at all
+/// (empty arrays; ``final_state`` holds the end). A start with the bodies
+/// interpenetrating is refused. ``energy_tolerance`` (relative, None:
+/// ``DEFAULT_ENERGY_TOLERANCE``, 0.05): a result whose energy balance (stored
+/// energy + dissipated work - external work = energy at the start) misses by
+/// more than that fraction of the energy in play, or one of whose contacts
+/// creates energy beyond it, raises ``EnergyBalanceError``.
 /// The GIL is released while integrating; Ctrl-C interrupts.
 #[pyfunction]
-#[pyo3(signature = (system, contact, initial, *, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000))]
+#[pyo3(signature = (system, contact, initial, *, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000, max_rows = None, energy_tolerance = None, history = true))]
 #[allow(clippy::too_many_arguments)]
 fn simulate(
     py: Python<'_>,
     system: &ImpactDamper,
     contact: &Contact,
     initial: &InitialState,
-    t_end: f64,
-    dt: Option<f64>,
+    #[pyo3(from_py_with = real)] t_end: f64,
+    #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
     method: &str,
     #[pyo3(from_py_with = every_arg)] every: u64,
     contact_timing: &str,
     stepping: Option<&str>,
-    beta: f64,
-    gamma: f64,
-    spectral_radius: f64,
-    rtol: f64,
-    atol: f64,
+    #[pyo3(from_py_with = real)] beta: f64,
+    #[pyo3(from_py_with = real)] gamma: f64,
+    #[pyo3(from_py_with = real)] spectral_radius: f64,
+    #[pyo3(from_py_with = real)] rtol: f64,
+    #[pyo3(from_py_with = real)] atol: f64,
     #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
+    #[pyo3(from_py_with = real_or_none)] energy_tolerance: Option<f64>,
+    history: bool,
 ) -> PyResult<Solution> {
     let settings = settings(
         dt,
@@ -682,6 +781,9 @@ fn simulate(
         rtol,
         atol,
         max_steps,
+        max_rows,
+        energy_tolerance,
+        history,
     )?;
     let parsed = settings.method;
     let (sys, con, init) = (system.0, contact.0, initial.0);
@@ -726,6 +828,8 @@ fn simulate(
         grazing_contacts: sol.grazing_contacts,
         final_time: sol.final_time,
         energy_growth: sol.energy_growth,
+        energy_residual: sol.energy_residual,
+        final_state: InitialState(sol.final_state),
         method: parsed.name(),
         stepping: match settings.stepping {
             core::Stepping::Fixed => "fixed",
@@ -742,12 +846,12 @@ fn simulate(
 #[pyfunction]
 #[pyo3(signature = (radius, youngs_modulus, poisson_ratio, other_youngs_modulus, other_poisson_ratio, other_radius = None))]
 fn hertz_stiffness(
-    radius: f64,
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-    other_youngs_modulus: f64,
-    other_poisson_ratio: f64,
-    other_radius: Option<f64>,
+    #[pyo3(from_py_with = real)] radius: f64,
+    #[pyo3(from_py_with = real)] youngs_modulus: f64,
+    #[pyo3(from_py_with = real)] poisson_ratio: f64,
+    #[pyo3(from_py_with = real)] other_youngs_modulus: f64,
+    #[pyo3(from_py_with = real)] other_poisson_ratio: f64,
+    #[pyo3(from_py_with = real_or_none)] other_radius: Option<f64>,
 ) -> PyResult<f64> {
     // Checked by the core, which names the second body's fields other_....
     let a = materials::Material {
@@ -797,13 +901,13 @@ impl BeamMode {
 #[pyfunction]
 #[pyo3(signature = (length, youngs_modulus, second_moment, density, area, mode = 1, position = None))]
 fn cantilever_mode(
-    length: f64,
-    youngs_modulus: f64,
-    second_moment: f64,
-    density: f64,
-    area: f64,
+    #[pyo3(from_py_with = real)] length: f64,
+    #[pyo3(from_py_with = real)] youngs_modulus: f64,
+    #[pyo3(from_py_with = real)] second_moment: f64,
+    #[pyo3(from_py_with = real)] density: f64,
+    #[pyo3(from_py_with = real)] area: f64,
     #[pyo3(from_py_with = mode_arg)] mode: u32,
-    position: Option<f64>,
+    #[pyo3(from_py_with = real_or_none)] position: Option<f64>,
 ) -> PyResult<BeamMode> {
     let b = beam::cantilever_mode(
         length,
@@ -857,9 +961,9 @@ fn derivative_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
 #[pyfunction]
 #[pyo3(signature = (length, mode, x, derivative = 0))]
 fn cantilever_mode_shape(
-    length: f64,
+    #[pyo3(from_py_with = real)] length: f64,
     #[pyo3(from_py_with = mode_arg)] mode: u32,
-    x: f64,
+    #[pyo3(from_py_with = real)] x: f64,
     #[pyo3(from_py_with = derivative_arg)] derivative: usize,
 ) -> PyResult<f64> {
     let values = beam::cantilever_mode_shape_derivatives(length, mode, x).map_err(to_py)?;
@@ -872,10 +976,10 @@ fn cantilever_mode_shape(
 #[pyfunction]
 #[pyo3(signature = (impact_mass, main_mass, hertz_stiffness, approach_speed, exact_constant = false))]
 fn goldsmith_contact_duration(
-    impact_mass: f64,
-    main_mass: f64,
-    hertz_stiffness: f64,
-    approach_speed: f64,
+    #[pyo3(from_py_with = real)] impact_mass: f64,
+    #[pyo3(from_py_with = real)] main_mass: f64,
+    #[pyo3(from_py_with = real)] hertz_stiffness: f64,
+    #[pyo3(from_py_with = real)] approach_speed: f64,
     exact_constant: bool,
 ) -> PyResult<f64> {
     closed_forms::goldsmith_contact_duration(
@@ -891,10 +995,10 @@ fn goldsmith_contact_duration(
 /// Goldsmith's maximum Hertz indentation (m): ``(5 v^2 / (4 K* K_hz))^(2/5)``.
 #[pyfunction]
 fn goldsmith_max_indentation(
-    impact_mass: f64,
-    main_mass: f64,
-    hertz_stiffness: f64,
-    approach_speed: f64,
+    #[pyo3(from_py_with = real)] impact_mass: f64,
+    #[pyo3(from_py_with = real)] main_mass: f64,
+    #[pyo3(from_py_with = real)] hertz_stiffness: f64,
+    #[pyo3(from_py_with = real)] approach_speed: f64,
 ) -> PyResult<f64> {
     closed_forms::goldsmith_max_indentation(impact_mass, main_mass, hertz_stiffness, approach_speed)
         .map_err(to_py)
@@ -905,10 +1009,10 @@ fn goldsmith_max_indentation(
 #[pyfunction]
 #[pyo3(signature = (impact_mass, main_mass, stiffness, damping = 0.0))]
 fn linear_contact_duration(
-    impact_mass: f64,
-    main_mass: f64,
-    stiffness: f64,
-    damping: f64,
+    #[pyo3(from_py_with = real)] impact_mass: f64,
+    #[pyo3(from_py_with = real)] main_mass: f64,
+    #[pyo3(from_py_with = real)] stiffness: f64,
+    #[pyo3(from_py_with = real)] damping: f64,
 ) -> PyResult<f64> {
     closed_forms::linear_contact_duration(impact_mass, main_mass, stiffness, damping).map_err(to_py)
 }
@@ -918,11 +1022,11 @@ fn linear_contact_duration(
 /// with ``wf1 = error_weight``.
 #[pyfunction]
 fn adequacy(
-    error: f64,
-    max_error: f64,
-    cpu_time: f64,
-    max_cpu_time: f64,
-    error_weight: f64,
+    #[pyo3(from_py_with = real)] error: f64,
+    #[pyo3(from_py_with = real)] max_error: f64,
+    #[pyo3(from_py_with = real)] cpu_time: f64,
+    #[pyo3(from_py_with = real)] max_cpu_time: f64,
+    #[pyo3(from_py_with = real)] error_weight: f64,
 ) -> PyResult<f64> {
     closed_forms::adequacy(error, max_error, cpu_time, max_cpu_time, error_weight).map_err(to_py)
 }
@@ -935,6 +1039,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "NumericalBlowUpError",
         py.get_type::<NumericalBlowUpError>(),
     )?;
+    m.add("EnergyBalanceError", py.get_type::<EnergyBalanceError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add("RestitutionWarning", py.get_type::<RestitutionWarning>())?;
     m.add_class::<ImpactDamper>()?;
@@ -955,5 +1060,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(linear_contact_duration, m)?)?;
     m.add_function(wrap_pyfunction!(adequacy, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULT_MAX_ROWS", core::DEFAULT_MAX_ROWS)?;
+    m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
     Ok(())
 }
