@@ -544,11 +544,15 @@ def test_the_table_and_help_say_what_dissipated_means(
     assert status == 0
     header = next(line for line in out.splitlines() if "onset (s)" in line)
     assert len(re.split(r"\s{2,}", header.strip())) == len(vi.ContactTable.columns)
-    assert cli.ENERGY_DISSIPATED_TEXT in out
+    assert "net change (J)" in header and "dissipated (J)" in header
+    assert cli.ENERGY_DISSIPATED_TEXT in out and cli.ENERGY_CHANGE_TEXT in out
     with pytest.raises(SystemExit):
         main(["simulate", "--help"])
-    assert cli.ENERGY_DISSIPATED_TEXT in " ".join(capsys.readouterr().out.split())
-    assert "work of the contact's dissipative forces" in " ".join(README.split())
+    described = " ".join(capsys.readouterr().out.split())
+    assert cli.ENERGY_DISSIPATED_TEXT in described and cli.ENERGY_CHANGE_TEXT in described
+    readme = " ".join(README.split())
+    assert "work of the contact's dissipative forces" in readme
+    assert "mechanical energy at separation minus at onset" in readme
 
 
 def test_the_readme_figures_for_the_default_run_are_its_own(
@@ -558,11 +562,18 @@ def test_the_readme_figures_for_the_default_run_are_its_own(
     assert status == 0
     (contact,) = json.loads(out)["contacts"]
     text = " ".join(README.split())
-    claim = re.search(r"rebounds at ([0-9.]+) of the approach speed while ([0-9.e-]+) J", text)
+    claim = re.search(
+        r"rebounds at ([0-9.]+) of the approach speed while ([0-9.e-]+) J are dissipated, "
+        r"and the system gains ([0-9.e-]+) J",
+        text,
+    )
     assert claim is not None
     assert float(claim.group(1)) == round(contact["restitution"], 4)
     assert float(claim.group(2)) == float(f"{contact['energy_dissipated']:.1e}")
+    assert float(claim.group(3)) == float(f"{contact['energy_change']:.1e}")
     assert contact["restitution"] > 1 and contact["energy_dissipated"] > 0
+    # A rebound faster than the approach is energy gained: the two columns agree on it.
+    assert contact["energy_change"] > 0
 
 
 def test_a_contact_open_at_the_end_reads_open_and_null(
@@ -572,6 +583,7 @@ def test_a_contact_open_at_the_end_reads_open_and_null(
     path.write_text(table1_toml.replace("t_end = 0.2", "t_end = 0.05"), encoding="utf-8")
     (row,) = vi.load_scenario(path).run().contacts.to_dicts()
     undefined = {name for name, value in row.items() if math.isnan(value)}
+    # The columns ContactTable's documentation calls undefined for an open contact.
     assert undefined == {"separation", "duration", "rebound_speed", "restitution", "energy_change"}
 
     status, out, _ = run_main(capsys, "simulate", str(path))

@@ -60,14 +60,13 @@ CONTACT_HEADERS = {
 }
 # What the energy columns are: printed under the table, the same words as in the help.
 ENERGY_DISSIPATED_TEXT = (
-    "dissipated (J) = work of the contact's dissipative forces (the law's hysteresis and "
-    "the contact damper c1) during the contact; it is not the net change of the energy"
+    "dissipated (J) is the work of the contact's dissipative forces (the law's hysteresis "
+    "and the contact damper c1) during the contact, not the net change of the energy"
 )
 ENERGY_CHANGE_TEXT = (
-    "net change (J) = change of the system's mechanical energy over the contact "
-    "(negative: lost; positive: created by the method's numerical error)"
+    "net change (J) is the system's mechanical energy at separation minus at onset, the "
+    "main damper's losses included: a positive value is energy the method created"
 )
-CONTACT_NOTES = {"energy_dissipated": ENERGY_DISSIPATED_TEXT, "energy_change": ENERGY_CHANGE_TEXT}
 # Energy growth (relative) above which `simulate` says the run gained energy.
 ENERGY_NOTE = 0.01
 
@@ -104,9 +103,10 @@ def _parser() -> argparse.ArgumentParser:
         description=(
             "Run one scenario and print its contacts (SI units). Without SCENARIO, the "
             "founding paper's Table 1 collision (Hertz, 0.1 m/s, Newmark-beta, dt = 1e-4 s, "
-            f"0.3 s). In the table of contacts, {ENERGY_DISSIPATED_TEXT}. A contact still "
-            "open at the end of the run shows 'open' for its separation, duration, rebound "
-            "and restitution (null in --json)."
+            f"0.3 s). In the table of contacts: {ENERGY_DISSIPATED_TEXT}. "
+            f"{ENERGY_CHANGE_TEXT}. A contact still open at the end of the run shows 'open' "
+            "for its separation, duration, rebound, restitution and net change (null in "
+            "--json)."
         ),
     )
     simulate.add_argument("scenario", nargs="?", type=Path, help="scenario file (.toml)")
@@ -163,7 +163,7 @@ def write_history(path: Path, sol: Solution) -> None:
 
 
 def contact_lines(sol: Solution) -> list[str]:
-    """The text table of contacts, then what its energy columns mean.
+    """The text table of contacts, then what its two energy columns mean.
 
     Columns come from ``ContactTable.columns``; a value left undefined because the
     contact is still open at the end of the run (NaN in the table) reads ``open``.
@@ -178,8 +178,7 @@ def contact_lines(sol: Solution) -> list[str]:
                 for name in columns
             )
         )
-    lines += [f"  {text}" for name, text in CONTACT_NOTES.items() if name in columns]
-    return lines
+    return [*lines, f"  {ENERGY_DISSIPATED_TEXT}", f"  {ENERGY_CHANGE_TEXT}"]
 
 
 def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
