@@ -399,7 +399,7 @@ def test_long_adaptive_runs_stop_at_the_row_cap_and_history_off_keeps_none() -> 
         "initial": {"damper_velocity": [1.0]},
         "method": "dop853",
     }
-    with pytest.raises(vi.InvalidInputError, match="max_rows = 2000") as err:
+    with pytest.raises(vi.SimulationError, match="max_rows = 2000") as err:
         simulate_system(**rattler, t_end=1e12, max_rows=2000)
     assert "history = false" in str(err.value) and "\n" not in str(err.value)
     sol = simulate_system(**rattler, t_end=50.0, history=False)
@@ -421,3 +421,77 @@ def test_fixed_step_history_beyond_the_cap_is_refused_before_running() -> None:
         len(simulate_system(osc, t_end=1.0, dt=1e-4, method="rk4", max_rows=1000, history=False).t)
         == 0
     )
+
+
+def test_lossless_runs_through_rest_keep_a_closed_balance() -> None:
+    """An undamped oscillator forced off resonance passes through near-zero energy: the
+    balance is judged against the largest energy in play, so exact runs are not
+    stopped (they were, by round-off, when judged against the energy of the moment)."""
+    w0 = 2 * math.pi
+    for method, dt in (("rk4", 1e-3), ("dop853", None), ("generalized-alpha", 1e-4)):
+        sol = simulate_system(
+            {"kind": "oscillator", "mass": 2.0, "stiffness": 2.0 * w0 * w0},
+            excitation=[
+                {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 3.0}
+            ],
+            t_end=3.0,
+            method=method,
+            dt=dt,
+            energy_tolerance=1e-6,
+        )
+        assert abs(sol.energy["residual"]) < 1e-6 * max(abs(sol.energy["input_work"]), 1e-3)
+
+
+@pytest.mark.parametrize("method", ["rk4", "newmark-implicit", "generalized-alpha", "dop853"])
+def test_a_zero_clearance_rigid_damper_stops_quickly_with_a_clear_error(method: str) -> None:
+    """A loose mass with no clearance and e = 1 impacts again at once: every method must
+    stop in seconds with a one-line error, not loop on steps at the round-off of time."""
+    with pytest.raises(vi.SimulationError, match="chattering") as err:
+        simulate_system(
+            {"kind": "oscillator", "mass": 1.0, "stiffness": 100.0},
+            damper=[{"mass": 1.0, "at": 0, "clearance": 0.0, "law": "rigid", "restitution": 1.0}],
+            initial={"structure_displacement": [0.01], "damper_displacement": [0.01]},
+            t_end=1.0,
+            method=method,
+            dt=1e-3,
+            history=False,
+        )
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"stiffness": 1e6}, 'stiffness applies to compliant laws only, not to law "rigid"'),
+        ({"damping": 0.1}, 'damping applies to compliant laws only, not to law "rigid"'),
+    ],
+)
+def test_keys_a_rigid_law_does_not_use_are_refused(change: dict[str, float], message: str) -> None:
+    damper = {"mass": 0.1, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.5}
+    with pytest.raises(vi.InvalidInputError, match=message):
+        simulate_system(BALL, damper=[{**damper, **change}], t_end=0.1, method="rk4", dt=1e-3)
+
+
+def test_keys_an_excitation_does_not_use_are_refused() -> None:
+    force = {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 2.0}
+    with pytest.raises(vi.InvalidInputError, match="duration not used by signal 'harmonic'"):
+        simulate_system(
+            BALL, excitation=[{**force, "duration": 1.0}], t_end=0.1, method="rk4", dt=1e-3
+        )
+    base = {**force, "kind": "base"}
+    with pytest.raises(vi.InvalidInputError, match='at applies to kind "force" only'):
+        simulate_system(BALL, excitation=[base], t_end=0.1, method="rk4", dt=1e-3)
+
+
+def test_a_start_on_the_wall_to_round_off_is_accepted() -> None:
+    x0 = -1.1 * 9.81 / 1000  # the damper placed exactly on its lower wall, in floats
+    sol = simulate_system(
+        {"kind": "oscillator", "mass": 1.0, "stiffness": 1000.0},
+        damper=[{"mass": 0.1, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.5}],
+        gravity={},
+        initial={"structure_displacement": [x0], "damper_displacement": [x0 - 0.01]},
+        t_end=0.1,
+        method="rk4",
+        dt=1e-3,
+    )
+    assert sol.final_time == pytest.approx(0.1)

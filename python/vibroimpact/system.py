@@ -153,6 +153,22 @@ _SIDES = ("upper", "lower")
 _LOADS = ("force", "base")
 _SIGNALS = ("harmonic", "sweep", "harmonics", "recorded", "white-noise", "kanai-tajimi")
 _SWEEPS = ("linear", "logarithmic")
+# The keys each signal takes (a key of another signal is an error, not ignored).
+_SIGNAL_KEYS: dict[str, set[str]] = {
+    "harmonic": {"amplitude", "frequency", "phase"},
+    "sweep": {"amplitude", "start_frequency", "end_frequency", "duration", "sweep", "phase"},
+    "harmonics": {"amplitudes", "frequencies", "phases"},
+    "recorded": {"file", "time", "value", "scale"},
+    "white-noise": {"intensity", "cutoff_frequency", "duration", "seed"},
+    "kanai-tajimi": {
+        "intensity",
+        "ground_frequency",
+        "ground_damping",
+        "cutoff_frequency",
+        "duration",
+        "seed",
+    },
+}
 
 
 def _choice(where: str, key: str, value: Any, choices: Sequence[str]) -> None:
@@ -161,13 +177,17 @@ def _choice(where: str, key: str, value: Any, choices: Sequence[str]) -> None:
         raise _fail(where, f'{key} must be one of {listed}, got "{value}"')
 
 
-def _check_law(where: str, d: Mapping[str, Any]) -> None:
-    """A pair's law: "rigid" with a restitution in [0, 1], or a compliant law that
-    :class:`vibroimpact.Contact` accepts with the same values."""
+def _check_law(where: str, d: Mapping[str, Any], given: Mapping[str, Any]) -> None:
+    """A pair's law: "rigid" with a restitution in [0, 1] (and nothing else), or a
+    compliant law that :class:`vibroimpact.Contact` accepts with the same values.
+    ``given`` is the table as written, to tell a key left out from its default."""
     if d["law"] == "rigid":
         e = d["restitution"]
         if e is None or not 0.0 <= e <= 1.0:
             raise _fail(where, f'law "rigid" needs restitution in [0, 1], got {e}')
+        for key in ("stiffness", "damping"):
+            if key in given:
+                raise _fail(where, f'{key} applies to compliant laws only, not to law "rigid"')
         return
     try:
         Contact(
@@ -297,6 +317,11 @@ def system_spec(
         raise _fail("[structure] ", f'kind must be one of {listed}, got "{kind}"')
     schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[kind]}
     spec: dict[str, Any] = {"structure": _table("[structure] ", structure, schema)}
+    if kind == "cantilever" and not 1 <= spec["structure"]["modes"] <= 200:
+        raise _fail(
+            "[structure] modes: ",
+            f"must be a whole number in [1, 200], got {spec['structure']['modes']}",
+        )
     if kind == "matrices" and spec["structure"]["damping"] is None:
         size = len(spec["structure"]["mass"])
         spec["structure"]["damping"] = [[0.0] * size for _ in range(size)]
@@ -315,22 +340,24 @@ def system_spec(
             elif both is not None:
                 raise _fail(f"[[damper]] {j}: ", f"give clearance or {side}, not both")
         del d["clearance"]
-        _check_law(f"[[damper]] {j}: ", d)
+        _check_law(f"[[damper]] {j}: ", d, table)
         dampers.append(d)
     spec["damper"] = dampers
     stops = []
     for j, table in enumerate(_list("stop", stop)):
         d = _table(f"[[stop]] {j}: ", table, _STOP)
         _choice(f"[[stop]] {j}: ", "side", d["side"], _SIDES)
-        _check_law(f"[[stop]] {j}: ", d)
+        _check_law(f"[[stop]] {j}: ", d, table)
         stops.append(d)
     spec["stop"] = stops
     if gravity is None:
         spec["gravity"] = {"acceleration": 0.0}
-    elif isinstance(gravity, int | float) and not isinstance(gravity, bool):
-        spec["gravity"] = {"acceleration": _value("gravity: ", _NUMBER, gravity)}
     else:
+        if isinstance(gravity, int | float) and not isinstance(gravity, bool):
+            gravity = {"acceleration": gravity}
         spec["gravity"] = _table("[gravity] ", gravity, _GRAVITY)
+        if not spec["gravity"]["acceleration"] >= 0:
+            raise _fail("[gravity] acceleration: ", "must be >= 0 (m/s^2, along -x)")
     excitations = []
     for j, table in enumerate(_list("excitation", excitation)):
         where = f"[[excitation]] {j}: "
@@ -341,6 +368,15 @@ def system_spec(
             _choice(where, "sweep", e["sweep"], _SWEEPS)
         if e["kind"] == "force" and e["at"] is None:
             raise _fail(where, 'kind "force" needs the point it acts at: at')
+        if e["kind"] == "base" and e["at"] is not None:
+            raise _fail(where, 'at applies to kind "force" only: a base motion moves every point')
+        extra = sorted(set(table) - {"kind", "at", "signal"} - _SIGNAL_KEYS[e["signal"]])
+        if extra:
+            allowed = ", ".join(sorted(_SIGNAL_KEYS[e["signal"]]))
+            raise _fail(
+                where,
+                f"{', '.join(extra)} not used by signal {e['signal']!r} (it takes {allowed})",
+            )
         if e["file"] is not None:
             if e["time"] is not None or e["value"] is not None:
                 raise _fail(where, "give file or time and value, not both")

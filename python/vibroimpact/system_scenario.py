@@ -130,9 +130,22 @@ def system_lines(name: str, sol: SystemSolution, cpu_time: float) -> list[str]:
         f"{name}: {sol.method}, {sol.steps} steps ({sol.rejected_steps} rejected, "
         f"{sol.rhs_evaluations} force evaluations) to t = {sol.final_time:g} s in "
         f"{cpu_time * 1e3:.3f} ms",
-        f"energy (J): stored {e['stored_start']:.6g} -> {e['stored_end']:.6g}, input work "
-        f"{e['input_work']:.6g}, dissipated {e['dissipated']:.6g} (viscous {e['viscous']:.6g}, "
-        f"contact {e['contact']:.6g}, impacts {e['impact']:.6g}), residual {e['residual']:.3g}",
+        "energy (J): stored {:.6g} -> {:.6g}, input work {:.6g}, dissipated {:.6g} (viscous "
+        "{:.6g}, contact {:.6g}, impacts {:.6g}), residual {:.3g}".format(
+            *(
+                e[key] + 0.0
+                for key in (
+                    "stored_start",
+                    "stored_end",
+                    "input_work",
+                    "dissipated",
+                    "viscous",
+                    "contact",
+                    "impact",
+                    "residual",
+                )
+            )
+        ),
         f"{len(sol.contacts)} contact(s)",
     ]
     if len(sol.contacts):
@@ -155,6 +168,7 @@ def system_lines(name: str, sol: SystemSolution, cpu_time: float) -> list[str]:
                 elif math.isnan(value):
                     cells.append(f"{'open':>17}")
                 else:
-                    cells.append(f"{value:>17.7g}")
+                    # + 0.0 turns a negative zero into a zero.
+                    cells.append(f"{value + 0.0:>17.7g}")
             lines.append("  ".join(cells))
     return lines

@@ -737,10 +737,15 @@ pub fn initial_state(
     }
     for i in 0..assembly.interactions.len() {
         let (gap, _) = assembly.gap(i, &y);
-        if gap < 0.0 {
+        let it = &assembly.interactions[i];
+        // On the wall to round-off is at the wall.
+        let round_off = 8.0
+            * f64::EPSILON
+            * (it.offset.abs() + it.h.iter().zip(&y).map(|(h, x)| (h * x).abs()).sum::<f64>());
+        if gap < -round_off {
             return Err(Error::Inconsistent(format!(
                 "initial state: {} starts {:.6e} m inside its wall; start every pair apart or just touching",
-                assembly.pairs[assembly.interactions[i].pair],
+                assembly.pairs[it.pair],
                 -gap
             )));
         }

@@ -32,7 +32,7 @@ pub enum Error {
     /// Contacts and separations follow each other ever faster.
     #[error(
         "chattering at t = {time:.6e} s: {events} contact changes in a row less than {interval:.1e} s apart, \
-         below the run's time resolution (an impact mass settling against a wall, or a contact far too stiff \
+         below the run's time resolution (an impact mass settling against a wall, a zero clearance, or a contact far too stiff \
          for the clearance); the run was stopped there"
     )]
     Chattering {

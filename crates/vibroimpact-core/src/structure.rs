@@ -244,8 +244,14 @@ impl Structure {
 fn square(key: &str, rows: &[Vec<f64>], n: usize) -> Result<Vec<f64>> {
     if rows.len() != n || rows.iter().any(|row| row.len() != n) {
         let shape: Vec<usize> = rows.iter().map(Vec::len).collect();
+        let like = if key == "mass" {
+            String::new()
+        } else {
+            " like structure.mass".into()
+        };
         return Err(Error::Inconsistent(format!(
-            "structure.{key} must be {n} x {n} like structure.mass, got rows of lengths {shape:?}"
+            "structure.{key} must be {n} x {n}{like} (an array of {n} rows of {n} numbers), \
+             got rows of lengths {shape:?}"
         )));
     }
     let flat: Vec<f64> = rows.iter().flatten().copied().collect();

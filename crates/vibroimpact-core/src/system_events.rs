@@ -428,6 +428,8 @@ fn locate<S: SystemStepper>(
 /// closer than the time's round-off can resolve, stop it.
 const CHATTER_EVENTS: u64 = 16;
 const CHATTER_ULPS: f64 = 1e3;
+/// Steps in a row at the round-off of time that stop a run.
+const STALLED_STEPS: u64 = 64;
 /// How often (steps) the energy balance is checked and the caller asked
 /// whether to stop.
 const ENERGY_INTERVAL: u64 = 32;
@@ -483,7 +485,7 @@ pub fn integrate_system<S: SystemStepper>(
     let mut scratch = Scratch::new(system);
     let mut modes = vec![Mode::Open; count];
     let mut open: Vec<Option<Open>> = vec![None; count];
-    let (stored_start, start_scale) = system.energy_terms(&y, &modes);
+    let (stored_start, mut energy_scale) = system.energy_terms(&y, &modes);
     let mut impact_loss = 0.0;
     let mut contacts: Vec<PairContact> = Vec::new();
     let row = 2 * d;
@@ -503,6 +505,7 @@ pub fn integrate_system<S: SystemStepper>(
     let mut until_kept = options.every;
     let (mut last_event, mut close_events) = (f64::NEG_INFINITY, 0u64);
     let mut just_rejected = false;
+    let mut stalled = 0u64;
 
     while time < t_end {
         let mut length = if adaptive {
@@ -753,13 +756,28 @@ pub fn integrate_system<S: SystemStepper>(
             keep(time, &y, &mut time_rows, &mut states);
         }
         if (time_rows.len() + contacts.len()) as u64 > options.max_rows {
-            return Err(Error::Inconsistent(format!(
-                "the run kept {} history rows and {} contacts by t = {time:.6e} s, more than max_rows = {}: \
-                 raise every, set history = false, shorten t_end or raise max_rows",
-                time_rows.len(),
-                contacts.len(),
-                options.max_rows
-            )));
+            return Err(Error::RowLimit {
+                time,
+                max_rows: options.max_rows,
+                rows: time_rows.len() as u64,
+                contacts: contacts.len() as u64,
+                advice: "raise every, set history = false, shorten t_end or raise max_rows",
+            });
+        }
+        // Steps within a thousand units of round-off of the time make no
+        // progress: an event that recurs at once (a zero clearance, say)
+        // would otherwise loop.
+        if taken <= chatter_interval(time) {
+            stalled += 1;
+            if stalled >= STALLED_STEPS {
+                return Err(Error::Chattering {
+                    time,
+                    events: stalled,
+                    interval: taken,
+                });
+            }
+        } else {
+            stalled = 0;
         }
         if accepted % ENERGY_INTERVAL == 0 || done {
             check_balance(
@@ -767,7 +785,7 @@ pub fn integrate_system<S: SystemStepper>(
                 &y,
                 &modes,
                 stored_start,
-                start_scale,
+                &mut energy_scale,
                 impact_loss,
                 options,
                 time,
@@ -842,20 +860,23 @@ fn check_balance(
     y: &[f64],
     modes: &[Mode],
     stored_start: f64,
-    start_scale: f64,
+    scale: &mut f64,
     impact: f64,
     options: &RunOptions,
     time: f64,
 ) -> Result<()> {
     let b = balance(system, y, modes, stored_start, impact);
-    let scale =
-        start_scale + system.energy_terms(y, modes).1 + b.input_work.abs() + b.dissipated.abs();
-    if b.residual.abs() > options.energy_tolerance * scale || !b.residual.is_finite() {
-        return Err(Error::NumericalBlowUp {
+    // The energy in play: the largest seen so far, since a system without
+    // losses can pass through states where every term is near zero.
+    *scale = scale
+        .max(system.energy_terms(y, modes).1 + b.input_work.abs() + b.dissipated.abs())
+        .max(f64::MIN_POSITIVE);
+    if b.residual.abs() > options.energy_tolerance * *scale || !b.residual.is_finite() {
+        return Err(Error::EnergyBalance {
             time,
-            reason:
-                "the energy balance does not close (stored - start - input + dissipated is beyond \
-                     energy_tolerance of the energies in play): reduce dt or tighten rtol/atol",
+            residual: b.residual,
+            scale: *scale,
+            tolerance: options.energy_tolerance,
         });
     }
     Ok(())
