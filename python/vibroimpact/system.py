@@ -41,7 +41,12 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact._core import Contact, InvalidInputError
+from vibroimpact._core import (
+    DEFAULT_ENERGY_TOLERANCE,
+    DEFAULT_MAX_ROWS,
+    Contact,
+    InvalidInputError,
+)
 from vibroimpact._core import simulate_system as _simulate_system
 
 __all__ = [
@@ -126,8 +131,9 @@ SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
     "rtol": 1e-8,
     "atol": 1e-12,
     "max_steps": 1_000_000_000,
-    "energy_tolerance": 1e-2,
-    "max_rows": 20_000_000,
+    # The same limits as the two-mass runs, from the core.
+    "energy_tolerance": DEFAULT_ENERGY_TOLERANCE,
+    "max_rows": DEFAULT_MAX_ROWS,
     "beta": 0.25,
     "gamma": 0.5,
     "spectral_radius": 0.9,

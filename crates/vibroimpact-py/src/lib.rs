@@ -69,6 +69,33 @@ fn to_py(err: core::Error) -> PyErr {
     }
 }
 
+/// Runs `work` with the GIL released, giving it a question to ask now and
+/// then: has Ctrl-C been pressed? An interruption becomes the Python
+/// exception (KeyboardInterrupt) that caused it; other errors map by kind.
+fn released<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&mut dyn FnMut() -> bool) -> core::Result<T> + Send,
+{
+    let mut signal: Option<PyErr> = None;
+    let result = py.detach(|| {
+        work(&mut || match Python::attach(|py| py.check_signals()) {
+            Ok(()) => false,
+            Err(e) => {
+                signal = Some(e);
+                true
+            }
+        })
+    });
+    match result {
+        Ok(value) => Ok(value),
+        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
+            Err(signal.take().expect("checked"))
+        }
+        Err(e) => Err(to_py(e)),
+    }
+}
+
 /// A whole number >= 1 from a Python int; one too large or too small for the
 /// core is an InvalidInputError naming the field, not an OverflowError.
 fn whole(field: &str, value: &Bound<'_, PyAny>) -> PyResult<u64> {
@@ -787,29 +814,9 @@ fn simulate(
     )?;
     let parsed = settings.method;
     let (sys, con, init) = (system.0, contact.0, initial.0);
-    let mut signal: Option<PyErr> = None;
-    let result = py.detach(|| {
-        core::simulate(
-            &sys,
-            &con,
-            &init,
-            &settings,
-            &mut || match Python::attach(|py| py.check_signals()) {
-                Ok(()) => false,
-                Err(e) => {
-                    signal = Some(e);
-                    true
-                }
-            },
-        )
-    });
-    let sol = match result {
-        Ok(sol) => sol,
-        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
-            return Err(signal.take().expect("checked"))
-        }
-        Err(e) => return Err(to_py(e)),
-    };
+    let sol = released(py, |interrupt| {
+        core::simulate(&sys, &con, &init, &settings, interrupt)
+    })?;
     let h = sol.history;
     Ok(Solution {
         rows: h.time.len(),

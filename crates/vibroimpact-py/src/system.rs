@@ -15,7 +15,7 @@ use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, RunOptions};
 use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 
-use crate::{to_py, InvalidInputError};
+use crate::{released, to_py, InvalidInputError};
 
 /// `where key` must be present: the Python side fills defaults, so a missing
 /// key is a bug of the caller's dict, reported as bad input all the same.
@@ -259,7 +259,7 @@ fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
     })
 }
 
-/// Integrate with the GIL released, checking for Ctrl-C now and then.
+/// Integrate with the GIL released (see [`crate::released`]).
 fn run<S: SystemStepper + Send>(
     py: Python<'_>,
     system: &Assembly,
@@ -267,29 +267,9 @@ fn run<S: SystemStepper + Send>(
     y0: &[f64],
     options: &RunOptions,
 ) -> PyResult<core::system_events::SystemSolution> {
-    let mut signal: Option<PyErr> = None;
-    let result = py.detach(|| {
-        integrate_system(
-            system,
-            stepper,
-            y0,
-            options,
-            &mut || match Python::attach(|py| py.check_signals()) {
-                Ok(()) => false,
-                Err(e) => {
-                    signal = Some(e);
-                    true
-                }
-            },
-        )
-    });
-    match result {
-        Ok(sol) => Ok(sol),
-        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
-            Err(signal.take().expect("checked"))
-        }
-        Err(e) => Err(to_py(e)),
-    }
+    released(py, |interrupt| {
+        integrate_system(system, stepper, y0, options, interrupt)
+    })
 }
 
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
