@@ -15,7 +15,7 @@ use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, RunOptions};
 use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 
-use crate::{released, to_py, InvalidInputError};
+use crate::errors::{released, to_py, InvalidInputError};
 
 /// `where key` must be present: the Python side fills defaults, so a missing
 /// key is a bug of the caller's dict, reported as bad input all the same.

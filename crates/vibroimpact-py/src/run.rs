@@ -1,0 +1,447 @@
+//! The two-mass run: its settings, `simulate`, and the results (history
+//! columns and the contact table, as NumPy arrays made on first access).
+
+use std::sync::{Mutex, OnceLock};
+
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use vibroimpact_core as core;
+
+use crate::convert::*;
+use crate::errors::*;
+use crate::inputs::{Contact, ImpactDamper, InitialState};
+/// A column of results that becomes a NumPy array on first access (without
+/// a copy): a call pays only for the arrays it reads.
+pub(crate) struct Column {
+    data: Mutex<Option<Vec<f64>>>,
+    array: OnceLock<Py<PyArray1<f64>>>,
+}
+
+impl Column {
+    fn new(data: Vec<f64>) -> Self {
+        Self {
+            data: Mutex::new(Some(data)),
+            array: OnceLock::new(),
+        }
+    }
+
+    fn get(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.array
+            .get_or_init(|| {
+                let data = self
+                    .data
+                    .lock()
+                    .map(|mut d| d.take().unwrap_or_default())
+                    .unwrap_or_default();
+                data.into_pyarray(py).unbind()
+            })
+            .clone_ref(py)
+    }
+}
+
+pub(crate) const CONTACT_COLUMNS: [&str; 9] = [
+    "onset",
+    "separation",
+    "duration",
+    "max_indentation",
+    "approach_speed",
+    "rebound_speed",
+    "restitution",
+    "energy_dissipated",
+    "energy_change",
+];
+
+pub(crate) fn record_values(r: &core::ContactRecord) -> [f64; 9] {
+    [
+        r.onset,
+        r.separation,
+        r.duration,
+        r.max_indentation,
+        r.approach_speed,
+        r.rebound_speed,
+        r.restitution,
+        r.energy_dissipated,
+        r.energy_change,
+    ]
+}
+
+/// The contacts of a run, one entry per contact, as NumPy arrays in SI units.
+/// A contact still open at the end of the run has NaN ``separation``,
+/// ``duration``, ``rebound_speed``, ``restitution`` and ``energy_change``.
+#[pyclass(frozen, module = "vibroimpact._core")]
+pub(crate) struct ContactTable {
+    records: Vec<core::ContactRecord>,
+    columns: [OnceLock<Py<PyArray1<f64>>>; 9],
+}
+
+impl ContactTable {
+    fn new(records: Vec<core::ContactRecord>) -> Self {
+        Self {
+            records,
+            columns: Default::default(),
+        }
+    }
+
+    fn column(&self, py: Python<'_>, index: usize) -> Py<PyArray1<f64>> {
+        self.columns[index]
+            .get_or_init(|| {
+                let values: Vec<f64> = self
+                    .records
+                    .iter()
+                    .map(|r| record_values(r)[index])
+                    .collect();
+                values.into_pyarray(py).unbind()
+            })
+            .clone_ref(py)
+    }
+}
+
+#[pymethods]
+impl ContactTable {
+    /// Column names, in order.
+    #[classattr]
+    fn columns() -> [&'static str; 9] {
+        CONTACT_COLUMNS
+    }
+    /// Onset, s.
+    #[getter]
+    fn onset(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 0)
+    }
+    /// Separation, s.
+    #[getter]
+    fn separation(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 1)
+    }
+    /// Duration, s.
+    #[getter]
+    fn duration(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 2)
+    }
+    /// Maximum indentation, m.
+    #[getter]
+    fn max_indentation(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 3)
+    }
+    /// Relative normal speed at onset, m/s.
+    #[getter]
+    fn approach_speed(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 4)
+    }
+    /// Relative normal speed at separation, m/s.
+    #[getter]
+    fn rebound_speed(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 5)
+    }
+    /// Effective restitution: rebound_speed / approach_speed.
+    #[getter]
+    fn restitution(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 6)
+    }
+    /// Work done during the contact by the contact's dissipative forces (the
+    /// law's hysteresis and the contact damper c1), J, >= 0: the integral of
+    /// ``(F - F_elastic) * delta'`` over the contact. The main damper C is not
+    /// in it.
+    #[getter]
+    fn energy_dissipated(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 7)
+    }
+    /// Net change of the whole system's mechanical energy over the contact
+    /// (kinetic energy of both masses, main spring and contact elastic energy;
+    /// at separation minus at onset), J. With no main damper it is
+    /// ``-energy_dissipated``; with one, the damper's work during the contact
+    /// is in it too. NaN for a contact still open at the end.
+    #[getter]
+    fn energy_change(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.column(py, 8)
+    }
+    fn __len__(&self) -> usize {
+        self.records.len()
+    }
+    /// One dict per contact, keyed by the column names.
+    fn to_dicts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for r in &self.records {
+            let d = PyDict::new(py);
+            for (name, value) in CONTACT_COLUMNS.iter().zip(record_values(r)) {
+                d.set_item(name, value)?;
+            }
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+    fn __repr__(&self) -> String {
+        format!("ContactTable({} contacts)", self.records.len())
+    }
+}
+
+/// What ``simulate`` returns: the time history (NumPy arrays, SI units), the
+/// table of contacts and the run's statistics.
+#[pyclass(frozen, module = "vibroimpact._core")]
+pub(crate) struct Solution {
+    history: [Column; 6],
+    rows: usize,
+    /// The contacts.
+    #[pyo3(get)]
+    contacts: Py<ContactTable>,
+    /// Steps taken (accepted).
+    #[pyo3(get)]
+    steps: u64,
+    /// Steps rejected by the error control (adaptive methods).
+    #[pyo3(get)]
+    rejected_steps: u64,
+    /// Force (right-hand-side) evaluations, Newton iterations included.
+    #[pyo3(get)]
+    rhs_evaluations: u64,
+    /// Touches shallower than round-off, not counted as contacts.
+    #[pyo3(get)]
+    grazing_contacts: u64,
+    /// Time reached, s (t_end rounded up to a whole number of steps by the
+    /// fixed-step methods).
+    #[pyo3(get)]
+    final_time: f64,
+    /// Method name.
+    #[pyo3(get)]
+    method: &'static str,
+    /// "fixed" or "events".
+    #[pyo3(get)]
+    stepping: &'static str,
+    /// Largest relative growth of the mechanical energy of the unforced system,
+    /// ``max(E)/E(0) - 1`` (NaN if it starts at rest). Physically <= 0: a
+    /// positive value is numerical error (above 0.5 the run is refused).
+    #[pyo3(get)]
+    energy_growth: f64,
+    /// Largest residual of the energy balance found by the run's checks
+    /// (stored energy + dissipated work - external work - energy at the
+    /// start), relative to the energy in play; NaN for a system at rest. The
+    /// run is refused when it exceeds ``energy_tolerance``.
+    #[pyo3(get)]
+    energy_residual: f64,
+    /// The state at ``final_time``.
+    #[pyo3(get)]
+    final_state: InitialState,
+}
+
+#[pymethods]
+impl Solution {
+    /// Time of each kept step, s.
+    #[getter]
+    fn t(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[0].get(py)
+    }
+    /// w, m.
+    #[getter]
+    fn main_displacement(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[1].get(py)
+    }
+    /// w', m/s.
+    #[getter]
+    fn main_velocity(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[2].get(py)
+    }
+    /// y, m.
+    #[getter]
+    fn impact_displacement(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[3].get(py)
+    }
+    /// y', m/s.
+    #[getter]
+    fn impact_velocity(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[4].get(py)
+    }
+    /// Force between the bodies (law + contact damper), N; > 0 pushes apart.
+    #[getter]
+    fn contact_force(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
+        self.history[5].get(py)
+    }
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "Solution(method={:?}, stepping={:?}, steps={}, rows={}, contacts={})",
+            self.method,
+            self.stepping,
+            self.steps,
+            self.rows,
+            self.contacts.bind(py).get().records.len()
+        )
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn settings(
+    dt: Option<f64>,
+    t_end: f64,
+    method: &str,
+    every: u64,
+    contact_timing: &str,
+    stepping: Option<&str>,
+    beta: f64,
+    gamma: f64,
+    spectral_radius: f64,
+    rtol: f64,
+    atol: f64,
+    max_steps: u64,
+    max_rows: Option<u64>,
+    energy_tolerance: Option<f64>,
+    history: bool,
+) -> PyResult<core::Settings> {
+    let options = core::MethodOptions {
+        beta,
+        gamma,
+        spectral_radius,
+        rtol,
+        atol,
+    };
+    let parsed = core::Method::parse(method, &options).map_err(to_py)?;
+    let timing = core::ContactTiming::parse(contact_timing).map_err(to_py)?;
+    let stepping = stepping
+        .map(core::Stepping::parse)
+        .transpose()
+        .map_err(to_py)?;
+    core::Settings::new(parsed, dt, t_end, every, timing, stepping, max_steps)
+        .and_then(|s| s.with_limits(history, max_rows, energy_tolerance))
+        .map_err(to_py)
+}
+
+/// Check solver settings as ``simulate`` would, without running; raises
+/// ``InvalidInputError`` naming the offending field.
+#[pyfunction]
+#[pyo3(signature = (*, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000, max_rows = None, energy_tolerance = None, history = true))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_solver(
+    #[pyo3(from_py_with = real)] t_end: f64,
+    #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
+    method: &str,
+    #[pyo3(from_py_with = every_arg)] every: u64,
+    contact_timing: &str,
+    stepping: Option<&str>,
+    #[pyo3(from_py_with = real)] beta: f64,
+    #[pyo3(from_py_with = real)] gamma: f64,
+    #[pyo3(from_py_with = real)] spectral_radius: f64,
+    #[pyo3(from_py_with = real)] rtol: f64,
+    #[pyo3(from_py_with = real)] atol: f64,
+    #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
+    #[pyo3(from_py_with = real_or_none)] energy_tolerance: Option<f64>,
+    history: bool,
+) -> PyResult<()> {
+    settings(
+        dt,
+        t_end,
+        method,
+        every,
+        contact_timing,
+        stepping,
+        beta,
+        gamma,
+        spectral_radius,
+        rtol,
+        atol,
+        max_steps,
+        max_rows,
+        energy_tolerance,
+        history,
+    )
+    .map(|_| ())
+}
+
+/// Integrate the impact damper from ``initial`` to ``t_end`` (s).
+///
+/// ``method``: ``"newmark"`` (the founding paper's Newmark-beta, contact force
+/// lagged one step), ``"newmark-implicit"`` (Newton on the contact force;
+/// ``beta``, ``gamma`` default 1/4, 1/2), ``"generalized-alpha"``
+/// (Chung-Hulbert, ``spectral_radius`` in [0, 1]), ``"rk4"`` (classical
+/// Runge-Kutta): fixed step ``dt`` (s); ``"dopri5"``, ``"dop853"``: adaptive
+/// with ``rtol``, ``atol`` (``dt`` is then the first step, optional).
+///
+/// ``stepping``: ``"events"`` locates every contact onset and separation to
+/// round-off, cuts the step there and restarts; ``"fixed"`` is the founding
+/// paper's stepping, for ``"newmark"`` and ``"rk4"`` only (their default),
+/// whose contact instants are ``contact_timing`` ``"located"`` (interpolated
+/// inside the step) or ``"step-count"`` (whole steps). ``every`` keeps every
+/// N-th step in the history; ``max_steps`` bounds the work.
+///
+/// Limits: ``max_rows`` bounds the history rows plus contacts a run keeps
+/// (None: ``DEFAULT_MAX_ROWS``, 2e7; a row is 48 bytes, a contact 72): a
+/// fixed-step history beyond it is refused before the run, any other run
+/// stops at it with a ``SimulationError``; ``history=False`` keeps no history at all
+/// (empty arrays; ``final_state`` holds the end). A start with the bodies
+/// interpenetrating is refused. ``energy_tolerance`` (relative, None:
+/// ``DEFAULT_ENERGY_TOLERANCE``, 0.05): a result whose energy balance (stored
+/// energy + dissipated work - external work = energy at the start) misses by
+/// more than that fraction of the energy in play, or one of whose contacts
+/// creates energy beyond it, raises ``EnergyBalanceError``.
+/// The GIL is released while integrating; Ctrl-C interrupts.
+#[pyfunction]
+#[pyo3(signature = (system, contact, initial, *, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000, max_rows = None, energy_tolerance = None, history = true))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn simulate(
+    py: Python<'_>,
+    system: &ImpactDamper,
+    contact: &Contact,
+    initial: &InitialState,
+    #[pyo3(from_py_with = real)] t_end: f64,
+    #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
+    method: &str,
+    #[pyo3(from_py_with = every_arg)] every: u64,
+    contact_timing: &str,
+    stepping: Option<&str>,
+    #[pyo3(from_py_with = real)] beta: f64,
+    #[pyo3(from_py_with = real)] gamma: f64,
+    #[pyo3(from_py_with = real)] spectral_radius: f64,
+    #[pyo3(from_py_with = real)] rtol: f64,
+    #[pyo3(from_py_with = real)] atol: f64,
+    #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
+    #[pyo3(from_py_with = real_or_none)] energy_tolerance: Option<f64>,
+    history: bool,
+) -> PyResult<Solution> {
+    let settings = settings(
+        dt,
+        t_end,
+        method,
+        every,
+        contact_timing,
+        stepping,
+        beta,
+        gamma,
+        spectral_radius,
+        rtol,
+        atol,
+        max_steps,
+        max_rows,
+        energy_tolerance,
+        history,
+    )?;
+    let parsed = settings.method;
+    let (sys, con, init) = (system.0, contact.0, initial.0);
+    let sol = released(py, |interrupt| {
+        core::simulate(&sys, &con, &init, &settings, interrupt)
+    })?;
+    let h = sol.history;
+    Ok(Solution {
+        rows: h.time.len(),
+        history: [
+            Column::new(h.time),
+            Column::new(h.main_displacement),
+            Column::new(h.main_velocity),
+            Column::new(h.impact_displacement),
+            Column::new(h.impact_velocity),
+            Column::new(h.contact_force),
+        ],
+        contacts: Py::new(py, ContactTable::new(sol.contacts))?,
+        steps: sol.steps,
+        rejected_steps: sol.rejected_steps,
+        rhs_evaluations: sol.rhs_evaluations,
+        grazing_contacts: sol.grazing_contacts,
+        final_time: sol.final_time,
+        energy_growth: sol.energy_growth,
+        energy_residual: sol.energy_residual,
+        final_state: InitialState(sol.final_state),
+        method: parsed.name(),
+        stepping: match settings.stepping {
+            core::Stepping::Fixed => "fixed",
+            core::Stepping::Events => "events",
+        },
+    })
+}
