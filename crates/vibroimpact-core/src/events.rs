@@ -13,10 +13,11 @@ use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
 use crate::hermite::{self, Quintic};
 use crate::model::{Excitation, Mode, Model};
-use crate::run::{
+use crate::records::{
     check_start, external_work, open_record, speed_squared_integral, ContactRecord, EnergyLedger,
-    Records, Settings, Solution,
+    Records, Solution,
 };
+use crate::settings::Settings;
 use crate::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
 use crate::system::State;
 

@@ -19,7 +19,9 @@ pub mod integrators;
 pub mod linalg;
 pub mod materials;
 pub mod model;
+pub mod records;
 pub mod run;
+pub mod settings;
 pub mod signals;
 pub mod steppers;
 pub mod structure;
@@ -30,9 +32,11 @@ pub mod tableau;
 
 pub use contact::{Contact, ContactLaw, LawKind};
 pub use error::{Error, Result};
-pub use run::{
-    simulate, ContactRecord, ContactTiming, History, Method, MethodOptions, Settings, Solution,
-    Stepping, DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
+pub use records::{ContactRecord, History, Solution};
+pub use run::simulate;
+pub use settings::{
+    ContactTiming, Method, MethodOptions, Settings, Stepping, DEFAULT_ENERGY_TOLERANCE,
+    DEFAULT_MAX_ROWS,
 };
 pub use steppers::Tolerances;
 pub use system::{ImpactDamper, State};
