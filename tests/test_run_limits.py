@@ -527,3 +527,26 @@ def test_energy_change_is_the_energy_at_separation_minus_at_onset() -> None:
         damper = 0.01 * np.trapezoid(sol.main_velocity[i : j + 1] ** 2, sol.t[i : j + 1])
         assert change < -dissipated < 0
         assert change == pytest.approx(-dissipated - damper, rel=1e-3)
+
+
+@pytest.mark.timeout(120)
+def test_a_long_undamped_rattler_runs_without_false_chattering_or_invented_contacts() -> None:
+    """The issue's rattler (no damping, DOP853) to t = 2.1e5 s: chattering used to be
+    judged against 1e-12 of t_end (1e-5 s for t_end = 1e7), stopping this run, and a
+    step that started on a wall it was leaving recorded a contact that never was (zero
+    duration, separating at its onset). Every contact must start by an approach."""
+    sol = vi.simulate(
+        vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01),
+        vi.Contact("hertz", stiffness=3000.0),
+        vi.InitialState(main_displacement=0.05, impact_displacement=0.05),
+        method="dop853",
+        t_end=2.1e5,
+        history=False,
+        max_steps=10**7,
+    )
+    c = sol.contacts
+    assert len(c) > 100_000
+    assert np.all(c.approach_speed > 0)
+    # Hertz contacts of this system last about 0.1 s; the invented ones lasted 0 to 4e-11 s.
+    finished = np.isfinite(c.duration)
+    assert np.min(c.duration[finished]) > 1e-3

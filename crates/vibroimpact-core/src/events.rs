@@ -134,14 +134,27 @@ fn find_crossing<L: ContactLaw, X: Excitation>(
                 let (g1, r1) = gap(model, end, side);
                 let (m0, m1) = (r0 * h, r1 * h);
                 let found = if g1 > 0.0 {
-                    let guess = if g0 < 0.0 {
+                    // On the wall at the start (just after a separation, to
+                    // round-off) and leaving it: the onset is the later
+                    // crossing, after the interpolant's lowest point, not
+                    // the start (that would be a contact that never was).
+                    let leaving = g0 >= -graze_tolerance && m0 < 0.0 && m1 > 0.0;
+                    let before = if leaving {
+                        hermite::argmax(-g0, -g1, -m0, -m1)
+                    } else {
+                        0.0
+                    };
+                    let (low, _) = hermite::eval(g0, g1, m0, m1, before);
+                    let guess = if leaving && low < 0.0 {
+                        before + (1.0 - before) * -low / (g1 - low)
+                    } else if g0 < 0.0 {
                         hermite::root(g0, g1, m0, m1)
                     } else {
                         0.0
                     };
                     Some(Crossing {
                         side,
-                        before: 0.0,
+                        before,
                         after: Some(1.0),
                         guess,
                     })
@@ -404,8 +417,8 @@ struct Open {
 /// How often (in accepted steps) the kernel asks whether to stop; a power of
 /// two, a multiple of the energy check's interval.
 const INTERRUPT_INTERVAL: u64 = 1 << 14;
-/// Mode changes in a row closer than this fraction of the run make chattering.
-const CHATTER_FRACTION: f64 = 1e-12;
+/// Mode changes in a row closer than this many units of round-off of the time make chattering.
+const CHATTER_ULPS: f64 = 1e3;
 const CHATTER_EVENTS: u64 = 16;
 
 /// Rebound over approach speed; NaN for a contact that did not start by an
@@ -455,7 +468,12 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
     };
     let every = settings.every;
     let graze_tolerance = 1e-12 * model.clearance.max(1e-9);
-    let chatter_interval = CHATTER_FRACTION * t_end;
+    // Events closer than a thousand units of round-off of the time itself
+    // cannot be told apart (the main mass's period, or the run without a
+    // spring, sets the scale near t = 0).
+    let period = std::f64::consts::TAU * (model.main_mass / model.stiffness).sqrt();
+    let time_scale = t_end.min(period);
+    let chatter_interval = |time: f64| CHATTER_ULPS * f64::EPSILON * time.abs().max(time_scale);
 
     let mut y = to_vector(initial, 0.0);
     let mut time = t0;
@@ -709,13 +727,13 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             if let (true, Mode::Contact { approach_rate, .. }) = (S::ADAPTIVE, mode) {
                 h = h.min(ONSET_STEP_FRACTION * contact_time_scale(model, approach_rate));
             }
-            if time - last_event < chatter_interval {
+            if time - last_event < chatter_interval(time) {
                 close_events += 1;
                 if close_events >= CHATTER_EVENTS {
                     return Err(Error::Chattering {
                         time,
                         events: close_events,
-                        interval: chatter_interval,
+                        interval: chatter_interval(time),
                     });
                 }
             } else {
