@@ -13,7 +13,9 @@ import csv
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -201,6 +203,16 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
 
 def _simulate(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario) if args.scenario else paper_collision()
+    keeps = (
+        scenario.prepared.output["history"]
+        if isinstance(scenario, SystemScenario)
+        else scenario.history
+    )
+    if args.out and not keeps:
+        raise UsageError(
+            f"--out writes the history, which {args.scenario} does not keep "
+            "([output] history = false): drop --out or keep the history"
+        )
     if isinstance(scenario, SystemScenario):
         return _simulate_system(args, scenario)
     start = time.perf_counter()
@@ -232,9 +244,22 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised where the program is, so that cleanups run."""
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise _Terminated
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
+    # A termination request (SIGTERM, what `timeout` and schedulers send) ends
+    # the run like Ctrl-C does, so that a file being written is removed and an
+    # earlier result stays whole.
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:
         if args.command == "paper":
             return run_paper(args.out)
@@ -249,8 +274,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("vibroimpact: interrupted", file=sys.stderr)
         return 130
+    except _Terminated:
+        print("vibroimpact: terminated", file=sys.stderr)
+        return 143
     except BrokenPipeError:
         # The reader (e.g. `| head`) left early: not an error of ours. Point
         # stdout at devnull so that Python's exit flush does not fail again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)

@@ -4,23 +4,44 @@
 use pyo3::prelude::*;
 
 use crate::errors::InvalidInputError;
+
+/// `value` as Python shows it, cut short for a one-line message.
+fn shown(value: &Bound<'_, PyAny>) -> String {
+    let text = value
+        .repr()
+        .map(|r| r.to_string())
+        .unwrap_or_else(|_| "?".into());
+    if text.chars().count() > 60 {
+        let head: String = text.chars().take(57).collect();
+        format!("{head}...")
+    } else {
+        text
+    }
+}
+
 /// A whole number >= 1 from a Python int; one too large or too small for the
 /// core is an InvalidInputError naming the field, not an OverflowError.
 pub(crate) fn whole(field: &str, value: &Bound<'_, PyAny>) -> PyResult<u64> {
-    let invalid = || {
-        InvalidInputError::new_err(format!(
-            "{field} must be a whole number in [1, {}], got {value}",
-            i64::MAX
-        ))
-    };
+    // A float (1e9, 2.5, nan), a string or an int out of range: all invalid
+    // input naming the field, never a bare TypeError or OverflowError.
     match value.extract::<i64>() {
         Ok(v) if v >= 1 => Ok(v as u64),
-        Ok(_) => Err(invalid()),
-        Err(err) if err.is_instance_of::<pyo3::exceptions::PyOverflowError>(value.py()) => {
-            Err(invalid())
-        }
-        Err(err) => Err(err),
+        _ => Err(InvalidInputError::new_err(format!(
+            "{field} must be a whole number in [1, {}] (an int, not a float), got {}",
+            i64::MAX,
+            shown(value)
+        ))),
     }
+}
+
+/// `history`: true or false only.
+pub(crate) fn history_arg(value: &Bound<'_, PyAny>) -> PyResult<bool> {
+    value.extract::<bool>().map_err(|_| {
+        InvalidInputError::new_err(format!(
+            "history must be True or False, got {}",
+            shown(value)
+        ))
+    })
 }
 
 /// A float argument (the `from_py_with` of every float parameter). A Python

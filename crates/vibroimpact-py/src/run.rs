@@ -323,7 +323,7 @@ pub(crate) fn check_solver(
     #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
     #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
     #[pyo3(from_py_with = real_or_none)] energy_tolerance: Option<f64>,
-    history: bool,
+    #[pyo3(from_py_with = history_arg)] history: bool,
 ) -> PyResult<()> {
     settings(
         dt,
@@ -394,7 +394,7 @@ pub(crate) fn simulate(
     #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
     #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
     #[pyo3(from_py_with = real_or_none)] energy_tolerance: Option<f64>,
-    history: bool,
+    #[pyo3(from_py_with = history_arg)] history: bool,
 ) -> PyResult<Solution> {
     let settings = settings(
         dt,
