@@ -33,3 +33,16 @@ def test_python_package_passes_mypy_strict() -> None:
 @pytest.mark.skipif(shutil.which("cargo") is None, reason="needs cargo")
 def test_rust_sources_are_formatted() -> None:
     run("cargo", "fmt", "--all", "--check")
+
+
+def test_every_rust_integration_test_runs_under_a_time_limit() -> None:
+    """cargo test has no per-test timeout: each #[test] in crates/*/tests must run its
+    body through common::timeout, so that a hang fails in seconds."""
+    import re
+
+    for path in sorted((ROOT / "crates").glob("*/tests/*.rs")):
+        text = path.read_text(encoding="utf-8")
+        tests = re.findall(r"#\[test\]\s*\n(?:#\[[^\n]*\]\s*\n)*fn (\w+)\(\) \{\n\s*(\S+)", text)
+        assert tests, path.name
+        for name, first in tests:
+            assert first.startswith("common::timeout("), f"{path.name}: {name}"
