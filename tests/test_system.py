@@ -495,3 +495,16 @@ def test_a_start_on_the_wall_to_round_off_is_accepted() -> None:
         dt=1e-3,
     )
     assert sol.final_time == pytest.approx(0.1)
+
+
+def test_values_nested_thousands_deep_are_invalid_input() -> None:
+    nested: object = [1.0]
+    for _ in range(100_000):
+        nested = [nested]
+    with pytest.raises(vi.InvalidInputError, match="nested too deeply"):
+        simulate_system(
+            {"kind": "matrices", "mass": nested, "stiffness": [[1.0]]},
+            t_end=1.0,
+            method="rk4",
+            dt=1e-3,
+        )

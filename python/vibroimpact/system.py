@@ -226,7 +226,7 @@ def _value(where: str, kind: str, value: Any) -> Any:
         return number
     if kind == _WHOLE:
         if isinstance(value, bool) or not isinstance(value, int) or value not in range(2**63):
-            raise _fail(where, f"must be a whole number >= 0 in 64 bits, got {value!r:.60}")
+            raise _fail(where, f"must be a whole number (an int in 64 bits), got {value!r:.60}")
         return value
     if kind == _TEXT:
         if not isinstance(value, str):
@@ -586,7 +586,11 @@ def prepare_system(
 ) -> PreparedRun:
     """Check every section of a 0.2 run (the sections of a TOML scenario, as dicts)
     and fill their defaults; errors name the section and key."""
-    spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
+    try:
+        spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
+    except RecursionError:
+        # Arrays nested thousands deep: no structure has them.
+        raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
     init = _table("[initial] ", initial or {}, _INITIAL)
     solver = _table("[solver] ", solver, _SOLVER)
     output = _table("[output] ", output or {}, _OUTPUT)
