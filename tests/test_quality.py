@@ -35,14 +35,22 @@ def test_rust_sources_are_formatted() -> None:
     run("cargo", "fmt", "--all", "--check")
 
 
-def test_every_rust_integration_test_runs_under_a_time_limit() -> None:
-    """cargo test has no per-test timeout: each #[test] in crates/*/tests must run its
-    body through common::timeout, so that a hang fails in seconds."""
+def test_every_rust_test_runs_under_a_time_limit() -> None:
+    """cargo test has no per-test timeout: each #[test], in crates/*/tests and in the
+    sources' unit tests, must run its body through the testing module's timeout, so
+    that a hang fails in seconds."""
     import re
 
-    for path in sorted((ROOT / "crates").glob("*/tests/*.rs")):
+    test = re.compile(r"#\[test\]\s*\n(?:\s*#\[[^\n]*\]\s*\n)*\s*fn (\w+)\(\) \{\n\s*(\S+)")
+    found = 0
+    for path in sorted((ROOT / "crates").glob("*/*/*.rs")):
         text = path.read_text(encoding="utf-8")
-        tests = re.findall(r"#\[test\]\s*\n(?:#\[[^\n]*\]\s*\n)*fn (\w+)\(\) \{\n\s*(\S+)", text)
-        assert tests, path.name
+        expected = text.count("#[test]")
+        tests = test.findall(text)
+        assert len(tests) == expected, path.name
         for name, first in tests:
-            assert first.startswith("common::timeout("), f"{path.name}: {name}"
+            assert first.startswith(("common::timeout(", "crate::testing::timeout(")), (
+                f"{path.name}: {name}"
+            )
+        found += expected
+    assert found >= 80

@@ -143,70 +143,78 @@ mod tests {
 
     #[test]
     fn exact_constant_matches_the_integral() {
-        // 2 * int_0^1 dx / sqrt(1 - x^(5/2)), by the substitution x = 1 - s^2
-        // (which removes the end singularity) and a fine midpoint rule.
-        let n = 200_000;
-        let h = 1.0 / n as f64;
-        let mut sum = 0.0;
-        for i in 0..n {
-            let s = (i as f64 + 0.5) * h;
-            let x: f64 = 1.0 - s * s;
-            sum += 2.0 * s / (1.0 - x.powf(2.5)).sqrt() * h;
-        }
-        assert!(
-            (2.0 * sum - HERTZ_DURATION_CONSTANT).abs() < 1e-8,
-            "{}",
-            2.0 * sum
-        );
+        crate::testing::timeout(60, || {
+            // 2 * int_0^1 dx / sqrt(1 - x^(5/2)), by the substitution x = 1 - s^2
+            // (which removes the end singularity) and a fine midpoint rule.
+            let n = 200_000;
+            let h = 1.0 / n as f64;
+            let mut sum = 0.0;
+            for i in 0..n {
+                let s = (i as f64 + 0.5) * h;
+                let x: f64 = 1.0 - s * s;
+                sum += 2.0 * s / (1.0 - x.powf(2.5)).sqrt() * h;
+            }
+            assert!(
+                (2.0 * sum - HERTZ_DURATION_CONSTANT).abs() < 1e-8,
+                "{}",
+                2.0 * sum
+            );
+        });
     }
 
     #[test]
     fn every_argument_is_checked_and_named() {
-        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-            let duration = |m, big, k, v| goldsmith_contact_duration(m, big, k, v, true);
-            assert_eq!(field(duration(bad, 1.0, 1.0, 1.0)), "impact_mass");
-            assert_eq!(field(duration(1.0, bad, 1.0, 1.0)), "main_mass");
-            assert_eq!(field(duration(1.0, 1.0, bad, 1.0)), "hertz_stiffness");
-            assert_eq!(field(duration(1.0, 1.0, 1.0, bad)), "approach_speed");
-            let indentation = |m, big, k, v| goldsmith_max_indentation(m, big, k, v);
-            assert_eq!(field(indentation(bad, 1.0, 1.0, 1.0)), "impact_mass");
-            assert_eq!(field(indentation(1.0, 1.0, 1.0, bad)), "approach_speed");
-            let linear = |m, big, k, c| linear_contact_duration(m, big, k, c);
-            assert_eq!(field(linear(bad, 1.0, 1.0, 0.0)), "impact_mass");
-            assert_eq!(field(linear(1.0, bad, 1.0, 0.0)), "main_mass");
-            assert_eq!(field(linear(1.0, 1.0, bad, 0.0)), "stiffness");
-            assert_eq!(field(linear(1.0, 1.0, 1.0, bad)), "damping");
-            assert_eq!(field(adequacy(bad, 1.0, 1.0, 1.0, 0.5)), "error");
-            assert_eq!(field(adequacy(1.0, bad, 1.0, 1.0, 0.5)), "max_error");
-            assert_eq!(field(adequacy(1.0, 1.0, bad, 1.0, 0.5)), "cpu_time");
-            assert_eq!(field(adequacy(1.0, 1.0, 1.0, bad, 0.5)), "max_cpu_time");
-            assert_eq!(field(adequacy(1.0, 1.0, 1.0, 1.0, bad)), "error_weight");
-        }
+        crate::testing::timeout(60, || {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                let duration = |m, big, k, v| goldsmith_contact_duration(m, big, k, v, true);
+                assert_eq!(field(duration(bad, 1.0, 1.0, 1.0)), "impact_mass");
+                assert_eq!(field(duration(1.0, bad, 1.0, 1.0)), "main_mass");
+                assert_eq!(field(duration(1.0, 1.0, bad, 1.0)), "hertz_stiffness");
+                assert_eq!(field(duration(1.0, 1.0, 1.0, bad)), "approach_speed");
+                let indentation = |m, big, k, v| goldsmith_max_indentation(m, big, k, v);
+                assert_eq!(field(indentation(bad, 1.0, 1.0, 1.0)), "impact_mass");
+                assert_eq!(field(indentation(1.0, 1.0, 1.0, bad)), "approach_speed");
+                let linear = |m, big, k, c| linear_contact_duration(m, big, k, c);
+                assert_eq!(field(linear(bad, 1.0, 1.0, 0.0)), "impact_mass");
+                assert_eq!(field(linear(1.0, bad, 1.0, 0.0)), "main_mass");
+                assert_eq!(field(linear(1.0, 1.0, bad, 0.0)), "stiffness");
+                assert_eq!(field(linear(1.0, 1.0, 1.0, bad)), "damping");
+                assert_eq!(field(adequacy(bad, 1.0, 1.0, 1.0, 0.5)), "error");
+                assert_eq!(field(adequacy(1.0, bad, 1.0, 1.0, 0.5)), "max_error");
+                assert_eq!(field(adequacy(1.0, 1.0, bad, 1.0, 0.5)), "cpu_time");
+                assert_eq!(field(adequacy(1.0, 1.0, 1.0, bad, 0.5)), "max_cpu_time");
+                assert_eq!(field(adequacy(1.0, 1.0, 1.0, 1.0, bad)), "error_weight");
+            }
+        });
     }
 
     #[test]
     fn results_beyond_floating_point_are_errors() {
-        let out_of_range = |r: Result<f64>| match r {
-            Err(Error::Inconsistent(message)) => {
-                assert!(message.contains("out of floating-point range"), "{message}")
-            }
-            other => panic!("expected an out-of-range error, got {other:?}"),
-        };
-        // (5 v^2 / (4 K* K_hz))^0.4 overflows; the duration delta_max / v underflows to 0.
-        out_of_range(goldsmith_max_indentation(1e300, 1e300, 1e-300, 1e300));
-        out_of_range(goldsmith_contact_duration(
-            1e-300, 1e-300, 1e300, 1e300, false,
-        ));
-        // 4 m M k1 and c1^2 (m + M) both overflow (inf - inf).
-        out_of_range(linear_contact_duration(1e300, 1e300, 1e300, 1e300));
-        out_of_range(adequacy(1e308, 1e-308, 0.0, 1.0, 0.5));
+        crate::testing::timeout(60, || {
+            let out_of_range = |r: Result<f64>| match r {
+                Err(Error::Inconsistent(message)) => {
+                    assert!(message.contains("out of floating-point range"), "{message}")
+                }
+                other => panic!("expected an out-of-range error, got {other:?}"),
+            };
+            // (5 v^2 / (4 K* K_hz))^0.4 overflows; the duration delta_max / v underflows to 0.
+            out_of_range(goldsmith_max_indentation(1e300, 1e300, 1e-300, 1e300));
+            out_of_range(goldsmith_contact_duration(
+                1e-300, 1e-300, 1e300, 1e300, false,
+            ));
+            // 4 m M k1 and c1^2 (m + M) both overflow (inf - inf).
+            out_of_range(linear_contact_duration(1e300, 1e300, 1e300, 1e300));
+            out_of_range(adequacy(1e308, 1e-308, 0.0, 1.0, 0.5));
+        });
     }
 
     #[test]
     fn table1_values() {
-        let tc = goldsmith_contact_duration(0.25, 1.0, 3000.0, 0.1, false).unwrap();
-        assert!((tc - 0.1089).abs() < 5e-5, "{tc}");
-        let tl = linear_contact_duration(0.25, 1.0, 49.05, 0.01).unwrap();
-        assert!((tl - 0.2006).abs() < 5e-5, "{tl}");
+        crate::testing::timeout(60, || {
+            let tc = goldsmith_contact_duration(0.25, 1.0, 3000.0, 0.1, false).unwrap();
+            assert!((tc - 0.1089).abs() < 5e-5, "{tc}");
+            let tl = linear_contact_duration(0.25, 1.0, 49.05, 0.01).unwrap();
+            assert!((tl - 0.2006).abs() < 5e-5, "{tl}");
+        });
     }
 }

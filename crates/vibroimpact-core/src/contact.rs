@@ -503,39 +503,43 @@ pub(crate) mod tests {
 
     #[test]
     fn law_force_refuses_non_finite_arguments() {
-        let contact = Contact::new(LawKind::HertzDamped, 3000.0, Some(0.5), 0.01).unwrap();
-        for bad in NON_FINITE {
-            assert_eq!(field(contact.law_force(bad, 0.0, 1.0)), "indentation");
-            assert_eq!(field(contact.law_force(1e-3, bad, 1.0)), "rate");
-            assert_eq!(field(contact.law_force(1e-3, 0.0, bad)), "approach_rate");
-        }
-        // A force beyond floating point is an error, not inf.
-        let err = contact.law_force(1e300, 0.0, 1.0).unwrap_err();
-        assert!(
-            err.to_string().contains("out of floating-point range"),
-            "{err}"
-        );
-        // Finite arguments still give the law: 3000 (1e-4)^1.5 N with no rate.
-        let force = contact.law_force(1e-4, 0.0, 1.0).unwrap();
-        assert!((force - 3000.0 * 1e-6).abs() < 1e-18, "{force}");
+        crate::testing::timeout(60, || {
+            let contact = Contact::new(LawKind::HertzDamped, 3000.0, Some(0.5), 0.01).unwrap();
+            for bad in NON_FINITE {
+                assert_eq!(field(contact.law_force(bad, 0.0, 1.0)), "indentation");
+                assert_eq!(field(contact.law_force(1e-3, bad, 1.0)), "rate");
+                assert_eq!(field(contact.law_force(1e-3, 0.0, bad)), "approach_rate");
+            }
+            // A force beyond floating point is an error, not inf.
+            let err = contact.law_force(1e300, 0.0, 1.0).unwrap_err();
+            assert!(
+                err.to_string().contains("out of floating-point range"),
+                "{err}"
+            );
+            // Finite arguments still give the law: 3000 (1e-4)^1.5 N with no rate.
+            let force = contact.law_force(1e-4, 0.0, 1.0).unwrap();
+            assert!((force - 3000.0 * 1e-6).abs() < 1e-18, "{force}");
+        });
     }
 
     #[test]
     fn helpers_refuse_values_outside_their_range() {
-        for bad in NON_FINITE.into_iter().chain([0.0, 1.5, -0.5]) {
-            assert_eq!(field(exact_hysteresis(bad)), "restitution");
-            assert_eq!(field(HysterHertz::new(1.0, bad)), "restitution");
-            assert_eq!(field(HysterHertz::exact(1.0, bad)), "restitution");
-            assert_eq!(field(HysterHertz::new(-bad.abs(), 0.5)), "stiffness");
-        }
-        for bad in NON_FINITE.into_iter().chain([-1e-3]) {
-            assert_eq!(field(rebound_ratio(bad)), "hysteresis");
-        }
-        // The checked helpers agree with the relation they solve:
-        // alpha (1 + e) = ln((1 + alpha) / (1 - alpha e)).
-        let alpha = exact_hysteresis(0.5).unwrap();
-        let residual = alpha * 1.5 - ((1.0 + alpha) / (1.0 - 0.5 * alpha)).ln();
-        assert!(residual.abs() < 1e-14, "{residual}");
-        assert!((rebound_ratio(alpha).unwrap() - 0.5).abs() < 1e-14);
+        crate::testing::timeout(60, || {
+            for bad in NON_FINITE.into_iter().chain([0.0, 1.5, -0.5]) {
+                assert_eq!(field(exact_hysteresis(bad)), "restitution");
+                assert_eq!(field(HysterHertz::new(1.0, bad)), "restitution");
+                assert_eq!(field(HysterHertz::exact(1.0, bad)), "restitution");
+                assert_eq!(field(HysterHertz::new(-bad.abs(), 0.5)), "stiffness");
+            }
+            for bad in NON_FINITE.into_iter().chain([-1e-3]) {
+                assert_eq!(field(rebound_ratio(bad)), "hysteresis");
+            }
+            // The checked helpers agree with the relation they solve:
+            // alpha (1 + e) = ln((1 + alpha) / (1 - alpha e)).
+            let alpha = exact_hysteresis(0.5).unwrap();
+            let residual = alpha * 1.5 - ((1.0 + alpha) / (1.0 - 0.5 * alpha)).ln();
+            assert!(residual.abs() < 1e-14, "{residual}");
+            assert!((rebound_ratio(alpha).unwrap() - 0.5).abs() < 1e-14);
+        });
     }
 }

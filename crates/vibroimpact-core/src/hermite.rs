@@ -111,26 +111,30 @@ mod tests {
 
     #[test]
     fn reproduces_a_cubic_exactly_and_finds_its_root() {
-        // p(t) = (t - 0.3)(t + 2)(t - 4) on [0, 1] is a cubic: Hermite data from it
-        // must reproduce it, so the located root is 0.3 to round-off.
-        let p = |t: f64| (t - 0.3) * (t + 2.0) * (t - 4.0);
-        let dp = |t: f64| (t + 2.0) * (t - 4.0) + (t - 0.3) * (t - 4.0) + (t - 0.3) * (t + 2.0);
-        let r = root(p(0.0), p(1.0), dp(0.0), dp(1.0));
-        assert!((r - 0.3).abs() < 1e-14, "{r}");
-        for k in 0..=10 {
-            let t = k as f64 / 10.0;
-            let (v, s) = eval(p(0.0), p(1.0), dp(0.0), dp(1.0), t);
-            assert!((v - p(t)).abs() < 1e-12 && (s - dp(t)).abs() < 1e-12);
-        }
+        crate::testing::timeout(60, || {
+            // p(t) = (t - 0.3)(t + 2)(t - 4) on [0, 1] is a cubic: Hermite data from it
+            // must reproduce it, so the located root is 0.3 to round-off.
+            let p = |t: f64| (t - 0.3) * (t + 2.0) * (t - 4.0);
+            let dp = |t: f64| (t + 2.0) * (t - 4.0) + (t - 0.3) * (t - 4.0) + (t - 0.3) * (t + 2.0);
+            let r = root(p(0.0), p(1.0), dp(0.0), dp(1.0));
+            assert!((r - 0.3).abs() < 1e-14, "{r}");
+            for k in 0..=10 {
+                let t = k as f64 / 10.0;
+                let (v, s) = eval(p(0.0), p(1.0), dp(0.0), dp(1.0), t);
+                assert!((v - p(t)).abs() < 1e-12 && (s - dp(t)).abs() < 1e-12);
+            }
+        });
     }
 
     #[test]
     fn finds_the_maximum_of_a_parabola() {
-        // q(t) = -(t - 0.7)^2 + 1 has its maximum at 0.7.
-        let q = |t: f64| 1.0 - (t - 0.7) * (t - 0.7);
-        let dq = |t: f64| -2.0 * (t - 0.7);
-        let a = argmax(q(0.0), q(1.0), dq(0.0), dq(1.0));
-        assert!((a - 0.7).abs() < 1e-12, "{a}");
+        crate::testing::timeout(60, || {
+            // q(t) = -(t - 0.7)^2 + 1 has its maximum at 0.7.
+            let q = |t: f64| 1.0 - (t - 0.7) * (t - 0.7);
+            let dq = |t: f64| -2.0 * (t - 0.7);
+            let a = argmax(q(0.0), q(1.0), dq(0.0), dq(1.0));
+            assert!((a - 0.7).abs() < 1e-12, "{a}");
+        });
     }
 }
 
@@ -235,57 +239,59 @@ mod quintic_tests {
 
     #[test]
     fn reproduces_a_quintic_and_finds_its_root_and_maximum() {
-        // p(t) = (t - 0.4)(t + 1)(t - 3)(t + 2)(t - 5), expanded by hand:
-        // a quintic, so the interpolant is exact and its root is 0.4.
-        let roots = [0.4, -1.0, 3.0, -2.0, 5.0];
-        let p = |t: f64| roots.iter().map(|r| t - r).product::<f64>();
-        let dp = |t: f64| {
-            (0..5)
-                .map(|i| {
-                    (0..5)
-                        .filter(|&j| j != i)
-                        .map(|j| t - roots[j])
-                        .product::<f64>()
-                })
-                .sum::<f64>()
-        };
-        let ddp = |t: f64| {
-            let mut sum = 0.0;
-            for i in 0..5 {
-                for j in 0..5 {
-                    if i != j {
-                        sum += (0..5)
-                            .filter(|&k| k != i && k != j)
-                            .map(|k| t - roots[k])
-                            .product::<f64>();
+        crate::testing::timeout(60, || {
+            // p(t) = (t - 0.4)(t + 1)(t - 3)(t + 2)(t - 5), expanded by hand:
+            // a quintic, so the interpolant is exact and its root is 0.4.
+            let roots = [0.4, -1.0, 3.0, -2.0, 5.0];
+            let p = |t: f64| roots.iter().map(|r| t - r).product::<f64>();
+            let dp = |t: f64| {
+                (0..5)
+                    .map(|i| {
+                        (0..5)
+                            .filter(|&j| j != i)
+                            .map(|j| t - roots[j])
+                            .product::<f64>()
+                    })
+                    .sum::<f64>()
+            };
+            let ddp = |t: f64| {
+                let mut sum = 0.0;
+                for i in 0..5 {
+                    for j in 0..5 {
+                        if i != j {
+                            sum += (0..5)
+                                .filter(|&k| k != i && k != j)
+                                .map(|k| t - roots[k])
+                                .product::<f64>();
+                        }
                     }
                 }
+                sum
+            };
+            let q = Quintic {
+                g0: p(0.0),
+                g1: p(1.0),
+                m0: dp(0.0),
+                m1: dp(1.0),
+                c0: ddp(0.0),
+                c1: ddp(1.0),
+            };
+            for k in 0..=10 {
+                let t = k as f64 / 10.0;
+                assert!((q.eval(t).0 - p(t)).abs() < 1e-12, "{t}");
+                assert!((q.eval(t).1 - dp(t)).abs() < 1e-11, "{t}");
             }
-            sum
-        };
-        let q = Quintic {
-            g0: p(0.0),
-            g1: p(1.0),
-            m0: dp(0.0),
-            m1: dp(1.0),
-            c0: ddp(0.0),
-            c1: ddp(1.0),
-        };
-        for k in 0..=10 {
-            let t = k as f64 / 10.0;
-            assert!((q.eval(t).0 - p(t)).abs() < 1e-12, "{t}");
-            assert!((q.eval(t).1 - dp(t)).abs() < 1e-11, "{t}");
-        }
-        assert!((q.root(0.0, 1.0) - 0.4).abs() < 1e-14);
-        // r(t) = 1 - (t - 0.6)^2 (1 + t) peaks at 0.6.
-        let r = Quintic {
-            g0: 1.0 - 0.36,
-            g1: 1.0 - 0.16 * 2.0,
-            m0: 0.84,
-            m1: -1.76,
-            c0: -(2.0 * 1.0 + 4.0 * (0.0 - 0.6)),
-            c1: -(2.0 * 2.0 + 4.0 * (1.0 - 0.6)),
-        };
-        assert!((r.argmax() - 0.6).abs() < 1e-12, "{}", r.argmax());
+            assert!((q.root(0.0, 1.0) - 0.4).abs() < 1e-14);
+            // r(t) = 1 - (t - 0.6)^2 (1 + t) peaks at 0.6.
+            let r = Quintic {
+                g0: 1.0 - 0.36,
+                g1: 1.0 - 0.16 * 2.0,
+                m0: 0.84,
+                m1: -1.76,
+                c0: -(2.0 * 1.0 + 4.0 * (0.0 - 0.6)),
+                c1: -(2.0 * 2.0 + 4.0 * (1.0 - 0.6)),
+            };
+            assert!((r.argmax() - 0.6).abs() < 1e-12, "{}", r.argmax());
+        });
     }
 }

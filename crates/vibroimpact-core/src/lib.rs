@@ -29,6 +29,7 @@ pub mod system;
 pub mod system_events;
 pub mod system_steppers;
 pub mod tableau;
+pub mod testing;
 
 pub use contact::{Contact, ContactLaw, LawKind};
 pub use error::{Error, Result};

@@ -207,34 +207,37 @@ mod tests {
 
     #[test]
     fn eigenvalues_of_a_known_matrix() {
-        // The second-difference matrix tridiag(-1, 2, -1) of size n has
-        // eigenvalues 2 - 2 cos(k pi / (n + 1)), k = 1..n.
-        let n = 7;
-        let mut a = vec![0.0; n * n];
-        for i in 0..n {
-            a[i * n + i] = 2.0;
-            if i + 1 < n {
-                a[i * n + i + 1] = -1.0;
-                a[(i + 1) * n + i] = -1.0;
+        crate::testing::timeout(60, || {
+            // The second-difference matrix tridiag(-1, 2, -1) of size n has
+            // eigenvalues 2 - 2 cos(k pi / (n + 1)), k = 1..n.
+            let n = 7;
+            let mut a = vec![0.0; n * n];
+            for i in 0..n {
+                a[i * n + i] = 2.0;
+                if i + 1 < n {
+                    a[i * n + i + 1] = -1.0;
+                    a[(i + 1) * n + i] = -1.0;
+                }
             }
-        }
-        let values = symmetric_eigenvalues(&a, n);
-        for (k, v) in values.iter().enumerate() {
-            let exact = 2.0 - 2.0 * ((k + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
-            assert!((v - exact).abs() < 1e-14, "{v} vs {exact}");
-        }
-        let l = cholesky(&a, n).expect("positive definite");
-        let inverse = inverse_from_cholesky(&l, n);
-        // A A^-1 = I.
-        for i in 0..n {
-            for j in 0..n {
-                let p: f64 = (0..n).map(|k| a[i * n + k] * inverse[k * n + j]).sum();
-                let expected = if i == j { 1.0 } else { 0.0 };
-                assert!((p - expected).abs() < 1e-13);
+            let values = symmetric_eigenvalues(&a, n);
+            for (k, v) in values.iter().enumerate() {
+                let exact =
+                    2.0 - 2.0 * ((k + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
+                assert!((v - exact).abs() < 1e-14, "{v} vs {exact}");
             }
-        }
-        // Singular (a free-free chain) and indefinite matrices have no factor.
-        assert!(cholesky(&[1.0, -1.0, -1.0, 1.0], 2).is_none());
-        assert!(cholesky(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
+            let l = cholesky(&a, n).expect("positive definite");
+            let inverse = inverse_from_cholesky(&l, n);
+            // A A^-1 = I.
+            for i in 0..n {
+                for j in 0..n {
+                    let p: f64 = (0..n).map(|k| a[i * n + k] * inverse[k * n + j]).sum();
+                    let expected = if i == j { 1.0 } else { 0.0 };
+                    assert!((p - expected).abs() < 1e-13);
+                }
+            }
+            // Singular (a free-free chain) and indefinite matrices have no factor.
+            assert!(cholesky(&[1.0, -1.0, -1.0, 1.0], 2).is_none());
+            assert!(cholesky(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
+        });
     }
 }

@@ -79,19 +79,21 @@ mod tests {
 
     #[test]
     fn matches_the_papers_form() {
-        // (4 / (3 pi)) sqrt(r) / ((1 - nu1^2)/(pi E1) + (1 - nu2^2)/(pi E2)).
-        let steel = Material::new(210e9, 0.3).unwrap();
-        let alu = Material::new(70e9, 0.33).unwrap();
-        let r: f64 = 0.01;
-        let pi = std::f64::consts::PI;
-        let paper = 4.0 / (3.0 * pi) * r.sqrt()
-            / ((1.0 - 0.09) / (pi * 210e9) + (1.0 - 0.33 * 0.33) / (pi * 70e9));
-        let ours = hertz_stiffness(r, &steel, &alu, None).unwrap();
-        assert!((ours / paper - 1.0).abs() < 1e-14);
-        // Two equal spheres act like one sphere of half the radius on a flat.
-        let two = hertz_stiffness(r, &steel, &steel, Some(r)).unwrap();
-        let half = hertz_stiffness(r / 2.0, &steel, &steel, None).unwrap();
-        assert!((two / half - 1.0).abs() < 1e-14);
+        crate::testing::timeout(60, || {
+            // (4 / (3 pi)) sqrt(r) / ((1 - nu1^2)/(pi E1) + (1 - nu2^2)/(pi E2)).
+            let steel = Material::new(210e9, 0.3).unwrap();
+            let alu = Material::new(70e9, 0.33).unwrap();
+            let r: f64 = 0.01;
+            let pi = std::f64::consts::PI;
+            let paper = 4.0 / (3.0 * pi) * r.sqrt()
+                / ((1.0 - 0.09) / (pi * 210e9) + (1.0 - 0.33 * 0.33) / (pi * 70e9));
+            let ours = hertz_stiffness(r, &steel, &alu, None).unwrap();
+            assert!((ours / paper - 1.0).abs() < 1e-14);
+            // Two equal spheres act like one sphere of half the radius on a flat.
+            let two = hertz_stiffness(r, &steel, &steel, Some(r)).unwrap();
+            let half = hertz_stiffness(r / 2.0, &steel, &steel, None).unwrap();
+            assert!((two / half - 1.0).abs() < 1e-14);
+        });
     }
 }
 
@@ -102,38 +104,40 @@ mod input_tests {
 
     #[test]
     fn every_argument_is_checked_and_named() {
-        let steel = Material::new(210e9, 0.3).unwrap();
-        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-            assert_eq!(field(Material::new(bad, 0.3)), "youngs_modulus");
-            assert_eq!(field(Material::new(1.0, bad)), "poisson_ratio");
-            assert_eq!(field(hertz_stiffness(bad, &steel, &steel, None)), "radius");
-            let r = Some(bad);
-            assert_eq!(
-                field(hertz_stiffness(1.0, &steel, &steel, r)),
-                "other_radius"
+        crate::testing::timeout(60, || {
+            let steel = Material::new(210e9, 0.3).unwrap();
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                assert_eq!(field(Material::new(bad, 0.3)), "youngs_modulus");
+                assert_eq!(field(Material::new(1.0, bad)), "poisson_ratio");
+                assert_eq!(field(hertz_stiffness(bad, &steel, &steel, None)), "radius");
+                let r = Some(bad);
+                assert_eq!(
+                    field(hertz_stiffness(1.0, &steel, &steel, r)),
+                    "other_radius"
+                );
+                // Fields set directly are checked too, the second body's as other_...
+                let set = Material {
+                    youngs_modulus: bad,
+                    poisson_ratio: 0.3,
+                };
+                assert_eq!(field(contact_modulus(&set, &steel)), "youngs_modulus");
+                assert_eq!(field(contact_modulus(&steel, &set)), "other_youngs_modulus");
+                let set = Material {
+                    youngs_modulus: 1.0,
+                    poisson_ratio: bad,
+                };
+                assert_eq!(
+                    field(hertz_stiffness(1.0, &steel, &set, None)),
+                    "other_poisson_ratio"
+                );
+            }
+            // 4/3 E* sqrt(R) beyond floating point is an error, not inf.
+            let stiff = Material::new(1e308, 0.0).unwrap();
+            let err = hertz_stiffness(1e10, &stiff, &stiff, None).unwrap_err();
+            assert!(
+                err.to_string().contains("out of floating-point range"),
+                "{err}"
             );
-            // Fields set directly are checked too, the second body's as other_...
-            let set = Material {
-                youngs_modulus: bad,
-                poisson_ratio: 0.3,
-            };
-            assert_eq!(field(contact_modulus(&set, &steel)), "youngs_modulus");
-            assert_eq!(field(contact_modulus(&steel, &set)), "other_youngs_modulus");
-            let set = Material {
-                youngs_modulus: 1.0,
-                poisson_ratio: bad,
-            };
-            assert_eq!(
-                field(hertz_stiffness(1.0, &steel, &set, None)),
-                "other_poisson_ratio"
-            );
-        }
-        // 4/3 E* sqrt(R) beyond floating point is an error, not inf.
-        let stiff = Material::new(1e308, 0.0).unwrap();
-        let err = hertz_stiffness(1e10, &stiff, &stiff, None).unwrap_err();
-        assert!(
-            err.to_string().contains("out of floating-point range"),
-            "{err}"
-        );
+        });
     }
 }

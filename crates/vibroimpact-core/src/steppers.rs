@@ -805,67 +805,71 @@ mod tests {
 
     #[test]
     fn newton_solves_a_linear_contact_in_one_update() {
-        // A linear spring and the contact damper make the residual linear in
-        // the new accelerations. With the exact Jacobian one update lands on
-        // the solution: the first evaluation is at the predictor, the second
-        // finds round-off, and the next update is too small to need a third.
-        // The step keeps the indentation positive (the force is linear only
-        // there): k1 h^2 <= 0.16 kg against the reduced mass of 0.2 kg keeps
-        // the phase of the contact oscillation within 1 rad. That still
-        // couples the two bodies (k1 h^2 up to 0.16 of their masses), so an
-        // error in the coupling terms shows.
-        for (name, stepper) in implicit_methods() {
-            for stiffness in [3e3, 1e6, 1e9, 1e12] {
-                let contact = Contact::new(LawKind::Linear, stiffness, None, 0.01).unwrap();
-                for h in [0.01, 0.1, 0.4].map(|f: f64| f / f64::sqrt(stiffness)) {
-                    for rate in [0.05, -0.05, 0.0] {
-                        let evaluations = contact.visit(OneStep {
-                            stepper: stepper.clone(),
-                            indentation: 3e-3,
-                            rate,
-                            h,
-                        });
-                        assert_eq!(
-                            evaluations, 2,
-                            "{name}, k1 = {stiffness:e} N/m, h = {h:e} s, rate {rate} m/s: \
-                             {evaluations} residual evaluations for a linear residual"
-                        );
+        crate::testing::timeout(60, || {
+            // A linear spring and the contact damper make the residual linear in
+            // the new accelerations. With the exact Jacobian one update lands on
+            // the solution: the first evaluation is at the predictor, the second
+            // finds round-off, and the next update is too small to need a third.
+            // The step keeps the indentation positive (the force is linear only
+            // there): k1 h^2 <= 0.16 kg against the reduced mass of 0.2 kg keeps
+            // the phase of the contact oscillation within 1 rad. That still
+            // couples the two bodies (k1 h^2 up to 0.16 of their masses), so an
+            // error in the coupling terms shows.
+            for (name, stepper) in implicit_methods() {
+                for stiffness in [3e3, 1e6, 1e9, 1e12] {
+                    let contact = Contact::new(LawKind::Linear, stiffness, None, 0.01).unwrap();
+                    for h in [0.01, 0.1, 0.4].map(|f: f64| f / f64::sqrt(stiffness)) {
+                        for rate in [0.05, -0.05, 0.0] {
+                            let evaluations = contact.visit(OneStep {
+                                stepper: stepper.clone(),
+                                indentation: 3e-3,
+                                rate,
+                                h,
+                            });
+                            assert_eq!(
+                                evaluations, 2,
+                                "{name}, k1 = {stiffness:e} N/m, h = {h:e} s, rate {rate} m/s: \
+                                 {evaluations} residual evaluations for a linear residual"
+                            );
+                        }
                     }
                 }
             }
-        }
+        });
     }
 
     #[test]
     fn newton_converges_quadratically_on_a_hertz_contact() {
-        // From the predictor the first iterate is at worst wrong in its
-        // leading digit; quadratic convergence doubles the correct digits at
-        // each update, so 53 bits take at most 6 updates (log2 53 < 6), plus
-        // the evaluation at the predictor. A Jacobian without the coupling
-        // converges linearly and takes 10 to 27 evaluations in some of these
-        // cases (K_hz = 3e3 N/m^1.5 with h = 1e-2 s, 1e6 with 1e-4 and 1e-3 s).
-        for (name, stepper) in implicit_methods() {
-            for stiffness in [3e3, 1e6, 1e9, 1e12] {
-                let contact =
-                    Contact::new(LawKind::HertzDamped, stiffness, Some(0.5), 0.01).unwrap();
-                for h in [1e-4, 1e-3, 1e-2] {
-                    for (indentation, rate) in [(1e-3, 0.05), (1e-3, -0.05), (3e-3, 0.0)] {
-                        let evaluations = contact.visit(OneStep {
-                            stepper: stepper.clone(),
-                            indentation,
-                            rate,
-                            h,
-                        });
-                        assert!(
-                            evaluations <= 7,
-                            "{name}, K_hz = {stiffness:e} N/m^1.5, h = {h:e} s, indentation \
-                             {indentation} m, rate {rate} m/s: {evaluations} residual \
-                             evaluations, more than quadratic convergence needs"
-                        );
+        crate::testing::timeout(60, || {
+            // From the predictor the first iterate is at worst wrong in its
+            // leading digit; quadratic convergence doubles the correct digits at
+            // each update, so 53 bits take at most 6 updates (log2 53 < 6), plus
+            // the evaluation at the predictor. A Jacobian without the coupling
+            // converges linearly and takes 10 to 27 evaluations in some of these
+            // cases (K_hz = 3e3 N/m^1.5 with h = 1e-2 s, 1e6 with 1e-4 and 1e-3 s).
+            for (name, stepper) in implicit_methods() {
+                for stiffness in [3e3, 1e6, 1e9, 1e12] {
+                    let contact =
+                        Contact::new(LawKind::HertzDamped, stiffness, Some(0.5), 0.01).unwrap();
+                    for h in [1e-4, 1e-3, 1e-2] {
+                        for (indentation, rate) in [(1e-3, 0.05), (1e-3, -0.05), (3e-3, 0.0)] {
+                            let evaluations = contact.visit(OneStep {
+                                stepper: stepper.clone(),
+                                indentation,
+                                rate,
+                                h,
+                            });
+                            assert!(
+                                evaluations <= 7,
+                                "{name}, K_hz = {stiffness:e} N/m^1.5, h = {h:e} s, indentation \
+                                 {indentation} m, rate {rate} m/s: {evaluations} residual \
+                                 evaluations, more than quadratic convergence needs"
+                            );
+                        }
                     }
                 }
             }
-        }
+        });
     }
 
     /// Checks a law's slopes, which make the contact terms of the Jacobian,
@@ -912,15 +916,17 @@ mod tests {
 
     #[test]
     fn contact_law_slopes_match_finite_differences() {
-        for (name, law, restitution) in [
-            ("hertz", LawKind::Hertz, None),
-            ("hyster-hertz", LawKind::HysterHertz, Some(0.5)),
-            ("hertz-damped", LawKind::HertzDamped, Some(0.5)),
-            ("linear", LawKind::Linear, None),
-        ] {
-            Contact::new(law, 3e3, restitution, 0.0)
-                .unwrap()
-                .visit(Slopes(name));
-        }
+        crate::testing::timeout(60, || {
+            for (name, law, restitution) in [
+                ("hertz", LawKind::Hertz, None),
+                ("hyster-hertz", LawKind::HysterHertz, Some(0.5)),
+                ("hertz-damped", LawKind::HertzDamped, Some(0.5)),
+                ("linear", LawKind::Linear, None),
+            ] {
+                Contact::new(law, 3e3, restitution, 0.0)
+                    .unwrap()
+                    .visit(Slopes(name));
+            }
+        });
     }
 }
