@@ -508,3 +508,78 @@ def test_values_nested_thousands_deep_are_invalid_input() -> None:
             method="rk4",
             dt=1e-3,
         )
+
+
+EVERY_KIND = {
+    "compliant damper, force": {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 400.0, "damping": 0.5},
+        "damper": [
+            {
+                "mass": 0.1,
+                "at": 0,
+                "clearance": 0.002,
+                "law": "hertz-damped",
+                "stiffness": 1e6,
+                "restitution": 0.7,
+            }
+        ],
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 5.0, "frequency": 3.0}
+        ],
+    },
+    "rigid damper, base motion, gravity": {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 400.0, "damping": 0.5},
+        "damper": [{"mass": 0.1, "at": 0, "clearance": 0.002, "law": "rigid", "restitution": 0.6}],
+        "gravity": {},
+        "excitation": [{"kind": "base", "signal": "harmonic", "amplitude": 20.0, "frequency": 3.0}],
+    },
+    "beam with a linear stop, two harmonics": {
+        "structure": {
+            "kind": "cantilever",
+            "length": 0.5,
+            "youngs_modulus": 7e10,
+            "second_moment": 1e-10,
+            "mass_per_length": 0.27,
+            "modes": 2,
+            "damping_ratio": 0.02,
+        },
+        "stop": [{"at": 0.5, "side": "upper", "gap": 5e-4, "law": "linear", "stiffness": 2e4}],
+        "excitation": [
+            {
+                "kind": "force",
+                "at": 0.5,
+                "signal": "harmonics",
+                "amplitudes": [0.5, 0.2],
+                "frequencies": [10.0, 25.0],
+            }
+        ],
+    },
+}
+# Each method at settings where it is accurate: (settings, tolerance on the end state
+# relative to its size, tolerance on the energy residual relative to the energies).
+METHODS = {
+    "rk4": ({"dt": 1e-5}, 1e-8, 1e-9),
+    "dopri5": ({"rtol": 1e-10, "atol": 1e-14}, 1e-7, 1e-8),
+    "newmark-implicit": ({"dt": 1e-5}, 1e-4, 1e-5),
+    "generalized-alpha": ({"dt": 1e-5}, 1e-4, 1e-5),
+}
+
+
+@pytest.mark.parametrize("kind", list(EVERY_KIND))
+def test_every_method_gives_the_same_run_and_closes_its_energy_balance(kind: str) -> None:
+    """Contacts one by one and the end state against DOP853 at rtol 1e-12, and the
+    energy balance of every method, for a compliant and a rigid damper, force and base
+    excitation, gravity, and a beam hitting a stop."""
+    case = EVERY_KIND[kind]
+    ref = simulate_system(**case, t_end=0.5, method="dop853", rtol=1e-12, atol=1e-15)
+    end = ref.final_state["structure_displacement"]
+    assert len(ref.contacts) > 5
+    for method, (settings, state_tolerance, energy_tolerance) in METHODS.items():
+        sol = simulate_system(**case, t_end=0.5, method=method, **settings)
+        assert sol.contacts.pair == ref.contacts.pair and sol.contacts.kind == ref.contacts.kind
+        np.testing.assert_allclose(sol.contacts.onset, ref.contacts.onset, atol=1e-4)
+        error = np.max(np.abs(sol.final_state["structure_displacement"] - end))
+        assert error < state_tolerance * np.max(np.abs(end)), (method, error)
+        e = sol.energy
+        scale = abs(e["input_work"]) + e["dissipated"] + abs(e["stored_end"])
+        assert abs(e["residual"]) < energy_tolerance * scale, (method, e)
