@@ -625,20 +625,70 @@ impl Assembly {
 
 /// The last value of a signal: Runge-Kutta stages share times (RK4's two
 /// midpoints, a step's end and the next one's start), and a harmonic's
-/// cosine is the costliest part of a small system's right-hand side.
+/// cosine is the costliest part of a small system's right-hand side. For a
+/// harmonic it also keeps the phasor `(cos, sin)` of its angle and the
+/// rotation of the last time increment: fixed steps repeat the same
+/// increments, so most values are a rotation (four multiplications), with a
+/// direct evaluation every `RESYNC` rotations to keep round-off from growing.
 #[derive(Debug, Clone, Copy)]
 struct Cached {
     time: f64,
     value: f64,
+    cos: f64,
+    sin: f64,
+    delta: f64,
+    delta_cos: f64,
+    delta_sin: f64,
+    rotations: u32,
 }
 
+/// Rotations between direct evaluations of a harmonic.
+const RESYNC: u32 = 64;
+
 impl Cached {
+    const EMPTY: Self = Self {
+        time: f64::NAN,
+        value: 0.0,
+        cos: 1.0,
+        sin: 0.0,
+        delta: f64::NAN,
+        delta_cos: 1.0,
+        delta_sin: 0.0,
+        rotations: RESYNC,
+    };
+
     #[inline(always)]
     fn value(&mut self, signal: &Signal, time: f64) -> f64 {
-        if time.to_bits() != self.time.to_bits() {
-            self.time = time;
-            self.value = signal.value(time);
+        if time.to_bits() == self.time.to_bits() {
+            return self.value;
         }
+        match signal {
+            Signal::Harmonic(h) => {
+                let omega = std::f64::consts::TAU * h.frequency;
+                let delta = time - self.time;
+                // The same increment to the round-off of the times themselves
+                // (t + h/2 and t + h differ by h/2 only to a few ulps of t):
+                // rotating by the cached one errs no more than the cosine's
+                // own argument does.
+                let same = (delta - self.delta).abs() <= 8.0 * f64::EPSILON * time.abs();
+                if same && self.rotations < RESYNC {
+                    let (c, s) = (self.cos, self.sin);
+                    self.cos = c * self.delta_cos - s * self.delta_sin;
+                    self.sin = s * self.delta_cos + c * self.delta_sin;
+                    self.rotations += 1;
+                } else {
+                    (self.sin, self.cos) = (omega * time + h.phase).sin_cos();
+                    if delta.is_finite() && delta.to_bits() != self.delta.to_bits() {
+                        (self.delta_sin, self.delta_cos) = (omega * delta).sin_cos();
+                        self.delta = delta;
+                    }
+                    self.rotations = 0;
+                }
+                self.value = h.amplitude * self.cos;
+            }
+            _ => self.value = signal.value(time),
+        }
+        self.time = time;
         self.value
     }
 }
@@ -659,10 +709,7 @@ pub struct Scratch {
 impl Scratch {
     pub fn new(assembly: &Assembly) -> Self {
         let m = assembly.interactions.len().max(1);
-        let empty = Cached {
-            time: f64::NAN,
-            value: 0.0,
-        };
+        let empty = Cached::EMPTY;
         Self {
             force_values: vec![empty; assembly.forces.len()],
             base_values: vec![empty; assembly.base.len()],

@@ -74,6 +74,31 @@ pub struct ExplicitRk {
     evaluations: u64,
 }
 
+/// `out = y + h sum_j weights_j k_j`, skipping zero weights.
+#[inline(always)]
+fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], k: &[Vec<f64>]) {
+    let mut first = true;
+    for (weight, kj) in weights.iter().zip(k) {
+        if *weight == 0.0 {
+            continue;
+        }
+        let hw = h * weight;
+        if first {
+            for ((o, y), k) in out.iter_mut().zip(y).zip(kj) {
+                *o = y + hw * k;
+            }
+            first = false;
+        } else {
+            for (o, k) in out.iter_mut().zip(kj) {
+                *o += hw * k;
+            }
+        }
+    }
+    if first {
+        out.copy_from_slice(y);
+    }
+}
+
 fn flatten<const S: usize>(a: &[[f64; S]; S]) -> Vec<f64> {
     a.iter().flatten().copied().collect()
 }
@@ -186,18 +211,11 @@ impl SystemStepper for ExplicitRk {
             self.evaluations += 1;
             self.start_valid = true;
         }
-        let len = y.len();
         for i in 1..s {
-            // One pass: y + h sum_j a_ij k_j (no copy first, no zero weights).
+            // y + h sum_j a_ij k_j over the nonzero weights only, the first
+            // term written over y (no copy), each pass a straight vector loop.
             let row = &self.a[i * s..i * s + i];
-            let (done, _) = self.k.split_at(i);
-            for n in 0..len {
-                let mut sum = 0.0;
-                for (weight, k) in row.iter().zip(done) {
-                    sum += weight * k[n];
-                }
-                self.point[n] = y[n] + h * sum;
-            }
+            combine(&mut self.point, y, h, row, &self.k);
             system.rates(
                 time + self.c[i] * h,
                 &self.point,
@@ -207,13 +225,7 @@ impl SystemStepper for ExplicitRk {
             );
             self.evaluations += 1;
         }
-        for n in 0..len {
-            let mut sum = 0.0;
-            for (weight, k) in self.b.iter().zip(&self.k) {
-                sum += weight * k[n];
-            }
-            out[n] = y[n] + h * sum;
-        }
+        combine(out, y, h, &self.b, &self.k);
         let coordinates = 2 * system.dim;
         let scale = |n: usize| self.atol + self.rtol * y[n].abs().max(out[n].abs());
         Ok(match &self.estimate {
