@@ -672,16 +672,17 @@ impl Cached {
                 // own argument does.
                 let same = (delta - self.delta).abs() <= 8.0 * f64::EPSILON * time.abs();
                 if same && self.rotations < RESYNC {
+                    if self.rotations == 0 {
+                        // The increment repeats: its rotation is worth having.
+                        (self.delta_sin, self.delta_cos) = (omega * self.delta).sin_cos();
+                    }
                     let (c, s) = (self.cos, self.sin);
                     self.cos = c * self.delta_cos - s * self.delta_sin;
                     self.sin = s * self.delta_cos + c * self.delta_sin;
                     self.rotations += 1;
                 } else {
                     (self.sin, self.cos) = (omega * time + h.phase).sin_cos();
-                    if delta.is_finite() && delta.to_bits() != self.delta.to_bits() {
-                        (self.delta_sin, self.delta_cos) = (omega * delta).sin_cos();
-                        self.delta = delta;
-                    }
+                    self.delta = delta;
                     self.rotations = 0;
                 }
                 self.value = h.amplitude * self.cos;
