@@ -160,8 +160,10 @@ pub struct Assembly {
     minv_k: Vec<f64>,
     minv_c: Vec<f64>,
     damper_mass: Vec<f64>,
-    /// Whether M, K and C are all diagonal (modal coordinates).
+    /// Whether M, K and C are all diagonal (modal coordinates), and then
+    /// `[M^-1 K, M^-1 C, C]` of each coordinate.
     diagonal: bool,
+    diagonals: Vec<[f64; 3]>,
     /// `r`, and `M r` (for the work of base loads).
     influence: Vec<f64>,
     mass_influence: Vec<f64>,
@@ -215,6 +217,9 @@ impl Assembly {
         };
         let minv_k = product(s.stiffness());
         let minv_c = product(s.damping());
+        let diagonals = (0..n)
+            .map(|i| [minv_k[i * n + i], minv_c[i * n + i], s.damping()[i * n + i]])
+            .collect();
         let mut mass_influence = vec![0.0; n];
         linalg::multiply(s.mass(), s.influence(), &mut mass_influence);
         let gravity = non_negative("gravity", spec.gravity)?;
@@ -319,6 +324,7 @@ impl Assembly {
             minv_k,
             minv_c,
             damper_mass,
+            diagonals,
             diagonal: [s.mass(), s.stiffness(), s.damping()]
                 .iter()
                 .all(|a| (0..n * n).all(|p| p % (n + 1) == 0 || a[p] == 0.0)),
@@ -371,7 +377,11 @@ impl Assembly {
     ) {
         let (n, d) = (self.n, self.dim);
         let (x, v) = (&y[..d], &y[d..2 * d]);
-        out[..d].copy_from_slice(v);
+        // A loop, not copy_from_slice: for a handful of values a call to
+        // memmove costs more than the copy.
+        for (o, v) in out[..d].iter_mut().zip(v) {
+            *o = *v;
+        }
         let mut base = 0.0;
         for (signal, cache) in self.base.iter().zip(&mut scratch.base_values) {
             base += cache.value(signal, time);
@@ -380,11 +390,18 @@ impl Assembly {
         let (acc, rest) = out[d..].split_at_mut(d);
         let viscous = if self.diagonal {
             // Modal coordinates: the matrices are diagonal.
-            for i in 0..n {
-                let (k, c) = (self.minv_k[i * n + i], self.minv_c[i * n + i]);
-                acc[i] = -(k * x[i] + c * v[i]) - self.influence[i] * inertial;
+            let mut viscous = 0.0;
+            for ((((a, x), v), [k, c, damping]), r) in acc[..n]
+                .iter_mut()
+                .zip(&x[..n])
+                .zip(&v[..n])
+                .zip(&self.diagonals)
+                .zip(&self.influence)
+            {
+                *a = -(k * x + c * v) - r * inertial;
+                viscous += damping * v * v;
             }
-            (0..n).map(|i| self.damping[i * n + i] * v[i] * v[i]).sum()
+            viscous
         } else {
             for (i, a) in acc[..n].iter_mut().enumerate() {
                 let row = i * n..(i + 1) * n;
@@ -420,8 +437,9 @@ impl Assembly {
         let (head, losses) = rest.split_at_mut(CONTACT);
         for (i, (it, mode)) in self.interactions.iter().zip(modes).enumerate() {
             losses[i] = 0.0;
-            match (*mode, it.law) {
+            match (mode, &it.law) {
                 (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
+                    let (approach_rate, damping) = (*approach_rate, *damping);
                     let indentation = -(it.offset + linalg::dot(&it.h, x));
                     let rate = -linalg::dot(&it.h, v);
                     let (force, elastic) = if indentation > 0.0 {
