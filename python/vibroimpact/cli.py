@@ -28,7 +28,7 @@ from vibroimpact._core import (
     Solution,
     __version__,
 )
-from vibroimpact.output import UsageError, written_whole
+from vibroimpact.output import UsageError, finite_or_none, written_whole
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
 from vibroimpact.system_scenario import (
@@ -128,10 +128,6 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _finite_or_none(x: float) -> float | None:
-    return x if math.isfinite(x) else None
-
-
 def run_summary(scenario: Scenario, sol: Solution, cpu_time: float) -> dict[str, Any]:
     """The JSON-ready summary of a run: settings, statistics and contacts (SI units)."""
     return {
@@ -146,9 +142,9 @@ def run_summary(scenario: Scenario, sol: Solution, cpu_time: float) -> dict[str,
         "grazing_contacts": sol.grazing_contacts,
         "history_rows": len(sol.t),
         "cpu_time": cpu_time,
-        "energy_growth": _finite_or_none(sol.energy_growth),
+        "energy_growth": finite_or_none(sol.energy_growth),
         "contacts": [
-            {key: _finite_or_none(value) for key, value in row.items()}
+            {key: finite_or_none(value) for key, value in row.items()}
             for row in sol.contacts.to_dicts()
         ],
     }

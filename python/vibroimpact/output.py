@@ -7,12 +7,19 @@ neither imports the other.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import secrets
 import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
+
+
+def finite_or_none(x: float) -> float | None:
+    """``x``, or None where it is NaN or infinite (JSON's null: a quantity not
+    defined, such as the separation of a contact still open at the end)."""
+    return x if math.isfinite(x) else None
 
 
 class UsageError(Exception):

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.output import written_whole
+from vibroimpact.output import finite_or_none, written_whole
 from vibroimpact.system import PreparedRun, SystemSolution, prepare_system
 
 SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
@@ -69,10 +69,6 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
     return SystemScenario(source, prepared)
 
 
-def _finite_or_none(x: float) -> float | None:
-    return x if math.isfinite(x) else None
-
-
 def system_summary(
     scenario: SystemScenario, sol: SystemSolution, cpu_time: float
 ) -> dict[str, Any]:
@@ -93,7 +89,7 @@ def system_summary(
         "final_state": {key: [float(v) for v in value] for key, value in sol.final_state.items()},
         "energy": dict(sol.energy),
         "contacts": [
-            {k: (v if isinstance(v, str) else _finite_or_none(v)) for k, v in row.items()}
+            {k: (v if isinstance(v, str) else finite_or_none(v)) for k, v in row.items()}
             for row in sol.contacts.to_dicts()
         ],
     }

@@ -812,7 +812,13 @@ pub fn integrate_system<S: SystemStepper>(
         }
     }
     contacts.sort_by(|a, b| a.onset.total_cmp(&b.onset));
-    let energy = balance(system, &y, &modes, stored_start, impact_loss);
+    let energy = balance(
+        system,
+        &y,
+        system.energy(&y, &modes),
+        stored_start,
+        impact_loss,
+    );
     Ok(SystemSolution {
         time: time_rows,
         states,
@@ -827,18 +833,17 @@ pub fn integrate_system<S: SystemStepper>(
     })
 }
 
-/// The energy balance at state `y`.
+/// The energy balance at state `y`, whose stored energy is `stored_end`.
 fn balance(
     system: &Assembly,
     y: &[f64],
-    modes: &[Mode],
+    stored_end: f64,
     stored_start: f64,
     impact: f64,
 ) -> EnergyBalance {
     let at = 2 * system.dim;
     let (viscous, input_work) = (y[at + VISCOUS], y[at + INPUT]);
     let contact: f64 = y[at + CONTACT..].iter().sum();
-    let stored_end = system.energy(y, modes);
     let dissipated = viscous + contact + impact;
     EnergyBalance {
         input_work,
@@ -865,11 +870,13 @@ fn check_balance(
     options: &RunOptions,
     time: f64,
 ) -> Result<()> {
-    let b = balance(system, y, modes, stored_start, impact);
+    // One evaluation of the stored energy gives both its value and its scale.
+    let (stored, magnitude) = system.energy_terms(y, modes);
+    let b = balance(system, y, stored, stored_start, impact);
     // The energy in play: the largest seen so far, since a system without
     // losses can pass through states where every term is near zero.
     *scale = scale
-        .max(system.energy_terms(y, modes).1 + b.input_work.abs() + b.dissipated.abs())
+        .max(magnitude + b.input_work.abs() + b.dissipated.abs())
         .max(f64::MIN_POSITIVE);
     if b.residual.abs() > options.energy_tolerance * *scale || !b.residual.is_finite() {
         return Err(Error::EnergyBalance {
