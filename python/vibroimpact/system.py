@@ -153,7 +153,7 @@ _SOLVER = {
 }
 _OUTPUT = {"every": (_WHOLE, 1), "history": ("boolean", True)}
 _INT64 = range(-(2**63), 2**63)
-_METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha")
+_METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha", "exact")
 _FIXED_STEP = ("rk4", "newmark-implicit", "generalized-alpha")
 _SIDES = ("upper", "lower")
 _LOADS = ("force", "base")
@@ -506,7 +506,10 @@ def simulate_system(
     ``damper_velocity`` (arrays, SI; zeros where left out). ``method``: ``"rk4"``
     (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``),
     ``"newmark-implicit"`` (``beta``, ``gamma``) or ``"generalized-alpha"``
-    (``spectral_radius``), implicit with Newton's method, fixed step ``dt``. Every
+    (``spectral_radius``), implicit with Newton's method, fixed step ``dt``; or
+    ``"exact"``: the closed-form flow of a linear structure with rigid pairs and
+    harmonic (or no) excitation, exact to round-off between impacts (``dt``, if
+    given, caps its step of an eighth of the fastest period). Every
     event (contact onset, separation, rigid impact, release) is located to
     round-off. ``every`` keeps every N-th step; ``history=False`` keeps none (the
     contacts and the final state only). A run stops with a clear error past

@@ -94,7 +94,19 @@ pub fn inverse_lower(l: &[f64], n: usize) -> Vec<f64> {
 /// Eigenvalues of a symmetric matrix by cyclic Jacobi rotations, ascending.
 /// Accurate to round-off relative to the largest eigenvalue.
 pub fn symmetric_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
+    symmetric_eigen(a, n).0
+}
+
+/// Eigenvalues (ascending) and orthonormal eigenvectors (the columns of a
+/// row-major `n x n` matrix, in the same order) of a symmetric matrix, by
+/// cyclic Jacobi rotations: accurate to round-off relative to the largest
+/// eigenvalue, and exactly orthonormal to round-off even for repeated ones.
+pub fn symmetric_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut m = a.to_vec();
+    let mut vectors = vec![0.0; n * n];
+    for i in 0..n {
+        vectors[i * n + i] = 1.0;
+    }
     let scale = max_abs(a);
     for _sweep in 0..100 {
         let off: f64 = (0..n)
@@ -117,10 +129,12 @@ pub fn symmetric_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
                 let t = if theta == 0.0 { 1.0 } else { t };
                 let c = 1.0 / (t * t + 1.0).sqrt();
                 let s = t * c;
-                for k in 0..n {
-                    let (akp, akq) = (m[k * n + p], m[k * n + q]);
-                    m[k * n + p] = c * akp - s * akq;
-                    m[k * n + q] = s * akp + c * akq;
+                for block in [&mut m, &mut vectors] {
+                    for k in 0..n {
+                        let (akp, akq) = (block[k * n + p], block[k * n + q]);
+                        block[k * n + p] = c * akp - s * akq;
+                        block[k * n + q] = s * akp + c * akq;
+                    }
                 }
                 for k in 0..n {
                     let (apk, aqk) = (m[p * n + k], m[q * n + k]);
@@ -130,9 +144,16 @@ pub fn symmetric_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
             }
         }
     }
-    let mut values: Vec<f64> = (0..n).map(|i| m[i * n + i]).collect();
-    values.sort_by(f64::total_cmp);
-    values
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&i, &j| m[i * n + i].total_cmp(&m[j * n + j]));
+    let values = order.iter().map(|&i| m[i * n + i]).collect();
+    let mut sorted = vec![0.0; n * n];
+    for (c, &i) in order.iter().enumerate() {
+        for r in 0..n {
+            sorted[r * n + c] = vectors[r * n + i];
+        }
+    }
+    (values, sorted)
 }
 
 /// `y = A x` for a row-major `rows x x.len()` matrix.
@@ -219,8 +240,13 @@ mod tests {
                     a[(i + 1) * n + i] = -1.0;
                 }
             }
-            let values = symmetric_eigenvalues(&a, n);
+            let (values, vectors) = symmetric_eigen(&a, n);
             for (k, v) in values.iter().enumerate() {
+                // A v = lambda v for each column.
+                for r in 0..n {
+                    let av: f64 = (0..n).map(|c| a[r * n + c] * vectors[c * n + k]).sum();
+                    assert!((av - v * vectors[r * n + k]).abs() < 1e-13);
+                }
                 let exact =
                     2.0 - 2.0 * ((k + 1) as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
                 assert!((v - exact).abs() < 1e-14, "{v} vs {exact}");

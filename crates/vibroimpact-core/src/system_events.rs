@@ -464,7 +464,7 @@ pub fn integrate_system<S: SystemStepper>(
     // The time resolution below which a chattering sequence is summed.
     // The time below which a chattering sequence is summed: the step, or a
     // millionth of the structure's longest period (of the run, without one).
-    let resolution = if adaptive {
+    let resolution = if adaptive || stepper.is_exact() {
         1e-6 * t_end.min(system.longest_period)
     } else {
         dt
@@ -679,6 +679,7 @@ pub fn integrate_system<S: SystemStepper>(
         } else {
             stepper.reset();
         }
+        stepper.finish(system, time, &y, taken, &modes, &mut scratch, &mut end)?;
         time += taken;
         if !adaptive && (switched.is_none() || (grid + 1) as f64 * dt - time <= 0.0) {
             grid += 1;

@@ -15,6 +15,11 @@ pub trait SystemStepper {
     fn name(&self) -> &'static str;
     /// Whether the step size is controlled by an error estimate.
     fn is_adaptive(&self) -> bool;
+    /// Whether a step lands on the exact solution (then the run's time
+    /// resolution is set by round-off, not by the step).
+    fn is_exact(&self) -> bool {
+        false
+    }
     /// Forget data carried from the last step (the right-hand side jumped).
     fn reset(&mut self);
     /// Attempt a step `h` from `(time, y)` into `out`; the scaled error
@@ -32,6 +37,22 @@ pub trait SystemStepper {
     ) -> Result<f64>;
     /// The last attempt is the new current point.
     fn accept(&mut self);
+    /// Complete the step `h` from `(time, y)` the kernel keeps, `end`, with
+    /// what only a kept step needs (a method that leaves its attempts'
+    /// energy accumulators out fills them here).
+    #[allow(clippy::too_many_arguments)]
+    fn finish(
+        &mut self,
+        _system: &Assembly,
+        _time: f64,
+        _y: &[f64],
+        _h: f64,
+        _modes: &[Mode],
+        _scratch: &mut Scratch,
+        _end: &mut [f64],
+    ) -> Result<()> {
+        Ok(())
+    }
     /// The step-size factor's core for a scaled `error`.
     fn shrink(&self, error: f64) -> f64;
     /// Right-hand-side evaluations so far.

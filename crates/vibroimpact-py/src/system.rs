@@ -11,6 +11,7 @@ use vibroimpact_core::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
 use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
+use vibroimpact_core::exact::ExactFlow;
 use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, RunOptions};
 use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
@@ -333,10 +334,21 @@ pub fn simulate_system<'py>(
             let mut stepper = NewmarkFamily::generalized_alpha(&system, spectral_radius);
             run(py, &system, &mut stepper, &y0, &options)
         }
+        "exact" => {
+            let mut stepper = ExactFlow::new(&system).map_err(to_py)?;
+            // dt, when given, caps the flow's own step (a finer check of
+            // the gaps between step ends).
+            let step = dt.unwrap_or(f64::INFINITY).min(stepper.step()).min(t_end);
+            let options = RunOptions {
+                dt: Some(step),
+                ..options
+            };
+            run(py, &system, &mut stepper, &y0, &options)
+        }
         other => {
             return Err(InvalidInputError::new_err(format!(
                 "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
-                 \"generalized-alpha\" for a [structure] system, got {other:?}"
+                 \"generalized-alpha\", \"exact\" for a [structure] system, got {other:?}"
             )))
         }
     };

@@ -1,0 +1,329 @@
+//! A linear system under equality constraints, in its own normal modes: what
+//! the exact flow needs for each set of sticking pairs.
+//!
+//! With the constraints `h_i . x + offset_i = 0` the coordinates are
+//! `x = x_p + N y` (`N`: an orthonormal basis of the constraints' null
+//! space, `x_p`: the least-norm point on them), and the reduced system
+//! `N^T M N y'' + N^T C N y' + N^T K N y = N^T (f - K x_p)` is decoupled by
+//! its mass-normalised modes `Phi`, when its damping is classical (`Phi^T C
+//! Phi` diagonal): `x = x_p + B eta`, `eta = T (x - x_p)` with `B = N Phi`
+//! and `T = Phi^T N^T M N N^T`, each modal coordinate an oscillator
+//! `eta'' + c eta' + w2 eta = F0 + sum_k Re(P_k e^(i omega_k t))`.
+
+use crate::assembly::LinearParts;
+use crate::error::{Error, Result};
+use crate::linalg;
+
+/// One harmonic of the forcing, with each mode's steady (particular)
+/// response `Re(Z e^(i omega t))` as `(Re Z, Im Z)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModalHarmonic {
+    /// rad/s (> 0).
+    pub omega: f64,
+    pub response: Vec<(f64, f64)>,
+    /// Each mode's force `Re(P e^(i omega t))` as `(Re P, Im P)`.
+    pub force: Vec<(f64, f64)>,
+}
+
+/// A linear system in the normal modes of one set of constraints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Configuration {
+    /// Modal coordinates (degrees of freedom left by the constraints).
+    pub modes: usize,
+    /// The least-norm point on the constraints, over all coordinates.
+    pub origin: Vec<f64>,
+    /// `B` (`dim x modes`, row-major): coordinates from modal coordinates.
+    pub to_coordinates: Vec<f64>,
+    /// `T` (`modes x dim`): modal coordinates from coordinates.
+    pub to_modal: Vec<f64>,
+    /// Each mode's `w2` (1/s^2, >= 0) and `c` (1/s, >= 0).
+    pub stiffness: Vec<f64>,
+    pub damping: Vec<f64>,
+    /// Each mode's constant force per unit modal mass, `F0`.
+    pub constant: Vec<f64>,
+    pub harmonics: Vec<ModalHarmonic>,
+}
+
+impl Configuration {
+    /// The modes of `parts` under `constraints` (`(h, offset)` pairs over all
+    /// coordinates). `what` names the configuration in errors.
+    pub fn new(parts: &LinearParts, constraints: &[(&[f64], f64)], what: &str) -> Result<Self> {
+        let dim = parts.constant.len();
+        let (rows, null) = split_space(constraints.iter().map(|c| c.0), dim);
+        let r = null.len();
+        // The least-norm point: x_p = U c with (H U) c = -offset over the
+        // orthonormal row basis U.
+        let mut origin = vec![0.0; dim];
+        if !rows.is_empty() {
+            let s = rows.len();
+            let m = constraints.len();
+            // Least squares (H U)^T (H U) c = -(H U)^T offset, consistent for
+            // dependent constraints on the same point.
+            let mut hu = vec![0.0; m * s];
+            for (i, (h, _)) in constraints.iter().enumerate() {
+                for (j, u) in rows.iter().enumerate() {
+                    hu[i * s + j] = linalg::dot(h, u);
+                }
+            }
+            let mut normal = vec![0.0; s * s];
+            let mut rhs = vec![0.0; s];
+            for a in 0..s {
+                for b in 0..s {
+                    normal[a * s + b] = (0..m).map(|i| hu[i * s + a] * hu[i * s + b]).sum();
+                }
+                rhs[a] = -(0..m).map(|i| hu[i * s + a] * constraints[i].1).sum::<f64>();
+            }
+            linalg::solve_in_place(&mut normal, &mut rhs, s);
+            for (u, c) in rows.iter().zip(&rhs) {
+                for (o, u) in origin.iter_mut().zip(u) {
+                    *o += c * u;
+                }
+            }
+        }
+        let reduce = |a: &[f64]| {
+            let mut out = vec![0.0; r * r];
+            for p in 0..r {
+                for q in 0..r {
+                    let mut sum = 0.0;
+                    for i in 0..dim {
+                        let row: f64 = (0..dim).map(|j| a[i * dim + j] * null[q][j]).sum();
+                        sum += null[p][i] * row;
+                    }
+                    out[p * r + q] = sum;
+                }
+            }
+            out
+        };
+        let (mr, kr, cr) = (
+            reduce(&parts.mass),
+            reduce(&parts.stiffness),
+            reduce(&parts.damping),
+        );
+        let l = linalg::cholesky(&mr, r).ok_or_else(|| {
+            Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
+        })?;
+        let linv = linalg::inverse_lower(&l, r);
+        // A = L^-1 K L^-T; Phi = L^-T V.
+        let similar = |a: &[f64]| {
+            let mut out = vec![0.0; r * r];
+            for p in 0..r {
+                for q in 0..r {
+                    let mut sum = 0.0;
+                    for i in 0..r {
+                        for j in 0..r {
+                            sum += linv[p * r + i] * a[i * r + j] * linv[q * r + j];
+                        }
+                    }
+                    out[p * r + q] = sum;
+                }
+            }
+            out
+        };
+        let a = similar(&kr);
+        let (mut values, vectors) = linalg::symmetric_eigen(&a, r);
+        // Columns of Phi = L^-T V.
+        let mut phi = vec![0.0; r * r];
+        for i in 0..r {
+            for c in 0..r {
+                phi[i * r + c] = (0..r).map(|k| linv[k * r + i] * vectors[k * r + c]).sum();
+            }
+        }
+        let modal_damping = |phi: &[f64]| {
+            let mut out = vec![0.0; r * r];
+            for p in 0..r {
+                for q in 0..r {
+                    let mut sum = 0.0;
+                    for i in 0..r {
+                        let row: f64 = (0..r).map(|j| cr[i * r + j] * phi[j * r + q]).sum();
+                        sum += phi[i * r + p] * row;
+                    }
+                    out[p * r + q] = sum;
+                }
+            }
+            out
+        };
+        // Within a repeated eigenvalue (free masses, symmetric structures)
+        // the modes are any basis of the eigenspace: take the one that
+        // diagonalises the damping there too.
+        let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scale;
+        let mut start = 0;
+        while start < r {
+            let mut end = start + 1;
+            while end < r && same(values[start], values[end]) {
+                end += 1;
+            }
+            if end - start > 1 {
+                let cm = modal_damping(&phi);
+                let g = end - start;
+                let block: Vec<f64> = (0..g * g)
+                    .map(|p| cm[(start + p / g) * r + start + p % g])
+                    .collect();
+                let (_, rotation) = linalg::symmetric_eigen(&block, g);
+                for i in 0..r {
+                    let old: Vec<f64> = (0..g).map(|c| phi[i * r + start + c]).collect();
+                    for c in 0..g {
+                        phi[i * r + start + c] =
+                            (0..g).map(|k| old[k] * rotation[k * g + c]).sum();
+                    }
+                }
+            }
+            start = end;
+        }
+        let cm = modal_damping(&phi);
+        let largest = (0..r).fold(0.0f64, |m, i| m.max(cm[i * r + i].abs()));
+        for p in 0..r {
+            for q in p + 1..r {
+                if cm[p * r + q].abs() > 1e-9 * largest {
+                    return Err(Error::Inconsistent(format!(
+                        "method \"exact\" needs classical damping (C diagonal in the normal \
+                         modes), and {what} couples modes {p} and {q} through damping; use \
+                         \"dop853\""
+                    )));
+                }
+            }
+        }
+        for v in values.iter_mut() {
+            // Rigid-body modes: round-off of zero.
+            if v.abs() <= 1e-12 * scale {
+                *v = 0.0;
+            }
+        }
+        // B = N Phi; T = Phi^T Mr N^T.
+        let mut to_coordinates = vec![0.0; dim * r];
+        for i in 0..dim {
+            for c in 0..r {
+                to_coordinates[i * r + c] = (0..r).map(|k| null[k][i] * phi[k * r + c]).sum();
+            }
+        }
+        let mut phi_t_m = vec![0.0; r * r];
+        for c in 0..r {
+            for k in 0..r {
+                phi_t_m[c * r + k] = (0..r).map(|j| phi[j * r + c] * mr[j * r + k]).sum();
+            }
+        }
+        let mut to_modal = vec![0.0; r * dim];
+        for c in 0..r {
+            for i in 0..dim {
+                to_modal[c * dim + i] = (0..r).map(|k| phi_t_m[c * r + k] * null[k][i]).sum();
+            }
+        }
+        // Modal loads: B^T f.
+        let project = |f: &[f64]| -> Vec<f64> {
+            (0..r)
+                .map(|c| (0..dim).map(|i| to_coordinates[i * r + c] * f[i]).sum())
+                .collect()
+        };
+        let mut static_load = parts.constant.clone();
+        for i in 0..dim {
+            static_load[i] -= linalg::dot(&parts.stiffness[i * dim..(i + 1) * dim], &origin);
+        }
+        let mut constant = project(&static_load);
+        let damping: Vec<f64> = (0..r).map(|i| cm[i * r + i].max(0.0)).collect();
+        let mut harmonics: Vec<ModalHarmonic> = Vec::new();
+        for load in &parts.harmonics {
+            let shape = project(&load.shape);
+            if load.omega == 0.0 {
+                for (c, s) in constant.iter_mut().zip(&shape) {
+                    *c += load.amplitude * load.phase.cos() * s;
+                }
+                continue;
+            }
+            let (sin, cos) = load.phase.sin_cos();
+            let mut response = Vec::with_capacity(r);
+            let mut force = Vec::with_capacity(r);
+            for j in 0..r {
+                let (pr, pi) = (load.amplitude * cos * shape[j], load.amplitude * sin * shape[j]);
+                force.push((pr, pi));
+                let (dr, di) = (values[j] - load.omega * load.omega, damping[j] * load.omega);
+                let norm = dr * dr + di * di;
+                if norm == 0.0 {
+                    if pr == 0.0 && pi == 0.0 {
+                        response.push((0.0, 0.0));
+                        continue;
+                    }
+                    return Err(Error::Inconsistent(format!(
+                        "{what}: an undamped mode at exactly the forcing frequency {} Hz grows \
+                         without bound; add damping or shift the frequency",
+                        load.omega / std::f64::consts::TAU
+                    )));
+                }
+                // Z = P / (w2 - omega^2 + i c omega).
+                response.push(((pr * dr + pi * di) / norm, (pi * dr - pr * di) / norm));
+            }
+            // Harmonics of one frequency add.
+            match harmonics.iter_mut().find(|h| h.omega == load.omega) {
+                Some(h) => {
+                    for (a, b) in h.response.iter_mut().zip(&response) {
+                        a.0 += b.0;
+                        a.1 += b.1;
+                    }
+                    for (a, b) in h.force.iter_mut().zip(&force) {
+                        a.0 += b.0;
+                        a.1 += b.1;
+                    }
+                }
+                None => harmonics.push(ModalHarmonic {
+                    omega: load.omega,
+                    response,
+                    force,
+                }),
+            }
+        }
+        Ok(Self {
+            modes: r,
+            origin,
+            to_coordinates,
+            to_modal,
+            stiffness: values,
+            damping,
+            constant,
+            harmonics,
+        })
+    }
+}
+
+/// Orthonormal bases of the span of `rows` (dependent rows dropped) and of
+/// its orthogonal complement in `R^dim`, by Gram-Schmidt twice over.
+fn split_space<'a>(
+    rows: impl Iterator<Item = &'a [f64]>,
+    dim: usize,
+) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let mut basis: Vec<Vec<f64>> = Vec::new();
+    let orthogonalise = |v: &mut Vec<f64>, basis: &[Vec<f64>]| {
+        for _ in 0..2 {
+            for b in basis {
+                let p = linalg::dot(v, b);
+                for (x, b) in v.iter_mut().zip(b) {
+                    *x -= p * b;
+                }
+            }
+        }
+        linalg::dot(v, v).sqrt()
+    };
+    for row in rows {
+        let size = linalg::dot(row, row).sqrt();
+        let mut v = row.to_vec();
+        let left = orthogonalise(&mut v, &basis);
+        if left > 1e-10 * size {
+            v.iter_mut().for_each(|x| *x /= left);
+            basis.push(v);
+        }
+    }
+    let count = basis.len();
+    let mut all = basis;
+    for e in 0..dim {
+        if all.len() == dim {
+            break;
+        }
+        let mut v = vec![0.0; dim];
+        v[e] = 1.0;
+        let left = orthogonalise(&mut v, &all);
+        if left > 1e-6 {
+            v.iter_mut().for_each(|x| *x /= left);
+            all.push(v);
+        }
+    }
+    let null = all.split_off(count);
+    (all, null)
+}
