@@ -125,6 +125,8 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
             "gamma": 0.5,
             "spectral_radius": 0.9,
             "energy_tolerance": 1e-2,
+            "record_from": 0.0,
+            "strobe_period": 5e-3,
         },
     ),
     "check_solver": (_core.check_solver, SOLVER),

@@ -211,6 +211,8 @@ def simulate_system(
     max_steps: int,
     max_rows: int,
     energy_tolerance: float,
+    record_from: float | None = None,
+    strobe_period: float | None = None,
 ) -> dict[str, Any]: ...
 def simulate(
     system: ImpactDamper,

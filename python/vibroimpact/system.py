@@ -151,7 +151,12 @@ _SOLVER = {
     "gamma": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["gamma"]),
     "spectral_radius": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["spectral_radius"]),
 }
-_OUTPUT = {"every": (_WHOLE, 1), "history": ("boolean", True)}
+_OUTPUT = {
+    "every": (_WHOLE, 1),
+    "history": ("boolean", True),
+    "record_from": (_NUMBER, None),
+    "strobe_period": (_NUMBER, None),
+}
 _INT64 = range(-(2**63), 2**63)
 _METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha", "exact")
 _FIXED_STEP = ("rk4", "newmark-implicit", "generalized-alpha")
@@ -473,6 +478,15 @@ class SystemSolution:
     grazing_contacts: int
     method: str
     pairs: list[str] = field(default_factory=list)
+    #: Per structure coordinate, from ``record_from`` on: the largest |displacement|
+    #: (m, located where the velocity changes sign or at an impact) and the RMS (m).
+    peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    recorded_time: float = 0.0
+    #: The state at each multiple of ``strobe_period`` (rows of the four arrays of
+    #: ``[initial]``, concatenated as the history's columns) and its times (s).
+    strobe: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    strobe_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def simulate_system(
@@ -497,6 +511,8 @@ def simulate_system(
     energy_tolerance: float = SYSTEM_SOLVER_DEFAULTS["energy_tolerance"],
     max_rows: int = SYSTEM_SOLVER_DEFAULTS["max_rows"],
     base_dir: Path | None = None,
+    record_from: float | None = None,
+    strobe_period: float | None = None,
 ) -> SystemSolution:
     """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
 
@@ -515,7 +531,10 @@ def simulate_system(
     contacts and the final state only). A run stops with a clear error past
     ``max_steps`` steps, past ``max_rows`` history rows and contacts, or when its
     energy balance is off by more than ``energy_tolerance`` of the energies in play.
-    The GIL is released while integrating; Ctrl-C interrupts.
+    From ``record_from`` (s) on, each structure coordinate's located peak and RMS
+    are kept (``peak``, ``rms``); every ``strobe_period`` (s) the state is kept
+    (``strobe``; fixed steps are shortened to divide it). The GIL is released while
+    integrating; Ctrl-C interrupts.
     """
     run = prepare_system(
         structure,
@@ -537,7 +556,12 @@ def simulate_system(
             "spectral_radius": spectral_radius,
             **({} if dt is None else {"dt": dt}),
         },
-        output={"every": every, "history": history},
+        output={
+            "every": every,
+            "history": history,
+            **({} if record_from is None else {"record_from": record_from}),
+            **({} if strobe_period is None else {"strobe_period": strobe_period}),
+        },
         base_dir=base_dir,
     )
     return run.run()
@@ -571,6 +595,8 @@ class PreparedRun:
             max_steps=solver["max_steps"],
             max_rows=solver["max_rows"],
             energy_tolerance=solver["energy_tolerance"],
+            record_from=output["record_from"],
+            strobe_period=output["strobe_period"],
         )
         return _solution(raw, solver["method"])
 
@@ -628,6 +654,10 @@ def prepare_system(
                 f"max_rows = {solver['max_rows']}: raise every, set history = false, "
                 "shorten t_end or raise max_rows",
             )
+    if output["record_from"] is not None and not output["record_from"] >= 0:
+        raise _fail("[output] record_from: ", f"must be >= 0 s, got {output['record_from']}")
+    if output["strobe_period"] is not None and not output["strobe_period"] > 0:
+        raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
     for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
         value = (output if section == "output" else solver)[key]
         if value < 1:
@@ -668,4 +698,11 @@ def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
         grazing_contacts=raw["grazing_contacts"],
         method=method,
         pairs=pairs,
+        peak=raw["peaks"],
+        rms=np.sqrt(raw["square_integrals"] / raw["recorded_time"])
+        if raw["recorded_time"] > 0
+        else np.full(n, np.nan),
+        recorded_time=raw["recorded_time"],
+        strobe=raw["strobe"].reshape(-1, width),
+        strobe_time=raw["strobe_time"],
     )

@@ -29,6 +29,7 @@ fn options(dt: Option<f64>, t_end: f64) -> RunOptions {
         max_steps: u64::MAX,
         max_rows: u64::MAX,
         energy_tolerance: 1e-2,
+        reduce: Default::default(),
     }
 }
 

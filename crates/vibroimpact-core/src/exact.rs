@@ -298,11 +298,7 @@ impl ExactFlow {
             self.rate[j] = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + dp;
         }
         let mut input = 0.0;
-        for ((h, (s0, c0)), (st, ct)) in cfg
-            .harmonics
-            .iter()
-            .zip(&self.phasors)
-            .zip(&factors.turns)
+        for ((h, (s0, c0)), (st, ct)) in cfg.harmonics.iter().zip(&self.phasors).zip(&factors.turns)
         {
             // The angle at the start turned by omega t.
             let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);

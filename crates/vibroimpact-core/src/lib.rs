@@ -22,6 +22,7 @@ pub mod materials;
 pub mod modal;
 pub mod model;
 pub mod records;
+pub mod reductions;
 pub mod run;
 pub mod settings;
 pub mod signals;

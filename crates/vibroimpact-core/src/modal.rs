@@ -71,7 +71,9 @@ impl Configuration {
                 for b in 0..s {
                     normal[a * s + b] = (0..m).map(|i| hu[i * s + a] * hu[i * s + b]).sum();
                 }
-                rhs[a] = -(0..m).map(|i| hu[i * s + a] * constraints[i].1).sum::<f64>();
+                rhs[a] = -(0..m)
+                    .map(|i| hu[i * s + a] * constraints[i].1)
+                    .sum::<f64>();
             }
             linalg::solve_in_place(&mut normal, &mut rhs, s);
             for (u, c) in rows.iter().zip(&rhs) {
@@ -163,8 +165,7 @@ impl Configuration {
                 for i in 0..r {
                     let old: Vec<f64> = (0..g).map(|c| phi[i * r + start + c]).collect();
                     for c in 0..g {
-                        phi[i * r + start + c] =
-                            (0..g).map(|k| old[k] * rotation[k * g + c]).sum();
+                        phi[i * r + start + c] = (0..g).map(|k| old[k] * rotation[k * g + c]).sum();
                     }
                 }
             }
@@ -233,7 +234,10 @@ impl Configuration {
             let mut response = Vec::with_capacity(r);
             let mut force = Vec::with_capacity(r);
             for j in 0..r {
-                let (pr, pi) = (load.amplitude * cos * shape[j], load.amplitude * sin * shape[j]);
+                let (pr, pi) = (
+                    load.amplitude * cos * shape[j],
+                    load.amplitude * sin * shape[j],
+                );
                 force.push((pr, pi));
                 let (dr, di) = (values[j] - load.omega * load.omega, damping[j] * load.omega);
                 let norm = dr * dr + di * di;

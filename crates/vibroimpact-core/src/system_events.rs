@@ -23,6 +23,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 }
 use crate::error::{Error, Result};
 use crate::hermite;
+use crate::reductions::{self, ReduceOptions, Reductions};
 use crate::system_steppers::SystemStepper;
 
 /// How to run and what to keep.
@@ -42,6 +43,8 @@ pub struct RunOptions {
     pub max_rows: u64,
     /// Largest energy-balance residual, relative to the energies in play.
     pub energy_tolerance: f64,
+    /// Peaks, mean squares and stroboscopic states to keep.
+    pub reduce: ReduceOptions,
 }
 
 /// What kind of contact a record is.
@@ -120,6 +123,7 @@ pub struct SystemSolution {
     pub rejected_steps: u64,
     pub rhs_evaluations: u64,
     pub grazing_contacts: u64,
+    pub reductions: Reductions,
 }
 
 /// A contact being followed.
@@ -301,6 +305,8 @@ enum Location {
 /// Buffers of the location.
 struct Buffers {
     probe: Vec<f64>,
+    /// Rates at a step's start (reductions).
+    start: Vec<f64>,
     best: Vec<f64>,
     work: Vec<f64>,
 }
@@ -481,6 +487,7 @@ pub fn integrate_system<S: SystemStepper>(
         probe: vec![0.0; len],
         best: vec![0.0; len],
         work: vec![0.0; len],
+        start: vec![0.0; len],
     };
     let mut scratch = Scratch::new(system);
     let mut modes = vec![Mode::Open; count];
@@ -506,12 +513,22 @@ pub fn integrate_system<S: SystemStepper>(
     let (mut last_event, mut close_events) = (f64::NEG_INFINITY, 0u64);
     let mut just_rejected = false;
     let mut stalled = 0u64;
+    let mut reductions = Reductions {
+        peaks: vec![0.0; system.n],
+        square_integrals: vec![0.0; system.n],
+        ..Reductions::default()
+    };
+    let mut next_strobe = options.reduce.strobe_period;
 
     while time < t_end {
+        if !adaptive && t_end - time <= 1e-9 * dt {
+            // On t_end to the round-off of the grid's times.
+            break;
+        }
         let mut length = if adaptive {
             h.min(t_end - time)
         } else {
-            (grid + 1) as f64 * dt - time
+            ((grid + 1) as f64 * dt - time).min(t_end - time)
         };
         if !adaptive && length <= 0.0 {
             grid += 1;
@@ -519,6 +536,10 @@ pub fn integrate_system<S: SystemStepper>(
         }
         if adaptive && (t_end - time - length) < 1e-3 * length {
             length = t_end - time;
+        }
+        if adaptive && next_strobe - time < length {
+            // Land on the stroboscopic instant.
+            length = next_strobe - time;
         }
         let error = stepper.attempt(system, time, &y, length, &modes, &mut scratch, &mut end)?;
         let mut full_error = error;
@@ -674,6 +695,23 @@ pub fn integrate_system<S: SystemStepper>(
                 oc.max_indentation = oc.max_indentation.max(deepest);
             }
         }
+        if time >= options.reduce.record_from {
+            let located = reduce_step(
+                system,
+                stepper,
+                time,
+                &y,
+                &end,
+                taken,
+                &modes,
+                &mut scratch,
+                &mut buffers,
+                &mut reductions,
+            )?;
+            if located {
+                last_attempt_kept = false;
+            }
+        }
         if last_attempt_kept {
             stepper.accept();
         } else {
@@ -750,13 +788,20 @@ pub fn integrate_system<S: SystemStepper>(
             }
         }
 
-        let done = time >= t_end;
+        if time >= next_strobe - 1e-9 * options.reduce.strobe_period {
+            reductions.strobe.extend_from_slice(&y[..row]);
+            reductions.strobe_time.push(time);
+            next_strobe = (reductions.strobe_time.len() + 1) as f64 * options.reduce.strobe_period;
+        }
+        let done = time >= t_end || (!adaptive && t_end - time <= 1e-9 * dt);
         until_kept -= 1;
         if options.keep_history && (until_kept == 0 || done) {
             until_kept = options.every;
             keep(time, &y, &mut time_rows, &mut states);
         }
-        if (time_rows.len() + contacts.len()) as u64 > options.max_rows {
+        if (time_rows.len() + contacts.len() + reductions.strobe_time.len()) as u64
+            > options.max_rows
+        {
             return Err(Error::RowLimit {
                 time,
                 max_rows: options.max_rows,
@@ -831,10 +876,62 @@ pub fn integrate_system<S: SystemStepper>(
         rejected_steps: rejected,
         rhs_evaluations: stepper.evaluations(),
         grazing_contacts: grazes,
+        reductions,
     })
 }
 
 /// The energy balance at state `y`, whose stored energy is `stored_end`.
+/// Add the kept step `(time, y) -> end` of length `h` to the reductions.
+/// Returns whether the stepper was used (its last attempt is then not the
+/// kept step).
+#[allow(clippy::too_many_arguments)]
+fn reduce_step<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    time: f64,
+    y: &[f64],
+    end: &[f64],
+    h: f64,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+    buffers: &mut Buffers,
+    out: &mut Reductions,
+) -> Result<bool> {
+    let d = system.dim;
+    system.rates(time, y, modes, scratch, &mut buffers.start);
+    system.rates(time + h, end, modes, scratch, &mut buffers.work);
+    let mut used = false;
+    for i in 0..system.n {
+        let a = reductions::quintic(
+            y[i],
+            end[i],
+            h * y[d + i],
+            h * end[d + i],
+            h * h * buffers.start[d + i],
+            h * h * buffers.work[d + i],
+        );
+        out.square_integrals[i] += h * reductions::square_integral(&a);
+        let mut peak = y[i].abs().max(end[i].abs());
+        if y[d + i] * end[d + i] < 0.0 {
+            let theta = reductions::derivative_root(&a);
+            stepper.attempt(
+                system,
+                time,
+                y,
+                theta * h,
+                modes,
+                scratch,
+                &mut buffers.probe,
+            )?;
+            used = true;
+            peak = peak.max(buffers.probe[i].abs());
+        }
+        out.peaks[i] = out.peaks[i].max(peak);
+    }
+    out.recorded_time += h;
+    Ok(used)
+}
+
 fn balance(
     system: &Assembly,
     y: &[f64],

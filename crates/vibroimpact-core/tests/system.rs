@@ -25,6 +25,7 @@ fn options(dt: Option<f64>, t_end: f64) -> RunOptions {
         max_steps: 100_000_000,
         max_rows: 100_000_000,
         energy_tolerance: 1e-6,
+        reduce: Default::default(),
     }
 }
 

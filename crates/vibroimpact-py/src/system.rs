@@ -10,12 +10,14 @@ use vibroimpact_core as core;
 use vibroimpact_core::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
-use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::exact::ExactFlow;
+use vibroimpact_core::reductions::ReduceOptions;
+use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, RunOptions};
 use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 
+use crate::convert::real_or_none;
 use crate::errors::{released, to_py, InvalidInputError};
 
 /// `where key` must be present: the Python side fills defaults, so a missing
@@ -276,7 +278,7 @@ fn run<S: SystemStepper + Send>(
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
 /// dict of flat arrays that the Python side shapes.
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, every, history, max_steps, max_rows, energy_tolerance))]
+#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, every, history, max_steps, max_rows, energy_tolerance, record_from=None, strobe_period=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_system<'py>(
     py: Python<'py>,
@@ -295,12 +297,24 @@ pub fn simulate_system<'py>(
     max_steps: u64,
     max_rows: u64,
     energy_tolerance: f64,
+    #[pyo3(from_py_with = real_or_none)] record_from: Option<f64>,
+    #[pyo3(from_py_with = real_or_none)] strobe_period: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let system_spec = system_spec(spec, t_end)?;
     let system = Assembly::new(&system_spec).map_err(to_py)?;
     let y0 = initial_state(&system, &initial[0], &initial[1], &initial[2], &initial[3])
         .map_err(to_py)?;
     let len = system.state_len();
+    let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
+    // A fixed step that divides the strobe period lands on its multiples.
+    let fit = |step: f64| {
+        if strobe_period.is_finite() {
+            strobe_period / (strobe_period / step - 1e-9).ceil().max(1.0)
+        } else {
+            step
+        }
+    };
+    let dt = dt.map(fit);
     let options = RunOptions {
         dt,
         t_end,
@@ -309,6 +323,10 @@ pub fn simulate_system<'py>(
         max_steps,
         max_rows,
         energy_tolerance,
+        reduce: ReduceOptions {
+            record_from: record_from.unwrap_or(f64::INFINITY),
+            strobe_period,
+        },
     };
     let result = match method {
         "rk4" => run(py, &system, &mut ExplicitRk::rk4(len), &y0, &options),
@@ -338,7 +356,7 @@ pub fn simulate_system<'py>(
             let mut stepper = ExactFlow::new(&system).map_err(to_py)?;
             // dt, when given, caps the flow's own step (a finer check of
             // the gaps between step ends).
-            let step = dt.unwrap_or(f64::INFINITY).min(stepper.step()).min(t_end);
+            let step = fit(dt.unwrap_or(f64::INFINITY).min(stepper.step()).min(t_end));
             let options = RunOptions {
                 dt: Some(step),
                 ..options
@@ -396,5 +414,11 @@ pub fn simulate_system<'py>(
     out.set_item("rejected_steps", sol.rejected_steps)?;
     out.set_item("rhs_evaluations", sol.rhs_evaluations)?;
     out.set_item("grazing_contacts", sol.grazing_contacts)?;
+    let r = sol.reductions;
+    out.set_item("peaks", r.peaks.into_pyarray(py))?;
+    out.set_item("square_integrals", r.square_integrals.into_pyarray(py))?;
+    out.set_item("recorded_time", r.recorded_time)?;
+    out.set_item("strobe", r.strobe.into_pyarray(py))?;
+    out.set_item("strobe_time", r.strobe_time.into_pyarray(py))?;
     Ok(out)
 }

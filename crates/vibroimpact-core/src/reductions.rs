@@ -1,0 +1,119 @@
+//! What a run can keep instead of (or beside) its history: each structure
+//! coordinate's peak |displacement| and mean square over a recording window,
+//! and the state at every multiple of a period (the stroboscopic map).
+//!
+//! Peaks are located, not read off step ends: where a coordinate's velocity
+//! changes sign within a step, the quintic Hermite interpolant through both
+//! ends' displacements, velocities and accelerations places the extremum,
+//! and the method's own solution is evaluated there (the displacement at an
+//! extremum is insensitive to the error of its time). Velocity jumps happen
+//! at impacts, which end steps, so peaks at impacts are step ends. Mean
+//! squares integrate the same interpolant (Gauss-Legendre, exact for it).
+
+/// What to reduce: from `record_from` (s) on, and a stroboscopic state every
+/// `strobe_period` (s; infinite for none).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReduceOptions {
+    pub record_from: f64,
+    pub strobe_period: f64,
+}
+
+impl Default for ReduceOptions {
+    fn default() -> Self {
+        Self {
+            record_from: f64::INFINITY,
+            strobe_period: f64::INFINITY,
+        }
+    }
+}
+
+/// The reductions of a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Reductions {
+    /// Per structure coordinate, the largest |displacement| (m) recorded.
+    pub peaks: Vec<f64>,
+    /// Per structure coordinate, the integral of the displacement squared
+    /// over the recorded time (m^2 s).
+    pub square_integrals: Vec<f64>,
+    /// s.
+    pub recorded_time: f64,
+    /// Rows of `x` then `v` at each multiple of the strobe period.
+    pub strobe: Vec<f64>,
+    /// Times of the strobe rows (s).
+    pub strobe_time: Vec<f64>,
+}
+
+/// Monomial coefficients (in `theta` in [0, 1]) of the quintic Hermite
+/// interpolant with values `p`, slopes `m` (per unit theta) and second
+/// derivatives `c` (per unit theta squared) at both ends.
+pub fn quintic(p0: f64, p1: f64, m0: f64, m1: f64, c0: f64, c1: f64) -> [f64; 6] {
+    let d = p1 - p0;
+    [
+        p0,
+        m0,
+        0.5 * c0,
+        10.0 * d - 6.0 * m0 - 4.0 * m1 - 1.5 * c0 + 0.5 * c1,
+        -15.0 * d + 8.0 * m0 + 7.0 * m1 + 1.5 * c0 - c1,
+        6.0 * d - 3.0 * m0 - 3.0 * m1 - 0.5 * c0 + 0.5 * c1,
+    ]
+}
+
+/// The polynomial `a` and its derivative at `t`.
+#[inline]
+pub fn evaluate(a: &[f64; 6], t: f64) -> (f64, f64) {
+    let mut value = a[5];
+    let mut slope = 0.0;
+    for k in (0..5).rev() {
+        slope = slope * t + value;
+        value = value * t + a[k];
+    }
+    (value, slope)
+}
+
+/// Where the derivative of `a` changes sign in (0, 1), given it does
+/// (bisection on the derivative's sign, 50 halvings: to round-off).
+pub fn derivative_root(a: &[f64; 6]) -> f64 {
+    let slope = |t: f64| evaluate(a, t).1;
+    let (mut lo, mut hi) = (0.0, 1.0);
+    let low_sign = slope(0.0) < 0.0;
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if (slope(mid) < 0.0) == low_sign {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Gauss-Legendre on [0, 1], 6 points: exact for the square of a quintic
+/// up to degree 11.
+const NODES: [f64; 6] = [
+    0.033_765_242_898_423_98,
+    0.169_395_306_766_867_74,
+    0.380_690_406_958_401_5,
+    0.619_309_593_041_598_5,
+    0.830_604_693_233_132_3,
+    0.966_234_757_101_576,
+];
+const WEIGHTS: [f64; 6] = [
+    0.085_662_246_189_585_17,
+    0.180_380_786_524_069_3,
+    0.233_956_967_286_345_5,
+    0.233_956_967_286_345_5,
+    0.180_380_786_524_069_3,
+    0.085_662_246_189_585_17,
+];
+
+/// The integral over [0, 1] of the square of the quintic `a`.
+pub fn square_integral(a: &[f64; 6]) -> f64 {
+    NODES
+        .iter()
+        .zip(WEIGHTS)
+        .map(|(t, w)| {
+            let v = evaluate(a, *t).0;
+            w * v * v
+        })
+        .sum()
+}
