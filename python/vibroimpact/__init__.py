@@ -48,7 +48,7 @@ from vibroimpact._core import (
     simulate,
 )
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
-from vibroimpact.system import simulate_system
+from vibroimpact.system import linear_parts, simulate_system
 
 
 def _equality_only(*classes: type) -> None:
@@ -69,6 +69,7 @@ def _equality_only(*classes: type) -> None:
 _equality_only(ImpactDamper, Contact, InitialState)
 
 __all__ = [
+    "linear_parts",
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
     "BeamMode",

@@ -31,6 +31,7 @@ __all__ = [
     "linear_contact_duration",
     "simulate",
     "simulate_system",
+    "linear_parts",
 ]
 
 __version__: str
@@ -214,6 +215,7 @@ def simulate_system(
     record_from: float | None = None,
     strobe_period: float | None = None,
 ) -> dict[str, Any]: ...
+def linear_parts(spec: dict[str, Any]) -> dict[str, Any]: ...
 def simulate(
     system: ImpactDamper,
     contact: Contact,

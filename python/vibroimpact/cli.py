@@ -28,6 +28,7 @@ from vibroimpact._core import (
     Solution,
     __version__,
 )
+from vibroimpact.analysis_commands import add_commands, run_orbit, run_sweep
 from vibroimpact.output import UsageError, finite_or_none, written_whole
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
@@ -125,6 +126,7 @@ def _parser() -> argparse.ArgumentParser:
         help="print one JSON object (steps, contacts, ...); a quantity not defined for a "
         "contact still open at the end of the run is null",
     )
+    add_commands(sub)
     return parser
 
 
@@ -259,6 +261,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "paper":
             return run_paper(args.out)
+        if args.command == "orbit":
+            return run_orbit(args)
+        if args.command == "sweep":
+            return run_sweep(args)
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
         print(f"vibroimpact: error: {err}", file=sys.stderr)

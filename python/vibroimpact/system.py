@@ -47,6 +47,7 @@ from vibroimpact._core import (
     Contact,
     InvalidInputError,
 )
+from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
 
 __all__ = [
@@ -706,3 +707,33 @@ def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],
     )
+
+
+def linear_parts(
+    structure: Mapping[str, Any],
+    *,
+    damper: Any = (),
+    stop: Any = (),
+    gravity: Any = None,
+    excitation: Any = (),
+    base_dir: Path | None = None,
+) -> dict[str, Any]:
+    """The system between contacts as a linear one over all its coordinates
+    (structure, then dampers; sections as for :func:`simulate_system`):
+    ``M x'' + C x' + K x = constant + sum of harmonic loads``. Returns ``mass``,
+    ``stiffness``, ``damping`` (``dim x dim`` arrays, SI), ``constant`` (gravity's
+    weight, N) and ``harmonics``: each ``amplitude``, ``omega`` (rad/s), ``phase`` and
+    ``shape`` (the load is ``amplitude cos(omega t + phase) shape``, N). Signals
+    other than harmonics are refused."""
+    spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
+    raw = _linear_parts({**spec, "gravity": spec["gravity"]["acceleration"]})
+    dim = raw["n"] + raw["k"]
+    return {
+        "n": raw["n"],
+        "k": raw["k"],
+        "mass": np.asarray(raw["mass"]).reshape(dim, dim),
+        "stiffness": np.asarray(raw["stiffness"]).reshape(dim, dim),
+        "damping": np.asarray(raw["damping"]).reshape(dim, dim),
+        "constant": np.asarray(raw["constant"]),
+        "harmonics": [dict(h) for h in raw["harmonics"]],
+    }

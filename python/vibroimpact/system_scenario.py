@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +19,17 @@ from vibroimpact._core import InvalidInputError
 from vibroimpact.output import finite_or_none, written_whole
 from vibroimpact.system import PreparedRun, SystemSolution, prepare_system
 
-SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
+SECTIONS = (
+    "structure",
+    "damper",
+    "stop",
+    "gravity",
+    "excitation",
+    "initial",
+    "solver",
+    "output",
+    "sweep",
+)
 
 
 @dataclass(frozen=True)
@@ -28,6 +38,9 @@ class SystemScenario:
 
     source: str
     prepared: PreparedRun
+    #: The parsed sections, for analyses that vary them.
+    data: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    base_dir: Path | None = None
 
     @property
     def solver(self) -> dict[str, Any]:
@@ -66,7 +79,15 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
         )
     except InvalidInputError as err:
         raise InvalidInputError(f"{source}: {err}") from None
-    return SystemScenario(source, prepared)
+    data = dict(data)
+    if "sweep" in data:
+        from vibroimpact.analyses import sweep_settings
+
+        try:
+            data["sweep"] = sweep_settings(data["sweep"])
+        except InvalidInputError as err:
+            raise InvalidInputError(f"{source}: {err}") from None
+    return SystemScenario(source, prepared, data, base_dir)
 
 
 def system_summary(

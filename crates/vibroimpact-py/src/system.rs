@@ -422,3 +422,37 @@ pub fn simulate_system<'py>(
     out.set_item("strobe_time", r.strobe_time.into_pyarray(py))?;
     Ok(out)
 }
+
+/// The linear parts of a 0.2 system over all its coordinates (structure, then
+/// dampers): `mass`, `stiffness`, `damping` (row-major `dim x dim`), the constant
+/// load (gravity, N) and each harmonic load (`amplitude`, `omega` in rad/s,
+/// `phase`, `shape`), for closed-form linear responses.
+#[pyfunction]
+#[pyo3(signature = (spec))]
+pub fn linear_parts<'py>(
+    py: Python<'py>,
+    spec: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    // Harmonic loads only: no signal needs the run's length.
+    let system_spec = system_spec(spec, 1.0)?;
+    let system = Assembly::new(&system_spec).map_err(to_py)?;
+    let parts = system.linear_parts("linear_parts").map_err(to_py)?;
+    let out = PyDict::new(py);
+    out.set_item("n", system.n)?;
+    out.set_item("k", system.k)?;
+    out.set_item("mass", parts.mass.into_pyarray(py))?;
+    out.set_item("stiffness", parts.stiffness.into_pyarray(py))?;
+    out.set_item("damping", parts.damping.into_pyarray(py))?;
+    out.set_item("constant", parts.constant.into_pyarray(py))?;
+    let harmonics = PyList::empty(py);
+    for h in parts.harmonics {
+        let d = PyDict::new(py);
+        d.set_item("amplitude", h.amplitude)?;
+        d.set_item("omega", h.omega)?;
+        d.set_item("phase", h.phase)?;
+        d.set_item("shape", h.shape.into_pyarray(py))?;
+        harmonics.append(d)?;
+    }
+    out.set_item("harmonics", harmonics)?;
+    Ok(out)
+}

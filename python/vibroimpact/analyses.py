@@ -1,0 +1,581 @@
+"""Forced-response analyses of 0.2 systems: steady state, frequency response sweeps
+and periodic orbits with their Floquet multipliers.
+
+Every analysis runs whole periods ``T`` of the first harmonic excitation (the
+forcing is T-periodic, so a run of whole periods may restart its clock at 0) on
+the core's event-driven kernel with the scenario's method; ``method = "exact"``
+(linear structure, rigid pairs, harmonic forcing) is exact between impacts and the
+fastest. Peaks are located by the kernel (where a velocity changes sign, or at an
+impact), never read off output samples. SI units throughout.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact._core import simulate_system as _simulate_system
+from vibroimpact.system import (
+    _NUMBER,
+    _REQ,
+    _TEXT,
+    _WHOLE,
+    PreparedRun,
+    _choice,
+    _table,
+    linear_parts,
+    prepare_system,
+)
+
+_INITIAL = (
+    "structure_displacement",
+    "structure_velocity",
+    "damper_displacement",
+    "damper_velocity",
+)
+_SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
+
+
+class AnalysisError(InvalidInputError):
+    """An analysis that cannot be set up as asked (a ValueError)."""
+
+
+def forcing_period(data: Mapping[str, Any]) -> float:
+    """The period (s) of the first harmonic excitation of a scenario's sections."""
+    for j, excitation in enumerate(data.get("excitation", ()) or ()):
+        if isinstance(excitation, Mapping) and excitation.get("signal") == "harmonic":
+            frequency = excitation.get("frequency")
+            if not isinstance(frequency, int | float) or not frequency > 0:
+                raise AnalysisError(
+                    f"[[excitation]] {j} frequency: must be > 0 Hz for a periodic analysis, "
+                    f"got {frequency!r}"
+                )
+            return 1.0 / float(frequency)
+    raise AnalysisError(
+        "a periodic analysis needs a harmonic excitation ([[excitation]] with "
+        'signal = "harmonic"): its period is the forcing period'
+    )
+
+
+def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str, Any]:
+    """A deep copy of a scenario's sections with the dotted ``path`` (such as
+    ``"excitation.0.frequency"`` or ``"damper.0.clearance"``) set to ``value``."""
+    out = copy.deepcopy(dict(data))
+    parts = path.split(".")
+    if parts[0] not in _SECTIONS or len(parts) < 2:
+        raise AnalysisError(
+            f"parameter {path!r}: must be a dotted path into a section ({', '.join(_SECTIONS)}),"
+            ' such as "excitation.0.frequency"'
+        )
+    node: Any = out
+    for depth, key in enumerate(parts[:-1]):
+        try:
+            if isinstance(node, list):
+                node = node[int(key)]
+            else:
+                if key not in node and depth == 0 and key in ("gravity", "initial", "output"):
+                    node[key] = {}
+                node = node[key]
+        except (KeyError, IndexError, ValueError, TypeError):
+            raise AnalysisError(
+                f"parameter {path!r}: {'.'.join(parts[: depth + 1])} is not in the scenario"
+            ) from None
+        if isinstance(node, Mapping) is False and not isinstance(node, list):
+            raise AnalysisError(f"parameter {path!r}: {'.'.join(parts[: depth + 1])} is a value")
+    if isinstance(node, list):
+        raise AnalysisError(f"parameter {path!r}: ends on a list; name an entry's key")
+    node[parts[-1]] = value
+    return out
+
+
+def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
+    solver = dict(data.get("solver", {}))
+    solver.setdefault("t_end", 1.0)
+    return prepare_system(
+        data["structure"],
+        damper=data.get("damper", ()),
+        stop=data.get("stop", ()),
+        gravity=data.get("gravity"),
+        excitation=data.get("excitation", ()),
+        initial=data.get("initial"),
+        solver=solver,
+        base_dir=base_dir,
+    )
+
+
+@dataclass
+class Runner:
+    """Runs of one checked system from any state over whole forcing periods."""
+
+    prepared: PreparedRun
+    period: float
+    n: int = 0
+    k: int = 0
+    runs: int = 0
+
+    def __post_init__(self) -> None:
+        structure = self.prepared.spec["structure"]
+        kind = structure["kind"]
+        if kind == "oscillator":
+            self.n = 1
+        elif kind == "matrices":
+            self.n = len(structure["mass"])
+        else:
+            self.n = int(structure["modes"])
+        self.k = len(self.prepared.spec.get("damper", ()))
+
+    def initial_state(self) -> np.ndarray:
+        """The scenario's ``[initial]`` as a flat state ``(x, v)``."""
+        n, k = self.n, self.k
+        init = self.prepared.initial
+        parts = [np.zeros(n), np.zeros(k), np.zeros(n), np.zeros(k)]
+        for slot, key in zip(
+            (0, 2, 1, 3),
+            (
+                "structure_displacement",
+                "structure_velocity",
+                "damper_displacement",
+                "damper_velocity",
+            ),
+            strict=True,
+        ):
+            if len(init[key]):
+                parts[slot] = np.asarray(init[key], dtype=float)
+        return np.concatenate(parts)
+
+    def _run(
+        self, state: np.ndarray | None, t_end: float, *, record: bool, strobe: bool
+    ) -> dict[str, Any]:
+        spec, solver = self.prepared.spec, self.prepared.solver
+        if state is None:
+            initial = [list(self.prepared.initial[key]) for key in _INITIAL]
+        else:
+            n, k = self.n, self.k
+            if len(state) != 2 * (n + k):
+                raise AnalysisError(
+                    f"state: must have {2 * (n + k)} values (x then v), got {len(state)}"
+                )
+            d = n + k
+            initial = [
+                list(state[:n]),
+                list(state[d : d + n]),
+                list(state[n:d]),
+                list(state[d + n :]),
+            ]
+        raw = _simulate_system(
+            {**spec, "gravity": spec["gravity"]["acceleration"]},
+            initial,
+            method=solver["method"],
+            t_end=t_end,
+            dt=solver["dt"],
+            rtol=solver["rtol"],
+            atol=solver["atol"],
+            beta=solver["beta"],
+            gamma=solver["gamma"],
+            spectral_radius=solver["spectral_radius"],
+            every=1,
+            history=False,
+            max_steps=solver["max_steps"],
+            max_rows=solver["max_rows"],
+            energy_tolerance=solver["energy_tolerance"],
+            record_from=0.0 if record else None,
+            strobe_period=self.period if strobe else None,
+        )
+        self.runs += 1
+        return raw
+
+    def periods(
+        self, state: np.ndarray, count: int, *, record: bool = False, strobe: bool = False
+    ) -> dict[str, Any]:
+        """Run ``count`` forcing periods from ``state``."""
+        return self._run(state, count * self.period, record=record, strobe=strobe)
+
+    def map(self, state: np.ndarray, count: int) -> np.ndarray:
+        """The stroboscopic map over ``count`` periods."""
+        return np.asarray(self.periods(state, count)["final_state"], dtype=float)
+
+
+def runner(data: Mapping[str, Any], base_dir: Path | None = None) -> Runner:
+    """A :class:`Runner` of a scenario's sections (as parsed from TOML)."""
+    return Runner(_prepare(data, base_dir), forcing_period(data))
+
+
+def _impacts(raw: Mapping[str, Any]) -> int:
+    kinds = raw["contacts"]["kind"]
+    return sum(1 for kind in kinds if kind in ("impact", "compliant"))
+
+
+def _scaled_distance(a: np.ndarray, b: np.ndarray, dim: int, reference: np.ndarray) -> float:
+    """|a - b| with displacements and velocities each scaled by their largest
+    magnitude in ``reference`` (rows of states)."""
+    x_scale = max(float(np.max(np.abs(reference[:, :dim]), initial=0.0)), 1e-300)
+    v_scale = max(float(np.max(np.abs(reference[:, dim:]), initial=0.0)), 1e-300)
+    dx = float(np.max(np.abs(a[:dim] - b[:dim]), initial=0.0)) / x_scale
+    dv = float(np.max(np.abs(a[dim:] - b[dim:]), initial=0.0)) / v_scale
+    return max(dx, dv)
+
+
+@dataclass
+class SteadyState:
+    """A steady response (SI units): per structure coordinate the located
+    ``amplitude`` (largest |displacement|, m) and ``rms`` (m) over the recorded
+    periods; ``impacts_per_period``; ``settled`` and the ``period`` (in forcing
+    periods) after which the stroboscopic state repeats, or None."""
+
+    settled: bool
+    period: int | None
+    amplitude: np.ndarray
+    rms: np.ndarray
+    impacts_per_period: float
+    state: np.ndarray
+    strobe: np.ndarray = field(repr=False)
+
+
+def steady_state(
+    run: Runner,
+    state: np.ndarray | None = None,
+    *,
+    settle_periods: int = 200,
+    record_periods: int = 50,
+    tolerance: float = 1e-6,
+    max_period: int = 8,
+) -> SteadyState:
+    """Run ``settle_periods`` forcing periods from ``state`` (default the scenario's
+    ``[initial]``), find the smallest p <= ``max_period`` with the stroboscopic state
+    repeating after p periods within ``tolerance`` (relative to the largest
+    displacement and velocity), then record ``record_periods`` periods."""
+    for name, value, low in (
+        ("settle_periods", settle_periods, 0),
+        ("record_periods", record_periods, 1),
+        ("max_period", max_period, 1),
+    ):
+        if not isinstance(value, int) or isinstance(value, bool) or value < low:
+            raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
+    if not tolerance > 0:
+        raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
+    x0 = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    dim = len(x0) // 2
+    period: int | None = None
+    strobe = np.zeros((0, len(x0)))
+    if settle_periods > 0:
+        raw = run.periods(x0, settle_periods, strobe=True)
+        strobe = np.asarray(raw["strobe"]).reshape(-1, len(x0))
+        x0 = np.asarray(raw["final_state"], dtype=float)
+        rows = np.vstack([strobe, x0[None, :]]) if len(strobe) == 0 else strobe
+        tail = rows[-(2 * max_period + 1) :]
+        for p in range(1, max_period + 1):
+            if len(rows) <= p:
+                break
+            if _scaled_distance(rows[-1], rows[-1 - p], dim, tail) <= tolerance:
+                period = p
+                break
+    recorded = run.periods(x0, record_periods, record=True)
+    return SteadyState(
+        settled=period is not None,
+        period=period,
+        amplitude=np.asarray(recorded["peaks"], dtype=float),
+        rms=np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"]),
+        impacts_per_period=_impacts(recorded) / record_periods,
+        state=np.asarray(recorded["final_state"], dtype=float),
+        strobe=strobe,
+    )
+
+
+def linear_amplitude(data: Mapping[str, Any], base_dir: Path | None = None) -> np.ndarray:
+    """Per structure coordinate, the steady amplitude (m) of the structure alone
+    (dampers and stops removed) under the scenario's harmonic excitations, from
+    ``(K - w^2 M + i w C) Q = F``: exact for one frequency; for several, the sum of
+    their amplitudes (a bound). NaN where a rigid-body mode makes it unbounded."""
+    parts = linear_parts(
+        data["structure"], excitation=data.get("excitation", ()), base_dir=base_dir
+    )
+    n = parts["n"]
+    m, k, c = parts["mass"], parts["stiffness"], parts["damping"]
+    total = np.zeros(n)
+    for h in parts["harmonics"]:
+        w = h["omega"]
+        force = h["amplitude"] * np.exp(1j * h["phase"]) * np.asarray(h["shape"])
+        matrix = k - w * w * m + 1j * w * c
+        try:
+            q = np.linalg.solve(matrix, force)
+        except np.linalg.LinAlgError:
+            return np.full(n, np.nan)
+        total += np.abs(q)
+    return total
+
+
+@dataclass
+class SweepPoint:
+    """One point of a sweep (see :func:`sweep`)."""
+
+    value: float
+    direction: str
+    settled: bool
+    amplitude: np.ndarray
+    rms: np.ndarray
+    impacts_per_period: float
+    linear_amplitude: np.ndarray
+    error: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        def floats(a: np.ndarray) -> list[float | None]:
+            return [float(v) if math.isfinite(v) else None for v in a]
+
+        return {
+            "value": self.value,
+            "direction": self.direction,
+            "amplitude": floats(self.amplitude),
+            "rms": floats(self.rms),
+            "impacts_per_period": self.impacts_per_period,
+            "settled": self.settled,
+            "linear_amplitude": floats(self.linear_amplitude),
+            "reduction": [
+                (1.0 - a / b) if (b and math.isfinite(a) and math.isfinite(b)) else None
+                for a, b in zip(self.amplitude, self.linear_amplitude, strict=True)
+            ],
+            **({"error": self.error} if self.error else {}),
+        }
+
+
+_DIRECTIONS = ("up", "down", "both")
+_SPACINGS = ("linear", "log")
+_SWEEP = {
+    "parameter": (_TEXT, _REQ),
+    "start": (_NUMBER, _REQ),
+    "stop": (_NUMBER, _REQ),
+    "count": (_WHOLE, _REQ),
+    "spacing": (_TEXT, "linear"),
+    "direction": (_TEXT, "up"),
+    "settle_periods": (_WHOLE, 200),
+    "record_periods": (_WHOLE, 50),
+    "tolerance": (_NUMBER, 1e-6),
+}
+
+
+def sweep_settings(table: Any) -> dict[str, Any]:
+    """The ``[sweep]`` section checked and with its defaults: ``parameter`` (a
+    dotted path such as ``"excitation.0.frequency"``), ``start``, ``stop``, ``count``
+    (>= 1), ``spacing`` (``"linear"`` or ``"log"``), ``direction`` (``"up"``,
+    ``"down"``, ``"both"``), ``settle_periods`` (>= 0), ``record_periods`` (>= 1) and
+    the stroboscopic ``tolerance`` of settling."""
+    out = _table("[sweep] ", table, _SWEEP)
+    _choice("[sweep] ", "direction", out["direction"], _DIRECTIONS)
+    _choice("[sweep] ", "spacing", out["spacing"], _SPACINGS)
+    for key, low in (("count", 1), ("settle_periods", 0), ("record_periods", 1)):
+        if out[key] < low:
+            raise AnalysisError(f"[sweep] {key}: must be >= {low}, got {out[key]}")
+    if not out["tolerance"] > 0:
+        raise AnalysisError(f"[sweep] tolerance: must be > 0, got {out['tolerance']}")
+    if out["spacing"] == "log" and not (out["start"] > 0 and out["stop"] > 0):
+        raise AnalysisError('[sweep] start, stop: must be > 0 for spacing = "log"')
+    if not math.isfinite(out["start"]) or not math.isfinite(out["stop"]):
+        raise AnalysisError("[sweep] start, stop: must be finite")
+    with_parameter_path_check(out["parameter"])
+    return out
+
+
+def with_parameter_path_check(path: str) -> None:
+    """Refuse a ``parameter`` that is not a dotted path into a section."""
+    parts = path.split(".")
+    if parts[0] not in _SECTIONS or len(parts) < 2 or "" in parts:
+        raise AnalysisError(
+            f"[sweep] parameter: must be a dotted path into a section "
+            f'({", ".join(_SECTIONS)}), such as "excitation.0.frequency", got {path!r}'
+        )
+
+
+def sweep_values(settings: Mapping[str, Any]) -> np.ndarray:
+    """The parameter's values of a checked ``[sweep]`` section."""
+    if settings["spacing"] == "log":
+        return np.geomspace(settings["start"], settings["stop"], settings["count"])
+    return np.linspace(settings["start"], settings["stop"], settings["count"])
+
+
+def sweep(
+    data: Mapping[str, Any],
+    parameter: str,
+    values: Sequence[float] | np.ndarray,
+    *,
+    direction: str = "up",
+    settle_periods: int = 200,
+    record_periods: int = 50,
+    tolerance: float = 1e-6,
+    base_dir: Path | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[SweepPoint]:
+    """A stepped sweep of ``parameter`` (a dotted path into the scenario's sections)
+    over ``values`` (ascending, as given), ``"up"``, ``"down"`` or ``"both"`` (up, then
+    down from where up ended), each point starting from the last one's state, so
+    that jumps and hysteresis show. A point whose run fails is reported with its
+    error (and the next starts from the last good state)."""
+    _choice("", "direction", direction, _DIRECTIONS)
+    values = [float(v) for v in values]
+    legs: list[tuple[str, list[float]]] = []
+    if direction in ("up", "both"):
+        legs.append(("up", values))
+    if direction in ("down", "both"):
+        legs.append(("down", values[::-1]))
+    points: list[SweepPoint] = []
+    state: np.ndarray | None = None
+    total = sum(len(v) for _, v in legs)
+    for leg, leg_values in legs:
+        for value in leg_values:
+            changed = with_parameter(data, parameter, value)
+            try:
+                run = runner(changed, base_dir)
+                linear = linear_amplitude(changed, base_dir)
+            except InvalidInputError as err:
+                raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
+            try:
+                result = steady_state(
+                    run,
+                    state,
+                    settle_periods=settle_periods,
+                    record_periods=record_periods,
+                    tolerance=tolerance,
+                )
+            except InvalidInputError:
+                raise
+            except Exception as err:  # a run that cannot be completed: record it
+                nan = np.full(len(linear), np.nan)
+                points.append(SweepPoint(value, leg, False, nan, nan, math.nan, linear, str(err)))
+            else:
+                state = result.state
+                points.append(
+                    SweepPoint(
+                        value,
+                        leg,
+                        result.settled,
+                        result.amplitude,
+                        result.rms,
+                        result.impacts_per_period,
+                        linear,
+                    )
+                )
+            if progress is not None:
+                progress(len(points), total)
+    return points
+
+
+@dataclass
+class Orbit:
+    """A periodic orbit of ``periods`` forcing periods found by shooting."""
+
+    converged: bool
+    state: np.ndarray
+    floquet_multipliers: np.ndarray
+    stable: bool
+    impacts_per_period: float
+    amplitude: np.ndarray
+    iterations: int
+    residual: float
+    monodromy: np.ndarray = field(repr=False)
+
+    def arrays(self, n: int, k: int) -> dict[str, list[float]]:
+        """The state as the four arrays of ``[initial]``."""
+        d = n + k
+        s = self.state
+        return {
+            "structure_displacement": [float(v) for v in s[:n]],
+            "structure_velocity": [float(v) for v in s[d : d + n]],
+            "damper_displacement": [float(v) for v in s[n:d]],
+            "damper_velocity": [float(v) for v in s[d + n :]],
+        }
+
+
+def orbit(
+    run: Runner,
+    state: np.ndarray | None = None,
+    *,
+    periods: int = 1,
+    tolerance: float = 1e-10,
+    max_iterations: int = 40,
+) -> Orbit:
+    """Shoot for an orbit of ``periods`` forcing periods from ``state`` (default the
+    scenario's ``[initial]``): Newton's method on ``P(z) - z = 0``, ``P`` the
+    stroboscopic map over ``periods`` periods, its Jacobian by central finite
+    differences (across impacts: the saltation is in the differences). At the orbit
+    the Jacobian is the monodromy matrix; its eigenvalues are the Floquet multipliers
+    and the orbit is stable when all lie inside the unit circle. Newton steps that
+    would start inside a wall are halved."""
+    if not isinstance(periods, int) or isinstance(periods, bool) or periods < 1:
+        raise AnalysisError(f"periods: must be a whole number >= 1, got {periods!r}")
+    z = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    size = len(z)
+    dim = size // 2
+
+    def scales(z: np.ndarray, image: np.ndarray) -> np.ndarray:
+        both = np.vstack([z, image])
+        x = max(float(np.max(np.abs(both[:, :dim]), initial=0.0)), 1e-12)
+        v = max(float(np.max(np.abs(both[:, dim:]), initial=0.0)), 1e-12)
+        return np.concatenate([np.full(dim, x), np.full(dim, v)])
+
+    def jacobian(z: np.ndarray, scale: np.ndarray, image: np.ndarray) -> np.ndarray:
+        jac = np.zeros((size, size))
+        for j in range(size):
+            h = 1e-6 * scale[j]
+            plus, minus = z.copy(), z.copy()
+            plus[j] += h
+            minus[j] -= h
+            try:
+                jac[:, j] = (run.map(plus, periods) - run.map(minus, periods)) / (2 * h)
+            except InvalidInputError:
+                # On a wall one side is inside it: a one-sided difference.
+                try:
+                    jac[:, j] = (run.map(plus, periods) - image) / h
+                except InvalidInputError:
+                    jac[:, j] = (image - run.map(minus, periods)) / h
+        return jac
+
+    image = run.map(z, periods)
+    residual = math.inf
+    converged = False
+    iterations = 0
+    jac = np.eye(size)
+    while iterations < max_iterations:
+        iterations += 1
+        scale = scales(z, image)
+        residual = float(np.max(np.abs(image - z) / scale))
+        if residual <= tolerance:
+            converged = True
+            break
+        jac = jacobian(z, scale, image)
+        try:
+            step = np.linalg.lstsq(jac - np.eye(size), -(image - z), rcond=None)[0]
+        except np.linalg.LinAlgError:
+            break
+        factor = 1.0
+        while True:
+            trial = z + factor * step
+            try:
+                trial_image = run.map(trial, periods)
+            except InvalidInputError:
+                # A start inside a wall: a shorter Newton step.
+                factor *= 0.5
+                if factor < 1e-6:
+                    raise
+                continue
+            break
+        z, image = trial, trial_image
+    if converged or residual <= tolerance:
+        jac = jacobian(z, scales(z, image), image)
+    multipliers = np.linalg.eigvals(jac)
+    recorded = run.periods(z, periods, record=True)
+    return Orbit(
+        converged=converged,
+        state=z,
+        floquet_multipliers=multipliers,
+        stable=bool(converged and np.all(np.abs(multipliers) < 1.0)),
+        impacts_per_period=_impacts(recorded) / periods,
+        amplitude=np.asarray(recorded["peaks"], dtype=float),
+        iterations=iterations,
+        residual=residual,
+        monodromy=jac,
+    )
