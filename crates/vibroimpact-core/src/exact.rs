@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! The exact flow of a linear system with rigid pairs (`method = "exact"`):
 //! between impacts each normal mode is an oscillator under constant and
 //! harmonic forcing, integrated in closed form, so a step of any length

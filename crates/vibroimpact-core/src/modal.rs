@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! A linear system under equality constraints, in its own normal modes: what
 //! the exact flow needs for each set of sticking pairs.
 //!

@@ -537,7 +537,7 @@ pub fn integrate_system<S: SystemStepper>(
         if adaptive && (t_end - time - length) < 1e-3 * length {
             length = t_end - time;
         }
-        if adaptive && next_strobe - time < length {
+        if next_strobe - time < length && next_strobe - time > 1e-9 * options.reduce.strobe_period {
             // Land on the stroboscopic instant.
             length = next_strobe - time;
         }

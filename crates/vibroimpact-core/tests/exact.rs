@@ -1,0 +1,312 @@
+//! The exact flow (`method = "exact"`) against closed forms written here: a
+//! free oscillator under-, critically and over-damped, a forced one on its
+//! steady state, a free mass under gravity, a loose mass stuck to a
+//! structure (the combined mass's frequency), the bouncing ball's Zeno time,
+//! the reductions (located peak, RMS, strobe) and what it refuses.
+
+mod common;
+
+use common::timeout;
+use std::f64::consts::TAU;
+use vibroimpact_core::assembly::{
+    initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+};
+use vibroimpact_core::contact::{Contact, LawKind};
+use vibroimpact_core::exact::ExactFlow;
+use vibroimpact_core::reductions::ReduceOptions;
+use vibroimpact_core::signals::{Signal, SweepLaw};
+use vibroimpact_core::structure::Structure;
+use vibroimpact_core::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
+
+fn spec(structure: Structure) -> SystemSpec {
+    SystemSpec {
+        structure,
+        dampers: vec![],
+        stops: vec![],
+        gravity: 0.0,
+        excitations: vec![],
+    }
+}
+
+fn exact(
+    spec: &SystemSpec,
+    y0: &[Vec<f64>; 4],
+    t_end: f64,
+    reduce: ReduceOptions,
+) -> SystemSolution {
+    let system = Assembly::new(spec).unwrap();
+    let y = initial_state(&system, &y0[0], &y0[1], &y0[2], &y0[3]).unwrap();
+    let mut flow = ExactFlow::new(&system).unwrap();
+    let options = RunOptions {
+        dt: Some(flow.step().min(t_end)),
+        t_end,
+        every: 1,
+        keep_history: true,
+        max_steps: 100_000_000,
+        max_rows: 100_000_000,
+        energy_tolerance: 1e-9,
+        reduce,
+    };
+    integrate_system(&system, &mut flow, &y, &options, &mut || false).unwrap()
+}
+
+fn close(a: f64, b: f64, tolerance: f64) -> bool {
+    (a - b).abs() <= tolerance * b.abs().max(1e-300)
+}
+
+#[test]
+fn free_oscillator_matches_its_closed_form_in_each_damping_regime() {
+    timeout(60, || {
+        let (m, k, x0, v0, t): (f64, f64, f64, f64, f64) = (2.0, 800.0, 0.01, -0.3, 0.37);
+        let wn = (k / m).sqrt();
+        for zeta in [0.0, 0.05, 1.0, 3.0] {
+            let c = 2.0 * zeta * m * wn;
+            let s = spec(Structure::oscillator(m, k, c).unwrap());
+            let sol = exact(
+                &s,
+                &[vec![x0], vec![v0], vec![], vec![]],
+                t,
+                ReduceOptions::default(),
+            );
+            // x(t) by the textbook forms of each regime.
+            let sigma = zeta * wn;
+            let (x, v) = if zeta < 1.0 {
+                let wd = wn * (1.0 - zeta * zeta).sqrt();
+                let (a, b) = (x0, (v0 + sigma * x0) / wd);
+                let e = (-sigma * t).exp();
+                let x = e * (a * (wd * t).cos() + b * (wd * t).sin());
+                let v = -sigma * x + e * wd * (-a * (wd * t).sin() + b * (wd * t).cos());
+                (x, v)
+            } else if zeta == 1.0 {
+                let (a, b) = (x0, v0 + wn * x0);
+                let e = (-wn * t).exp();
+                (e * (a + b * t), e * (b - wn * (a + b * t)))
+            } else {
+                let r = wn * (zeta * zeta - 1.0).sqrt();
+                let (l1, l2) = (-sigma + r, -sigma - r);
+                let b = (v0 - l1 * x0) / (l2 - l1);
+                let a = x0 - b;
+                (
+                    a * (l1 * t).exp() + b * (l2 * t).exp(),
+                    a * l1 * (l1 * t).exp() + b * l2 * (l2 * t).exp(),
+                )
+            };
+            let end = &sol.final_state;
+            assert!(close(end[0], x, 1e-11), "zeta {zeta}: x {} vs {x}", end[0]);
+            assert!(close(end[1], v, 1e-11), "zeta {zeta}: v {} vs {v}", end[1]);
+            // The viscous loss is the energy that left: the balance closes.
+            assert!(
+                sol.energy.residual.abs() <= 1e-10 * sol.energy.stored_start,
+                "zeta {zeta}: {:?}",
+                sol.energy
+            );
+        }
+    });
+}
+
+#[test]
+fn forced_oscillator_stays_on_its_steady_state_and_reduces_it() {
+    timeout(60, || {
+        let (m, k, c, force, f) = (1.0, 3000.0, 3.0, 2.0, 7.0);
+        let w = TAU * f;
+        // Q = F / (k - m w^2 + i c w).
+        let (re, im) = (k - m * w * w, c * w);
+        let norm = re * re + im * im;
+        let (qr, qi) = (force * re / norm, -force * im / norm);
+        let mut s = spec(Structure::oscillator(m, k, c).unwrap());
+        s.excitations.push(Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(force, f, 0.0).unwrap(),
+        });
+        let periods = 20.0;
+        let sol = exact(
+            &s,
+            &[vec![qr], vec![-w * qi], vec![], vec![]],
+            periods / f,
+            ReduceOptions {
+                record_from: 0.0,
+                strobe_period: 1.0 / f,
+            },
+        );
+        let amplitude = (qr * qr + qi * qi).sqrt();
+        assert!(
+            close(sol.final_state[0], qr, 1e-9),
+            "{} vs {qr}",
+            sol.final_state[0]
+        );
+        let r = &sol.reductions;
+        assert!(
+            close(r.peaks[0], amplitude, 1e-10),
+            "peak {} vs {amplitude}",
+            r.peaks[0]
+        );
+        let rms = (r.square_integrals[0] / r.recorded_time).sqrt();
+        assert!(close(rms, amplitude / 2f64.sqrt(), 1e-5), "rms {rms}");
+        assert_eq!(r.strobe_time.len(), periods as usize);
+        for row in r.strobe.chunks(2) {
+            assert!(close(row[0], qr, 1e-9), "strobe {row:?} vs {qr}");
+        }
+        // Input work equals the viscous loss over whole periods (steady state).
+        let e = sol.energy;
+        assert!(close(e.input_work, e.viscous, 1e-8), "{e:?}");
+        assert!(close(
+            e.viscous,
+            periods * 0.5 * c * w * w * amplitude * amplitude / f,
+            1e-8
+        ));
+    });
+}
+
+#[test]
+fn a_free_mass_falls_as_a_parabola() {
+    timeout(60, || {
+        let g = 9.81;
+        let mut s = spec(Structure::oscillator(0.3, 0.0, 0.0).unwrap());
+        s.gravity = g;
+        let t = 0.8;
+        let sol = exact(
+            &s,
+            &[vec![1.0], vec![2.0], vec![], vec![]],
+            t,
+            ReduceOptions::default(),
+        );
+        assert!(close(
+            sol.final_state[0],
+            1.0 + 2.0 * t - 0.5 * g * t * t,
+            1e-14
+        ));
+        assert!(close(sol.final_state[1], 2.0 - g * t, 1e-14));
+    });
+}
+
+#[test]
+fn ball_on_a_floor_accumulates_at_the_zeno_time_then_rests() {
+    timeout(60, || {
+        let (g, h, e) = (9.81, 1.0, 0.8);
+        let mut s = spec(Structure::oscillator(0.2, 0.0, 0.0).unwrap());
+        s.gravity = g;
+        s.stops.push(Stop {
+            at: 0.0,
+            side: Side::Lower,
+            gap: h,
+            law: PairLaw::rigid(e).unwrap(),
+        });
+        let sol = exact(
+            &s,
+            &[vec![], vec![], vec![], vec![]],
+            6.0,
+            ReduceOptions::default(),
+        );
+        let t_inf = (2.0 * h / g).sqrt() * (1.0 + e) / (1.0 - e);
+        let last = sol.contacts.last().unwrap();
+        assert_eq!(last.kind, ContactKind::Sticking);
+        assert!(close(last.onset, t_inf, 1e-9), "{} vs {t_inf}", last.onset);
+        // Impact speeds sqrt(2 g h) e^(n - 1).
+        let first = sqrt_2gh(g, h);
+        for (n, c) in sol
+            .contacts
+            .iter()
+            .filter(|c| c.kind == ContactKind::Impact)
+            .take(10)
+            .enumerate()
+        {
+            assert!(close(c.approach_speed, first * e.powi(n as i32), 1e-9));
+        }
+        assert!(close(sol.final_state[0], -h, 1e-12));
+        assert!(sol.final_state[1].abs() < 1e-12);
+    });
+}
+
+fn sqrt_2gh(g: f64, h: f64) -> f64 {
+    (2.0 * g * h).sqrt()
+}
+
+#[test]
+fn a_loose_mass_stuck_to_its_structure_moves_with_the_combined_mass() {
+    timeout(60, || {
+        // A vertical oscillator carrying a loose mass resting on its lower
+        // wall: with a gentle motion (peak acceleration below g) the mass never
+        // lifts off, so after the first touch they oscillate together at
+        // sqrt(k / (M + m)) about the combined static deflection.
+        let (big, small, k, g) = (1.0, 0.25, 400.0, 9.81);
+        let mut s = spec(Structure::oscillator(big, k, 0.0).unwrap());
+        s.gravity = g;
+        s.dampers.push(Damper {
+            mass: small,
+            at: 0.0,
+            lower_clearance: 0.0,
+            upper_clearance: 0.05,
+            law: PairLaw::rigid(0.0).unwrap(),
+        });
+        let static_both = -(big + small) * g / k;
+        let amplitude = 0.1 * g / (k / (big + small)); // peak acceleration 0.1 g
+        let x0 = static_both + amplitude;
+        let t = 0.9;
+        // Start resting together on the wall (gap zero, same velocity).
+        let sol = exact(
+            &s,
+            &[vec![x0], vec![0.0], vec![x0], vec![0.0]],
+            t,
+            ReduceOptions::default(),
+        );
+        let w = (k / (big + small)).sqrt();
+        let x = static_both + amplitude * (w * t).cos();
+        assert!(
+            close(sol.final_state[0], x, 1e-8),
+            "{} vs {x}",
+            sol.final_state[0]
+        );
+        assert!(
+            close(sol.final_state[1], x, 1e-8),
+            "{:?} {:?}",
+            sol.final_state,
+            sol.contacts
+        );
+        // Starting on the wall, the first located touch is an impact at round-off
+        // speed, then one sticking contact to the end.
+        let sticking: Vec<_> = sol
+            .contacts
+            .iter()
+            .filter(|c| c.kind == ContactKind::Sticking)
+            .collect();
+        assert_eq!(sticking.len(), 1, "{:?}", sol.contacts);
+        assert!(sticking[0].onset < 1e-6 && sticking[0].separation.is_nan());
+        assert!(sol
+            .contacts
+            .iter()
+            .all(|c| c.kind == ContactKind::Sticking || c.approach_speed < 1e-6));
+    });
+}
+
+#[test]
+fn refuses_what_it_cannot_integrate_exactly() {
+    timeout(60, || {
+        let base = spec(Structure::oscillator(1.0, 100.0, 0.1).unwrap());
+        let mut compliant = base.clone();
+        compliant.stops.push(Stop {
+            at: 0.0,
+            side: Side::Upper,
+            gap: 0.01,
+            law: PairLaw::Compliant(Contact::new(LawKind::Linear, 1e5, None, 0.5).unwrap()),
+        });
+        let mut swept = base.clone();
+        swept.excitations.push(Excitation {
+            load: Load::Base,
+            signal: Signal::sweep(1.0, 1.0, 2.0, 1.0, SweepLaw::Linear, 0.0).unwrap(),
+        });
+        // Two modes coupled through damping: C not proportional.
+        let m = vec![vec![1.0, 0.0], vec![0.0, 1.0]];
+        let k = vec![vec![200.0, -100.0], vec![-100.0, 200.0]];
+        let c = vec![vec![1.0, 0.0], vec![0.0, 0.0]];
+        let coupled = spec(Structure::matrices(&m, &k, &c).unwrap());
+        for (what, s, word) in [
+            ("compliant", compliant, "rigid"),
+            ("sweep", swept, "harmonic"),
+            ("non-classical", coupled, "classical"),
+        ] {
+            let system = Assembly::new(&s).unwrap();
+            let err = ExactFlow::new(&system).unwrap_err().to_string();
+            assert!(err.contains("exact") && err.contains(word), "{what}: {err}");
+        }
+    });
+}
