@@ -381,12 +381,104 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     return out
 
 
-def with_parameter_path_check(path: str) -> None:
+_CONTINUATION = {
+    "parameter": (_TEXT, _REQ),
+    "stop": (_NUMBER, _REQ),
+    "periods": (_WHOLE, 1),
+    "step": (_NUMBER, None),
+    "max_points": (_WHOLE, 200),
+    "tolerance": (_NUMBER, 1e-9),
+}
+
+
+def continuation_settings(table: Any) -> dict[str, Any]:
+    """The ``[continuation]`` section checked, with its defaults: ``parameter`` (a
+    dotted path, continued from the scenario's value), ``stop``, ``periods`` (K),
+    ``step`` (about, in the parameter's unit), ``max_points``, ``tolerance``."""
+    out = _table("[continuation] ", table, _CONTINUATION)
+    with_parameter_path_check(out["parameter"], "[continuation]")
+    for key, low in (("periods", 1), ("max_points", 2)):
+        if out[key] < low:
+            raise AnalysisError(f"[continuation] {key}: must be >= {low}, got {out[key]}")
+    for key in ("step", "tolerance"):
+        if out[key] is not None and not out[key] > 0:
+            raise AnalysisError(f"[continuation] {key}: must be > 0, got {out[key]}")
+    return out
+
+
+_AXIS = {
+    "state": (_TEXT, _REQ),
+    "start": (_NUMBER, _REQ),
+    "stop": (_NUMBER, _REQ),
+    "count": (_WHOLE, _REQ),
+}
+_BASINS = {
+    "x": ("table", _REQ),
+    "y": ("table", _REQ),
+    "settle_periods": (_WHOLE, 200),
+    "record_periods": (_WHOLE, 20),
+    "tolerance": (_NUMBER, 1e-6),
+}
+_STATE_KEYS = (
+    "structure_displacement",
+    "structure_velocity",
+    "damper_displacement",
+    "damper_velocity",
+)
+
+
+def basins_settings(table: Any) -> dict[str, Any]:
+    """The ``[basins]`` section checked: ``x`` and ``y``, each ``{state =
+    "structure_displacement.0", start, stop, count}`` (an entry of one of the four
+    arrays of ``[initial]``), ``settle_periods``, ``record_periods``, ``tolerance``."""
+    if not isinstance(table, Mapping):
+        raise AnalysisError(f"[basins]: must be a table, got {table!r:.60}")
+    out = _table(
+        "[basins] ",
+        {k: v for k, v in table.items() if k not in ("x", "y")},
+        {key: spec for key, spec in _BASINS.items() if key not in ("x", "y")},
+    )
+    for axis in ("x", "y"):
+        if axis not in table:
+            raise AnalysisError(f"[basins] missing key {axis!r} ({{state, start, stop, count}})")
+        checked = _table(f"[basins] {axis}.", table[axis], _AXIS)
+        name, _, index = checked["state"].partition(".")
+        if name not in _STATE_KEYS or not index.isdigit():
+            raise AnalysisError(
+                f"[basins] {axis}.state: must be one of {', '.join(_STATE_KEYS)} with an "
+                f'index, such as "structure_displacement.0", got {checked["state"]!r}'
+            )
+        if checked["count"] < 1:
+            raise AnalysisError(f"[basins] {axis}.count: must be >= 1, got {checked['count']}")
+        out[axis] = checked
+    for key, low in (("settle_periods", 0), ("record_periods", 1)):
+        if out[key] < low:
+            raise AnalysisError(f"[basins] {key}: must be >= {low}, got {out[key]}")
+    return out
+
+
+def state_index(path: str, n: int, k: int) -> int:
+    """The index in the flat state ``(x, v)`` of ``"structure_velocity.0"`` etc."""
+    name, _, index = path.partition(".")
+    i = int(index)
+    d = n + k
+    size, offset = {
+        "structure_displacement": (n, 0),
+        "damper_displacement": (k, n),
+        "structure_velocity": (n, d),
+        "damper_velocity": (k, d + n),
+    }[name]
+    if i >= size:
+        raise AnalysisError(f"{path}: the system has {size} such values")
+    return offset + i
+
+
+def with_parameter_path_check(path: str, section: str = "[sweep]") -> None:
     """Refuse a ``parameter`` that is not a dotted path into a section."""
     parts = path.split(".")
     if parts[0] not in _SECTIONS or len(parts) < 2 or "" in parts:
         raise AnalysisError(
-            f"[sweep] parameter: must be a dotted path into a section "
+            f"{section} parameter: must be a dotted path into a section "
             f'({", ".join(_SECTIONS)}), such as "excitation.0.frequency", got {path!r}'
         )
 
@@ -579,3 +671,11 @@ def orbit(
         residual=residual,
         monodromy=jac,
     )
+
+
+#: Sections of analyses, checked when a scenario is read.
+SETTINGS: dict[str, Callable[[Any], dict[str, Any]]] = {
+    "sweep": sweep_settings,
+    "continuation": continuation_settings,
+    "basins": basins_settings,
+}

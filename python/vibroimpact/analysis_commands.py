@@ -11,15 +11,18 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact import analysis_plots as plots
 from vibroimpact.analyses import (
     AnalysisError,
-    SweepPoint,
     orbit,
     runner,
+    state_index,
     sweep,
     sweep_values,
 )
-from vibroimpact.output import UsageError, finite_or_none, written_whole
+from vibroimpact.continuation import continue_orbit
+from vibroimpact.maps import basins, bifurcation, poincare
+from vibroimpact.output import UsageError, finite_or_none
 from vibroimpact.scenario import load_scenario
 from vibroimpact.system_scenario import SystemScenario
 
@@ -49,6 +52,12 @@ def add_commands(sub: Any) -> None:
         help="largest |P(z) - z| relative to the largest displacement and velocity (1e-10)",
     )
     orbit_parser.add_argument("--json", action="store_true", help="print one JSON object")
+    orbit_parser.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="plot the orbit's time history and phase portrait with its impacts marked",
+    )
 
     sweep_parser = sub.add_parser(
         "sweep",
@@ -70,6 +79,64 @@ def add_commands(sub: Any) -> None:
         metavar="FILE.png",
         help="plot the response against the parameter, with and without the dampers",
     )
+
+    bif = sub.add_parser(
+        "bifurcation",
+        help="bifurcation diagram: stroboscopic samples against a [sweep] parameter",
+        description=(
+            "For each value of the [sweep] section's parameter (up, down or both, each "
+            "point starting from the last one's state), settle settle_periods forcing "
+            "periods, then keep record_periods stroboscopic states; prints or plots the "
+            "sampled displacements of structure coordinate 0 (m)."
+        ),
+    )
+    bif.add_argument("scenario", type=Path, help="scenario file (.toml) with [sweep]")
+    bif.add_argument("--json", action="store_true", help="print one JSON object")
+    bif.add_argument("--plot", type=Path, metavar="FILE.png", help="plot the diagram")
+
+    sec = sub.add_parser(
+        "poincare",
+        help="Poincare sections: stroboscopic and at impacts",
+        description=(
+            "From the scenario's [initial] state, settle --settle forcing periods, then "
+            "sample --periods more: the state at each period (stroboscopic section) and "
+            "each impact's phase in the forcing period (rad) and speed (m/s)."
+        ),
+    )
+    sec.add_argument("scenario", type=Path, help="scenario file (.toml, [structure])")
+    sec.add_argument("--settle", type=int, default=200, help="forcing periods to settle (200)")
+    sec.add_argument("--periods", type=int, default=500, help="forcing periods sampled (500)")
+    sec.add_argument("--json", action="store_true", help="print one JSON object")
+    sec.add_argument("--plot", type=Path, metavar="FILE.png", help="plot both sections")
+
+    bas = sub.add_parser(
+        "basins",
+        help="basins of attraction over two initial values, from a [basins] section",
+        description=(
+            "For each start on a grid of two entries of [initial] ([basins] x and y: state "
+            '= "structure_displacement.0" and the like, start, stop, count), find the '
+            "steady state and group the starts by the attractor they reach (period, impacts "
+            "per period, amplitude)."
+        ),
+    )
+    bas.add_argument("scenario", type=Path, help="scenario file (.toml) with [basins]")
+    bas.add_argument("--json", action="store_true", help="print one JSON object")
+    bas.add_argument("--plot", type=Path, metavar="FILE.png", help="plot the basins")
+
+    cont = sub.add_parser(
+        "continue",
+        help="continue a periodic orbit in a parameter (pseudo-arclength), from [continuation]",
+        description=(
+            "From the orbit found from [initial] at the scenario's value of [continuation] "
+            "parameter, follow the branch of K-period orbits (periods) towards stop, "
+            "through folds, with Floquet multipliers and stability at each point, flagging "
+            "folds, flips, Neimark-Sacker and branch points, and grazing (a change of "
+            "impacts per period)."
+        ),
+    )
+    cont.add_argument("scenario", type=Path, help="scenario file (.toml) with [continuation]")
+    cont.add_argument("--json", action="store_true", help="print one JSON object")
+    cont.add_argument("--plot", type=Path, metavar="FILE.png", help="plot the branch")
 
 
 def _system(path: Path) -> SystemScenario:
@@ -102,6 +169,8 @@ def run_orbit(args: argparse.Namespace) -> int:
         "residual": finite_or_none(found.residual),
         "cpu_time": cpu_time,
     }
+    if args.plot:
+        plots.plot_history(args.plot, plots.orbit_history(run, found.state, args.periods))
     if args.json:
         print(json.dumps(summary))
         return 0
@@ -118,6 +187,8 @@ def run_orbit(args: argparse.Namespace) -> int:
     ]
     for key, values in summary["state"].items():
         lines.append(f"{key} = [{', '.join(f'{v:.12g}' for v in values)}]")
+    if args.plot:
+        lines.append(f"plot written to {args.plot}")
     print("\n".join(lines))
     return 0
 
@@ -155,7 +226,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
-        plot_sweep(args.plot, settings["parameter"], points)
+        plots.plot_sweep(args.plot, settings["parameter"], points)
     if args.json:
         print(
             json.dumps(
@@ -190,36 +261,216 @@ def run_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def plot_sweep(path: Path, parameter: str, points: list[SweepPoint]) -> None:
-    """The amplitude of structure coordinate 0 against the parameter, each direction,
-    with the linear structure's beside it; PNG, written whole."""
-    import matplotlib
+def _progress(enabled: bool) -> Any:
+    def progress(done: int, total: int) -> None:
+        if enabled:
+            print(f"\r{done}/{total}", end="", file=sys.stderr, flush=True)
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    return progress
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    values = np.array([p.value for p in points])
-    order = np.argsort(values, kind="stable")
-    linear = np.array([p.linear_amplitude[0] for p in points])
-    ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers (linear)")
-    for direction, marker in (("up", "^"), ("down", "v")):
-        chosen = [p for p in points if p.direction == direction]
-        if chosen:
-            ax.plot(
-                [p.value for p in chosen],
-                [p.amplitude[0] for p in chosen],
-                marker=marker,
-                ms=3,
-                lw=1,
-                label=f"with dampers, sweep {direction}",
+
+def _section(scenario: SystemScenario, name: str, path: Path) -> dict[str, Any]:
+    settings = scenario.data.get(name)
+    if settings is None:
+        raise UsageError(f"{path}: this command needs a [{name}] section")
+    return dict(settings)
+
+
+def run_bifurcation(args: argparse.Namespace) -> int:
+    scenario = _system(args.scenario)
+    settings = _section(scenario, "sweep", args.scenario)
+    show = sys.stderr.isatty() and not args.json
+    start = time.perf_counter()
+    points = bifurcation(
+        scenario.data,
+        settings["parameter"],
+        sweep_values(settings),
+        direction=settings["direction"],
+        settle_periods=settings["settle_periods"],
+        sample_periods=settings["record_periods"],
+        base_dir=scenario.base_dir,
+        progress=_progress(show),
+    )
+    if show:
+        print(file=sys.stderr)
+    cpu_time = time.perf_counter() - start
+    if args.plot:
+        plots.plot_bifurcation(args.plot, settings["parameter"], points)
+    rows = [
+        {
+            "value": p.value,
+            "direction": p.direction,
+            "strobe_displacement": [float(v) for v in p.strobe[:, 0]] if p.strobe.size else [],
+            **({"error": p.error} if p.error else {}),
+        }
+        for p in points
+    ]
+    if args.json:
+        print(
+            json.dumps({"parameter": settings["parameter"], "points": rows, "cpu_time": cpu_time})
+        )
+        return 0
+    print(f"{args.scenario}: {len(points)} values of {settings['parameter']} in {cpu_time:.3f} s")
+    for row in rows:
+        samples = np.asarray(row["strobe_displacement"])
+        distinct = len(np.unique(np.round(samples / (np.max(np.abs(samples)) or 1), 6)))
+        print(
+            f"{row['value']:>12.6g} {row['direction']:>5}: {distinct} distinct stroboscopic "
+            f"displacement(s) of {len(samples)}"
+        )
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+def run_poincare(args: argparse.Namespace) -> int:
+    scenario = _system(args.scenario)
+    if args.settle < 0 or args.periods < 1:
+        raise UsageError("--settle must be >= 0 and --periods >= 1")
+    run = runner(scenario.data, scenario.base_dir)
+    start = time.perf_counter()
+    section = poincare(run, settle_periods=args.settle, periods=args.periods)
+    cpu_time = time.perf_counter() - start
+    if args.plot:
+        plots.plot_section(args.plot, section, run.period)
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "forcing_period": run.period,
+                    "strobe": section.strobe.tolist(),
+                    "impact_phase": section.impact_phase.tolist(),
+                    "impact_speed": section.impact_speed.tolist(),
+                    "impact_pair": section.impact_pair,
+                    "cpu_time": cpu_time,
+                }
             )
-    unit = " (Hz)" if parameter.endswith("frequency") else ""
-    ax.set_xlabel(f"{parameter}{unit}")
-    ax.set_ylabel("amplitude of structure coordinate 0 (m)")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    with written_whole(path, binary=True) as f:
-        fig.savefig(f, format="png", dpi=120)
-    plt.close(fig)
+        )
+        return 0
+    print(
+        f"{args.scenario}: {len(section.strobe)} stroboscopic points and "
+        f"{len(section.impact_phase)} impacts in {cpu_time:.3f} s"
+    )
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+def run_basins(args: argparse.Namespace) -> int:
+    scenario = _system(args.scenario)
+    settings = _section(scenario, "basins", args.scenario)
+    run = runner(scenario.data, scenario.base_dir)
+    axes = []
+    for axis in ("x", "y"):
+        a = settings[axis]
+        axes.append(
+            (state_index(a["state"], run.n, run.k), np.linspace(a["start"], a["stop"], a["count"]))
+        )
+    show = sys.stderr.isatty() and not args.json
+    start = time.perf_counter()
+    result = basins(
+        run,
+        axes[0],
+        axes[1],
+        settle_periods=settings["settle_periods"],
+        record_periods=settings["record_periods"],
+        tolerance=settings["tolerance"],
+        progress=_progress(show),
+    )
+    if show:
+        print(file=sys.stderr)
+    cpu_time = time.perf_counter() - start
+    if args.plot:
+        plots.plot_basins(args.plot, result, settings["x"]["state"], settings["y"]["state"])
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "x": settings["x"]["state"],
+                    "y": settings["y"]["state"],
+                    "x_values": result.first.tolist(),
+                    "y_values": result.second.tolist(),
+                    "labels": result.labels.tolist(),
+                    "attractors": result.attractors,
+                    "cpu_time": cpu_time,
+                }
+            )
+        )
+        return 0
+    print(f"{args.scenario}: {result.labels.size} starts in {cpu_time:.3f} s")
+    for index, a in enumerate(result.attractors):
+        share = float(np.mean(result.labels == index))
+        print(
+            f"attractor {index}: {a['period']}-periodic, {a['impacts_per_period']:g} impacts per "
+            f"period, amplitude {a['amplitude']} m: {share:.1%} of the starts"
+        )
+    for label, name in ((-1, "not settled"), (-2, "failed"), (-3, "not admissible")):
+        share = float(np.mean(result.labels == label))
+        if share:
+            print(f"{name}: {share:.1%}")
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+def run_continue(args: argparse.Namespace) -> int:
+    scenario = _system(args.scenario)
+    settings = _section(scenario, "continuation", args.scenario)
+    show = sys.stderr.isatty() and not args.json
+    start = time.perf_counter()
+    branch = continue_orbit(
+        scenario.data,
+        settings["parameter"],
+        stop=settings["stop"],
+        periods=settings["periods"],
+        step=settings["step"],
+        max_points=settings["max_points"],
+        tolerance=settings["tolerance"],
+        base_dir=scenario.base_dir,
+        progress=_progress(show),
+    )
+    if show:
+        print(file=sys.stderr)
+    cpu_time = time.perf_counter() - start
+    if args.plot:
+        plots.plot_branch(args.plot, branch)
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "parameter": branch.parameter,
+                    "periods": branch.periods,
+                    "stopped": branch.stopped,
+                    "points": [p.to_dict(branch.n, branch.k) for p in branch.points],
+                    "cpu_time": cpu_time,
+                }
+            )
+        )
+        return 0
+    print(
+        f"{args.scenario}: {len(branch.points)} orbits of {branch.periods} period(s) along "
+        f"{branch.parameter} in {cpu_time:.3f} s; stopped: {branch.stopped}"
+    )
+    for p in branch.points:
+        flags = ", ".join(
+            f"{f} at {p.crossings[f]:.6g}" if f in p.crossings else f for f in p.flags
+        )
+        largest = float(np.max(np.abs(p.floquet_multipliers)))
+        print(
+            f"{p.value:>12.6g}  amplitude {p.amplitude[0]:.6g} m  max|multiplier| "
+            f"{largest:.6f}  {'stable' if p.stable else 'unstable'}  "
+            f"{p.impacts_per_period:g} impacts/period  {flags}"
+        )
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+COMMANDS = {
+    "orbit": run_orbit,
+    "sweep": run_sweep,
+    "bifurcation": run_bifurcation,
+    "poincare": run_poincare,
+    "basins": run_basins,
+    "continue": run_continue,
+}

@@ -28,7 +28,7 @@ from vibroimpact._core import (
     Solution,
     __version__,
 )
-from vibroimpact.analysis_commands import add_commands, run_orbit, run_sweep
+from vibroimpact.analysis_commands import COMMANDS, add_commands
 from vibroimpact.output import UsageError, finite_or_none, written_whole
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
@@ -261,10 +261,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "paper":
             return run_paper(args.out)
-        if args.command == "orbit":
-            return run_orbit(args)
-        if args.command == "sweep":
-            return run_sweep(args)
+        if args.command in COMMANDS:
+            return COMMANDS[args.command](args)
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
         print(f"vibroimpact: error: {err}", file=sys.stderr)

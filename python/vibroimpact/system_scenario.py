@@ -29,6 +29,8 @@ SECTIONS = (
     "solver",
     "output",
     "sweep",
+    "continuation",
+    "basins",
 )
 
 
@@ -80,13 +82,14 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
     except InvalidInputError as err:
         raise InvalidInputError(f"{source}: {err}") from None
     data = dict(data)
-    if "sweep" in data:
-        from vibroimpact.analyses import sweep_settings
+    from vibroimpact.analyses import SETTINGS
 
-        try:
-            data["sweep"] = sweep_settings(data["sweep"])
-        except InvalidInputError as err:
-            raise InvalidInputError(f"{source}: {err}") from None
+    for section, check in SETTINGS.items():
+        if section in data:
+            try:
+                data[section] = check(data[section])
+            except InvalidInputError as err:
+                raise InvalidInputError(f"{source}: {err}") from None
     return SystemScenario(source, prepared, data, base_dir)
 
 

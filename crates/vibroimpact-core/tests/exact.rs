@@ -6,7 +6,6 @@
 
 mod common;
 
-use common::timeout;
 use std::f64::consts::TAU;
 use vibroimpact_core::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
@@ -56,7 +55,7 @@ fn close(a: f64, b: f64, tolerance: f64) -> bool {
 
 #[test]
 fn free_oscillator_matches_its_closed_form_in_each_damping_regime() {
-    timeout(60, || {
+    common::timeout(60, || {
         let (m, k, x0, v0, t): (f64, f64, f64, f64, f64) = (2.0, 800.0, 0.01, -0.3, 0.37);
         let wn = (k / m).sqrt();
         for zeta in [0.0, 0.05, 1.0, 3.0] {
@@ -106,7 +105,7 @@ fn free_oscillator_matches_its_closed_form_in_each_damping_regime() {
 
 #[test]
 fn forced_oscillator_stays_on_its_steady_state_and_reduces_it() {
-    timeout(60, || {
+    common::timeout(60, || {
         let (m, k, c, force, f) = (1.0, 3000.0, 3.0, 2.0, 7.0);
         let w = TAU * f;
         // Q = F / (k - m w^2 + i c w).
@@ -159,7 +158,7 @@ fn forced_oscillator_stays_on_its_steady_state_and_reduces_it() {
 
 #[test]
 fn a_free_mass_falls_as_a_parabola() {
-    timeout(60, || {
+    common::timeout(60, || {
         let g = 9.81;
         let mut s = spec(Structure::oscillator(0.3, 0.0, 0.0).unwrap());
         s.gravity = g;
@@ -181,7 +180,7 @@ fn a_free_mass_falls_as_a_parabola() {
 
 #[test]
 fn ball_on_a_floor_accumulates_at_the_zeno_time_then_rests() {
-    timeout(60, || {
+    common::timeout(60, || {
         let (g, h, e) = (9.81, 1.0, 0.8);
         let mut s = spec(Structure::oscillator(0.2, 0.0, 0.0).unwrap());
         s.gravity = g;
@@ -223,7 +222,7 @@ fn sqrt_2gh(g: f64, h: f64) -> f64 {
 
 #[test]
 fn a_loose_mass_stuck_to_its_structure_moves_with_the_combined_mass() {
-    timeout(60, || {
+    common::timeout(60, || {
         // A vertical oscillator carrying a loose mass resting on its lower
         // wall: with a gentle motion (peak acceleration below g) the mass never
         // lifts off, so after the first touch they oscillate together at
@@ -280,7 +279,7 @@ fn a_loose_mass_stuck_to_its_structure_moves_with_the_combined_mass() {
 
 #[test]
 fn refuses_what_it_cannot_integrate_exactly() {
-    timeout(60, || {
+    common::timeout(60, || {
         let base = spec(Structure::oscillator(1.0, 100.0, 0.1).unwrap());
         let mut compliant = base.clone();
         compliant.stops.push(Stop {

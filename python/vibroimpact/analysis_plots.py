@@ -1,0 +1,233 @@
+"""Plots of the analyses (PNG, SI units on every axis), each written whole or not at
+all: frequency response, time history with phase portrait and impact markers,
+Poincare section, bifurcation diagram, basins of attraction and continued branches."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.analyses import Runner, SweepPoint
+from vibroimpact.continuation import Branch
+from vibroimpact.maps import Basins, BifurcationPoint, Section
+from vibroimpact.output import written_whole
+from vibroimpact.system import SystemSolution
+
+
+@contextmanager
+def _figure(
+    path: Path, rows: int = 1, cols: int = 1, size: tuple[float, float] = (7, 4.5)
+) -> Iterator[Any]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(rows, cols, figsize=size)
+    try:
+        yield fig, axes
+        fig.tight_layout()
+        with written_whole(path, binary=True) as f:
+            fig.savefig(f, format="png", dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def _unit(parameter: str) -> str:
+    last = parameter.rsplit(".", 1)[-1]
+    units = {
+        "frequency": "Hz",
+        "amplitude": "N or m/s^2",
+        "clearance": "m",
+        "lower_clearance": "m",
+        "upper_clearance": "m",
+        "gap": "m",
+        "mass": "kg",
+        "stiffness": "N/m",
+        "damping": "N s/m",
+        "restitution": "-",
+        "acceleration": "m/s^2",
+        "phase": "rad",
+    }
+    return f" ({units[last]})" if last in units else ""
+
+
+def plot_sweep(path: Path, parameter: str, points: list[SweepPoint]) -> None:
+    """Amplitude of structure coordinate 0 against the parameter, each direction,
+    with the linear structure's beside it."""
+    with _figure(path) as (fig, ax):
+        values = np.array([p.value for p in points])
+        order = np.argsort(values, kind="stable")
+        linear = np.array([p.linear_amplitude[0] for p in points])
+        ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers (linear)")
+        for direction, marker in (("up", "^"), ("down", "v")):
+            chosen = [p for p in points if p.direction == direction]
+            if chosen:
+                ax.plot(
+                    [p.value for p in chosen],
+                    [p.amplitude[0] for p in chosen],
+                    marker=marker,
+                    ms=3,
+                    lw=1,
+                    label=f"with dampers, sweep {direction}",
+                )
+        ax.set_xlabel(f"{parameter}{_unit(parameter)}")
+        ax.set_ylabel("amplitude of structure coordinate 0 (m)")
+        ax.legend()
+        ax.grid(alpha=0.3)
+
+
+def plot_history(path: Path, sol: SystemSolution) -> None:
+    """Time history of structure coordinate 0 (and each damper's displacement), its
+    phase portrait, and the impacts marked on both."""
+    with _figure(path, 1, 2, (11, 4.5)) as (fig, (left, right)):
+        x = sol.structure_displacement[:, 0]
+        v = sol.structure_velocity[:, 0]
+        left.plot(sol.t, x, lw=1, label="structure coordinate 0")
+        for j in range(sol.damper_displacement.shape[1]):
+            left.plot(sol.t, sol.damper_displacement[:, j], lw=0.8, label=f"damper {j}")
+        right.plot(x, v, lw=1)
+        onsets = np.asarray(sol.contacts.onset)
+        kinds = list(sol.contacts.kind)
+        hits = np.array([k != "sticking" for k in kinds], dtype=bool)
+        if len(onsets) and hits.any() and len(sol.t) > 1:
+            times = onsets[hits]
+            xs = np.interp(times, sol.t, x)
+            left.plot(times, xs, "rx", ms=5, label="impacts")
+            right.plot(xs, np.interp(times, sol.t, v), "rx", ms=5, label="impacts")
+            right.legend()
+        left.set_xlabel("t (s)")
+        left.set_ylabel("displacement (m, relative to the base)")
+        left.legend(fontsize=8)
+        right.set_xlabel("structure displacement 0 (m)")
+        right.set_ylabel("structure velocity 0 (m/s)")
+        for ax in (left, right):
+            ax.grid(alpha=0.3)
+
+
+def orbit_history(run: Runner, state: np.ndarray, periods: int) -> SystemSolution:
+    """The history of a run of ``periods`` forcing periods from ``state``."""
+    prepared = run.prepared
+    n, k = run.n, run.k
+    d = n + k
+    initial = {
+        "structure_displacement": list(state[:n]),
+        "structure_velocity": list(state[d : d + n]),
+        "damper_displacement": list(state[n:d]),
+        "damper_velocity": list(state[d + n :]),
+    }
+    solver = {**prepared.solver, "t_end": periods * run.period}
+    if solver["method"] == "exact" and solver["dt"] is None:
+        # Smooth curves: about 200 rows a period.
+        solver["dt"] = run.period / 200
+    output = {**prepared.output, "history": True, "every": 1}
+    return dataclasses.replace(prepared, initial=initial, solver=solver, output=output).run()
+
+
+def plot_section(path: Path, section: Section, period: float) -> None:
+    """The stroboscopic section (structure coordinate 0) and the impact section
+    (impact phase against impact speed)."""
+    with _figure(path, 1, 2, (11, 4.5)) as (fig, (left, right)):
+        dim = section.strobe.shape[1] // 2
+        left.plot(section.strobe[:, 0], section.strobe[:, dim], ".", ms=3)
+        left.set_xlabel("structure displacement 0 (m)")
+        left.set_ylabel("structure velocity 0 (m/s)")
+        left.set_title(f"stroboscopic, every {period:.6g} s")
+        for pair in sorted(set(section.impact_pair)):
+            chosen = np.array([p == pair for p in section.impact_pair], dtype=bool)
+            right.plot(
+                section.impact_phase[chosen], section.impact_speed[chosen], ".", ms=3, label=pair
+            )
+        right.set_xlabel("impact phase in the forcing period (rad)")
+        right.set_ylabel("impact speed (m/s)")
+        right.set_xlim(0, 2 * np.pi)
+        if section.impact_pair:
+            right.legend()
+        for ax in (left, right):
+            ax.grid(alpha=0.3)
+
+
+def plot_bifurcation(path: Path, parameter: str, points: list[BifurcationPoint]) -> None:
+    """Sampled stroboscopic displacements of structure coordinate 0 against the
+    parameter, each direction."""
+    with _figure(path) as (fig, ax):
+        for direction, colour in (("up", "tab:blue"), ("down", "tab:orange")):
+            xs: list[float] = []
+            ys: list[float] = []
+            for p in points:
+                if p.direction == direction and p.strobe.size:
+                    xs += [p.value] * len(p.strobe)
+                    ys += list(p.strobe[:, 0])
+            if xs:
+                ax.plot(xs, ys, ".", ms=1.5, color=colour, label=f"sweep {direction}")
+        ax.set_xlabel(f"{parameter}{_unit(parameter)}")
+        ax.set_ylabel("stroboscopic structure displacement 0 (m)")
+        ax.legend(markerscale=6)
+        ax.grid(alpha=0.3)
+
+
+def plot_basins(path: Path, result: Basins, x_name: str, y_name: str) -> None:
+    """The attractor reached from each start (colours), not settled (white),
+    failed (grey) and not admissible (black)."""
+    import matplotlib.colors as colors
+
+    with _figure(path) as (fig, ax):
+        count = max(len(result.attractors), 1)
+        palette = ["#000000", "#dddddd", "#ffffff"] + [
+            colors.to_hex(c)
+            for c in __import__("matplotlib").colormaps["tab10"](np.arange(count) % 10)
+        ]
+        cmap = colors.ListedColormap(palette)
+        mesh = ax.pcolormesh(
+            result.first,
+            result.second,
+            (result.labels + 3).T,
+            cmap=cmap,
+            vmin=-0.5,
+            vmax=len(palette) - 0.5,
+            shading="nearest",
+        )
+        ticks = list(range(len(palette)))
+        labels = ["not admissible", "failed", "not settled"] + [
+            f"{a['period']}-periodic, {a['impacts_per_period']:g} impacts/period"
+            for a in result.attractors
+        ]
+        bar = fig.colorbar(mesh, ax=ax, ticks=ticks)
+        bar.ax.set_yticklabels(labels, fontsize=7)
+        unit = " (m/s)" if "velocity" in x_name else " (m)"
+        ax.set_xlabel(f"initial {x_name}{unit}")
+        unit = " (m/s)" if "velocity" in y_name else " (m)"
+        ax.set_ylabel(f"initial {y_name}{unit}")
+
+
+def plot_branch(path: Path, branch: Branch) -> None:
+    """Amplitude of structure coordinate 0 along the branch: stable solid, unstable
+    dashed, bifurcations marked."""
+    with _figure(path) as (fig, ax):
+        values = [p.value for p in branch.points]
+        amplitude = [p.amplitude[0] for p in branch.points]
+        for i in range(1, len(values)):
+            stable = branch.points[i].stable and branch.points[i - 1].stable
+            ax.plot(
+                values[i - 1 : i + 1],
+                amplitude[i - 1 : i + 1],
+                "-" if stable else "--",
+                color="tab:blue" if stable else "tab:red",
+                lw=1.2,
+            )
+        for p in branch.points:
+            for flag in p.flags:
+                ax.annotate(flag, (p.value, p.amplitude[0]), fontsize=7)
+                ax.plot([p.value], [p.amplitude[0]], "ko", ms=3)
+        ax.plot([], [], "-", color="tab:blue", label="stable")
+        ax.plot([], [], "--", color="tab:red", label="unstable")
+        ax.set_xlabel(f"{branch.parameter}{_unit(branch.parameter)}")
+        ax.set_ylabel("amplitude of structure coordinate 0 (m)")
+        ax.set_title(f"{branch.periods}-period orbits")
+        ax.legend()
+        ax.grid(alpha=0.3)

@@ -1,0 +1,218 @@
+"""Poincare sections, bifurcation diagrams and basins of attraction of forced 0.2
+systems, built on the stroboscopic states and the located impacts of the core's
+runs (see :mod:`vibroimpact.analyses`). SI units throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.analyses import AnalysisError, Runner, runner, steady_state, with_parameter
+
+
+@dataclass
+class Section:
+    """A Poincare section: ``strobe`` rows of the state ``(x, v)`` at each forcing
+    period (after settling), and at each impact its phase in the forcing period
+    (``impact_phase``, rad in [0, 2 pi)), its ``impact_speed`` (m/s) and the
+    ``impact_pair`` it belongs to."""
+
+    strobe: np.ndarray
+    impact_phase: np.ndarray
+    impact_speed: np.ndarray
+    impact_pair: list[str]
+
+
+def poincare(
+    run: Runner,
+    state: np.ndarray | None = None,
+    *,
+    settle_periods: int = 200,
+    periods: int = 500,
+) -> Section:
+    """Settle ``settle_periods`` forcing periods, then sample ``periods`` more: the
+    stroboscopic section and the impact section."""
+    _whole("settle_periods", settle_periods, 0)
+    _whole("periods", periods, 1)
+    z = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    if settle_periods:
+        z = run.map(z, settle_periods)
+    raw = run.periods(z, periods, strobe=True)
+    contacts = raw["contacts"]
+    onset = np.asarray(contacts["onset"])
+    kinds = list(contacts["kind"])
+    impacts = np.array([kind == "impact" for kind in kinds], dtype=bool)
+    pairs = list(raw["pairs"])
+    phase = (2 * math.pi * onset[impacts] / run.period) % (2 * math.pi)
+    return Section(
+        strobe=np.asarray(raw["strobe"]).reshape(-1, len(z)),
+        impact_phase=phase,
+        impact_speed=np.asarray(contacts["approach_speed"])[impacts],
+        impact_pair=[pairs[p] for p, hit in zip(contacts["pair"], impacts, strict=True) if hit],
+    )
+
+
+@dataclass
+class BifurcationPoint:
+    """The sampled stroboscopic states at one parameter value."""
+
+    value: float
+    direction: str
+    strobe: np.ndarray
+    error: str | None = None
+
+
+def bifurcation(
+    data: Mapping[str, Any],
+    parameter: str,
+    values: Sequence[float] | np.ndarray,
+    *,
+    direction: str = "up",
+    settle_periods: int = 200,
+    sample_periods: int = 50,
+    base_dir: Path | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[BifurcationPoint]:
+    """A bifurcation diagram: for each value of ``parameter`` (a dotted path), in
+    the order given (``"up"``), reversed (``"down"``) or both, settle from the last
+    point's state and keep ``sample_periods`` stroboscopic states."""
+    _whole("settle_periods", settle_periods, 0)
+    _whole("sample_periods", sample_periods, 1)
+    legs = _legs(direction, [float(v) for v in values])
+    points: list[BifurcationPoint] = []
+    state: np.ndarray | None = None
+    total = sum(len(v) for _, v in legs)
+    for leg, leg_values in legs:
+        for value in leg_values:
+            run = _runner_at(data, parameter, value, base_dir)
+            try:
+                z = run.initial_state() if state is None else state
+                if settle_periods:
+                    z = run.map(z, settle_periods)
+                raw = run.periods(z, sample_periods, strobe=True)
+            except InvalidInputError:
+                raise
+            except Exception as err:  # a run that cannot complete: recorded
+                points.append(BifurcationPoint(value, leg, np.zeros((0, 0)), str(err)))
+            else:
+                state = np.asarray(raw["final_state"], dtype=float)
+                strobe = np.asarray(raw["strobe"]).reshape(-1, len(state))
+                points.append(BifurcationPoint(value, leg, strobe))
+            if progress is not None:
+                progress(len(points), total)
+    return points
+
+
+@dataclass
+class Basins:
+    """Basins of attraction over a grid of two initial values: ``labels[i, j]`` is
+    the attractor reached from ``(first[i], second[j])``, an index into
+    ``attractors`` (each with its ``period``, ``impacts_per_period``, ``amplitude``);
+    -1 where the run did not settle, -2 where it failed, -3 where the start is not
+    admissible (a pair inside its wall)."""
+
+    first: np.ndarray
+    second: np.ndarray
+    labels: np.ndarray
+    attractors: list[dict[str, Any]]
+
+
+def basins(
+    run: Runner,
+    first: tuple[int, np.ndarray],
+    second: tuple[int, np.ndarray],
+    *,
+    state: np.ndarray | None = None,
+    settle_periods: int = 200,
+    record_periods: int = 20,
+    tolerance: float = 1e-6,
+    progress: Callable[[int, int], None] | None = None,
+) -> Basins:
+    """For each pair of values of two state components (``(index into the flat
+    state (x, v), values)``), starting from ``state`` (default ``[initial]``) with
+    those two set, find the steady state and group the results into attractors:
+    same period, same impacts per period and amplitudes within 1e-3 relative."""
+    base = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    for name, (index, _) in (("first", first), ("second", second)):
+        if not 0 <= index < len(base):
+            raise AnalysisError(f"{name}: a state index in [0, {len(base)}), got {index}")
+    a_values, b_values = np.asarray(first[1], float), np.asarray(second[1], float)
+    labels = np.full((len(a_values), len(b_values)), -2, dtype=int)
+    attractors: list[dict[str, Any]] = []
+    done = 0
+    for i, a in enumerate(a_values):
+        for j, b in enumerate(b_values):
+            z = base.copy()
+            z[first[0]] = a
+            z[second[0]] = b
+            try:
+                result = steady_state(
+                    run,
+                    z,
+                    settle_periods=settle_periods,
+                    record_periods=record_periods,
+                    tolerance=tolerance,
+                )
+            except InvalidInputError:
+                labels[i, j] = -3  # a start inside a wall
+            except Exception:  # a run that cannot complete
+                labels[i, j] = -2
+            else:
+                if not result.settled:
+                    labels[i, j] = -1
+                else:
+                    labels[i, j] = _attractor(attractors, result)
+            done += 1
+            if progress is not None:
+                progress(done, labels.size)
+    return Basins(a_values, b_values, labels, attractors)
+
+
+def _attractor(attractors: list[dict[str, Any]], result: Any) -> int:
+    for index, known in enumerate(attractors):
+        if (
+            known["period"] == result.period
+            and known["impacts_per_period"] == result.impacts_per_period
+            and np.allclose(known["amplitude"], result.amplitude, rtol=1e-3, atol=0.0)
+        ):
+            return index
+    attractors.append(
+        {
+            "period": result.period,
+            "impacts_per_period": result.impacts_per_period,
+            "amplitude": [float(a) for a in result.amplitude],
+        }
+    )
+    return len(attractors) - 1
+
+
+def _runner_at(
+    data: Mapping[str, Any], parameter: str, value: float, base_dir: Path | None
+) -> Runner:
+    try:
+        return runner(with_parameter(data, parameter, value), base_dir)
+    except InvalidInputError as err:
+        raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
+
+
+def _legs(direction: str, values: list[float]) -> list[tuple[str, list[float]]]:
+    if direction not in ("up", "down", "both"):
+        raise AnalysisError(f'direction must be one of "up", "down", "both", got "{direction}"')
+    legs: list[tuple[str, list[float]]] = []
+    if direction in ("up", "both"):
+        legs.append(("up", values))
+    if direction in ("down", "both"):
+        legs.append(("down", values[::-1]))
+    return legs
+
+
+def _whole(name: str, value: Any, low: int) -> None:
+    if not isinstance(value, int) or isinstance(value, bool) or value < low:
+        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
