@@ -83,6 +83,34 @@ def _simulate_system(**kwargs: Any) -> Any:
     )
 
 
+PREPARED = {
+    "t_end": 1e-2,
+    "dt": 1e-3,
+    "rtol": 1e-8,
+    "atol": 1e-12,
+    "beta": 0.25,
+    "gamma": 0.5,
+    "spectral_radius": 0.9,
+    "energy_tolerance": 1e-2,
+}
+# The binding's own: the sections as vibroimpact.system checks and fills them.
+SPEC = {
+    "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 10.0, "damping": 0.0},
+    "damper": [],
+    "stop": [],
+    "excitation": [],
+    "gravity": 0.0,
+}
+
+
+def _prepared_system(**kwargs: Any) -> Any:
+    return _core.PreparedSystem(SPEC, method="rk4", max_steps=10**6, max_rows=10**6, **kwargs)
+
+
+def _prepared_run(**kwargs: Any) -> Any:
+    return _prepared_system(**PREPARED).run([0.01, 0.0], **kwargs)
+
+
 def _simulate(**kwargs: Any) -> Any:
     return vi.simulate(
         vi.ImpactDamper(**SYSTEM),
@@ -128,6 +156,11 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
             "record_from": 0.0,
             "strobe_period": 5e-3,
         },
+    ),
+    "PreparedSystem": (_prepared_system, PREPARED),
+    "PreparedSystem.run": (
+        _prepared_run,
+        {"t_end": 1e-2, "record_from": 0.0, "strobe_period": 5e-3},
     ),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (

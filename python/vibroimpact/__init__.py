@@ -32,6 +32,7 @@ from vibroimpact._core import (
     InitialState,
     InvalidInputError,
     NumericalBlowUpError,
+    PreparedSystem,
     RestitutionWarning,
     SimulationError,
     Solution,
@@ -70,6 +71,7 @@ _equality_only(ImpactDamper, Contact, InitialState)
 
 __all__ = [
     "linear_parts",
+    "PreparedSystem",
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
     "BeamMode",

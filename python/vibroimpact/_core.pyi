@@ -32,6 +32,7 @@ __all__ = [
     "simulate",
     "simulate_system",
     "linear_parts",
+    "PreparedSystem",
 ]
 
 __version__: str
@@ -216,6 +217,34 @@ def simulate_system(
     strobe_period: float | None = None,
 ) -> dict[str, Any]: ...
 def linear_parts(spec: dict[str, Any]) -> dict[str, Any]: ...
+
+@final
+class PreparedSystem:
+    def __new__(
+        cls,
+        spec: dict[str, Any],
+        *,
+        method: str,
+        t_end: float,
+        dt: float | None,
+        rtol: float,
+        atol: float,
+        beta: float,
+        gamma: float,
+        spectral_radius: float,
+        max_steps: int,
+        max_rows: int,
+        energy_tolerance: float,
+    ) -> PreparedSystem: ...
+    def run(
+        self,
+        state: list[float],
+        t_end: float,
+        *,
+        record_from: float | None = None,
+        strobe_period: float | None = None,
+    ) -> dict[str, Any]: ...
+
 def simulate(
     system: ImpactDamper,
     contact: Contact,

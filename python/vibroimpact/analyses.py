@@ -20,8 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError
-from vibroimpact._core import simulate_system as _simulate_system
+from vibroimpact._core import InvalidInputError, PreparedSystem
 from vibroimpact.system import (
     _NUMBER,
     _REQ,
@@ -119,6 +118,7 @@ class Runner:
     n: int = 0
     k: int = 0
     runs: int = 0
+    _prepared_system: PreparedSystem | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         structure = self.prepared.spec["structure"]
@@ -153,38 +153,30 @@ class Runner:
     def _run(
         self, state: np.ndarray | None, t_end: float, *, record: bool, strobe: bool
     ) -> dict[str, Any]:
-        spec, solver = self.prepared.spec, self.prepared.solver
-        if state is None:
-            initial = [list(self.prepared.initial[key]) for key in _INITIAL]
-        else:
-            n, k = self.n, self.k
-            if len(state) != 2 * (n + k):
-                raise AnalysisError(
-                    f"state: must have {2 * (n + k)} values (x then v), got {len(state)}"
-                )
-            d = n + k
-            initial = [
-                list(state[:n]),
-                list(state[d : d + n]),
-                list(state[n:d]),
-                list(state[d + n :]),
-            ]
-        raw = _simulate_system(
-            {**spec, "gravity": spec["gravity"]["acceleration"]},
-            initial,
-            method=solver["method"],
-            t_end=t_end,
-            dt=solver["dt"],
-            rtol=solver["rtol"],
-            atol=solver["atol"],
-            beta=solver["beta"],
-            gamma=solver["gamma"],
-            spectral_radius=solver["spectral_radius"],
-            every=1,
-            history=False,
-            max_steps=solver["max_steps"],
-            max_rows=solver["max_rows"],
-            energy_tolerance=solver["energy_tolerance"],
+        if self._prepared_system is None:
+            spec, solver = self.prepared.spec, self.prepared.solver
+            self._prepared_system = PreparedSystem(
+                {**spec, "gravity": spec["gravity"]["acceleration"]},
+                method=solver["method"],
+                t_end=solver["t_end"],
+                dt=solver["dt"],
+                rtol=solver["rtol"],
+                atol=solver["atol"],
+                beta=solver["beta"],
+                gamma=solver["gamma"],
+                spectral_radius=solver["spectral_radius"],
+                max_steps=solver["max_steps"],
+                max_rows=solver["max_rows"],
+                energy_tolerance=solver["energy_tolerance"],
+            )
+        z = self.initial_state() if state is None else state
+        if len(z) != 2 * (self.n + self.k):
+            raise AnalysisError(
+                f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(z)}"
+            )
+        raw = self._prepared_system.run(
+            [float(v) for v in z],
+            t_end,
             record_from=0.0 if record else None,
             strobe_period=self.period if strobe else None,
         )

@@ -125,6 +125,8 @@ pub struct ExactFlow {
     step: f64,
     /// Per mode, the free part's start `(d0, d0')`.
     start: Vec<(f64, f64)>,
+    /// Per mode, the modal coordinate and its rate at the start.
+    origin_modal: Vec<(f64, f64)>,
     /// Per harmonic, `(sin, cos)` of its angle at the flow's start.
     phasors: Vec<(f64, f64)>,
     eta: Vec<f64>,
@@ -148,8 +150,8 @@ impl ExactFlow {
             .find(|it| !matches!(it.law, crate::assembly::InteractionLaw::Rigid { .. }))
         {
             return Err(Error::Inconsistent(format!(
-                "method \"exact\" takes rigid laws only, and {} is compliant (its contact force \
-                 is not linear); use law = \"rigid\" or method \"dop853\"",
+                "method \"exact\" takes rigid laws only, and {} is compliant; use law = \
+                 \"rigid\" or method \"dop853\"",
                 system.pairs[it.pair]
             )));
         }
@@ -166,6 +168,7 @@ impl ExactFlow {
         let dim = system.dim;
         Ok(Self {
             start: vec![(0.0, 0.0); dim],
+            origin_modal: vec![(0.0, 0.0); dim],
             phasors: vec![(0.0, 1.0); parts.harmonics.len()],
             eta: vec![0.0; dim],
             rate: vec![0.0; dim],
@@ -279,6 +282,7 @@ impl ExactFlow {
                 dp -= h.omega * (zr * s + zi * c);
             }
             self.start[j] = (eta - p, rate - dp);
+            self.origin_modal[j] = (eta, rate);
         }
     }
 
@@ -318,10 +322,17 @@ impl ExactFlow {
         let viscous: f64 = (0..r)
             .map(|j| m.oscillators[j].c * self.rate[j] * self.rate[j])
             .sum();
+        // The start plus the modes' increments: the flow is continuous at its
+        // start to the last bit (a state on a wall stays on it), and a start
+        // off the constraints of sticking pairs by round-off stays as close.
+        for j in 0..r {
+            self.eta[j] -= self.origin_modal[j].0;
+            self.rate[j] -= self.origin_modal[j].1;
+        }
         for i in 0..dim {
             let row = &cfg.to_coordinates[i * r..(i + 1) * r];
-            let mut x = cfg.origin[i];
-            let mut v = 0.0;
+            let mut x = self.begun_state[i];
+            let mut v = self.begun_state[dim + i];
             for j in 0..r {
                 x += row[j] * self.eta[j];
                 v += row[j] * self.rate[j];

@@ -224,6 +224,7 @@ fn find_crossing(
     grazes: &mut u64,
     scratch: &mut Scratch,
     work: &mut [f64],
+    skip: &[bool],
 ) -> Option<Crossing> {
     let mut best: Option<Crossing> = None;
     let mut consider = |c: Crossing| {
@@ -232,6 +233,9 @@ fn find_crossing(
         }
     };
     for (i, &mode) in modes.iter().enumerate() {
+        if skip[i] {
+            continue;
+        }
         let sign = match mode {
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
@@ -480,6 +484,8 @@ pub fn integrate_system<S: SystemStepper>(
     let time_scale = t_end.min(system.longest_period);
     let chatter_interval = |time: f64| CHATTER_ULPS * f64::EPSILON * time.abs().max(time_scale);
 
+    // A stepper may be reused across runs: nothing carries over from the last.
+    stepper.reset();
     let mut y = initial.to_vec();
     let mut end = vec![0.0; len];
     let mut full = vec![0.0; len];
@@ -513,6 +519,9 @@ pub fn integrate_system<S: SystemStepper>(
     let (mut last_event, mut close_events) = (f64::NEG_INFINITY, 0u64);
     let mut just_rejected = false;
     let mut stalled = 0u64;
+    // Interactions whose dip in this step was checked and stays open.
+    let mut unconfirmed = vec![false; count];
+    let mut any_unconfirmed = false;
     let mut reductions = Reductions {
         peaks: vec![0.0; system.n],
         square_integrals: vec![0.0; system.n],
@@ -546,6 +555,10 @@ pub fn integrate_system<S: SystemStepper>(
         let mut taken = length;
         let mut switched: Option<usize> = None;
         let mut last_attempt_kept = true;
+        if any_unconfirmed {
+            unconfirmed.iter_mut().for_each(|u| *u = false);
+            any_unconfirmed = false;
+        }
         let mut crossing = find_crossing(
             system,
             time,
@@ -557,6 +570,7 @@ pub fn integrate_system<S: SystemStepper>(
             &mut grazes,
             &mut scratch,
             &mut buffers.work,
+            &unconfirmed,
         );
         // An event inside the step: locate it; another interaction that
         // turns out to have crossed before it is located in its turn.
@@ -598,7 +612,24 @@ pub fn integrate_system<S: SystemStepper>(
                 Location::Unconfirmed => {
                     last_attempt_kept = false;
                     if switched.is_none() {
-                        crossing = None;
+                        // That dip stays above its wall: another pair may
+                        // still cross within the step.
+                        unconfirmed[c.i] = true;
+                        any_unconfirmed = true;
+                        let mut counted = 0;
+                        crossing = find_crossing(
+                            system,
+                            time,
+                            &y,
+                            &end,
+                            taken,
+                            &modes,
+                            graze,
+                            &mut counted,
+                            &mut scratch,
+                            &mut buffers.work,
+                            &unconfirmed,
+                        );
                         continue;
                     }
                 }

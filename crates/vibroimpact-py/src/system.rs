@@ -15,7 +15,7 @@ use vibroimpact_core::reductions::ReduceOptions;
 use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, RunOptions};
-use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
+use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily};
 
 use crate::convert::real_or_none;
 use crate::errors::{released, to_py, InvalidInputError};
@@ -262,17 +262,254 @@ fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
     })
 }
 
-/// Integrate with the GIL released (see [`crate::released`]).
-fn run<S: SystemStepper + Send>(
-    py: Python<'_>,
-    system: &Assembly,
-    stepper: &mut S,
-    y0: &[f64],
-    options: &RunOptions,
-) -> PyResult<core::system_events::SystemSolution> {
-    released(py, |interrupt| {
-        integrate_system(system, stepper, y0, options, interrupt)
-    })
+/// The method of a run, made once per system.
+enum AnyStepper {
+    Rk(ExplicitRk),
+    Newmark(NewmarkFamily),
+    Exact(ExactFlow),
+}
+
+/// The numbers a run takes beside its system and method.
+#[derive(Debug, Clone, Copy)]
+struct Limits {
+    dt: Option<f64>,
+    max_steps: u64,
+    max_rows: u64,
+    energy_tolerance: f64,
+}
+
+/// A checked system with its method, ready to run from any state.
+struct Ready {
+    system: Assembly,
+    stepper: AnyStepper,
+    limits: Limits,
+}
+
+impl Ready {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        spec: &Bound<'_, PyDict>,
+        method: &str,
+        t_end: f64,
+        rtol: f64,
+        atol: f64,
+        beta: f64,
+        gamma: f64,
+        spectral_radius: f64,
+        limits: Limits,
+    ) -> PyResult<Self> {
+        let system_spec = system_spec(spec, t_end)?;
+        let system = Assembly::new(&system_spec).map_err(to_py)?;
+        let len = system.state_len();
+        let stepper = match method {
+            "rk4" => AnyStepper::Rk(ExplicitRk::rk4(len)),
+            "dopri5" => AnyStepper::Rk(ExplicitRk::dopri5(len, rtol, atol)),
+            "dop853" => AnyStepper::Rk(ExplicitRk::dop853(len, rtol, atol)),
+            "newmark-implicit" => AnyStepper::Newmark(NewmarkFamily::newmark(&system, beta, gamma)),
+            "generalized-alpha" => {
+                AnyStepper::Newmark(NewmarkFamily::generalized_alpha(&system, spectral_radius))
+            }
+            "exact" => AnyStepper::Exact(ExactFlow::new(&system).map_err(to_py)?),
+            other => {
+                return Err(InvalidInputError::new_err(format!(
+                    "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
+                     \"generalized-alpha\", \"exact\" for a [structure] system, got {other:?}"
+                )))
+            }
+        };
+        Ok(Self {
+            system,
+            stepper,
+            limits,
+        })
+    }
+
+    /// Integrate from `y0` with the GIL released (see [`crate::released`]).
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        y0: &[f64],
+        t_end: f64,
+        history: (bool, u64),
+        record_from: Option<f64>,
+        strobe_period: Option<f64>,
+    ) -> PyResult<core::system_events::SystemSolution> {
+        let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
+        // A fixed step that divides the strobe period lands on its multiples.
+        let fit = |step: f64| {
+            if strobe_period.is_finite() {
+                strobe_period / (strobe_period / step - 1e-9).ceil().max(1.0)
+            } else {
+                step
+            }
+        };
+        let limits = self.limits;
+        let dt = match &self.stepper {
+            // dt, when given, caps the flow's own step (a finer check of the
+            // gaps between step ends).
+            AnyStepper::Exact(flow) => Some(fit(limits
+                .dt
+                .unwrap_or(f64::INFINITY)
+                .min(flow.step())
+                .min(t_end))),
+            _ => limits.dt.map(fit),
+        };
+        let options = RunOptions {
+            dt,
+            t_end,
+            every: history.1,
+            keep_history: history.0,
+            max_steps: limits.max_steps,
+            max_rows: limits.max_rows,
+            energy_tolerance: limits.energy_tolerance,
+            reduce: ReduceOptions {
+                record_from: record_from.unwrap_or(f64::INFINITY),
+                strobe_period,
+            },
+        };
+        let system = &self.system;
+        match &mut self.stepper {
+            AnyStepper::Rk(s) => released(py, |i| integrate_system(system, s, y0, &options, i)),
+            AnyStepper::Newmark(s) => {
+                released(py, |i| integrate_system(system, s, y0, &options, i))
+            }
+            AnyStepper::Exact(s) => released(py, |i| integrate_system(system, s, y0, &options, i)),
+        }
+    }
+}
+
+/// A 0.2 system checked once, with its method, to run many times from any
+/// state (the analyses' stroboscopic maps): see `vibroimpact.analyses`.
+#[pyclass(frozen, module = "vibroimpact._core")]
+pub struct PreparedSystem {
+    /// A run at a time: the method's buffers are the system's.
+    ready: std::sync::Mutex<Ready>,
+}
+
+#[pymethods]
+impl PreparedSystem {
+    /// Check `spec` (the sections, as `simulate_system` takes them) and make
+    /// its method; the settings as for `simulate_system` (`t_end`, s, sets the
+    /// default duration of swept signals).
+    #[new]
+    #[pyo3(signature = (spec, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, max_rows, energy_tolerance))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        spec: &Bound<'_, PyDict>,
+        method: &str,
+        #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
+        #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::real)] rtol: f64,
+        #[pyo3(from_py_with = crate::convert::real)] atol: f64,
+        #[pyo3(from_py_with = crate::convert::real)] beta: f64,
+        #[pyo3(from_py_with = crate::convert::real)] gamma: f64,
+        #[pyo3(from_py_with = crate::convert::real)] spectral_radius: f64,
+        max_steps: u64,
+        max_rows: u64,
+        #[pyo3(from_py_with = crate::convert::real)] energy_tolerance: f64,
+    ) -> PyResult<Self> {
+        for (field, value, ok, allowed) in [
+            ("t_end", t_end, t_end > 0.0, "> 0 s"),
+            (
+                "dt",
+                dt.unwrap_or(1.0),
+                dt.unwrap_or(1.0) > 0.0,
+                "> 0 s or None",
+            ),
+            ("rtol", rtol, rtol > 0.0, "> 0"),
+            ("atol", atol, atol > 0.0, "> 0"),
+            ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
+            ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
+            (
+                "spectral_radius",
+                spectral_radius,
+                (0.0..=1.0).contains(&spectral_radius),
+                "in [0, 1]",
+            ),
+            (
+                "energy_tolerance",
+                energy_tolerance,
+                energy_tolerance > 0.0,
+                "> 0",
+            ),
+        ] {
+            check(field, value, ok, allowed)?;
+        }
+        let limits = Limits {
+            dt,
+            max_steps,
+            max_rows,
+            energy_tolerance,
+        };
+        Ok(Self {
+            ready: std::sync::Mutex::new(Ready::new(
+                spec,
+                method,
+                t_end,
+                rtol,
+                atol,
+                beta,
+                gamma,
+                spectral_radius,
+                limits,
+            )?),
+        })
+    }
+
+    /// Run from the flat state `x` then `v` (the structure's coordinates, then
+    /// the dampers') for `t_end` s, keeping no history: a dict as
+    /// `simulate_system` returns.
+    #[pyo3(signature = (state, t_end, *, record_from=None, strobe_period=None))]
+    fn run<'py>(
+        &self,
+        py: Python<'py>,
+        state: Vec<f64>,
+        #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
+        #[pyo3(from_py_with = real_or_none)] record_from: Option<f64>,
+        #[pyo3(from_py_with = real_or_none)] strobe_period: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let mut ready = self.ready.lock().map_err(|_| {
+            InvalidInputError::new_err("a run of this system failed; make it again")
+        })?;
+        let system = &ready.system;
+        let (n, d) = (system.n, system.dim);
+        if state.len() != 2 * d {
+            return Err(InvalidInputError::new_err(format!(
+                "state must have {} values (x then v), got {}",
+                2 * d,
+                state.len()
+            )));
+        }
+        check("t_end", t_end, t_end > 0.0, "> 0 s")?;
+        if let Some(value) = record_from {
+            check("record_from", value, value >= 0.0, ">= 0 s or None")?;
+        }
+        if let Some(value) = strobe_period {
+            check("strobe_period", value, value > 0.0, "> 0 s or None")?;
+        }
+        let y0 = initial_state(
+            system,
+            &state[..n],
+            &state[d..d + n],
+            &state[n..d],
+            &state[d + n..],
+        )
+        .map_err(to_py)?;
+        let sol = ready.run(py, &y0, t_end, (false, 1), record_from, strobe_period)?;
+        solution_dict(py, &ready.system, sol)
+    }
+}
+
+/// `value` of `field`, unless it is not finite or not `ok` (then an error
+/// saying what is `allowed`).
+fn check(field: &str, value: f64, ok: bool, allowed: &str) -> PyResult<f64> {
+    if value.is_finite() && ok {
+        Ok(value)
+    } else {
+        Err(InvalidInputError::new_err(format!(
+            "{field} must be finite and {allowed}, got {value}"
+        )))
+    }
 }
 
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
@@ -300,77 +537,41 @@ pub fn simulate_system<'py>(
     #[pyo3(from_py_with = real_or_none)] record_from: Option<f64>,
     #[pyo3(from_py_with = real_or_none)] strobe_period: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let system_spec = system_spec(spec, t_end)?;
-    let system = Assembly::new(&system_spec).map_err(to_py)?;
-    let y0 = initial_state(&system, &initial[0], &initial[1], &initial[2], &initial[3])
-        .map_err(to_py)?;
-    let len = system.state_len();
-    let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
-    // A fixed step that divides the strobe period lands on its multiples.
-    let fit = |step: f64| {
-        if strobe_period.is_finite() {
-            strobe_period / (strobe_period / step - 1e-9).ceil().max(1.0)
-        } else {
-            step
-        }
-    };
-    let dt = dt.map(fit);
-    let options = RunOptions {
+    let limits = Limits {
         dt,
-        t_end,
-        every,
-        keep_history: history,
         max_steps,
         max_rows,
         energy_tolerance,
-        reduce: ReduceOptions {
-            record_from: record_from.unwrap_or(f64::INFINITY),
-            strobe_period,
-        },
     };
-    let result = match method {
-        "rk4" => run(py, &system, &mut ExplicitRk::rk4(len), &y0, &options),
-        "dopri5" => run(
-            py,
-            &system,
-            &mut ExplicitRk::dopri5(len, rtol, atol),
-            &y0,
-            &options,
-        ),
-        "dop853" => run(
-            py,
-            &system,
-            &mut ExplicitRk::dop853(len, rtol, atol),
-            &y0,
-            &options,
-        ),
-        "newmark-implicit" => {
-            let mut stepper = NewmarkFamily::newmark(&system, beta, gamma);
-            run(py, &system, &mut stepper, &y0, &options)
-        }
-        "generalized-alpha" => {
-            let mut stepper = NewmarkFamily::generalized_alpha(&system, spectral_radius);
-            run(py, &system, &mut stepper, &y0, &options)
-        }
-        "exact" => {
-            let mut stepper = ExactFlow::new(&system).map_err(to_py)?;
-            // dt, when given, caps the flow's own step (a finer check of
-            // the gaps between step ends).
-            let step = fit(dt.unwrap_or(f64::INFINITY).min(stepper.step()).min(t_end));
-            let options = RunOptions {
-                dt: Some(step),
-                ..options
-            };
-            run(py, &system, &mut stepper, &y0, &options)
-        }
-        other => {
-            return Err(InvalidInputError::new_err(format!(
-                "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
-                 \"generalized-alpha\", \"exact\" for a [structure] system, got {other:?}"
-            )))
-        }
-    };
-    let sol = result?;
+    let mut ready = Ready::new(
+        spec,
+        method,
+        t_end,
+        rtol,
+        atol,
+        beta,
+        gamma,
+        spectral_radius,
+        limits,
+    )?;
+    let y0 = initial_state(
+        &ready.system,
+        &initial[0],
+        &initial[1],
+        &initial[2],
+        &initial[3],
+    )
+    .map_err(to_py)?;
+    let sol = ready.run(py, &y0, t_end, (history, every), record_from, strobe_period)?;
+    solution_dict(py, &ready.system, sol)
+}
+
+/// A run's results as a dict of flat arrays.
+fn solution_dict<'py>(
+    py: Python<'py>,
+    system: &Assembly,
+    sol: core::system_events::SystemSolution,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("n", system.n)?;
     out.set_item("k", system.k)?;
