@@ -387,28 +387,16 @@ FILE_NAMED = [
         "orbit",
         "compliant",
         id="orbit, exact with a compliant law",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="orbit: an error from running the scenario does not name its file",
-        ),
     ),
     pytest.param(
         "sweep",
         "compliant",
         id="sweep, exact with a compliant law",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="sweep: an error from running a point does not name the file",
-        ),
     ),
     pytest.param(
         "orbit",
         "unforced",
         id="orbit without a harmonic excitation",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="orbit: 'needs a harmonic excitation' does not name the file",
-        ),
     ),
 ]
 
@@ -422,14 +410,6 @@ def test_errors_from_a_scenario_name_its_file(
     assert_one_line_error(run_cli(command, str(path)), str(path))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "a run of whole forcing periods that ends inside a compliant contact cannot be "
-        "restarted: the next run is refused as 'initial state: damper 0 starts ... inside "
-        "its wall' (exit 2)"
-    ),
-)
 def test_a_sweep_with_a_compliant_contact_completes(run_cli: RunCli, tmp_path: Path) -> None:
     path = compliant_frf(tmp_path, "dop853")
     text = edited(

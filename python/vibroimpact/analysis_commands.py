@@ -6,14 +6,15 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from vibroimpact import analysis_plots as plots
+from vibroimpact._core import InvalidInputError
 from vibroimpact.analyses import (
-    AnalysisError,
     orbit,
     runner,
     state_index,
@@ -220,10 +221,9 @@ def run_sweep(args: argparse.Namespace) -> int:
             base_dir=scenario.base_dir,
             progress=progress,
         )
-    except AnalysisError as err:
-        raise AnalysisError(f"{args.scenario}: {err}") from None
-    if show:
-        print(file=sys.stderr)
+    finally:
+        if show:
+            print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
         plots.plot_sweep(args.plot, settings["parameter"], points)
@@ -466,11 +466,32 @@ def run_continue(args: argparse.Namespace) -> int:
     return 0
 
 
+def _naming_the_file(
+    command: Callable[[argparse.Namespace], int],
+) -> Callable[[argparse.Namespace], int]:
+    """Errors of bad input raised while a command runs, prefixed with the scenario
+    file as the errors of reading it are."""
+
+    def run(args: argparse.Namespace) -> int:
+        try:
+            return command(args)
+        except InvalidInputError as err:
+            text = str(err)
+            if text.startswith(str(args.scenario)):
+                raise
+            raise InvalidInputError(f"{args.scenario}: {text}") from None
+
+    return run
+
+
 COMMANDS = {
-    "orbit": run_orbit,
-    "sweep": run_sweep,
-    "bifurcation": run_bifurcation,
-    "poincare": run_poincare,
-    "basins": run_basins,
-    "continue": run_continue,
+    name: _naming_the_file(command)
+    for name, command in {
+        "orbit": run_orbit,
+        "sweep": run_sweep,
+        "bifurcation": run_bifurcation,
+        "poincare": run_poincare,
+        "basins": run_basins,
+        "continue": run_continue,
+    }.items()
 }

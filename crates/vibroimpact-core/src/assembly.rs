@@ -888,6 +888,28 @@ pub fn initial_state(
     damper_displacement: &[f64],
     damper_velocity: &[f64],
 ) -> Result<Vec<f64>> {
+    state_from(
+        assembly,
+        [
+            structure_displacement,
+            structure_velocity,
+            damper_displacement,
+            damper_velocity,
+        ],
+        false,
+    )
+}
+
+/// A state to continue from, as a run left it: the same as
+/// [`initial_state`] but a compliant pair may be in contact (the kernel
+/// resumes the contact, its approach rate taken as the indentation rate
+/// then); a rigid pair may not be inside its wall.
+pub fn resumed_state(assembly: &Assembly, arrays: [&[f64]; 4]) -> Result<Vec<f64>> {
+    state_from(assembly, arrays, true)
+}
+
+fn state_from(assembly: &Assembly, arrays: [&[f64]; 4], resumed: bool) -> Result<Vec<f64>> {
+    let [structure_displacement, structure_velocity, damper_displacement, damper_velocity] = arrays;
     let (n, k, d) = (assembly.n, assembly.k, assembly.dim);
     let mut y = vec![0.0; assembly.state_len()];
     for (key, values, size, at) in [
@@ -909,6 +931,9 @@ pub fn initial_state(
     for i in 0..assembly.interactions.len() {
         let (gap, _) = assembly.gap(i, &y);
         let it = &assembly.interactions[i];
+        if resumed && matches!(it.law, InteractionLaw::Compliant { .. }) {
+            continue;
+        }
         // On the wall to round-off is at the wall.
         let round_off = 8.0
             * f64::EPSILON

@@ -498,6 +498,24 @@ pub fn integrate_system<S: SystemStepper>(
     let mut scratch = Scratch::new(system);
     let mut modes = vec![Mode::Open; count];
     let mut open: Vec<Option<Open>> = vec![None; count];
+    // A compliant pair that starts in contact (a run continued from another's
+    // end) resumes it, its approach rate taken as the indentation rate now.
+    for i in 0..count {
+        let (gap, rate) = system.gap(i, &y);
+        if gap < 0.0 && matches!(system.interactions[i].law, InteractionLaw::Compliant { .. }) {
+            let approach = rate.abs().max(f64::MIN_POSITIVE);
+            modes[i] = Mode::Compliant {
+                approach_rate: approach,
+            };
+            open[i] = Some(Open {
+                kind: ContactKind::Compliant,
+                onset: 0.0,
+                approach_speed: approach,
+                max_indentation: -gap,
+                dissipated: y[loss_slot(system, i)],
+            });
+        }
+    }
     let (stored_start, mut energy_scale) = system.energy_terms(&y, &modes);
     let mut impact_loss = 0.0;
     let mut contacts: Vec<PairContact> = Vec::new();

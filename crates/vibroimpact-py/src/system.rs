@@ -8,7 +8,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::assembly::{
-    initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+    initial_state, resumed_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop,
+    SystemSpec,
 };
 use vibroimpact_core::exact::ExactFlow;
 use vibroimpact_core::reductions::ReduceOptions;
@@ -487,12 +488,9 @@ impl PreparedSystem {
         if let Some(value) = strobe_period {
             check("strobe_period", value, value > 0.0, "> 0 s or None")?;
         }
-        let y0 = initial_state(
+        let y0 = resumed_state(
             system,
-            &state[..n],
-            &state[d..d + n],
-            &state[n..d],
-            &state[d + n..],
+            [&state[..n], &state[d..d + n], &state[n..d], &state[d + n..]],
         )
         .map_err(to_py)?;
         let sol = ready.run(py, &y0, t_end, (false, 1), record_from, strobe_period)?;
