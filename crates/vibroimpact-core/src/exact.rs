@@ -131,7 +131,6 @@ pub struct ExactFlow {
     phasors: Vec<(f64, f64)>,
     eta: Vec<f64>,
     rate: Vec<f64>,
-    node: Vec<f64>,
     factors: Vec<Factors>,
     next_slot: usize,
     /// The start last set: its time's bits and modes, and its state.
@@ -164,7 +163,6 @@ impl ExactFlow {
             .chain(free.configuration.harmonics.iter().map(|h| h.omega))
             .fold(0.0f64, f64::max);
         let step = std::f64::consts::TAU / (STEPS_PER_PERIOD * fastest);
-        let len = system.state_len();
         let dim = system.dim;
         Ok(Self {
             start: vec![(0.0, 0.0); dim],
@@ -172,7 +170,6 @@ impl ExactFlow {
             phasors: vec![(0.0, 1.0); parts.harmonics.len()],
             eta: vec![0.0; dim],
             rate: vec![0.0; dim],
-            node: vec![0.0; len],
             factors: vec![
                 Factors {
                     key: None,
@@ -286,9 +283,8 @@ impl ExactFlow {
         }
     }
 
-    /// The coordinates and velocities `t` after the start, into `out`;
-    /// returns the viscous and the input power there (W).
-    fn at(&mut self, index: usize, dim: usize, t: f64, out: &mut [f64]) -> (f64, f64) {
+    /// The coordinates and velocities `t` after the start, into `out`.
+    fn at(&mut self, index: usize, dim: usize, t: f64, out: &mut [f64]) {
         let slot = self.factors_at(index, t);
         let m = &self.modes[index];
         let cfg = &m.configuration;
@@ -302,7 +298,6 @@ impl ExactFlow {
             self.eta[j] = ec * d0 + es * (r0 + o.sigma * d0) + p;
             self.rate[j] = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + dp;
         }
-        let mut input = 0.0;
         for ((h, (s0, c0)), (st, ct)) in cfg.harmonics.iter().zip(&self.phasors).zip(&factors.turns)
         {
             // The angle at the start turned by omega t.
@@ -312,16 +307,7 @@ impl ExactFlow {
                 self.eta[j] += zr * c - zi * s;
                 self.rate[j] -= h.omega * (zr * s + zi * c);
             }
-            for j in 0..r {
-                let (pr, pi) = h.force[j];
-                input += (pr * c - pi * s) * self.rate[j];
-            }
         }
-        // Mass-normalised modes with classical damping: the viscous power is
-        // the sum of each mode's.
-        let viscous: f64 = (0..r)
-            .map(|j| m.oscillators[j].c * self.rate[j] * self.rate[j])
-            .sum();
         // The start plus the modes' increments: the flow is continuous at its
         // start to the last bit (a state on a wall stays on it), and a start
         // off the constraints of sticking pairs by round-off stays as close.
@@ -341,6 +327,39 @@ impl ExactFlow {
             out[dim + i] = v;
         }
         self.evaluations += 1;
+    }
+
+    /// The viscous and the input power (W) `t` after the start: the modal
+    /// rates only, without the coordinates (what the energy quadrature needs).
+    fn powers_at(&mut self, index: usize, t: f64) -> (f64, f64) {
+        let slot = self.factors_at(index, t);
+        let m = &self.modes[index];
+        let cfg = &m.configuration;
+        let r = cfg.modes;
+        let factors = &self.factors[slot];
+        for (j, o) in m.oscillators.iter().enumerate() {
+            let (d0, r0) = self.start[j];
+            let (ec, es) = factors.modes[j];
+            self.rate[j] = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + o.steady(t).1;
+        }
+        let mut input = 0.0;
+        for ((h, (s0, c0)), (st, ct)) in cfg.harmonics.iter().zip(&self.phasors).zip(&factors.turns)
+        {
+            let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
+            for j in 0..r {
+                let (zr, zi) = h.response[j];
+                self.rate[j] -= h.omega * (zr * s + zi * c);
+            }
+            for j in 0..r {
+                let (pr, pi) = h.force[j];
+                input += (pr * c - pi * s) * self.rate[j];
+            }
+        }
+        // Mass-normalised modes with classical damping: the viscous power is
+        // the sum of each mode's.
+        let viscous: f64 = (0..r)
+            .map(|j| m.oscillators[j].c * self.rate[j] * self.rate[j])
+            .sum();
         (viscous, input)
     }
 
@@ -348,15 +367,15 @@ impl ExactFlow {
     /// fixed steps and their Gauss nodes repeat a few lengths, whose
     /// exponentials, sines and cosines are kept.
     fn factors_at(&mut self, index: usize, t: f64) -> usize {
-        let key = (t.to_bits(), index);
-        if let Some(slot) = self.factors.iter().position(|f| f.key == Some(key)) {
+        let key = Some((t.to_bits(), index));
+        if let Some(slot) = self.factors.iter().position(|f| f.key == key) {
             return slot;
         }
         let slot = self.next_slot;
         self.next_slot = (self.next_slot + 1) % self.factors.len();
         let m = &self.modes[index];
         let f = &mut self.factors[slot];
-        f.key = Some(key);
+        f.key = key;
         for (out, o) in f.modes.iter_mut().zip(&m.oscillators) {
             *out = o.factors(t);
         }
@@ -410,7 +429,7 @@ impl SystemStepper for ExactFlow {
         // The accumulators are filled for the kept step only (`finish`).
         let at = 2 * dim;
         out[at..].copy_from_slice(&y[at..]);
-        let _ = self.at(index, dim, h, out);
+        self.at(index, dim, h, out);
         Ok(0.0)
     }
 
@@ -433,14 +452,12 @@ impl SystemStepper for ExactFlow {
         let at = 2 * dim;
         let index = self.select(system, modes)?;
         self.begin(index, dim, time, y);
-        let mut node = std::mem::take(&mut self.node);
         let (mut viscous, mut input) = (0.0, 0.0);
         for (x, w) in NODES.iter().zip(WEIGHTS) {
-            let (v, i) = self.at(index, dim, x * h, &mut node);
+            let (v, i) = self.powers_at(index, x * h);
             viscous += w * v;
             input += w * i;
         }
-        self.node = node;
         end[at + VISCOUS] = y[at + VISCOUS] + h * viscous;
         end[at + INPUT] = y[at + INPUT] + h * input;
         Ok(())
