@@ -154,20 +154,8 @@ class Runner:
         self, state: np.ndarray | None, t_end: float, *, record: bool, strobe: bool
     ) -> dict[str, Any]:
         if self._prepared_system is None:
-            spec, solver = self.prepared.spec, self.prepared.solver
             self._prepared_system = PreparedSystem(
-                {**spec, "gravity": spec["gravity"]["acceleration"]},
-                method=solver["method"],
-                t_end=solver["t_end"],
-                dt=solver["dt"],
-                rtol=solver["rtol"],
-                atol=solver["atol"],
-                beta=solver["beta"],
-                gamma=solver["gamma"],
-                spectral_radius=solver["spectral_radius"],
-                max_steps=solver["max_steps"],
-                max_rows=solver["max_rows"],
-                energy_tolerance=solver["energy_tolerance"],
+                self.prepared.binding_spec(), **self.prepared.method_arguments()
             )
         z = self.initial_state() if state is None else state
         if len(z) != 2 * (self.n + self.k):

@@ -91,9 +91,7 @@ def add_commands(sub: Any) -> None:
             "sampled displacements of structure coordinate 0 (m)."
         ),
     )
-    bif.add_argument("scenario", type=Path, help="scenario file (.toml) with [sweep]")
-    bif.add_argument("--json", action="store_true", help="print one JSON object")
-    bif.add_argument("--plot", type=Path, metavar="FILE.png", help="plot the diagram")
+    _outputs(bif, "scenario file (.toml) with [sweep]", "plot the diagram")
 
     sec = sub.add_parser(
         "poincare",
@@ -120,9 +118,7 @@ def add_commands(sub: Any) -> None:
             "per period, amplitude)."
         ),
     )
-    bas.add_argument("scenario", type=Path, help="scenario file (.toml) with [basins]")
-    bas.add_argument("--json", action="store_true", help="print one JSON object")
-    bas.add_argument("--plot", type=Path, metavar="FILE.png", help="plot the basins")
+    _outputs(bas, "scenario file (.toml) with [basins]", "plot the basins")
 
     cont = sub.add_parser(
         "continue",
@@ -135,9 +131,14 @@ def add_commands(sub: Any) -> None:
             "impacts per period)."
         ),
     )
-    cont.add_argument("scenario", type=Path, help="scenario file (.toml) with [continuation]")
-    cont.add_argument("--json", action="store_true", help="print one JSON object")
-    cont.add_argument("--plot", type=Path, metavar="FILE.png", help="plot the branch")
+    _outputs(cont, "scenario file (.toml) with [continuation]", "plot the branch")
+
+
+def _outputs(parser: argparse.ArgumentParser, scenario: str, plot: str) -> None:
+    """The scenario argument, --json and --plot of an analysis command."""
+    parser.add_argument("scenario", type=Path, help=scenario)
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--plot", type=Path, metavar="FILE.png", help=plot)
 
 
 def _system(path: Path) -> SystemScenario:

@@ -577,25 +577,38 @@ class PreparedRun:
     solver: dict[str, Any]
     output: dict[str, Any]
 
+    def binding_spec(self) -> dict[str, Any]:
+        """The sections as the binding takes them (gravity as a number)."""
+        return {**self.spec, "gravity": self.spec["gravity"]["acceleration"]}
+
+    def method_arguments(self) -> dict[str, Any]:
+        """The solver settings as the binding's keyword arguments."""
+        return {
+            key: self.solver[key]
+            for key in (
+                "method",
+                "t_end",
+                "dt",
+                "rtol",
+                "atol",
+                "beta",
+                "gamma",
+                "spectral_radius",
+                "max_steps",
+                "max_rows",
+                "energy_tolerance",
+            )
+        }
+
     def run(self) -> SystemSolution:
         """Integrate it."""
-        spec, init, solver, output = self.spec, self.initial, self.solver, self.output
+        init, solver, output = self.initial, self.solver, self.output
         raw = _simulate_system(
-            {**spec, "gravity": spec["gravity"]["acceleration"]},
+            self.binding_spec(),
             [init[k] for k in _INITIAL],
-            method=solver["method"],
-            t_end=solver["t_end"],
-            dt=solver["dt"],
-            rtol=solver["rtol"],
-            atol=solver["atol"],
-            beta=solver["beta"],
-            gamma=solver["gamma"],
-            spectral_radius=solver["spectral_radius"],
+            **self.method_arguments(),
             every=output["every"],
             history=output["history"],
-            max_steps=solver["max_steps"],
-            max_rows=solver["max_rows"],
-            energy_tolerance=solver["energy_tolerance"],
             record_from=output["record_from"],
             strobe_period=output["strobe_period"],
         )
