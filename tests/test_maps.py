@@ -363,15 +363,6 @@ def test_basins_separate_the_period_one_orbit_from_chattering() -> None:
     assert len(result.attractors) == 2
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        'product bug: method "exact" stops a chattering sequence of the ball on the '
-        "table with SimulationError (64 contact changes less than 4.3e-19 s apart) "
-        "from the basins example's own grid start (0.012 m, -0.08 m/s), so basins "
-        "labels it -2 (failed); dop853 sums the same sequence to sticking at 0.4552969 s"
-    ),
-)
 def test_every_start_of_the_basins_example_grid_completes() -> None:
     data = load(BASINS)
     run = an.runner(data)

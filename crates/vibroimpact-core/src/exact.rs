@@ -14,14 +14,20 @@
 //! one step (grazing). The energy accumulators (viscous loss, input work) are
 //! integrated by 5-point Gauss-Legendre over each step, on the exact flow.
 
-use crate::assembly::{Assembly, LinearParts, Mode, Scratch, INPUT, VISCOUS};
+use crate::assembly::{Assembly, InteractionLaw, LinearParts, Mode, Scratch, INPUT, VISCOUS};
+use crate::contact::AnyLaw;
 use crate::error::{Error, Result};
+use crate::matrix_flow::MatrixFlow;
 use crate::modal::Configuration;
 use crate::system_steppers::SystemStepper;
 
 /// Steps per fastest period: the event kernel's cubic check of a gap between
 /// step ends is then within a few 1e-3 of the gap's swing.
 const STEPS_PER_PERIOD: f64 = 8.0;
+
+/// The shortest step the limit of closing gaps asks for, in steps of the
+/// configuration.
+const APEX_STEPS: f64 = 64.0;
 
 /// One modal oscillator `eta'' + c eta' + w2 eta = F0 + forcing`.
 #[derive(Debug, Clone, Copy)]
@@ -92,12 +98,32 @@ impl Oscillator {
     }
 }
 
-/// The modes of one set of sticking interactions.
+/// What each interaction does in a configuration.
+const OPEN: u8 = 0;
+const STICKING: u8 = 1;
+const TOUCHING: u8 = 2;
+
+fn state_of(mode: &Mode) -> u8 {
+    match mode {
+        Mode::Open => OPEN,
+        Mode::Sticking => STICKING,
+        Mode::Compliant { .. } => TOUCHING,
+    }
+}
+
+/// The flow of one configuration (which pairs stick, which linear contacts
+/// touch): its normal modes when its damping is classical, else the matrix
+/// exponential (`matrix`, and no modes).
 #[derive(Debug, Clone)]
 struct Modes {
-    sticking: Vec<bool>,
+    key: Vec<u8>,
     configuration: Configuration,
     oscillators: Vec<Oscillator>,
+    matrix: Option<MatrixFlow>,
+    /// Whether a contact touches (its losses are the contact's, not viscous).
+    touching: bool,
+    /// An eighth of the configuration's fastest period (s).
+    step: f64,
 }
 
 /// Gauss-Legendre nodes on [0, 1] and weights (5 points, exact to degree 9).
@@ -136,6 +162,9 @@ pub struct ExactFlow {
     /// The start last set: its time's bits and modes, and its state.
     begun: Option<(u64, usize)>,
     begun_state: Vec<f64>,
+    /// A state and its rates at a Gauss node (the energy of contacts).
+    node: Vec<f64>,
+    rates: Vec<f64>,
     evaluations: u64,
 }
 
@@ -143,26 +172,25 @@ impl ExactFlow {
     /// The flow of `system`, or an error saying what it cannot take
     /// (compliant laws, signals other than harmonics, non-classical damping).
     pub fn new(system: &Assembly) -> Result<Self> {
-        if let Some(it) = system
-            .interactions
-            .iter()
-            .find(|it| !matches!(it.law, crate::assembly::InteractionLaw::Rigid { .. }))
-        {
+        if let Some(it) = system.interactions.iter().find(|it| {
+            !matches!(
+                it.law,
+                InteractionLaw::Rigid { .. }
+                    | InteractionLaw::Compliant {
+                        law: AnyLaw::Linear(_),
+                        ..
+                    }
+            )
+        }) {
             return Err(Error::Inconsistent(format!(
-                "method \"exact\" takes rigid laws only, and {} is compliant; use law = \
-                 \"rigid\" or method \"dop853\"",
+                "method \"exact\" takes rigid and linear laws only (a piecewise-linear system), \
+                 and {} is not linear; use law = \"rigid\" or \"linear\", or method \"dop853\"",
                 system.pairs[it.pair]
             )));
         }
         let parts = system.linear_parts("exact")?;
-        let free = Self::modes_of(&parts, system, &vec![false; system.interactions.len()])?;
-        let fastest = free
-            .oscillators
-            .iter()
-            .map(|o| o.w2.sqrt().max(o.c))
-            .chain(free.configuration.harmonics.iter().map(|h| h.omega))
-            .fold(0.0f64, f64::max);
-        let step = std::f64::consts::TAU / (STEPS_PER_PERIOD * fastest);
+        let free = Self::modes_of(&parts, system, &vec![OPEN; system.interactions.len()])?;
+        let step = free.step;
         let dim = system.dim;
         Ok(Self {
             start: vec![(0.0, 0.0); dim],
@@ -181,6 +209,8 @@ impl ExactFlow {
             next_slot: 0,
             begun: None,
             begun_state: vec![0.0; 2 * dim],
+            node: vec![0.0; system.state_len()],
+            rates: vec![0.0; system.state_len()],
             parts,
             modes: vec![free],
             step,
@@ -195,56 +225,101 @@ impl ExactFlow {
         self.step
     }
 
-    fn modes_of(parts: &LinearParts, system: &Assembly, sticking: &[bool]) -> Result<Modes> {
-        let constraints: Vec<(&[f64], f64)> = system
-            .interactions
-            .iter()
-            .zip(sticking)
-            .filter(|(_, s)| **s)
-            .map(|(it, _)| (it.h.as_slice(), it.offset))
+    fn modes_of(parts: &LinearParts, system: &Assembly, key: &[u8]) -> Result<Modes> {
+        let chosen = |state: u8| {
+            system
+                .interactions
+                .iter()
+                .zip(key)
+                .filter(move |(_, s)| **s == state)
+                .map(|(it, _)| it)
+        };
+        let constraints: Vec<(&[f64], f64)> = chosen(STICKING)
+            .map(|it| (it.h.as_slice(), it.offset))
             .collect();
-        let names: Vec<&str> = system
-            .interactions
-            .iter()
-            .zip(sticking)
-            .filter(|(_, s)| **s)
-            .map(|(it, _)| system.pairs[it.pair].as_str())
+        // A touching linear contact pushes with k delta + c delta', delta =
+        // -(h.x + offset): stiffness k h h^T and damping c h h^T on top, and
+        // the load -k offset h.
+        let mut parts = parts.clone();
+        let dim = system.dim;
+        for it in chosen(TOUCHING) {
+            if let InteractionLaw::Compliant {
+                law: AnyLaw::Linear(law),
+                damping,
+            } = it.law
+            {
+                for i in 0..dim {
+                    parts.constant[i] -= law.stiffness * it.offset * it.h[i];
+                    for j in 0..dim {
+                        parts.stiffness[i * dim + j] += law.stiffness * it.h[i] * it.h[j];
+                        parts.damping[i * dim + j] += damping * it.h[i] * it.h[j];
+                    }
+                }
+            }
+        }
+        let mut names: Vec<String> = chosen(STICKING)
+            .map(|it| format!("{} sticking", system.pairs[it.pair]))
             .collect();
+        names.extend(chosen(TOUCHING).map(|it| format!("{} in contact", system.pairs[it.pair])));
         let what = if names.is_empty() {
             "the system".to_string()
         } else {
-            format!("the system with {} sticking", names.join(" and "))
+            format!("the system with {}", names.join(" and "))
         };
-        let configuration = Configuration::new(parts, &constraints, &what)?;
-        let oscillators = (0..configuration.modes)
-            .map(|j| {
-                Oscillator::new(
-                    configuration.stiffness[j],
-                    configuration.damping[j],
-                    configuration.constant[j],
-                )
-            })
-            .collect();
-        Ok(Modes {
-            sticking: sticking.to_vec(),
-            configuration,
-            oscillators,
-        })
+        let touching = key.contains(&TOUCHING);
+        let step = |fastest: f64| std::f64::consts::TAU / (STEPS_PER_PERIOD * fastest);
+        match Configuration::classical(&parts, &constraints, &what)? {
+            Some(configuration) => {
+                let oscillators: Vec<Oscillator> = (0..configuration.modes)
+                    .map(|j| {
+                        Oscillator::new(
+                            configuration.stiffness[j],
+                            configuration.damping[j],
+                            configuration.constant[j],
+                        )
+                    })
+                    .collect();
+                let fastest = oscillators
+                    .iter()
+                    .map(|o| o.w2.sqrt().max(o.c))
+                    .chain(configuration.harmonics.iter().map(|h| h.omega))
+                    .fold(0.0f64, f64::max);
+                Ok(Modes {
+                    key: key.to_vec(),
+                    configuration,
+                    oscillators,
+                    matrix: None,
+                    touching,
+                    step: step(fastest),
+                })
+            }
+            None => {
+                let flow = MatrixFlow::new(&parts, &constraints, &what)?;
+                Ok(Modes {
+                    key: key.to_vec(),
+                    configuration: Configuration::empty(),
+                    oscillators: Vec::new(),
+                    step: step(flow.fastest),
+                    matrix: Some(flow),
+                    touching,
+                })
+            }
+        }
     }
 
     /// The modes for the sticking interactions of `modes`, made when first met.
     fn select(&mut self, system: &Assembly, modes: &[Mode]) -> Result<usize> {
         let found = self.modes.iter().position(|m| {
-            m.sticking
+            m.key
                 .iter()
                 .zip(modes)
-                .all(|(s, mode)| *s == (*mode == Mode::Sticking))
+                .all(|(s, mode)| *s == state_of(mode))
         });
         match found {
             Some(index) => Ok(index),
             None => {
-                let sticking: Vec<bool> = modes.iter().map(|m| *m == Mode::Sticking).collect();
-                let made = Self::modes_of(&self.parts, system, &sticking)?;
+                let key: Vec<u8> = modes.iter().map(state_of).collect();
+                let made = Self::modes_of(&self.parts, system, &key)?;
                 self.modes.push(made);
                 Ok(self.modes.len() - 1)
             }
@@ -259,6 +334,10 @@ impl ExactFlow {
         }
         self.begun = Some((time.to_bits(), index));
         self.begun_state.copy_from_slice(&y[..2 * dim]);
+        if let Some(flow) = self.modes[index].matrix.as_mut() {
+            flow.begin(time, y);
+            return;
+        }
         let m = &self.modes[index];
         let cfg = &m.configuration;
         for (h, p) in cfg.harmonics.iter().zip(self.phasors.iter_mut()) {
@@ -285,6 +364,11 @@ impl ExactFlow {
 
     /// The coordinates and velocities `t` after the start, into `out`.
     fn at(&mut self, index: usize, dim: usize, t: f64, out: &mut [f64]) {
+        if let Some(flow) = self.modes[index].matrix.as_mut() {
+            flow.at(&self.begun_state, t, out);
+            self.evaluations += 1;
+            return;
+        }
         let slot = self.factors_at(index, t);
         let m = &self.modes[index];
         let cfg = &m.configuration;
@@ -413,6 +497,50 @@ impl SystemStepper for ExactFlow {
 
     fn reset(&mut self) {}
 
+    /// A configuration's own step (a touching contact is stiffer than the
+    /// free system, so its steps are shorter), and not much longer than the
+    /// time in which any open gap under a closing acceleration would reach its
+    /// wall: a small rebound that comes back within one step could rise, dip
+    /// through the wall and rise again between the step's ends, where the
+    /// kernel's check of the ends and their slopes cannot see it.
+    fn step_limit(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) -> Result<f64> {
+        let index = self.select(system, modes)?;
+        let step = self.modes[index].step;
+        let mut limit = step;
+        let d = system.dim;
+        let mut rates = std::mem::take(&mut self.rates);
+        let mut evaluated = false;
+        for (i, mode) in modes.iter().enumerate() {
+            if *mode != Mode::Open {
+                continue;
+            }
+            if !evaluated {
+                system.rates(time, y, modes, scratch, &mut rates);
+                evaluated = true;
+            }
+            let (gap, rate) = system.gap(i, y);
+            let closing = -crate::linalg::dot(&system.interactions[i].h, &rates[d..2 * d]);
+            if closing > 0.0 {
+                // The gap's parabola reaches the wall at `hit`: end the step a
+                // little after it, so that the step's end sees the gap shut
+                // even if the wall would draw away again later in the step.
+                // Rebounds that come back sooner than the floor come back
+                // within the next few steps, where their ends see them.
+                let hit = (rate + (rate * rate + 2.0 * closing * gap.max(0.0)).sqrt()) / closing;
+                limit = limit.min((1.5 * hit).max(step / APEX_STEPS));
+            }
+        }
+        self.rates = rates;
+        Ok(limit)
+    }
+
     fn attempt(
         &mut self,
         system: &Assembly,
@@ -442,15 +570,32 @@ impl SystemStepper for ExactFlow {
         y: &[f64],
         h: f64,
         modes: &[Mode],
-        _scratch: &mut Scratch,
+        scratch: &mut Scratch,
         end: &mut [f64],
     ) -> Result<()> {
-        if !system.has_powers() {
-            return Ok(());
-        }
         let dim = system.dim;
         let at = 2 * dim;
         let index = self.select(system, modes)?;
+        if self.modes[index].matrix.is_some() || self.modes[index].touching {
+            // Every accumulator, the contacts' losses too, from the system's
+            // own rates at the Gauss nodes of the exact flow.
+            self.begin(index, dim, time, y);
+            let mut node = std::mem::take(&mut self.node);
+            let mut rates = std::mem::take(&mut self.rates);
+            for (x, w) in NODES.iter().zip(WEIGHTS) {
+                self.at(index, dim, x * h, &mut node);
+                system.rates(time + x * h, &node, modes, scratch, &mut rates);
+                for k in at..end.len() {
+                    end[k] += w * h * rates[k];
+                }
+            }
+            self.node = node;
+            self.rates = rates;
+            return Ok(());
+        }
+        if !system.has_powers() {
+            return Ok(());
+        }
         self.begin(index, dim, time, y);
         let (mut viscous, mut input) = (0.0, 0.0);
         for (x, w) in NODES.iter().zip(WEIGHTS) {

@@ -19,6 +19,7 @@ mod hermite;
 pub mod integrators;
 pub mod linalg;
 pub mod materials;
+pub mod matrix_flow;
 pub mod modal;
 pub mod model;
 pub mod records;

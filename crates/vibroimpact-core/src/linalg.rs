@@ -214,6 +214,134 @@ pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
     }
 }
 
+/// `C = A B` for row-major `n x n` matrices.
+pub fn matmul(a: &[f64], b: &[f64], c: &mut [f64], n: usize) {
+    for i in 0..n {
+        for j in 0..n {
+            c[i * n + j] = 0.0;
+        }
+        for k in 0..n {
+            let aik = a[i * n + k];
+            if aik == 0.0 {
+                continue;
+            }
+            for j in 0..n {
+                c[i * n + j] += aik * b[k * n + j];
+            }
+        }
+    }
+}
+
+/// Solves `A X = B` for row-major `n x n` matrices in place (`b` becomes `X`)
+/// by Gaussian elimination with partial pivoting; `a` is overwritten.
+pub fn solve_matrix_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
+            .unwrap_or(col);
+        if pivot != col {
+            for c in 0..n {
+                a.swap(col * n + c, pivot * n + c);
+                b.swap(col * n + c, pivot * n + c);
+            }
+        }
+        let diagonal = a[col * n + col];
+        for row in col + 1..n {
+            let factor = a[row * n + col] / diagonal;
+            if factor == 0.0 {
+                continue;
+            }
+            for c in col..n {
+                a[row * n + c] -= factor * a[col * n + c];
+            }
+            for c in 0..n {
+                b[row * n + c] -= factor * b[col * n + c];
+            }
+        }
+    }
+    for row in (0..n).rev() {
+        let diagonal = a[row * n + row];
+        for c in 0..n {
+            let sum: f64 = (row + 1..n).map(|k| a[row * n + k] * b[k * n + c]).sum();
+            b[row * n + c] = (b[row * n + c] - sum) / diagonal;
+        }
+    }
+}
+
+/// `e^A` of a row-major `n x n` matrix by scaling and squaring with the
+/// [13/13] Pade approximant (Higham 2005): accurate to a few ulps of its norm.
+pub fn expm(a: &[f64], n: usize) -> Vec<f64> {
+    const B: [f64; 14] = [
+        64764752532480000.0,
+        32382376266240000.0,
+        7771770303897600.0,
+        1187353796428800.0,
+        129060195264000.0,
+        10559470521600.0,
+        670442572800.0,
+        33522128640.0,
+        1323241920.0,
+        40840800.0,
+        960960.0,
+        16380.0,
+        182.0,
+        1.0,
+    ];
+    const THETA_13: f64 = 5.371920351148152;
+    let norm = (0..n)
+        .map(|c| (0..n).map(|r| a[r * n + c].abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let squarings = if norm > THETA_13 {
+        (norm / THETA_13).log2().ceil() as i32
+    } else {
+        0
+    };
+    let scale = 0.5f64.powi(squarings);
+    let a: Vec<f64> = a.iter().map(|v| v * scale).collect();
+    let mut a2 = vec![0.0; n * n];
+    let mut a4 = vec![0.0; n * n];
+    let mut a6 = vec![0.0; n * n];
+    matmul(&a, &a, &mut a2, n);
+    matmul(&a2, &a2, &mut a4, n);
+    matmul(&a4, &a2, &mut a6, n);
+    let combine = |w: [f64; 4], out: &mut [f64]| {
+        for p in 0..n * n {
+            out[p] = w[0] * a6[p] + w[1] * a4[p] + w[2] * a2[p];
+        }
+        for i in 0..n {
+            out[i * n + i] += w[3];
+        }
+    };
+    // U = A [A6 (b13 A6 + b11 A4 + b9 A2) + b7 A6 + b5 A4 + b3 A2 + b1 I]
+    let mut inner = vec![0.0; n * n];
+    let mut tmp = vec![0.0; n * n];
+    combine([B[13], B[11], B[9], 0.0], &mut inner);
+    matmul(&a6, &inner, &mut tmp, n);
+    combine([B[7], B[5], B[3], B[1]], &mut inner);
+    for p in 0..n * n {
+        inner[p] += tmp[p];
+    }
+    let mut u = vec![0.0; n * n];
+    matmul(&a, &inner, &mut u, n);
+    // V = A6 (b12 A6 + b10 A4 + b8 A2) + b6 A6 + b4 A4 + b2 A2 + b0 I
+    combine([B[12], B[10], B[8], 0.0], &mut inner);
+    let mut v = vec![0.0; n * n];
+    matmul(&a6, &inner, &mut v, n);
+    combine([B[6], B[4], B[2], B[0]], &mut inner);
+    for p in 0..n * n {
+        v[p] += inner[p];
+    }
+    // (V - U) R = V + U.
+    let mut lhs: Vec<f64> = v.iter().zip(&u).map(|(v, u)| v - u).collect();
+    let mut r: Vec<f64> = v.iter().zip(&u).map(|(v, u)| v + u).collect();
+    solve_matrix_in_place(&mut lhs, &mut r, n);
+    for _ in 0..squarings {
+        matmul(&r, &r, &mut tmp, n);
+        std::mem::swap(&mut r, &mut tmp);
+    }
+    r
+}
+
 /// `x^T A x` for a symmetric row-major matrix.
 pub fn quadratic_form(a: &[f64], x: &[f64]) -> f64 {
     let n = x.len();
@@ -260,6 +388,18 @@ mod tests {
                     let expected = if i == j { 1.0 } else { 0.0 };
                     assert!((p - expected).abs() < 1e-13);
                 }
+            }
+            // e^A of a rotation generator and of a Jordan block, in closed form.
+            let (w, t) = (3.0, 2.5);
+            let e = expm(&[0.0, w * t, -w * t, 0.0], 2);
+            let (s, c) = (w * t).sin_cos();
+            for (got, want) in e.iter().zip([c, s, -s, c]) {
+                assert!((got - want).abs() < 1e-14, "{e:?}");
+            }
+            let e = expm(&[-2.0 * t, t, 0.0, -2.0 * t], 2);
+            let d = (-2.0 * t).exp();
+            for (got, want) in e.iter().zip([d, t * d, 0.0, d]) {
+                assert!((got - want).abs() < 1e-15, "{e:?}");
             }
             // Singular (a free-free chain) and indefinite matrices have no factor.
             assert!(cholesky(&[1.0, -1.0, -1.0, 1.0], 2).is_none());

@@ -46,63 +46,42 @@ pub struct Configuration {
 }
 
 impl Configuration {
+    /// No modes (a configuration integrated otherwise).
+    pub fn empty() -> Self {
+        Self {
+            modes: 0,
+            origin: Vec::new(),
+            to_coordinates: Vec::new(),
+            to_modal: Vec::new(),
+            stiffness: Vec::new(),
+            damping: Vec::new(),
+            constant: Vec::new(),
+            harmonics: Vec::new(),
+        }
+    }
+
     /// The modes of `parts` under `constraints` (`(h, offset)` pairs over all
     /// coordinates). `what` names the configuration in errors.
     pub fn new(parts: &LinearParts, constraints: &[(&[f64], f64)], what: &str) -> Result<Self> {
+        Self::classical(parts, constraints, what)?.ok_or_else(|| {
+            Error::Inconsistent(format!(
+                "method \"exact\" needs classical damping (C diagonal in the normal modes), \
+                 and {what} couples modes through damping; use \"dop853\""
+            ))
+        })
+    }
+
+    /// [`Configuration::new`], or None when the damping is not classical.
+    pub fn classical(
+        parts: &LinearParts,
+        constraints: &[(&[f64], f64)],
+        what: &str,
+    ) -> Result<Option<Self>> {
         let dim = parts.constant.len();
-        let (rows, null) = split_space(constraints.iter().map(|c| c.0), dim);
-        let r = null.len();
-        // The least-norm point: x_p = U c with (H U) c = -offset over the
-        // orthonormal row basis U.
-        let mut origin = vec![0.0; dim];
-        if !rows.is_empty() {
-            let s = rows.len();
-            let m = constraints.len();
-            // Least squares (H U)^T (H U) c = -(H U)^T offset, consistent for
-            // dependent constraints on the same point.
-            let mut hu = vec![0.0; m * s];
-            for (i, (h, _)) in constraints.iter().enumerate() {
-                for (j, u) in rows.iter().enumerate() {
-                    hu[i * s + j] = linalg::dot(h, u);
-                }
-            }
-            let mut normal = vec![0.0; s * s];
-            let mut rhs = vec![0.0; s];
-            for a in 0..s {
-                for b in 0..s {
-                    normal[a * s + b] = (0..m).map(|i| hu[i * s + a] * hu[i * s + b]).sum();
-                }
-                rhs[a] = -(0..m)
-                    .map(|i| hu[i * s + a] * constraints[i].1)
-                    .sum::<f64>();
-            }
-            linalg::solve_in_place(&mut normal, &mut rhs, s);
-            for (u, c) in rows.iter().zip(&rhs) {
-                for (o, u) in origin.iter_mut().zip(u) {
-                    *o += c * u;
-                }
-            }
-        }
-        let reduce = |a: &[f64]| {
-            let mut out = vec![0.0; r * r];
-            for p in 0..r {
-                for q in 0..r {
-                    let mut sum = 0.0;
-                    for i in 0..dim {
-                        let row: f64 = (0..dim).map(|j| a[i * dim + j] * null[q][j]).sum();
-                        sum += null[p][i] * row;
-                    }
-                    out[p * r + q] = sum;
-                }
-            }
-            out
-        };
-        let (mr, kr, cr) = (
-            reduce(&parts.mass),
-            reduce(&parts.stiffness),
-            reduce(&parts.damping),
-        );
-        let l = linalg::cholesky(&mr, r).ok_or_else(|| {
+        let reduced = Reduced::new(parts, constraints);
+        let (r, null, origin) = (reduced.size, &reduced.null, &reduced.origin);
+        let (mr, kr, cr) = (&reduced.mass, &reduced.stiffness, &reduced.damping);
+        let l = linalg::cholesky(mr, r).ok_or_else(|| {
             Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
         })?;
         let linv = linalg::inverse_lower(&l, r);
@@ -122,7 +101,7 @@ impl Configuration {
             }
             out
         };
-        let a = similar(&kr);
+        let a = similar(kr);
         let (mut values, vectors) = linalg::symmetric_eigen(&a, r);
         // Columns of Phi = L^-T V.
         let mut phi = vec![0.0; r * r];
@@ -177,11 +156,7 @@ impl Configuration {
         for p in 0..r {
             for q in p + 1..r {
                 if cm[p * r + q].abs() > 1e-9 * largest {
-                    return Err(Error::Inconsistent(format!(
-                        "method \"exact\" needs classical damping (C diagonal in the normal \
-                         modes), and {what} couples modes {p} and {q} through damping; use \
-                         \"dop853\""
-                    )));
+                    return Ok(None);
                 }
             }
         }
@@ -218,7 +193,7 @@ impl Configuration {
         };
         let mut static_load = parts.constant.clone();
         for i in 0..dim {
-            static_load[i] -= linalg::dot(&parts.stiffness[i * dim..(i + 1) * dim], &origin);
+            static_load[i] -= linalg::dot(&parts.stiffness[i * dim..(i + 1) * dim], origin);
         }
         let mut constant = project(&static_load);
         let damping: Vec<f64> = (0..r).map(|i| cm[i * r + i].max(0.0)).collect();
@@ -275,16 +250,95 @@ impl Configuration {
                 }),
             }
         }
-        Ok(Self {
+        Ok(Some(Self {
             modes: r,
-            origin,
+            origin: origin.clone(),
             to_coordinates,
             to_modal,
             stiffness: values,
             damping,
             constant,
             harmonics,
-        })
+        }))
+    }
+}
+
+/// A linear system reduced to the null space of its constraints: `x = origin
+/// + N y` with `N`'s columns (`null`, orthonormal) and the reduced matrices
+/// `N^T A N` (row-major `size x size`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reduced {
+    pub size: usize,
+    pub null: Vec<Vec<f64>>,
+    pub origin: Vec<f64>,
+    pub mass: Vec<f64>,
+    pub stiffness: Vec<f64>,
+    pub damping: Vec<f64>,
+}
+
+impl Reduced {
+    pub fn new(parts: &LinearParts, constraints: &[(&[f64], f64)]) -> Self {
+        let dim = parts.constant.len();
+        let (rows, null) = split_space(constraints.iter().map(|c| c.0), dim);
+        let r = null.len();
+        // The least-norm point: x_p = U c with (H U) c = -offset over the
+        // orthonormal row basis U.
+        let mut origin = vec![0.0; dim];
+        if !rows.is_empty() {
+            let s = rows.len();
+            let m = constraints.len();
+            // Least squares (H U)^T (H U) c = -(H U)^T offset, consistent for
+            // dependent constraints on the same point.
+            let mut hu = vec![0.0; m * s];
+            for (i, (h, _)) in constraints.iter().enumerate() {
+                for (j, u) in rows.iter().enumerate() {
+                    hu[i * s + j] = linalg::dot(h, u);
+                }
+            }
+            let mut normal = vec![0.0; s * s];
+            let mut rhs = vec![0.0; s];
+            for a in 0..s {
+                for b in 0..s {
+                    normal[a * s + b] = (0..m).map(|i| hu[i * s + a] * hu[i * s + b]).sum();
+                }
+                rhs[a] = -(0..m)
+                    .map(|i| hu[i * s + a] * constraints[i].1)
+                    .sum::<f64>();
+            }
+            linalg::solve_in_place(&mut normal, &mut rhs, s);
+            for (u, c) in rows.iter().zip(&rhs) {
+                for (o, u) in origin.iter_mut().zip(u) {
+                    *o += c * u;
+                }
+            }
+        }
+        let reduce = |a: &[f64]| {
+            let mut out = vec![0.0; r * r];
+            for p in 0..r {
+                for q in 0..r {
+                    let mut sum = 0.0;
+                    for i in 0..dim {
+                        let row: f64 = (0..dim).map(|j| a[i * dim + j] * null[q][j]).sum();
+                        sum += null[p][i] * row;
+                    }
+                    out[p * r + q] = sum;
+                }
+            }
+            out
+        };
+        Self {
+            size: r,
+            mass: reduce(&parts.mass),
+            stiffness: reduce(&parts.stiffness),
+            damping: reduce(&parts.damping),
+            null,
+            origin,
+        }
+    }
+
+    /// `N^T f`.
+    pub fn project(&self, f: &[f64]) -> Vec<f64> {
+        self.null.iter().map(|n| linalg::dot(n, f)).collect()
     }
 }
 

@@ -555,7 +555,9 @@ pub fn integrate_system<S: SystemStepper>(
         let mut length = if adaptive {
             h.min(t_end - time)
         } else {
-            ((grid + 1) as f64 * dt - time).min(t_end - time)
+            ((grid + 1) as f64 * dt - time)
+                .min(t_end - time)
+                .min(stepper.step_limit(system, time, &y, &modes, &mut scratch)?)
         };
         if !adaptive && length <= 0.0 {
             grid += 1;

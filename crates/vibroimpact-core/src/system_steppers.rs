@@ -20,6 +20,19 @@ pub trait SystemStepper {
     fn is_exact(&self) -> bool {
         false
     }
+    /// The longest step the method takes from `(time, y)` in `modes` (s): a
+    /// method whose step is set by the system it integrates shortens it where
+    /// that changes.
+    fn step_limit(
+        &mut self,
+        _system: &Assembly,
+        _time: f64,
+        _y: &[f64],
+        _modes: &[Mode],
+        _scratch: &mut Scratch,
+    ) -> Result<f64> {
+        Ok(f64::INFINITY)
+    }
     /// Forget data carried from the last step (the right-hand side jumped).
     fn reset(&mut self);
     /// Attempt a step `h` from `(time, y)` into `out`; the scaled error
