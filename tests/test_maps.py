@@ -385,29 +385,12 @@ def test_every_start_of_the_basins_example_grid_completes() -> None:
     np.testing.assert_allclose(exact.contacts.onset, adaptive.contacts.onset, atol=1e-8)
 
 
-RELEASE_BUG = (
-    "product bug: a ball resting on a table whose downward acceleration exceeds g "
-    "(Gamma = 1.2) must leave it at the first such instant (0.05756 s here); {method} "
-    "keeps it stuck past it: the run to 0.09 s stops with EnergyBalanceError (a "
-    "round-off error of 1e-17 J or less, but most of the energy 'in play' of a ball that "
-    "never left), and with energy_tolerance raised its "
-    "sticking never ends (duration nan); over 20 s dop853 records 26 contacts against "
-    "exact's 2391 (the ball chatters and sticks each period)"
-)
-
-
 @pytest.mark.parametrize(
     "method",
     [
         "exact",
-        pytest.param(
-            "dop853",
-            marks=pytest.mark.xfail(strict=True, reason=RELEASE_BUG.format(method="dop853")),
-        ),
-        pytest.param(
-            "dopri5",
-            marks=pytest.mark.xfail(strict=True, reason=RELEASE_BUG.format(method="dopri5")),
-        ),
+        "dop853",
+        "dopri5",
     ],
 )
 def test_a_ball_resting_on_the_table_leaves_it_when_the_table_falls_faster_than_g(

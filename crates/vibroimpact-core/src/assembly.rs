@@ -174,6 +174,14 @@ pub struct Assembly {
     /// The structure's longest natural period (s; infinite without a
     /// spring): the time scale of the run's resolution.
     pub longest_period: f64,
+    /// The fastest time scale of the system and its excitations (s; a tenth
+    /// of the shortest natural or forcing period): how long an adaptive step
+    /// may be while a pair sticks, whose release nothing else foretells.
+    pub sticking_step: f64,
+    /// An energy (J) below which a balance residual is round-off: 1e-12 of
+    /// what the largest acceleration acting (gravity, base, force) gives the
+    /// total mass over the system's time scale.
+    pub energy_floor: f64,
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
 }
@@ -314,7 +322,37 @@ impl Assembly {
                 Load::Base => base.push(excitation.signal.clone()),
             }
         }
+        let frequencies = s.natural_frequencies();
+        let fastest_natural = frequencies.iter().fold(0.0f64, |m, w| m.max(*w));
+        let mut shortest = if fastest_natural > 0.0 {
+            std::f64::consts::TAU / fastest_natural
+        } else {
+            f64::INFINITY
+        };
+        let total_mass: f64 =
+            linalg::dot(&mass_influence, s.influence()) + damper_mass.iter().sum::<f64>();
+        let mut acceleration = gravity;
+        for excitation in &spec.excitations {
+            let (largest, period) = excitation.signal.extent();
+            shortest = shortest.min(period);
+            acceleration += match excitation.load {
+                Load::Base => largest,
+                Load::Force { .. } => largest / total_mass,
+            };
+        }
+        let longest_period = frequencies
+            .iter()
+            .find(|w| **w > 0.0)
+            .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w);
+        let time_scale = shortest.min(longest_period);
+        let energy_floor = if time_scale.is_finite() {
+            1e-12 * total_mass * (acceleration * time_scale).powi(2)
+        } else {
+            0.0
+        };
         Ok(Self {
+            sticking_step: 0.1 * shortest,
+            energy_floor,
             n,
             k,
             dim,
@@ -334,11 +372,7 @@ impl Assembly {
             forces,
             base,
             interactions,
-            longest_period: s
-                .natural_frequencies()
-                .into_iter()
-                .find(|w| *w > 0.0)
-                .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w),
+            longest_period,
             pairs,
         })
     }

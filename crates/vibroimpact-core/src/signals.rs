@@ -239,6 +239,37 @@ impl Signal {
 
     /// The signal's value at `time` (s).
     #[inline]
+    /// The largest |value| the signal takes (in its unit) and its shortest
+    /// period or sampling interval (s; infinite for a constant).
+    pub fn extent(&self) -> (f64, f64) {
+        let period = |f: f64| if f > 0.0 { 1.0 / f } else { f64::INFINITY };
+        match self {
+            Self::Harmonic(h) => (h.amplitude.abs(), period(h.frequency)),
+            Self::Harmonics(list) => (
+                list.iter().map(|h| h.amplitude.abs()).sum(),
+                list.iter()
+                    .map(|h| period(h.frequency))
+                    .fold(f64::INFINITY, f64::min),
+            ),
+            Self::Sweep {
+                amplitude,
+                start_frequency,
+                end_frequency,
+                ..
+            } => (amplitude.abs(), period(start_frequency.max(*end_frequency))),
+            Self::Recorded { time, value } => (
+                value.iter().fold(0.0, |m, v| m.max(v.abs())),
+                time.windows(2)
+                    .map(|w| 2.0 * (w[1] - w[0]))
+                    .fold(f64::INFINITY, f64::min),
+            ),
+            Self::Sampled { interval, value } => (
+                value.iter().fold(0.0, |m, v| m.max(v.abs())),
+                2.0 * interval,
+            ),
+        }
+    }
+
     pub fn value(&self, time: f64) -> f64 {
         match self {
             Self::Harmonic(h) => h.value(time),

@@ -566,6 +566,11 @@ pub fn integrate_system<S: SystemStepper>(
         if adaptive && (t_end - time - length) < 1e-3 * length {
             length = t_end - time;
         }
+        if adaptive && modes.contains(&Mode::Sticking) {
+            // A sticking pair's release shows only as its constraint force
+            // at a step's end: steps short enough not to pass over it.
+            length = length.min(system.sticking_step);
+        }
         if next_strobe - time < length && next_strobe - time > 1e-9 * options.reduce.strobe_period {
             // Land on the stroboscopic instant.
             length = next_strobe - time;
@@ -1026,6 +1031,7 @@ fn check_balance(
     // losses can pass through states where every term is near zero.
     *scale = scale
         .max(magnitude + b.input_work.abs() + b.dissipated.abs())
+        .max(system.energy_floor)
         .max(f64::MIN_POSITIVE);
     if b.residual.abs() > options.energy_tolerance * *scale || !b.residual.is_finite() {
         return Err(Error::EnergyBalance {
