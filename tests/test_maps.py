@@ -890,14 +890,6 @@ def test_bad_basins_sections_exit_2_naming_the_key(
     assert_one_line_error(run_cli("basins", str(path)), str(path), *fragments)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        'product bug: [basins] x.state = "structure_displacement.3" on a one-coordinate '
-        'system exits 2 with "FILE: structure_displacement.3: the system has 1 such '
-        'values", naming neither [basins] nor x.state'
-    ),
-)
 def test_a_basins_state_index_out_of_range_names_the_key(run_cli: RunCli, tmp_path: Path) -> None:
     path = small_basins(
         tmp_path, ('state = "structure_displacement.0"', 'state = "structure_displacement.3"')

@@ -449,7 +449,7 @@ def state_index(path: str, n: int, k: int) -> int:
         "damper_velocity": (k, d + n),
     }[name]
     if i >= size:
-        raise AnalysisError(f"{path}: the system has {size} such values")
+        raise AnalysisError(f"{path}: must index one of the system's {size} {name} values (from 0)")
     return offset + i
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from vibroimpact import analysis_plots as plots
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analyses import (
+    AnalysisError,
     orbit,
     runner,
     state_index,
@@ -364,9 +365,11 @@ def run_basins(args: argparse.Namespace) -> int:
     axes = []
     for axis in ("x", "y"):
         a = settings[axis]
-        axes.append(
-            (state_index(a["state"], run.n, run.k), np.linspace(a["start"], a["stop"], a["count"]))
-        )
+        try:
+            index = state_index(a["state"], run.n, run.k)
+        except AnalysisError as err:
+            raise AnalysisError(f"[basins] {axis}.state: {err}") from None
+        axes.append((index, np.linspace(a["start"], a["stop"], a["count"])))
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()
     result = basins(
