@@ -524,7 +524,7 @@ def simulate_system(
     (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``),
     ``"newmark-implicit"`` (``beta``, ``gamma``) or ``"generalized-alpha"``
     (``spectral_radius``), implicit with Newton's method, fixed step ``dt``; or
-    ``"exact"``: the closed-form flow of a linear structure with rigid pairs and
+    ``"exact"``: the closed-form flow of a linear structure with rigid or linear pairs and
     harmonic (or no) excitation, exact to round-off between impacts (``dt``, if
     given, caps its step of an eighth of the fastest period). Every
     event (contact onset, separation, rigid impact, release) is located to
