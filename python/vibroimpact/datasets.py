@@ -1,0 +1,629 @@
+"""The forced-response analyses' results as labelled xarray Datasets.
+
+Each function takes what an analysis of :mod:`vibroimpact.analyses`,
+:mod:`vibroimpact.maps` or :mod:`vibroimpact.continuation` returns and gives an
+:class:`xarray.Dataset` with named dimensions, coordinates and, on every variable,
+a ``long_name`` and, for a physical quantity, its SI ``units`` (UDUNITS spelling,
+as CF asks: ``"m"``, ``"m s-1"``, ``"rad"``, ``"1"`` for a dimensionless one).
+
+A sweep written as NetCDF::
+
+    import vibroimpact as vi
+    from vibroimpact.analyses import sweep
+    from vibroimpact.datasets import sweep_dataset
+
+    data = vi.load_scenario("examples/frf_impact_damper.toml").data
+    points = sweep(data, "excitation.0.frequency", [9.0, 10.0, 11.0])
+    sweep_dataset(points, "excitation.0.frequency").to_netcdf("frf.nc", engine="scipy")
+
+Every Dataset can be written as NetCDF3 by SciPy (``engine="scipy"``, no netCDF C
+library needed) and read back equal: numbers are float64 or int32; booleans are kept
+as ``bool`` and written by xarray as int8 with the attribute ``dtype = "bool"``
+(read back as ``bool``); strings are kept as ``str`` and written as fixed-width
+character arrays (read back as ``str``); complex Floquet multipliers are split
+into real and imaginary parts; lists of records that NetCDF attributes cannot hold
+(a basin's attractors) are a JSON string attribute.
+
+State vectors use the analyses' flat state ``(x, v)``: the ``n`` structure
+coordinates' then the ``k`` dampers' displacements, then the same velocities. A
+``state`` dimension names each entry (``"structure_displacement_0"``, ...,
+``"damper_velocity_0"``) and its coordinate ``state_units`` gives each entry's
+unit (``"m"`` or ``"m s-1"``); a variable along ``state`` mixes the two and so has
+no single ``units`` attribute. A cantilever's structure coordinates are modal
+amplitudes (m, the shapes being dimensionless).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from numpy.typing import NDArray
+
+from vibroimpact._core import __version__
+from vibroimpact.analyses import AnalysisError, SweepPoint
+from vibroimpact.continuation import Branch
+from vibroimpact.maps import Basins, BifurcationPoint, Section
+
+__all__ = [
+    "basins_dataset",
+    "bifurcation_dataset",
+    "branch_dataset",
+    "parameter_units",
+    "section_dataset",
+    "state_names",
+    "sweep_dataset",
+]
+
+_M = "m"
+_M_S = "m s-1"
+_ONE = "1"
+
+#: The unit of a scenario key whatever its section or law.
+_KEY_UNITS = {
+    "frequency": "Hz",
+    "start_frequency": "Hz",
+    "end_frequency": "Hz",
+    "cutoff_frequency": "Hz",
+    "ground_frequency": "Hz",
+    "frequencies": "Hz",
+    "phase": "rad",
+    "phases": "rad",
+    "duration": "s",
+    "t_end": "s",
+    "dt": "s",
+    "record_from": "s",
+    "strobe_period": "s",
+    "mass": "kg",
+    "damping": "N s m-1",
+    "clearance": _M,
+    "lower_clearance": _M,
+    "upper_clearance": _M,
+    "gap": _M,
+    "restitution": _ONE,
+    "damping_ratio": _ONE,
+    "ground_damping": _ONE,
+    "length": _M,
+    "youngs_modulus": "Pa",
+    "second_moment": "m4",
+    "mass_per_length": "kg m-1",
+    "acceleration": "m s-2",
+    "structure_displacement": _M,
+    "damper_displacement": _M,
+    "structure_velocity": _M_S,
+    "damper_velocity": _M_S,
+}
+_HERTZ_LAWS = ("hertz", "hyster-hertz", "hertz-damped")
+_CROSSINGS = ("fold", "flip", "neimark-sacker", "branch")
+_SOURCE = f"vibroimpact {__version__}"
+
+
+def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> str | None:
+    """The SI unit (UDUNITS spelling) of a scenario parameter given as a dotted path
+    (``"excitation.0.frequency"`` -> ``"Hz"``, ``"damper.0.clearance"`` -> ``"m"``),
+    or None where it cannot be told. Some keys' units depend on the scenario: an
+    excitation's ``amplitude`` (N for a force, m s-2 for a base acceleration), a
+    damper's or stop's ``stiffness`` (N m-1 for the linear law, N m-1.5 for the
+    Hertz laws), a point's ``at`` (an index, or m along a cantilever); give the
+    scenario's sections as ``data`` to resolve those."""
+    parts = parameter.split(".")
+    keys = [p for p in parts if not p.isdigit()]
+    if len(keys) < 2:
+        return None
+    section, key = keys[0], keys[1]
+    if key in _KEY_UNITS:
+        return _KEY_UNITS[key]
+    if section == "structure" and key == "stiffness":
+        return "N m-1"
+    if section == "solver" and key in ("rtol", "energy_tolerance", "beta", "gamma"):
+        return _ONE
+    if section == "solver" and key == "atol":
+        return None  # m and m s-1 alike
+    if data is None:
+        return None
+    entry = _entry(data, parts)
+    if entry is None:
+        return None
+    if key in ("amplitude", "amplitudes") and section == "excitation":
+        return {"force": "N", "base": "m s-2"}.get(str(entry.get("kind")))
+    if key == "stiffness" and section in ("damper", "stop"):
+        law = entry.get("law")
+        return "N m-1" if law == "linear" else "N m-1.5" if law in _HERTZ_LAWS else None
+    if key == "at" and section in ("damper", "stop", "excitation"):
+        structure = data.get("structure")
+        if isinstance(structure, Mapping):
+            return _M if structure.get("kind") == "cantilever" else _ONE
+    return None
+
+
+def _entry(data: Mapping[str, Any], parts: list[str]) -> Mapping[str, Any] | None:
+    """The table of a dotted path's section (the list entry, for ``[[damper]]`` etc.)."""
+    node: Any = data.get(parts[0])
+    if isinstance(node, list) and len(parts) > 1 and parts[1].isdigit():
+        index = int(parts[1])
+        node = node[index] if index < len(node) else None
+    return node if isinstance(node, Mapping) else None
+
+
+def state_names(n: int, k: int) -> list[str]:
+    """The names of the flat state's ``2 (n + k)`` entries, in order:
+    ``structure_displacement_i`` (i < n), ``damper_displacement_j`` (j < k), then
+    ``structure_velocity_i`` and ``damper_velocity_j``."""
+    return [
+        f"{name}_{i}"
+        for name, size in (
+            ("structure_displacement", n),
+            ("damper_displacement", k),
+            ("structure_velocity", n),
+            ("damper_velocity", k),
+        )
+        for i in range(size)
+    ]
+
+
+def _state_coords(size: int, n: int | None, k: int | None) -> dict[str, Any]:
+    """The ``state`` coordinate (entry names) and ``state_units`` of a flat state of
+    ``size`` entries; without ``n`` and ``k`` the names are ``displacement_i`` and
+    ``velocity_i`` (the first half of the state are displacements)."""
+    half = size // 2
+    if n is not None and k is not None:
+        names = state_names(n, k)
+    else:
+        names = [f"displacement_{i}" for i in range(half)]
+        names += [f"velocity_{i}" for i in range(half)]
+    units = [_M] * half + [_M_S] * half
+    return {
+        "state": (
+            "state",
+            np.array(names, dtype=str),
+            {"long_name": "entry of the flat state (x, v)"},
+        ),
+        "state_units": (
+            "state",
+            np.array(units, dtype=str),
+            {"long_name": "unit of the state entry"},
+        ),
+    }
+
+
+def _strings(values: Sequence[str]) -> NDArray[np.str_]:
+    """Strings as a NumPy unicode array (written as NetCDF3 characters)."""
+    return np.array(list(values), dtype=str)
+
+
+def _attrs(long_name: str, units: str | None = None, **more: Any) -> dict[str, Any]:
+    out: dict[str, Any] = {"long_name": long_name}
+    if units is not None:
+        out["units"] = units
+    out.update(more)
+    return out
+
+
+def _value_coord(
+    values: Sequence[float], parameter: str, units: str | None
+) -> tuple[str, NDArray[np.float64], dict[str, Any]]:
+    units = parameter_units(parameter) if units is None else units
+    return (
+        "point",
+        np.array(values, dtype=np.float64),
+        _attrs(parameter, units, name=parameter),
+    )
+
+
+def _count(name: str, value: int, low: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
+
+
+def sweep_dataset(
+    points: list[SweepPoint], parameter: str, *, units: str | None = None
+) -> xr.Dataset:
+    """A sweep's points (:func:`vibroimpact.analyses.sweep`) as a Dataset.
+
+    Dimensions ``point`` (in the sweep's order, up then down) and ``coordinate``
+    (the structure's coordinates, with an integer coordinate 0, 1, ...).
+    Coordinates along ``point``: ``value``, the swept parameter (attributes
+    ``name`` = ``parameter`` and its ``units``, from ``units`` or else
+    :func:`parameter_units`), and ``direction`` (``"up"`` or ``"down"``).
+    Variables: ``amplitude`` and ``rms`` (m, NaN where the point's run failed),
+    ``linear_amplitude`` (m, the structure alone), ``reduction`` (``1 - amplitude /
+    linear_amplitude``, NaN where either is not finite or the linear one is 0),
+    all ``point`` x ``coordinate``; ``impacts_per_period``, ``settled`` (bool) and
+    ``error`` (the failed run's message, ``""`` where none) along ``point``.
+    Attributes: ``parameter``."""
+    if not points:
+        raise AnalysisError("sweep_dataset: no points")
+    n = len(points[0].linear_amplitude)
+
+    def rows(name: str) -> NDArray[np.float64]:
+        out = np.array([getattr(p, name) for p in points], dtype=np.float64)
+        if out.shape != (len(points), n):
+            raise AnalysisError(f"sweep_dataset: every point's {name} must have {n} values")
+        return out
+
+    amplitude = rows("amplitude")
+    linear = rows("linear_amplitude")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reduction = 1.0 - amplitude / linear
+    reduction[~(np.isfinite(amplitude) & np.isfinite(linear) & (linear != 0))] = np.nan
+    pc = ("point", "coordinate")
+    return xr.Dataset(
+        data_vars={
+            "amplitude": (pc, amplitude, _attrs("steady amplitude (largest |displacement|)", _M)),
+            "rms": (pc, rows("rms"), _attrs("steady root mean square displacement", _M)),
+            "linear_amplitude": (
+                pc,
+                linear,
+                _attrs("steady amplitude of the structure alone (no dampers, no stops)", _M),
+            ),
+            "reduction": (
+                pc,
+                reduction,
+                _attrs("amplitude reduction, 1 - amplitude / linear_amplitude", _ONE),
+            ),
+            "impacts_per_period": (
+                "point",
+                np.array([p.impacts_per_period for p in points], dtype=np.float64),
+                _attrs("impacts per forcing period", _ONE),
+            ),
+            "settled": (
+                "point",
+                np.array([p.settled for p in points], dtype=bool),
+                _attrs("whether the stroboscopic state repeated (a periodic steady state)"),
+            ),
+            "error": (
+                "point",
+                _strings([p.error or "" for p in points]),
+                _attrs('why the point\'s run failed ("" where it did not)'),
+            ),
+        },
+        coords={
+            "value": _value_coord([p.value for p in points], parameter, units),
+            "direction": (
+                "point",
+                _strings([p.direction for p in points]),
+                _attrs("direction of the sweep's leg"),
+            ),
+            "coordinate": (
+                "coordinate",
+                np.arange(n, dtype=np.int32),
+                _attrs("structure coordinate (index)"),
+            ),
+        },
+        attrs={"parameter": parameter, "source": _SOURCE},
+    )
+
+
+def bifurcation_dataset(
+    points: list[BifurcationPoint],
+    parameter: str,
+    *,
+    n: int | None = None,
+    k: int | None = None,
+    units: str | None = None,
+) -> xr.Dataset:
+    """A bifurcation diagram (:func:`vibroimpact.maps.bifurcation`) as a Dataset.
+
+    Dimensions ``point``, ``sample`` (the stroboscopic samples, with the coordinate
+    ``sample`` = forcing periods after settling: 1, 2, ...) and ``state`` (the flat
+    state's entries, named by the coordinate ``state``, with ``state_units``; the
+    names are those of :func:`state_names` when the structure's ``n`` coordinates
+    and ``k`` dampers are given, ``displacement_i`` and ``velocity_i`` otherwise).
+    Coordinates along ``point``: ``value`` (attributes ``name`` = ``parameter``,
+    ``units``) and ``direction``. Variables: ``strobe`` (``point`` x ``sample`` x
+    ``state``, NaN-padded past a point's own samples and where its run failed),
+    ``sample_count`` (each point's samples, 0 where its run failed) and ``error``
+    (``""`` where none). Attributes: ``parameter``."""
+    if not points:
+        raise AnalysisError("bifurcation_dataset: no points")
+    if (n is None) != (k is None):
+        raise AnalysisError("bifurcation_dataset: give both n and k, or neither")
+    if n is not None and k is not None:
+        _count("n", n, 0)
+        _count("k", k, 0)
+        width = 2 * (n + k)
+    else:
+        width = max((p.strobe.shape[1] for p in points if p.strobe.size), default=0)
+    good = [p.strobe for p in points if p.strobe.size]
+    for strobe in good:
+        if strobe.ndim != 2 or strobe.shape[1] != width:
+            raise AnalysisError(
+                f"bifurcation_dataset: every strobe must have {width} columns (the flat "
+                f"state), got shape {strobe.shape}"
+            )
+    samples = max((len(s) for s in good), default=0)
+    samples = max(samples, 1)  # a zero-length dimension is NetCDF3's unlimited one
+    strobe = np.full((len(points), samples, width), np.nan)
+    counts = np.zeros(len(points), dtype=np.int32)
+    for i, p in enumerate(points):
+        if p.strobe.size:
+            strobe[i, : len(p.strobe)] = p.strobe
+            counts[i] = len(p.strobe)
+    return xr.Dataset(
+        data_vars={
+            "strobe": (
+                ("point", "sample", "state"),
+                strobe,
+                _attrs(
+                    "stroboscopic state (each entry's unit: state_units)",
+                    comment="NaN past a point's samples and where its run failed",
+                ),
+            ),
+            "sample_count": ("point", counts, _attrs("stroboscopic samples of the point", _ONE)),
+            "error": (
+                "point",
+                _strings([p.error or "" for p in points]),
+                _attrs('why the point\'s run failed ("" where it did not)'),
+            ),
+        },
+        coords={
+            "value": _value_coord([p.value for p in points], parameter, units),
+            "direction": (
+                "point",
+                _strings([p.direction for p in points]),
+                _attrs("direction of the leg"),
+            ),
+            "sample": (
+                "sample",
+                np.arange(1, samples + 1, dtype=np.int32),
+                _attrs("forcing periods after settling", _ONE),
+            ),
+            **_state_coords(width, n, k),
+        },
+        attrs={"parameter": parameter, "source": _SOURCE},
+    )
+
+
+def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
+    """A Poincare section (:func:`vibroimpact.maps.poincare`) of a system of ``n``
+    structure coordinates and ``k`` dampers as a Dataset.
+
+    Dimensions ``sample`` (coordinate: forcing periods after settling, 1, 2, ...)
+    and ``state`` (coordinates ``state``, named as by :func:`state_names`, and
+    ``state_units``) for the stroboscopic section ``strobe``; ``impact`` for the
+    impact section: ``impact_phase`` (rad, in [0, 2 pi) of the forcing period),
+    ``impact_speed`` (m s-1, the approach speed) and ``impact_pair`` (the pair's
+    name, such as ``"damper 0"``). Attributes: ``structure_coordinates`` (n) and
+    ``dampers`` (k). With no impact the ``impact`` dimension has length 0 (NetCDF3
+    writes it as its unlimited dimension)."""
+    _count("n", n, 0)
+    _count("k", k, 0)
+    width = 2 * (n + k)
+    strobe = np.asarray(section.strobe, dtype=np.float64)
+    if strobe.ndim != 2 or strobe.shape[1] != width:
+        raise AnalysisError(
+            f"section_dataset: the strobe must have {width} columns (2 (n + k)), got shape "
+            f"{strobe.shape}"
+        )
+    size = len(section.impact_phase)
+    if len(section.impact_speed) != size or len(section.impact_pair) != size:
+        raise AnalysisError("section_dataset: impact_phase, impact_speed, impact_pair differ")
+    return xr.Dataset(
+        data_vars={
+            "strobe": (
+                ("sample", "state"),
+                strobe,
+                _attrs("stroboscopic state (each entry's unit: state_units)"),
+            ),
+            "impact_phase": (
+                "impact",
+                np.asarray(section.impact_phase, dtype=np.float64),
+                _attrs("phase of the impact in the forcing period", "rad"),
+            ),
+            "impact_speed": (
+                "impact",
+                np.asarray(section.impact_speed, dtype=np.float64),
+                _attrs("approach speed of the impact", _M_S),
+            ),
+            "impact_pair": (
+                "impact",
+                _strings(section.impact_pair),
+                _attrs("pair that impacts"),
+            ),
+        },
+        coords={
+            "sample": (
+                "sample",
+                np.arange(1, len(strobe) + 1, dtype=np.int32),
+                _attrs("forcing periods after settling", _ONE),
+            ),
+            **_state_coords(width, n, k),
+        },
+        attrs={"structure_coordinates": n, "dampers": k, "source": _SOURCE},
+    )
+
+
+_LABELS = (
+    "0, 1, ...: index into the attractors (attribute attractors, JSON: each one's period "
+    "in forcing periods, impacts_per_period and amplitude in m per structure coordinate); "
+    "-1: the run did not settle; -2: the run failed; -3: the start is not admissible "
+    "(a pair inside its wall)"
+)
+
+
+def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
+    """Basins of attraction (:func:`vibroimpact.maps.basins`) as a Dataset.
+
+    Dimensions ``x`` and ``y``, with coordinates the two initial values varied
+    (``result.first`` and ``result.second``), each with the attribute ``name``
+    (``x_name``, ``y_name``: the state entry, such as
+    ``"structure_displacement.0"``) and its ``units`` (m or m s-1, told from the
+    name). Variable ``label`` (``x`` x ``y``, int32): the attractor reached from
+    each start, an index into the attractors; -1 where the run did not settle, -2
+    where it failed, -3 where the start is not admissible; its attributes
+    ``flag_values`` and ``flag_meanings`` name the negative ones (CF). Attributes:
+    ``attractors`` (a JSON list of ``{period, impacts_per_period, amplitude}``:
+    NetCDF attributes cannot hold a list of records), ``label_meanings`` (the
+    labels in words), ``x_name``, ``y_name``."""
+    first = np.asarray(result.first, dtype=np.float64)
+    second = np.asarray(result.second, dtype=np.float64)
+    labels = np.asarray(result.labels)
+    if labels.shape != (len(first), len(second)):
+        raise AnalysisError(
+            f"basins_dataset: labels must have shape {(len(first), len(second))}, got "
+            f"{labels.shape}"
+        )
+    attractors = json.dumps([_json_safe(a) for a in result.attractors])
+    return xr.Dataset(
+        data_vars={
+            "label": (
+                ("x", "y"),
+                labels.astype(np.int32),
+                _attrs(
+                    "attractor reached",
+                    flag_values=np.array([-3, -2, -1], dtype=np.int32),
+                    flag_meanings="inadmissible_start run_failed not_settled",
+                    comment=_LABELS,
+                ),
+            ),
+        },
+        coords={
+            "x": ("x", first, _attrs(x_name, _state_unit(x_name), name=x_name)),
+            "y": ("y", second, _attrs(y_name, _state_unit(y_name), name=y_name)),
+        },
+        attrs={
+            "attractors": attractors,
+            "label_meanings": _LABELS,
+            "x_name": x_name,
+            "y_name": y_name,
+            "source": _SOURCE,
+        },
+    )
+
+
+def _state_unit(name: str) -> str | None:
+    """m or m s-1 for a state entry's name (``"structure_velocity.0"`` etc.)."""
+    if "velocity" in name:
+        return _M_S
+    if "displacement" in name:
+        return _M
+    return None
+
+
+def _json_safe(value: Any) -> Any:
+    """A value JSON can write: NumPy numbers as Python ones, non-finite floats as None."""
+    if isinstance(value, Mapping):
+        return {str(key): _json_safe(v) for key, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:
+    """A continued branch (:func:`vibroimpact.continuation.continue_orbit`) as a
+    Dataset.
+
+    Dimensions ``point`` (along the branch), ``state`` (coordinates ``state``, as
+    :func:`state_names` of the branch's ``n`` and ``k``, and ``state_units``),
+    ``multiplier`` (the Floquet multipliers, 2 (n + k), in the order of the
+    eigenvalue solver: not tracked from point to point), ``coordinate`` (the
+    structure's) and ``bifurcation`` (``"fold"``, ``"flip"``, ``"neimark-sacker"``,
+    ``"branch"``). Coordinate ``value`` along ``point`` (attributes ``name`` = the
+    parameter and ``units``, from ``units`` or else :func:`parameter_units`).
+    Variables: ``orbit_state`` (``point`` x ``state``: the state on the orbit at
+    t = 0; named so since a variable cannot share the name of the ``state``
+    dimension), ``multiplier_real`` and ``multiplier_imag`` (``point`` x
+    ``multiplier``, 1), ``stable`` (bool), ``impacts_per_period``, ``amplitude``
+    (``point`` x ``coordinate``, m), ``flags`` (the bifurcations flagged between
+    the previous point and this one, comma-joined, ``""`` where none) and
+    ``crossing`` (``point`` x ``bifurcation``: the parameter's value where the
+    flagged bifurcation lies, NaN where not flagged). Attributes: ``parameter``,
+    ``periods`` (K), ``stopped`` (why the continuation stopped),
+    ``structure_coordinates`` (n), ``dampers`` (k)."""
+    points = branch.points
+    if not points:
+        raise AnalysisError("branch_dataset: no points")
+    width = 2 * (branch.n + branch.k)
+    state = np.array([p.state for p in points], dtype=np.float64)
+    multipliers = np.array([p.floquet_multipliers for p in points], dtype=np.complex128)
+    amplitude = np.array([p.amplitude for p in points], dtype=np.float64)
+    if state.shape != (len(points), width) or multipliers.shape != (len(points), width):
+        raise AnalysisError(
+            f"branch_dataset: every point's state and multipliers must have {width} values"
+        )
+    if amplitude.ndim != 2 or amplitude.shape[1] != branch.n:
+        raise AnalysisError(f"branch_dataset: every point's amplitude must have {branch.n} values")
+    kinds = list(_CROSSINGS)
+    for p in points:
+        kinds += [name for name in p.crossings if name not in kinds]
+    crossing = np.full((len(points), len(kinds)), np.nan)
+    for i, p in enumerate(points):
+        for name, value in p.crossings.items():
+            crossing[i, kinds.index(name)] = value
+    parameter_unit = parameter_units(branch.parameter) if units is None else units
+    pm = ("point", "multiplier")
+    return xr.Dataset(
+        data_vars={
+            "orbit_state": (
+                ("point", "state"),
+                state,
+                _attrs("state on the orbit at t = 0 (each entry's unit: state_units)"),
+            ),
+            "multiplier_real": (
+                pm,
+                multipliers.real.copy(),
+                _attrs("Floquet multiplier, real part", _ONE),
+            ),
+            "multiplier_imag": (
+                pm,
+                multipliers.imag.copy(),
+                _attrs("Floquet multiplier, imaginary part", _ONE),
+            ),
+            "stable": (
+                "point",
+                np.array([p.stable for p in points], dtype=bool),
+                _attrs("whether every Floquet multiplier lies inside the unit circle"),
+            ),
+            "impacts_per_period": (
+                "point",
+                np.array([p.impacts_per_period for p in points], dtype=np.float64),
+                _attrs("impacts per forcing period", _ONE),
+            ),
+            "amplitude": (
+                ("point", "coordinate"),
+                amplitude,
+                _attrs("amplitude on the orbit (largest |displacement|)", _M),
+            ),
+            "flags": (
+                "point",
+                _strings([",".join(p.flags) for p in points]),
+                _attrs("bifurcations flagged since the previous point (comma-separated)"),
+            ),
+            "crossing": (
+                ("point", "bifurcation"),
+                crossing,
+                _attrs(
+                    f"{branch.parameter} where the flagged bifurcation lies",
+                    parameter_unit,
+                ),
+            ),
+        },
+        coords={
+            "value": _value_coord([p.value for p in points], branch.parameter, units),
+            "coordinate": (
+                "coordinate",
+                np.arange(branch.n, dtype=np.int32),
+                _attrs("structure coordinate (index)"),
+            ),
+            "bifurcation": ("bifurcation", _strings(kinds), _attrs("kind of bifurcation")),
+            **_state_coords(width, branch.n, branch.k),
+        },
+        attrs={
+            "parameter": branch.parameter,
+            "periods": branch.periods,
+            "stopped": branch.stopped,
+            "structure_coordinates": branch.n,
+            "dampers": branch.k,
+            "source": _SOURCE,
+        },
+    )
