@@ -14,6 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 import vibroimpact as vi
@@ -107,6 +108,22 @@ def _prepared_system(**kwargs: Any) -> Any:
     return _core.PreparedSystem(SPEC, method="rk4", max_steps=10**6, max_rows=10**6, **kwargs)
 
 
+def _run_study(**kwargs: Any) -> Any:
+    return _core.run_study(
+        SPEC,
+        [[0.01], [], [], []],
+        paths=["initial.structure_velocity.0"],
+        values=np.array([0.0, 0.1]),
+        method="rk4",
+        max_steps=10**6,
+        analysis="run",
+        settle_periods=1,
+        record_periods=1,
+        threads=1,
+        **kwargs,
+    )
+
+
 def _prepared_run(**kwargs: Any) -> Any:
     return _prepared_system(**PREPARED).run([0.01, 0.0], **kwargs)
 
@@ -161,6 +178,21 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
     "PreparedSystem.run": (
         _prepared_run,
         {"t_end": 1e-2, "record_from": 0.0, "strobe_period": 5e-3},
+    ),
+    "run_study": (
+        _run_study,
+        {
+            "t_end": 1e-2,
+            "dt": 1e-3,
+            "rtol": 1e-8,
+            "atol": 1e-12,
+            "beta": 0.25,
+            "gamma": 0.5,
+            "spectral_radius": 0.9,
+            "energy_tolerance": 1e-2,
+            "record_from": 0.0,
+            "tolerance": 1e-6,
+        },
     ),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (

@@ -46,6 +46,7 @@ from vibroimpact._core import (
     goldsmith_max_indentation,
     hertz_stiffness,
     linear_contact_duration,
+    run_study,
     simulate,
 )
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
@@ -70,6 +71,7 @@ def _equality_only(*classes: type) -> None:
 _equality_only(ImpactDamper, Contact, InitialState)
 
 __all__ = [
+    "run_study",
     "linear_parts",
     "PreparedSystem",
     "DEFAULT_ENERGY_TOLERANCE",

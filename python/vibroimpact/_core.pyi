@@ -33,6 +33,7 @@ __all__ = [
     "simulate_system",
     "linear_parts",
     "PreparedSystem",
+    "run_study",
 ]
 
 __version__: str
@@ -217,6 +218,29 @@ def simulate_system(
     strobe_period: float | None = None,
 ) -> dict[str, Any]: ...
 def linear_parts(spec: dict[str, Any]) -> dict[str, Any]: ...
+def run_study(
+    spec: dict[str, Any],
+    initial: list[list[float]],
+    *,
+    paths: list[str],
+    values: npt.NDArray[np.float64],
+    method: str,
+    dt: float | None,
+    rtol: float,
+    atol: float,
+    beta: float,
+    gamma: float,
+    spectral_radius: float,
+    max_steps: int,
+    energy_tolerance: float,
+    analysis: str,
+    t_end: float,
+    record_from: float,
+    settle_periods: int,
+    record_periods: int,
+    tolerance: float,
+    threads: int,
+) -> dict[str, Any]: ...
 
 @final
 class PreparedSystem:

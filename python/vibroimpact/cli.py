@@ -32,6 +32,8 @@ from vibroimpact.analysis_commands import COMMANDS, add_commands
 from vibroimpact.output import UsageError, finite_or_none, written_whole
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
+from vibroimpact.study_commands import add_command as add_study
+from vibroimpact.study_commands import run_study_command
 from vibroimpact.system_scenario import (
     SystemScenario,
     system_lines,
@@ -127,6 +129,7 @@ def _parser() -> argparse.ArgumentParser:
         "contact still open at the end of the run is null",
     )
     add_commands(sub)
+    add_study(sub)
     return parser
 
 
@@ -263,6 +266,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return run_paper(args.out)
         if args.command in COMMANDS:
             return COMMANDS[args.command](args)
+        if args.command == "study":
+            return run_study_command(args)
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
         print(f"vibroimpact: error: {err}", file=sys.stderr)

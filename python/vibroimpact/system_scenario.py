@@ -31,6 +31,7 @@ SECTIONS = (
     "sweep",
     "continuation",
     "basins",
+    "study",
 )
 
 
@@ -83,8 +84,9 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
         raise InvalidInputError(f"{source}: {err}") from None
     data = dict(data)
     from vibroimpact.analyses import SETTINGS
+    from vibroimpact.study import study_settings
 
-    for section, check in SETTINGS.items():
+    for section, check in {**SETTINGS, "study": study_settings}.items():
         if section in data:
             try:
                 data[section] = check(data[section])

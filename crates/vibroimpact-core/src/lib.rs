@@ -29,6 +29,7 @@ pub mod settings;
 pub mod signals;
 pub mod steppers;
 pub mod structure;
+pub mod study;
 pub mod system;
 pub mod system_events;
 pub mod system_steppers;

@@ -38,6 +38,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system::simulate_system, m)?)?;
     m.add_function(wrap_pyfunction!(system::linear_parts, m)?)?;
     m.add_class::<system::PreparedSystem>()?;
+    m.add_function(wrap_pyfunction!(system::run_study, m)?)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_mode, m)?)?;

@@ -655,3 +655,147 @@ pub fn linear_parts<'py>(
     out.set_item("harmonics", harmonics)?;
     Ok(out)
 }
+
+/// Run a chunk of a study (see `vibroimpact.study`): each row of `values`
+/// (`len(paths)` values a row, flat) sets the parameters at `paths` in a
+/// copy of the system and runs it, on `threads` threads (0: all cores), with
+/// the GIL released. Returns the metrics as flat arrays, one row a run.
+#[pyfunction]
+#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_study<'py>(
+    py: Python<'py>,
+    spec: &Bound<'py, PyDict>,
+    initial: [Vec<f64>; 4],
+    paths: Vec<String>,
+    values: numpy::PyReadonlyArray1<'py, f64>,
+    method: String,
+    #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::real)] rtol: f64,
+    #[pyo3(from_py_with = crate::convert::real)] atol: f64,
+    #[pyo3(from_py_with = crate::convert::real)] beta: f64,
+    #[pyo3(from_py_with = crate::convert::real)] gamma: f64,
+    #[pyo3(from_py_with = crate::convert::real)] spectral_radius: f64,
+    max_steps: u64,
+    #[pyo3(from_py_with = crate::convert::real)] energy_tolerance: f64,
+    analysis: &str,
+    #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
+    #[pyo3(from_py_with = crate::convert::real)] record_from: f64,
+    settle_periods: u64,
+    record_periods: u64,
+    #[pyo3(from_py_with = crate::convert::real)] tolerance: f64,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    use core::study::{run_study as study, Analysis, Parameter, StudySettings};
+    for (field, value, ok, allowed) in [
+        ("t_end", t_end, t_end > 0.0, "> 0 s"),
+        (
+            "dt",
+            dt.unwrap_or(1.0),
+            dt.unwrap_or(1.0) > 0.0,
+            "> 0 s or None",
+        ),
+        ("rtol", rtol, rtol > 0.0, "> 0"),
+        ("atol", atol, atol > 0.0, "> 0"),
+        ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
+        ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
+        (
+            "spectral_radius",
+            spectral_radius,
+            (0.0..=1.0).contains(&spectral_radius),
+            "in [0, 1]",
+        ),
+        (
+            "energy_tolerance",
+            energy_tolerance,
+            energy_tolerance > 0.0,
+            "> 0",
+        ),
+        ("record_from", record_from, record_from >= 0.0, ">= 0 s"),
+        ("tolerance", tolerance, tolerance > 0.0, "> 0"),
+    ] {
+        check(field, value, ok, allowed)?;
+    }
+    let system_spec = system_spec(spec, t_end)?;
+    // The base system and start must be valid on their own.
+    let base = Assembly::new(&system_spec).map_err(to_py)?;
+    initial_state(&base, &initial[0], &initial[1], &initial[2], &initial[3]).map_err(to_py)?;
+    let parameters = paths
+        .iter()
+        .map(|p| Parameter::parse(p, &system_spec))
+        .collect::<core::Result<Vec<_>>>()
+        .map_err(to_py)?;
+    let values = values.as_slice()?.to_vec();
+    if !parameters.is_empty() && values.len() % parameters.len() != 0 {
+        return Err(InvalidInputError::new_err(format!(
+            "values must hold {} values a run, got {} in all",
+            parameters.len(),
+            values.len()
+        )));
+    }
+    let analysis = match analysis {
+        "run" => Analysis::Run { t_end, record_from },
+        "steady-state" => Analysis::SteadyState {
+            settle: settle_periods,
+            record: record_periods.max(1),
+            tolerance,
+        },
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "analysis must be \"run\" or \"steady-state\", got {other:?}"
+            )))
+        }
+    };
+    let settings = StudySettings {
+        method,
+        dt,
+        rtol,
+        atol,
+        beta,
+        gamma,
+        spectral_radius,
+        max_steps,
+        energy_tolerance,
+        analysis,
+    };
+    let results = released(py, |_| {
+        study(
+            &system_spec,
+            &initial,
+            &parameters,
+            &values,
+            &settings,
+            threads,
+            &|| false,
+        )
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("n", base.n)?;
+    out.set_item("pairs", base.pairs.clone())?;
+    out.set_item(
+        "status",
+        results
+            .iter()
+            .map(|r| r.status)
+            .collect::<Vec<u8>>()
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "reason",
+        results.iter().map(|r| r.reason.clone()).collect::<Vec<_>>(),
+    )?;
+    let flat = |f: &dyn Fn(&core::study::RunMetrics) -> Vec<f64>| {
+        results
+            .iter()
+            .flat_map(f)
+            .collect::<Vec<f64>>()
+            .into_pyarray(py)
+    };
+    out.set_item("peak", flat(&|r| r.peak.clone()))?;
+    out.set_item("rms", flat(&|r| r.rms.clone()))?;
+    out.set_item("impacts", flat(&|r| vec![r.impacts]))?;
+    out.set_item("energy_dissipated", flat(&|r| r.energy_dissipated.clone()))?;
+    out.set_item("impacts_per_period", flat(&|r| vec![r.impacts_per_period]))?;
+    out.set_item("settled", flat(&|r| vec![r.settled]))?;
+    Ok(out)
+}

@@ -1,0 +1,538 @@
+//! Studies: many runs of one system with some of its parameters varied, on
+//! every core (rayon), each reduced to a few metrics instead of a history.
+//!
+//! A parameter is a dotted path into the scenario, parsed once
+//! ([`Parameter::parse`]) and applied to a copy of the base system for each
+//! run. Each run is independent of the others and of how they are shared out
+//! among threads, so the results are the same bit for bit whatever the number
+//! of threads. A run that fails (a blow-up, chattering, a bad combination of
+//! values) is recorded with its reason and the others go on.
+
+use rayon::prelude::*;
+
+use crate::assembly::{initial_state, Assembly, PairLaw, SystemSpec};
+use crate::contact::Contact;
+use crate::error::{Error, Result};
+use crate::exact::ExactFlow;
+use crate::reductions::ReduceOptions;
+use crate::signals::Signal;
+use crate::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
+use crate::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
+
+/// Which entry of the scenario a study varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    DamperMass(usize),
+    DamperClearance(usize),
+    DamperLowerClearance(usize),
+    DamperUpperClearance(usize),
+    DamperRestitution(usize),
+    DamperStiffness(usize),
+    DamperDamping(usize),
+    StopGap(usize),
+    StopRestitution(usize),
+    StopStiffness(usize),
+    StopDamping(usize),
+    Gravity,
+    ExcitationAmplitude(usize),
+    ExcitationFrequency(usize),
+    ExcitationPhase(usize),
+    /// One of the four arrays of `[initial]` (0 to 3, in their order) and
+    /// its entry.
+    Initial(usize, usize),
+}
+
+/// A parsed dotted path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    pub path: String,
+    pub target: Target,
+}
+
+/// The paths a study can vary, for error messages.
+pub const PATHS: &str = "damper.N.{mass, clearance, lower_clearance, upper_clearance, \
+     restitution, stiffness, damping}, stop.N.{gap, restitution, stiffness, damping}, \
+     gravity.acceleration, excitation.N.{amplitude, frequency, phase} (harmonic signals), \
+     initial.{structure_displacement, structure_velocity, damper_displacement, \
+     damper_velocity}.I";
+
+const INITIAL: [&str; 4] = [
+    "structure_displacement",
+    "structure_velocity",
+    "damper_displacement",
+    "damper_velocity",
+];
+
+impl Parameter {
+    /// Parse `path` against `spec` (indices must exist).
+    pub fn parse(path: &str, spec: &SystemSpec) -> Result<Self> {
+        let parts: Vec<&str> = path.split('.').collect();
+        let bad = || {
+            Error::Inconsistent(format!(
+                "study axis {path:?}: not a path a study can vary; allowed: {PATHS}"
+            ))
+        };
+        let index = |text: &str, count: usize, what: &str| -> Result<usize> {
+            let i: usize = text.parse().map_err(|_| bad())?;
+            if i < count {
+                Ok(i)
+            } else {
+                Err(Error::Inconsistent(format!(
+                    "study axis {path:?}: the scenario has {count} {what}"
+                )))
+            }
+        };
+        let target = match parts.as_slice() {
+            ["damper", i, key] => {
+                let i = index(i, spec.dampers.len(), "[[damper]]")?;
+                match *key {
+                    "mass" => Target::DamperMass(i),
+                    "clearance" => Target::DamperClearance(i),
+                    "lower_clearance" => Target::DamperLowerClearance(i),
+                    "upper_clearance" => Target::DamperUpperClearance(i),
+                    "restitution" => Target::DamperRestitution(i),
+                    "stiffness" => Target::DamperStiffness(i),
+                    "damping" => Target::DamperDamping(i),
+                    _ => return Err(bad()),
+                }
+            }
+            ["stop", i, key] => {
+                let i = index(i, spec.stops.len(), "[[stop]]")?;
+                match *key {
+                    "gap" => Target::StopGap(i),
+                    "restitution" => Target::StopRestitution(i),
+                    "stiffness" => Target::StopStiffness(i),
+                    "damping" => Target::StopDamping(i),
+                    _ => return Err(bad()),
+                }
+            }
+            ["gravity", "acceleration"] => Target::Gravity,
+            ["excitation", i, key] => {
+                let i = index(i, spec.excitations.len(), "[[excitation]]")?;
+                if !matches!(spec.excitations[i].signal, Signal::Harmonic(_)) {
+                    return Err(Error::Inconsistent(format!(
+                        "study axis {path:?}: excitation {i} is not a harmonic signal"
+                    )));
+                }
+                match *key {
+                    "amplitude" => Target::ExcitationAmplitude(i),
+                    "frequency" => Target::ExcitationFrequency(i),
+                    "phase" => Target::ExcitationPhase(i),
+                    _ => return Err(bad()),
+                }
+            }
+            ["initial", array, i] => {
+                let which = INITIAL.iter().position(|a| a == array).ok_or_else(bad)?;
+                let size = if which < 2 {
+                    spec.structure.dofs()
+                } else {
+                    spec.dampers.len()
+                };
+                Target::Initial(which, index(i, size, array)?)
+            }
+            _ => return Err(bad()),
+        };
+        Ok(Self {
+            path: path.to_string(),
+            target,
+        })
+    }
+
+    /// Set this parameter to `value` in `spec` (or in `initial`).
+    pub fn apply(
+        &self,
+        spec: &mut SystemSpec,
+        initial: &mut [Vec<f64>; 4],
+        value: f64,
+    ) -> Result<()> {
+        let law = |law: &mut PairLaw, key: &str| -> Result<()> {
+            match (law, key) {
+                (PairLaw::Rigid { restitution }, "restitution") => {
+                    *restitution = value;
+                    Ok(())
+                }
+                (PairLaw::Compliant(c), "stiffness") => {
+                    *c = rebuilt(c, value, c.damping)?;
+                    Ok(())
+                }
+                (PairLaw::Compliant(c), "damping") => {
+                    *c = rebuilt(c, c.stiffness, value)?;
+                    Ok(())
+                }
+                _ => Err(Error::Inconsistent(format!(
+                    "study axis {:?}: the pair's law has no {key}",
+                    self.path
+                ))),
+            }
+        };
+        match self.target {
+            Target::DamperMass(i) => spec.dampers[i].mass = value,
+            Target::DamperClearance(i) => {
+                spec.dampers[i].lower_clearance = value;
+                spec.dampers[i].upper_clearance = value;
+            }
+            Target::DamperLowerClearance(i) => spec.dampers[i].lower_clearance = value,
+            Target::DamperUpperClearance(i) => spec.dampers[i].upper_clearance = value,
+            Target::DamperRestitution(i) => law(&mut spec.dampers[i].law, "restitution")?,
+            Target::DamperStiffness(i) => law(&mut spec.dampers[i].law, "stiffness")?,
+            Target::DamperDamping(i) => law(&mut spec.dampers[i].law, "damping")?,
+            Target::StopGap(i) => spec.stops[i].gap = value,
+            Target::StopRestitution(i) => law(&mut spec.stops[i].law, "restitution")?,
+            Target::StopStiffness(i) => law(&mut spec.stops[i].law, "stiffness")?,
+            Target::StopDamping(i) => law(&mut spec.stops[i].law, "damping")?,
+            Target::Gravity => spec.gravity = value,
+            Target::ExcitationAmplitude(i)
+            | Target::ExcitationFrequency(i)
+            | Target::ExcitationPhase(i) => {
+                if let Signal::Harmonic(h) = &mut spec.excitations[i].signal {
+                    match self.target {
+                        Target::ExcitationAmplitude(_) => h.amplitude = value,
+                        Target::ExcitationFrequency(_) => {
+                            if !(value >= 0.0 && value.is_finite()) {
+                                return Err(Error::Inconsistent(format!(
+                                    "{} must be >= 0 Hz, got {value}",
+                                    self.path
+                                )));
+                            }
+                            h.frequency = value
+                        }
+                        _ => h.phase = value,
+                    }
+                }
+            }
+            Target::Initial(which, i) => {
+                let array = &mut initial[which];
+                let size = if which < 2 {
+                    spec.structure.dofs()
+                } else {
+                    spec.dampers.len()
+                };
+                if array.len() != size {
+                    array.resize(size, 0.0);
+                }
+                array[i] = value;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn rebuilt(c: &Contact, stiffness: f64, damping: f64) -> Result<Contact> {
+    let restitution = c.law.uses_restitution().then_some(c.restitution);
+    Contact::new(c.law, stiffness, restitution, damping)
+}
+
+/// How each run of a study is made and what it keeps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudySettings {
+    pub method: String,
+    pub dt: Option<f64>,
+    pub rtol: f64,
+    pub atol: f64,
+    pub beta: f64,
+    pub gamma: f64,
+    pub spectral_radius: f64,
+    pub max_steps: u64,
+    pub energy_tolerance: f64,
+    /// `"run"` (to `t_end`) or `"steady-state"` (whole forcing periods).
+    pub analysis: Analysis,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Analysis {
+    /// A run to `t_end`, metrics from `record_from` on.
+    Run { t_end: f64, record_from: f64 },
+    /// `settle` then `record` periods of the first harmonic excitation;
+    /// settled when the stroboscopic state repeats after p <= 8 periods
+    /// within `tolerance` (relative).
+    SteadyState {
+        settle: u64,
+        record: u64,
+        tolerance: f64,
+    },
+}
+
+/// The metrics of one run. NaN where a run failed (see `status`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunMetrics {
+    /// 0 when the run completed, else 1 (the reason in `reason`).
+    pub status: u8,
+    pub reason: String,
+    /// Per structure coordinate, m.
+    pub peak: Vec<f64>,
+    pub rms: Vec<f64>,
+    /// Contacts (impacts, compliant contacts and sticking) recorded.
+    pub impacts: f64,
+    /// Per pair, J, over the recorded time.
+    pub energy_dissipated: Vec<f64>,
+    /// Steady state only: impacts per forcing period, and 1 / 0 for settled.
+    pub impacts_per_period: f64,
+    pub settled: f64,
+}
+
+/// Run the study: for each row of `values` (one value per parameter), set
+/// the parameters in a copy of `spec` and `initial` and run; on `threads`
+/// threads (0: all cores). Results in the order of the rows.
+pub fn run_study(
+    spec: &SystemSpec,
+    initial: &[Vec<f64>; 4],
+    parameters: &[Parameter],
+    values: &[f64],
+    settings: &StudySettings,
+    threads: usize,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<RunMetrics>> {
+    let width = parameters.len().max(1);
+    let rows = if parameters.is_empty() {
+        1
+    } else {
+        values.len() / width
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::Inconsistent(format!("cannot start the study's threads: {e}")))?;
+    let results = pool.install(|| {
+        (0..rows)
+            .into_par_iter()
+            .map(|row| {
+                if interrupt() {
+                    return Err(Error::Interrupted { time: 0.0 });
+                }
+                let row_values = if parameters.is_empty() {
+                    &[][..]
+                } else {
+                    &values[row * width..(row + 1) * width]
+                };
+                Ok(one_run(spec, initial, parameters, row_values, settings))
+            })
+            .collect::<Vec<Result<RunMetrics>>>()
+    });
+    results.into_iter().collect()
+}
+
+fn one_run(
+    spec: &SystemSpec,
+    initial: &[Vec<f64>; 4],
+    parameters: &[Parameter],
+    values: &[f64],
+    settings: &StudySettings,
+) -> RunMetrics {
+    let mut spec = spec.clone();
+    let mut initial = initial.clone();
+    let n = spec.structure.dofs();
+    let pairs = spec.dampers.len() + spec.stops.len();
+    let failed = |reason: String| RunMetrics {
+        status: 1,
+        reason,
+        peak: vec![f64::NAN; n],
+        rms: vec![f64::NAN; n],
+        impacts: f64::NAN,
+        energy_dissipated: vec![f64::NAN; pairs],
+        impacts_per_period: f64::NAN,
+        settled: f64::NAN,
+    };
+    for (p, v) in parameters.iter().zip(values) {
+        if let Err(e) = p.apply(&mut spec, &mut initial, *v) {
+            return failed(e.to_string());
+        }
+    }
+    match measured(&spec, &initial, settings) {
+        Ok(metrics) => metrics,
+        Err(e) => failed(e.to_string()),
+    }
+}
+
+fn measured(
+    spec: &SystemSpec,
+    initial: &[Vec<f64>; 4],
+    settings: &StudySettings,
+) -> Result<RunMetrics> {
+    let system = Assembly::new(spec)?;
+    let y0 = initial_state(&system, &initial[0], &initial[1], &initial[2], &initial[3])?;
+    let period = || {
+        spec.excitations
+            .iter()
+            .find_map(|e| match &e.signal {
+                Signal::Harmonic(h) if h.frequency > 0.0 => Some(1.0 / h.frequency),
+                _ => None,
+            })
+            .ok_or_else(|| {
+                Error::Inconsistent(
+                    "a steady-state study needs a harmonic excitation (its period)".to_string(),
+                )
+            })
+    };
+    let (t_end, record_from, strobe_period) = match settings.analysis {
+        Analysis::Run { t_end, record_from } => (t_end, record_from, f64::INFINITY),
+        Analysis::SteadyState { settle, record, .. } => {
+            let t = period()?;
+            ((settle + record) as f64 * t, settle as f64 * t, t)
+        }
+    };
+    let mut options = RunOptions {
+        dt: settings.dt,
+        t_end,
+        every: 1,
+        keep_history: false,
+        max_steps: settings.max_steps,
+        max_rows: u64::MAX,
+        energy_tolerance: settings.energy_tolerance,
+        reduce: ReduceOptions {
+            record_from,
+            strobe_period,
+        },
+    };
+    let len = system.state_len();
+    let never = &mut || false;
+    let sol = match settings.method.as_str() {
+        "rk4" => integrate_system(&system, &mut ExplicitRk::rk4(len), &y0, &options, never),
+        "dopri5" => integrate(
+            &system,
+            &mut ExplicitRk::dopri5(len, settings.rtol, settings.atol),
+            &y0,
+            &options,
+        ),
+        "dop853" => integrate(
+            &system,
+            &mut ExplicitRk::dop853(len, settings.rtol, settings.atol),
+            &y0,
+            &options,
+        ),
+        "newmark-implicit" => integrate(
+            &system,
+            &mut NewmarkFamily::newmark(&system, settings.beta, settings.gamma),
+            &y0,
+            &options,
+        ),
+        "generalized-alpha" => integrate(
+            &system,
+            &mut NewmarkFamily::generalized_alpha(&system, settings.spectral_radius),
+            &y0,
+            &options,
+        ),
+        "exact" => {
+            let mut flow = ExactFlow::new(&system)?;
+            let mut step = options
+                .dt
+                .unwrap_or(f64::INFINITY)
+                .min(flow.step())
+                .min(t_end);
+            if strobe_period.is_finite() {
+                step = strobe_period / (strobe_period / step - 1e-9).ceil().max(1.0);
+            }
+            options.dt = Some(step);
+            integrate(&system, &mut flow, &y0, &options)
+        }
+        other => {
+            return Err(Error::UnknownChoice {
+                field: "method",
+                allowed: "\"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
+                          \"generalized-alpha\", \"exact\"",
+                value: other.to_string(),
+            })
+        }
+    }?;
+    Ok(metrics_of(&system, &sol, record_from, settings))
+}
+
+fn integrate<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    y0: &[f64],
+    options: &RunOptions,
+) -> Result<SystemSolution> {
+    integrate_system(system, stepper, y0, options, &mut || false)
+}
+
+fn metrics_of(
+    system: &Assembly,
+    sol: &SystemSolution,
+    record_from: f64,
+    settings: &StudySettings,
+) -> RunMetrics {
+    let r = &sol.reductions;
+    let rms = r
+        .square_integrals
+        .iter()
+        .map(|s| {
+            if r.recorded_time > 0.0 {
+                (s / r.recorded_time).sqrt()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let recorded: Vec<_> = sol
+        .contacts
+        .iter()
+        .filter(|c| c.onset >= record_from)
+        .collect();
+    let impacts = recorded
+        .iter()
+        .filter(|c| c.kind != ContactKind::Sticking)
+        .count() as f64;
+    let mut energy = vec![0.0; system.pairs.len()];
+    for c in &recorded {
+        if c.energy_dissipated.is_finite() {
+            energy[c.pair] += c.energy_dissipated;
+        }
+    }
+    let (impacts_per_period, settled) = match settings.analysis {
+        Analysis::SteadyState {
+            settle,
+            record,
+            tolerance,
+        } => {
+            // Judged at the end of settling, as the analysis does.
+            let width = 2 * system.dim;
+            let rows = (settle as usize).min(r.strobe.len() / width);
+            (
+                impacts / record as f64,
+                settled(&r.strobe[..rows * width], width, tolerance),
+            )
+        }
+        Analysis::Run { .. } => (f64::NAN, f64::NAN),
+    };
+    RunMetrics {
+        status: 0,
+        reason: String::new(),
+        peak: r.peaks.clone(),
+        rms,
+        impacts,
+        energy_dissipated: energy,
+        impacts_per_period,
+        settled,
+    }
+}
+
+/// 1 when the stroboscopic states (rows of `width`) of the settling periods
+/// repeat after p <= 8 periods within `tolerance` of their scale, else 0.
+fn settled(strobe: &[f64], width: usize, tolerance: f64) -> f64 {
+    let rows: Vec<&[f64]> = strobe.chunks(width).collect();
+    let half = width / 2;
+    let tail = &rows[rows.len().saturating_sub(17)..];
+    let scale = |range: std::ops::Range<usize>| {
+        tail.iter()
+            .flat_map(|r| r[range.clone()].iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300)
+    };
+    let (xs, vs) = (scale(0..half), scale(half..width));
+    let Some(last) = rows.last() else {
+        return 0.0;
+    };
+    for p in 1..=8usize {
+        if rows.len() <= p {
+            break;
+        }
+        let other = rows[rows.len() - 1 - p];
+        let distance = (0..width)
+            .map(|i| (last[i] - other[i]).abs() / if i < half { xs } else { vs })
+            .fold(0.0f64, f64::max);
+        if distance <= tolerance {
+            return 1.0;
+        }
+    }
+    0.0
+}

@@ -1,0 +1,401 @@
+"""Studies: a grid of runs of one 0.2 scenario with some of its parameters varied,
+run on every core by the Rust core (rayon, the GIL released), each reduced to
+metrics; the result an xarray Dataset written as NetCDF, chunk by chunk so that an
+interrupted study resumes where it stopped and gives the same file.
+
+The ``[study]`` section::
+
+    [study]
+    analysis = "steady-state"      # or "run" (to [solver] t_end; record_from, s)
+    settle_periods = 200           # steady-state: forcing periods to settle
+    record_periods = 50            #   and to record
+    metrics = ["peak", "rms", "impacts", "energy_dissipated",
+               "amplitude", "impacts_per_period", "settled"]
+    chunk_size = 1024              # runs a chunk (what a resume can lose at most)
+
+    [study.axes]
+    "damper.0.clearance" = { start = 0.001, stop = 0.01, count = 10 }
+    "damper.0.mass" = [0.01, 0.02, 0.05]
+    "excitation.0.frequency" = { start = 5.0, stop = 50.0, count = 20, spacing = "log" }
+
+Axes vary the paths :data:`vibroimpact._core` lists in its error for another one
+(dampers, stops, gravity, harmonic excitations, entries of ``[initial]``). In the
+Dataset each axis is a dimension named by its path, the metrics are data
+variables (with a ``coordinate`` dimension for per-structure-coordinate metrics and
+``pair`` for per-pair ones), and ``status`` is 0 for a run that completed, else
+``k``, the ``k``-th reason of the attribute ``reasons``. SI units.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import shutil
+import sys
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact._core import __version__, run_study
+from vibroimpact.analyses import AnalysisError, _prepare
+from vibroimpact.output import UsageError, written_whole
+from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
+
+METRICS = (
+    "peak",
+    "rms",
+    "impacts",
+    "energy_dissipated",
+    "amplitude",
+    "impacts_per_period",
+    "settled",
+)
+_ANALYSES = ("run", "steady-state")
+_SPACINGS = ("linear", "log")
+_STUDY = {
+    "analysis": (_TEXT, "run"),
+    "settle_periods": (_WHOLE, 200),
+    "record_periods": (_WHOLE, 50),
+    "record_from": (_NUMBER, 0.0),
+    "tolerance": (_NUMBER, 1e-6),
+    "chunk_size": (_WHOLE, 1024),
+}
+_AXIS = {
+    "start": (_NUMBER, _REQ),
+    "stop": (_NUMBER, _REQ),
+    "count": (_WHOLE, _REQ),
+    "spacing": (_TEXT, "linear"),
+}
+# What each metric means and its unit (attrs of the Dataset's variables).
+_DESCRIPTIONS = {
+    "peak": ("largest |displacement| of each structure coordinate, recorded", "m"),
+    "rms": ("RMS displacement of each structure coordinate, recorded", "m"),
+    "impacts": ("impacts and contacts recorded", "1"),
+    "energy_dissipated": ("energy taken by each pair's contacts and impacts, recorded", "J"),
+    "amplitude": (
+        "largest |displacement| of each structure coordinate over the recorded periods",
+        "m",
+    ),
+    "impacts_per_period": ("impacts and contacts per forcing period, recorded", "1"),
+    "settled": ("1 when the stroboscopic state repeats within tolerance, else 0", "1"),
+}
+
+
+class StudyError(AnalysisError):
+    """A study that cannot be set up as asked (a ValueError)."""
+
+
+def study_settings(table: Any) -> dict[str, Any]:
+    """The ``[study]`` section checked, with its defaults; each axis as its list of
+    values (``axes``: a dict, path to array)."""
+    if not isinstance(table, Mapping):
+        raise StudyError(f"[study]: must be a table, got {table!r:.60}")
+    plain = {k: v for k, v in table.items() if k not in ("metrics", "axes")}
+    out = _table("[study] ", plain, _STUDY)
+    _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
+    metrics = table.get("metrics", ["peak", "rms", "impacts"])
+    if isinstance(metrics, str) or not isinstance(metrics, Sequence) or not metrics:
+        raise StudyError(f"[study] metrics: must be a list of names, got {metrics!r:.60}")
+    for name in metrics:
+        _choice("[study] ", "metrics", name, METRICS)
+    steady_only = {"amplitude", "impacts_per_period", "settled"} & set(metrics)
+    if steady_only and out["analysis"] != "steady-state":
+        raise StudyError(
+            f'[study] metrics: {", ".join(sorted(steady_only))} need analysis = "steady-state"'
+        )
+    out["metrics"] = list(dict.fromkeys(metrics))
+    for key, low in (("settle_periods", 0), ("record_periods", 1), ("chunk_size", 1)):
+        if out[key] < low:
+            raise StudyError(f"[study] {key}: must be >= {low}, got {out[key]}")
+    if not out["record_from"] >= 0:
+        raise StudyError(f"[study] record_from: must be >= 0 s, got {out['record_from']}")
+    if not out["tolerance"] > 0:
+        raise StudyError(f"[study] tolerance: must be > 0, got {out['tolerance']}")
+    axes = table.get("axes")
+    if not isinstance(axes, Mapping) or not axes:
+        raise StudyError(
+            "[study.axes]: required, a table of dotted paths to a list of values or "
+            "{start, stop, count}"
+        )
+    out["axes"] = {str(path): _axis_values(str(path), spec) for path, spec in axes.items()}
+    return out
+
+
+def _axis_values(path: str, spec: Any) -> np.ndarray:
+    where = f"[study.axes] {path!r}: "
+    if isinstance(spec, Mapping):
+        axis = _table(where, spec, _AXIS)
+        _choice(where, "spacing", axis["spacing"], _SPACINGS)
+        if axis["count"] < 1:
+            raise StudyError(f"{where}count: must be >= 1, got {axis['count']}")
+        if axis["spacing"] == "log":
+            if not (axis["start"] > 0 and axis["stop"] > 0):
+                raise StudyError(f'{where}start, stop: must be > 0 for spacing = "log"')
+            return np.geomspace(axis["start"], axis["stop"], axis["count"])
+        return np.linspace(axis["start"], axis["stop"], axis["count"])
+    if isinstance(spec, str) or not isinstance(spec, Sequence) or not spec:
+        raise StudyError(f"{where}must be a list of numbers or {{start, stop, count}}")
+    values = []
+    for v in spec:
+        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            raise StudyError(f"{where}must hold finite numbers, got {v!r:.40}")
+        values.append(float(v))
+    return np.asarray(values)
+
+
+@dataclass
+class Study:
+    """A checked study of a scenario's sections (see the module docstring)."""
+
+    data: dict[str, Any]
+    settings: dict[str, Any]
+    source: str = "<study>"
+    base_dir: Path | None = None
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(v) for v in self.settings["axes"].values())
+
+    @property
+    def runs(self) -> int:
+        return int(np.prod(self.shape))
+
+    def fingerprint(self) -> str:
+        """A hash of everything that decides the results."""
+        canonical = json.dumps(
+            {"data": _plain(self.data), "version": __version__},
+            sort_keys=True,
+            default=str,
+        )
+        return hashlib.sha256(canonical.encode()).hexdigest()
+
+    def chunks(self) -> list[range]:
+        size = self.settings["chunk_size"]
+        return [range(i, min(i + size, self.runs)) for i in range(0, self.runs, size)]
+
+    def run_chunk(self, runs: range, threads: int = 0) -> dict[str, Any]:
+        """The raw metrics of the runs ``runs`` (flat indices into the grid)."""
+        prepared = _prepare({k: v for k, v in self.data.items() if k != "study"}, self.base_dir)
+        axes = list(self.settings["axes"].values())
+        index = np.unravel_index(np.arange(runs.start, runs.stop), self.shape)
+        values = np.column_stack([axis[i] for axis, i in zip(axes, index, strict=True)])
+        solver = prepared.solver
+        s = self.settings
+        raw: dict[str, Any] = run_study(
+            prepared.binding_spec(),
+            [list(prepared.initial[k]) for k in _INITIAL],
+            paths=list(self.settings["axes"]),
+            values=np.ascontiguousarray(values.ravel(), dtype=float),
+            method=solver["method"],
+            dt=solver["dt"],
+            rtol=solver["rtol"],
+            atol=solver["atol"],
+            beta=solver["beta"],
+            gamma=solver["gamma"],
+            spectral_radius=solver["spectral_radius"],
+            max_steps=solver["max_steps"],
+            energy_tolerance=solver["energy_tolerance"],
+            analysis=s["analysis"],
+            t_end=solver["t_end"],
+            record_from=s["record_from"],
+            settle_periods=s["settle_periods"],
+            record_periods=s["record_periods"],
+            tolerance=s["tolerance"],
+            threads=threads,
+        )
+        return raw
+
+
+_INITIAL = (
+    "structure_displacement",
+    "structure_velocity",
+    "damper_displacement",
+    "damper_velocity",
+)
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def study_of(
+    data: Mapping[str, Any], source: str = "<study>", base_dir: Path | None = None
+) -> Study:
+    """A :class:`Study` of a scenario's sections with a ``[study]`` section."""
+    if "study" not in data:
+        raise StudyError(f"{source}: a study needs a [study] section with [study.axes]")
+    settings = data["study"]
+    if (
+        "axes" in settings
+        and isinstance(settings["axes"], Mapping)
+        and all(isinstance(v, np.ndarray) for v in settings["axes"].values())
+    ):
+        checked = dict(settings)
+    else:
+        checked = study_settings(settings)
+    study = Study(dict(data), checked, source, base_dir)
+    # The base scenario and every axis path are checked by a run of none.
+    study.run_chunk(range(0, 0))
+    return study
+
+
+def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
+    """The study's xarray Dataset from its chunks' raw metrics, in order."""
+    import xarray as xr
+
+    n = parts[0]["n"] if parts else 0
+    pairs = list(parts[0]["pairs"]) if parts else []
+    shape = study.shape
+    dims = list(study.settings["axes"])
+    reasons: list[str] = []
+    status = np.concatenate([np.asarray(p["status"], dtype=np.int16) for p in parts])
+    codes = np.zeros(len(status), dtype=np.int16)
+    flat_reasons = [r for p in parts for r in p["reason"]]
+    for i, (s, reason) in enumerate(zip(status, flat_reasons, strict=True)):
+        if s:
+            if reason not in reasons:
+                reasons.append(reason)
+            codes[i] = reasons.index(reason) + 1
+    data_vars: dict[str, Any] = {
+        "status": (
+            dims,
+            codes.reshape(shape),
+            {"long_name": "0: run completed; k: failed for the k-th of attrs reasons"},
+        )
+    }
+    for name in study.settings["metrics"]:
+        key = "peak" if name == "amplitude" else name
+        values = np.concatenate([np.asarray(p[key], dtype=float) for p in parts])
+        description, unit = _DESCRIPTIONS[name]
+        attrs = {"long_name": description, "units": unit}
+        if name in ("peak", "rms", "amplitude"):
+            data_vars[name] = ([*dims, "coordinate"], values.reshape(*shape, n), attrs)
+        elif name == "energy_dissipated":
+            data_vars[name] = ([*dims, "pair"], values.reshape(*shape, len(pairs)), attrs)
+        else:
+            data_vars[name] = (dims, values.reshape(shape), attrs)
+    coords: dict[str, Any] = {
+        path: (path, values) for path, values in study.settings["axes"].items()
+    }
+    coords["coordinate"] = ("coordinate", np.arange(n))
+    coords["pair"] = ("pair", np.array(pairs, dtype=str))
+    return xr.Dataset(
+        data_vars,
+        coords=coords,
+        attrs={
+            "title": f"vibroimpact study of {study.source}",
+            "vibroimpact_version": __version__,
+            "scenario": json.dumps(_plain(study.data), sort_keys=True, default=str),
+            "input_hash": study.fingerprint(),
+            "analysis": study.settings["analysis"],
+            "reasons": json.dumps(reasons),
+        },
+    )
+
+
+def run(
+    study: Study,
+    out: Path,
+    *,
+    threads: int = 0,
+    progress: Callable[[int, int, float], None] | None = None,
+) -> Any:
+    """Run ``study`` into the NetCDF file ``out``, chunk by chunk: each finished
+    chunk is kept in ``OUT.parts/`` (written whole), so a study interrupted or killed
+    loses at most the chunk in flight and, run again, goes on where it stopped; the
+    file is written whole at the end (the same file as an uninterrupted run) and the
+    parts removed. Returns the Dataset."""
+    parts_dir = out.with_name(out.name + ".parts")
+    fingerprint = study.fingerprint()
+    manifest = parts_dir / "manifest.json"
+    if parts_dir.exists():
+        try:
+            known = json.loads(manifest.read_text())
+        except (OSError, ValueError):
+            known = {}
+        if known.get("input_hash") != fingerprint:
+            raise UsageError(
+                f"{parts_dir} holds the chunks of another study (or is damaged): remove it "
+                "to start this one"
+            )
+    else:
+        try:
+            parts_dir.mkdir(parents=True)
+        except OSError as err:
+            raise UsageError(f"cannot write {str(parts_dir)!r}: {err.strerror or err}") from None
+        with written_whole(manifest) as f:
+            f.write(json.dumps({"input_hash": fingerprint, "runs": study.runs}))
+    chunks = study.chunks()
+    parts: list[dict[str, Any]] = []
+    start = time.perf_counter()
+    computed = 0
+    for number, runs in enumerate(chunks):
+        path = parts_dir / f"chunk-{number:06d}.json"
+        if path.exists():
+            parts.append(json.loads(path.read_text()))
+        else:
+            raw = study.run_chunk(runs, threads)
+            part = {
+                "n": raw["n"],
+                "pairs": list(raw["pairs"]),
+                "status": [int(s) for s in raw["status"]],
+                "reason": list(raw["reason"]),
+                **{
+                    key: [_json_float(v) for v in np.asarray(raw[key], dtype=float)]
+                    for key in (
+                        "peak",
+                        "rms",
+                        "impacts",
+                        "energy_dissipated",
+                        "impacts_per_period",
+                        "settled",
+                    )
+                },
+            }
+            with written_whole(path) as f:
+                f.write(json.dumps(part))
+            parts.append(part)
+            computed += len(runs)
+        if progress is not None:
+            done = sum(len(c) for c in chunks[: number + 1])
+            progress(done, study.runs, computed / max(time.perf_counter() - start, 1e-9))
+    for part in parts:
+        for key in ("peak", "rms", "impacts", "energy_dissipated", "impacts_per_period", "settled"):
+            part[key] = [math.nan if v is None else v for v in part[key]]
+    dataset = assemble(study, parts)
+    with written_whole(out, binary=True) as f:
+        f.write(dataset.to_netcdf(engine="scipy"))
+    shutil.rmtree(parts_dir, ignore_errors=True)
+    return dataset
+
+
+def _json_float(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def terminal_progress(stream: Any = sys.stderr) -> Callable[[int, int, float], None]:
+    """A progress line with the rate and the time left, on a terminal only."""
+    show = hasattr(stream, "isatty") and stream.isatty()
+
+    def progress(done: int, total: int, rate: float) -> None:
+        if not show:
+            return
+        left = (total - done) / rate if rate > 0 else math.inf
+        eta = f"{left:.0f} s left" if math.isfinite(left) else ""
+        stream.write(f"\r{done}/{total} runs, {rate:,.0f} runs/s, {eta}   ")
+        stream.flush()
+        if done == total:
+            stream.write("\n")
+
+    return progress

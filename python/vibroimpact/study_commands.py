@@ -1,0 +1,79 @@
+"""The ``study`` command: a ``[study]`` grid of runs into a NetCDF file."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.output import UsageError
+from vibroimpact.scenario import load_scenario
+from vibroimpact.study import run, study_of, terminal_progress
+from vibroimpact.system_scenario import SystemScenario
+
+
+def add_command(sub: Any) -> None:
+    """Register ``study`` on the command line's subparsers."""
+    parser = sub.add_parser(
+        "study",
+        help="a grid of runs varying [study.axes], metrics into a NetCDF file",
+        description=(
+            "Run every combination of the [study.axes] values of a 0.2 scenario on all "
+            "cores (or --workers N), each run reduced to the [study] metrics, and write "
+            "them as an xarray Dataset in NetCDF (one dimension per axis, a status "
+            "variable, the reasons of failed runs in its attributes). Finished chunks are "
+            "kept beside the output (OUT.parts/): a study interrupted or killed resumes "
+            "where it stopped when run again, and gives the same file."
+        ),
+    )
+    parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [study]")
+    parser.add_argument(
+        "--out", type=Path, required=True, metavar="RESULT.nc", help="NetCDF file to write"
+    )
+    parser.add_argument(
+        "--workers", type=int, default=0, metavar="N", help="threads (default: all cores)"
+    )
+    parser.add_argument("--json", action="store_true", help="print a JSON summary")
+
+
+def run_study_command(args: argparse.Namespace) -> int:
+    if args.workers < 0:
+        raise UsageError(f"--workers must be >= 0 (0: all cores), got {args.workers}")
+    scenario = load_scenario(args.scenario)
+    if not isinstance(scenario, SystemScenario):
+        raise UsageError(f"{args.scenario}: study takes a 0.2 scenario (a [structure] section)")
+    try:
+        study = study_of(scenario.data, str(args.scenario), scenario.base_dir)
+    except InvalidInputError as err:
+        text = str(err)
+        if not text.startswith(str(args.scenario)):
+            text = f"{args.scenario}: {text}"
+        raise InvalidInputError(text) from None
+    start = time.perf_counter()
+    dataset = run(study, args.out, threads=args.workers, progress=terminal_progress())
+    elapsed = time.perf_counter() - start
+    failed = int(np.count_nonzero(dataset["status"].values))
+    summary: dict[str, Any] = {
+        "out": str(args.out),
+        "runs": study.runs,
+        "failed": failed,
+        "reasons": json.loads(dataset.attrs["reasons"]),
+        "axes": {path: len(values) for path, values in study.settings["axes"].items()},
+        "metrics": list(study.settings["metrics"]),
+        "cpu_time": elapsed,
+    }
+    if args.json:
+        print(json.dumps(summary))
+        return 0
+    print(
+        f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, "
+        f"written to {args.out}"
+    )
+    for reason in summary["reasons"]:
+        print(f"  failed: {reason}")
+    return 0

@@ -1,0 +1,270 @@
+"""Studies: a [study] grid run by the core on all cores, against the same runs made
+one by one; the same results whatever the number of threads; failed runs recorded
+with their reasons while the others go on; the NetCDF file, and an interrupted study
+resumed into the same file as an uninterrupted one; the command line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import vibroimpact as vi
+from vibroimpact import study as st
+from vibroimpact.analyses import runner, steady_state
+from vibroimpact.system_scenario import SystemScenario
+
+BASE = """
+[structure]
+kind = "oscillator"
+mass = 1.0
+stiffness = 3947.8
+damping = 2.513
+
+[[damper]]
+mass = 0.05
+at = 0
+clearance = 0.005
+law = "rigid"
+restitution = 0.6
+
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = 5.0
+frequency = 10.0
+
+[solver]
+method = "exact"
+t_end = 0.5
+"""
+
+STEADY = """
+[study]
+analysis = "steady-state"
+settle_periods = 60
+record_periods = 10
+metrics = ["peak", "rms", "impacts", "energy_dissipated", "amplitude",
+           "impacts_per_period", "settled"]
+chunk_size = 7
+
+[study.axes]
+"damper.0.clearance" = { start = 0.002, stop = 0.01, count = 4 }
+"excitation.0.frequency" = [9.0, 10.0, 11.0]
+"""
+
+
+def scenario(tmp_path: Path, text: str, name: str = "study.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def load(path: Path) -> st.Study:
+    sc = vi.load_scenario(path)
+    assert isinstance(sc, SystemScenario)
+    return st.study_of(sc.data, str(path), sc.base_dir)
+
+
+def without_study(study: st.Study, **changes: Any) -> dict[str, Any]:
+    data = {k: v for k, v in study.data.items() if k != "study"}
+    for path, value in changes.items():
+        from vibroimpact.analyses import with_parameter
+
+        data = with_parameter(data, path, value)
+    return data
+
+
+def test_a_run_study_equals_the_runs_made_one_by_one(tmp_path: Path) -> None:
+    text = BASE + (
+        '[study]\nanalysis = "run"\nrecord_from = 0.1\n'
+        'metrics = ["peak", "rms", "impacts", "energy_dissipated"]\n'
+        '[study.axes]\n"damper.0.mass" = [0.02, 0.05]\n'
+        '"initial.structure_velocity.0" = [0.0, 0.2, -0.3]\n'
+    )
+    study = load(scenario(tmp_path, text))
+    ds = st.run(study, tmp_path / "out.nc", threads=2)
+    for mass in (0.02, 0.05):
+        for velocity in (0.0, 0.2, -0.3):
+            data = without_study(study, **{"damper.0.mass": mass})
+            sol = vi.simulate_system(
+                data["structure"],
+                damper=data["damper"],
+                excitation=data["excitation"],
+                initial={"structure_velocity": [velocity]},
+                method="exact",
+                t_end=0.5,
+                history=False,
+                record_from=0.1,
+            )
+            point = ds.sel({"damper.0.mass": mass, "initial.structure_velocity.0": velocity})
+            # The same computation: equal to the last bit.
+            assert point["peak"].values.tolist() == sol.peak.tolist()
+            assert point["rms"].values.tolist() == sol.rms.tolist()
+            recorded = [
+                (kind, onset, loss)
+                for kind, onset, loss in zip(
+                    sol.contacts.kind,
+                    sol.contacts.onset,
+                    sol.contacts.energy_dissipated,
+                    strict=True,
+                )
+                if onset >= 0.1
+            ]
+            assert point["impacts"].item() == sum(k != "sticking" for k, _, _ in recorded)
+            assert point["energy_dissipated"].values.tolist() == pytest.approx(
+                [sum(loss for _, _, loss in recorded)], rel=1e-12
+            )
+    assert int(ds["status"].max()) == 0
+
+
+def test_steady_state_metrics_match_the_analysis(tmp_path: Path) -> None:
+    study = load(scenario(tmp_path, BASE + STEADY))
+    ds = st.run(study, tmp_path / "out.nc")
+    assert dict(ds.sizes) == {
+        "damper.0.clearance": 4,
+        "excitation.0.frequency": 3,
+        "coordinate": 1,
+        "pair": 1,
+    }
+    for clearance in (0.002, 0.01):
+        for frequency in (9.0, 11.0):
+            data = without_study(
+                study,
+                **{"damper.0.clearance": clearance, "excitation.0.frequency": frequency},
+            )
+            result = steady_state(
+                runner(data), settle_periods=60, record_periods=10, tolerance=1e-6
+            )
+            point = ds.sel(
+                {"damper.0.clearance": clearance, "excitation.0.frequency": frequency},
+                method="nearest",
+            )
+            np.testing.assert_allclose(point["amplitude"].values, result.amplitude, rtol=1e-8)
+            np.testing.assert_allclose(point["rms"].values, result.rms, rtol=1e-6)
+            assert point["impacts_per_period"].item() == result.impacts_per_period
+            assert point["settled"].item() == float(result.settled)
+
+
+def test_results_do_not_depend_on_the_number_of_threads(tmp_path: Path) -> None:
+    study = load(scenario(tmp_path, BASE + STEADY))
+    one = study.run_chunk(range(0, study.runs), threads=1)
+    two = study.run_chunk(range(0, study.runs), threads=2)
+    for key in ("peak", "rms", "impacts", "energy_dissipated", "impacts_per_period", "settled"):
+        assert np.array_equal(np.asarray(one[key]), np.asarray(two[key]), equal_nan=True), key
+
+
+def test_a_failed_run_is_recorded_with_its_reason_and_the_others_go_on(tmp_path: Path) -> None:
+    text = BASE + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        '[study.axes]\n"damper.0.mass" = [0.05, -1.0, 0.1]\n'
+    )
+    ds = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    status = ds["status"].values
+    assert status.tolist() == [0, 1, 0]
+    reasons = json.loads(ds.attrs["reasons"])
+    assert len(reasons) == 1 and "mass" in reasons[0] and "damper 0" in reasons[0]
+    assert np.isnan(ds["peak"].values[1]).all() and np.isfinite(ds["peak"].values[[0, 2]]).all()
+
+
+def test_the_netcdf_file_holds_the_dataset(tmp_path: Path) -> None:
+    study = load(scenario(tmp_path, BASE + STEADY))
+    out = tmp_path / "out.nc"
+    ds = st.run(study, out)
+    with xr.open_dataset(out, engine="scipy") as back:
+        assert back.attrs["input_hash"] == study.fingerprint()
+        assert back.attrs["analysis"] == "steady-state"
+        for name in ("status", "peak", "amplitude", "settled", "energy_dissipated"):
+            np.testing.assert_array_equal(back[name].values, ds[name].values)
+        np.testing.assert_array_equal(
+            back["damper.0.clearance"].values, np.linspace(0.002, 0.01, 4)
+        )
+        assert back["peak"].attrs["units"] == "m"
+    assert not out.with_name(out.name + ".parts").exists()
+
+
+class Stop(Exception):
+    pass
+
+
+def test_an_interrupted_study_resumes_into_the_same_file(tmp_path: Path) -> None:
+    study = load(scenario(tmp_path, (BASE + STEADY).replace("chunk_size = 7", "chunk_size = 3")))
+    whole = tmp_path / "whole.nc"
+    st.run(study, whole)
+    resumed = tmp_path / "resumed.nc"
+
+    def stop_after_two(done: int, total: int, rate: float) -> None:
+        if done >= 6:
+            raise Stop
+
+    with pytest.raises(Stop):
+        st.run(study, resumed, progress=stop_after_two)
+    parts = resumed.with_name(resumed.name + ".parts")
+    assert sorted(p.name for p in parts.glob("chunk-*.json")) == [
+        "chunk-000000.json",
+        "chunk-000001.json",
+    ]
+    assert not resumed.exists()
+    computed: list[int] = []
+    st.run(study, resumed, progress=lambda done, total, rate: computed.append(done))
+    assert resumed.read_bytes() == whole.read_bytes()
+    assert not parts.exists()
+
+
+def test_chunks_of_another_study_are_refused(tmp_path: Path) -> None:
+    study = load(scenario(tmp_path, BASE + STEADY))
+    out = tmp_path / "out.nc"
+    parts = out.with_name(out.name + ".parts")
+    parts.mkdir()
+    (parts / "manifest.json").write_text(json.dumps({"input_hash": "another"}))
+    with pytest.raises(vi.output.UsageError, match="another study"):
+        st.run(study, out)
+
+
+def cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "vibroimpact", *args], capture_output=True, text=True, timeout=50
+    )
+
+
+def test_the_study_command_writes_the_file(tmp_path: Path) -> None:
+    path = scenario(tmp_path, BASE + STEADY)
+    out = tmp_path / "result.nc"
+    done = cli("study", str(path), "--out", str(out), "--workers", "2", "--json")
+    assert done.returncode == 0, done.stderr
+    summary = json.loads(done.stdout)
+    assert summary["runs"] == 12 and summary["failed"] == 0
+    with xr.open_dataset(out, engine="scipy") as ds:
+        assert ds["amplitude"].shape == (4, 3, 1)
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        (("chunk_size = 7", "chunk_sise = 7"), ["[study]", "chunk_sise"]),
+        (('"damper.0.clearance"', '"damper.3.clearance"'), ["damper.3.clearance", "[[damper]]"]),
+        (('"damper.0.clearance"', '"structure.mass"'), ["structure.mass", "allowed"]),
+        (('analysis = "steady-state"', 'analysis = "run"'), ["metrics", "steady-state"]),
+        (("count = 4", "count = 0"), ["count", ">= 1"]),
+        (('metrics = ["peak"', 'metrics = ["peek"'), ["metrics", "peek"]),
+    ],
+)
+def test_bad_studies_exit_2_naming_the_key(
+    tmp_path: Path, change: tuple[str, str], words: list[str]
+) -> None:
+    text = (BASE + STEADY).replace(*change)
+    assert text != BASE + STEADY
+    done = cli("study", str(scenario(tmp_path, text)), "--out", str(tmp_path / "r.nc"))
+    assert done.returncode == 2, done.stdout
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert not (tmp_path / "r.nc").exists()
