@@ -266,22 +266,6 @@ def test_damping_solved_with_the_loose_mass_alone_misses_the_rigid_orbit() -> No
     assert errors[-1] > 10 * state_error(right[-1].state, mid)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "method exact loses precision in proportion to the contact stiffness: the "
-        "stroboscopic map's round-off noise is 1e-13 (relative) at k = 1e3 N/m, 1.1e-10 at "
-        "1e6, 7e-10 at 1e7 and 1.1e-8 at 1e8, where dop853 at rtol 1e-13 on the same "
-        "event kernel stays at 4e-12 to 1.4e-11. Here the shooting stalls at residual "
-        "1.3e-9 (k = 1e7) and 1.5e-8 (1e8) > its tolerance 1e-10 (converged False after "
-        "40 iterations), and the finite-difference multipliers stop approaching the rigid "
-        "ones (determinant off e^4 by -1.5e-3, -1.2e-3, -2.3e-2 at 1e6, 1e7, 1e8; dop853: "
-        "-1.3e-3, -3.8e-4, -1.1e-4). Likely cause: crates/vibroimpact-core/src/linalg.rs "
-        "expm (Pade 13 scaled by the 1-norm, no balancing) on matrix_flow.rs's unbalanced "
-        "generator (rows of k/m beside rows of 1, a k clearance / m constant column): 11-12 "
-        "squarings, about 1e-9 m/s error per step at k = 1e8 against 3e-13 by scipy's expm"
-    ),
-)
 def test_stiffer_contacts_keep_converging_in_the_multipliers() -> None:
     # Beyond 1e6 N/m the trend of the passing test goes on (dop853 at rtol 1e-13
     # converges at every stiffness here, with the determinant's error falling about

@@ -271,6 +271,62 @@ pub fn solve_matrix_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
 /// `e^A` of a row-major `n x n` matrix by scaling and squaring with the
 /// [13/13] Pade approximant (Higham 2005): accurate to a few ulps of its norm.
 pub fn expm(a: &[f64], n: usize) -> Vec<f64> {
+    // Balance first (Parlett and Reinsch: a diagonal similarity by powers of
+    // two, exact in floating point), so that rows and columns of very
+    // different sizes (a stiff contact beside a soft structure) do not set
+    // the scaling and its round-off: e^A = D e^(D^-1 A D) D^-1.
+    let mut b = a.to_vec();
+    let mut d = vec![1.0; n];
+    for _ in 0..32 {
+        let mut changed = false;
+        for i in 0..n {
+            let (mut column, mut row) = (0.0, 0.0);
+            for j in 0..n {
+                if j != i {
+                    column += b[j * n + i].abs();
+                    row += b[i * n + j].abs();
+                }
+            }
+            if column == 0.0 || row == 0.0 {
+                continue;
+            }
+            let mut f = 1.0;
+            let total = column + row;
+            let (mut c, mut r) = (column, row);
+            while c < r / 2.0 {
+                c *= 2.0;
+                r /= 2.0;
+                f *= 2.0;
+            }
+            while c >= r * 2.0 {
+                c /= 2.0;
+                r *= 2.0;
+                f /= 2.0;
+            }
+            if (c + r) < 0.95 * total {
+                changed = true;
+                d[i] *= f;
+                for j in 0..n {
+                    b[i * n + j] /= f;
+                    b[j * n + i] *= f;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let mut e = expm_balanced(&b, n);
+    for i in 0..n {
+        for j in 0..n {
+            e[i * n + j] *= d[i] / d[j];
+        }
+    }
+    e
+}
+
+/// [`expm`] without balancing.
+fn expm_balanced(a: &[f64], n: usize) -> Vec<f64> {
     const B: [f64; 14] = [
         64764752532480000.0,
         32382376266240000.0,
