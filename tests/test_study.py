@@ -268,3 +268,30 @@ def test_bad_studies_exit_2_naming_the_key(
     for word in words:
         assert word in lines[0], lines[0]
     assert not (tmp_path / "r.nc").exists()
+
+
+def test_the_readme_study_commands_work_as_written(tmp_path: Path) -> None:
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## Studies", 1)[1].split("\n## ", 1)[0]
+    shell = section.split("```sh\n", 1)[1].split("```", 1)[0].strip()
+    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+    root = Path(__file__).resolve().parents[1]
+    argv = shell.split()
+    assert argv[:2] == ["vibroimpact", "study"]
+    # Run where the README is, the output kept out of the checkout.
+    (tmp_path / "examples").symlink_to(root / "examples")
+    done = subprocess.run(
+        [sys.executable, "-m", "vibroimpact", *argv[1:]],
+        capture_output=True,
+        text=True,
+        timeout=50,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr
+    printed = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=50, cwd=tmp_path
+    )
+    assert printed.returncode == 0, printed.stderr
+    # The best clearance for each mass: one of the axis's values, three masses.
+    best = np.array(printed.stdout.strip().strip("[]").split(), dtype=float)
+    assert len(best) == 3 and set(best) <= set(np.linspace(0.002, 0.011, 4).round(12))
