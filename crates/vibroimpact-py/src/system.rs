@@ -409,33 +409,16 @@ impl PreparedSystem {
         max_rows: u64,
         #[pyo3(from_py_with = crate::convert::real)] energy_tolerance: f64,
     ) -> PyResult<Self> {
-        for (field, value, ok, allowed) in [
-            ("t_end", t_end, t_end > 0.0, "> 0 s"),
-            (
-                "dt",
-                dt.unwrap_or(1.0),
-                dt.unwrap_or(1.0) > 0.0,
-                "> 0 s or None",
-            ),
-            ("rtol", rtol, rtol > 0.0, "> 0"),
-            ("atol", atol, atol > 0.0, "> 0"),
-            ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
-            ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
-            (
-                "spectral_radius",
-                spectral_radius,
-                (0.0..=1.0).contains(&spectral_radius),
-                "in [0, 1]",
-            ),
-            (
-                "energy_tolerance",
-                energy_tolerance,
-                energy_tolerance > 0.0,
-                "> 0",
-            ),
-        ] {
-            check(field, value, ok, allowed)?;
-        }
+        check_method(
+            t_end,
+            dt,
+            rtol,
+            atol,
+            beta,
+            gamma,
+            spectral_radius,
+            energy_tolerance,
+        )?;
         let limits = Limits {
             dt,
             max_steps,
@@ -496,6 +479,44 @@ impl PreparedSystem {
         let sol = ready.run(py, &y0, t_end, (false, 1), record_from, strobe_period)?;
         solution_dict(py, &ready.system, sol)
     }
+}
+
+/// The method settings a run takes, each finite and in its range.
+#[allow(clippy::too_many_arguments)]
+fn check_method(
+    t_end: f64,
+    dt: Option<f64>,
+    rtol: f64,
+    atol: f64,
+    beta: f64,
+    gamma: f64,
+    spectral_radius: f64,
+    energy_tolerance: f64,
+) -> PyResult<()> {
+    let dt = dt.unwrap_or(1.0);
+    for (field, value, ok, allowed) in [
+        ("t_end", t_end, t_end > 0.0, "> 0 s"),
+        ("dt", dt, dt > 0.0, "> 0 s or None"),
+        ("rtol", rtol, rtol > 0.0, "> 0"),
+        ("atol", atol, atol > 0.0, "> 0"),
+        ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
+        ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
+        (
+            "spectral_radius",
+            spectral_radius,
+            (0.0..=1.0).contains(&spectral_radius),
+            "in [0, 1]",
+        ),
+        (
+            "energy_tolerance",
+            energy_tolerance,
+            energy_tolerance > 0.0,
+            "> 0",
+        ),
+    ] {
+        check(field, value, ok, allowed)?;
+    }
+    Ok(())
 }
 
 /// `value` of `field`, unless it is not finite or not `ok` (then an error
@@ -687,35 +708,18 @@ pub fn run_study<'py>(
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     use core::study::{run_study as study, Analysis, Parameter, StudySettings};
-    for (field, value, ok, allowed) in [
-        ("t_end", t_end, t_end > 0.0, "> 0 s"),
-        (
-            "dt",
-            dt.unwrap_or(1.0),
-            dt.unwrap_or(1.0) > 0.0,
-            "> 0 s or None",
-        ),
-        ("rtol", rtol, rtol > 0.0, "> 0"),
-        ("atol", atol, atol > 0.0, "> 0"),
-        ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
-        ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
-        (
-            "spectral_radius",
-            spectral_radius,
-            (0.0..=1.0).contains(&spectral_radius),
-            "in [0, 1]",
-        ),
-        (
-            "energy_tolerance",
-            energy_tolerance,
-            energy_tolerance > 0.0,
-            "> 0",
-        ),
-        ("record_from", record_from, record_from >= 0.0, ">= 0 s"),
-        ("tolerance", tolerance, tolerance > 0.0, "> 0"),
-    ] {
-        check(field, value, ok, allowed)?;
-    }
+    check_method(
+        t_end,
+        dt,
+        rtol,
+        atol,
+        beta,
+        gamma,
+        spectral_radius,
+        energy_tolerance,
+    )?;
+    check("record_from", record_from, record_from >= 0.0, ">= 0 s")?;
+    check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
     let system_spec = system_spec(spec, t_end)?;
     // The base system and start must be valid on their own.
     let base = Assembly::new(&system_spec).map_err(to_py)?;
