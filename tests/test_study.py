@@ -295,3 +295,75 @@ def test_the_readme_study_commands_work_as_written(tmp_path: Path) -> None:
     # The best clearance for each mass: one of the axis's values, three masses.
     best = np.array(printed.stdout.strip().strip("[]").split(), dtype=float)
     assert len(best) == 3 and set(best) <= set(np.linspace(0.002, 0.011, 4).round(12))
+
+
+@pytest.mark.timeout(120)
+def test_a_study_on_a_local_dask_cluster_writes_the_same_file(tmp_path: Path) -> None:
+    path = scenario(tmp_path, BASE + STEADY)
+    local, on_dask = tmp_path / "local.nc", tmp_path / "dask.nc"
+    assert cli("study", str(path), "--out", str(local)).returncode == 0
+    done = cli("study", str(path), "--out", str(on_dask), "--dask", "local", "--workers", "2")
+    assert done.returncode == 0, done.stderr
+    assert on_dask.read_bytes() == local.read_bytes()
+
+
+def test_a_killed_study_resumes_from_the_command_line(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    text = (BASE + STEADY).replace("chunk_size = 7", "chunk_size = 1")
+    text = text.replace("settle_periods = 60", "settle_periods = 3000")
+    path = scenario(tmp_path, text)
+    whole = tmp_path / "whole.nc"
+    assert cli("study", str(path), "--out", str(whole), "--workers", "1").returncode == 0
+    out = tmp_path / "out.nc"
+    parts = out.with_name(out.name + ".parts")
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "vibroimpact",
+            "study",
+            str(path),
+            "--out",
+            str(out),
+            "--workers",
+            "1",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 40
+    while len(list(parts.glob("chunk-*.json"))) < 3 and time.monotonic() < deadline:
+        time.sleep(0.005)
+    process.send_signal(signal.SIGKILL)
+    process.wait(timeout=10)
+    kept = len(list(parts.glob("chunk-*.json")))
+    assert 3 <= kept < 12 and not out.exists()
+    assert cli("study", str(path), "--out", str(out)).returncode == 0
+    assert out.read_bytes() == whole.read_bytes()
+
+
+def test_the_study_command_plots_a_heat_map(tmp_path: Path) -> None:
+    path = scenario(tmp_path, BASE + STEADY)
+    png = tmp_path / "heat.png"
+    done = cli(
+        "study",
+        str(path),
+        "--out",
+        str(tmp_path / "r.nc"),
+        "--plot",
+        str(png),
+        "--metric",
+        "amplitude",
+        "--x",
+        "excitation.0.frequency",
+        "--y",
+        "damper.0.clearance",
+    )
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    bad = cli(
+        "study", str(path), "--out", str(tmp_path / "s.nc"), "--plot", str(png), "--metric", "speed"
+    )
+    assert bad.returncode == 2 and "--metric" in bad.stderr and "amplitude" in bad.stderr

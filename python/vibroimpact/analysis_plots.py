@@ -231,3 +231,32 @@ def plot_branch(path: Path, branch: Branch) -> None:
         ax.set_title(f"{branch.periods}-period orbits")
         ax.legend()
         ax.grid(alpha=0.3)
+
+
+def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
+    """A heat map of ``metric`` over the axes ``x`` and ``y`` of a study's Dataset:
+    the other axes (and structure coordinates or pairs beyond the first) reduced to
+    their worst case, the largest value; the optimum, the smallest, marked."""
+    values = dataset[metric]
+    for dim in ("coordinate", "pair"):
+        if dim in values.dims:
+            values = values.isel({dim: 0})
+    others = [d for d in values.dims if d not in (x, y)]
+    if others:
+        values = values.max(others)
+    grid = values.transpose(y, x)
+    with _figure(path) as (fig, ax):
+        mesh = ax.pcolormesh(
+            dataset[x].values, dataset[y].values, grid.values, shading="nearest", cmap="viridis"
+        )
+        units = dataset[metric].attrs.get("units", "")
+        label = metric + (f" ({units})" if units and units != "1" else "")
+        if others:
+            label += ", worst over " + ", ".join(others)
+        fig.colorbar(mesh, ax=ax, label=label)
+        flat = np.nanargmin(grid.values)
+        iy, ix = np.unravel_index(flat, grid.shape)
+        ax.plot(dataset[x].values[ix], dataset[y].values[iy], "r*", ms=14, label="optimum")
+        ax.legend(loc="upper right")
+        ax.set_xlabel(f"{x}{_unit(x)}")
+        ax.set_ylabel(f"{y}{_unit(y)}")

@@ -29,8 +29,10 @@ variables (with a ``coordinate`` dimension for per-structure-coordinate metrics 
 from __future__ import annotations
 
 import hashlib
+import importlib
 import json
 import math
+import os
 import shutil
 import sys
 import time
@@ -304,18 +306,39 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     )
 
 
+_METRIC_KEYS = ("peak", "rms", "impacts", "energy_dissipated", "impacts_per_period", "settled")
+
+
+def chunk_part(study: Study, start: int, stop: int, threads: int = 0) -> dict[str, Any]:
+    """The metrics of runs ``start`` to ``stop`` as plain data (what a chunk file
+    holds and a Dask task returns)."""
+    raw = study.run_chunk(range(start, stop), threads)
+    return {
+        "n": raw["n"],
+        "pairs": list(raw["pairs"]),
+        "status": [int(s) for s in raw["status"]],
+        "reason": list(raw["reason"]),
+        **{
+            key: [_json_float(v) for v in np.asarray(raw[key], dtype=float)] for key in _METRIC_KEYS
+        },
+    }
+
+
 def run(
     study: Study,
     out: Path,
     *,
     threads: int = 0,
     progress: Callable[[int, int, float], None] | None = None,
+    dask: str | None = None,
 ) -> Any:
     """Run ``study`` into the NetCDF file ``out``, chunk by chunk: each finished
     chunk is kept in ``OUT.parts/`` (written whole), so a study interrupted or killed
-    loses at most the chunk in flight and, run again, goes on where it stopped; the
+    loses at most the chunks in flight and, run again, goes on where it stopped; the
     file is written whole at the end (the same file as an uninterrupted run) and the
-    parts removed. Returns the Dataset."""
+    parts removed. ``dask``: the address of a Dask scheduler, or ``"local"`` for a
+    LocalCluster of ``threads`` processes (all cores for 0), the chunks its tasks;
+    the results are the same. Returns the Dataset."""
     parts_dir = out.with_name(out.name + ".parts")
     fingerprint = study.fingerprint()
     manifest = parts_dir / "manifest.json"
@@ -337,47 +360,79 @@ def run(
         with written_whole(manifest) as f:
             f.write(json.dumps({"input_hash": fingerprint, "runs": study.runs}))
     chunks = study.chunks()
-    parts: list[dict[str, Any]] = []
+    path_of = [parts_dir / f"chunk-{number:06d}.json" for number in range(len(chunks))]
+    pending = [number for number, path in enumerate(path_of) if not path.exists()]
     start = time.perf_counter()
-    computed = 0
-    for number, runs in enumerate(chunks):
-        path = parts_dir / f"chunk-{number:06d}.json"
-        if path.exists():
-            parts.append(json.loads(path.read_text()))
-        else:
-            raw = study.run_chunk(runs, threads)
-            part = {
-                "n": raw["n"],
-                "pairs": list(raw["pairs"]),
-                "status": [int(s) for s in raw["status"]],
-                "reason": list(raw["reason"]),
-                **{
-                    key: [_json_float(v) for v in np.asarray(raw[key], dtype=float)]
-                    for key in (
-                        "peak",
-                        "rms",
-                        "impacts",
-                        "energy_dissipated",
-                        "impacts_per_period",
-                        "settled",
-                    )
-                },
-            }
-            with written_whole(path) as f:
-                f.write(json.dumps(part))
-            parts.append(part)
-            computed += len(runs)
+    state = {"computed": 0, "done": study.runs - sum(len(chunks[i]) for i in pending)}
+
+    def finished(number: int, part: dict[str, Any]) -> None:
+        with written_whole(path_of[number]) as f:
+            f.write(json.dumps(part))
+        state["computed"] += len(chunks[number])
+        state["done"] += len(chunks[number])
         if progress is not None:
-            done = sum(len(c) for c in chunks[: number + 1])
-            progress(done, study.runs, computed / max(time.perf_counter() - start, 1e-9))
+            rate = state["computed"] / max(time.perf_counter() - start, 1e-9)
+            progress(state["done"], study.runs, rate)
+
+    if dask is None:
+        for number in pending:
+            runs = chunks[number]
+            finished(number, chunk_part(study, runs.start, runs.stop, threads))
+    else:
+        _run_on_dask(study, chunks, pending, dask, threads, finished)
+    parts = [json.loads(path.read_text()) for path in path_of]
     for part in parts:
-        for key in ("peak", "rms", "impacts", "energy_dissipated", "impacts_per_period", "settled"):
+        for key in _METRIC_KEYS:
             part[key] = [math.nan if v is None else v for v in part[key]]
     dataset = assemble(study, parts)
     with written_whole(out, binary=True) as f:
         f.write(dataset.to_netcdf(engine="scipy"))
     shutil.rmtree(parts_dir, ignore_errors=True)
     return dataset
+
+
+def _run_on_dask(
+    study: Study,
+    chunks: list[range],
+    pending: list[int],
+    address: str,
+    workers: int,
+    finished: Callable[[int, dict[str, Any]], None],
+) -> None:
+    """The pending chunks as tasks of a Dask cluster, each kept as it completes."""
+    try:
+        # Untyped: taken as Any.
+        distributed: Any = importlib.import_module("dask.distributed")
+    except ImportError:
+        raise UsageError(
+            '--dask needs dask and distributed: pip install "vibroimpact[dask]"'
+        ) from None
+    cluster = None
+    try:
+        if address == "local":
+            cluster = distributed.LocalCluster(
+                n_workers=workers or os.cpu_count() or 1,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+            )
+            client = distributed.Client(cluster)
+        else:
+            client = distributed.Client(address, timeout="10s")
+    except OSError as err:
+        raise UsageError(f"--dask {address}: cannot reach the scheduler ({err})") from None
+    try:
+        shared = client.scatter(study, broadcast=True)
+        futures = {
+            client.submit(chunk_part, shared, chunks[n].start, chunks[n].stop, 1, pure=False): n
+            for n in pending
+        }
+        for future in distributed.as_completed(futures):
+            finished(futures[future], future.result())
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def _json_float(v: float) -> float | None:

@@ -38,7 +38,23 @@ def add_command(sub: Any) -> None:
     parser.add_argument(
         "--workers", type=int, default=0, metavar="N", help="threads (default: all cores)"
     )
+    parser.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        help="run the chunks as tasks of a Dask cluster (a scheduler address, or 'local' "
+        "for a LocalCluster of --workers processes); needs vibroimpact[dask]",
+    )
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="heat map of --metric over the axes --x and --y (the others reduced to their "
+        "worst, the largest value), the optimum (smallest) marked",
+    )
+    parser.add_argument("--metric", help="the metric to plot (default: the first one)")
+    parser.add_argument("--x", help="the axis across (default: the first)")
+    parser.add_argument("--y", help="the axis up (default: the second)")
 
 
 def run_study_command(args: argparse.Namespace) -> int:
@@ -54,8 +70,35 @@ def run_study_command(args: argparse.Namespace) -> int:
         if not text.startswith(str(args.scenario)):
             text = f"{args.scenario}: {text}"
         raise InvalidInputError(text) from None
+    axes = list(study.settings["axes"])
+    metric = args.metric or study.settings["metrics"][0]
+    x = args.x or axes[0]
+    y = args.y or (axes[1] if len(axes) > 1 else None)
+    if args.plot:
+        metrics = ", ".join(study.settings["metrics"])
+        if metric not in study.settings["metrics"]:
+            raise UsageError(
+                f"--metric must be one of the study's metrics ({metrics}), got {metric!r}"
+            )
+        for flag, axis in (("--x", x), ("--y", y)):
+            if axis is None or axis not in axes:
+                raise UsageError(
+                    f"{flag} must be one of the study's axes ({', '.join(axes)}), got {axis!r}"
+                )
+        if x == y:
+            raise UsageError("--x and --y must be two different axes")
     start = time.perf_counter()
-    dataset = run(study, args.out, threads=args.workers, progress=terminal_progress())
+    dataset = run(
+        study,
+        args.out,
+        threads=args.workers,
+        progress=terminal_progress(),
+        dask=args.dask,
+    )
+    if args.plot:
+        from vibroimpact.analysis_plots import plot_study
+
+        plot_study(args.plot, dataset, metric, x, str(y))
     elapsed = time.perf_counter() - start
     failed = int(np.count_nonzero(dataset["status"].values))
     summary: dict[str, Any] = {
@@ -74,6 +117,8 @@ def run_study_command(args: argparse.Namespace) -> int:
         f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, "
         f"written to {args.out}"
     )
+    if args.plot:
+        print(f"plot written to {args.plot}")
     for reason in summary["reasons"]:
         print(f"  failed: {reason}")
     return 0
