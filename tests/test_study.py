@@ -207,9 +207,9 @@ def test_an_interrupted_study_resumes_into_the_same_file(tmp_path: Path) -> None
     with pytest.raises(Stop):
         st.run(study, resumed, progress=stop_after_two)
     parts = resumed.with_name(resumed.name + ".parts")
-    assert sorted(p.name for p in parts.glob("chunk-*.json")) == [
-        "chunk-000000.json",
-        "chunk-000001.json",
+    assert sorted(p.name for p in parts.glob("chunk-*.npz")) == [
+        "chunk-000000.npz",
+        "chunk-000001.npz",
     ]
     assert not resumed.exists()
     computed: list[int] = []
@@ -334,11 +334,11 @@ def test_a_killed_study_resumes_from_the_command_line(tmp_path: Path) -> None:
         stderr=subprocess.DEVNULL,
     )
     deadline = time.monotonic() + 40
-    while len(list(parts.glob("chunk-*.json"))) < 3 and time.monotonic() < deadline:
+    while len(list(parts.glob("chunk-*.npz"))) < 3 and time.monotonic() < deadline:
         time.sleep(0.005)
     process.send_signal(signal.SIGKILL)
     process.wait(timeout=10)
-    kept = len(list(parts.glob("chunk-*.json")))
+    kept = len(list(parts.glob("chunk-*.npz")))
     assert 3 <= kept < 12 and not out.exists()
     assert cli("study", str(path), "--out", str(out)).returncode == 0
     assert out.read_bytes() == whole.read_bytes()

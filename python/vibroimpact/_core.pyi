@@ -240,6 +240,7 @@ def run_study(
     record_periods: int,
     tolerance: float,
     threads: int,
+    mean_square: bool = True,
 ) -> dict[str, Any]: ...
 
 @final

@@ -209,6 +209,7 @@ class Study:
             record_periods=s["record_periods"],
             tolerance=s["tolerance"],
             threads=threads,
+            mean_square="rms" in s["metrics"],
         )
         return raw
 
@@ -310,18 +311,34 @@ _METRIC_KEYS = ("peak", "rms", "impacts", "energy_dissipated", "impacts_per_peri
 
 
 def chunk_part(study: Study, start: int, stop: int, threads: int = 0) -> dict[str, Any]:
-    """The metrics of runs ``start`` to ``stop`` as plain data (what a chunk file
-    holds and a Dask task returns)."""
+    """The metrics of runs ``start`` to ``stop`` as arrays (what a chunk file holds and
+    a Dask task returns)."""
     raw = study.run_chunk(range(start, stop), threads)
     return {
-        "n": raw["n"],
-        "pairs": list(raw["pairs"]),
-        "status": [int(s) for s in raw["status"]],
-        "reason": list(raw["reason"]),
-        **{
-            key: [_json_float(v) for v in np.asarray(raw[key], dtype=float)] for key in _METRIC_KEYS
-        },
+        "n": np.int64(raw["n"]),
+        "pairs": np.array(list(raw["pairs"]), dtype=str),
+        "status": np.asarray(raw["status"], dtype=np.int16),
+        "reason": np.array(list(raw["reason"]), dtype=str),
+        **{key: np.asarray(raw[key], dtype=float) for key in _METRIC_KEYS},
     }
+
+
+def _save(path: Path, part: dict[str, Any]) -> None:
+    import io
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **part)
+    with written_whole(path, binary=True) as f:
+        f.write(buffer.getvalue())
+
+
+def _load(path: Path) -> dict[str, Any]:
+    with np.load(path, allow_pickle=False) as data:
+        part = {key: data[key] for key in data.files}
+    part["n"] = int(part["n"])
+    part["pairs"] = [str(p) for p in part["pairs"]]
+    part["reason"] = [str(r) for r in part["reason"]]
+    return part
 
 
 def run(
@@ -360,14 +377,13 @@ def run(
         with written_whole(manifest) as f:
             f.write(json.dumps({"input_hash": fingerprint, "runs": study.runs}))
     chunks = study.chunks()
-    path_of = [parts_dir / f"chunk-{number:06d}.json" for number in range(len(chunks))]
+    path_of = [parts_dir / f"chunk-{number:06d}.npz" for number in range(len(chunks))]
     pending = [number for number, path in enumerate(path_of) if not path.exists()]
     start = time.perf_counter()
     state = {"computed": 0, "done": study.runs - sum(len(chunks[i]) for i in pending)}
 
     def finished(number: int, part: dict[str, Any]) -> None:
-        with written_whole(path_of[number]) as f:
-            f.write(json.dumps(part))
+        _save(path_of[number], part)
         state["computed"] += len(chunks[number])
         state["done"] += len(chunks[number])
         if progress is not None:
@@ -380,10 +396,7 @@ def run(
             finished(number, chunk_part(study, runs.start, runs.stop, threads))
     else:
         _run_on_dask(study, chunks, pending, dask, threads, finished)
-    parts = [json.loads(path.read_text()) for path in path_of]
-    for part in parts:
-        for key in _METRIC_KEYS:
-            part[key] = [math.nan if v is None else v for v in part[key]]
+    parts = [_load(path) for path in path_of]
     dataset = assemble(study, parts)
     with written_whole(out, binary=True) as f:
         f.write(dataset.to_netcdf(engine="scipy"))
@@ -433,10 +446,6 @@ def _run_on_dask(
         client.close()
         if cluster is not None:
             cluster.close()
-
-
-def _json_float(v: float) -> float | None:
-    return float(v) if math.isfinite(v) else None
 
 
 def terminal_progress(stream: Any = sys.stderr) -> Callable[[int, int, float], None]:

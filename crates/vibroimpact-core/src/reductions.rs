@@ -16,6 +16,8 @@
 pub struct ReduceOptions {
     pub record_from: f64,
     pub strobe_period: f64,
+    /// Whether to integrate the mean squares (the peaks cost less without).
+    pub mean_square: bool,
 }
 
 impl Default for ReduceOptions {
@@ -23,6 +25,7 @@ impl Default for ReduceOptions {
         Self {
             record_from: f64::INFINITY,
             strobe_period: f64::INFINITY,
+            mean_square: true,
         }
     }
 }

@@ -236,6 +236,8 @@ pub struct StudySettings {
     pub energy_tolerance: f64,
     /// `"run"` (to `t_end`) or `"steady-state"` (whole forcing periods).
     pub analysis: Analysis,
+    /// Whether to integrate the mean squares (the RMS metric).
+    pub mean_square: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -381,6 +383,7 @@ fn measured(
         reduce: ReduceOptions {
             record_from,
             strobe_period,
+            mean_square: settings.mean_square,
         },
     };
     let len = system.state_len();

@@ -763,6 +763,7 @@ pub fn integrate_system<S: SystemStepper>(
                 &mut scratch,
                 &mut buffers,
                 &mut reductions,
+                options.reduce.mean_square,
             )?;
             if located {
                 last_attempt_kept = false;
@@ -952,35 +953,46 @@ fn reduce_step<S: SystemStepper>(
     scratch: &mut Scratch,
     buffers: &mut Buffers,
     out: &mut Reductions,
+    mean_square: bool,
 ) -> Result<bool> {
     let d = system.dim;
-    system.rates(time, y, modes, scratch, &mut buffers.start);
-    system.rates(time + h, end, modes, scratch, &mut buffers.work);
+    // The accelerations at both ends only where the interpolant is needed:
+    // for the mean square, or where a velocity changes sign (a peak inside).
+    let turning = (0..system.n).any(|i| y[d + i] * end[d + i] < 0.0);
+    if mean_square || turning {
+        system.rates(time, y, modes, scratch, &mut buffers.start);
+        system.rates(time + h, end, modes, scratch, &mut buffers.work);
+    }
     let mut used = false;
     for i in 0..system.n {
-        let a = reductions::quintic(
-            y[i],
-            end[i],
-            h * y[d + i],
-            h * end[d + i],
-            h * h * buffers.start[d + i],
-            h * h * buffers.work[d + i],
-        );
-        out.square_integrals[i] += h * reductions::square_integral(&a);
         let mut peak = y[i].abs().max(end[i].abs());
-        if y[d + i] * end[d + i] < 0.0 {
-            let theta = reductions::derivative_root(&a);
-            stepper.attempt(
-                system,
-                time,
-                y,
-                theta * h,
-                modes,
-                scratch,
-                &mut buffers.probe,
-            )?;
-            used = true;
-            peak = peak.max(buffers.probe[i].abs());
+        let inside = y[d + i] * end[d + i] < 0.0;
+        if mean_square || inside {
+            let a = reductions::quintic(
+                y[i],
+                end[i],
+                h * y[d + i],
+                h * end[d + i],
+                h * h * buffers.start[d + i],
+                h * h * buffers.work[d + i],
+            );
+            if mean_square {
+                out.square_integrals[i] += h * reductions::square_integral(&a);
+            }
+            if inside {
+                let theta = reductions::derivative_root(&a);
+                stepper.attempt(
+                    system,
+                    time,
+                    y,
+                    theta * h,
+                    modes,
+                    scratch,
+                    &mut buffers.probe,
+                )?;
+                used = true;
+                peak = peak.max(buffers.probe[i].abs());
+            }
         }
         out.peaks[i] = out.peaks[i].max(peak);
     }

@@ -125,6 +125,7 @@ fn forced_oscillator_stays_on_its_steady_state_and_reduces_it() {
             ReduceOptions {
                 record_from: 0.0,
                 strobe_period: 1.0 / f,
+                mean_square: true,
             },
         );
         let amplitude = (qr * qr + qi * qi).sqrt();

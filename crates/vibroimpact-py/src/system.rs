@@ -366,6 +366,7 @@ impl Ready {
             reduce: ReduceOptions {
                 record_from: record_from.unwrap_or(f64::INFINITY),
                 strobe_period,
+                mean_square: true,
             },
         };
         let system = &self.system;
@@ -682,7 +683,7 @@ pub fn linear_parts<'py>(
 /// copy of the system and runs it, on `threads` threads (0: all cores), with
 /// the GIL released. Returns the metrics as flat arrays, one row a run.
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads))]
+#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_study<'py>(
     py: Python<'py>,
@@ -706,6 +707,7 @@ pub fn run_study<'py>(
     record_periods: u64,
     #[pyo3(from_py_with = crate::convert::real)] tolerance: f64,
     threads: usize,
+    mean_square: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     use core::study::{run_study as study, Analysis, Parameter, StudySettings};
     check_method(
@@ -761,6 +763,7 @@ pub fn run_study<'py>(
         max_steps,
         energy_tolerance,
         analysis,
+        mean_square,
     };
     let results = released(py, |_| {
         study(
