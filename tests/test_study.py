@@ -367,3 +367,74 @@ def test_the_study_command_plots_a_heat_map(tmp_path: Path) -> None:
         "study", str(path), "--out", str(tmp_path / "s.nc"), "--plot", str(png), "--metric", "speed"
     )
     assert bad.returncode == 2 and "--metric" in bad.stderr and "amplitude" in bad.stderr
+
+
+MONTE_CARLO = """
+[study]
+analysis = "run"
+record_from = 0.1
+metrics = ["peak", "impacts"]
+samples = 5
+seed = 11
+
+[study.axes]
+"damper.0.clearance" = [0.004, 0.008]
+
+[study.random]
+"damper.0.restitution" = { uniform = [0.3, 0.9] }
+"excitation.0.phase" = { normal = [0.0, 1.0] }
+"""
+
+
+def test_monte_carlo_samples_draw_from_the_seed_and_run_each_draw(tmp_path: Path) -> None:
+    study = load(scenario(tmp_path, BASE + MONTE_CARLO))
+    ds = st.run(study, tmp_path / "out.nc")
+    assert dict(ds["peak"].sizes) == {"damper.0.clearance": 2, "sample": 5, "coordinate": 1}
+    # The draws: numpy's PCG64 from the seed, in the order of [study.random].
+    generator = np.random.default_rng(11)
+    restitution = generator.uniform(0.3, 0.9, 5)
+    phase = generator.normal(0.0, 1.0, 5)
+    assert ds["damper.0.restitution"].values.tolist() == restitution.tolist()
+    assert ds["excitation.0.phase"].values.tolist() == phase.tolist()
+    for clearance in (0.004, 0.008):
+        for k in (0, 3):
+            data = without_study(
+                study,
+                **{
+                    "damper.0.clearance": clearance,
+                    "damper.0.restitution": float(restitution[k]),
+                    "excitation.0.phase": float(phase[k]),
+                },
+            )
+            sol = vi.simulate_system(
+                data["structure"],
+                damper=data["damper"],
+                excitation=data["excitation"],
+                method="exact",
+                t_end=0.5,
+                history=False,
+                record_from=0.1,
+            )
+            point = ds.sel({"damper.0.clearance": clearance, "sample": k})
+            assert point["peak"].values.tolist() == sol.peak.tolist()
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        (("samples = 5", "samples = 0"), ["samples", "[study.random]"]),
+        (('"excitation.0.phase" = { normal', '"damper.0.clearance" = { normal'), ["also an axis"]),
+        (("uniform = [0.3, 0.9]", "uniform = [0.9, 0.3]"), ["low < high"]),
+        (("normal = [0.0, 1.0]", "lognormal = [0.0, 1.0]"), ["uniform", "normal"]),
+    ],
+)
+def test_bad_monte_carlo_sections_exit_2(
+    tmp_path: Path, change: tuple[str, str], words: list[str]
+) -> None:
+    text = (BASE + MONTE_CARLO).replace(*change)
+    assert text != BASE + MONTE_CARLO
+    done = cli("study", str(scenario(tmp_path, text)), "--out", str(tmp_path / "r.nc"))
+    assert done.returncode == 2, done.stdout
+    assert len(done.stderr.strip().splitlines()) == 1
+    for word in words:
+        assert word in done.stderr, done.stderr

@@ -13,17 +13,27 @@ The ``[study]`` section::
                "amplitude", "impacts_per_period", "settled"]
     chunk_size = 1024              # runs a chunk (what a resume can lose at most)
 
+    samples = 100                  # Monte Carlo: runs of random draws at each grid point
+    seed = 7                       #   of the generator of [study.random]
+
     [study.axes]
     "damper.0.clearance" = { start = 0.001, stop = 0.01, count = 10 }
     "damper.0.mass" = [0.01, 0.02, 0.05]
     "excitation.0.frequency" = { start = 5.0, stop = 50.0, count = 20, spacing = "log" }
+
+    [study.random]
+    "damper.0.restitution" = { uniform = [0.4, 0.8] }
+    "excitation.0.phase" = { normal = [0.0, 0.5] }
 
 Axes vary the paths :data:`vibroimpact._core` lists in its error for another one
 (dampers, stops, gravity, harmonic excitations, entries of ``[initial]``). In the
 Dataset each axis is a dimension named by its path, the metrics are data
 variables (with a ``coordinate`` dimension for per-structure-coordinate metrics and
 ``pair`` for per-pair ones), and ``status`` is 0 for a run that completed, else
-``k``, the ``k``-th reason of the attribute ``reasons``. SI units.
+``k``, the ``k``-th reason of the attribute ``reasons``. With ``samples``, a ``sample``
+dimension follows the axes, and each random parameter is a variable over it: the same
+draws (numpy's PCG64 from ``seed``, in the order of ``[study.random]``) at every grid
+point. SI units.
 """
 
 from __future__ import annotations
@@ -66,6 +76,8 @@ _STUDY = {
     "record_from": (_NUMBER, 0.0),
     "tolerance": (_NUMBER, 1e-6),
     "chunk_size": (_WHOLE, 1024),
+    "samples": (_WHOLE, 0),
+    "seed": (_WHOLE, 0),
 }
 _AXIS = {
     "start": (_NUMBER, _REQ),
@@ -97,7 +109,7 @@ def study_settings(table: Any) -> dict[str, Any]:
     values (``axes``: a dict, path to array)."""
     if not isinstance(table, Mapping):
         raise StudyError(f"[study]: must be a table, got {table!r:.60}")
-    plain = {k: v for k, v in table.items() if k not in ("metrics", "axes")}
+    plain = {k: v for k, v in table.items() if k not in ("metrics", "axes", "random")}
     out = _table("[study] ", plain, _STUDY)
     _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
     metrics = table.get("metrics", ["peak", "rms", "impacts"])
@@ -125,7 +137,53 @@ def study_settings(table: Any) -> dict[str, Any]:
             "{start, stop, count}"
         )
     out["axes"] = {str(path): _axis_values(str(path), spec) for path, spec in axes.items()}
+    random = table.get("random", {})
+    if not isinstance(random, Mapping):
+        raise StudyError("[study.random]: must be a table of dotted paths to distributions")
+    if random and out["samples"] < 1:
+        raise StudyError("[study] samples: must be >= 1 with [study.random]")
+    if out["samples"] and not random:
+        raise StudyError(
+            "[study] samples: needs [study.random] (the parameters drawn for each sample)"
+        )
+    # Every distribution from one generator seeded by `seed`, in the order given:
+    # the same draws on every platform (numpy's PCG64), the same for every grid point.
+    generator = np.random.default_rng(out["seed"])
+    out["random"] = {}
+    for path, spec in random.items():
+        path = str(path)
+        if path in out["axes"]:
+            raise StudyError(f"[study.random] {path!r}: is also an axis")
+        out["random"][path] = _draws(path, spec, out["samples"], generator)
     return out
+
+
+def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -> np.ndarray:
+    where = f"[study.random] {path!r}: "
+    if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in _LAWS:
+        raise StudyError(
+            f"{where}must be one of {{uniform = [low, high]}}, {{normal = [mean, std]}}"
+        )
+    law, bounds = next(iter(spec.items()))
+    if (
+        isinstance(bounds, str)
+        or not isinstance(bounds, Sequence)
+        or len(bounds) != 2
+        or any(isinstance(b, bool) or not isinstance(b, int | float) for b in bounds)
+        or not all(math.isfinite(b) for b in bounds)
+    ):
+        raise StudyError(f"{where}{law} must be two finite numbers, got {bounds!r:.40}")
+    a, b = float(bounds[0]), float(bounds[1])
+    if law == "uniform":
+        if not a < b:
+            raise StudyError(f"{where}uniform needs low < high, got [{a}, {b}]")
+        return generator.uniform(a, b, samples)
+    if not b >= 0:
+        raise StudyError(f"{where}normal needs std >= 0, got {b}")
+    return generator.normal(a, b, samples)
+
+
+_LAWS = ("uniform", "normal")
 
 
 def _axis_values(path: str, spec: Any) -> np.ndarray:
@@ -161,7 +219,14 @@ class Study:
 
     @property
     def shape(self) -> tuple[int, ...]:
-        return tuple(len(v) for v in self.settings["axes"].values())
+        """The grid: one dimension per axis, then the samples if any."""
+        grid = tuple(len(v) for v in self.settings["axes"].values())
+        samples = self.settings.get("samples", 0)
+        return (*grid, samples) if samples else grid
+
+    @property
+    def dims(self) -> list[str]:
+        return list(self.settings["axes"]) + (["sample"] if self.settings.get("samples") else [])
 
     @property
     def runs(self) -> int:
@@ -184,14 +249,18 @@ class Study:
         """The raw metrics of the runs ``runs`` (flat indices into the grid)."""
         prepared = _prepare({k: v for k, v in self.data.items() if k != "study"}, self.base_dir)
         axes = list(self.settings["axes"].values())
+        random = self.settings.get("random", {})
         index = np.unravel_index(np.arange(runs.start, runs.stop), self.shape)
-        values = np.column_stack([axis[i] for axis, i in zip(axes, index, strict=True)])
+        columns = [axis[i] for axis, i in zip(axes, index, strict=False)]
+        if random:
+            columns += [draws[index[-1]] for draws in random.values()]
+        values = np.column_stack(columns) if columns else np.zeros((0, 0))
         solver = prepared.solver
         s = self.settings
         raw: dict[str, Any] = run_study(
             prepared.binding_spec(),
             [list(prepared.initial[k]) for k in _INITIAL],
-            paths=list(self.settings["axes"]),
+            paths=list(self.settings["axes"]) + list(random),
             values=np.ascontiguousarray(values.ravel(), dtype=float),
             method=solver["method"],
             dt=solver["dt"],
@@ -260,7 +329,7 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     n = parts[0]["n"] if parts else 0
     pairs = list(parts[0]["pairs"]) if parts else []
     shape = study.shape
-    dims = list(study.settings["axes"])
+    dims = study.dims
     reasons: list[str] = []
     status = np.concatenate([np.asarray(p["status"], dtype=np.int16) for p in parts])
     codes = np.zeros(len(status), dtype=np.int16)
@@ -291,6 +360,14 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     coords: dict[str, Any] = {
         path: (path, values) for path, values in study.settings["axes"].items()
     }
+    if study.settings.get("samples"):
+        coords["sample"] = ("sample", np.arange(study.settings["samples"]))
+        for path, draws in study.settings["random"].items():
+            data_vars[path] = (
+                ["sample"],
+                draws,
+                {"long_name": f"{path}, drawn for each sample (seed {study.settings['seed']})"},
+            )
     coords["coordinate"] = ("coordinate", np.arange(n))
     coords["pair"] = ("pair", np.array(pairs, dtype=str))
     return xr.Dataset(
