@@ -16,6 +16,7 @@ period changes). SI units.
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -25,7 +26,14 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.analyses import AnalysisError, Runner, orbit, runner, with_parameter
+from vibroimpact.analyses import (
+    AnalysisError,
+    Runner,
+    forcing_period,
+    orbit,
+    runner,
+    with_parameter,
+)
 
 
 @dataclass
@@ -105,9 +113,19 @@ def continue_orbit(
     if not ds > 0:
         raise AnalysisError(f"step: must be > 0, got {step!r}")
 
-    def run_at(p: float) -> Runner:
+    # The stroboscopic section, as a fraction of the forcing period after t = 0: moved
+    # away from the impacts when one comes near it, where the map jumps (an impact
+    # just before the section or just after it), so that the branch stays smooth.
+    section = [0.0]
+    shiftable = all(
+        isinstance(e, Mapping) and e.get("signal") in ("harmonic", "harmonics")
+        for e in data.get("excitation", ()) or ()
+    )
+
+    def run_at(p: float, fraction: float | None = None) -> Runner:
         try:
-            return runner(with_parameter(data, parameter, p), base_dir)
+            changed = with_parameter(data, parameter, p)
+            return runner(_shifted(changed, section[0] if fraction is None else fraction), base_dir)
         except InvalidInputError as err:
             raise AnalysisError(f"{parameter} = {p:g}: {err}") from None
 
@@ -152,22 +170,60 @@ def continue_orbit(
         # The monodromy from the scaled Jacobian: D P = S (J_z + I) S^-1.
         monodromy = (jac_z + np.eye(size)) * scale[:size, None] / scale[None, :size]
         multipliers = np.linalg.eigvals(monodromy)
-        recorded = run_at(p).periods(z, periods, record=True)
+        run = run_at(p)
+        recorded = run.periods(z, periods, record=True)
         kinds = recorded["contacts"]["kind"]
         impacts = sum(1 for kind in kinds if kind in ("impact", "compliant")) / periods
+        # The state at t = 0: the rest of the period from the section.
+        at_zero = z
+        if section[0]:
+            at_zero = np.asarray(
+                run._run(z, (1.0 - section[0]) * run.period, record=False, strobe=False)[
+                    "final_state"
+                ],
+                dtype=float,
+            )
         return BranchPoint(
             value=p,
-            state=z,
+            state=at_zero,
             floquet_multipliers=multipliers,
             stable=bool(np.all(np.abs(multipliers) < 1.0)),
             impacts_per_period=impacts,
             amplitude=np.asarray(recorded["peaks"], dtype=float),
         )
 
+    def clear_of_impacts(u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``u`` and ``t`` on a section moved away from the impacts, if one is near."""
+        if not shiftable:
+            return u, t
+        p = float(u[size] * scale[size])
+        z = u[:size] * scale[:size]
+        run = run_at(p)
+        raw = run.periods(z, periods)
+        onsets = np.asarray(raw["contacts"]["onset"], dtype=float)
+        if onsets.size == 0:
+            return u, t
+        span_t = periods * run.period
+        phases = np.sort(np.mod(onsets / span_t, 1.0))
+        near = min(float(phases[0]), float(1.0 - phases[-1]))
+        if near > 0.02:
+            return u, t
+        gaps = np.diff(np.concatenate([phases, [phases[0] + 1.0]]))
+        widest = int(np.argmax(gaps))
+        move = float(phases[widest] + gaps[widest] / 2) % 1.0
+        moved = np.asarray(
+            run._run(z, move * span_t, record=False, strobe=False)["final_state"], dtype=float
+        )
+        section[0] = (section[0] + move * periods) % 1.0
+        u = np.concatenate([moved / scale[:size], [u[size]]])
+        new_t = tangent(jacobian(u), None)
+        return u, (new_t if new_t[size] * t[size] > 0 else -new_t)
+
     u = np.concatenate([first.state, [start_value]]) / scale
     jac = jacobian(u)
     t = tangent(jac, None)
     points = [point(u, jac[:, :size])]
+    u, t = clear_of_impacts(u, t)
     h = ds / abs(span)
     stopped = "max_points"
     while len(points) < max_points:
@@ -202,7 +258,7 @@ def continue_orbit(
         candidate = point(corrected, jac[:, :size])
         candidate.flags, candidate.crossings = _flags(points[-1], candidate, t, new_t, size)
         points.append(candidate)
-        u, t = corrected, new_t
+        u, t = clear_of_impacts(corrected, new_t)
         h = min(h * 1.5, 4 * ds / abs(span))
         if (candidate.value - stop) * span >= 0:
             stopped = "reached stop"
@@ -242,6 +298,26 @@ def _flags(
     if before.impacts_per_period != after.impacts_per_period:
         flags.append("grazing")
     return flags, crossings
+
+
+def _shifted(data: dict[str, Any], fraction: float) -> dict[str, Any]:
+    """``data`` with its harmonic excitations started ``fraction`` of the forcing period
+    later (each phase advanced by its frequency times that time): t = 0 then is that
+    instant of the original forcing."""
+    if not fraction:
+        return data
+    out = copy.deepcopy(data)
+    delay = fraction * forcing_period(out)
+    for e in out.get("excitation", ()):
+        if e.get("signal") == "harmonic":
+            e["phase"] = float(e.get("phase", 0.0)) + 2 * math.pi * e["frequency"] * delay
+        elif e.get("signal") == "harmonics":
+            phases = list(e.get("phases", [0.0] * len(e["frequencies"])))
+            e["phases"] = [
+                float(ph) + 2 * math.pi * f * delay
+                for ph, f in zip(phases, e["frequencies"], strict=True)
+            ]
+    return out
 
 
 def _value_of(data: Mapping[str, Any], parameter: str) -> float:
