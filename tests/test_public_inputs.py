@@ -124,6 +124,10 @@ def _run_study(**kwargs: Any) -> Any:
     )
 
 
+def _prepared_shoot(**kwargs: Any) -> Any:
+    return _prepared_system(**PREPARED).shoot([0.01, 0.0], max_iterations=2, **kwargs)
+
+
 def _prepared_run(**kwargs: Any) -> Any:
     return _prepared_system(**PREPARED).run([0.01, 0.0], **kwargs)
 
@@ -194,6 +198,7 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
             "tolerance": 1e-6,
         },
     ),
+    "PreparedSystem.shoot": (_prepared_shoot, {"t_end": 1e-2, "tolerance": 1e-10}),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (
         vi.hertz_stiffness,

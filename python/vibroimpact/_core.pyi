@@ -269,6 +269,9 @@ class PreparedSystem:
         record_from: float | None = None,
         strobe_period: float | None = None,
     ) -> dict[str, Any]: ...
+    def shoot(
+        self, state: list[float], t_end: float, *, tolerance: float, max_iterations: int
+    ) -> dict[str, Any]: ...
 
 def simulate(
     system: ImpactDamper,

@@ -153,16 +153,12 @@ class Runner:
     def _run(
         self, state: np.ndarray | None, t_end: float, *, record: bool, strobe: bool
     ) -> dict[str, Any]:
-        if self._prepared_system is None:
-            self._prepared_system = PreparedSystem(
-                self.prepared.binding_spec(), **self.prepared.method_arguments()
-            )
         z = self.initial_state() if state is None else state
         if len(z) != 2 * (self.n + self.k):
             raise AnalysisError(
                 f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(z)}"
             )
-        raw = self._prepared_system.run(
+        raw = self.system().run(
             [float(v) for v in z],
             t_end,
             record_from=0.0 if record else None,
@@ -170,6 +166,14 @@ class Runner:
         )
         self.runs += 1
         return raw
+
+    def system(self) -> PreparedSystem:
+        """The core's checked system with its method (made once)."""
+        if self._prepared_system is None:
+            self._prepared_system = PreparedSystem(
+                self.prepared.binding_spec(), **self.prepared.method_arguments()
+            )
+        return self._prepared_system
 
     def periods(
         self, state: np.ndarray, count: int, *, record: bool = False, strobe: bool = False
@@ -180,6 +184,24 @@ class Runner:
     def map(self, state: np.ndarray, count: int) -> np.ndarray:
         """The stroboscopic map over ``count`` periods."""
         return np.asarray(self.periods(state, count)["final_state"], dtype=float)
+
+    def shoot(
+        self, state: np.ndarray, count: int, tolerance: float, max_iterations: int
+    ) -> dict[str, Any]:
+        """Newton's shooting over ``count`` periods from ``state``, in the core (see
+        :func:`orbit`)."""
+        if len(state) != 2 * (self.n + self.k):
+            raise AnalysisError(
+                f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(state)}"
+            )
+        shot: dict[str, Any] = self.system().shoot(
+            [float(v) for v in state],
+            count * self.period,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+        )
+        self.runs += int(shot["maps"])
+        return shot
 
 
 def runner(data: Mapping[str, Any], base_dir: Path | None = None) -> Runner:
@@ -579,65 +601,16 @@ def orbit(
     would start inside a wall are halved."""
     if not isinstance(periods, int) or isinstance(periods, bool) or periods < 1:
         raise AnalysisError(f"periods: must be a whole number >= 1, got {periods!r}")
+    if not tolerance > 0:
+        raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    shot = run.shoot(z, periods, tolerance, max_iterations)
     size = len(z)
-    dim = size // 2
-
-    def scales(z: np.ndarray, image: np.ndarray) -> np.ndarray:
-        both = np.vstack([z, image])
-        x = max(float(np.max(np.abs(both[:, :dim]), initial=0.0)), 1e-12)
-        v = max(float(np.max(np.abs(both[:, dim:]), initial=0.0)), 1e-12)
-        return np.concatenate([np.full(dim, x), np.full(dim, v)])
-
-    def jacobian(z: np.ndarray, scale: np.ndarray, image: np.ndarray) -> np.ndarray:
-        jac = np.zeros((size, size))
-        for j in range(size):
-            h = 1e-6 * scale[j]
-            plus, minus = z.copy(), z.copy()
-            plus[j] += h
-            minus[j] -= h
-            try:
-                jac[:, j] = (run.map(plus, periods) - run.map(minus, periods)) / (2 * h)
-            except InvalidInputError:
-                # On a wall one side is inside it: a one-sided difference.
-                try:
-                    jac[:, j] = (run.map(plus, periods) - image) / h
-                except InvalidInputError:
-                    jac[:, j] = (image - run.map(minus, periods)) / h
-        return jac
-
-    image = run.map(z, periods)
-    residual = math.inf
-    converged = False
-    iterations = 0
-    jac = np.eye(size)
-    while iterations < max_iterations:
-        iterations += 1
-        scale = scales(z, image)
-        residual = float(np.max(np.abs(image - z) / scale))
-        if residual <= tolerance:
-            converged = True
-            break
-        jac = jacobian(z, scale, image)
-        try:
-            step = np.linalg.lstsq(jac - np.eye(size), -(image - z), rcond=None)[0]
-        except np.linalg.LinAlgError:
-            break
-        factor = 1.0
-        while True:
-            trial = z + factor * step
-            try:
-                trial_image = run.map(trial, periods)
-            except InvalidInputError:
-                # A start inside a wall: a shorter Newton step.
-                factor *= 0.5
-                if factor < 1e-6:
-                    raise
-                continue
-            break
-        z, image = trial, trial_image
-    if converged or residual <= tolerance:
-        jac = jacobian(z, scales(z, image), image)
+    z = np.asarray(shot["state"], dtype=float)
+    jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
+    converged = bool(shot["converged"])
+    iterations = int(shot["iterations"])
+    residual = float(shot["residual"])
     multipliers = np.linalg.eigvals(jac)
     recorded = run.periods(z, periods, record=True)
     return Orbit(

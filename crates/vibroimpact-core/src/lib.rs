@@ -26,6 +26,7 @@ pub mod records;
 pub mod reductions;
 pub mod run;
 pub mod settings;
+pub mod shooting;
 pub mod signals;
 pub mod steppers;
 pub mod structure;

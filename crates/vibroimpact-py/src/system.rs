@@ -335,6 +335,21 @@ impl Ready {
         record_from: Option<f64>,
         strobe_period: Option<f64>,
     ) -> PyResult<core::system_events::SystemSolution> {
+        released(py, |interrupt| {
+            self.integrate(y0, t_end, history, record_from, strobe_period, interrupt)
+        })
+    }
+
+    /// Integrate from `y0` (the caller holds no GIL).
+    fn integrate(
+        &mut self,
+        y0: &[f64],
+        t_end: f64,
+        history: (bool, u64),
+        record_from: Option<f64>,
+        strobe_period: Option<f64>,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> core::Result<core::system_events::SystemSolution> {
         let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
         // A fixed step that divides the strobe period lands on its multiples.
         let fit = |step: f64| {
@@ -371,12 +386,24 @@ impl Ready {
         };
         let system = &self.system;
         match &mut self.stepper {
-            AnyStepper::Rk(s) => released(py, |i| integrate_system(system, s, y0, &options, i)),
-            AnyStepper::Newmark(s) => {
-                released(py, |i| integrate_system(system, s, y0, &options, i))
-            }
-            AnyStepper::Exact(s) => released(py, |i| integrate_system(system, s, y0, &options, i)),
+            AnyStepper::Rk(s) => integrate_system(system, s, y0, &options, interrupt),
+            AnyStepper::Newmark(s) => integrate_system(system, s, y0, &options, interrupt),
+            AnyStepper::Exact(s) => integrate_system(system, s, y0, &options, interrupt),
         }
+    }
+
+    /// The stroboscopic map over `t_end` from the flat state `z` (x then v).
+    fn map(
+        &mut self,
+        z: &[f64],
+        t_end: f64,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> core::Result<Vec<f64>> {
+        let (n, d) = (self.system.n, self.system.dim);
+        let y0 = resumed_state(&self.system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..]])?;
+        Ok(self
+            .integrate(&y0, t_end, (false, 1), None, None, interrupt)?
+            .final_state)
     }
 }
 
@@ -479,6 +506,51 @@ impl PreparedSystem {
         .map_err(to_py)?;
         let sol = ready.run(py, &y0, t_end, (false, 1), record_from, strobe_period)?;
         solution_dict(py, &ready.system, sol)
+    }
+
+    /// Shoot for a periodic orbit over `t_end` s (whole forcing periods) from
+    /// the flat state `state` (see `vibroimpact.analyses.orbit`): Newton's
+    /// method with a central-difference Jacobian, all in the core with the GIL
+    /// released. Returns `state`, `monodromy` (flat, row-major), `converged`,
+    /// `iterations`, `residual`.
+    #[pyo3(signature = (state, t_end, *, tolerance, max_iterations))]
+    fn shoot<'py>(
+        &self,
+        py: Python<'py>,
+        state: Vec<f64>,
+        #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
+        #[pyo3(from_py_with = crate::convert::real)] tolerance: f64,
+        max_iterations: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        check("t_end", t_end, t_end > 0.0, "> 0 s")?;
+        check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
+        let mut ready = self.ready.lock().map_err(|_| {
+            InvalidInputError::new_err("a run of this system failed; make it again")
+        })?;
+        if state.len() != 2 * ready.system.dim {
+            return Err(InvalidInputError::new_err(format!(
+                "state must have {} values (x then v), got {}",
+                2 * ready.system.dim,
+                state.len()
+            )));
+        }
+        let ready: &mut Ready = &mut ready;
+        let shot = released(py, |interrupt| {
+            core::shooting::shoot(
+                &mut |z| ready.map(z, t_end, interrupt),
+                &state,
+                tolerance,
+                max_iterations,
+            )
+        })?;
+        let out = PyDict::new(py);
+        out.set_item("state", shot.state.into_pyarray(py))?;
+        out.set_item("monodromy", shot.monodromy.into_pyarray(py))?;
+        out.set_item("converged", shot.converged)?;
+        out.set_item("iterations", shot.iterations)?;
+        out.set_item("residual", shot.residual)?;
+        out.set_item("maps", shot.maps)?;
+        Ok(out)
     }
 }
 

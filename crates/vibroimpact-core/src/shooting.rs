@@ -1,0 +1,140 @@
+//! Shooting for periodic orbits: Newton's method on `P(z) - z = 0`, `P` a
+//! stroboscopic map, with a central-difference Jacobian (across impacts the
+//! differences include the saltation). At the orbit the Jacobian is the
+//! monodromy matrix, whose eigenvalues are the Floquet multipliers.
+
+use crate::error::{Error, Result};
+use crate::linalg;
+
+/// What a shooting found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shot {
+    pub state: Vec<f64>,
+    /// `dP/dz` at `state`, row-major.
+    pub monodromy: Vec<f64>,
+    pub converged: bool,
+    pub iterations: usize,
+    /// `max |P(z) - z|`, displacements and velocities each relative to their
+    /// largest magnitude.
+    pub residual: f64,
+    /// Maps evaluated.
+    pub maps: usize,
+}
+
+/// A start the map refuses (inside a wall) is a bad Newton step, not a failure.
+fn refused(e: &Error) -> bool {
+    matches!(e, Error::Inconsistent(_) | Error::InvalidParameter { .. })
+}
+
+/// Shoot from `z0` (displacements then velocities) for `P(z) = z`.
+pub fn shoot(
+    map: &mut dyn FnMut(&[f64]) -> Result<Vec<f64>>,
+    z0: &[f64],
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<Shot> {
+    let size = z0.len();
+    let dim = size / 2;
+    let mut maps = 0usize;
+    let scales = |z: &[f64], image: &[f64]| {
+        let largest = |range: std::ops::Range<usize>| {
+            range
+                .flat_map(|i| [z[i].abs(), image[i].abs()])
+                .fold(1e-12f64, f64::max)
+        };
+        let (x, v) = (largest(0..dim), largest(dim..size));
+        (0..size)
+            .map(|i| if i < dim { x } else { v })
+            .collect::<Vec<f64>>()
+    };
+    let mut z = z0.to_vec();
+    maps += 1;
+    let mut image = map(&z)?;
+    let residual_of = |z: &[f64], image: &[f64], scale: &[f64]| {
+        (0..size)
+            .map(|i| (image[i] - z[i]).abs() / scale[i])
+            .fold(0.0f64, f64::max)
+    };
+    let (mut residual, mut converged, mut iterations) = (f64::INFINITY, false, 0);
+    while iterations < max_iterations {
+        iterations += 1;
+        let scale = scales(&z, &image);
+        residual = residual_of(&z, &image, &scale);
+        if residual <= tolerance {
+            converged = true;
+            break;
+        }
+        let jac = jacobian(map, &z, &image, &scale, &mut maps)?;
+        let mut system = jac.clone();
+        for i in 0..size {
+            system[i * size + i] -= 1.0;
+        }
+        let mut step: Vec<f64> = (0..size).map(|i| z[i] - image[i]).collect();
+        linalg::solve_in_place(&mut system, &mut step, size);
+        let mut factor = 1.0;
+        loop {
+            let trial: Vec<f64> = z.iter().zip(&step).map(|(z, s)| z + factor * s).collect();
+            maps += 1;
+            match map(&trial) {
+                Ok(next) => {
+                    z = trial;
+                    image = next;
+                    break;
+                }
+                Err(e) if refused(&e) && factor > 1e-6 => factor *= 0.5,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+    if !converged {
+        let scale = scales(&z, &image);
+        residual = residual_of(&z, &image, &scale);
+        converged = residual <= tolerance;
+    }
+    let scale = scales(&z, &image);
+    let monodromy = jacobian(map, &z, &image, &scale, &mut maps)?;
+    Ok(Shot {
+        state: z,
+        monodromy,
+        converged,
+        iterations,
+        residual,
+        maps,
+    })
+}
+
+/// The central-difference Jacobian of `map` at `z` (`image = map(z)`), steps
+/// of 1e-6 of `scale`; one-sided where one side is refused (inside a wall).
+fn jacobian(
+    map: &mut dyn FnMut(&[f64]) -> Result<Vec<f64>>,
+    z: &[f64],
+    image: &[f64],
+    scale: &[f64],
+    maps: &mut usize,
+) -> Result<Vec<f64>> {
+    let size = z.len();
+    let mut jac = vec![0.0; size * size];
+    for j in 0..size {
+        let h = 1e-6 * scale[j];
+        let (mut plus, mut minus) = (z.to_vec(), z.to_vec());
+        plus[j] += h;
+        minus[j] -= h;
+        *maps += 2;
+        let up = map(&plus);
+        let down = map(&minus);
+        let column: Vec<f64> = match (up, down) {
+            (Ok(a), Ok(b)) => a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect(),
+            (Ok(a), Err(e)) if refused(&e) => {
+                a.iter().zip(image).map(|(a, b)| (a - b) / h).collect()
+            }
+            (Err(e), Ok(b)) if refused(&e) => {
+                image.iter().zip(&b).map(|(a, b)| (a - b) / h).collect()
+            }
+            (Err(e), _) | (_, Err(e)) => return Err(e),
+        };
+        for i in 0..size {
+            jac[i * size + j] = column[i];
+        }
+    }
+    Ok(jac)
+}
