@@ -438,3 +438,14 @@ def test_bad_monte_carlo_sections_exit_2(
     assert len(done.stderr.strip().splitlines()) == 1
     for word in words:
         assert word in done.stderr, done.stderr
+
+
+def test_an_unreachable_dask_scheduler_is_a_usage_error_and_leaves_nothing(
+    tmp_path: Path,
+) -> None:
+    path = scenario(tmp_path, BASE + STEADY)
+    out = tmp_path / "r.nc"
+    done = cli("study", str(path), "--out", str(out), "--dask", "tcp://127.0.0.1:9")
+    assert done.returncode == 2, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "--dask" in done.stderr
+    assert not out.exists() and not out.with_name(out.name + ".parts").exists()

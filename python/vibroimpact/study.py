@@ -467,12 +467,18 @@ def run(
             rate = state["computed"] / max(time.perf_counter() - start, 1e-9)
             progress(state["done"], study.runs, rate)
 
-    if dask is None:
-        for number in pending:
-            runs = chunks[number]
-            finished(number, chunk_part(study, runs.start, runs.stop, threads))
-    else:
-        _run_on_dask(study, chunks, pending, dask, threads, finished)
+    try:
+        if dask is None:
+            for number in pending:
+                runs = chunks[number]
+                finished(number, chunk_part(study, runs.start, runs.stop, threads))
+        else:
+            _run_on_dask(study, chunks, pending, dask, threads, finished)
+    except BaseException:
+        # Nothing finished: leave nothing behind (a resume has nothing to go on).
+        if not any(parts_dir.glob("chunk-*.npz")):
+            shutil.rmtree(parts_dir, ignore_errors=True)
+        raise
     parts = [_load(path) for path in path_of]
     dataset = assemble(study, parts)
     with written_whole(out, binary=True) as f:
