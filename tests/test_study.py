@@ -449,3 +449,35 @@ def test_an_unreachable_dask_scheduler_is_a_usage_error_and_leaves_nothing(
     assert done.returncode == 2, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and "--dask" in done.stderr
     assert not out.exists() and not out.with_name(out.name + ".parts").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "text", "words"),
+    [
+        (["--dask", "lcoal"], BASE + STEADY, ["--dask lcoal", "tcp://HOST:8786"]),
+        ([], (BASE + STEADY).replace("metrics =", "metric ="), ["did you mean 'metrics'"]),
+        (
+            ["--plot", "p.png"],
+            (BASE + STEADY).replace('"excitation.0.frequency" = [9.0, 10.0, 11.0]\n', ""),
+            ["two axes", "has one"],
+        ),
+    ],
+    ids=["misspelt dask address", "misspelt metrics key", "plot of one axis"],
+)
+def test_study_mistakes_found_by_a_new_user_exit_2(
+    tmp_path: Path, args: list[str], text: str, words: list[str]
+) -> None:
+    out = tmp_path / "r.nc"
+    done = cli("study", str(scenario(tmp_path, text)), "--out", str(out), *args)
+    assert done.returncode == 2, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    for word in words:
+        assert word in done.stderr, done.stderr
+    assert not out.exists() and not out.with_name(out.name + ".parts").exists()
+
+
+def test_a_study_into_a_missing_folder_is_refused(tmp_path: Path) -> None:
+    out = tmp_path / "missing" / "r.nc"
+    done = cli("study", str(scenario(tmp_path, BASE + STEADY)), "--out", str(out))
+    assert done.returncode == 2 and "cannot write" in done.stderr, done.stderr
+    assert not (tmp_path / "missing").exists()

@@ -38,9 +38,11 @@ point. SI units.
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import importlib
 import json
+import logging
 import math
 import os
 import shutil
@@ -109,7 +111,14 @@ def study_settings(table: Any) -> dict[str, Any]:
     values (``axes``: a dict, path to array)."""
     if not isinstance(table, Mapping):
         raise StudyError(f"[study]: must be a table, got {table!r:.60}")
-    plain = {k: v for k, v in table.items() if k not in ("metrics", "axes", "random")}
+    sections = ("metrics", "axes", "random")
+    allowed = [*_STUDY, *sections]
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(str(key), allowed, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise StudyError(f"[study] unknown key {key!r} (allowed: {', '.join(allowed)}){hint}")
+    plain = {k: v for k, v in table.items() if k not in sections}
     out = _table("[study] ", plain, _STUDY)
     _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
     metrics = table.get("metrics", ["peak", "rms", "impacts"])
@@ -120,7 +129,8 @@ def study_settings(table: Any) -> dict[str, Any]:
     steady_only = {"amplitude", "impacts_per_period", "settled"} & set(metrics)
     if steady_only and out["analysis"] != "steady-state":
         raise StudyError(
-            f'[study] metrics: {", ".join(sorted(steady_only))} need analysis = "steady-state"'
+            f"[study] metrics: {', '.join(sorted(steady_only))} "
+            f'{"needs" if len(steady_only) == 1 else "need"} analysis = "steady-state"'
         )
     out["metrics"] = list(dict.fromkeys(metrics))
     for key, low in (("settle_periods", 0), ("record_periods", 1), ("chunk_size", 1)):
@@ -448,7 +458,7 @@ def run(
             )
     else:
         try:
-            parts_dir.mkdir(parents=True)
+            parts_dir.mkdir()
         except OSError as err:
             raise UsageError(f"cannot write {str(parts_dir)!r}: {err.strerror or err}") from None
         with written_whole(manifest) as f:
@@ -511,12 +521,17 @@ def _run_on_dask(
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=None,
+                # Its workers' own messages (an interrupt stops them too) are noise.
+                silence_logs=logging.CRITICAL,
             )
             client = distributed.Client(cluster)
         else:
             client = distributed.Client(address, timeout="10s")
-    except OSError as err:
-        raise UsageError(f"--dask {address}: cannot reach the scheduler ({err})") from None
+    except (OSError, ValueError, TypeError) as err:
+        raise UsageError(
+            f"--dask {address}: cannot reach the scheduler ({err}); give 'local' or an "
+            "address such as tcp://HOST:8786"
+        ) from None
     try:
         shared = client.scatter(study, broadcast=True)
         futures = {

@@ -74,6 +74,11 @@ def run_study_command(args: argparse.Namespace) -> int:
     metric = args.metric or study.settings["metrics"][0]
     x = args.x or axes[0]
     y = args.y or (axes[1] if len(axes) > 1 else None)
+    if args.plot and len(axes) < 2:
+        raise UsageError(
+            f"--plot draws a heat map over two axes; the study has one ({axes[0]}): add an "
+            "axis or drop --plot"
+        )
     if args.plot:
         metrics = ", ".join(study.settings["metrics"])
         if metric not in study.settings["metrics"]:
