@@ -481,3 +481,11 @@ def test_a_study_into_a_missing_folder_is_refused(tmp_path: Path) -> None:
     done = cli("study", str(scenario(tmp_path, BASE + STEADY)), "--out", str(out))
     assert done.returncode == 2 and "cannot write" in done.stderr, done.stderr
     assert not (tmp_path / "missing").exists()
+
+
+def test_the_axes_carry_their_units(tmp_path: Path) -> None:
+    ds = st.run(load(scenario(tmp_path, BASE + STEADY)), tmp_path / "out.nc")
+    assert ds["damper.0.clearance"].attrs["units"] == "m"
+    assert ds["excitation.0.frequency"].attrs["units"] == "Hz"
+    with xr.open_dataset(tmp_path / "out.nc", engine="scipy") as back:
+        assert back["excitation.0.frequency"].attrs["units"] == "Hz"

@@ -258,5 +258,14 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
         iy, ix = np.unravel_index(flat, grid.shape)
         ax.plot(dataset[x].values[ix], dataset[y].values[iy], "r*", ms=14, label="optimum")
         ax.legend(loc="upper right")
+        for axis, name in ((ax.xaxis, x), (ax.yaxis, y)):
+            values = np.asarray(dataset[name].values, dtype=float)
+            # An axis spaced logarithmically is drawn so.
+            if len(values) > 2 and np.all(values > 0):
+                steps = np.diff(np.log(values))
+                if np.allclose(steps, steps[0]) and not np.allclose(
+                    np.diff(values), values[1] - values[0]
+                ):
+                    (ax.set_xscale if axis is ax.xaxis else ax.set_yscale)("log")
         ax.set_xlabel(f"{x}{_unit(x)}")
         ax.set_ylabel(f"{y}{_unit(y)}")

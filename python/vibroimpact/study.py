@@ -367,16 +367,23 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
             data_vars[name] = ([*dims, "pair"], values.reshape(*shape, len(pairs)), attrs)
         else:
             data_vars[name] = (dims, values.reshape(shape), attrs)
-    coords: dict[str, Any] = {
-        path: (path, values) for path, values in study.settings["axes"].items()
-    }
+    from vibroimpact.datasets import parameter_units
+
+    coords: dict[str, Any] = {}
+    for path, values in study.settings["axes"].items():
+        axis_unit = parameter_units(path, study.data)
+        coords[path] = (path, values, {"units": axis_unit} if axis_unit else {})
     if study.settings.get("samples"):
         coords["sample"] = ("sample", np.arange(study.settings["samples"]))
         for path, draws in study.settings["random"].items():
+            axis_unit = parameter_units(path, study.data)
             data_vars[path] = (
                 ["sample"],
                 draws,
-                {"long_name": f"{path}, drawn for each sample (seed {study.settings['seed']})"},
+                {
+                    "long_name": f"{path}, drawn for each sample (seed {study.settings['seed']})",
+                    **({"units": axis_unit} if axis_unit else {}),
+                },
             )
     coords["coordinate"] = ("coordinate", np.arange(n))
     coords["pair"] = ("pair", np.array(pairs, dtype=str))
