@@ -19,7 +19,6 @@ the stroboscopic map is smooth.
 
 from __future__ import annotations
 
-import itertools
 import math
 from typing import Any
 
@@ -29,6 +28,7 @@ from numpy.typing import NDArray
 from scipy.linalg import expm
 
 import vibroimpact as vi
+from orbit_checks import spectrum_distance, state_error  # noqa: E402
 from vibroimpact import analyses as an
 from vibroimpact.system import SystemSolution
 
@@ -37,29 +37,6 @@ Complex = NDArray[np.complex128]
 
 EXACT: dict[str, Any] = {"method": "exact", "t_end": 1.0}
 DOP853: dict[str, Any] = {"method": "dop853", "t_end": 1.0, "rtol": 1e-12, "atol": 1e-15}
-
-
-def spectrum_distance(actual: NDArray[Any], expected: NDArray[Any]) -> float:
-    """The largest distance between two sets of eigenvalues, best paired."""
-    a = np.asarray(actual, dtype=complex)
-    b = np.asarray(expected, dtype=complex)
-    assert a.shape == b.shape
-    return min(
-        float(np.max(np.abs(a[list(p)] - b), initial=0.0))
-        for p in itertools.permutations(range(len(a)))
-    )
-
-
-def state_error(actual: Array, expected: Array) -> float:
-    """max |actual - expected|, displacements and velocities each relative to the
-    largest |value| of ``expected`` of their kind."""
-    d = len(expected) // 2
-    x_scale = float(np.max(np.abs(expected[:d])))
-    v_scale = float(np.max(np.abs(expected[d:])))
-    return max(
-        float(np.max(np.abs(actual[:d] - expected[:d]))) / x_scale,
-        float(np.max(np.abs(actual[d:] - expected[d:]))) / v_scale,
-    )
 
 
 # --------------------------------------------------------------------------------------

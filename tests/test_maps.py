@@ -21,7 +21,6 @@ acceleration is ``A cos(w t + p)``, i.e. the table's displacement is
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 import re
@@ -41,6 +40,7 @@ from scipy.linalg import expm
 from scipy.optimize import minimize_scalar
 
 import vibroimpact as vi
+from orbit_checks import spectrum_distance, state_error  # noqa: E402
 from vibroimpact import analyses as an
 from vibroimpact.continuation import Branch, continue_orbit
 from vibroimpact.maps import basins, bifurcation, poincare
@@ -63,27 +63,6 @@ PNG_END = b"IEND\xaeB`\x82"
 def load(path: Path) -> dict[str, Any]:
     with path.open("rb") as f:
         return tomllib.load(f)
-
-
-def state_error(actual: Array, expected: Array) -> float:
-    """max |actual - expected|, displacements and velocities each relative to the
-    largest |value| of ``expected`` of their kind."""
-    d = len(expected) // 2
-    return max(
-        float(np.max(np.abs(actual[:d] - expected[:d]))) / float(np.max(np.abs(expected[:d]))),
-        float(np.max(np.abs(actual[d:] - expected[d:]))) / float(np.max(np.abs(expected[d:]))),
-    )
-
-
-def spectrum_distance(actual: NDArray[Any], expected: NDArray[Any]) -> float:
-    """The largest distance between two sets of eigenvalues, best paired."""
-    a = np.asarray(actual, dtype=complex)
-    b = np.asarray(expected, dtype=complex)
-    assert a.shape == b.shape
-    return min(
-        float(np.max(np.abs(a[list(p)] - b), initial=0.0))
-        for p in itertools.permutations(range(len(a)))
-    )
 
 
 def angle_between(a: Array, b: float) -> Array:

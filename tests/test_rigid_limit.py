@@ -34,6 +34,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from orbit_checks import spectrum_distance, state_error  # noqa: E402
 from vibroimpact import analyses as an
 
 Array = NDArray[np.float64]
@@ -46,29 +47,6 @@ from masri_caughey import MC_F0, MC_K, MC_M, masri_caughey, mc_scenario, mc_si  
 # The stable roots of tests/test_analyses.py's MC_CASES: (mu, r, d, e).
 CASES = {"two": (0.05, 0.6, 6.0, 0.3), "one": (0.2, 1.2, 4.0, 0.6)}
 STIFFNESSES = (1e3, 1e4, 1e5, 1e6)  # N/m: the contact's w / w_n from about 60 to 1e4
-
-
-def spectrum_distance(actual: NDArray[Any], expected: NDArray[Any]) -> float:
-    """The largest distance between two sets of eigenvalues, best paired."""
-    a = np.asarray(actual, dtype=complex)
-    b = np.asarray(expected, dtype=complex)
-    assert a.shape == b.shape
-    return min(
-        float(np.max(np.abs(a[list(p)] - b), initial=0.0))
-        for p in itertools.permutations(range(len(a)))
-    )
-
-
-def state_error(actual: Array, expected: Array) -> float:
-    """max |actual - expected|, displacements and velocities each relative to the
-    largest |value| of ``expected`` of their kind."""
-    d = len(expected) // 2
-    x_scale = float(np.max(np.abs(expected[:d])))
-    v_scale = float(np.max(np.abs(expected[d:])))
-    return max(
-        float(np.max(np.abs(actual[:d] - expected[:d]))) / x_scale,
-        float(np.max(np.abs(actual[d:] - expected[d:]))) / v_scale,
-    )
 
 
 # --------------------------------------------------------------------------------------

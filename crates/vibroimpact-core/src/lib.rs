@@ -33,6 +33,7 @@ pub mod structure;
 pub mod study;
 pub mod system;
 pub mod system_events;
+pub mod system_methods;
 pub mod system_steppers;
 pub mod tableau;
 pub mod testing;

@@ -13,11 +13,10 @@ use rayon::prelude::*;
 use crate::assembly::{initial_state, Assembly, PairLaw, SystemSpec};
 use crate::contact::Contact;
 use crate::error::{Error, Result};
-use crate::exact::ExactFlow;
 use crate::reductions::ReduceOptions;
 use crate::signals::Signal;
-use crate::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
-use crate::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
+use crate::system_events::{ContactKind, RunOptions, SystemSolution};
+use crate::system_methods::AnyStepper;
 
 /// Which entry of the scenario a study varies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -372,8 +371,17 @@ fn measured(
             ((settle + record) as f64 * t, settle as f64 * t, t)
         }
     };
-    let mut options = RunOptions {
-        dt: settings.dt,
+    let mut stepper = AnyStepper::new(
+        &system,
+        &settings.method,
+        settings.rtol,
+        settings.atol,
+        settings.beta,
+        settings.gamma,
+        settings.spectral_radius,
+    )?;
+    let options = RunOptions {
+        dt: stepper.step(settings.dt, t_end, strobe_period),
         t_end,
         every: 1,
         keep_history: false,
@@ -386,66 +394,8 @@ fn measured(
             mean_square: settings.mean_square,
         },
     };
-    let len = system.state_len();
-    let never = &mut || false;
-    let sol = match settings.method.as_str() {
-        "rk4" => integrate_system(&system, &mut ExplicitRk::rk4(len), &y0, &options, never),
-        "dopri5" => integrate(
-            &system,
-            &mut ExplicitRk::dopri5(len, settings.rtol, settings.atol),
-            &y0,
-            &options,
-        ),
-        "dop853" => integrate(
-            &system,
-            &mut ExplicitRk::dop853(len, settings.rtol, settings.atol),
-            &y0,
-            &options,
-        ),
-        "newmark-implicit" => integrate(
-            &system,
-            &mut NewmarkFamily::newmark(&system, settings.beta, settings.gamma),
-            &y0,
-            &options,
-        ),
-        "generalized-alpha" => integrate(
-            &system,
-            &mut NewmarkFamily::generalized_alpha(&system, settings.spectral_radius),
-            &y0,
-            &options,
-        ),
-        "exact" => {
-            let mut flow = ExactFlow::new(&system)?;
-            let mut step = options
-                .dt
-                .unwrap_or(f64::INFINITY)
-                .min(flow.step())
-                .min(t_end);
-            if strobe_period.is_finite() {
-                step = strobe_period / (strobe_period / step - 1e-9).ceil().max(1.0);
-            }
-            options.dt = Some(step);
-            integrate(&system, &mut flow, &y0, &options)
-        }
-        other => {
-            return Err(Error::UnknownChoice {
-                field: "method",
-                allowed: "\"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
-                          \"generalized-alpha\", \"exact\"",
-                value: other.to_string(),
-            })
-        }
-    }?;
+    let sol = stepper.integrate(&system, &y0, &options, &mut || false)?;
     Ok(metrics_of(&system, &sol, record_from, settings))
-}
-
-fn integrate<S: SystemStepper>(
-    system: &Assembly,
-    stepper: &mut S,
-    y0: &[f64],
-    options: &RunOptions,
-) -> Result<SystemSolution> {
-    integrate_system(system, stepper, y0, options, &mut || false)
 }
 
 fn metrics_of(

@@ -11,12 +11,11 @@ use vibroimpact_core::assembly::{
     initial_state, resumed_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop,
     SystemSpec,
 };
-use vibroimpact_core::exact::ExactFlow;
 use vibroimpact_core::reductions::ReduceOptions;
 use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::{integrate_system, RunOptions};
-use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily};
+use vibroimpact_core::system_events::RunOptions;
+use vibroimpact_core::system_methods::AnyStepper;
 
 use crate::convert::real_or_none;
 use crate::errors::{released, to_py, InvalidInputError};
@@ -263,13 +262,6 @@ fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
     })
 }
 
-/// The method of a run, made once per system.
-enum AnyStepper {
-    Rk(ExplicitRk),
-    Newmark(NewmarkFamily),
-    Exact(ExactFlow),
-}
-
 /// The numbers a run takes beside its system and method.
 #[derive(Debug, Clone, Copy)]
 struct Limits {
@@ -301,23 +293,8 @@ impl Ready {
     ) -> PyResult<Self> {
         let system_spec = system_spec(spec, t_end)?;
         let system = Assembly::new(&system_spec).map_err(to_py)?;
-        let len = system.state_len();
-        let stepper = match method {
-            "rk4" => AnyStepper::Rk(ExplicitRk::rk4(len)),
-            "dopri5" => AnyStepper::Rk(ExplicitRk::dopri5(len, rtol, atol)),
-            "dop853" => AnyStepper::Rk(ExplicitRk::dop853(len, rtol, atol)),
-            "newmark-implicit" => AnyStepper::Newmark(NewmarkFamily::newmark(&system, beta, gamma)),
-            "generalized-alpha" => {
-                AnyStepper::Newmark(NewmarkFamily::generalized_alpha(&system, spectral_radius))
-            }
-            "exact" => AnyStepper::Exact(ExactFlow::new(&system).map_err(to_py)?),
-            other => {
-                return Err(InvalidInputError::new_err(format!(
-                    "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
-                     \"generalized-alpha\", \"exact\" for a [structure] system, got {other:?}"
-                )))
-            }
-        };
+        let stepper = AnyStepper::new(&system, method, rtol, atol, beta, gamma, spectral_radius)
+            .map_err(to_py)?;
         Ok(Self {
             system,
             stepper,
@@ -351,25 +328,8 @@ impl Ready {
         interrupt: &mut dyn FnMut() -> bool,
     ) -> core::Result<core::system_events::SystemSolution> {
         let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
-        // A fixed step that divides the strobe period lands on its multiples.
-        let fit = |step: f64| {
-            if strobe_period.is_finite() {
-                strobe_period / (strobe_period / step - 1e-9).ceil().max(1.0)
-            } else {
-                step
-            }
-        };
         let limits = self.limits;
-        let dt = match &self.stepper {
-            // dt, when given, caps the flow's own step (a finer check of the
-            // gaps between step ends).
-            AnyStepper::Exact(flow) => Some(fit(limits
-                .dt
-                .unwrap_or(f64::INFINITY)
-                .min(flow.step())
-                .min(t_end))),
-            _ => limits.dt.map(fit),
-        };
+        let dt = self.stepper.step(limits.dt, t_end, strobe_period);
         let options = RunOptions {
             dt,
             t_end,
@@ -384,12 +344,8 @@ impl Ready {
                 mean_square: true,
             },
         };
-        let system = &self.system;
-        match &mut self.stepper {
-            AnyStepper::Rk(s) => integrate_system(system, s, y0, &options, interrupt),
-            AnyStepper::Newmark(s) => integrate_system(system, s, y0, &options, interrupt),
-            AnyStepper::Exact(s) => integrate_system(system, s, y0, &options, interrupt),
-        }
+        self.stepper
+            .integrate(&self.system, y0, &options, interrupt)
     }
 
     /// The stroboscopic map over `t_end` from the flat state `z` (x then v).
