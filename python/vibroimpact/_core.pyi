@@ -241,6 +241,7 @@ def run_study(
     tolerance: float,
     threads: int,
     mean_square: bool = True,
+    stepping: str = "events",
 ) -> dict[str, Any]: ...
 
 @final

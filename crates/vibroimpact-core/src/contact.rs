@@ -111,7 +111,7 @@ impl HysterHertz {
     }
 
     /// [`HysterHertz::new`] for inputs already checked.
-    fn paper(stiffness: f64, restitution: f64) -> Self {
+    pub(crate) fn paper(stiffness: f64, restitution: f64) -> Self {
         Self {
             stiffness,
             hysteresis: paper_hysteresis(restitution),
@@ -119,7 +119,7 @@ impl HysterHertz {
     }
 
     /// [`HysterHertz::exact`] for inputs already checked.
-    fn rebounding_at(stiffness: f64, restitution: f64) -> Self {
+    pub(crate) fn rebounding_at(stiffness: f64, restitution: f64) -> Self {
         Self {
             stiffness,
             hysteresis: hysteresis_for(restitution),

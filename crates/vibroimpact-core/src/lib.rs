@@ -12,6 +12,7 @@ pub mod assembly;
 pub mod beam;
 pub mod closed_forms;
 pub mod contact;
+pub mod ensemble;
 pub mod error;
 pub mod events;
 pub mod exact;

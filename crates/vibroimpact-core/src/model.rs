@@ -1,6 +1,7 @@
 //! The equations of motion in the plain-data form the kernels use.
 
 use crate::contact::ContactLaw;
+use crate::hermite;
 use crate::system::{ImpactDamper, State};
 
 /// A force on the main mass that depends on time only (N). The hook for
@@ -54,6 +55,17 @@ pub enum Mode {
     },
 }
 
+/// A contact onset located inside a fixed step ([`Model::onset_in_step`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Onset {
+    /// Fraction of the step, in [0, 1].
+    pub theta: f64,
+    /// Indentation rate at the onset, m/s (> 0 approaching).
+    pub rate: f64,
+    /// The gap function at the step start, m (> 0: already past the wall).
+    pub gap_at_start: f64,
+}
+
 /// The impact damper with its contact law and excitation, ready to integrate.
 #[derive(Debug, Clone, Copy)]
 pub struct Model<L: ContactLaw, X: Excitation> {
@@ -66,10 +78,10 @@ pub struct Model<L: ContactLaw, X: Excitation> {
     pub law: L,
     pub excitation: X,
     /// `1 / main_mass` and `1 / impact_mass`: multiplications in the hot loop.
-    inverse_main_mass: f64,
-    inverse_impact_mass: f64,
-    damping_per_mass: f64,
-    stiffness_per_mass: f64,
+    pub(crate) inverse_main_mass: f64,
+    pub(crate) inverse_impact_mass: f64,
+    pub(crate) damping_per_mass: f64,
+    pub(crate) stiffness_per_mass: f64,
 }
 
 impl<L: ContactLaw, X: Excitation> Model<L, X> {
@@ -99,6 +111,32 @@ impl<L: ContactLaw, X: Excitation> Model<L, X> {
             1.0
         } else {
             -1.0
+        }
+    }
+
+    /// A contact onset against wall `side` in the fixed step `s0 -> s1` of
+    /// length `dt` (s1 past the wall): where the cubic Hermite interpolant
+    /// of the gap crosses zero, as a fraction `theta` of the step, and the
+    /// indentation rate there (m/s). A step that starts past the wall (it
+    /// jumped from one wall's contact to the other's) cannot be
+    /// interpolated: its onset is the step start.
+    #[inline]
+    pub fn onset_in_step(&self, s0: &State, s1: &State, side: f64, dt: f64) -> Onset {
+        let d = self.clearance;
+        let gap_at_start = side * s0.relative_displacement() - d;
+        let g1 = side * s1.relative_displacement() - d;
+        let m0 = side * s0.relative_velocity() * dt;
+        let m1 = side * s1.relative_velocity() * dt;
+        let theta = if gap_at_start <= 0.0 {
+            hermite::root(gap_at_start, g1, m0, m1)
+        } else {
+            0.0
+        };
+        let (_, slope) = hermite::eval(gap_at_start, g1, m0, m1, theta);
+        Onset {
+            theta,
+            rate: slope / dt,
+            gap_at_start,
         }
     }
 

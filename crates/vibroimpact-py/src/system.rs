@@ -710,8 +710,10 @@ pub fn linear_parts<'py>(
 /// (`len(paths)` values a row, flat) sets the parameters at `paths` in a
 /// copy of the system and runs it, on `threads` threads (0: all cores), with
 /// the GIL released. Returns the metrics as flat arrays, one row a run.
+/// `stepping = "fixed"` runs them as a lockstep ensemble of fixed RK4 steps
+/// (one mass, one compliant damper, unforced; see `core::ensemble`).
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true))]
+#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true, stepping="events"))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_study<'py>(
     py: Python<'py>,
@@ -736,6 +738,7 @@ pub fn run_study<'py>(
     #[pyo3(from_py_with = crate::convert::real)] tolerance: f64,
     threads: usize,
     mean_square: bool,
+    stepping: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     use core::study::{run_study as study, Analysis, Parameter, StudySettings};
     check_method(
@@ -792,6 +795,15 @@ pub fn run_study<'py>(
         energy_tolerance,
         analysis,
         mean_square,
+        lockstep: match stepping {
+            "events" => false,
+            "fixed" => true,
+            other => {
+                return Err(InvalidInputError::new_err(format!(
+                    "stepping must be \"events\" or \"fixed\", got {other:?}"
+                )))
+            }
+        },
     };
     let results = released(py, |_| {
         study(

@@ -1,0 +1,193 @@
+"""Studies with ``stepping = "fixed"``: the runs advanced in lockstep by the core's
+ensemble kernel. Each run is the fixed-step RK4 run that ``vi.simulate`` makes of the
+same two-mass damper, bit for bit (its contacts, and its history's peak and RMS); the
+event-driven study of the same grid agrees to the methods' accuracy; the same results
+whatever the number of threads; a run that blows up fails alone; scenarios the kernel
+cannot take are refused naming the key."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from vibroimpact import study as st
+from vibroimpact.system_scenario import SystemScenario
+
+M, K, C, MD, D, KHZ, C1 = 1.0, 1.0, 0.01, 0.25, 0.01, 3000.0, 0.01
+DT, T_END = 1e-4, 3.0
+
+BASE = f"""
+[structure]
+kind = "oscillator"
+mass = {M}
+stiffness = {K}
+damping = {C}
+
+[[damper]]
+mass = {MD}
+at = 0
+clearance = {D}
+law = "hertz"
+stiffness = {KHZ}
+damping = {C1}
+
+[solver]
+method = "rk4"
+dt = {DT}
+t_end = {T_END}
+"""
+
+STUDY = """
+[study]
+analysis = "run"
+stepping = "fixed"
+metrics = ["peak", "rms", "impacts"]
+chunk_size = 5
+
+[study.axes]
+"initial.damper_velocity.0" = [0.06, 0.1, 0.14]
+"damper.0.clearance" = [0.005, 0.01, 0.02]
+"""
+
+
+def load(tmp_path: Path, text: str) -> st.Study:
+    path = tmp_path / "study.toml"
+    path.write_text(text)
+    sc = vi.load_scenario(path)
+    assert isinstance(sc, SystemScenario)
+    return st.study_of(sc.data, str(path), sc.base_dir)
+
+
+def test_each_run_is_the_fixed_step_kernels_run(tmp_path: Path) -> None:
+    ds = st.run(load(tmp_path, BASE + STUDY), tmp_path / "out.nc", threads=2)
+    assert int(ds["status"].max()) == 0
+    for velocity in (0.06, 0.1, 0.14):
+        for clearance in (0.005, 0.01, 0.02):
+            sol = vi.simulate(
+                vi.ImpactDamper(
+                    main_mass=M, stiffness=K, damping=C, impact_mass=MD, clearance=clearance
+                ),
+                vi.Contact("hertz", stiffness=KHZ, damping=C1),
+                vi.InitialState(impact_velocity=velocity),
+                method="rk4",
+                stepping="fixed",
+                dt=DT,
+                t_end=T_END,
+            )
+            point = ds.sel({"initial.damper_velocity.0": velocity, "damper.0.clearance": clearance})
+            assert point["impacts"].item() == len(sol.contacts.onset) > 0
+            w = sol.main_displacement
+            # RMS: the trapezoidal rule over the same step ends.
+            rms = np.sqrt(np.trapezoid(w * w, dx=DT) / T_END)
+            assert point["rms"].item() == pytest.approx(rms, rel=1e-12)
+            # Peak: at least the largest step end, above it only by the located
+            # extremum inside a step (the curvature over one step: ~ (w dt)^2).
+            peak = point["peak"].item()
+            assert np.abs(w).max() <= peak <= np.abs(w).max() * (1 + 1e-7)
+
+
+def test_fixed_and_event_stepping_agree_to_the_methods_accuracy(tmp_path: Path) -> None:
+    fixed = st.run(load(tmp_path, BASE + STUDY), tmp_path / "fixed.nc")
+    events = st.run(
+        load(tmp_path, BASE + STUDY.replace('stepping = "fixed"', 'stepping = "events"')),
+        tmp_path / "events.nc",
+    )
+    assert np.array_equal(fixed["impacts"].values, events["impacts"].values)
+    # The fixed steps run through each contact onset, where the contact damper's force
+    # jumps (first order there); the event-driven steps end on it.
+    for key in ("peak", "rms"):
+        assert np.allclose(fixed[key].values, events[key].values, rtol=1e-5, atol=0), key
+        assert not np.array_equal(fixed[key].values, events[key].values), key
+
+
+def test_results_do_not_depend_on_the_number_of_threads(tmp_path: Path) -> None:
+    study = load(tmp_path, BASE + STUDY)
+    one = study.run_chunk(range(0, study.runs), threads=1)
+    two = study.run_chunk(range(1, study.runs), threads=2)
+    for key in ("peak", "rms", "impacts"):
+        a, b = np.asarray(one[key]), np.asarray(two[key])
+        assert np.array_equal(a[1:], b), key
+
+
+def test_a_run_that_blows_up_fails_alone(tmp_path: Path) -> None:
+    text = BASE + STUDY.replace(
+        '"damper.0.clearance" = [0.005, 0.01, 0.02]',
+        '"damper.0.stiffness" = [3000.0, 1e13, 3000.0]',
+    )
+    ds = st.run(load(tmp_path, text), tmp_path / "out.nc")
+    status = ds["status"].values
+    assert (status[:, 1] > 0).all() and (status[:, [0, 2]] == 0).all()
+    reasons = json.loads(ds.attrs["reasons"])
+    assert reasons and all("reduce dt" in r for r in reasons)
+    assert np.isnan(ds["peak"].values[:, 1]).all()
+
+
+def cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "vibroimpact", *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        (('stepping = "fixed"', 'stepping = "lockstep"'), ["stepping", "fixed"]),
+        (
+            ('metrics = ["peak", "rms", "impacts"]', 'metrics = ["energy_dissipated"]'),
+            ["energy_dissipated", "stepping"],
+        ),
+        (('analysis = "run"', 'analysis = "steady-state"'), ["stepping", "analysis"]),
+        (('method = "rk4"', 'method = "dop853"'), ["stepping", "rk4"]),
+        (
+            (
+                f'law = "hertz"\nstiffness = {KHZ}\ndamping = {C1}',
+                'law = "rigid"\nrestitution = 0.5',
+            ),
+            ["stepping", "rigid"],
+        ),
+        (
+            ("clearance = 0.01", "lower_clearance = 0.01\nupper_clearance = 0.02"),
+            ["stepping", "clearances"],
+        ),
+        (("[solver]", "[gravity]\n[solver]"), ["stepping", "gravity"]),
+    ],
+)
+def test_what_the_lockstep_kernel_cannot_take_exits_2_naming_the_key(
+    tmp_path: Path, change: tuple[str, str], words: list[str]
+) -> None:
+    text = (BASE + STUDY).replace(*change)
+    assert text != BASE + STUDY
+    path = tmp_path / "study.toml"
+    path.write_text(text)
+    done = cli("study", str(path), "--out", str(tmp_path / "r.nc"))
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert not (tmp_path / "r.nc").exists()
+
+
+def test_the_readme_lockstep_block_runs(tmp_path: Path) -> None:
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("### Lockstep ensembles", 1)[1].split("\n## ", 1)[0]
+    block = section.split("```toml\n", 1)[1].split("```", 1)[0]
+    # Fewer runs than the README's 10000, to keep the test short.
+    assert "count = 10000" in block
+    ds = st.run(
+        load(tmp_path, BASE + block.replace("count = 10000", "count = 16")), tmp_path / "r.nc"
+    )
+    assert int(ds["status"].max()) == 0
+    assert (ds["impacts"].values > 0).all()
+    # A faster loose mass rattles harder: the peak grows along the axis.
+    assert (np.diff(ds["peak"].values[:, 0]) > 0).all()
