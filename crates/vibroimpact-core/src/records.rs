@@ -375,6 +375,13 @@ impl EnergyLedger {
         self.external
     }
 
+    /// The first step count after `steps` at which a check is due (short of
+    /// the last step's).
+    #[inline(always)]
+    pub(crate) fn next_due(&self, steps: u64) -> u64 {
+        (steps / ENERGY_INTERVAL + 1) * ENERGY_INTERVAL
+    }
+
     /// Whether to check at this many steps (every few steps, and at the end).
     #[inline(always)]
     pub(crate) fn due(&self, steps: u64, last: bool) -> bool {

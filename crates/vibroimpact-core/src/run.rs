@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::events::integrate_events;
 use crate::hermite;
 use crate::integrators::{Integrator, Newmark, Rk4};
-use crate::model::{Excitation, Free, Model};
+use crate::model::{Excitation, Free, Model, Onset};
 use crate::records::*;
 use crate::settings::*;
 use crate::steppers::{Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper};
@@ -25,6 +25,9 @@ struct OpenContact {
     energy: f64,
     /// The ledger's non-conservative work at onset, J.
     work: f64,
+    /// The power of the contact's dissipative forces now (at the step's
+    /// start), W: the last step's end value, not evaluated again.
+    power: f64,
 }
 
 /// How often (in steps) the kernel asks whether to stop; a power of two, a
@@ -71,6 +74,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
             dissipated: 0.0,
             energy: ledger.initial,
             work: 0.0,
+            power: model.contact_dissipation(&start),
         })
     } else {
         None
@@ -86,15 +90,23 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
     // cost more than a Newmark step.
     let mut until_kept = every;
 
-    for n in 0..n_steps {
+    // A step the free flight below took and handed over (it left |y - w| <= d).
+    let mut pending: Option<State> = None;
+    let mut n: u64 = 0;
+    while n < n_steps {
         let t = t0 + n as f64 * dt;
         let t1 = t0 + (n + 1) as f64 * dt;
-        if open.is_none() {
-            // Provisional latch for stages that enter contact within this step;
-            // replaced by the located onset rate once the onset is found.
-            approach = model.side(&s) * s.relative_velocity();
-        }
-        let s1 = integrator.step(model, &s, t, dt, approach);
+        let s1 = match pending.take() {
+            Some(s1) => s1,
+            None => {
+                if open.is_none() {
+                    // Provisional latch for stages that enter contact within this
+                    // step; replaced by the located onset rate once it is found.
+                    approach = model.side(&s) * s.relative_velocity();
+                }
+                integrator.step(model, &s, t, dt, approach)
+            }
+        };
         if !s1.is_finite() {
             return Err(Error::NumericalBlowUp {
                 time: t1,
@@ -112,23 +124,16 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                 let side = model.side(&s1);
                 let g1 = side * s1.relative_displacement() - d;
                 if g1 > 0.0 {
-                    let g0 = side * s.relative_displacement() - d;
-                    let m0 = side * s.relative_velocity() * dt;
-                    let m1 = side * s1.relative_velocity() * dt;
-                    // A step that jumps from one wall's contact to the other's
-                    // cannot be interpolated; the onset is then the step start.
-                    let theta = if g0 <= 0.0 {
-                        hermite::root(g0, g1, m0, m1)
-                    } else {
-                        0.0
-                    };
-                    let (_, slope) = hermite::eval(g0, g1, m0, m1, theta);
-                    let rate = slope / dt;
+                    let Onset {
+                        theta,
+                        rate,
+                        gap_at_start,
+                    } = model.onset_in_step(&s, &s1, side, dt);
                     // Counting steps, a sample exactly at the wall (|y - w| = d) is
                     // already touching, as in the paper's |y - w| >= d.
                     let onset = if located {
                         t + theta * dt
-                    } else if g0 >= 0.0 {
+                    } else if gap_at_start >= 0.0 {
                         t
                     } else {
                         t1
@@ -146,6 +151,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                         dissipated: 0.5 * (1.0 - theta) * dt * (p_onset + p1),
                         energy: within_step(model.energy(&s), model.energy(&s1), theta),
                         work: within_step(before, after, theta),
+                        power: p1,
                     });
                     approach = rate;
                 }
@@ -162,11 +168,11 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                     oc.max_indentation = oc.max_indentation.max(peak);
                 }
                 oc.max_indentation = oc.max_indentation.max(g1);
-                let c0 = model.contact(&s, approach);
-                let p0 = model.contact_dissipation(&c0);
+                let p0 = oc.power;
                 if g1 > 0.0 {
                     let c = model.contact(&s1, approach);
-                    oc.dissipated += 0.5 * dt * (p0 + model.contact_dissipation(&c));
+                    oc.power = model.contact_dissipation(&c);
+                    oc.dissipated += 0.5 * dt * (p0 + oc.power);
                 } else {
                     let theta = if g0 > 0.0 {
                         hermite::root(g0, g1, m0, m1)
@@ -200,7 +206,8 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
         }
 
         s = s1;
-        let step = n + 1;
+        n += 1;
+        let step = n;
         until_kept -= 1;
         // The rare work, behind one test in the hot loop: a history row, the
         // energy check, the question whether to stop (its interval a
@@ -226,6 +233,39 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
             }
         }
         // No step count check: n_steps <= max_steps was checked up front.
+
+        if open.is_none() {
+            // Free flight: the bodies apart, no history row and no check due
+            // before `bound`: the step alone, with the trapezoidal sum of the
+            // damper's work, until a step ends with |y - w| > d (or not finite:
+            // the comparison fails for NaN), which is handed to the full
+            // bookkeeping above, or the next step is one with bookkeeping.
+            let mut bound = ledger.next_due(n).min(n_steps);
+            if keep {
+                bound = bound.min(n + until_kept);
+            }
+            let start = n;
+            while n + 1 < bound {
+                let t = t0 + n as f64 * dt;
+                // The provisional latch as above (not computed where the law
+                // ignores it).
+                let s1 = integrator.step(model, &s, t, dt, model.side(&s) * s.relative_velocity());
+                // Fails for NaN too: a state no longer finite goes to the checks.
+                let apart = s1.relative_displacement().abs() <= d;
+                if !apart {
+                    approach = model.side(&s) * s.relative_velocity();
+                    pending = Some(s1);
+                    break;
+                }
+                squares += s1.main_velocity * s1.main_velocity;
+                ledger.external_step(model, t, dt, &s, &s1);
+                s = s1;
+                n += 1;
+            }
+            if keep {
+                until_kept -= n - start;
+            }
+        }
     }
 
     let final_time = t0 + n_steps as f64 * dt;
