@@ -40,6 +40,8 @@ struct Oscillator {
     /// `sqrt(|disc|)`.
     root: f64,
     constant: f64,
+    /// `constant / w2` (w2 > 0): the static response.
+    offset: f64,
 }
 
 impl Oscillator {
@@ -53,6 +55,7 @@ impl Oscillator {
             disc,
             root: disc.abs().sqrt(),
             constant,
+            offset: if w2 > 0.0 { constant / w2 } else { 0.0 },
         }
     }
 
@@ -61,20 +64,24 @@ impl Oscillator {
     /// `e^(-sigma t) (d0 C + (d0' + sigma d0) S)`.
     #[inline(always)]
     fn factors(&self, t: f64) -> (f64, f64) {
+        if self.disc == 0.0 && self.sigma == 0.0 {
+            // A free mass: the series below, exactly.
+            return (1.0, t);
+        }
         let z = self.disc * t * t;
         if z.abs() < 1e-3 {
             // Near critical damping (and for free masses): the series.
             let e = if self.sigma == 0.0 {
                 1.0
             } else {
-                (-self.sigma * t).exp()
+                exp(-self.sigma * t)
             };
             let c = 1.0 + z * (0.5 + z * (1.0 / 24.0 + z / 720.0));
             let s = t * (1.0 + z * (1.0 / 6.0 + z * (1.0 / 120.0 + z / 5040.0)));
             (e * c, e * s)
         } else if self.disc < 0.0 {
-            let e = (-self.sigma * t).exp();
-            let (s, c) = (self.root * t).sin_cos();
+            let e = exp(-self.sigma * t);
+            let (s, c) = sin_cos(self.root * t);
             (e * c, e * s / self.root)
         } else {
             // root <= sigma: neither exponential overflows.
@@ -84,12 +91,30 @@ impl Oscillator {
         }
     }
 
+    /// The factors at `a + b` from those at `a` and at `b` (the addition
+    /// theorem of `C` and `S`; the exponentials multiply).
+    #[inline(always)]
+    fn sum(&self, a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+        (a.0 * b.0 + self.disc * a.1 * b.1, a.1 * b.0 + a.0 * b.1)
+    }
+
+    /// The factors at `a - b` from those at `a` and at `b`: those at `-b`
+    /// are `(C, -S) / e^(-2 sigma b)`, and `C^2 - disc S^2 = 1`.
+    #[inline(always)]
+    fn difference(&self, a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+        let det = b.0 * b.0 - self.disc * b.1 * b.1;
+        (
+            (a.0 * b.0 - self.disc * a.1 * b.1) / det,
+            (a.1 * b.0 - a.0 * b.1) / det,
+        )
+    }
+
     /// The constant force's particular response and its rate, `t` after the
     /// start of the flow.
     #[inline(always)]
     fn steady(&self, t: f64) -> (f64, f64) {
         if self.w2 > 0.0 {
-            (self.constant / self.w2, 0.0)
+            (self.offset, 0.0)
         } else if self.c > 0.0 {
             (self.constant * t / self.c, self.constant / self.c)
         } else {
@@ -98,11 +123,86 @@ impl Oscillator {
     }
 }
 
+/// The largest angle (rad) [`sin_cos`] takes its series at: the steps turn
+/// every mode and harmonic by at most an eighth of a turn.
+const SERIES_ANGLE: f64 = std::f64::consts::FRAC_PI_4 * (1.0 + 1e-9);
+
+/// `(sin x, cos x)`: for `|x| <= pi/4` by their Taylor series to `x^17` and
+/// `x^16` (truncated below 1e-17 relative; a third of the library's cost),
+/// else the library's.
+#[inline(always)]
+fn sin_cos(x: f64) -> (f64, f64) {
+    if x.abs() <= SERIES_ANGLE {
+        sin_cos_series(x)
+    } else {
+        x.sin_cos()
+    }
+}
+
+#[inline(always)]
+fn sin_cos_series(x: f64) -> (f64, f64) {
+    let z = x * x;
+    let z2 = z * z;
+    let z4 = z2 * z2;
+    // Estrin's scheme: shorter chains of dependent operations than Horner's.
+    let s = (-1.0 / 6.0 + z * (1.0 / 120.0))
+        + z2 * (-1.0 / 5040.0 + z * (1.0 / 362_880.0))
+        + z4 * ((-1.0 / 39_916_800.0 + z * (1.0 / 6_227_020_800.0))
+            + z2 * (-1.0 / 1_307_674_368_000.0 + z * (1.0 / 355_687_428_096_000.0)));
+    let c = (-0.5 + z * (1.0 / 24.0))
+        + z2 * (-1.0 / 720.0 + z * (1.0 / 40_320.0))
+        + z4 * ((-1.0 / 3_628_800.0 + z * (1.0 / 479_001_600.0))
+            + z2 * (-1.0 / 87_178_291_200.0 + z * (1.0 / 20_922_789_888_000.0)));
+    (x + x * z * s, 1.0 + z * c)
+}
+
+/// `e^x`: for `|x| <= 1/16` (light damping over a step) by its Taylor
+/// series to `x^9` (truncated below 1e-18 relative), else the library's.
+#[inline(always)]
+fn exp(x: f64) -> f64 {
+    if x.abs() <= 0.0625 {
+        exp_series(x)
+    } else {
+        x.exp()
+    }
+}
+
+#[inline(always)]
+fn exp_series(x: f64) -> f64 {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let low = (1.0 + x) + x2 * (0.5 + x * (1.0 / 6.0));
+    let high = (1.0 / 24.0 + x * (1.0 / 120.0)) + x2 * (1.0 / 720.0 + x * (1.0 / 5040.0));
+    let top = 1.0 / 40_320.0 + x * (1.0 / 362_880.0);
+    low + x4 * (high + x4 * top)
+}
+
+/// Mode `j`'s coordinate and rate in the state `y` (`x` then `v`, `dim`
+/// each).
+#[inline(always)]
+fn modal_state(cfg: &Configuration, dim: usize, j: usize, y: &[f64]) -> (f64, f64) {
+    let row = &cfg.to_modal[j * dim..(j + 1) * dim];
+    let (x, v) = (&y[..dim], &y[dim..2 * dim]);
+    let (mut eta, mut rate) = (0.0, 0.0);
+    for i in 0..dim {
+        eta += row[i] * (x[i] - cfg.origin[i]);
+        rate += row[i] * v[i];
+    }
+    (eta, rate)
+}
+
 /// What each interaction does in a configuration.
 const OPEN: u8 = 0;
 const STICKING: u8 = 1;
 const TOUCHING: u8 = 2;
 
+/// Whether `key` is the configuration of `modes`.
+#[inline(always)]
+fn fits(key: &[u8], modes: &[Mode]) -> bool {
+    key.iter().zip(modes).all(|(s, mode)| *s == state_of(mode))
+}
+
+#[inline(always)]
 fn state_of(mode: &Mode) -> u8 {
     match mode {
         Mode::Open => OPEN,
@@ -142,11 +242,28 @@ const WEIGHTS: [f64; 5] = [
     0.118_463_442_528_094_54,
 ];
 
+/// The nodes as the midpoint less and plus these fractions of the step
+/// (`0.5 - NODES[0]`, `0.5 - NODES[1]`).
+const OFFSETS: [f64; 2] = [0.453_089_922_969_332, 0.269_234_655_052_841_55];
+
+/// `(sin, cos)` of the sum and of the difference of two angles given theirs.
+#[inline(always)]
+fn turn_sum(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0 * b.1 + a.1 * b.0, a.1 * b.1 - a.0 * b.0)
+}
+
+#[inline(always)]
+fn turn_difference(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0 * b.1 - a.1 * b.0, a.1 * b.1 + a.0 * b.0)
+}
+
 /// The exact flow as a stepper.
 #[derive(Debug, Clone)]
 pub struct ExactFlow {
     parts: LinearParts,
     modes: Vec<Modes>,
+    /// The index of the modes last selected.
+    selected: usize,
     /// The free system's step: an eighth of its fastest period (s).
     step: f64,
     /// Per mode, the free part's start `(d0, d0')`.
@@ -157,8 +274,10 @@ pub struct ExactFlow {
     phasors: Vec<(f64, f64)>,
     eta: Vec<f64>,
     rate: Vec<f64>,
-    factors: Vec<Factors>,
-    next_slot: usize,
+    /// Per mode then node, the factors at the Gauss nodes of the step
+    /// `finish` integrates; per harmonic then node, its turns there.
+    node_modes: Vec<(f64, f64)>,
+    node_turns: Vec<(f64, f64)>,
     /// The start last set: its time's bits and modes, and its state.
     begun: Option<(u64, usize)>,
     begun_state: Vec<f64>,
@@ -198,21 +317,15 @@ impl ExactFlow {
             phasors: vec![(0.0, 1.0); parts.harmonics.len()],
             eta: vec![0.0; dim],
             rate: vec![0.0; dim],
-            factors: vec![
-                Factors {
-                    key: None,
-                    modes: vec![(0.0, 0.0); dim],
-                    turns: vec![(0.0, 1.0); parts.harmonics.len()],
-                };
-                FACTOR_SLOTS
-            ],
-            next_slot: 0,
+            node_modes: vec![(0.0, 0.0); NODES.len() * dim],
+            node_turns: vec![(0.0, 1.0); NODES.len() * parts.harmonics.len()],
             begun: None,
             begun_state: vec![0.0; 2 * dim],
             node: vec![0.0; system.state_len()],
             rates: vec![0.0; system.state_len()],
             parts,
             modes: vec![free],
+            selected: 0,
             step,
             evaluations: 0,
         })
@@ -308,32 +421,48 @@ impl ExactFlow {
     }
 
     /// The modes for the sticking interactions of `modes`, made when first met.
+    #[inline(always)]
     fn select(&mut self, system: &Assembly, modes: &[Mode]) -> Result<usize> {
-        let found = self.modes.iter().position(|m| {
-            m.key
-                .iter()
-                .zip(modes)
-                .all(|(s, mode)| *s == state_of(mode))
-        });
-        match found {
-            Some(index) => Ok(index),
+        // The modes of the last call, most often.
+        if fits(&self.modes[self.selected].key, modes) {
+            return Ok(self.selected);
+        }
+        self.select_other(system, modes)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn select_other(&mut self, system: &Assembly, modes: &[Mode]) -> Result<usize> {
+        self.selected = match self.modes.iter().position(|m| fits(&m.key, modes)) {
+            Some(index) => index,
             None => {
                 let key: Vec<u8> = modes.iter().map(state_of).collect();
                 let made = Self::modes_of(&self.parts, system, &key)?;
                 self.modes.push(made);
-                Ok(self.modes.len() - 1)
+                self.modes.len() - 1
             }
-        }
+        };
+        Ok(self.selected)
     }
 
     /// Set the flow's start at `time`, state `y`, in the modes `index`.
+    #[inline(always)]
     fn begin(&mut self, index: usize, dim: usize, time: f64, y: &[f64]) {
         // Locating an event restarts from the same point many times.
-        if self.begun == Some((time.to_bits(), index)) && self.begun_state[..] == y[..2 * dim] {
-            return;
+        if self.begun != Some((time.to_bits(), index))
+            || self.begun_state.iter().zip(y).any(|(b, v)| b != v)
+        {
+            self.begin_at(index, dim, time, y);
         }
+    }
+
+    #[inline(never)]
+    fn begin_at(&mut self, index: usize, dim: usize, time: f64, y: &[f64]) {
         self.begun = Some((time.to_bits(), index));
-        self.begun_state.copy_from_slice(&y[..2 * dim]);
+        // A loop: for a handful of values a call to memcpy costs more.
+        for (b, v) in self.begun_state.iter_mut().zip(y) {
+            *b = *v;
+        }
         if let Some(flow) = self.modes[index].matrix.as_mut() {
             flow.begin(time, y);
             return;
@@ -344,13 +473,7 @@ impl ExactFlow {
             *p = (h.omega * time).sin_cos();
         }
         for j in 0..cfg.modes {
-            let row = &cfg.to_modal[j * dim..(j + 1) * dim];
-            let mut eta = 0.0;
-            let mut rate = 0.0;
-            for i in 0..dim {
-                eta += row[i] * (y[i] - cfg.origin[i]);
-                rate += row[i] * y[dim + i];
-            }
+            let (eta, rate) = modal_state(cfg, dim, j, y);
             let (mut p, mut dp) = m.oscillators[j].steady(0.0);
             for (h, (s, c)) in cfg.harmonics.iter().zip(&self.phasors) {
                 let (zr, zi) = h.response[j];
@@ -362,6 +485,27 @@ impl ExactFlow {
         }
     }
 
+    /// The accelerations at the start (of modes without a matrix flow), into
+    /// `out`: each mode's `F0 + f - w2 eta - c eta'` taken to coordinates.
+    fn accelerations(&mut self, index: usize, dim: usize, out: &mut [f64]) {
+        let m = &self.modes[index];
+        let cfg = &m.configuration;
+        let r = cfg.modes;
+        for (j, o) in m.oscillators.iter().enumerate() {
+            let (eta, rate) = self.origin_modal[j];
+            self.eta[j] = o.constant - o.w2 * eta - o.c * rate;
+        }
+        for (h, (s, c)) in cfg.harmonics.iter().zip(&self.phasors) {
+            for (a, (pr, pi)) in self.eta[..r].iter_mut().zip(&h.force) {
+                *a += pr * c - pi * s;
+            }
+        }
+        for (i, a) in out[..dim].iter_mut().enumerate() {
+            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
+            *a = row.iter().zip(&self.eta[..r]).map(|(b, e)| b * e).sum();
+        }
+    }
+
     /// The coordinates and velocities `t` after the start, into `out`.
     fn at(&mut self, index: usize, dim: usize, t: f64, out: &mut [f64]) {
         if let Some(flow) = self.modes[index].matrix.as_mut() {
@@ -369,29 +513,9 @@ impl ExactFlow {
             self.evaluations += 1;
             return;
         }
-        let slot = self.factors_at(index, t);
-        let m = &self.modes[index];
-        let cfg = &m.configuration;
+        self.modal_at(index, t);
+        let cfg = &self.modes[index].configuration;
         let r = cfg.modes;
-        let factors = &self.factors[slot];
-        for j in 0..r {
-            let o = &m.oscillators[j];
-            let (d0, r0) = self.start[j];
-            let (ec, es) = factors.modes[j];
-            let (p, dp) = o.steady(t);
-            self.eta[j] = ec * d0 + es * (r0 + o.sigma * d0) + p;
-            self.rate[j] = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + dp;
-        }
-        for ((h, (s0, c0)), (st, ct)) in cfg.harmonics.iter().zip(&self.phasors).zip(&factors.turns)
-        {
-            // The angle at the start turned by omega t.
-            let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
-            for j in 0..r {
-                let (zr, zi) = h.response[j];
-                self.eta[j] += zr * c - zi * s;
-                self.rate[j] -= h.omega * (zr * s + zi * c);
-            }
-        }
         // The start plus the modes' increments: the flow is continuous at its
         // start to the last bit (a state on a wall stays on it), and a start
         // off the constraints of sticking pairs by round-off stays as close.
@@ -413,22 +537,154 @@ impl ExactFlow {
         self.evaluations += 1;
     }
 
-    /// The viscous and the input power (W) `t` after the start: the modal
-    /// rates only, without the coordinates (what the energy quadrature needs).
-    fn powers_at(&mut self, index: usize, t: f64) -> (f64, f64) {
-        let slot = self.factors_at(index, t);
+    /// The modal coordinates and rates `t` after the start, into `eta` and
+    /// `rate`.
+    fn modal_at(&mut self, index: usize, t: f64) {
         let m = &self.modes[index];
         let cfg = &m.configuration;
         let r = cfg.modes;
-        let factors = &self.factors[slot];
+        let (eta, rate) = (&mut self.eta[..r], &mut self.rate[..r]);
+        for (((o, &(d0, r0)), e), v) in m
+            .oscillators
+            .iter()
+            .zip(&self.start)
+            .zip(eta.iter_mut())
+            .zip(rate.iter_mut())
+        {
+            let (ec, es) = o.factors(t);
+            let (p, dp) = o.steady(t);
+            *e = ec * d0 + es * (r0 + o.sigma * d0) + p;
+            *v = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + dp;
+        }
+        for (h, &(s0, c0)) in cfg.harmonics.iter().zip(&self.phasors) {
+            // The angle at the start turned by omega t.
+            let (st, ct) = sin_cos(h.omega * t);
+            let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
+            for ((e, v), &(zr, zi)) in eta.iter_mut().zip(rate.iter_mut()).zip(&h.response) {
+                *e += zr * c - zi * s;
+                *v -= h.omega * (zr * s + zi * c);
+            }
+        }
+    }
+
+    /// The viscous loss and the input work (J) over the step `h` from the
+    /// start, in closed form from the modal states at its ends (one forcing
+    /// harmonic at most). Each mode obeys `eta'' + c eta' + w2 eta = F0 +
+    /// f(t)`, `f = Re(P u)`, `u = e^(i omega t)`, whose particular response
+    /// is `Re(Z u)`; the rest `v` obeys `v'' + c v' + w2 v = F0`, so that
+    /// integrating by parts twice gives `int u v' = (mu [u v'] + w2 [u v] -
+    /// F0 [u]) / (mu^2 - c mu + w2)` (`mu = i omega`, `[.]` the change over
+    /// the step), and `int f Re(Z u)'` is elementary. The viscous loss `c int
+    /// eta'^2` is then the mode's input `int f eta'` plus `F0` times its
+    /// displacement less the change of its energy `eta'^2 / 2 + w2 eta^2 / 2`.
+    fn step_energies(&mut self, index: usize, dim: usize, h: f64, end: &[f64]) -> (f64, f64) {
+        let m = &self.modes[index];
+        let cfg = &m.configuration;
+        // The modal state at the end, from the step's end.
+        for j in 0..cfg.modes {
+            (self.eta[j], self.rate[j]) = modal_state(cfg, dim, j, end);
+        }
+        let forcing = cfg.harmonics.first().map(|harmonic| {
+            let (s0, c0) = self.phasors[0];
+            let (st, ct) = sin_cos(harmonic.omega * h);
+            // u at both ends as (Re, Im), and sin(omega h).
+            let end = (c0 * ct - s0 * st, s0 * ct + c0 * st);
+            (harmonic, (c0, s0), end, st)
+        });
+        let (mut viscous, mut input) = (0.0, 0.0);
+        for (j, o) in m.oscillators.iter().enumerate() {
+            let (eta0, rate0) = self.origin_modal[j];
+            let (eta1, rate1) = (self.eta[j], self.rate[j]);
+            let mut work = 0.0;
+            if let Some((harmonic, u0, u1, sin_turn)) = forcing {
+                let w = harmonic.omega;
+                let (zr, zi) = harmonic.response[j];
+                let (pr, pi) = harmonic.force[j];
+                // v and v' at an end: the particular response taken off.
+                let rest = |(c, s): (f64, f64), eta: f64, rate: f64| {
+                    (eta - (zr * c - zi * s), rate + w * (zr * s + zi * c))
+                };
+                let (v0, dv0) = rest(u0, eta0, rate0);
+                let (v1, dv1) = rest(u1, eta1, rate1);
+                // [u v'], [u v], [u].
+                let (ar, ai) = (u1.0 * dv1 - u0.0 * dv0, u1.1 * dv1 - u0.1 * dv0);
+                let (br, bi) = (u1.0 * v1 - u0.0 * v0, u1.1 * v1 - u0.1 * v0);
+                let (gr, gi) = (u1.0 - u0.0, u1.1 - u0.1);
+                let nr = -w * ai + o.w2 * br - o.constant * gr;
+                let ni = w * ar + o.w2 * bi - o.constant * gi;
+                let (dr, di) = (o.w2 - w * w, -o.c * w);
+                let norm = dr * dr + di * di;
+                let (jr, ji) = ((nr * dr + ni * di) / norm, (ni * dr - nr * di) / norm);
+                work += pr * jr - pi * ji;
+                // int Re(P u) Re(B u), B = i omega Z: half of Re(P conj(B)) h
+                // plus half of Re(P B int u^2), int u^2 = u0 u1 sin(omega h) / omega.
+                let (qr, qi) = (-w * zi, w * zr);
+                let (er, ei) = (u0.0 * u1.0 - u0.1 * u1.1, u0.0 * u1.1 + u0.1 * u1.0);
+                let (pqr, pqi) = (pr * qr - pi * qi, pr * qi + pi * qr);
+                work += 0.5 * h * (pr * qr + pi * qi) + 0.5 * (pqr * er - pqi * ei) * sin_turn / w;
+            }
+            input += work;
+            if o.c > 0.0 {
+                let (de, dr) = (eta1 - eta0, rate1 - rate0);
+                let stored = 0.5 * dr * (rate1 + rate0) + 0.5 * o.w2 * de * (eta1 + eta0);
+                viscous += o.constant * de + work - stored;
+            }
+        }
+        (viscous, input)
+    }
+
+    /// The factors of the modes `index` at the Gauss nodes of a step `h`
+    /// from a start, into `node_modes` and `node_turns`: three evaluations
+    /// (the midpoint and the two offsets), the other two nodes by the
+    /// addition theorems.
+    fn node_factors(&mut self, index: usize, h: f64) {
+        let m = &self.modes[index];
+        let (mid, far, near) = (0.5 * h, OFFSETS[0] * h, OFFSETS[1] * h);
+        let nodes = NODES.len();
+        for (o, out) in m
+            .oscillators
+            .iter()
+            .zip(self.node_modes.chunks_exact_mut(nodes))
+        {
+            let (at_mid, at_far, at_near) = (o.factors(mid), o.factors(far), o.factors(near));
+            out[0] = o.difference(at_mid, at_far);
+            out[1] = o.difference(at_mid, at_near);
+            out[2] = at_mid;
+            out[3] = o.sum(at_mid, at_near);
+            out[4] = o.sum(at_mid, at_far);
+        }
+        for (h, out) in m
+            .configuration
+            .harmonics
+            .iter()
+            .zip(self.node_turns.chunks_exact_mut(nodes))
+        {
+            let at_mid = sin_cos(h.omega * mid);
+            let (at_far, at_near) = (sin_cos(h.omega * far), sin_cos(h.omega * near));
+            out[0] = turn_difference(at_mid, at_far);
+            out[1] = turn_difference(at_mid, at_near);
+            out[2] = at_mid;
+            out[3] = turn_sum(at_mid, at_near);
+            out[4] = turn_sum(at_mid, at_far);
+        }
+    }
+
+    /// The viscous and the input power (W) at Gauss node `k` (`t` after the
+    /// start; [`Self::node_factors`] made its factors): the modal rates
+    /// only, without the coordinates (what the energy quadrature needs).
+    fn powers_at(&mut self, index: usize, k: usize, t: f64) -> (f64, f64) {
+        let m = &self.modes[index];
+        let cfg = &m.configuration;
+        let r = cfg.modes;
+        let nodes = NODES.len();
         for (j, o) in m.oscillators.iter().enumerate() {
             let (d0, r0) = self.start[j];
-            let (ec, es) = factors.modes[j];
+            let (ec, es) = self.node_modes[nodes * j + k];
             self.rate[j] = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + o.steady(t).1;
         }
         let mut input = 0.0;
-        for ((h, (s0, c0)), (st, ct)) in cfg.harmonics.iter().zip(&self.phasors).zip(&factors.turns)
-        {
+        for (n, (h, (s0, c0))) in cfg.harmonics.iter().zip(&self.phasors).enumerate() {
+            let (st, ct) = self.node_turns[nodes * n + k];
             let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
             for j in 0..r {
                 let (zr, zi) = h.response[j];
@@ -446,41 +702,7 @@ impl ExactFlow {
             .sum();
         (viscous, input)
     }
-
-    /// The slot of the factors of the modes `index` at `t` after a start:
-    /// fixed steps and their Gauss nodes repeat a few lengths, whose
-    /// exponentials, sines and cosines are kept.
-    fn factors_at(&mut self, index: usize, t: f64) -> usize {
-        let key = Some((t.to_bits(), index));
-        if let Some(slot) = self.factors.iter().position(|f| f.key == key) {
-            return slot;
-        }
-        let slot = self.next_slot;
-        self.next_slot = (self.next_slot + 1) % self.factors.len();
-        let m = &self.modes[index];
-        let f = &mut self.factors[slot];
-        f.key = key;
-        for (out, o) in f.modes.iter_mut().zip(&m.oscillators) {
-            *out = o.factors(t);
-        }
-        for (out, h) in f.turns.iter_mut().zip(&m.configuration.harmonics) {
-            *out = (h.omega * t).sin_cos();
-        }
-        slot
-    }
 }
-
-/// The factors of every mode and the turn of every harmonic at one time
-/// after a start.
-#[derive(Debug, Clone)]
-struct Factors {
-    key: Option<(u64, usize)>,
-    modes: Vec<(f64, f64)>,
-    turns: Vec<(f64, f64)>,
-}
-
-/// Lengths whose factors are kept: a step, its five Gauss nodes and two more.
-const FACTOR_SLOTS: usize = 8;
 
 impl SystemStepper for ExactFlow {
     fn name(&self) -> &'static str {
@@ -522,7 +744,12 @@ impl SystemStepper for ExactFlow {
                 continue;
             }
             if !evaluated {
-                system.rates(time, y, modes, scratch, &mut rates);
+                if self.modes[index].matrix.is_some() {
+                    system.rates(time, y, modes, scratch, &mut rates);
+                } else {
+                    self.begin(index, d, time, y);
+                    self.accelerations(index, d, &mut rates[d..2 * d]);
+                }
                 evaluated = true;
             }
             let (gap, rate) = system.gap(i, y);
@@ -556,7 +783,9 @@ impl SystemStepper for ExactFlow {
         self.begin(index, dim, time, y);
         // The accumulators are filled for the kept step only (`finish`).
         let at = 2 * dim;
-        out[at..].copy_from_slice(&y[at..]);
+        for (o, v) in out[at..].iter_mut().zip(&y[at..]) {
+            *o = *v;
+        }
         self.at(index, dim, h, out);
         Ok(0.0)
     }
@@ -597,9 +826,16 @@ impl SystemStepper for ExactFlow {
             return Ok(());
         }
         self.begin(index, dim, time, y);
+        if self.modes[index].configuration.harmonics.len() <= 1 {
+            let (viscous, input) = self.step_energies(index, dim, h, end);
+            end[at + VISCOUS] = y[at + VISCOUS] + viscous;
+            end[at + INPUT] = y[at + INPUT] + input;
+            return Ok(());
+        }
+        self.node_factors(index, h);
         let (mut viscous, mut input) = (0.0, 0.0);
-        for (x, w) in NODES.iter().zip(WEIGHTS) {
-            let (v, i) = self.powers_at(index, x * h);
+        for (k, (x, w)) in NODES.iter().zip(WEIGHTS).enumerate() {
+            let (v, i) = self.powers_at(index, k, x * h);
             viscous += w * v;
             input += w * i;
         }
@@ -616,5 +852,130 @@ impl SystemStepper for ExactFlow {
 
     fn evaluations(&self) -> u64 {
         self.evaluations
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec};
+    use crate::signals::Signal;
+    use crate::structure::Structure;
+
+    fn ulps(a: f64, b: f64) -> f64 {
+        (a - b).abs() / (f64::EPSILON * b.abs().max(f64::MIN_POSITIVE))
+    }
+
+    #[test]
+    fn the_series_are_the_library_s_sine_cosine_and_exponential_to_an_ulp() {
+        crate::testing::timeout(30, || {
+            for k in -1000..=1000 {
+                let x = SERIES_ANGLE * k as f64 / 1000.0;
+                let ((s, c), (ls, lc)) = (sin_cos(x), x.sin_cos());
+                assert!(ulps(s, ls) <= 1.0 && ulps(c, lc) <= 1.0, "{x}");
+                let x = 0.0625 * k as f64 / 1000.0;
+                assert!(ulps(exp(x), x.exp()) <= 1.0, "{x}");
+            }
+            assert_eq!(sin_cos(2.0), 2f64.sin_cos());
+        });
+    }
+
+    #[test]
+    fn nodes_by_the_addition_theorems_are_the_factors_there() {
+        crate::testing::timeout(30, || {
+            let h = 0.01;
+            // Underdamped, near critical, overdamped, free, free and damped.
+            for (w2, c) in [
+                (4e3, 3.0),
+                (400.0, 40.0),
+                (100.0, 60.0),
+                (0.0, 0.0),
+                (0.0, 5.0),
+            ] {
+                let o = Oscillator::new(w2, c, 0.0);
+                let (mid, far, near) = (
+                    o.factors(0.5 * h),
+                    o.factors(OFFSETS[0] * h),
+                    o.factors(OFFSETS[1] * h),
+                );
+                let derived = [
+                    o.difference(mid, far),
+                    o.difference(mid, near),
+                    mid,
+                    o.sum(mid, near),
+                    o.sum(mid, far),
+                ];
+                for (x, d) in NODES.iter().zip(derived) {
+                    let direct = o.factors(x * h);
+                    assert!(
+                        (d.0 - direct.0).abs() <= 1e-15,
+                        "{w2} {c}: {d:?} {direct:?}"
+                    );
+                    assert!(
+                        (d.1 - direct.1).abs() <= 1e-15 * h,
+                        "{w2} {c}: {d:?} {direct:?}"
+                    );
+                }
+            }
+        });
+    }
+
+    /// The forced damper (a structure and a loose mass, gravity), its flow
+    /// started at a state in motion.
+    fn forced_flow(damping: f64) -> (Assembly, ExactFlow, Vec<f64>) {
+        let spec = SystemSpec {
+            structure: Structure::oscillator(1.0, 3000.0, damping).unwrap(),
+            dampers: vec![Damper {
+                mass: 0.05,
+                at: 0.0,
+                lower_clearance: 0.01,
+                upper_clearance: 0.01,
+                law: PairLaw::rigid(0.6).unwrap(),
+            }],
+            stops: vec![],
+            gravity: 9.81,
+            excitations: vec![Excitation {
+                load: Load::Force { at: 0.0 },
+                signal: Signal::harmonic(20.0, 7.0, 0.3).unwrap(),
+            }],
+        };
+        let system = Assembly::new(&spec).unwrap();
+        let y = initial_state(&system, &[0.004], &[-0.2], &[0.002], &[0.3]).unwrap();
+        let flow = ExactFlow::new(&system).unwrap();
+        (system, flow, y)
+    }
+
+    #[test]
+    fn closed_form_step_energies_are_the_gauss_legendre_quadrature_s() {
+        crate::testing::timeout(30, || {
+            for damping in [3.0, 200.0] {
+                let (system, mut flow, y) = forced_flow(damping);
+                let dim = system.dim;
+                let modes = vec![Mode::Open; system.interactions.len()];
+                let index = flow.select(&system, &modes).unwrap();
+                let mut end = vec![0.0; system.state_len()];
+                for (time, h) in [(0.0, flow.step()), (1.37, 0.3 * flow.step()), (2.0, 1e-6)] {
+                    flow.begin(index, dim, time, &y);
+                    flow.at(index, dim, h, &mut end);
+                    let (viscous, input) = flow.step_energies(index, dim, h, &end);
+                    flow.node_factors(index, h);
+                    let (mut v, mut i) = (0.0, 0.0);
+                    for (k, (x, w)) in NODES.iter().zip(WEIGHTS).enumerate() {
+                        let (pv, pi) = flow.powers_at(index, k, x * h);
+                        v += w * h * pv;
+                        i += w * h * pi;
+                    }
+                    let scale = v.abs().max(i.abs());
+                    assert!(
+                        (viscous - v).abs() <= 1e-10 * scale,
+                        "{damping} {h}: {viscous} {v}"
+                    );
+                    assert!(
+                        (input - i).abs() <= 1e-10 * scale,
+                        "{damping} {h}: {input} {i}"
+                    );
+                }
+            }
+        });
     }
 }
