@@ -160,10 +160,10 @@ pub struct Assembly {
     minv_k: Vec<f64>,
     minv_c: Vec<f64>,
     damper_mass: Vec<f64>,
-    /// Whether M, K and C are all diagonal (modal coordinates), and then
-    /// `[M^-1 K, M^-1 C, C]` of each coordinate.
+    /// Whether M, K and C are all diagonal (modal coordinates).
     diagonal: bool,
-    diagonals: Vec<[f64; 3]>,
+    /// `[M^-1 K, M^-1 C, C, r]` of each coordinate (used when diagonal).
+    diagonals: Vec<[f64; 4]>,
     /// `r`, and `M r` (for the work of base loads).
     influence: Vec<f64>,
     mass_influence: Vec<f64>,
@@ -171,6 +171,10 @@ pub struct Assembly {
     forces: Vec<ForceLoad>,
     base: Vec<Signal>,
     pub interactions: Vec<Interaction>,
+    /// Whether an interaction's `h` is the previous one's negated (the two
+    /// walls of a damper): its products are then that one's negated, to the
+    /// bit (round-to-nearest is symmetric).
+    mirrors_previous: Vec<bool>,
     /// The structure's longest natural period (s; infinite without a
     /// spring): the time scale of the run's resolution.
     pub longest_period: f64,
@@ -226,7 +230,14 @@ impl Assembly {
         let minv_k = product(s.stiffness());
         let minv_c = product(s.damping());
         let diagonals = (0..n)
-            .map(|i| [minv_k[i * n + i], minv_c[i * n + i], s.damping()[i * n + i]])
+            .map(|i| {
+                [
+                    minv_k[i * n + i],
+                    minv_c[i * n + i],
+                    s.damping()[i * n + i],
+                    s.influence()[i],
+                ]
+            })
             .collect();
         let mut mass_influence = vec![0.0; n];
         linalg::multiply(s.mass(), s.influence(), &mut mass_influence);
@@ -350,7 +361,18 @@ impl Assembly {
         } else {
             0.0
         };
+        let mirrors_previous = (0..interactions.len())
+            .map(|i| {
+                i > 0
+                    && interactions[i]
+                        .h
+                        .iter()
+                        .zip(&interactions[i - 1].h)
+                        .all(|(a, b)| *a == -*b)
+            })
+            .collect();
         Ok(Self {
+            mirrors_previous,
             sticking_step: 0.1 * shortest,
             energy_floor,
             n,
@@ -398,6 +420,27 @@ impl Assembly {
         )
     }
 
+    /// Every interaction's gap and its rate at state `y` into `out`, as
+    /// [`Self::gap`] gives them (a damper's two walls share their products).
+    pub fn gaps(&self, y: &[f64], out: &mut [(f64, f64)]) {
+        let d = self.dim;
+        let (x, v) = (&y[..d], &y[d..2 * d]);
+        let mut products = (0.0, 0.0);
+        for ((it, mirror), out) in self
+            .interactions
+            .iter()
+            .zip(&self.mirrors_previous)
+            .zip(out.iter_mut())
+        {
+            products = if *mirror {
+                (-products.0, -products.1)
+            } else {
+                dots(&it.h, x, v)
+            };
+            *out = (it.offset + products.0, products.1);
+        }
+    }
+
     /// The derivative of the state `y` at `time` in `modes` into `out`; the
     /// constraint forces of sticking interactions are solved for on the way
     /// (`scratch` holds them). Allocates nothing.
@@ -411,45 +454,65 @@ impl Assembly {
     ) {
         let (n, d) = (self.n, self.dim);
         let (x, v) = (&y[..d], &y[d..2 * d]);
-        // A loop, not copy_from_slice: for a handful of values a call to
-        // memmove costs more than the copy.
-        for (o, v) in out[..d].iter_mut().zip(v) {
-            *o = *v;
-        }
+        let (velocity, rest) = out[..self.state_len()].split_at_mut(d);
+        let (acc, rest) = rest.split_at_mut(d);
+        let (head, losses) = rest.split_at_mut(CONTACT);
         let mut base = 0.0;
         for (signal, cache) in self.base.iter().zip(&mut scratch.base_values) {
             base += cache.value(signal, time);
         }
         let inertial = base + self.gravity;
-        let (acc, rest) = out[d..].split_at_mut(d);
-        let viscous = if self.diagonal {
-            // Modal coordinates: the matrices are diagonal.
+        // The velocities are copied inside the loops over the coordinates
+        // (a lone copy of a handful of values becomes a call to memmove).
+        let mut input = 0.0;
+        let (viscous, fused) = if self.diagonal {
+            // Modal coordinates: the matrices are diagonal. The first force
+            // is added in the same pass (each sum in the same order).
+            let (x, v) = (&x[..n], &v[..n]);
+            let (acc, velocity, diagonals) =
+                (&mut acc[..n], &mut velocity[..n], &self.diagonals[..n]);
             let mut viscous = 0.0;
-            for ((((a, x), v), [k, c, damping]), r) in acc[..n]
-                .iter_mut()
-                .zip(&x[..n])
-                .zip(&v[..n])
-                .zip(&self.diagonals)
-                .zip(&self.influence)
+            if let (Some(f), Some(cache)) = (self.forces.first(), scratch.force_values.first_mut())
             {
-                *a = -(k * x + c * v) - r * inertial;
-                viscous += damping * v * v;
+                let value = cache.value(&f.signal, time);
+                let (push, row) = (&f.push[..n], &f.row[..n]);
+                let mut power = -0.0;
+                for i in 0..n {
+                    let [k, c, damping, r] = diagonals[i];
+                    velocity[i] = v[i];
+                    acc[i] = -(k * x[i] + c * v[i]) - r * inertial + push[i] * value;
+                    viscous += damping * v[i] * v[i];
+                    power += row[i] * v[i];
+                }
+                input += value * power;
+                (viscous, 1)
+            } else {
+                for i in 0..n {
+                    let [k, c, damping, r] = diagonals[i];
+                    velocity[i] = v[i];
+                    acc[i] = -(k * x[i] + c * v[i]) - r * inertial;
+                    viscous += damping * v[i] * v[i];
+                }
+                (viscous, 0)
             }
-            viscous
         } else {
             for (i, a) in acc[..n].iter_mut().enumerate() {
                 let row = i * n..(i + 1) * n;
+                velocity[i] = v[i];
                 *a = -linalg::dot(&self.minv_k[row.clone()], &x[..n])
                     - linalg::dot(&self.minv_c[row], &v[..n])
                     - self.influence[i] * inertial;
             }
-            linalg::quadratic_form(&self.damping, &v[..n])
+            (linalg::quadratic_form(&self.damping, &v[..n]), 0)
         };
-        for a in acc[n..].iter_mut() {
+        for ((a, o), v) in acc[n..].iter_mut().zip(&mut velocity[n..]).zip(&v[n..]) {
+            *o = *v;
             *a = -inertial;
         }
-        let mut input = 0.0;
-        for (f, cache) in self.forces.iter().zip(&mut scratch.force_values) {
+        for (f, cache) in self.forces[fused..]
+            .iter()
+            .zip(&mut scratch.force_values[fused..])
+        {
             let value = cache.value(&f.signal, time);
             for (a, p) in acc[..n].iter_mut().zip(&f.push) {
                 *a += p * value;
@@ -468,14 +531,19 @@ impl Assembly {
             input -= base * momentum;
         }
         let mut sticking = 0;
-        let (head, losses) = rest.split_at_mut(CONTACT);
-        for (i, (it, mode)) in self.interactions.iter().zip(modes).enumerate() {
-            losses[i] = 0.0;
+        for (i, ((it, mode), loss)) in self
+            .interactions
+            .iter()
+            .zip(modes)
+            .zip(losses.iter_mut())
+            .enumerate()
+        {
+            *loss = 0.0;
             match (mode, &it.law) {
                 (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
                     let (approach_rate, damping) = (*approach_rate, *damping);
-                    let indentation = -(it.offset + linalg::dot(&it.h, x));
-                    let rate = -linalg::dot(&it.h, v);
+                    let (hx, hv) = dots(&it.h, x, v);
+                    let (indentation, rate) = (-(it.offset + hx), -hv);
                     let (force, elastic) = if indentation > 0.0 {
                         law.force_and_elastic(indentation, rate, approach_rate)
                     } else {
@@ -485,7 +553,7 @@ impl Assembly {
                     for (a, p) in acc.iter_mut().zip(&it.push) {
                         *a += p * total;
                     }
-                    losses[i] = (total - elastic) * rate;
+                    *loss = (total - elastic) * rate;
                 }
                 (Mode::Sticking, _) => {
                     scratch.sticking[sticking] = i;
@@ -494,7 +562,16 @@ impl Assembly {
                 _ => {}
             }
         }
-        if sticking > 0 {
+        if sticking == 1 {
+            // One constraint: W lambda = -h . a with W = h M^-1 h^T, what
+            // the elimination below gives for one row.
+            let it = &self.interactions[scratch.sticking[0]];
+            let lambda = -linalg::dot(&it.h, acc) / it.inverse_mass;
+            scratch.forces[0] = lambda;
+            for (a, p) in acc.iter_mut().zip(&it.push) {
+                *a += p * lambda;
+            }
+        } else if sticking > 1 {
             self.constraint_forces(
                 &scratch.sticking[..sticking],
                 acc,
@@ -507,10 +584,8 @@ impl Assembly {
                     *a += p * lambda;
                 }
             }
-            scratch.count = sticking;
-        } else {
-            scratch.count = 0;
         }
+        scratch.count = sticking;
         head[VISCOUS] = viscous;
         head[INPUT] = input;
     }
@@ -673,6 +748,20 @@ impl Assembly {
         }
         0.5 * (1.0 - restitution * restitution) * rate * rate / it.inverse_mass
     }
+}
+
+/// `(h . x, h . v)` in one pass, each summed in order as [`linalg::dot`]
+/// sums it (the same bits).
+#[inline(always)]
+fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
+    let n = h.len();
+    let (x, v) = (&x[..n], &v[..n]);
+    let (mut hx, mut hv) = (-0.0, -0.0);
+    for i in 0..n {
+        hx += h[i] * x[i];
+        hv += h[i] * v[i];
+    }
+    (hx, hv)
 }
 
 /// One harmonic load over all coordinates: `amplitude cos(omega t + phase)`

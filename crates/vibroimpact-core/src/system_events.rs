@@ -209,14 +209,22 @@ struct Crossing {
     before: f64,
 }
 
-/// The earliest event in the step `y -> end` of length `h`, from the end
-/// values and, for gaps, the cubic Hermite interpolant (an interior touch or
-/// separation deeper than `graze` m counts; a shallower one is a graze).
+/// Every interaction's gap and rate (see [`Assembly::gaps`]) at a step's
+/// start and at its end: a kept step's end is the next one's start.
+struct Gaps {
+    start: Vec<(f64, f64)>,
+    end: Vec<(f64, f64)>,
+}
+
+/// The earliest event in the step `y -> end` of length `h` (`gaps` at both),
+/// from the end values and, for gaps, the cubic Hermite interpolant (an
+/// interior touch or separation deeper than `graze` m counts; a shallower one
+/// is a graze).
 #[allow(clippy::too_many_arguments)]
 fn find_crossing(
     system: &Assembly,
     time: f64,
-    y: &[f64],
+    gaps: &Gaps,
     end: &[f64],
     h: f64,
     modes: &[Mode],
@@ -252,8 +260,7 @@ fn find_crossing(
                 continue;
             }
         };
-        let (g0, r0) = system.gap(i, y);
-        let (g1, r1) = system.gap(i, end);
+        let ((g0, r0), (g1, r1)) = (gaps.start[i], gaps.end[i]);
         let (v0, v1, m0, m1) = (sign * g0, sign * g1, sign * r0 * h, sign * r1 * h);
         if v1 < 0.0 {
             // On the wall at the start (to round-off, just after an event)
@@ -516,6 +523,11 @@ pub fn integrate_system<S: SystemStepper>(
             });
         }
     }
+    let mut gaps = Gaps {
+        start: vec![(0.0, 0.0); count],
+        end: vec![(0.0, 0.0); count],
+    };
+    system.gaps(&y, &mut gaps.start);
     let (stored_start, mut energy_scale) = system.energy_terms(&y, &modes);
     let mut impact_loss = 0.0;
     let mut contacts: Vec<PairContact> = Vec::new();
@@ -576,6 +588,7 @@ pub fn integrate_system<S: SystemStepper>(
             length = next_strobe - time;
         }
         let error = stepper.attempt(system, time, &y, length, &modes, &mut scratch, &mut end)?;
+        system.gaps(&end, &mut gaps.end);
         let mut full_error = error;
         let mut taken = length;
         let mut switched: Option<usize> = None;
@@ -587,7 +600,7 @@ pub fn integrate_system<S: SystemStepper>(
         let mut crossing = find_crossing(
             system,
             time,
-            &y,
+            &gaps,
             &end,
             length,
             &modes,
@@ -633,6 +646,7 @@ pub fn integrate_system<S: SystemStepper>(
                     switched = Some(c.i);
                     last_attempt_kept = false;
                     end.copy_from_slice(&buffers.best);
+                    system.gaps(&end, &mut gaps.end);
                 }
                 Location::Unconfirmed => {
                     last_attempt_kept = false;
@@ -645,7 +659,7 @@ pub fn integrate_system<S: SystemStepper>(
                         crossing = find_crossing(
                             system,
                             time,
-                            &y,
+                            &gaps,
                             &end,
                             taken,
                             &modes,
@@ -740,8 +754,7 @@ pub fn integrate_system<S: SystemStepper>(
         // Deepest indentation of each compliant contact within the step.
         for (i, record) in open.iter_mut().enumerate() {
             if let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), modes[i]) {
-                let (g0, r0) = system.gap(i, &y);
-                let (g1, r1) = system.gap(i, &end);
+                let ((g0, r0), (g1, r1)) = (gaps.start[i], gaps.end[i]);
                 let (m0, m1) = (r0 * taken, r1 * taken);
                 let mut deepest = -g1;
                 if m0 < 0.0 && m1 > 0.0 {
@@ -779,7 +792,9 @@ pub fn integrate_system<S: SystemStepper>(
         if !adaptive && (switched.is_none() || (grid + 1) as f64 * dt - time <= 0.0) {
             grid += 1;
         }
-        y.copy_from_slice(&end);
+        // The attempt is overwritten by the next one: the buffers trade places.
+        std::mem::swap(&mut y, &mut end);
+        std::mem::swap(&mut gaps.start, &mut gaps.end);
         accepted += 1;
 
         if switched.is_some() {
@@ -843,6 +858,8 @@ pub fn integrate_system<S: SystemStepper>(
                 }
                 last_event = time;
             }
+            // Impacts change the velocities.
+            system.gaps(&y, &mut gaps.start);
         }
 
         if time >= next_strobe - 1e-9 * options.reduce.strobe_period {

@@ -98,6 +98,8 @@ pub struct ExplicitRk {
     pub rtol: f64,
     pub atol: f64,
     stages: usize,
+    /// Classical RK4 (a fixed step taken by a loop of its own).
+    rk4: bool,
     /// Stage derivatives, plus one slot for `f` at the new point.
     k: Vec<Vec<f64>>,
     point: Vec<f64>,
@@ -158,6 +160,7 @@ impl ExplicitRk {
             rtol: 0.0,
             atol: 0.0,
             stages,
+            rk4: name == "rk4",
             k: vec![vec![0.0; len]; stages + 1],
             point: vec![0.0; len],
             start_valid: false,
@@ -213,6 +216,60 @@ impl ExplicitRk {
     }
 }
 
+impl ExplicitRk {
+    /// RK4's stages after the first (in `k[0]`) and its new point, in the
+    /// tableau's arithmetic: each stage point from the one nonzero weight of
+    /// its row, the new point `y + h b_0 k_0 + ... + h b_3 k_3` summed in
+    /// order, in one pass.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn rk4_stages(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &[f64],
+        h: f64,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+    ) {
+        let coordinates = 2 * system.dim;
+        let len = out.len();
+        let times = [0, 1, 2, 3].map(|i| if i == 0 { time } else { time + self.c[i] * h });
+        // Each stage's one nonzero weight, on the stage before.
+        let hw = [1, 2, 3].map(|i| h * self.a[i * 4 + i - 1]);
+        let w = [0, 1, 2, 3].map(|i| h * self.b[i]);
+        if !self.start_valid {
+            system.rates(time, y, modes, scratch, &mut self.k[0]);
+            self.evaluations += 1;
+            self.start_valid = true;
+        }
+        for i in 1..4 {
+            let (done, next) = self.k.split_at_mut(i);
+            let (point, y, k) = (
+                &mut self.point[..coordinates],
+                &y[..coordinates],
+                &done[i - 1][..coordinates],
+            );
+            let hw = hw[i - 1];
+            for e in 0..coordinates {
+                point[e] = y[e] + hw * k[e];
+            }
+            system.rates(times[i], &self.point, modes, scratch, &mut next[0]);
+            self.evaluations += 1;
+        }
+        let [k0, k1, k2, k3, ..] = &self.k[..] else {
+            unreachable!("RK4 has four stages")
+        };
+        // Indexed over slices of one length: a loop the compiler vectorises.
+        let (out, y) = (&mut out[..len], &y[..len]);
+        let (k0, k1, k2, k3) = (&k0[..len], &k1[..len], &k2[..len], &k3[..len]);
+        for e in 0..len {
+            out[e] = y[e] + w[0] * k0[e] + w[1] * k1[e] + w[2] * k2[e] + w[3] * k3[e];
+        }
+    }
+}
+
 impl SystemStepper for ExplicitRk {
     fn name(&self) -> &'static str {
         self.name
@@ -240,16 +297,30 @@ impl SystemStepper for ExplicitRk {
         out: &mut [f64],
     ) -> Result<f64> {
         let s = self.stages;
+        if self.rk4 {
+            self.rk4_stages(system, time, y, h, modes, scratch, out);
+            self.end_slot = None;
+            return Ok(0.0);
+        }
         if !self.start_valid {
             system.rates(time, y, modes, scratch, &mut self.k[0]);
             self.evaluations += 1;
             self.start_valid = true;
         }
+        // The stages' points need the coordinates and velocities only: the
+        // rates do not depend on the energy accumulators.
+        let coordinates = 2 * system.dim;
         for i in 1..s {
             // y + h sum_j a_ij k_j over the nonzero weights only, the first
             // term written over y (no copy), each pass a straight vector loop.
             let row = &self.a[i * s..i * s + i];
-            combine(&mut self.point, y, h, row, &self.k);
+            combine(
+                &mut self.point[..coordinates],
+                &y[..coordinates],
+                h,
+                row,
+                &self.k,
+            );
             system.rates(
                 time + self.c[i] * h,
                 &self.point,
@@ -260,7 +331,6 @@ impl SystemStepper for ExplicitRk {
             self.evaluations += 1;
         }
         combine(out, y, h, &self.b, &self.k);
-        let coordinates = 2 * system.dim;
         let scale = |n: usize| self.atol + self.rtol * y[n].abs().max(out[n].abs());
         Ok(match &self.estimate {
             Estimate::None => {
@@ -538,5 +608,132 @@ impl SystemStepper for NewmarkFamily {
 
     fn evaluations(&self) -> u64 {
         self.evaluations
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec, CONTACT};
+    use crate::contact::{Contact, LawKind};
+    use crate::signals::Signal;
+    use crate::structure::Structure;
+
+    /// A modal cantilever with two dampers (one compliant, one rigid), two
+    /// forces, a base excitation and gravity: every term of the rates.
+    fn beam() -> Assembly {
+        let contact = Contact::new(LawKind::HertzDamped, 1e7, Some(0.6), 1.0).unwrap();
+        let spec = SystemSpec {
+            structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap(),
+            dampers: vec![
+                Damper {
+                    mass: 0.01,
+                    at: 0.5,
+                    lower_clearance: 2e-4,
+                    upper_clearance: 2e-4,
+                    law: PairLaw::Compliant(contact),
+                },
+                Damper {
+                    mass: 0.02,
+                    at: 0.25,
+                    lower_clearance: 1e-4,
+                    upper_clearance: 3e-4,
+                    law: PairLaw::rigid(0.5).unwrap(),
+                },
+            ],
+            stops: vec![],
+            gravity: 9.81,
+            excitations: vec![
+                Excitation {
+                    load: Load::Force { at: 0.5 },
+                    signal: Signal::harmonic(0.5, 8.0, 0.0).unwrap(),
+                },
+                Excitation {
+                    load: Load::Force { at: 0.3 },
+                    signal: Signal::harmonic(0.2, 13.0, 0.4).unwrap(),
+                },
+                Excitation {
+                    load: Load::Base,
+                    signal: Signal::harmonic(1.5, 5.0, 0.1).unwrap(),
+                },
+            ],
+        };
+        Assembly::new(&spec).unwrap()
+    }
+
+    /// A state whose coordinates and accumulators are all nonzero.
+    fn state(system: &Assembly, seed: f64) -> Vec<f64> {
+        let mut y = initial_state(system, &[], &[], &[], &[]).unwrap();
+        for (i, v) in y.iter_mut().enumerate() {
+            *v = 1e-4 * (seed + 0.37 * i as f64).sin();
+        }
+        y
+    }
+
+    #[test]
+    fn rk4_own_loop_matches_its_tableau_to_the_bit() {
+        crate::testing::timeout(60, || {
+            let system = beam();
+            let len = system.state_len();
+            let count = system.interactions.len();
+            // Open, in compliant contact and sticking: each branch of the rates.
+            let mut sets = vec![vec![Mode::Open; count]];
+            let mut compliant = vec![Mode::Open; count];
+            compliant[1] = Mode::Compliant {
+                approach_rate: 0.01,
+            };
+            sets.push(compliant.clone());
+            compliant[2] = Mode::Sticking;
+            sets.push(compliant);
+            for modes in &sets {
+                let mut own = ExplicitRk::rk4(len);
+                let mut tableau = ExplicitRk::build(
+                    "rk4 by its tableau",
+                    &RK4_C,
+                    flatten(&RK4_A),
+                    &RK4_B,
+                    Estimate::None,
+                    5.0,
+                    len,
+                );
+                let (mut s1, mut s2) = (Scratch::new(&system), Scratch::new(&system));
+                let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+                let mut time = 0.0;
+                for step in 0..200 {
+                    let y = state(&system, step as f64);
+                    // Repeated attempts from one point reuse its rates.
+                    for h in [1e-5, 0.4e-5] {
+                        own.attempt(&system, time, &y, h, modes, &mut s1, &mut a)
+                            .unwrap();
+                        tableau
+                            .attempt(&system, time, &y, h, modes, &mut s2, &mut b)
+                            .unwrap();
+                        let same = a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits());
+                        assert!(same, "step {step}, h {h}: {a:?} != {b:?}");
+                    }
+                    own.accept();
+                    tableau.accept();
+                    time += 1e-5;
+                }
+                assert_eq!(own.evaluations(), tableau.evaluations());
+                assert!(a[2 * system.dim + CONTACT..].iter().all(|l| l.is_finite()));
+            }
+        });
+    }
+
+    #[test]
+    fn all_gaps_at_once_match_each_gap_to_the_bit() {
+        crate::testing::timeout(60, || {
+            let system = beam();
+            let mut gaps = vec![(0.0, 0.0); system.interactions.len()];
+            for seed in 0..50 {
+                let y = state(&system, seed as f64);
+                system.gaps(&y, &mut gaps);
+                for (i, (g, r)) in gaps.iter().enumerate() {
+                    let (g0, r0) = system.gap(i, &y);
+                    assert_eq!((g.to_bits(), r.to_bits()), (g0.to_bits(), r0.to_bits()));
+                }
+            }
+        });
     }
 }
