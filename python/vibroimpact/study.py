@@ -39,7 +39,7 @@ point. SI units.
 ``stepping = "fixed"`` runs a study of the two-mass impact damper (one mass on a spring,
 one ``[[damper]]`` with equal clearances and a compliant law, no stops, gravity or
 excitation; ``[solver] method = "rk4"`` with its ``dt``; ``analysis = "run"``) as a
-lockstep ensemble: eight runs advanced together in vector instructions, each the same bit
+lockstep ensemble: sixteen runs advanced together in vector instructions, each the same bit
 for bit as the fixed-step run ``vibroimpact.simulate(..., method="rk4",
 stepping="fixed")`` makes of it (steps are not cut at contacts; contact onsets are located
 inside the step). It keeps ``peak`` (step ends and extrema located on the cubic Hermite

@@ -15,6 +15,9 @@ use crate::error::{finite, non_negative, positive, within, Error, Result};
 /// them through a validated [`Contact`] ([`Contact::visit`]); the checked way
 /// to evaluate a law is [`Contact::law_force`].
 pub trait ContactLaw: Copy + Send + Sync {
+    /// Whether the force depends on the rate latched at the onset (kernels
+    /// that need it only for such laws may skip keeping it).
+    const USES_APPROACH_RATE: bool = true;
     /// Force in N (>= 0) at indentation `indentation` > 0 (m), indentation
     /// rate `rate` (m/s, > 0 while approaching) and the rate latched at the
     /// onset of this contact `approach_rate` (m/s).
@@ -45,6 +48,7 @@ pub struct Hertz {
 }
 
 impl ContactLaw for Hertz {
+    const USES_APPROACH_RATE: bool = false;
     #[inline(always)]
     fn force(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> f64 {
         self.elastic_force(indentation)
@@ -258,6 +262,7 @@ pub struct Linear {
 }
 
 impl ContactLaw for Linear {
+    const USES_APPROACH_RATE: bool = false;
     #[inline(always)]
     fn force(&self, indentation: f64, _rate: f64, _approach_rate: f64) -> f64 {
         self.stiffness * indentation

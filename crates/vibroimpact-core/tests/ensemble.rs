@@ -86,7 +86,7 @@ fn every_lane_is_the_fixed_step_kernels_run_bit_for_bit() {
             LawKind::HysterHertz,
             LawKind::HertzDamped,
         ] {
-            // 13 members: a full group and a padded one.
+            // 2 LANES - 3 members: a full group and a padded one.
             let members = members(kind, 2 * LANES - 3);
             let steps = 30_000;
             let results = run_ensemble(&members, &options(steps), 1, &|| false).unwrap();
