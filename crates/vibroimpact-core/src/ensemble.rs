@@ -18,6 +18,9 @@
 //! (an unforced damped system can only lose energy; more is the step's
 //! error), is failed with its reason and the others go on.
 
+// Lane loops index several arrays by the same lane, which is what vectorises.
+#![allow(clippy::needless_range_loop)]
+
 use rayon::prelude::*;
 
 use crate::contact::{Contact, ContactLaw, Hertz, HysterHertz, LawKind, Linear};
@@ -454,19 +457,19 @@ fn steps<L: ContactLaw>(
         let s = lanes.state;
         // The provisional latch of the lanes apart (the fixed-step kernel's),
         // for the laws that read it.
-        for l in 0..LANES * usize::from(L::USES_APPROACH_RATE) {
-            let u = s.y[l] - s.w[l];
-            let v = s.yv[l] - s.wv[l];
-            let side = if u > 0.0 || (u == 0.0 && v >= 0.0) {
-                1.0
-            } else {
-                -1.0
-            };
-            approach[l] = if open_side[l] != 0.0 {
-                approach[l]
-            } else {
-                side * v
-            };
+        if L::USES_APPROACH_RATE {
+            for l in 0..LANES {
+                let u = s.y[l] - s.w[l];
+                let v = s.yv[l] - s.wv[l];
+                let side = if u > 0.0 || (u == 0.0 && v >= 0.0) {
+                    1.0
+                } else {
+                    -1.0
+                };
+                if open_side[l] == 0.0 {
+                    approach[l] = side * v;
+                }
+            }
         }
         let k1 = derivative(lanes, &s, &approach);
         let k2 = derivative(lanes, &s.offset(half, &k1), &approach);
