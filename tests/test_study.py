@@ -16,35 +16,12 @@ import pytest
 import xarray as xr
 
 import vibroimpact as vi
+from study_checks import FORCED_DAMPER  # noqa: E402
 from vibroimpact import study as st
 from vibroimpact.analyses import runner, steady_state
 from vibroimpact.system_scenario import SystemScenario
 
-BASE = """
-[structure]
-kind = "oscillator"
-mass = 1.0
-stiffness = 3947.8
-damping = 2.513
-
-[[damper]]
-mass = 0.05
-at = 0
-clearance = 0.005
-law = "rigid"
-restitution = 0.6
-
-[[excitation]]
-kind = "force"
-at = 0
-signal = "harmonic"
-amplitude = 5.0
-frequency = 10.0
-
-[solver]
-method = "exact"
-t_end = 0.5
-"""
+BASE = FORCED_DAMPER
 
 STEADY = """
 [study]

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
+from study_checks import load_study  # noqa: E402
 from vibroimpact import study as st
-from vibroimpact.system_scenario import SystemScenario
 
 M, K, C, MD, D, KHZ, C1 = 1.0, 1.0, 0.01, 0.25, 0.01, 3000.0, 0.01
 DT, T_END = 1e-4, 3.0
@@ -57,11 +57,7 @@ chunk_size = 5
 
 
 def load(tmp_path: Path, text: str) -> st.Study:
-    path = tmp_path / "study.toml"
-    path.write_text(text)
-    sc = vi.load_scenario(path)
-    assert isinstance(sc, SystemScenario)
-    return st.study_of(sc.data, str(path), sc.base_dir)
+    return load_study(tmp_path / "study.toml", text)
 
 
 def test_each_run_is_the_fixed_step_kernels_run(tmp_path: Path) -> None:

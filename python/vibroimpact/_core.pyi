@@ -242,6 +242,7 @@ def run_study(
     threads: int,
     mean_square: bool = True,
     stepping: str = "events",
+    orbit_periods: int = 1,
 ) -> dict[str, Any]: ...
 
 @final

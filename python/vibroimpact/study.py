@@ -6,11 +6,13 @@ interrupted study resumes where it stopped and gives the same file.
 The ``[study]`` section::
 
     [study]
-    analysis = "steady-state"      # or "run" (to [solver] t_end; record_from, s)
-    settle_periods = 200           # steady-state: forcing periods to settle
-    record_periods = 50            #   and to record
+    analysis = "steady-state"      # or "run" (to [solver] t_end; record_from, s), "orbit"
+    settle_periods = 200           # steady-state, orbit: forcing periods to settle
+    record_periods = 50            # steady-state: periods to record
+    orbit_periods = 1              # orbit: its period, in forcing periods
     metrics = ["peak", "rms", "impacts", "energy_dissipated",
                "amplitude", "impacts_per_period", "settled"]
+               # orbit: "amplitude", "impacts_per_period", "stable", "largest_multiplier"
     chunk_size = 1024              # runs a chunk (what a resume can lose at most)
 
     samples = 100                  # Monte Carlo: runs of random draws at each grid point
@@ -35,6 +37,14 @@ variables (with a ``coordinate`` dimension for per-structure-coordinate metrics 
 dimension follows the axes, and each random parameter is a variable over it: the same
 draws (numpy's PCG64 from ``seed``, in the order of ``[study.random]``) at every grid
 point. SI units.
+
+``analysis = "orbit"`` settles each point for ``settle_periods`` forcing periods, then
+shoots for an orbit of ``orbit_periods`` periods from there (Newton's method with the
+central-difference monodromy, as :func:`vibroimpact.analyses.orbit`, in the core): ``stable``
+is 1 when it converged and every Floquet multiplier is inside the unit circle,
+``largest_multiplier`` the largest multiplier's modulus, ``amplitude`` and
+``impacts_per_period`` those of the orbit. A point whose shooting fails (no orbit near its
+settled state) is recorded with its reason.
 
 ``stepping = "fixed"`` runs a study of the two-mass impact damper (one mass on a spring,
 one ``[[damper]]`` with equal clearances and a compliant law, no stops, gravity or
@@ -73,21 +83,22 @@ from vibroimpact.analyses import AnalysisError, _prepare
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
 
-METRICS = (
-    "peak",
-    "rms",
-    "impacts",
-    "energy_dissipated",
-    "amplitude",
-    "impacts_per_period",
-    "settled",
-)
-_ANALYSES = ("run", "steady-state")
+# What each analysis keeps; every metric.
+_RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated")
+_STEADY_METRICS = (*_RUN_METRICS, "amplitude", "impacts_per_period", "settled")
+_ANALYSIS_METRICS = {
+    "run": _RUN_METRICS,
+    "steady-state": _STEADY_METRICS,
+    "orbit": ("amplitude", "impacts_per_period", "stable", "largest_multiplier"),
+}
+METRICS = (*_STEADY_METRICS, "stable", "largest_multiplier")
+_ANALYSES = tuple(_ANALYSIS_METRICS)
 _SPACINGS = ("linear", "log")
 _STUDY = {
     "analysis": (_TEXT, "run"),
     "settle_periods": (_WHOLE, 200),
     "record_periods": (_WHOLE, 50),
+    "orbit_periods": (_WHOLE, 1),
     "record_from": (_NUMBER, 0.0),
     "tolerance": (_NUMBER, 1e-6),
     "chunk_size": (_WHOLE, 1024),
@@ -116,6 +127,11 @@ _DESCRIPTIONS = {
     ),
     "impacts_per_period": ("impacts and contacts per forcing period, recorded", "1"),
     "settled": ("1 when the stroboscopic state repeats within tolerance, else 0", "1"),
+    "stable": (
+        "1 when the orbit converged and every Floquet multiplier is inside the unit circle",
+        "1",
+    ),
+    "largest_multiplier": ("modulus of the orbit's largest Floquet multiplier", "1"),
 }
 
 
@@ -156,14 +172,22 @@ def study_settings(table: Any) -> dict[str, Any]:
                 f'[study] metrics: {", ".join(other)} not kept by stepping = "fixed" '
                 f'(allowed: {", ".join(_FIXED_METRICS)}; or stepping = "events")'
             )
-    steady_only = {"amplitude", "impacts_per_period", "settled"} & set(metrics)
-    if steady_only and out["analysis"] != "steady-state":
+    kept = _ANALYSIS_METRICS[out["analysis"]]
+    other = [name for name in metrics if name not in kept]
+    if other:
+        keeping = [a for a, names in _ANALYSIS_METRICS.items() if set(other) <= set(names)]
+        hint = f"; use analysis = {' or '.join(repr(a) for a in keeping)}" if keeping else ""
         raise StudyError(
-            f"[study] metrics: {', '.join(sorted(steady_only))} "
-            f'{"needs" if len(steady_only) == 1 else "need"} analysis = "steady-state"'
+            f"[study] metrics: {', '.join(other)} not kept by analysis = "
+            f'"{out["analysis"]}" (it keeps {", ".join(kept)}){hint}'
         )
     out["metrics"] = list(dict.fromkeys(metrics))
-    for key, low in (("settle_periods", 0), ("record_periods", 1), ("chunk_size", 1)):
+    for key, low in (
+        ("settle_periods", 0),
+        ("record_periods", 1),
+        ("orbit_periods", 1),
+        ("chunk_size", 1),
+    ):
         if out[key] < low:
             raise StudyError(f"[study] {key}: must be >= {low}, got {out[key]}")
     if not out["record_from"] >= 0:
@@ -320,6 +344,7 @@ class Study:
             threads=threads,
             mean_square="rms" in s["metrics"],
             stepping=s.get("stepping", "events"),
+            orbit_periods=s.get("orbit_periods", 1),
         )
         return raw
 
@@ -432,7 +457,16 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     )
 
 
-_METRIC_KEYS = ("peak", "rms", "impacts", "energy_dissipated", "impacts_per_period", "settled")
+_METRIC_KEYS = (
+    "peak",
+    "rms",
+    "impacts",
+    "energy_dissipated",
+    "impacts_per_period",
+    "settled",
+    "stable",
+    "largest_multiplier",
+)
 
 
 def chunk_part(study: Study, start: int, stop: int, threads: int = 0) -> dict[str, Any]:

@@ -398,6 +398,220 @@ fn expm_balanced(a: &[f64], n: usize) -> Vec<f64> {
     r
 }
 
+/// The eigenvalues of a general real `n x n` matrix (row-major), as
+/// `(real, imaginary)` pairs in no particular order: reduction to upper
+/// Hessenberg form by stabilised elementary similarity transformations, then
+/// the Francis double-shift QR iteration (EISPACK's `elmhes` and `hqr`, as
+/// Numerical Recipes gives them, with 1-based indices kept so that the
+/// algorithm reads as published). None if an eigenvalue takes more than 30
+/// iterations.
+pub fn eigenvalues(matrix: &[f64], n: usize) -> Option<Vec<(f64, f64)>> {
+    let w = n + 1;
+    let mut a = vec![0.0; w * w];
+    for i in 1..=n {
+        for j in 1..=n {
+            a[i * w + j] = matrix[(i - 1) * n + (j - 1)];
+        }
+    }
+    let at = |i: usize, j: usize| i * w + j;
+    // elmhes
+    for m in 2..n {
+        let (mut x, mut i) = (0.0f64, m);
+        for j in m..=n {
+            if a[at(j, m - 1)].abs() > x.abs() {
+                x = a[at(j, m - 1)];
+                i = j;
+            }
+        }
+        if i != m {
+            for j in (m - 1)..=n {
+                a.swap(at(i, j), at(m, j));
+            }
+            for j in 1..=n {
+                a.swap(at(j, i), at(j, m));
+            }
+        }
+        if x != 0.0 {
+            for i in (m + 1)..=n {
+                let mut y = a[at(i, m - 1)];
+                if y != 0.0 {
+                    y /= x;
+                    a[at(i, m - 1)] = y;
+                    for j in m..=n {
+                        a[at(i, j)] -= y * a[at(m, j)];
+                    }
+                    for j in 1..=n {
+                        a[at(j, m)] += y * a[at(j, i)];
+                    }
+                }
+            }
+        }
+    }
+    // elmhes leaves its multipliers below the subdiagonal.
+    for i in 3..=n {
+        for j in 1..(i - 1) {
+            a[at(i, j)] = 0.0;
+        }
+    }
+    // hqr
+    let sign = |x: f64, y: f64| if y >= 0.0 { x.abs() } else { -x.abs() };
+    let mut values = vec![(0.0, 0.0); n + 1];
+    let mut anorm = 0.0;
+    for i in 1..=n {
+        for j in (i.max(2) - 1)..=n {
+            anorm += a[at(i, j)].abs();
+        }
+    }
+    let mut nn = n;
+    let mut t = 0.0;
+    while nn >= 1 {
+        let mut its = 0;
+        loop {
+            let mut l = nn;
+            while l >= 2 {
+                let mut s = a[at(l - 1, l - 1)].abs() + a[at(l, l)].abs();
+                if s == 0.0 {
+                    s = anorm;
+                }
+                if a[at(l, l - 1)].abs() + s == s {
+                    a[at(l, l - 1)] = 0.0;
+                    break;
+                }
+                l -= 1;
+            }
+            let mut x = a[at(nn, nn)];
+            if l == nn {
+                values[nn] = (x + t, 0.0);
+                nn -= 1;
+            } else {
+                let mut y = a[at(nn - 1, nn - 1)];
+                let mut w2 = a[at(nn, nn - 1)] * a[at(nn - 1, nn)];
+                if l == nn - 1 {
+                    let p = 0.5 * (y - x);
+                    let q = p * p + w2;
+                    let mut z = q.abs().sqrt();
+                    x += t;
+                    if q >= 0.0 {
+                        z = p + sign(z, p);
+                        let low = if z != 0.0 { x - w2 / z } else { x + z };
+                        values[nn - 1] = (x + z, 0.0);
+                        values[nn] = (low, 0.0);
+                    } else {
+                        values[nn - 1] = (x + p, -z);
+                        values[nn] = (x + p, z);
+                    }
+                    nn -= 2;
+                } else {
+                    if its == 30 {
+                        return None;
+                    }
+                    if its == 10 || its == 20 {
+                        // Exceptional shift.
+                        t += x;
+                        for i in 1..=nn {
+                            a[at(i, i)] -= x;
+                        }
+                        let s = a[at(nn, nn - 1)].abs() + a[at(nn - 1, nn - 2)].abs();
+                        x = 0.75 * s;
+                        y = x;
+                        w2 = -0.4375 * s * s;
+                    }
+                    its += 1;
+                    let (mut p, mut q, mut r): (f64, f64, f64);
+                    let mut m = nn - 2;
+                    loop {
+                        let z = a[at(m, m)];
+                        let rr = x - z;
+                        let ss = y - z;
+                        p = (rr * ss - w2) / a[at(m + 1, m)] + a[at(m, m + 1)];
+                        q = a[at(m + 1, m + 1)] - z - rr - ss;
+                        r = a[at(m + 2, m + 1)];
+                        let s = p.abs() + q.abs() + r.abs();
+                        p /= s;
+                        q /= s;
+                        r /= s;
+                        if m == l {
+                            break;
+                        }
+                        let u = a[at(m, m - 1)].abs() * (q.abs() + r.abs());
+                        let v = p.abs()
+                            * (a[at(m - 1, m - 1)].abs() + z.abs() + a[at(m + 1, m + 1)].abs());
+                        if u + v == v {
+                            break;
+                        }
+                        m -= 1;
+                    }
+                    for i in (m + 2)..=nn {
+                        a[at(i, i - 2)] = 0.0;
+                        if i != m + 2 {
+                            a[at(i, i - 3)] = 0.0;
+                        }
+                    }
+                    let mut k = m;
+                    while k < nn {
+                        if k != m {
+                            p = a[at(k, k - 1)];
+                            q = a[at(k + 1, k - 1)];
+                            r = if k != nn - 1 {
+                                a[at(k + 2, k - 1)]
+                            } else {
+                                0.0
+                            };
+                            x = p.abs() + q.abs() + r.abs();
+                            if x != 0.0 {
+                                p /= x;
+                                q /= x;
+                                r /= x;
+                            }
+                        }
+                        let s = sign((p * p + q * q + r * r).sqrt(), p);
+                        if s != 0.0 {
+                            if k == m {
+                                if l != m {
+                                    a[at(k, k - 1)] = -a[at(k, k - 1)];
+                                }
+                            } else {
+                                a[at(k, k - 1)] = -s * x;
+                            }
+                            p += s;
+                            x = p / s;
+                            y = q / s;
+                            let z = r / s;
+                            q /= p;
+                            r /= p;
+                            for j in k..=nn {
+                                p = a[at(k, j)] + q * a[at(k + 1, j)];
+                                if k != nn - 1 {
+                                    p += r * a[at(k + 2, j)];
+                                    a[at(k + 2, j)] -= p * z;
+                                }
+                                a[at(k + 1, j)] -= p * y;
+                                a[at(k, j)] -= p * x;
+                            }
+                            let last = nn.min(k + 3);
+                            for i in l..=last {
+                                p = x * a[at(i, k)] + y * a[at(i, k + 1)];
+                                if k != nn - 1 {
+                                    p += z * a[at(i, k + 2)];
+                                    a[at(i, k + 2)] -= p * r;
+                                }
+                                a[at(i, k + 1)] -= p * q;
+                                a[at(i, k)] -= p;
+                            }
+                        }
+                        k += 1;
+                    }
+                }
+            }
+            if nn < 2 || l >= nn - 1 {
+                break;
+            }
+        }
+    }
+    values.remove(0);
+    Some(values)
+}
+
 /// `x^T A x` for a symmetric row-major matrix.
 pub fn quadratic_form(a: &[f64], x: &[f64]) -> f64 {
     let n = x.len();
@@ -460,6 +674,84 @@ mod tests {
             // Singular (a free-free chain) and indefinite matrices have no factor.
             assert!(cholesky(&[1.0, -1.0, -1.0, 1.0], 2).is_none());
             assert!(cholesky(&[1.0, 2.0, 2.0, 1.0], 2).is_none());
+        });
+    }
+    #[test]
+    fn eigenvalues_of_general_matrices() {
+        crate::testing::timeout(60, || {
+            let sorted = |mut v: Vec<(f64, f64)>| {
+                v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+                v
+            };
+            let close = |got: &[(f64, f64)], want: &[(f64, f64)], tol: f64| {
+                assert_eq!(got.len(), want.len());
+                for (g, w) in got.iter().zip(want) {
+                    assert!(
+                        (g.0 - w.0).abs() < tol && (g.1 - w.1).abs() < tol,
+                        "{got:?} vs {want:?}"
+                    );
+                }
+            };
+            // A rotation scaled by r: r e^(+-i phi).
+            let (r, phi) = (0.9f64, 0.7f64);
+            let (c, s) = (r * phi.cos(), r * phi.sin());
+            close(
+                &sorted(eigenvalues(&[c, -s, s, c], 2).unwrap()),
+                &[(c, -s), (c, s)],
+                1e-15,
+            );
+            // The companion matrix of (x - 0.5)(x + 0.3)(x - 1.1)(x^2 - 0.4 x + 0.53):
+            // roots 0.5, -0.3, 1.1 and 0.2 +- 0.7 i.
+            let roots = [(0.5, 0.0), (-0.3, 0.0), (1.1, 0.0), (0.2, 0.7), (0.2, -0.7)];
+            // Coefficients of the monic polynomial, highest first, by expansion.
+            let mut poly: Vec<(f64, f64)> = vec![(1.0, 0.0)];
+            for &(rr, ri) in &roots {
+                let mut next = vec![(0.0, 0.0); poly.len() + 1];
+                for (i, &(pr, pi)) in poly.iter().enumerate() {
+                    next[i].0 += pr;
+                    next[i].1 += pi;
+                    next[i + 1].0 -= pr * rr - pi * ri;
+                    next[i + 1].1 -= pr * ri + pi * rr;
+                }
+                poly = next;
+            }
+            let n = 5;
+            let mut companion = vec![0.0; n * n];
+            for j in 0..n {
+                companion[j] = -poly[j + 1].0;
+            }
+            for i in 1..n {
+                companion[i * n + i - 1] = 1.0;
+            }
+            close(
+                &sorted(eigenvalues(&companion, n).unwrap()),
+                &sorted(roots.to_vec()),
+                1e-12,
+            );
+            // Any matrix: the eigenvalues sum to the trace, and (n = 3) their
+            // product is the determinant.
+            let m = [0.3, -1.2, 2.5, 0.7, 0.1, -0.4, -2.0, 1.5, 0.9];
+            let e = eigenvalues(&m, 3).unwrap();
+            let trace: f64 = e.iter().map(|v| v.0).sum();
+            assert!((trace - (0.3 + 0.1 + 0.9)).abs() < 1e-13);
+            assert!(e.iter().map(|v| v.1).sum::<f64>().abs() < 1e-13);
+            let det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6])
+                + m[2] * (m[3] * m[7] - m[4] * m[6]);
+            let (mut pr, mut pi) = (1.0, 0.0);
+            for (a, b) in &e {
+                (pr, pi) = (pr * a - pi * b, pr * b + pi * a);
+            }
+            assert!(
+                (pr - det).abs() < 1e-12 && pi.abs() < 1e-12,
+                "{pr} {pi} vs {det}"
+            );
+            // Triangular: its diagonal. One by one: itself.
+            close(
+                &sorted(eigenvalues(&[2.0, 5.0, 7.0, 0.0, -1.0, 3.0, 0.0, 0.0, 0.5], 3).unwrap()),
+                &[(-1.0, 0.0), (0.5, 0.0), (2.0, 0.0)],
+                1e-14,
+            );
+            close(&eigenvalues(&[4.2], 1).unwrap(), &[(4.2, 0.0)], 1e-15);
         });
     }
 }

@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use crate::assembly::{initial_state, Assembly, PairLaw, SystemSpec};
+use crate::assembly::{initial_state, resumed_state, Assembly, PairLaw, SystemSpec};
 use crate::contact::Contact;
 use crate::ensemble::{run_ensemble, EnsembleOptions, Member};
 use crate::error::{Error, Result};
@@ -20,6 +20,7 @@ use crate::signals::Signal;
 use crate::system::{ImpactDamper, State};
 use crate::system_events::{ContactKind, RunOptions, SystemSolution};
 use crate::system_methods::AnyStepper;
+use crate::{linalg, shooting};
 
 /// Which entry of the scenario a study varies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -258,7 +259,16 @@ pub enum Analysis {
         record: u64,
         tolerance: f64,
     },
+    /// `settle` forcing periods, then Newton shooting for an orbit of
+    /// `periods` periods from there (see [`crate::shooting`]): its Floquet
+    /// multipliers, amplitude and impacts.
+    Orbit { settle: u64, periods: u64 },
 }
+
+/// Newton's tolerance and iterations for an orbit study's shooting (as
+/// `vibroimpact.analyses.orbit`'s defaults).
+const ORBIT_TOLERANCE: f64 = 1e-10;
+const ORBIT_ITERATIONS: usize = 40;
 
 /// The metrics of one run. NaN where a run failed (see `status`).
 #[derive(Debug, Clone, PartialEq)]
@@ -276,6 +286,10 @@ pub struct RunMetrics {
     /// Steady state only: impacts per forcing period, and 1 / 0 for settled.
     pub impacts_per_period: f64,
     pub settled: f64,
+    /// Orbit only: 1 when Newton converged and every Floquet multiplier is
+    /// inside the unit circle, else 0; the largest multiplier's modulus.
+    pub stable: f64,
+    pub largest_multiplier: f64,
 }
 
 /// Run the study: for each row of `values` (one value per parameter), set
@@ -406,6 +420,8 @@ fn run_lockstep(
                 energy_dissipated: vec![nan],
                 impacts_per_period: nan,
                 settled: nan,
+                stable: nan,
+                largest_multiplier: nan,
             }
         })
         .collect())
@@ -475,6 +491,8 @@ fn one_run(
         energy_dissipated: vec![f64::NAN; pairs],
         impacts_per_period: f64::NAN,
         settled: f64::NAN,
+        stable: f64::NAN,
+        largest_multiplier: f64::NAN,
     };
     for (p, v) in parameters.iter().zip(values) {
         if let Err(e) = p.apply(&mut spec, &mut initial, *v) {
@@ -513,32 +531,129 @@ fn measured(
             let t = period()?;
             ((settle + record) as f64 * t, settle as f64 * t, t)
         }
+        Analysis::Orbit { settle, periods } => {
+            return orbit_metrics(&system, &y0, settings, period()?, settle, periods);
+        }
     };
-    let mut stepper = AnyStepper::new(
-        &system,
-        &settings.method,
-        settings.rtol,
-        settings.atol,
-        settings.beta,
-        settings.gamma,
-        settings.spectral_radius,
-    )?;
-    let options = RunOptions {
-        dt: stepper.step(settings.dt, t_end, strobe_period),
+    let mut stepper = stepper_of(&system, settings)?;
+    let options = run_options(
+        settings,
+        stepper.step(settings.dt, t_end, strobe_period),
+        t_end,
+        ReduceOptions {
+            record_from,
+            strobe_period,
+            mean_square: settings.mean_square,
+        },
+    );
+    let sol = stepper.integrate(&system, &y0, &options, &mut || false)?;
+    Ok(metrics_of(&system, &sol, record_from, settings))
+}
+
+/// A study run's options: no history, the study's limits.
+fn run_options(
+    settings: &StudySettings,
+    dt: Option<f64>,
+    t_end: f64,
+    reduce: ReduceOptions,
+) -> RunOptions {
+    RunOptions {
+        dt,
         t_end,
         every: 1,
         keep_history: false,
         max_steps: settings.max_steps,
         max_rows: u64::MAX,
         energy_tolerance: settings.energy_tolerance,
-        reduce: ReduceOptions {
-            record_from,
-            strobe_period,
-            mean_square: settings.mean_square,
-        },
+        reduce,
+    }
+}
+
+/// The study's method for `system`.
+fn stepper_of(system: &Assembly, settings: &StudySettings) -> Result<AnyStepper> {
+    AnyStepper::new(
+        system,
+        &settings.method,
+        settings.rtol,
+        settings.atol,
+        settings.beta,
+        settings.gamma,
+        settings.spectral_radius,
+    )
+}
+
+/// An orbit study's run: settle, shoot, then one more orbit recorded.
+fn orbit_metrics(
+    system: &Assembly,
+    y0: &[f64],
+    settings: &StudySettings,
+    period: f64,
+    settle: u64,
+    periods: u64,
+) -> Result<RunMetrics> {
+    let mut stepper = stepper_of(system, settings)?;
+    let span = periods as f64 * period;
+    let options = |t_end: f64, record: bool| {
+        let reduce = ReduceOptions {
+            record_from: if record { 0.0 } else { f64::INFINITY },
+            strobe_period: f64::INFINITY,
+            mean_square: false,
+        };
+        run_options(
+            settings,
+            stepper.step(settings.dt, t_end, period),
+            t_end,
+            reduce,
+        )
     };
-    let sol = stepper.integrate(&system, &y0, &options, &mut || false)?;
-    Ok(metrics_of(&system, &sol, record_from, settings))
+    let (n, d) = (system.n, system.dim);
+    let settle_options = options(settle.max(1) as f64 * period, false);
+    let span_options = options(span, false);
+    let record_options = options(span, true);
+    let mut z = if settle > 0 {
+        stepper
+            .integrate(system, y0, &settle_options, &mut || false)?
+            .final_state
+    } else {
+        y0[..2 * d].to_vec()
+    };
+    let mut run_from = |z: &[f64], options: &RunOptions| -> Result<SystemSolution> {
+        let y = resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..2 * d]])?;
+        stepper.integrate(system, &y, options, &mut || false)
+    };
+    let shot = shooting::shoot(
+        &mut |z| Ok(run_from(z, &span_options)?.final_state),
+        &z,
+        ORBIT_TOLERANCE,
+        ORBIT_ITERATIONS,
+    )?;
+    z.clone_from(&shot.state);
+    let multipliers = linalg::eigenvalues(&shot.monodromy, 2 * d).ok_or_else(|| {
+        Error::Inconsistent("the orbit's Floquet multipliers did not converge".into())
+    })?;
+    let largest = multipliers
+        .iter()
+        .map(|(re, im)| re.hypot(*im))
+        .fold(0.0f64, f64::max);
+    let orbit = run_from(&z, &record_options)?;
+    let impacts = orbit
+        .contacts
+        .iter()
+        .filter(|c| c.kind != ContactKind::Sticking)
+        .count() as f64;
+    let nan = f64::NAN;
+    Ok(RunMetrics {
+        status: 0,
+        reason: String::new(),
+        peak: orbit.reductions.peaks.clone(),
+        rms: vec![nan; n],
+        impacts,
+        energy_dissipated: vec![nan; system.pairs.len()],
+        impacts_per_period: impacts / periods as f64,
+        settled: nan,
+        stable: f64::from(u8::from(shot.converged && largest < 1.0)),
+        largest_multiplier: largest,
+    })
 }
 
 fn metrics_of(
@@ -588,7 +703,7 @@ fn metrics_of(
                 settled(&r.strobe[..rows * width], width, tolerance),
             )
         }
-        Analysis::Run { .. } => (f64::NAN, f64::NAN),
+        Analysis::Run { .. } | Analysis::Orbit { .. } => (f64::NAN, f64::NAN),
     };
     RunMetrics {
         status: 0,
@@ -599,6 +714,8 @@ fn metrics_of(
         energy_dissipated: energy,
         impacts_per_period,
         settled,
+        stable: f64::NAN,
+        largest_multiplier: f64::NAN,
     }
 }
 

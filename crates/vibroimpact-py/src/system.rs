@@ -710,10 +710,12 @@ pub fn linear_parts<'py>(
 /// (`len(paths)` values a row, flat) sets the parameters at `paths` in a
 /// copy of the system and runs it, on `threads` threads (0: all cores), with
 /// the GIL released. Returns the metrics as flat arrays, one row a run.
+/// `analysis = "orbit"` settles, then shoots for an orbit of `orbit_periods`
+/// forcing periods (its multipliers, amplitude and impacts).
 /// `stepping = "fixed"` runs them as a lockstep ensemble of fixed RK4 steps
 /// (one mass, one compliant damper, unforced; see `core::ensemble`).
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true, stepping="events"))]
+#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true, stepping="events", orbit_periods=1))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_study<'py>(
     py: Python<'py>,
@@ -739,6 +741,7 @@ pub fn run_study<'py>(
     threads: usize,
     mean_square: bool,
     stepping: &str,
+    orbit_periods: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use core::study::{run_study as study, Analysis, Parameter, StudySettings};
     check_method(
@@ -777,9 +780,13 @@ pub fn run_study<'py>(
             record: record_periods.max(1),
             tolerance,
         },
+        "orbit" => Analysis::Orbit {
+            settle: settle_periods,
+            periods: orbit_periods.max(1),
+        },
         other => {
             return Err(InvalidInputError::new_err(format!(
-                "analysis must be \"run\" or \"steady-state\", got {other:?}"
+                "analysis must be \"run\", \"steady-state\" or \"orbit\", got {other:?}"
             )))
         }
     };
@@ -844,5 +851,7 @@ pub fn run_study<'py>(
     out.set_item("energy_dissipated", flat(&|r| r.energy_dissipated.clone()))?;
     out.set_item("impacts_per_period", flat(&|r| vec![r.impacts_per_period]))?;
     out.set_item("settled", flat(&|r| vec![r.settled]))?;
+    out.set_item("stable", flat(&|r| vec![r.stable]))?;
+    out.set_item("largest_multiplier", flat(&|r| vec![r.largest_multiplier]))?;
     Ok(out)
 }

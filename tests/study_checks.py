@@ -1,0 +1,46 @@
+"""What the study tests share: a forced impact damper's scenario (rigid impacts) and a
+study loaded from scenario text."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import vibroimpact as vi
+from vibroimpact import study as st
+from vibroimpact.system_scenario import SystemScenario
+
+# A 10 Hz structure with 2 % damping, a 0.05 kg loose mass with 5 mm clearance each side
+# and rigid impacts (e = 0.6), forced by 5 N at 10 Hz; the exact method.
+FORCED_DAMPER = """
+[structure]
+kind = "oscillator"
+mass = 1.0
+stiffness = 3947.8
+damping = 2.513
+
+[[damper]]
+mass = 0.05
+at = 0
+clearance = 0.005
+law = "rigid"
+restitution = 0.6
+
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = 5.0
+frequency = 10.0
+
+[solver]
+method = "exact"
+t_end = 0.5
+"""
+
+
+def load_study(path: Path, text: str) -> st.Study:
+    """The study of the scenario ``text``, written to ``path`` (a .toml file)."""
+    path.write_text(text)
+    sc = vi.load_scenario(path)
+    assert isinstance(sc, SystemScenario)
+    return st.study_of(sc.data, str(path), sc.base_dir)

@@ -1,0 +1,116 @@
+"""Studies with ``analysis = "orbit"``: each point settled, then its periodic orbit shot
+for in the core with its Floquet multipliers (a Hessenberg QR eigensolver in Rust).
+Against closed forms for a forced linear oscillator (multipliers of modulus
+exp(-zeta wn T), amplitude |F / (K - w^2 M + i w C)|), and against
+``analyses.orbit`` (numpy's eigenvalues) for a forced impact damper."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from study_checks import FORCED_DAMPER, load_study  # noqa: E402
+from vibroimpact import study as st
+from vibroimpact.analyses import orbit, runner, with_parameter
+
+M, K, ZETA, F0 = 1.0, 3947.8, 0.02, 5.0
+WN = math.sqrt(K / M)
+C = 2 * ZETA * WN * M
+
+LINEAR = f"""
+[structure]
+kind = "oscillator"
+mass = {M}
+stiffness = {K}
+damping = {C}
+
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = {F0}
+frequency = 10.0
+
+[solver]
+method = "exact"
+t_end = 1.0
+
+[study]
+analysis = "orbit"
+settle_periods = 5
+metrics = ["amplitude", "impacts_per_period", "stable", "largest_multiplier"]
+
+[study.axes]
+"excitation.0.frequency" = [5.0, 9.5, 10.0, 12.0]
+"""
+
+DAMPER = (
+    FORCED_DAMPER
+    + """
+[study]
+analysis = "orbit"
+settle_periods = 60
+metrics = ["amplitude", "impacts_per_period", "stable", "largest_multiplier"]
+
+[study.axes]
+"excitation.0.frequency" = [9.0, 10.0, 11.0]
+"""
+)
+
+
+def load(tmp_path: Path, text: str) -> st.Study:
+    return load_study(tmp_path / "study.toml", text)
+
+
+def test_a_forced_linear_oscillators_orbits_match_the_closed_form(tmp_path: Path) -> None:
+    ds = st.run(load(tmp_path, LINEAR), tmp_path / "out.nc")
+    assert int(ds["status"].max()) == 0
+    for frequency in (5.0, 9.5, 10.0, 12.0):
+        point = ds.sel({"excitation.0.frequency": frequency})
+        w, period = 2 * math.pi * frequency, 1 / frequency
+        # The monodromy is exp(A T): both multipliers of modulus exp(-zeta wn T). Its
+        # central differences err by ~1e-7 at resonance (10 Hz), where the two
+        # multipliers nearly coincide and move most with the matrix.
+        decay = math.exp(-ZETA * WN * period)
+        assert point["largest_multiplier"].item() == pytest.approx(decay, rel=1e-6)
+        assert point["stable"].item() == 1.0
+        amplitude = F0 / abs(K - w * w * M + 1j * w * C)
+        assert point["amplitude"].values[0] == pytest.approx(amplitude, rel=1e-8)
+        assert point["impacts_per_period"].item() == 0.0
+
+
+def test_an_impact_dampers_orbits_match_the_analysis(tmp_path: Path) -> None:
+    study = load(tmp_path, DAMPER)
+    ds = st.run(study, tmp_path / "out.nc")
+    assert int(ds["status"].max()) == 0
+    base = {k: v for k, v in study.data.items() if k != "study"}
+    stable_seen = False
+    for frequency in (9.0, 10.0, 11.0):
+        data = with_parameter(base, "excitation.0.frequency", frequency)
+        run = runner(data)
+        settled = run.map(run.initial_state(), 60)
+        result = orbit(run, settled)
+        assert result.converged
+        point = ds.sel({"excitation.0.frequency": frequency})
+        # Rust's Hessenberg QR against numpy's LAPACK on the same monodromy.
+        largest = float(np.abs(result.floquet_multipliers).max())
+        assert point["largest_multiplier"].item() == pytest.approx(largest, rel=1e-9)
+        assert point["stable"].item() == float(result.stable)
+        np.testing.assert_allclose(point["amplitude"].values, result.amplitude, rtol=1e-9)
+        assert point["impacts_per_period"].item() == result.impacts_per_period
+        stable_seen |= result.stable
+    assert stable_seen
+
+
+def test_orbit_metrics_belong_to_the_orbit_analysis(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="stable.*not kept by analysis.*orbit"):
+        load(tmp_path, LINEAR.replace('analysis = "orbit"', 'analysis = "run"'))
+    with pytest.raises(ValueError, match="rms.*not kept.*orbit"):
+        load(tmp_path, LINEAR.replace('metrics = ["amplitude"', 'metrics = ["rms", "amplitude"'))
+    with pytest.raises(ValueError, match="orbit_periods.*>= 1"):
+        load(
+            tmp_path, LINEAR.replace("settle_periods = 5", "settle_periods = 5\norbit_periods = 0")
+        )
