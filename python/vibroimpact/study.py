@@ -1,7 +1,8 @@
 """Studies: a grid of runs of one 0.2 scenario with some of its parameters varied,
 run on every core by the Rust core (rayon, the GIL released), each reduced to
-metrics; the result an xarray Dataset written as NetCDF, chunk by chunk so that an
-interrupted study resumes where it stopped and gives the same file.
+metrics; the result an xarray Dataset written as a NetCDF file (``RESULT.nc``) or a Zarr
+store (``RESULT.zarr``, with the optional zarr package), chunk by chunk so that an
+interrupted study resumes where it stopped and gives the same file or store.
 
 The ``[study]`` section::
 
@@ -68,6 +69,7 @@ import json
 import logging
 import math
 import os
+import secrets
 import shutil
 import sys
 import time
@@ -508,13 +510,15 @@ def run(
     progress: Callable[[int, int, float], None] | None = None,
     dask: str | None = None,
 ) -> Any:
-    """Run ``study`` into the NetCDF file ``out``, chunk by chunk: each finished
-    chunk is kept in ``OUT.parts/`` (written whole), so a study interrupted or killed
-    loses at most the chunks in flight and, run again, goes on where it stopped; the
-    file is written whole at the end (the same file as an uninterrupted run) and the
-    parts removed. ``dask``: the address of a Dask scheduler, or ``"local"`` for a
-    LocalCluster of ``threads`` processes (all cores for 0), the chunks its tasks;
-    the results are the same. Returns the Dataset."""
+    """Run ``study`` into ``out``, by its suffix the NetCDF file ``RESULT.nc`` or the
+    Zarr store ``RESULT.zarr`` (needs zarr; see :func:`output_kind`), chunk by chunk:
+    each finished chunk is kept in ``OUT.parts/`` (written whole), so a study
+    interrupted or killed loses at most the chunks in flight and, run again, goes on
+    where it stopped; the output is written whole at the end (the same file or store as
+    an uninterrupted run) and the parts removed. ``dask``: the address of a Dask
+    scheduler, or ``"local"`` for a LocalCluster of ``threads`` processes (all cores for
+    0), the chunks its tasks; the results are the same. Returns the Dataset."""
+    kind = output_kind(out)
     parts_dir = out.with_name(out.name + ".parts")
     fingerprint = study.fingerprint()
     manifest = parts_dir / "manifest.json"
@@ -563,10 +567,136 @@ def run(
         raise
     parts = [_load(path) for path in path_of]
     dataset = assemble(study, parts)
-    with written_whole(out, binary=True) as f:
-        f.write(dataset.to_netcdf(engine="scipy"))
+    if kind == ".zarr":
+        _write_zarr(dataset, out)
+    else:
+        with written_whole(out, binary=True) as f:
+            f.write(dataset.to_netcdf(engine="scipy"))
     shutil.rmtree(parts_dir, ignore_errors=True)
     return dataset
+
+
+# What a study's output may end in, and what each suffix writes.
+OUTPUTS = {".nc": "a NetCDF file", ".zarr": "a Zarr store"}
+
+
+def output_kind(out: Path) -> str:
+    """The suffix of ``out`` that decides its format (``.nc`` or ``.zarr``), checked
+    before a study runs: another suffix, a Zarr store without the zarr package, or a
+    ``.zarr`` path that holds something other than a Zarr store (which the store
+    would replace) raise :class:`UsageError`."""
+    kind = out.suffix.lower()
+    if kind not in OUTPUTS:
+        allowed = " or ".join(f"{suffix} ({what})" for suffix, what in OUTPUTS.items())
+        raise UsageError(f"--out {out}: must end in {allowed}")
+    if kind == ".zarr":
+        try:
+            importlib.import_module("zarr")
+        except ImportError:
+            raise UsageError(
+                f'--out {out}: a Zarr store needs zarr: pip install "vibroimpact[zarr]"'
+            ) from None
+        _replaceable_store(out)
+    return kind
+
+
+def _replaceable_store(out: Path) -> None:
+    """Refuse a ``.zarr`` path that holds a file, or a folder that is neither empty nor
+    a Zarr store: writing the study there would replace what is not a result."""
+    if out.is_symlink():
+        out = out.resolve()
+    if not out.exists():
+        return
+    if out.is_dir() and (
+        not any(out.iterdir()) or any((out / name).is_file() for name in _STORE_MARKS)
+    ):
+        return
+    raise UsageError(
+        f"--out {out}: exists and is not a Zarr store; remove it or choose another name"
+    )
+
+
+# What marks a folder as a Zarr store: format 2's group or consolidated metadata, or 3's.
+_STORE_MARKS = (".zgroup", ".zmetadata", "zarr.json")
+
+
+def _write_zarr(dataset: Any, out: Path) -> None:
+    """Write ``dataset`` as the Zarr store ``out`` whole or not at all: built in a hidden
+    folder beside ``out`` (so that the rename cannot cross file systems), its files on
+    disk, then renamed into place; an earlier store at ``out`` is moved aside for the
+    rename and removed only once the new one stands in its place (put back if the rename
+    fails). A write that fails or is interrupted removes the folder and leaves ``out`` as
+    it was; a killed one can leave the hidden folder, never a partial ``out``.
+
+    Zarr format 2 with consolidated metadata: its specification covers every dtype of
+    the Dataset (format 3 has none yet for fixed-width strings, and zarr warns), and
+    ``xr.open_zarr`` reads it in one request, with no warning."""
+    if out.is_symlink():
+        # Replace the store the link points to, and keep the link.
+        out = out.resolve()
+    _replaceable_store(out)
+    temporary: Path | None = None
+    earlier: Path | None = None
+    try:
+        temporary = _folder_beside(out, "tmp")
+        dataset.to_zarr(temporary, mode="w", zarr_format=2, consolidated=True)
+        _sync(temporary)
+        if out.exists():
+            earlier = _folder_beside(out, "old")
+            os.replace(out, earlier)
+        os.replace(temporary, out)
+        temporary = None
+        _sync_folder(out.parent)
+    except OSError as err:
+        raise UsageError(f"cannot write {str(out)!r}: {err.strerror or err}") from None
+    finally:
+        if earlier is not None:
+            if temporary is None:
+                shutil.rmtree(earlier, ignore_errors=True)
+            else:
+                # The new store is not in place: the earlier one goes back.
+                os.replace(earlier, out)
+        if temporary is not None:
+            shutil.rmtree(temporary, ignore_errors=True)
+
+
+def _folder_beside(path: Path, tag: str) -> Path:
+    """A new, hidden, empty folder next to ``path``, created exclusively (``tag``
+    ``"old"``: a name only, for a folder renamed there)."""
+    while True:
+        folder = path.with_name(f".{path.name}.{secrets.token_hex(4)}.{tag}")
+        if tag == "old":
+            if not os.path.lexists(folder):
+                return folder
+            continue
+        try:
+            folder.mkdir()
+            return folder
+        except FileExistsError:
+            continue
+
+
+def _sync(folder: Path) -> None:
+    """The files below ``folder`` and the folders themselves on disk."""
+    for root, _, files in os.walk(folder):
+        for name in files:
+            with open(os.path.join(root, name), "rb") as f:
+                os.fsync(f.fileno())
+        _sync_folder(Path(root))
+
+
+def _sync_folder(folder: Path) -> None:
+    # A folder's entries on disk, where the system can (not on Windows).
+    try:
+        descriptor = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(descriptor)
+    except OSError:
+        pass
+    finally:
+        os.close(descriptor)
 
 
 def _run_on_dask(

@@ -1,4 +1,4 @@
-"""The ``study`` command: a ``[study]`` grid of runs into a NetCDF file."""
+"""The ``study`` command: a ``[study]`` grid of runs into a NetCDF file or a Zarr store."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import numpy as np
 from vibroimpact._core import InvalidInputError
 from vibroimpact.output import UsageError
 from vibroimpact.scenario import load_scenario
-from vibroimpact.study import run, study_of, terminal_progress
+from vibroimpact.study import output_kind, run, study_of, terminal_progress
 from vibroimpact.system_scenario import SystemScenario
 
 
@@ -21,19 +21,24 @@ def add_command(sub: Any) -> None:
     """Register ``study`` on the command line's subparsers."""
     parser = sub.add_parser(
         "study",
-        help="a grid of runs varying [study.axes], metrics into a NetCDF file",
+        help="a grid of runs varying [study.axes], metrics into a NetCDF file or Zarr store",
         description=(
             "Run every combination of the [study.axes] values of a 0.2 scenario on all "
             "cores (or --workers N), each run reduced to the [study] metrics, and write "
-            "them as an xarray Dataset in NetCDF (one dimension per axis, a status "
-            "variable, the reasons of failed runs in its attributes). Finished chunks are "
-            "kept beside the output (OUT.parts/): a study interrupted or killed resumes "
-            "where it stopped when run again, and gives the same file."
+            "them as an xarray Dataset (one dimension per axis, a status variable, the "
+            "reasons of failed runs in its attributes) in NetCDF (--out RESULT.nc) or Zarr "
+            "(--out RESULT.zarr, needs vibroimpact[zarr]). Finished chunks are kept beside "
+            "the output (OUT.parts/): a study interrupted or killed resumes where it "
+            "stopped when run again, and gives the same file or store."
         ),
     )
     parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [study]")
     parser.add_argument(
-        "--out", type=Path, required=True, metavar="RESULT.nc", help="NetCDF file to write"
+        "--out",
+        type=Path,
+        required=True,
+        metavar="RESULT.nc|RESULT.zarr",
+        help="NetCDF file (.nc) or Zarr store (.zarr; needs vibroimpact[zarr]) to write",
     )
     parser.add_argument(
         "--workers", type=int, default=0, metavar="N", help="threads (default: all cores)"
@@ -60,6 +65,8 @@ def add_command(sub: Any) -> None:
 def run_study_command(args: argparse.Namespace) -> int:
     if args.workers < 0:
         raise UsageError(f"--workers must be >= 0 (0: all cores), got {args.workers}")
+    # The output's suffix (and zarr, for a store) before anything runs.
+    output_kind(args.out)
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
         raise UsageError(f"{args.scenario}: study takes a 0.2 scenario (a [structure] section)")
