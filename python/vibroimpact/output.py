@@ -43,7 +43,16 @@ def written_whole(path: Path, binary: bool = False) -> Iterator[IO[Any]]:
         # Write the file the link points to, as open() would, and keep the link.
         path = path.resolve()
     try:
-        descriptor, temporary = _create_beside(path)
+        while True:
+            # Named before it is created, so that an interrupt (SIGTERM, Ctrl-C)
+            # arriving just after the creation still finds it to remove below.
+            temporary = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
+            try:
+                # 0o666 minus the umask: the permissions a plain open() would give.
+                descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+                break
+            except FileExistsError:
+                temporary = None  # someone else's: not ours to remove
         file: IO[Any] = (
             os.fdopen(descriptor, "wb")
             if binary
@@ -64,14 +73,3 @@ def written_whole(path: Path, binary: bool = False) -> Iterator[IO[Any]]:
         if temporary is not None:
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
-
-
-def _create_beside(path: Path) -> tuple[int, Path]:
-    """A new, hidden file next to ``path``, created exclusively; its descriptor and path."""
-    while True:
-        temporary = path.with_name(f".{path.name}.{secrets.token_hex(4)}.tmp")
-        try:
-            # 0o666 minus the umask: the permissions a plain open() would give.
-            return os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), temporary
-        except FileExistsError:
-            continue
