@@ -434,3 +434,18 @@ def test_a_random_seed_must_count_from_a_whole_number(
     assert len(lines) == 1, done.stderr
     for word in words:
         assert word in lines[0], lines[0]
+
+
+@pytest.mark.timeout(120)
+def test_a_seed_study_on_a_local_dask_cluster_writes_the_same_file(
+    tmp_path: Path, write_scenario: Write, run_cli: Cli
+) -> None:
+    text = NOISY + '[study.axes]\n"excitation.0.seed" = [1, 2, 3, 4, 5]\n'
+    path = write_scenario(text)
+    local, on_dask = tmp_path / "local.nc", tmp_path / "dask.nc"
+    assert run_cli("study", str(path), "--out", str(local), "--workers", "1").returncode == 0
+    done = run_cli(
+        "study", str(path), "--out", str(on_dask), "--dask", "local", "--workers", "2", timeout=100
+    )
+    assert done.returncode == 0, done.stderr
+    assert on_dask.read_bytes() == local.read_bytes()
