@@ -227,7 +227,7 @@ def test_the_study_command_writes_the_file(tmp_path: Path) -> None:
     [
         (("chunk_size = 7", "chunk_sise = 7"), ["[study]", "chunk_sise"]),
         (('"damper.0.clearance"', '"damper.3.clearance"'), ["damper.3.clearance", "[[damper]]"]),
-        (('"damper.0.clearance"', '"structure.mass"'), ["structure.mass", "allowed"]),
+        (('"damper.0.clearance"', '"structure.modes"'), ["structure.modes", "allowed"]),
         (('analysis = "steady-state"', 'analysis = "run"'), ["metrics", "steady-state"]),
         (("count = 4", "count = 0"), ["count", ">= 1"]),
         (('metrics = ["peak"', 'metrics = ["peek"'), ["metrics", "peek"]),

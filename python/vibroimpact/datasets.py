@@ -85,6 +85,7 @@ _KEY_UNITS = {
     "upper_clearance": _M,
     "gap": _M,
     "restitution": _ONE,
+    "seed": _ONE,
     "damping_ratio": _ONE,
     "ground_damping": _ONE,
     "length": _M,
@@ -106,7 +107,8 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
     """The SI unit (UDUNITS spelling) of a scenario parameter given as a dotted path
     (``"excitation.0.frequency"`` -> ``"Hz"``, ``"damper.0.clearance"`` -> ``"m"``),
     or None where it cannot be told. Some keys' units depend on the scenario: an
-    excitation's ``amplitude`` (N for a force, m s-2 for a base acceleration), a
+    excitation's ``amplitude`` (N for a force, m s-2 for a base acceleration) and
+    ``intensity`` (N2 s or m2 s-3: a spectral density per rad/s), a
     damper's or stop's ``stiffness`` (N m-1 for the linear law, N m-1.5 for the
     Hertz laws), a point's ``at`` (an index, or m along a cantilever); give the
     scenario's sections as ``data`` to resolve those."""
@@ -130,6 +132,9 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
         return None
     if key in ("amplitude", "amplitudes") and section == "excitation":
         return {"force": "N", "base": "m s-2"}.get(str(entry.get("kind")))
+    if key == "intensity" and section == "excitation":
+        # A two-sided spectral density per rad/s: the signal's unit squared times s.
+        return {"force": "N2 s", "base": "m2 s-3"}.get(str(entry.get("kind")))
     if key == "stiffness" and section in ("damper", "stop"):
         law = entry.get("law")
         return "N m-1" if law == "linear" else "N m-1.5" if law in _HERTZ_LAWS else None

@@ -30,7 +30,21 @@ The ``[study]`` section::
     "excitation.0.phase" = { normal = [0.0, 0.5] }
 
 Axes vary the paths :data:`vibroimpact._core` lists in its error for another one
-(dampers, stops, gravity, harmonic excitations, entries of ``[initial]``). In the
+(dampers, stops, gravity, harmonic excitations, entries of ``[initial]``; the structure's
+``mass``, ``stiffness``, ``damping`` for ``kind = "oscillator"`` and ``length``,
+``youngs_modulus``, ``second_moment``, ``mass_per_length``, ``damping_ratio`` for
+``kind = "cantilever"``, the structure made again for each run, its points staying where
+they are; random signals' ``seed``, ``intensity``, ``cutoff_frequency``, ``duration``, and
+``ground_frequency``, ``ground_damping`` for ``"kanai-tajimi"``, the signal generated again
+for each run that varies it). A bad value fails its run alone, with its reason naming the
+key. A seed axis holds whole numbers in [0, 2^53]::
+
+    [study.axes]
+    "excitation.0.seed" = { start = 0, stop = 99, count = 100 }   # 100 realisations
+
+Each run's signal is the one a scenario written with that seed has, bit for bit, whatever
+the threads, chunks or Dask workers. With ``samples``, ``"excitation.0.seed" = { from = N }``
+in ``[study.random]`` gives sample ``k`` the seed ``N + k`` (no draw taken). In the
 Dataset each axis is a dimension named by its path, the metrics are data
 variables (with a ``coordinate`` dimension for per-structure-coordinate metrics and
 ``pair`` for per-pair ones), and ``status`` is 0 for a run that completed, else
@@ -203,6 +217,9 @@ def study_settings(table: Any) -> dict[str, Any]:
             "{start, stop, count}"
         )
     out["axes"] = {str(path): _axis_values(str(path), spec) for path, spec in axes.items()}
+    for path, values in out["axes"].items():
+        if _is_seed(path):
+            _check_seeds(f"[study.axes] {path!r}: ", values)
     random = table.get("random", {})
     if not isinstance(random, Mapping):
         raise StudyError("[study.random]: must be a table of dotted paths to distributions")
@@ -224,11 +241,38 @@ def study_settings(table: Any) -> dict[str, Any]:
     return out
 
 
+def _is_seed(path: str) -> bool:
+    """Whether ``path`` is a random signal's seed (``excitation.N.seed``)."""
+    parts = path.split(".")
+    return len(parts) == 3 and parts[0] == "excitation" and parts[2] == "seed"
+
+
+#: Seeds travel among the study's values as floats: whole numbers up to 2^53.
+_MAX_SEED = 2**53
+
+
+def _check_seeds(where: str, values: np.ndarray) -> None:
+    bad = [v for v in values if not (0 <= v <= _MAX_SEED and float(v).is_integer())]
+    if bad:
+        raise StudyError(f"{where}a seed must be a whole number in [0, 2^53], got {float(bad[0])}")
+
+
 def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -> np.ndarray:
     where = f"[study.random] {path!r}: "
+    if _is_seed(path):
+        # A seed of its own for each sample: from, from + 1, ... (no draw taken).
+        first = spec.get("from") if isinstance(spec, Mapping) and len(spec) == 1 else None
+        if isinstance(first, bool) or not isinstance(first, int):
+            raise StudyError(
+                f"{where}a seed is given as {{from = N}}: seed N + k for sample k, got {spec!r:.40}"
+            )
+        seeds = np.arange(samples, dtype=float) + first
+        _check_seeds(where, seeds)
+        return seeds
     if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in _LAWS:
         raise StudyError(
-            f"{where}must be one of {{uniform = [low, high]}}, {{normal = [mean, std]}}"
+            f"{where}must be one of {{uniform = [low, high]}}, {{normal = [mean, std]}} "
+            "(or {from = N} for a seed)"
         )
     law, bounds = next(iter(spec.items()))
     if (
@@ -435,11 +479,16 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
         coords["sample"] = ("sample", np.arange(study.settings["samples"]))
         for path, draws in study.settings["random"].items():
             axis_unit = parameter_units(path, study.data)
+            long_name = (
+                f"{path}, the seed of each sample's signal"
+                if _is_seed(path)
+                else f"{path}, drawn for each sample (seed {study.settings['seed']})"
+            )
             data_vars[path] = (
                 ["sample"],
                 draws,
                 {
-                    "long_name": f"{path}, drawn for each sample (seed {study.settings['seed']})",
+                    "long_name": long_name,
                     **({"units": axis_unit} if axis_unit else {}),
                 },
             )

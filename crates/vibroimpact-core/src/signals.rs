@@ -86,8 +86,136 @@ pub enum Signal {
     /// record (a recorded ground motion ends at rest).
     Recorded { time: Vec<f64>, value: Vec<f64> },
     /// Values every `interval` s from t = 0, linearly interpolated, zero
-    /// after the last sample (generated random signals).
-    Sampled { interval: f64, value: Vec<f64> },
+    /// after the last sample (generated random signals), with the `recipe`
+    /// they were generated from (to generate them again with another seed).
+    Sampled {
+        interval: f64,
+        value: Vec<f64>,
+        recipe: Option<Recipe>,
+    },
+}
+
+/// What a random signal is generated from: kept beside its samples so that a
+/// study can generate it again with one input changed (another seed, another
+/// intensity), the same bit for bit as a scenario written with those inputs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Recipe {
+    /// S0, the signal's unit^2 per rad/s.
+    pub intensity: f64,
+    /// Hz.
+    pub cutoff_frequency: f64,
+    /// s.
+    pub duration: f64,
+    pub seed: u64,
+    /// The ground's frequency (Hz) and damping ratio of a Kanai-Tajimi
+    /// signal; none for white noise.
+    pub ground: Option<(f64, f64)>,
+}
+
+/// An input of a [`Recipe`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RecipeKey {
+    Seed,
+    Intensity,
+    CutoffFrequency,
+    Duration,
+    /// Kanai-Tajimi only.
+    GroundFrequency,
+    /// Kanai-Tajimi only.
+    GroundDamping,
+}
+
+/// The largest seed a study can set: a seed travels as an `f64` among the
+/// study's values, whole numbers exactly so up to 2^53.
+pub const MAX_STUDY_SEED: u64 = 1 << 53;
+
+impl RecipeKey {
+    /// The key of the scenario named `name` for a signal made by `recipe`,
+    /// if it has one.
+    pub fn parse(name: &str, recipe: &Recipe) -> Option<Self> {
+        let key = match name {
+            "seed" => Self::Seed,
+            "intensity" => Self::Intensity,
+            "cutoff_frequency" => Self::CutoffFrequency,
+            "duration" => Self::Duration,
+            "ground_frequency" => Self::GroundFrequency,
+            "ground_damping" => Self::GroundDamping,
+            _ => return None,
+        };
+        let ground = matches!(key, Self::GroundFrequency | Self::GroundDamping);
+        (!ground || recipe.ground.is_some()).then_some(key)
+    }
+}
+
+impl Recipe {
+    /// The keys of this recipe's signal, for error messages.
+    pub fn keys(&self) -> &'static str {
+        match self.ground {
+            None => "seed, intensity, cutoff_frequency, duration",
+            Some(_) => {
+                "seed, intensity, cutoff_frequency, duration, ground_frequency, ground_damping"
+            }
+        }
+    }
+
+    /// The signal's name in a scenario.
+    pub fn name(&self) -> &'static str {
+        match self.ground {
+            None => "white-noise",
+            Some(_) => "kanai-tajimi",
+        }
+    }
+
+    /// Set `key` (see [`RecipeKey::parse`]) to `value`; a seed must be a whole
+    /// number in [0, 2^53]. The other values are checked by [`Recipe::generate`].
+    pub fn set(&mut self, key: RecipeKey, value: f64) -> Result<()> {
+        match (key, &mut self.ground) {
+            (RecipeKey::Seed, _) => {
+                if !(value >= 0.0 && value <= MAX_STUDY_SEED as f64 && value.fract() == 0.0) {
+                    return Err(Error::InvalidParameter {
+                        field: "seed",
+                        allowed: "a whole number in [0, 2^53]",
+                        value,
+                    });
+                }
+                self.seed = value as u64;
+            }
+            (RecipeKey::Intensity, _) => self.intensity = value,
+            (RecipeKey::CutoffFrequency, _) => self.cutoff_frequency = value,
+            (RecipeKey::Duration, _) => self.duration = value,
+            (RecipeKey::GroundFrequency, Some((frequency, _))) => *frequency = value,
+            (RecipeKey::GroundDamping, Some((_, damping))) => *damping = value,
+            (RecipeKey::GroundFrequency | RecipeKey::GroundDamping, None) => {
+                return Err(Error::Inconsistent(
+                    "a white-noise signal has no ground_frequency or ground_damping".into(),
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// The signal, generated (validated as [`Signal::white_noise`] and
+    /// [`Signal::kanai_tajimi`] validate it).
+    pub fn generate(&self) -> Result<Signal> {
+        let Self {
+            intensity,
+            cutoff_frequency,
+            duration,
+            seed,
+            ground,
+        } = *self;
+        match ground {
+            None => Signal::white_noise(intensity, cutoff_frequency, duration, seed),
+            Some((frequency, damping)) => Signal::kanai_tajimi(
+                intensity,
+                frequency,
+                damping,
+                cutoff_frequency,
+                duration,
+                seed,
+            ),
+        }
+    }
 }
 
 impl Signal {
@@ -177,7 +305,17 @@ impl Signal {
         let deviation = (2.0 * intensity * cutoff).sqrt();
         let mut gauss = Gaussian::new(seed);
         let value = (0..count).map(|_| deviation * gauss.next()).collect();
-        Ok(Self::Sampled { interval, value })
+        Ok(Self::Sampled {
+            interval,
+            value,
+            recipe: Some(Recipe {
+                intensity,
+                cutoff_frequency,
+                duration,
+                seed,
+                ground: None,
+            }),
+        })
     }
 
     /// The Kanai-Tajimi ground acceleration (m/s^2): band-limited white noise
@@ -201,8 +339,9 @@ impl Signal {
                 "cutoff_frequency ({cutoff_frequency} Hz) must exceed ground_frequency ({ground_frequency} Hz)"
             )));
         }
-        let Self::Sampled { interval, value } =
-            Self::white_noise(intensity, cutoff_frequency, duration, seed)?
+        let Self::Sampled {
+            interval, value, ..
+        } = Self::white_noise(intensity, cutoff_frequency, duration, seed)?
         else {
             unreachable!("white_noise returns samples")
         };
@@ -234,11 +373,24 @@ impl Signal {
         Ok(Self::Sampled {
             interval,
             value: out,
+            recipe: Some(Recipe {
+                intensity,
+                cutoff_frequency,
+                duration,
+                seed,
+                ground: Some((ground_frequency, ground_damping)),
+            }),
         })
     }
 
-    /// The signal's value at `time` (s).
-    #[inline]
+    /// What a generated random signal was generated from.
+    pub fn recipe(&self) -> Option<&Recipe> {
+        match self {
+            Self::Sampled { recipe, .. } => recipe.as_ref(),
+            _ => None,
+        }
+    }
+
     /// The largest |value| the signal takes (in its unit) and its shortest
     /// period or sampling interval (s; infinite for a constant).
     pub fn extent(&self) -> (f64, f64) {
@@ -263,13 +415,17 @@ impl Signal {
                     .map(|w| 2.0 * (w[1] - w[0]))
                     .fold(f64::INFINITY, f64::min),
             ),
-            Self::Sampled { interval, value } => (
+            Self::Sampled {
+                interval, value, ..
+            } => (
                 value.iter().fold(0.0, |m, v| m.max(v.abs())),
                 2.0 * interval,
             ),
         }
     }
 
+    /// The signal's value at `time` (s).
+    #[inline]
     pub fn value(&self, time: f64) -> f64 {
         match self {
             Self::Harmonic(h) => h.value(time),
@@ -298,7 +454,9 @@ impl Signal {
                 let (v0, v1) = (value[next - 1], value[next]);
                 v0 + (v1 - v0) * ((time - t0) / (t1 - t0))
             }
-            Self::Sampled { interval, value } => {
+            Self::Sampled {
+                interval, value, ..
+            } => {
                 let position = time / interval;
                 if position.is_nan() || position < 0.0 {
                     return 0.0;

@@ -29,6 +29,99 @@ enum Points {
     },
 }
 
+/// The inputs a structure was made from: kept so that a study can make it
+/// again with one of them changed, the same bit for bit as a scenario
+/// written with that value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Recipe {
+    Oscillator {
+        mass: f64,
+        stiffness: f64,
+        damping: f64,
+    },
+    /// Matrices given as they are (not remade).
+    Matrices,
+    Cantilever {
+        length: f64,
+        youngs_modulus: f64,
+        second_moment: f64,
+        mass_per_length: f64,
+        modes: u32,
+        damping_ratio: f64,
+    },
+}
+
+impl Recipe {
+    /// The `kind` of the scenario's `[structure]`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Oscillator { .. } => "oscillator",
+            Self::Matrices => "matrices",
+            Self::Cantilever { .. } => "cantilever",
+        }
+    }
+
+    /// The keys a study can set (see [`Recipe::set`]), for error messages.
+    pub fn keys(&self) -> &'static str {
+        match self {
+            Self::Oscillator { .. } => "mass, stiffness, damping",
+            Self::Matrices => "",
+            Self::Cantilever { .. } => {
+                "length, youngs_modulus, second_moment, mass_per_length, damping_ratio"
+            }
+        }
+    }
+
+    /// The input named `key` (one of [`Recipe::keys`]), to set.
+    pub fn input(&mut self, key: &str) -> Option<&mut f64> {
+        match (self, key) {
+            (Self::Oscillator { mass, .. }, "mass") => Some(mass),
+            (Self::Oscillator { stiffness, .. }, "stiffness") => Some(stiffness),
+            (Self::Oscillator { damping, .. }, "damping") => Some(damping),
+            (Self::Cantilever { length, .. }, "length") => Some(length),
+            (Self::Cantilever { youngs_modulus, .. }, "youngs_modulus") => Some(youngs_modulus),
+            (Self::Cantilever { second_moment, .. }, "second_moment") => Some(second_moment),
+            (
+                Self::Cantilever {
+                    mass_per_length, ..
+                },
+                "mass_per_length",
+            ) => Some(mass_per_length),
+            (Self::Cantilever { damping_ratio, .. }, "damping_ratio") => Some(damping_ratio),
+            _ => None,
+        }
+    }
+
+    /// The structure (validated as its constructor validates it).
+    pub fn build(&self) -> Result<Structure> {
+        match *self {
+            Self::Oscillator {
+                mass,
+                stiffness,
+                damping,
+            } => Structure::oscillator(mass, stiffness, damping),
+            Self::Matrices => Err(Error::Inconsistent(
+                "a structure of kind \"matrices\" is not made from inputs a study can vary".into(),
+            )),
+            Self::Cantilever {
+                length,
+                youngs_modulus,
+                second_moment,
+                mass_per_length,
+                modes,
+                damping_ratio,
+            } => Structure::cantilever(
+                length,
+                youngs_modulus,
+                second_moment,
+                mass_per_length,
+                modes,
+                damping_ratio,
+            ),
+        }
+    }
+}
+
 /// A linear structure (SI units: kg, N/m, N s/m), validated.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Structure {
@@ -39,6 +132,7 @@ pub struct Structure {
     damping: Vec<f64>,
     influence: Vec<f64>,
     points: Points,
+    recipe: Recipe,
 }
 
 impl Structure {
@@ -51,6 +145,11 @@ impl Structure {
             damping: vec![non_negative("damping", damping)?],
             influence: vec![1.0],
             points: Points::Indices,
+            recipe: Recipe::Oscillator {
+                mass,
+                stiffness,
+                damping,
+            },
         })
     }
 
@@ -94,6 +193,7 @@ impl Structure {
             damping,
             influence: vec![1.0; n],
             points: Points::Indices,
+            recipe: Recipe::Matrices,
         })
     }
 
@@ -150,6 +250,14 @@ impl Structure {
             damping,
             influence,
             points: Points::Beam { length, shapes },
+            recipe: Recipe::Cantilever {
+                length,
+                youngs_modulus,
+                second_moment,
+                mass_per_length,
+                modes,
+                damping_ratio,
+            },
         })
     }
 
@@ -178,6 +286,11 @@ impl Structure {
             .into_iter()
             .map(|v| v.max(0.0).sqrt())
             .collect()
+    }
+
+    /// The inputs it was made from.
+    pub fn recipe(&self) -> Recipe {
+        self.recipe
     }
 
     /// Number of generalised coordinates.
