@@ -868,7 +868,8 @@ pub fn integrate_system<S: SystemStepper>(
             next_strobe = (reductions.strobe_time.len() + 1) as f64 * options.reduce.strobe_period;
         }
         let done = time >= t_end || (!adaptive && t_end - time <= 1e-9 * dt);
-        until_kept -= 1;
+        // Counts down only while it matters (no history: it stays at 0).
+        until_kept = until_kept.saturating_sub(1);
         if options.keep_history && (until_kept == 0 || done) {
             until_kept = options.every;
             keep(time, &y, &mut time_rows, &mut states);

@@ -482,3 +482,23 @@ fn newmark_family_bounces_the_ball_and_closes_the_balance() {
         }
     });
 }
+
+#[test]
+fn a_run_without_history_ends_where_the_run_with_one_does() {
+    common::timeout(60, || {
+        // Many steps without a history (the way studies run; its countdown of
+        // steps to the next row must not overflow): the same end, no rows.
+        let system = Assembly::new(&spec(Structure::oscillator(1.0, 100.0, 0.2).unwrap())).unwrap();
+        let y = initial_state(&system, &[0.01], &[0.0], &[], &[]).unwrap();
+        let len = system.state_len();
+        let kept = options(Some(1e-3), 1.0);
+        let bare = RunOptions {
+            keep_history: false,
+            ..kept
+        };
+        let a = integrate(&system, &mut ExplicitRk::rk4(len), &y, &kept).unwrap();
+        let b = integrate(&system, &mut ExplicitRk::rk4(len), &y, &bare).unwrap();
+        assert_eq!(a.final_state, b.final_state);
+        assert!(a.time.len() > 1000 && b.time.is_empty());
+    });
+}
