@@ -187,3 +187,29 @@ def test_the_readme_lockstep_block_runs(tmp_path: Path) -> None:
     assert (ds["impacts"].values > 0).all()
     # A faster loose mass rattles harder: the peak grows along the axis.
     assert (np.diff(ds["peak"].values[:, 0]) > 0).all()
+
+
+def test_structure_axes_run_in_lockstep_too(tmp_path: Path) -> None:
+    text = BASE + STUDY.replace(
+        '"damper.0.clearance" = [0.005, 0.01, 0.02]', '"structure.stiffness" = [0.5, 1.0, 4.0]'
+    )
+    ds = st.run(load(tmp_path, text), tmp_path / "out.nc")
+    assert int(ds["status"].max()) == 0
+    for stiffness in (0.5, 4.0):
+        sol = vi.simulate(
+            vi.ImpactDamper(
+                main_mass=M, stiffness=stiffness, damping=C, impact_mass=MD, clearance=D
+            ),
+            vi.Contact("hertz", stiffness=KHZ, damping=C1),
+            vi.InitialState(impact_velocity=0.1),
+            method="rk4",
+            stepping="fixed",
+            dt=DT,
+            t_end=T_END,
+        )
+        point = ds.sel({"initial.damper_velocity.0": 0.1, "structure.stiffness": stiffness})
+        assert point["impacts"].item() == len(sol.contacts.onset)
+        w = sol.main_displacement
+        assert point["rms"].item() == pytest.approx(
+            np.sqrt(np.trapezoid(w * w, dx=DT) / T_END), rel=1e-12
+        )
