@@ -78,10 +78,25 @@ def overhead() -> None:
         "[study.axes]\n"
         f'"initial.damper_velocity.0" = {{ start = 0.0, stop = 0.1, count = {runs} }}\n',
     )
+    rebuilt = study_of(
+        text,
+        f'[study.axes]\n"damper.0.clearance" = {{ start = 0.005, stop = 0.02, count = {runs} }}\n',
+    )
+    fixed = study_of(
+        text,
+        "[study.axes]\n"
+        f'"initial.damper_velocity.0" = {{ start = 0.0, stop = 0.1, count = {runs} }}\n',
+        'stepping = "fixed"\n',
+    )
     print(f"1. overhead per run: {runs} runs of one RK4 step (metrics only)")
-    for threads in sorted({1, CORES}):
-        t = median_time(lambda n=threads: s.run_chunk(range(0, runs), n), 3)
-        print(f"   study engine, {threads} thread(s): {t / runs * 1e6:.2f} us per run")
+    for label, study in (
+        ("the start varied (one system, one method a thread)", s),
+        ("the clearance varied (the system made again each run)", rebuilt),
+        ('the start varied, stepping = "fixed" (lockstep)', fixed),
+    ):
+        for threads in sorted({1, CORES}):
+            t = median_time(lambda n=threads, st=study: st.run_chunk(range(0, runs), n), 3)
+            print(f"   {label}, {threads} thread(s): {t / runs * 1e6:.2f} us per run")
     peer_runs = 2000
     data = {k: v for k, v in s.data.items() if k != "study"}
 

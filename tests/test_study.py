@@ -466,3 +466,50 @@ def test_the_axes_carry_their_units(tmp_path: Path) -> None:
     assert ds["excitation.0.frequency"].attrs["units"] == "Hz"
     with xr.open_dataset(tmp_path / "out.nc", engine="scipy") as back:
         assert back["excitation.0.frequency"].attrs["units"] == "Hz"
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "newmark-implicit"])
+def test_a_study_of_starts_equals_the_runs_made_one_by_one(tmp_path: Path, method: str) -> None:
+    # Only the start varies: the runs share one system and, on each thread, one method,
+    # which must start afresh every run (an adaptive step or a Newmark acceleration
+    # left over from the last run would change the next).
+    solver = f'method = "{method}"\ndt = 1e-3\n' if method != "exact" else 'method = "exact"\n'
+    text = BASE.replace('method = "exact"\n', solver) + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak", "rms", "impacts", "energy_dissipated"]\n'
+        '[study.axes]\n"initial.structure_velocity.0" = [0.3, -0.2, 0.0, 0.25, -0.1]\n'
+    )
+    study = load(scenario(tmp_path, text))
+    ds = st.run(study, tmp_path / "out.nc", threads=2)
+    data = without_study(study)
+    for velocity in (0.3, -0.2, 0.0, 0.25, -0.1):
+        sol = vi.simulate_system(
+            data["structure"],
+            damper=data["damper"],
+            excitation=data["excitation"],
+            initial={"structure_velocity": [velocity]},
+            method=method,
+            dt=None if method == "exact" else 1e-3,
+            t_end=0.5,
+            history=False,
+            record_from=0.0,
+        )
+        point = ds.sel({"initial.structure_velocity.0": velocity})
+        assert point["peak"].values.tolist() == sol.peak.tolist(), method
+        assert point["impacts"].item() == sum(k != "sticking" for k in sol.contacts.kind)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known: with newmark-implicit the located peak differs in the last bit when the "
+    "RMS is not also integrated (the end rates the mean square evaluates change the "
+    "method's scratch state); found while testing studies of starts",
+)
+def test_newmark_peaks_do_not_depend_on_whether_rms_is_kept(tmp_path: Path) -> None:
+    text = BASE.replace('method = "exact"\n', 'method = "newmark-implicit"\ndt = 1e-3\n') + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        '[study.axes]\n"initial.structure_velocity.0" = [0.3, -0.2]\n'
+    )
+    peaks = st.run(load(scenario(tmp_path, text)), tmp_path / "a.nc")["peak"].values
+    with_rms = text.replace('metrics = ["peak"]', 'metrics = ["peak", "rms"]')
+    other = st.run(load(scenario(tmp_path, with_rms, "b.toml")), tmp_path / "b.nc")
+    assert peaks.tolist() == other["peak"].values.tolist()

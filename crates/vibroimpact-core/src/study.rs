@@ -401,6 +401,15 @@ pub fn run_study(
         .num_threads(threads)
         .build()
         .map_err(|e| Error::Inconsistent(format!("cannot start the study's threads: {e}")))?;
+    let starts_only = !parameters.is_empty()
+        && parameters
+            .iter()
+            .all(|p| matches!(p.target, Target::Initial(..)));
+    if starts_only {
+        return run_starts(
+            spec, initial, parameters, values, rows, settings, &pool, interrupt,
+        );
+    }
     let results = pool.install(|| {
         (0..rows)
             .into_par_iter()
@@ -553,18 +562,11 @@ fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Member> {
     })
 }
 
-fn one_run(
-    spec: &SystemSpec,
-    initial: &[Vec<f64>; 4],
-    parameters: &[Parameter],
-    values: &[f64],
-    settings: &StudySettings,
-) -> RunMetrics {
-    let mut spec = spec.clone();
-    let mut initial = initial.clone();
+/// The metrics of a run of `spec` that failed for `reason`: NaN.
+fn failed_run(spec: &SystemSpec, reason: String) -> RunMetrics {
     let n = spec.structure.dofs();
     let pairs = spec.dampers.len() + spec.stops.len();
-    let failed = |reason: String| RunMetrics {
+    RunMetrics {
         status: 1,
         reason,
         peak: vec![f64::NAN; n],
@@ -575,15 +577,71 @@ fn one_run(
         settled: f64::NAN,
         stable: f64::NAN,
         largest_multiplier: f64::NAN,
-    };
+    }
+}
+
+/// Runs that vary only the start: one system for all, one method a thread.
+#[allow(clippy::too_many_arguments)]
+fn run_starts(
+    spec: &SystemSpec,
+    initial: &[Vec<f64>; 4],
+    parameters: &[Parameter],
+    values: &[f64],
+    rows: usize,
+    settings: &StudySettings,
+    pool: &rayon::ThreadPool,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<RunMetrics>> {
+    let system = Assembly::new(spec)?;
+    let width = parameters.len();
+    let results = pool.install(|| {
+        (0..rows)
+            .into_par_iter()
+            .map_init(
+                || stepper_of(&system, settings),
+                |stepper, row| {
+                    if interrupt() {
+                        return Err(Error::Interrupted { time: 0.0 });
+                    }
+                    let mut start = initial.clone();
+                    let mut scratch = spec.clone();
+                    for (p, v) in parameters
+                        .iter()
+                        .zip(&values[row * width..(row + 1) * width])
+                    {
+                        if let Err(e) = p.apply(&mut scratch, &mut start, *v) {
+                            return Ok(failed_run(spec, e.to_string()));
+                        }
+                    }
+                    let run = match stepper {
+                        Ok(stepper) => measured_on(spec, &system, stepper, &start, settings),
+                        Err(e) => Err(e.clone()),
+                    };
+                    Ok(run.unwrap_or_else(|e| failed_run(spec, e.to_string())))
+                },
+            )
+            .collect::<Vec<Result<RunMetrics>>>()
+    });
+    results.into_iter().collect()
+}
+
+fn one_run(
+    spec: &SystemSpec,
+    initial: &[Vec<f64>; 4],
+    parameters: &[Parameter],
+    values: &[f64],
+    settings: &StudySettings,
+) -> RunMetrics {
+    let mut spec = spec.clone();
+    let mut initial = initial.clone();
     for (p, v) in parameters.iter().zip(values) {
         if let Err(e) = p.apply(&mut spec, &mut initial, *v) {
-            return failed(e.to_string());
+            return failed_run(&spec, e.to_string());
         }
     }
     match measured(&spec, &initial, settings) {
         Ok(metrics) => metrics,
-        Err(e) => failed(e.to_string()),
+        Err(e) => failed_run(&spec, e.to_string()),
     }
 }
 
@@ -593,7 +651,20 @@ fn measured(
     settings: &StudySettings,
 ) -> Result<RunMetrics> {
     let system = Assembly::new(spec)?;
-    let y0 = initial_state(&system, &initial[0], &initial[1], &initial[2], &initial[3])?;
+    let mut stepper = stepper_of(&system, settings)?;
+    measured_on(spec, &system, &mut stepper, initial, settings)
+}
+
+/// A run of `system` (made of `spec`) from `initial`, by `stepper` (which
+/// starts afresh in every run, so that it may serve many).
+fn measured_on(
+    spec: &SystemSpec,
+    system: &Assembly,
+    stepper: &mut AnyStepper,
+    initial: &[Vec<f64>; 4],
+    settings: &StudySettings,
+) -> Result<RunMetrics> {
+    let y0 = initial_state(system, &initial[0], &initial[1], &initial[2], &initial[3])?;
     let period = || {
         spec.excitations
             .iter()
@@ -614,10 +685,9 @@ fn measured(
             ((settle + record) as f64 * t, settle as f64 * t, t)
         }
         Analysis::Orbit { settle, periods } => {
-            return orbit_metrics(&system, &y0, settings, period()?, settle, periods);
+            return orbit_metrics(system, stepper, &y0, settings, period()?, settle, periods);
         }
     };
-    let mut stepper = stepper_of(&system, settings)?;
     let options = run_options(
         settings,
         stepper.step(settings.dt, t_end, strobe_period),
@@ -628,8 +698,8 @@ fn measured(
             mean_square: settings.mean_square,
         },
     );
-    let sol = stepper.integrate(&system, &y0, &options, &mut || false)?;
-    Ok(metrics_of(&system, &sol, record_from, settings))
+    let sol = stepper.integrate(system, &y0, &options, &mut || false)?;
+    Ok(metrics_of(system, &sol, record_from, settings))
 }
 
 /// A study run's options: no history, the study's limits.
@@ -667,13 +737,13 @@ fn stepper_of(system: &Assembly, settings: &StudySettings) -> Result<AnyStepper>
 /// An orbit study's run: settle, shoot, then one more orbit recorded.
 fn orbit_metrics(
     system: &Assembly,
+    stepper: &mut AnyStepper,
     y0: &[f64],
     settings: &StudySettings,
     period: f64,
     settle: u64,
     periods: u64,
 ) -> Result<RunMetrics> {
-    let mut stepper = stepper_of(system, settings)?;
     let span = periods as f64 * period;
     let options = |t_end: f64, record: bool| {
         let reduce = ReduceOptions {
