@@ -280,6 +280,9 @@ pub struct ExactFlow {
     node_turns: Vec<(f64, f64)>,
     /// The start last set: its time's bits and modes, and its state.
     begun: Option<(u64, usize)>,
+    /// The modes and the time after the start of the last evaluation by
+    /// the modes (`eta` and `rate` hold its increments), if it was the last.
+    last: Option<(usize, f64)>,
     begun_state: Vec<f64>,
     /// A state and its rates at a Gauss node (the energy of contacts).
     node: Vec<f64>,
@@ -320,6 +323,7 @@ impl ExactFlow {
             node_modes: vec![(0.0, 0.0); NODES.len() * dim],
             node_turns: vec![(0.0, 1.0); NODES.len() * parts.harmonics.len()],
             begun: None,
+            last: None,
             begun_state: vec![0.0; 2 * dim],
             node: vec![0.0; system.state_len()],
             rates: vec![0.0; system.state_len()],
@@ -488,6 +492,7 @@ impl ExactFlow {
     /// The accelerations at the start (of modes without a matrix flow), into
     /// `out`: each mode's `F0 + f - w2 eta - c eta'` taken to coordinates.
     fn accelerations(&mut self, index: usize, dim: usize, out: &mut [f64]) {
+        self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
         let r = cfg.modes;
@@ -506,14 +511,59 @@ impl ExactFlow {
         }
     }
 
+    /// The accelerations and their rates at the last evaluation by the modes
+    /// (see [`Self::at`]), into `accel` and `jerk`: each mode's `eta'' = F0 +
+    /// f - w2 eta - c eta'` and `eta''' = f' - w2 eta' - c eta''`, taken to
+    /// coordinates. False when the last evaluation was not by the modes.
+    fn last_derivatives(&mut self, dim: usize, accel: &mut [f64], jerk: &mut [f64]) -> bool {
+        let Some((index, t)) = self.last.take() else {
+            return false;
+        };
+        let m = &self.modes[index];
+        let cfg = &m.configuration;
+        let r = cfg.modes;
+        // In place of the increments (`eta`: accelerations, `rate`: jerks).
+        let (a, j) = (&mut self.eta[..r], &mut self.rate[..r]);
+        for (k, o) in m.oscillators.iter().enumerate() {
+            let eta = a[k] + self.origin_modal[k].0;
+            let rate = j[k] + self.origin_modal[k].1;
+            a[k] = o.constant - o.w2 * eta - o.c * rate;
+            j[k] = -o.w2 * rate;
+        }
+        for (h, &(s0, c0)) in cfg.harmonics.iter().zip(&self.phasors) {
+            let (st, ct) = sin_cos(h.omega * t);
+            let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
+            for ((a, j), &(pr, pi)) in a.iter_mut().zip(j.iter_mut()).zip(&h.force) {
+                *a += pr * c - pi * s;
+                *j -= h.omega * (pr * s + pi * c);
+            }
+        }
+        for ((j, a), o) in j.iter_mut().zip(a.iter()).zip(&m.oscillators) {
+            *j -= o.c * a;
+        }
+        for i in 0..dim {
+            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
+            let (mut x, mut y) = (0.0, 0.0);
+            for k in 0..r {
+                x += row[k] * a[k];
+                y += row[k] * j[k];
+            }
+            accel[i] = x;
+            jerk[i] = y;
+        }
+        true
+    }
+
     /// The coordinates and velocities `t` after the start, into `out`.
     fn at(&mut self, index: usize, dim: usize, t: f64, out: &mut [f64]) {
         if let Some(flow) = self.modes[index].matrix.as_mut() {
             flow.at(&self.begun_state, t, out);
             self.evaluations += 1;
+            self.last = None;
             return;
         }
         self.modal_at(index, t);
+        self.last = Some((index, t));
         let cfg = &self.modes[index].configuration;
         let r = cfg.modes;
         // The start plus the modes' increments: the flow is continuous at its
@@ -578,6 +628,7 @@ impl ExactFlow {
     /// eta'^2` is then the mode's input `int f eta'` plus `F0` times its
     /// displacement less the change of its energy `eta'^2 / 2 + w2 eta^2 / 2`.
     fn step_energies(&mut self, index: usize, dim: usize, h: f64, end: &[f64]) -> (f64, f64) {
+        self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
         // The modal state at the end, from the step's end.
@@ -673,6 +724,7 @@ impl ExactFlow {
     /// start; [`Self::node_factors`] made its factors): the modal rates
     /// only, without the coordinates (what the energy quadrature needs).
     fn powers_at(&mut self, index: usize, k: usize, t: f64) -> (f64, f64) {
+        self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
         let r = cfg.modes;
@@ -844,6 +896,10 @@ impl SystemStepper for ExactFlow {
         Ok(())
     }
 
+    fn end_derivatives(&mut self, system: &Assembly, accel: &mut [f64], jerk: &mut [f64]) -> bool {
+        self.last_derivatives(system.dim, accel, jerk)
+    }
+
     fn accept(&mut self) {}
 
     fn shrink(&self, _error: f64) -> f64 {
@@ -943,6 +999,51 @@ mod tests {
         let y = initial_state(&system, &[0.004], &[-0.2], &[0.002], &[0.3]).unwrap();
         let flow = ExactFlow::new(&system).unwrap();
         (system, flow, y)
+    }
+
+    #[test]
+    fn end_derivatives_are_the_system_s_accelerations_and_their_rates() {
+        crate::testing::timeout(30, || {
+            for damping in [3.0, 200.0] {
+                let (system, mut flow, y) = forced_flow(damping);
+                let (dim, len) = (system.dim, system.state_len());
+                let modes = vec![Mode::Open; system.interactions.len()];
+                let mut scratch = Scratch::new(&system);
+                let (mut end, mut rates) = (vec![0.0; len], vec![0.0; len]);
+                let (mut accel, mut jerk) = (vec![0.0; dim], vec![0.0; dim]);
+                let (time, h) = (0.37, 0.6 * flow.step());
+                // The accelerations at `t` after the start, by the system.
+                let mut accelerations = |flow: &mut ExactFlow, t: f64| {
+                    flow.attempt(&system, time, &y, t, &modes, &mut scratch, &mut end)
+                        .unwrap();
+                    system.rates(time + t, &end, &modes, &mut scratch, &mut rates);
+                    rates[dim..2 * dim].to_vec()
+                };
+                let expected = accelerations(&mut flow, h);
+                assert!(flow.end_derivatives(&system, &mut accel, &mut jerk));
+                let delta = 1e-5 * h;
+                let (ahead, behind) = (
+                    accelerations(&mut flow, h + delta),
+                    accelerations(&mut flow, h - delta),
+                );
+                for i in 0..dim {
+                    let scale = expected.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                    assert!(
+                        (accel[i] - expected[i]).abs() <= 1e-12 * scale,
+                        "{damping}: {accel:?} {expected:?}"
+                    );
+                    let difference = (ahead[i] - behind[i]) / (2.0 * delta);
+                    let jerk_scale = jerk.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                    assert!(
+                        (jerk[i] - difference).abs() <= 1e-6 * jerk_scale,
+                        "{damping}: {jerk:?} {difference}"
+                    );
+                }
+                // Only for the last evaluation, once.
+                assert!(flow.end_derivatives(&system, &mut accel, &mut jerk));
+                assert!(!flow.end_derivatives(&system, &mut accel, &mut jerk));
+            }
+        });
     }
 
     #[test]

@@ -48,6 +48,19 @@ pub trait SystemStepper {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) -> Result<f64>;
+    /// The accelerations and their rates (`dim` values each, into `accel`
+    /// and `jerk`) at the end of the last attempt, where the method has them
+    /// for little (the exact flow, from its modal state there): locating an
+    /// event then solves the value's cubic Taylor polynomial about a trial
+    /// instead of its tangent. False (the default) where it has not.
+    fn end_derivatives(
+        &mut self,
+        _system: &Assembly,
+        _accel: &mut [f64],
+        _jerk: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// The last attempt is the new current point.
     fn accept(&mut self);
     /// Complete the step `h` from `(time, y)` the kernel keeps, `end`, with
