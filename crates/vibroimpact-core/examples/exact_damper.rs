@@ -78,10 +78,11 @@ fn main() {
     };
     if let Some(sol) = one {
         println!(
-            "{} steps, {} evaluations, {} contacts",
+            "{} steps, {} evaluations, {} contacts; energy {:?}",
             sol.steps,
             sol.rhs_evaluations,
-            sol.contacts.len()
+            sol.contacts.len(),
+            sol.energy
         );
         return;
     }

@@ -257,6 +257,18 @@ fn turn_difference(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
     (a.0 * b.1 - a.1 * b.0, a.1 * b.1 + a.0 * b.0)
 }
 
+/// Kept steps whose energy accumulators wait for one closed form over all of
+/// them (they are one flow: no event between them): the modes, the time at
+/// the first one's start and the first harmonic's phasor there, and the time
+/// (bits) at the last one's end.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    index: usize,
+    time: f64,
+    phasor: (f64, f64),
+    end: u64,
+}
+
 /// The exact flow as a stepper.
 #[derive(Debug, Clone)]
 pub struct ExactFlow {
@@ -283,6 +295,10 @@ pub struct ExactFlow {
     /// The modes and the time after the start of the last evaluation by
     /// the modes (`eta` and `rate` hold its increments), if it was the last.
     last: Option<(usize, f64)>,
+    /// The steps whose energies are still to be added, and the modal state
+    /// at their start.
+    span: Option<Span>,
+    span_modal: Vec<(f64, f64)>,
     begun_state: Vec<f64>,
     /// A state and its rates at a Gauss node (the energy of contacts).
     node: Vec<f64>,
@@ -324,6 +340,8 @@ impl ExactFlow {
             node_turns: vec![(0.0, 1.0); NODES.len() * parts.harmonics.len()],
             begun: None,
             last: None,
+            span: None,
+            span_modal: vec![(0.0, 0.0); dim],
             begun_state: vec![0.0; 2 * dim],
             node: vec![0.0; system.state_len()],
             rates: vec![0.0; system.state_len()],
@@ -627,7 +645,17 @@ impl ExactFlow {
     /// the step), and `int f Re(Z u)'` is elementary. The viscous loss `c int
     /// eta'^2` is then the mode's input `int f eta'` plus `F0` times its
     /// displacement less the change of its energy `eta'^2 / 2 + w2 eta^2 / 2`.
-    fn step_energies(&mut self, index: usize, dim: usize, h: f64, end: &[f64]) -> (f64, f64) {
+    ///
+    /// The start is `span_modal` with the first harmonic's phasor `phasor`
+    /// there, `h` before `end`: any stretch of one flow.
+    fn step_energies(
+        &mut self,
+        index: usize,
+        dim: usize,
+        h: f64,
+        phasor: (f64, f64),
+        end: &[f64],
+    ) -> (f64, f64) {
         self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
@@ -636,7 +664,7 @@ impl ExactFlow {
             (self.eta[j], self.rate[j]) = modal_state(cfg, dim, j, end);
         }
         let forcing = cfg.harmonics.first().map(|harmonic| {
-            let (s0, c0) = self.phasors[0];
+            let (s0, c0) = phasor;
             let (st, ct) = sin_cos(harmonic.omega * h);
             // u at both ends as (Re, Im), and sin(omega h).
             let end = (c0 * ct - s0 * st, s0 * ct + c0 * st);
@@ -644,7 +672,7 @@ impl ExactFlow {
         });
         let (mut viscous, mut input) = (0.0, 0.0);
         for (j, o) in m.oscillators.iter().enumerate() {
-            let (eta0, rate0) = self.origin_modal[j];
+            let (eta0, rate0) = self.span_modal[j];
             let (eta1, rate1) = (self.eta[j], self.rate[j]);
             let mut work = 0.0;
             if let Some((harmonic, u0, u1, sin_turn)) = forcing {
@@ -853,6 +881,7 @@ impl SystemStepper for ExactFlow {
         modes: &[Mode],
         scratch: &mut Scratch,
         end: &mut [f64],
+        settle: bool,
     ) -> Result<()> {
         let dim = system.dim;
         let at = 2 * dim;
@@ -879,7 +908,32 @@ impl SystemStepper for ExactFlow {
         }
         self.begin(index, dim, time, y);
         if self.modes[index].configuration.harmonics.len() <= 1 {
-            let (viscous, input) = self.step_energies(index, dim, h, end);
+            // The closed form holds over any stretch of one flow: the steps
+            // between settlements share one (their accumulators stay those
+            // at its start, in `y`, meanwhile).
+            let continued = matches!(self.span, Some(span)
+                if span.index == index && span.end == time.to_bits());
+            if !continued {
+                let r = self.modes[index].configuration.modes;
+                self.span_modal[..r].copy_from_slice(&self.origin_modal[..r]);
+                self.span = Some(Span {
+                    index,
+                    time,
+                    phasor: self.phasors.first().copied().unwrap_or((0.0, 1.0)),
+                    end: 0,
+                });
+            }
+            let Some(span) = self.span.as_mut() else {
+                unreachable!("a span was just begun")
+            };
+            if !settle {
+                span.end = (time + h).to_bits();
+                return Ok(());
+            }
+            let span = *span;
+            self.span = None;
+            let length = if continued { time + h - span.time } else { h };
+            let (viscous, input) = self.step_energies(index, dim, length, span.phasor, end);
             end[at + VISCOUS] = y[at + VISCOUS] + viscous;
             end[at + INPUT] = y[at + INPUT] + input;
             return Ok(());
@@ -1047,6 +1101,56 @@ mod tests {
     }
 
     #[test]
+    fn energies_left_to_a_later_step_are_the_steps_own_sum() {
+        crate::testing::timeout(30, || {
+            for damping in [3.0, 200.0] {
+                let (system, mut flow, y0) = forced_flow(damping);
+                let (at, len) = (2 * system.dim, system.state_len());
+                let modes = vec![Mode::Open; system.interactions.len()];
+                let mut scratch = Scratch::new(&system);
+                let h = 0.7 * flow.step();
+                // Seven steps, settled every step or at the third and the last.
+                let mut run = |settle_at: &dyn Fn(usize) -> bool| {
+                    let (mut y, mut end) = (y0.clone(), vec![0.0; len]);
+                    let mut time = 0.25;
+                    for k in 0..7 {
+                        flow.attempt(&system, time, &y, h, &modes, &mut scratch, &mut end)
+                            .unwrap();
+                        flow.finish(
+                            &system,
+                            time,
+                            &y,
+                            h,
+                            &modes,
+                            &mut scratch,
+                            &mut end,
+                            settle_at(k),
+                        )
+                        .unwrap();
+                        if !settle_at(k) {
+                            assert_eq!(end[at..], y[at..], "left as they were");
+                        }
+                        std::mem::swap(&mut y, &mut end);
+                        time += h;
+                    }
+                    y
+                };
+                let each = run(&|_| true);
+                let later = run(&|k| k == 2 || k == 6);
+                assert_eq!(each[..at], later[..at]);
+                for k in at..len {
+                    let scale = each[k].abs().max(1e-300);
+                    assert!(
+                        (each[k] - later[k]).abs() <= 1e-12 * scale,
+                        "{damping}: {each:?} {later:?}"
+                    );
+                }
+                assert!(each[at..].iter().any(|e| e.abs() > 0.0));
+            }
+        });
+    }
+
+    #[test]
     fn closed_form_step_energies_are_the_gauss_legendre_quadrature_s() {
         crate::testing::timeout(30, || {
             for damping in [3.0, 200.0] {
@@ -1058,7 +1162,10 @@ mod tests {
                 for (time, h) in [(0.0, flow.step()), (1.37, 0.3 * flow.step()), (2.0, 1e-6)] {
                     flow.begin(index, dim, time, &y);
                     flow.at(index, dim, h, &mut end);
-                    let (viscous, input) = flow.step_energies(index, dim, h, &end);
+                    let r = flow.modes[index].configuration.modes;
+                    flow.span_modal[..r].copy_from_slice(&flow.origin_modal[..r]);
+                    let phasor = flow.phasors[0];
+                    let (viscous, input) = flow.step_energies(index, dim, h, phasor, &end);
                     flow.node_factors(index, h);
                     let (mut v, mut i) = (0.0, 0.0);
                     for (k, (x, w)) in NODES.iter().zip(WEIGHTS).enumerate() {

@@ -927,7 +927,23 @@ pub fn integrate_system<S: SystemStepper>(
         } else {
             stepper.reset();
         }
-        stepper.finish(system, time, &y, taken, &modes, &mut scratch, &mut end)?;
+        // The energy accumulators are read at an event, at a balance check
+        // and at the end; in between a stepper may leave them to a later step.
+        let next = time + taken;
+        let settle = switched.is_some()
+            || (accepted + 1) % ENERGY_INTERVAL == 0
+            || next >= t_end
+            || (!adaptive && t_end - next <= 1e-9 * dt);
+        stepper.finish(
+            system,
+            time,
+            &y,
+            taken,
+            &modes,
+            &mut scratch,
+            &mut end,
+            settle,
+        )?;
         time += taken;
         if !adaptive && (switched.is_none() || (grid + 1) as f64 * dt - time <= 0.0) {
             grid += 1;

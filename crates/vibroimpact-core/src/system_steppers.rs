@@ -65,7 +65,11 @@ pub trait SystemStepper {
     fn accept(&mut self);
     /// Complete the step `h` from `(time, y)` the kernel keeps, `end`, with
     /// what only a kept step needs (a method that leaves its attempts'
-    /// energy accumulators out fills them here).
+    /// energy accumulators out fills them here). Unless `settle` (the kernel
+    /// reads the accumulators at `end`: an event there, a balance check, the
+    /// run's end), a method may leave them as they are in `y` and add this
+    /// step's share at a later step's settlement (the kernel then passes on
+    /// `end` unchanged as the next step's start).
     #[allow(clippy::too_many_arguments)]
     fn finish(
         &mut self,
@@ -76,6 +80,7 @@ pub trait SystemStepper {
         _modes: &[Mode],
         _scratch: &mut Scratch,
         _end: &mut [f64],
+        _settle: bool,
     ) -> Result<()> {
         Ok(())
     }
