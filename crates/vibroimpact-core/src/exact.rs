@@ -587,20 +587,34 @@ impl ExactFlow {
         // The start plus the modes' increments: the flow is continuous at its
         // start to the last bit (a state on a wall stays on it), and a start
         // off the constraints of sticking pairs by round-off stays as close.
-        for j in 0..r {
-            self.eta[j] -= self.origin_modal[j].0;
-            self.rate[j] -= self.origin_modal[j].1;
+        // Slices of one length each (no bounds checks in the loops: for a
+        // few modes those cost as much as the arithmetic).
+        let (eta, rate) = (&mut self.eta[..r], &mut self.rate[..r]);
+        for ((e, v), o) in eta
+            .iter_mut()
+            .zip(rate.iter_mut())
+            .zip(&self.origin_modal[..r])
+        {
+            *e -= o.0;
+            *v -= o.1;
         }
-        for i in 0..dim {
-            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
-            let mut x = self.begun_state[i];
-            let mut v = self.begun_state[dim + i];
-            for j in 0..r {
-                x += row[j] * self.eta[j];
-                v += row[j] * self.rate[j];
+        if r == 0 {
+            // Every coordinate held (all pairs sticking): the start.
+            out[..2 * dim].copy_from_slice(&self.begun_state[..2 * dim]);
+            self.evaluations += 1;
+            return;
+        }
+        let (x0, v0) = self.begun_state[..2 * dim].split_at(dim);
+        let (xs, vs) = out[..2 * dim].split_at_mut(dim);
+        let rows = cfg.to_coordinates[..dim * r].chunks_exact(r);
+        for ((((row, x1), v1), x0), v0) in rows.zip(xs).zip(vs).zip(x0).zip(v0) {
+            let (mut x, mut v) = (*x0, *v0);
+            for ((b, e), w) in row.iter().zip(eta.iter()).zip(rate.iter()) {
+                x += b * e;
+                v += b * w;
             }
-            out[i] = x;
-            out[dim + i] = v;
+            *x1 = x;
+            *v1 = v;
         }
         self.evaluations += 1;
     }
