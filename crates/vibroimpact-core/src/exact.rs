@@ -257,6 +257,18 @@ fn turn_difference(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
     (a.0 * b.1 - a.1 * b.0, a.1 * b.1 + a.0 * b.0)
 }
 
+/// Kept steps whose energy accumulators wait for one closed form over all of
+/// them (they are one flow: no event between them): the modes, the time at
+/// the first one's start and the first harmonic's phasor there, and the time
+/// (bits) at the last one's end.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    index: usize,
+    time: f64,
+    phasor: (f64, f64),
+    end: u64,
+}
+
 /// The exact flow as a stepper.
 #[derive(Debug, Clone)]
 pub struct ExactFlow {
@@ -280,6 +292,13 @@ pub struct ExactFlow {
     node_turns: Vec<(f64, f64)>,
     /// The start last set: its time's bits and modes, and its state.
     begun: Option<(u64, usize)>,
+    /// The modes and the time after the start of the last evaluation by
+    /// the modes (`eta` and `rate` hold its increments), if it was the last.
+    last: Option<(usize, f64)>,
+    /// The steps whose energies are still to be added, and the modal state
+    /// at their start.
+    span: Option<Span>,
+    span_modal: Vec<(f64, f64)>,
     begun_state: Vec<f64>,
     /// A state and its rates at a Gauss node (the energy of contacts).
     node: Vec<f64>,
@@ -320,6 +339,9 @@ impl ExactFlow {
             node_modes: vec![(0.0, 0.0); NODES.len() * dim],
             node_turns: vec![(0.0, 1.0); NODES.len() * parts.harmonics.len()],
             begun: None,
+            last: None,
+            span: None,
+            span_modal: vec![(0.0, 0.0); dim],
             begun_state: vec![0.0; 2 * dim],
             node: vec![0.0; system.state_len()],
             rates: vec![0.0; system.state_len()],
@@ -488,6 +510,7 @@ impl ExactFlow {
     /// The accelerations at the start (of modes without a matrix flow), into
     /// `out`: each mode's `F0 + f - w2 eta - c eta'` taken to coordinates.
     fn accelerations(&mut self, index: usize, dim: usize, out: &mut [f64]) {
+        self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
         let r = cfg.modes;
@@ -506,33 +529,92 @@ impl ExactFlow {
         }
     }
 
+    /// The accelerations and their rates at the last evaluation by the modes
+    /// (see [`Self::at`]), into `accel` and `jerk`: each mode's `eta'' = F0 +
+    /// f - w2 eta - c eta'` and `eta''' = f' - w2 eta' - c eta''`, taken to
+    /// coordinates. False when the last evaluation was not by the modes.
+    fn last_derivatives(&mut self, dim: usize, accel: &mut [f64], jerk: &mut [f64]) -> bool {
+        let Some((index, t)) = self.last.take() else {
+            return false;
+        };
+        let m = &self.modes[index];
+        let cfg = &m.configuration;
+        let r = cfg.modes;
+        // In place of the increments (`eta`: accelerations, `rate`: jerks).
+        let (a, j) = (&mut self.eta[..r], &mut self.rate[..r]);
+        for (k, o) in m.oscillators.iter().enumerate() {
+            let eta = a[k] + self.origin_modal[k].0;
+            let rate = j[k] + self.origin_modal[k].1;
+            a[k] = o.constant - o.w2 * eta - o.c * rate;
+            j[k] = -o.w2 * rate;
+        }
+        for (h, &(s0, c0)) in cfg.harmonics.iter().zip(&self.phasors) {
+            let (st, ct) = sin_cos(h.omega * t);
+            let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
+            for ((a, j), &(pr, pi)) in a.iter_mut().zip(j.iter_mut()).zip(&h.force) {
+                *a += pr * c - pi * s;
+                *j -= h.omega * (pr * s + pi * c);
+            }
+        }
+        for ((j, a), o) in j.iter_mut().zip(a.iter()).zip(&m.oscillators) {
+            *j -= o.c * a;
+        }
+        for i in 0..dim {
+            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
+            let (mut x, mut y) = (0.0, 0.0);
+            for k in 0..r {
+                x += row[k] * a[k];
+                y += row[k] * j[k];
+            }
+            accel[i] = x;
+            jerk[i] = y;
+        }
+        true
+    }
+
     /// The coordinates and velocities `t` after the start, into `out`.
     fn at(&mut self, index: usize, dim: usize, t: f64, out: &mut [f64]) {
         if let Some(flow) = self.modes[index].matrix.as_mut() {
             flow.at(&self.begun_state, t, out);
             self.evaluations += 1;
+            self.last = None;
             return;
         }
         self.modal_at(index, t);
+        self.last = Some((index, t));
         let cfg = &self.modes[index].configuration;
         let r = cfg.modes;
         // The start plus the modes' increments: the flow is continuous at its
         // start to the last bit (a state on a wall stays on it), and a start
         // off the constraints of sticking pairs by round-off stays as close.
-        for j in 0..r {
-            self.eta[j] -= self.origin_modal[j].0;
-            self.rate[j] -= self.origin_modal[j].1;
+        // Slices of one length each (no bounds checks in the loops: for a
+        // few modes those cost as much as the arithmetic).
+        let (eta, rate) = (&mut self.eta[..r], &mut self.rate[..r]);
+        for ((e, v), o) in eta
+            .iter_mut()
+            .zip(rate.iter_mut())
+            .zip(&self.origin_modal[..r])
+        {
+            *e -= o.0;
+            *v -= o.1;
         }
-        for i in 0..dim {
-            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
-            let mut x = self.begun_state[i];
-            let mut v = self.begun_state[dim + i];
-            for j in 0..r {
-                x += row[j] * self.eta[j];
-                v += row[j] * self.rate[j];
+        if r == 0 {
+            // Every coordinate held (all pairs sticking): the start.
+            out[..2 * dim].copy_from_slice(&self.begun_state[..2 * dim]);
+            self.evaluations += 1;
+            return;
+        }
+        let (x0, v0) = self.begun_state[..2 * dim].split_at(dim);
+        let (xs, vs) = out[..2 * dim].split_at_mut(dim);
+        let rows = cfg.to_coordinates[..dim * r].chunks_exact(r);
+        for ((((row, x1), v1), x0), v0) in rows.zip(xs).zip(vs).zip(x0).zip(v0) {
+            let (mut x, mut v) = (*x0, *v0);
+            for ((b, e), w) in row.iter().zip(eta.iter()).zip(rate.iter()) {
+                x += b * e;
+                v += b * w;
             }
-            out[i] = x;
-            out[dim + i] = v;
+            *x1 = x;
+            *v1 = v;
         }
         self.evaluations += 1;
     }
@@ -577,7 +659,18 @@ impl ExactFlow {
     /// the step), and `int f Re(Z u)'` is elementary. The viscous loss `c int
     /// eta'^2` is then the mode's input `int f eta'` plus `F0` times its
     /// displacement less the change of its energy `eta'^2 / 2 + w2 eta^2 / 2`.
-    fn step_energies(&mut self, index: usize, dim: usize, h: f64, end: &[f64]) -> (f64, f64) {
+    ///
+    /// The start is `span_modal` with the first harmonic's phasor `phasor`
+    /// there, `h` before `end`: any stretch of one flow.
+    fn step_energies(
+        &mut self,
+        index: usize,
+        dim: usize,
+        h: f64,
+        phasor: (f64, f64),
+        end: &[f64],
+    ) -> (f64, f64) {
+        self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
         // The modal state at the end, from the step's end.
@@ -585,7 +678,7 @@ impl ExactFlow {
             (self.eta[j], self.rate[j]) = modal_state(cfg, dim, j, end);
         }
         let forcing = cfg.harmonics.first().map(|harmonic| {
-            let (s0, c0) = self.phasors[0];
+            let (s0, c0) = phasor;
             let (st, ct) = sin_cos(harmonic.omega * h);
             // u at both ends as (Re, Im), and sin(omega h).
             let end = (c0 * ct - s0 * st, s0 * ct + c0 * st);
@@ -593,7 +686,7 @@ impl ExactFlow {
         });
         let (mut viscous, mut input) = (0.0, 0.0);
         for (j, o) in m.oscillators.iter().enumerate() {
-            let (eta0, rate0) = self.origin_modal[j];
+            let (eta0, rate0) = self.span_modal[j];
             let (eta1, rate1) = (self.eta[j], self.rate[j]);
             let mut work = 0.0;
             if let Some((harmonic, u0, u1, sin_turn)) = forcing {
@@ -673,6 +766,7 @@ impl ExactFlow {
     /// start; [`Self::node_factors`] made its factors): the modal rates
     /// only, without the coordinates (what the energy quadrature needs).
     fn powers_at(&mut self, index: usize, k: usize, t: f64) -> (f64, f64) {
+        self.last = None;
         let m = &self.modes[index];
         let cfg = &m.configuration;
         let r = cfg.modes;
@@ -801,6 +895,7 @@ impl SystemStepper for ExactFlow {
         modes: &[Mode],
         scratch: &mut Scratch,
         end: &mut [f64],
+        settle: bool,
     ) -> Result<()> {
         let dim = system.dim;
         let at = 2 * dim;
@@ -827,7 +922,32 @@ impl SystemStepper for ExactFlow {
         }
         self.begin(index, dim, time, y);
         if self.modes[index].configuration.harmonics.len() <= 1 {
-            let (viscous, input) = self.step_energies(index, dim, h, end);
+            // The closed form holds over any stretch of one flow: the steps
+            // between settlements share one (their accumulators stay those
+            // at its start, in `y`, meanwhile).
+            let continued = matches!(self.span, Some(span)
+                if span.index == index && span.end == time.to_bits());
+            if !continued {
+                let r = self.modes[index].configuration.modes;
+                self.span_modal[..r].copy_from_slice(&self.origin_modal[..r]);
+                self.span = Some(Span {
+                    index,
+                    time,
+                    phasor: self.phasors.first().copied().unwrap_or((0.0, 1.0)),
+                    end: 0,
+                });
+            }
+            let Some(span) = self.span.as_mut() else {
+                unreachable!("a span was just begun")
+            };
+            if !settle {
+                span.end = (time + h).to_bits();
+                return Ok(());
+            }
+            let span = *span;
+            self.span = None;
+            let length = if continued { time + h - span.time } else { h };
+            let (viscous, input) = self.step_energies(index, dim, length, span.phasor, end);
             end[at + VISCOUS] = y[at + VISCOUS] + viscous;
             end[at + INPUT] = y[at + INPUT] + input;
             return Ok(());
@@ -842,6 +962,10 @@ impl SystemStepper for ExactFlow {
         end[at + VISCOUS] = y[at + VISCOUS] + h * viscous;
         end[at + INPUT] = y[at + INPUT] + h * input;
         Ok(())
+    }
+
+    fn end_derivatives(&mut self, system: &Assembly, accel: &mut [f64], jerk: &mut [f64]) -> bool {
+        self.last_derivatives(system.dim, accel, jerk)
     }
 
     fn accept(&mut self) {}
@@ -946,6 +1070,101 @@ mod tests {
     }
 
     #[test]
+    fn end_derivatives_are_the_system_s_accelerations_and_their_rates() {
+        crate::testing::timeout(30, || {
+            for damping in [3.0, 200.0] {
+                let (system, mut flow, y) = forced_flow(damping);
+                let (dim, len) = (system.dim, system.state_len());
+                let modes = vec![Mode::Open; system.interactions.len()];
+                let mut scratch = Scratch::new(&system);
+                let (mut end, mut rates) = (vec![0.0; len], vec![0.0; len]);
+                let (mut accel, mut jerk) = (vec![0.0; dim], vec![0.0; dim]);
+                let (time, h) = (0.37, 0.6 * flow.step());
+                // The accelerations at `t` after the start, by the system.
+                let mut accelerations = |flow: &mut ExactFlow, t: f64| {
+                    flow.attempt(&system, time, &y, t, &modes, &mut scratch, &mut end)
+                        .unwrap();
+                    system.rates(time + t, &end, &modes, &mut scratch, &mut rates);
+                    rates[dim..2 * dim].to_vec()
+                };
+                let expected = accelerations(&mut flow, h);
+                assert!(flow.end_derivatives(&system, &mut accel, &mut jerk));
+                let delta = 1e-5 * h;
+                let (ahead, behind) = (
+                    accelerations(&mut flow, h + delta),
+                    accelerations(&mut flow, h - delta),
+                );
+                for i in 0..dim {
+                    let scale = expected.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                    assert!(
+                        (accel[i] - expected[i]).abs() <= 1e-12 * scale,
+                        "{damping}: {accel:?} {expected:?}"
+                    );
+                    let difference = (ahead[i] - behind[i]) / (2.0 * delta);
+                    let jerk_scale = jerk.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+                    assert!(
+                        (jerk[i] - difference).abs() <= 1e-6 * jerk_scale,
+                        "{damping}: {jerk:?} {difference}"
+                    );
+                }
+                // Only for the last evaluation, once.
+                assert!(flow.end_derivatives(&system, &mut accel, &mut jerk));
+                assert!(!flow.end_derivatives(&system, &mut accel, &mut jerk));
+            }
+        });
+    }
+
+    #[test]
+    fn energies_left_to_a_later_step_are_the_steps_own_sum() {
+        crate::testing::timeout(30, || {
+            for damping in [3.0, 200.0] {
+                let (system, mut flow, y0) = forced_flow(damping);
+                let (at, len) = (2 * system.dim, system.state_len());
+                let modes = vec![Mode::Open; system.interactions.len()];
+                let mut scratch = Scratch::new(&system);
+                let h = 0.7 * flow.step();
+                // Seven steps, settled every step or at the third and the last.
+                let mut run = |settle_at: &dyn Fn(usize) -> bool| {
+                    let (mut y, mut end) = (y0.clone(), vec![0.0; len]);
+                    let mut time = 0.25;
+                    for k in 0..7 {
+                        flow.attempt(&system, time, &y, h, &modes, &mut scratch, &mut end)
+                            .unwrap();
+                        flow.finish(
+                            &system,
+                            time,
+                            &y,
+                            h,
+                            &modes,
+                            &mut scratch,
+                            &mut end,
+                            settle_at(k),
+                        )
+                        .unwrap();
+                        if !settle_at(k) {
+                            assert_eq!(end[at..], y[at..], "left as they were");
+                        }
+                        std::mem::swap(&mut y, &mut end);
+                        time += h;
+                    }
+                    y
+                };
+                let each = run(&|_| true);
+                let later = run(&|k| k == 2 || k == 6);
+                assert_eq!(each[..at], later[..at]);
+                for k in at..len {
+                    let scale = each[k].abs().max(1e-300);
+                    assert!(
+                        (each[k] - later[k]).abs() <= 1e-12 * scale,
+                        "{damping}: {each:?} {later:?}"
+                    );
+                }
+                assert!(each[at..].iter().any(|e| e.abs() > 0.0));
+            }
+        });
+    }
+
+    #[test]
     fn closed_form_step_energies_are_the_gauss_legendre_quadrature_s() {
         crate::testing::timeout(30, || {
             for damping in [3.0, 200.0] {
@@ -957,7 +1176,10 @@ mod tests {
                 for (time, h) in [(0.0, flow.step()), (1.37, 0.3 * flow.step()), (2.0, 1e-6)] {
                     flow.begin(index, dim, time, &y);
                     flow.at(index, dim, h, &mut end);
-                    let (viscous, input) = flow.step_energies(index, dim, h, &end);
+                    let r = flow.modes[index].configuration.modes;
+                    flow.span_modal[..r].copy_from_slice(&flow.origin_modal[..r]);
+                    let phasor = flow.phasors[0];
+                    let (viscous, input) = flow.step_energies(index, dim, h, phasor, &end);
                     flow.node_factors(index, h);
                     let (mut v, mut i) = (0.0, 0.0);
                     for (k, (x, w)) in NODES.iter().zip(WEIGHTS).enumerate() {

@@ -207,6 +207,9 @@ struct Crossing {
     /// A fraction of the step on the old side (0: the start), for a value
     /// that starts on the wall (just after an event) and moves away first.
     before: f64,
+    /// The interpolant's root (a fraction of the step): the first guess of
+    /// the crossing (for an interior dip, once the dip is confirmed).
+    root: f64,
 }
 
 /// Every interaction's gap and rate (see [`Assembly::gaps`]) at a step's
@@ -214,6 +217,88 @@ struct Crossing {
 struct Gaps {
     start: Vec<(f64, f64)>,
     end: Vec<(f64, f64)>,
+}
+
+/// Where the slope of the cubic Hermite interpolant (see [`hermite::eval`])
+/// falls from `m0 > 0` to `m1 <= 0`: its maximum over the step, in closed
+/// form (the slope is a quadratic in theta with one root in [0, 1]).
+fn cubic_argmax(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
+    // slope(theta) = a theta^2 + b theta + m0.
+    let a = 6.0 * (g0 - g1) + 3.0 * (m0 + m1);
+    let b = 6.0 * (g1 - g0) - 4.0 * m0 - 2.0 * m1;
+    if m1 >= 0.0 {
+        return 1.0;
+    }
+    let root = if a == 0.0 {
+        -m0 / b
+    } else {
+        // The two roots without cancellation: q / a and m0 / q.
+        let q = -0.5 * (b + b.signum() * (b * b - 4.0 * a * m0).max(0.0).sqrt());
+        let (r1, r2) = (q / a, if q != 0.0 { m0 / q } else { f64::NAN });
+        // The one in [0, 1] (slope(0) > 0 >= slope(1): exactly one).
+        if (0.0..=1.0).contains(&r1) && !(0.0..=1.0).contains(&r2) {
+            r1
+        } else if (0.0..=1.0).contains(&r2) && !(0.0..=1.0).contains(&r1) {
+            r2
+        } else {
+            // Both (or neither) by round-off: the one whose slope is closer to 0.
+            let slope = |t: f64| hermite::eval(g0, g1, m0, m1, t.clamp(0.0, 1.0)).1.abs();
+            if slope(r1) <= slope(r2) || r2.is_nan() {
+                r1
+            } else {
+                r2
+            }
+        }
+    };
+    if root.is_nan() {
+        0.5
+    } else {
+        root.clamp(0.0, 1.0)
+    }
+}
+
+/// A root of the cubic Hermite interpolant (see [`hermite::eval`]) between
+/// `lo` and `hi` in theta, where it has opposite signs (else `hi`): Newton's
+/// method on its power form, safeguarded by bisection, to 1e-10 in theta
+/// (the interpolant itself is off by ~ theta^4 of the value's swing). The
+/// first guess of an event's location.
+fn cubic_root(g0: f64, g1: f64, m0: f64, m1: f64, mut lo: f64, mut hi: f64) -> f64 {
+    // g0 + m0 t + c2 t^2 + c3 t^3.
+    let c2 = 3.0 * (g1 - g0) - 2.0 * m0 - m1;
+    let c3 = 2.0 * (g0 - g1) + m0 + m1;
+    let value = |t: f64| g0 + t * (m0 + t * (c2 + t * c3));
+    let (v_lo, v_hi) = (value(lo), value(hi));
+    if v_lo == 0.0 {
+        return lo;
+    }
+    if v_hi == 0.0 || (v_lo > 0.0) == (v_hi > 0.0) {
+        return hi;
+    }
+    let positive_below = v_lo > 0.0;
+    let mut theta = lo + (hi - lo) * v_lo / (v_lo - v_hi);
+    for _ in 0..64 {
+        let v = value(theta);
+        if v == 0.0 {
+            return theta;
+        }
+        if (v > 0.0) == positive_below {
+            lo = theta;
+        } else {
+            hi = theta;
+        }
+        let slope = m0 + theta * (2.0 * c2 + 3.0 * theta * c3);
+        let newton = theta - v / slope;
+        let next = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if (next - theta).abs() <= 1e-10 || hi - lo <= 1e-10 {
+            return next;
+        }
+        theta = next;
+    }
+    theta
 }
 
 /// The earliest event in the step `y -> end` of length `h` (`gaps` at both),
@@ -255,6 +340,7 @@ fn find_crossing(
                         guess: 1.0,
                         interior: false,
                         before: 0.0,
+                        root: f64::NAN,
                     });
                 }
                 continue;
@@ -267,13 +353,14 @@ fn find_crossing(
             // and moving away: the crossing is the later one, after the
             // interpolant's maximum.
             let before = if v0 <= graze && m0 > 0.0 && m1 < 0.0 {
-                hermite::argmax(v0, v1, m0, m1)
+                cubic_argmax(v0, v1, m0, m1)
             } else {
                 0.0
             };
             let top = hermite::eval(v0, v1, m0, m1, before).0;
+            // The interpolant's root: a guess within its error of the event.
             let guess = if top > 0.0 {
-                before + (1.0 - before) * top / (top - v1)
+                cubic_root(v0, v1, m0, m1, before, 1.0)
             } else {
                 before
             };
@@ -282,10 +369,11 @@ fn find_crossing(
                 guess,
                 interior: false,
                 before,
+                root: guess,
             });
         } else if m0 < 0.0 && m1 > 0.0 {
             // The value falls then rises within the step: a dip below zero?
-            let theta = hermite::argmax(-v0, -v1, -m0, -m1);
+            let theta = cubic_argmax(-v0, -v1, -m0, -m1);
             let low = hermite::eval(v0, v1, m0, m1, theta).0;
             if low < -graze {
                 consider(Crossing {
@@ -293,6 +381,7 @@ fn find_crossing(
                     guess: theta,
                     interior: true,
                     before: 0.0,
+                    root: cubic_root(v0, v1, m0, m1, 0.0, theta),
                 });
             } else if low < 0.0 {
                 *grazes += 1;
@@ -300,6 +389,35 @@ fn find_crossing(
         }
     }
     best
+}
+
+/// The root `dt` near `-v / slope` of `v + slope dt + second dt^2 / 2 +
+/// third dt^3 / 6` (a value's Taylor polynomial about a trial): Newton's
+/// method on the polynomial from the tangent's root. Its error is that of the
+/// polynomial, fourth order in the distance to the event, against second
+/// order for the tangent's root alone (which it falls back to where the
+/// polynomial turns away).
+fn taylor_root(v: f64, slope: f64, second: f64, third: f64) -> f64 {
+    let tangent = -v / slope;
+    let mut dt = tangent;
+    for _ in 0..4 {
+        let p = v + dt * (slope + dt * (0.5 * second + dt * (third / 6.0)));
+        let dp = slope + dt * (second + dt * (0.5 * third));
+        if dp == 0.0 || (dp > 0.0) != (slope > 0.0) {
+            return tangent;
+        }
+        let step = p / dp;
+        dt -= step;
+        if step.abs() <= 1e-3 * f64::EPSILON * dt.abs() {
+            break;
+        }
+    }
+    // Within twice the tangent's step: the polynomial's root near the trial.
+    if dt.is_finite() && (dt - tangent).abs() <= tangent.abs() {
+        dt
+    } else {
+        tangent
+    }
 }
 
 /// What locating an event found.
@@ -320,6 +438,10 @@ struct Buffers {
     start: Vec<f64>,
     best: Vec<f64>,
     work: Vec<f64>,
+    /// Accelerations and their rates at a trial's end (`dim` each), where
+    /// the stepper gives them.
+    accel: Vec<f64>,
+    jerk: Vec<f64>,
 }
 
 /// Locates interaction `c.i`'s event in the step of length `h` whose end is
@@ -383,7 +505,11 @@ fn locate<S: SystemStepper>(
         // Starting on the wall to round-off: the event is the start.
         v_lo = 0.0;
     }
-    let mut guess = if c.interior { f64::NAN } else { c.guess * h };
+    // The interpolant's root first (within its error of the event), then
+    // Newton's steps on the step length from the value's rate at each
+    // trial's end (a gap's rate is in the state), kept inside the bracket;
+    // regula falsi (Illinois) where Newton's step leaves it.
+    let mut guess = c.root * h;
     let mut kept = 0i8;
     let mut first = true;
     for _ in 0..200 {
@@ -406,18 +532,29 @@ fn locate<S: SystemStepper>(
         }
         first = false;
         let v = value(&buffers.probe, time + trial, scratch, &mut buffers.work);
-        // Newton's step on the step length from the value's rate at the
-        // trial's end (a gap's rate is in the state): near the event it
-        // converges in one or two steps where regula falsi would creep.
-        let slope = match mode {
-            Mode::Open => system.gap(c.i, &buffers.probe).1,
-            Mode::Compliant { .. } => -system.gap(c.i, &buffers.probe).1,
+        let sign = match mode {
+            Mode::Open => 1.0,
+            Mode::Compliant { .. } => -1.0,
             Mode::Sticking => f64::NAN,
         };
-        if slope != 0.0 {
-            guess = trial - v / slope;
+        let slope = sign * system.gap(c.i, &buffers.probe).1;
+        let mut converged = false;
+        if slope != 0.0 && slope.is_finite() {
+            let correction = v / slope;
+            // Newton's correction within the round-off of the time itself:
+            // the trial is the event (to a unit in the last place of the
+            // time, as a bracket that narrow would say).
+            converged = correction.abs() <= f64::EPSILON * (time.abs() + trial);
+            guess = trial - correction;
+            if !converged && stepper.end_derivatives(system, &mut buffers.accel, &mut buffers.jerk)
+            {
+                let h_i = &system.interactions[c.i].h;
+                let second = sign * crate::linalg::dot(h_i, &buffers.accel);
+                let third = sign * crate::linalg::dot(h_i, &buffers.jerk);
+                guess = trial + taylor_root(v, slope, second, third);
+            }
         }
-        if v < 0.0 || v.abs() <= round_off {
+        if v < 0.0 || v.abs() <= round_off || converged {
             hi = trial;
             v_hi = v;
             best_error = error;
@@ -434,7 +571,7 @@ fn locate<S: SystemStepper>(
             }
             kept = -1;
         }
-        if v.abs() <= round_off {
+        if v.abs() <= round_off || converged {
             break;
         }
     }
@@ -501,6 +638,8 @@ pub fn integrate_system<S: SystemStepper>(
         best: vec![0.0; len],
         work: vec![0.0; len],
         start: vec![0.0; len],
+        accel: vec![0.0; d],
+        jerk: vec![0.0; d],
     };
     let mut scratch = Scratch::new(system);
     let mut modes = vec![Mode::Open; count];
@@ -707,6 +846,7 @@ pub fn integrate_system<S: SystemStepper>(
                         guess: 1.0,
                         interior: false,
                         before: 0.0,
+                        root: f64::NAN,
                     });
                     break;
                 }
@@ -758,7 +898,7 @@ pub fn integrate_system<S: SystemStepper>(
                 let (m0, m1) = (r0 * taken, r1 * taken);
                 let mut deepest = -g1;
                 if m0 < 0.0 && m1 > 0.0 {
-                    let theta = hermite::argmax(-g0, -g1, -m0, -m1);
+                    let theta = cubic_argmax(-g0, -g1, -m0, -m1);
                     deepest = deepest.max(hermite::eval(-g0, -g1, -m0, -m1, theta).0);
                 }
                 oc.max_indentation = oc.max_indentation.max(deepest);
@@ -787,7 +927,23 @@ pub fn integrate_system<S: SystemStepper>(
         } else {
             stepper.reset();
         }
-        stepper.finish(system, time, &y, taken, &modes, &mut scratch, &mut end)?;
+        // The energy accumulators are read at an event, at a balance check
+        // and at the end; in between a stepper may leave them to a later step.
+        let next = time + taken;
+        let settle = switched.is_some()
+            || (accepted + 1) % ENERGY_INTERVAL == 0
+            || next >= t_end
+            || (!adaptive && t_end - next <= 1e-9 * dt);
+        stepper.finish(
+            system,
+            time,
+            &y,
+            taken,
+            &modes,
+            &mut scratch,
+            &mut end,
+            settle,
+        )?;
         time += taken;
         if !adaptive && (switched.is_none() || (grid + 1) as f64 * dt - time <= 0.0) {
             grid += 1;
@@ -1219,5 +1375,84 @@ fn settle_sticking(
                 contacts.push(oc.close(system.interactions[i].pair, time, 0.0, oc.dissipated));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Hermite data `(g0, g1, m0, m1)` over [0, 1] of `p` with derivative `dp`.
+    fn data(p: impl Fn(f64) -> f64, dp: impl Fn(f64) -> f64) -> (f64, f64, f64, f64) {
+        (p(0.0), p(1.0), dp(0.0), dp(1.0))
+    }
+
+    #[test]
+    fn the_interpolant_s_root_is_a_cubic_s_root() {
+        crate::testing::timeout(30, || {
+            // A cubic is its own Hermite interpolant: its root, to round-off.
+            let p = |t: f64| (t - 0.3) * (t + 2.0) * (t - 4.0);
+            let dp = |t: f64| (t + 2.0) * (t - 4.0) + (t - 0.3) * (t - 4.0) + (t - 0.3) * (t + 2.0);
+            let (g0, g1, m0, m1) = data(p, dp);
+            for (lo, hi) in [(0.0, 1.0), (0.25, 0.9), (0.1, 0.3000001)] {
+                let r = cubic_root(g0, g1, m0, m1, lo, hi);
+                assert!((r - 0.3).abs() < 1e-14, "[{lo}, {hi}]: {r}");
+            }
+            // Falling through zero (the sign of the old side is positive).
+            let r = cubic_root(-g0, -g1, -m0, -m1, 0.0, 1.0);
+            assert!((r - 0.3).abs() < 1e-14, "{r}");
+            // No sign change in the bracket: its end.
+            assert_eq!(cubic_root(g0, g1, m0, m1, 0.5, 1.0), 1.0);
+        });
+    }
+
+    #[test]
+    fn the_interpolant_s_maximum_in_closed_form() {
+        crate::testing::timeout(30, || {
+            // -(t^3 - t^2 / 2 - 3 t / 2): slope 1.5 at 0, -0.5 at 1, zero at
+            // (1 + sqrt(19)) / 6.
+            let p = |t: f64| -(t * t * t - 0.5 * t * t - 1.5 * t);
+            let dp = |t: f64| -(3.0 * t * t - t - 1.5);
+            let (g0, g1, m0, m1) = data(p, dp);
+            let expected = (1.0 + 19f64.sqrt()) / 6.0;
+            let a = cubic_argmax(g0, g1, m0, m1);
+            assert!((a - expected).abs() < 1e-15, "{a} {expected}");
+            // A parabola (the slope is linear): its vertex.
+            let q = |t: f64| 1.0 - (t - 0.7) * (t - 0.7);
+            let dq = |t: f64| -2.0 * (t - 0.7);
+            let (g0, g1, m0, m1) = data(q, dq);
+            assert!((cubic_argmax(g0, g1, m0, m1) - 0.7).abs() < 1e-15);
+            // Hermite's own argmax agrees.
+            let reference = hermite::argmax(g0, g1, m0, m1);
+            assert!((cubic_argmax(g0, g1, m0, m1) - reference).abs() < 1e-12);
+            // Still rising at the end: the end.
+            assert_eq!(cubic_argmax(0.0, 1.0, 1.0, 0.5), 1.0);
+        });
+    }
+
+    #[test]
+    fn the_taylor_polynomial_s_root_is_fourth_order() {
+        crate::testing::timeout(30, || {
+            // A cubic about a trial: its root exactly, where the tangent is off.
+            let p = |t: f64| (t - 0.3) * (t + 2.0) * (t - 4.0);
+            let dp = |t: f64| 3.0 * t * t - 4.6 * t - 7.4;
+            let d2p = |t: f64| 6.0 * t - 4.6;
+            let trial = 0.36;
+            let dt = taylor_root(p(trial), dp(trial), d2p(trial), 6.0);
+            assert!((trial + dt - 0.3).abs() < 1e-15, "{}", trial + dt);
+            let tangent = -p(trial) / dp(trial);
+            assert!((trial + tangent - 0.3).abs() > 1e-5);
+            // sin t = 1/2 from 0.5: error ~ (pi/6 - 0.5)^4 / 24 against the
+            // tangent's ~ (pi/6 - 0.5)^2 / 2.
+            let t = 0.5f64;
+            let dt = taylor_root(t.sin() - 0.5, t.cos(), -t.sin(), -t.cos());
+            let root = std::f64::consts::FRAC_PI_6;
+            assert!((t + dt - root).abs() < 2e-8, "{}", t + dt - root);
+            let tangent = -(t.sin() - 0.5) / t.cos();
+            assert!((t + tangent - root).abs() > 1e-4);
+            // A polynomial that turns away before reaching zero: the tangent.
+            let dt = taylor_root(1.0, -1.0, 4.0, 0.0);
+            assert_eq!(dt, 1.0);
+        });
     }
 }

@@ -48,11 +48,28 @@ pub trait SystemStepper {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) -> Result<f64>;
+    /// The accelerations and their rates (`dim` values each, into `accel`
+    /// and `jerk`) at the end of the last attempt, where the method has them
+    /// for little (the exact flow, from its modal state there): locating an
+    /// event then solves the value's cubic Taylor polynomial about a trial
+    /// instead of its tangent. False (the default) where it has not.
+    fn end_derivatives(
+        &mut self,
+        _system: &Assembly,
+        _accel: &mut [f64],
+        _jerk: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// The last attempt is the new current point.
     fn accept(&mut self);
     /// Complete the step `h` from `(time, y)` the kernel keeps, `end`, with
     /// what only a kept step needs (a method that leaves its attempts'
-    /// energy accumulators out fills them here).
+    /// energy accumulators out fills them here). Unless `settle` (the kernel
+    /// reads the accumulators at `end`: an event there, a balance check, the
+    /// run's end), a method may leave them as they are in `y` and add this
+    /// step's share at a later step's settlement (the kernel then passes on
+    /// `end` unchanged as the next step's start).
     #[allow(clippy::too_many_arguments)]
     fn finish(
         &mut self,
@@ -63,6 +80,7 @@ pub trait SystemStepper {
         _modes: &[Mode],
         _scratch: &mut Scratch,
         _end: &mut [f64],
+        _settle: bool,
     ) -> Result<()> {
         Ok(())
     }

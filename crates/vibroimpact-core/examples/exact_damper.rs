@@ -1,0 +1,114 @@
+//! The exact flow alone (no Python): the forced damper of
+//! benchmarks/bench_analyses.py part 1 over 1000 forcing periods and the ball
+//! dropped 1 m (part 4); medians of repeated runs, with the flow evaluations
+//! per impact. `exact_damper once` runs the damper once (for callgrind).
+//!
+//!     cargo run --release -p vibroimpact-core --example exact_damper
+
+use std::time::Instant;
+use vibroimpact_core::assembly::{
+    initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+};
+use vibroimpact_core::reductions::ReduceOptions;
+use vibroimpact_core::signals::Signal;
+use vibroimpact_core::structure::Structure;
+use vibroimpact_core::system_events::{RunOptions, SystemSolution};
+use vibroimpact_core::system_methods::AnyStepper;
+
+fn run(spec: &SystemSpec, t_end: f64) -> SystemSolution {
+    let system = Assembly::new(spec).unwrap();
+    let y = initial_state(&system, &[], &[], &[], &[]).unwrap();
+    let mut stepper = AnyStepper::new(&system, "exact", 1e-8, 1e-11, 0.25, 0.5, 0.8).unwrap();
+    let options = RunOptions {
+        dt: stepper.step(None, t_end, f64::INFINITY),
+        t_end,
+        every: 1,
+        keep_history: false,
+        max_steps: 1_000_000_000,
+        max_rows: u64::MAX,
+        energy_tolerance: 1e-6,
+        reduce: ReduceOptions::default(),
+    };
+    stepper
+        .integrate(&system, &y, &options, &mut || false)
+        .unwrap()
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let wn = 2.0 * std::f64::consts::PI * 10.0;
+    let k = wn * wn;
+    let damper = SystemSpec {
+        structure: Structure::oscillator(1.0, k, 2.0 * 0.01 * wn).unwrap(),
+        dampers: vec![Damper {
+            mass: 0.05,
+            at: 0.0,
+            lower_clearance: 0.01,
+            upper_clearance: 0.01,
+            law: PairLaw::rigid(0.6).unwrap(),
+        }],
+        stops: vec![],
+        gravity: 0.0,
+        excitations: vec![Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(0.3 * k * 0.01 * 3.0, 8.0, 0.0).unwrap(),
+        }],
+    };
+    let ball = SystemSpec {
+        structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
+        dampers: vec![],
+        stops: vec![Stop {
+            at: 0.0,
+            side: Side::Lower,
+            gap: 1.0,
+            law: PairLaw::rigid(0.8).unwrap(),
+        }],
+        gravity: 9.81,
+        excitations: vec![],
+    };
+    // One run, for callgrind: the damper ("once") or the ball ("ball").
+    let one = match std::env::args().nth(1).as_deref() {
+        Some("once") => Some(run(&damper, 125.0)),
+        Some("ball") => Some(run(&ball, 6.0)),
+        _ => None,
+    };
+    if let Some(sol) = one {
+        println!(
+            "{} steps, {} evaluations, {} contacts; energy {:?}",
+            sol.steps,
+            sol.rhs_evaluations,
+            sol.contacts.len(),
+            sol.energy
+        );
+        return;
+    }
+    for (name, spec, t_end, repeats) in [
+        ("damper, 1000 periods", &damper, 125.0, 41),
+        ("ball", &ball, 6.0, 2001),
+    ] {
+        let mut last = None;
+        let times = (0..repeats)
+            .map(|_| {
+                let start = Instant::now();
+                let sol = run(spec, t_end);
+                let elapsed = start.elapsed().as_secs_f64();
+                last = Some(sol);
+                elapsed
+            })
+            .collect();
+        let sol = last.unwrap();
+        let t = median(times);
+        println!(
+            "{name}: {:.1} us per run; {} steps, {} evaluations, {} contacts, final {:?}",
+            t * 1e6,
+            sol.steps,
+            sol.rhs_evaluations,
+            sol.contacts.len(),
+            &sol.final_state
+        );
+    }
+}
