@@ -71,7 +71,7 @@ inside the step). It keeps ``peak`` (step ends and extrema located on the cubic 
 interpolant), ``rms`` (trapezoidal rule over the step ends) and ``impacts`` (contacts whose
 located onset is at or after ``record_from``). A run whose state stops being finite, or
 whose mechanical energy grows past its start by more than ``energy_tolerance``, fails with
-its reason.
+its reason; these are its only checks, looser than a single run's energy ledger.
 """
 
 from __future__ import annotations

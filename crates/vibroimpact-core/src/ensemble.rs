@@ -241,7 +241,12 @@ fn run_group<L: ContactLaw>(
     let first_kept = if options.record_from <= 0.0 {
         0
     } else {
-        ((options.record_from / dt).ceil() as u64).min(options.steps + 1)
+        // The first k with k dt >= record_from (the division may round up past it).
+        let mut k = (options.record_from / dt).ceil() as u64;
+        if k > 0 && (k - 1) as f64 * dt >= options.record_from {
+            k -= 1;
+        }
+        k.min(options.steps + 1)
     };
     let kept_steps = options.steps.saturating_sub(first_kept);
     if first_kept == 0 {

@@ -614,9 +614,14 @@ fn run_starts(
                         }
                     }
                     let run = match stepper {
-                        Ok(stepper) => measured_on(spec, &system, stepper, &start, settings),
+                        Ok(method) => measured_on(spec, &system, method, &start, settings),
                         Err(e) => Err(e.clone()),
                     };
+                    if run.is_err() {
+                        // A run stopped part way may leave work in the method
+                        // (the exact flow's pending energies): a fresh one next.
+                        *stepper = stepper_of(&system, settings);
+                    }
                     Ok(run.unwrap_or_else(|e| failed_run(spec, e.to_string())))
                 },
             )
@@ -674,7 +679,8 @@ fn measured_on(
             })
             .ok_or_else(|| {
                 Error::Inconsistent(
-                    "a steady-state study needs a harmonic excitation (its period)".to_string(),
+                    "a steady-state or orbit study needs a harmonic excitation (its period)"
+                        .to_string(),
                 )
             })
     };
@@ -771,7 +777,13 @@ fn orbit_metrics(
     };
     let mut run_from = |z: &[f64], options: &RunOptions| -> Result<SystemSolution> {
         let y = resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..2 * d]])?;
-        stepper.integrate(system, &y, options, &mut || false)
+        let run = stepper.integrate(system, &y, options, &mut || false);
+        if run.is_err() {
+            // A run stopped part way may leave work in the method (the exact
+            // flow's pending energies): the next starts with a fresh one.
+            *stepper = stepper_of(system, settings)?;
+        }
+        run
     };
     let shot = shooting::shoot(
         &mut |z| Ok(run_from(z, &span_options)?.final_state),
@@ -779,6 +791,14 @@ fn orbit_metrics(
         ORBIT_TOLERANCE,
         ORBIT_ITERATIONS,
     )?;
+    if !shot.converged {
+        return Err(Error::Inconsistent(format!(
+            "no orbit of {periods} forcing period(s) found near the settled state: Newton's \
+             method stopped after {} iterations at residual {:.1e} (settle longer, or look for \
+             an orbit of more periods)",
+            shot.iterations, shot.residual
+        )));
+    }
     z.clone_from(&shot.state);
     let multipliers = linalg::eigenvalues(&shot.monodromy, 2 * d).ok_or_else(|| {
         Error::Inconsistent("the orbit's Floquet multipliers did not converge".into())

@@ -162,8 +162,8 @@ fn free_oscillation_reductions_match_the_closed_form() {
         assert_eq!(whole.contacts, 0);
         assert!((whole.peak - amplitude).abs() < 1e-12 * amplitude);
         assert!((whole.rms - amplitude / 2f64.sqrt()).abs() < 1e-10 * amplitude);
-        // Steps of 2 pi / 20000 do not land on t = pi / 3 + k pi; the
-        // extremum at t = pi is located inside a step by the interpolant.
+        // From t = pi / 3 (not a step end) over the trough at t = pi (a step
+        // end here; the case below puts it inside a step).
         let later = run(std::f64::consts::PI / 3.0, 20_000);
         assert!((later.peak - amplitude).abs() < 1e-12 * amplitude);
         // The RMS from the first step end at or after pi / 3 to 2 pi: the
