@@ -1,8 +1,9 @@
-"""What the study tests share: a forced impact damper's scenario (rigid impacts) and a
-study loaded from scenario text."""
+"""What the study tests share: a forced impact damper's scenario (rigid impacts), a
+study loaded from scenario text, and the check of a refused study command."""
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import vibroimpact as vi
@@ -44,3 +45,14 @@ def load_study(path: Path, text: str) -> st.Study:
     sc = vi.load_scenario(path)
     assert isinstance(sc, SystemScenario)
     return st.study_of(sc.data, str(path), sc.base_dir)
+
+
+def assert_refused(done: subprocess.CompletedProcess[str], words: list[str], out: Path) -> None:
+    """A study command refused: exit 2, one line on stderr naming each of ``words``, no
+    traceback, and no ``out`` written."""
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert not out.exists()

@@ -373,33 +373,27 @@ fn advance<L: ContactLaw>(
     steps(lanes, tallies, models, n, stop, first_kept, options)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn advance_avx512<L: ContactLaw>(
-    lanes: &mut Lanes<L>,
-    tallies: &mut [Tally],
-    models: &[Model<L, Free>; LANES],
-    n: u64,
-    stop: u64,
-    first_kept: u64,
-    options: &EnsembleOptions,
-) {
-    steps(lanes, tallies, models, n, stop, first_kept, options)
+/// [`steps`] compiled for a processor feature (the same operations, so the
+/// same bits, in wider vector instructions).
+macro_rules! steps_with {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        unsafe fn $name<L: ContactLaw>(
+            lanes: &mut Lanes<L>,
+            tallies: &mut [Tally],
+            models: &[Model<L, Free>; LANES],
+            n: u64,
+            stop: u64,
+            first_kept: u64,
+            options: &EnsembleOptions,
+        ) {
+            steps(lanes, tallies, models, n, stop, first_kept, options)
+        }
+    };
 }
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn advance_avx2<L: ContactLaw>(
-    lanes: &mut Lanes<L>,
-    tallies: &mut [Tally],
-    models: &[Model<L, Free>; LANES],
-    n: u64,
-    stop: u64,
-    first_kept: u64,
-    options: &EnsembleOptions,
-) {
-    steps(lanes, tallies, models, n, stop, first_kept, options)
-}
+steps_with!(advance_avx512, "avx512f");
+steps_with!(advance_avx2, "avx2");
 
 /// The rates of every lane's state, `(w', w'', y', y'')`: the velocities and
 /// [`Model::accelerations`] of an unforced model, with the contact branch as

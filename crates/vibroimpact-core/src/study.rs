@@ -274,20 +274,26 @@ impl Parameter {
                     .map_err(|e| in_section(&section(), e))?;
                 *signal = recipe.generate().map_err(|e| in_section(&section(), e))?;
             }
-            Target::Initial(which, i) => {
-                let array = &mut initial[which];
-                let size = if which < 2 {
-                    spec.structure.dofs()
-                } else {
-                    spec.dampers.len()
-                };
-                if array.len() != size {
-                    array.resize(size, 0.0);
-                }
-                array[i] = value;
-            }
+            Target::Initial(..) => self.apply_start(spec, initial, value),
         }
         Ok(())
+    }
+
+    /// Set a start parameter (`initial.*`) to `value` in `initial`; the
+    /// system `spec` is only read (its sizes). Other parameters: nothing.
+    fn apply_start(&self, spec: &SystemSpec, initial: &mut [Vec<f64>; 4], value: f64) {
+        if let Target::Initial(which, i) = self.target {
+            let array = &mut initial[which];
+            let size = if which < 2 {
+                spec.structure.dofs()
+            } else {
+                spec.dampers.len()
+            };
+            if array.len() != size {
+                array.resize(size, 0.0);
+            }
+            array[i] = value;
+        }
     }
 }
 
@@ -603,15 +609,13 @@ fn run_starts(
                     if interrupt() {
                         return Err(Error::Interrupted { time: 0.0 });
                     }
+                    // Only the start changes: no copy of the system.
                     let mut start = initial.clone();
-                    let mut scratch = spec.clone();
                     for (p, v) in parameters
                         .iter()
                         .zip(&values[row * width..(row + 1) * width])
                     {
-                        if let Err(e) = p.apply(&mut scratch, &mut start, *v) {
-                            return Ok(failed_run(spec, e.to_string()));
-                        }
+                        p.apply_start(spec, &mut start, *v);
                     }
                     let run = match stepper {
                         Ok(method) => measured_on(spec, &system, method, &start, settings),
