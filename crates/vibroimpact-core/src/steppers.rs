@@ -7,6 +7,7 @@
 
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
+use crate::integrators::{rk4_step, LaggedContact, PaperNewmark};
 use crate::model::{Excitation, Mode, Model};
 use crate::system::State;
 use crate::tableau::*;
@@ -197,7 +198,8 @@ impl Tolerances {
     }
 }
 
-/// Classical fourth-order Runge-Kutta, fixed step.
+/// Classical fourth-order Runge-Kutta, fixed step: the fixed-step kernel's
+/// [`rk4_step`], with the non-conservative work integrated alongside.
 #[derive(Debug, Clone, Default)]
 pub struct Rk4Stepper {
     evaluations: u64,
@@ -225,12 +227,9 @@ impl Stepper for Rk4Stepper {
         h: f64,
         mode: Mode,
     ) -> Result<Attempt> {
-        let mut k = [[0.0; 5]; 4];
-        k[0] = derivative(model, time, y, mode);
-        stages(model, time, y, h, mode, &RK4_C, &RK4_A, &mut k);
         self.evaluations += 4;
         Ok(Attempt {
-            end: combine(y, h, &RK4_B, &k),
+            end: rk4_step(time, y, h, |t, p| derivative(model, t, p, mode)),
             error: 0.0,
         })
     }
@@ -500,15 +499,17 @@ impl<P: EmbeddedPair> Stepper for Adaptive<P> {
 /// Newmark-beta (average acceleration for 1/4, 1/2: second order, no
 /// numerical damping); Chung-Hulbert's generalised-alpha sets all four from
 /// the spectral radius at infinite frequency. With `lagged` the contact law's
-/// force is taken from the start of the step (the founding paper's method),
-/// leaving only the contact damper implicit.
+/// force is taken from the start of the step, leaving only the contact
+/// damper implicit: the founding paper's method, which the fixed-step kernel
+/// runs too, one implementation ([`PaperNewmark`]) for both.
 #[derive(Debug, Clone)]
 pub struct NewmarkFamily {
     pub alpha_m: f64,
     pub alpha_f: f64,
     pub beta: f64,
     pub gamma: f64,
-    pub lagged: bool,
+    /// The founding paper's lagged Newmark, which takes no Newton iteration.
+    paper: Option<PaperNewmark>,
     /// Accelerations at the current point and at the end of the last attempt.
     accel: (f64, f64),
     pending: (f64, f64),
@@ -530,7 +531,7 @@ impl NewmarkFamily {
             alpha_f: 0.0,
             beta,
             gamma,
-            lagged,
+            paper: lagged.then(|| PaperNewmark::new(beta, gamma)),
             accel: (0.0, 0.0),
             pending: (0.0, 0.0),
             losses: 0.0,
@@ -551,7 +552,7 @@ impl NewmarkFamily {
             alpha_f,
             beta,
             gamma,
-            lagged: false,
+            paper: None,
             accel: (0.0, 0.0),
             pending: (0.0, 0.0),
             losses: 0.0,
@@ -586,10 +587,64 @@ impl Stepper for NewmarkFamily {
         h: f64,
         mode: Mode,
     ) -> Result<Attempt> {
+        let (end_state, accel) = match &mut self.paper {
+            Some(paper) => {
+                paper.prepare(model, h);
+                let s0 = to_state(y);
+                let contact = match mode {
+                    Mode::Free => LaggedContact {
+                        side: 1.0,
+                        law_force: 0.0,
+                        in_contact: false,
+                    },
+                    Mode::Contact {
+                        side,
+                        approach_rate,
+                    } => LaggedContact {
+                        side,
+                        law_force: model.contact_at(&s0, side, approach_rate).law_force,
+                        in_contact: true,
+                    },
+                };
+                self.evaluations += 1;
+                paper.step(model, &s0, self.accel, time, h, contact)
+            }
+            None => self.newton(model, time, y, h, mode)?,
+        };
+        // Non-conservative work by the trapezoidal rule, second order like the
+        // method (the power at the start carried from the step before).
+        let power1 = model.losses_in(time + h, &end_state, mode);
+        self.pending = accel;
+        self.pending_losses = power1;
+        Ok(Attempt {
+            end: to_vector(&end_state, y[4] + 0.5 * h * (self.losses + power1)),
+            error: 0.0,
+        })
+    }
+
+    fn accept(&mut self) {
+        self.accel = self.pending;
+        self.losses = self.pending_losses;
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+}
+
+impl NewmarkFamily {
+    /// The new state and accelerations by Newton's method on the residual.
+    fn newton<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        time: f64,
+        y: &Vector,
+        h: f64,
+        mode: Mode,
+    ) -> Result<(State, (f64, f64))> {
         let (am, af, beta, gamma) = (self.alpha_m, self.alpha_f, self.beta, self.gamma);
         let (m_main, m_imp) = (model.main_mass, model.impact_mass);
         let (a0w, a0y) = self.accel;
-        let s0 = to_state(y);
         // Predictors: the parts of x_(n+1), v_(n+1) that do not depend on a_(n+1).
         let xw = y[0] + h * y[1] + h * h * (0.5 - beta) * a0w;
         let xy = y[2] + h * y[3] + h * h * (0.5 - beta) * a0y;
@@ -598,14 +653,6 @@ impl Stepper for NewmarkFamily {
         let (bx, gv) = (beta * h * h, gamma * h);
         let force_ext =
             (1.0 - af) * model.external_force(time + h) + af * model.external_force(time);
-        // The lagged law force: from the start of the step, not differentiated.
-        let lagged_force = match mode {
-            Mode::Contact {
-                side,
-                approach_rate,
-            } if self.lagged => model.contact_at(&s0, side, approach_rate).law_force,
-            _ => 0.0,
-        };
         let kx = (1.0 - af) * bx;
         let cv = (1.0 - af) * gv;
         // Residual of both equations at trial accelerations, with the slopes
@@ -626,9 +673,7 @@ impl Stepper for NewmarkFamily {
                     let indentation = side * (xfy - xfw) - model.clearance;
                     let rate = side * (vfy - vfw);
                     let c1 = model.contact_damping;
-                    if self.lagged {
-                        (side * (lagged_force + c1 * rate), 0.0, c1)
-                    } else if indentation > 0.0 {
+                    if indentation > 0.0 {
                         let (f, fd, fr) =
                             model
                                 .law
@@ -663,9 +708,9 @@ impl Stepper for NewmarkFamily {
         let (mut rw, mut ry, mut coupling, mut noise) = residual(aw, ay);
         self.evaluations += 1;
         let mut converged = false;
-        // Apart, and with the law's force lagged, the equations are linear in
-        // the new accelerations: one Newton update solves them exactly.
-        let linear = self.lagged || matches!(mode, Mode::Free);
+        // Apart, the equations are linear in the new accelerations: one
+        // Newton update solves them exactly.
+        let linear = matches!(mode, Mode::Free);
         for _ in 0..NEWTON_ITERATIONS {
             // Jacobian d(r)/d(a_(n+1)): symmetric 2x2.
             let j11 = (1.0 - am) * m_main + kx * model.stiffness + cv * model.damping + coupling;
@@ -729,24 +774,7 @@ impl Stepper for NewmarkFamily {
             impact_displacement: xy + bx * ay,
             impact_velocity: vy + gv * ay,
         };
-        // Non-conservative work by the trapezoidal rule, second order like the
-        // method (the power at the start carried from the step before).
-        let power1 = model.losses_in(time + h, &end_state, mode);
-        self.pending = (aw, ay);
-        self.pending_losses = power1;
-        Ok(Attempt {
-            end: to_vector(&end_state, y[4] + 0.5 * h * (self.losses + power1)),
-            error: 0.0,
-        })
-    }
-
-    fn accept(&mut self) {
-        self.accel = self.pending;
-        self.losses = self.pending_losses;
-    }
-
-    fn evaluations(&self) -> u64 {
-        self.evaluations
+        Ok((end_state, (aw, ay)))
     }
 }
 
