@@ -235,33 +235,28 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
         // No step count check: n_steps <= max_steps was checked up front.
 
         if open.is_none() {
-            // Free flight: the bodies apart, no history row and no check due
-            // before `bound`: the step alone, with the trapezoidal sum of the
-            // damper's work, until a step ends with |y - w| > d (or not finite:
-            // the comparison fails for NaN), which is handed to the full
-            // bookkeeping above, or the next step is one with bookkeeping.
+            // Free flight ([`free_flight`]) until the next step with
+            // bookkeeping: a history row or an energy check.
             let mut bound = ledger.next_due(n).min(n_steps);
             if keep {
                 bound = bound.min(n + until_kept);
             }
             let start = n;
-            while n + 1 < bound {
-                let t = t0 + n as f64 * dt;
-                // The provisional latch as above (not computed where the law
-                // ignores it).
-                let s1 = integrator.step(model, &s, t, dt, model.side(&s) * s.relative_velocity());
-                // Fails for NaN too: a state no longer finite goes to the checks.
-                let apart = s1.relative_displacement().abs() <= d;
-                if !apart {
-                    approach = model.side(&s) * s.relative_velocity();
-                    pending = Some(s1);
-                    break;
-                }
-                squares += s1.main_velocity * s1.main_velocity;
-                ledger.external_step(model, t, dt, &s, &s1);
-                s = s1;
-                n += 1;
-            }
+            let flight = Flight {
+                state: s,
+                steps: n,
+                squares,
+                pending: None,
+                approach,
+            };
+            let flight = free_flight(model, integrator, &mut ledger, flight, bound, t0, dt);
+            (s, n, squares, pending, approach) = (
+                flight.state,
+                flight.steps,
+                flight.squares,
+                flight.pending,
+                flight.approach,
+            );
             if keep {
                 until_kept -= n - start;
             }
@@ -291,6 +286,56 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
         energy_growth: ledger.growth(),
         energy_residual: ledger.residual(),
     })
+}
+
+/// Where a free flight stands: the state after `steps` steps, the sum of
+/// `w'^2` at the step ends, and, when it ended with the bodies closer than
+/// the clearance, that step's end (`pending`) with the latch from its start.
+struct Flight {
+    state: State,
+    steps: u64,
+    squares: f64,
+    pending: Option<State>,
+    approach: f64,
+}
+
+/// Free flight: the bodies apart, no history row and no check due before
+/// step `bound`: the step alone, with the trapezoidal sum of the damper's
+/// work, until a step ends with |y - w| > d (or not finite: the comparison
+/// fails for NaN), which is handed back to the full bookkeeping. A function
+/// of its own so that the state stays in registers (in the kernel it lives
+/// in memory, its address taken by the bookkeeping).
+#[inline(never)]
+fn free_flight<L: ContactLaw, X: Excitation, I: Integrator>(
+    model: &Model<L, X>,
+    integrator: &mut I,
+    ledger: &mut EnergyLedger,
+    mut flight: Flight,
+    bound: u64,
+    t0: f64,
+    dt: f64,
+) -> Flight {
+    let d = model.clearance;
+    let (mut s, mut n, mut squares) = (flight.state, flight.steps, flight.squares);
+    while n + 1 < bound {
+        let t = t0 + n as f64 * dt;
+        // The provisional latch (not computed where the law ignores it).
+        let latch = model.side(&s) * s.relative_velocity();
+        let s1 = integrator.step(model, &s, t, dt, latch);
+        // Fails for NaN too: a state no longer finite goes to the checks.
+        let apart = s1.relative_displacement().abs() <= d;
+        if !apart {
+            flight.pending = Some(s1);
+            flight.approach = latch;
+            break;
+        }
+        squares += s1.main_velocity * s1.main_velocity;
+        ledger.external_step(model, t, dt, &s, &s1);
+        s = s1;
+        n += 1;
+    }
+    (flight.state, flight.steps, flight.squares) = (s, n, squares);
+    flight
 }
 
 /// The non-conservative work outside the contact (main damper minus external
