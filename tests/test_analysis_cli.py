@@ -350,7 +350,33 @@ def test_orbit_needs_a_harmonic_excitation(run_cli: RunCli, tmp_path: Path) -> N
         ("frequency = 10.0", "start_frequency = 9.0\nend_frequency = 11.0"),
     )
     path = write(tmp_path, "swept.toml", swept)
-    assert_one_line_error(run_cli("orbit", str(path)), "needs a harmonic excitation")
+    assert_one_line_error(
+        run_cli("orbit", str(path)), "[[excitation]] 0 signal", "every excitation harmonic"
+    )
+
+
+@pytest.mark.parametrize(
+    ("second", "fragment"),
+    [
+        ('signal = "harmonic"\namplitude = 1.0\nfrequency = 15.0', "not a whole multiple"),
+        ('signal = "harmonic"\namplitude = 1.0\nfrequency = 20.0', None),
+        ('signal = "recorded"\ntime = [0.0, 1.0]\nvalue = [0.0, 1.0]', "every excitation harmonic"),
+    ],
+    ids=["harmonics with no common period", "a whole multiple", "a recorded force"],
+)
+def test_orbit_needs_forcing_with_a_period(
+    run_cli: RunCli, tmp_path: Path, second: str, fragment: str | None
+) -> None:
+    # The 10 Hz table plus a second force on the ball.
+    text = BALL_TABLE.read_text(encoding="utf-8")
+    head, tail = text.split("[solver]")
+    extra = f'[[excitation]]\nkind = "force"\nat = 0\n{second}\n\n'
+    path = write(tmp_path, "two.toml", head + extra + "[solver]" + tail)
+    done = run_cli("orbit", str(path))
+    if fragment is None:
+        assert done.returncode != 2, done.stderr
+    else:
+        assert_one_line_error(done, "[[excitation]] 1", fragment)
 
 
 @pytest.mark.parametrize(

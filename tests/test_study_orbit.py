@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
-from study_checks import FORCED_DAMPER, load_study  # noqa: E402
+from study_checks import FORCED_DAMPER, assert_refused, load_study  # noqa: E402
 from vibroimpact import study as st
 from vibroimpact.analyses import orbit, runner, with_parameter
 
@@ -114,3 +115,70 @@ def test_orbit_metrics_belong_to_the_orbit_analysis(tmp_path: Path) -> None:
         load(
             tmp_path, LINEAR.replace("settle_periods = 5", "settle_periods = 5\norbit_periods = 0")
         )
+
+
+SECOND_FORCE = """
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = {amplitude}
+frequency = {frequency}
+"""
+
+
+def with_second_force(text: str, amplitude: float, frequency: float) -> str:
+    """``text`` with a second harmonic force on the mass (after the first)."""
+    head, tail = text.split("[solver]")
+    return head + SECOND_FORCE.format(amplitude=amplitude, frequency=frequency) + "[solver]" + tail
+
+
+def test_two_harmonics_with_a_common_period_give_the_superposed_orbit(tmp_path: Path) -> None:
+    # 10 Hz and 20 Hz on the linear oscillator: the orbit is the sum of the two
+    # steady responses, its amplitude their sum's largest |x| over a period.
+    text = with_second_force(LINEAR, 3.0, 20.0).replace(
+        '"excitation.0.frequency" = [5.0, 9.5, 10.0, 12.0]', '"excitation.0.amplitude" = [5.0]'
+    )
+    ds = st.run(load(tmp_path, text), tmp_path / "out.nc")
+    assert int(ds["status"].max()) == 0
+    t = np.linspace(0.0, 0.1, 200_001)
+    x = np.zeros_like(t)
+    for force, frequency in ((F0, 10.0), (3.0, 20.0)):
+        w = 2 * math.pi * frequency
+        x += (force / (K - w * w * M + 1j * w * C) * np.exp(1j * w * t)).real
+    assert ds["amplitude"].values[0, 0] == pytest.approx(np.abs(x).max(), rel=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("second", "words"),
+    [
+        (SECOND_FORCE.format(amplitude=1.0, frequency=15.0), ["excitation 1", "15", "multiple"]),
+        (
+            '[[excitation]]\nkind = "base"\nsignal = "white-noise"\nintensity = 1e-4\n'
+            "cutoff_frequency = 50.0\nduration = 2.0\nseed = 1\n",
+            ["excitation 1", "harmonic", 'analysis = "run"'],
+        ),
+    ],
+    ids=["harmonics with no common period", "a random excitation"],
+)
+def test_an_orbit_study_of_forcing_with_no_period_is_refused(
+    tmp_path: Path, run_cli: Any, second: str, words: list[str]
+) -> None:
+    head, tail = LINEAR.split("[solver]")
+    path = tmp_path / "study.toml"
+    path.write_text(head + second + "[solver]" + tail)
+    out = tmp_path / "out.nc"
+    assert_refused(run_cli("study", str(path), "--out", str(out)), words, out)
+
+
+def test_a_point_an_axis_makes_aperiodic_fails_alone(tmp_path: Path) -> None:
+    # The second force at 20 Hz, then at 25 Hz: not a whole multiple of 10 Hz.
+    text = with_second_force(LINEAR, 1.0, 20.0).replace(
+        '"excitation.0.frequency" = [5.0, 9.5, 10.0, 12.0]',
+        '"excitation.1.frequency" = [20.0, 25.0]',
+    )
+    ds = st.run(load(tmp_path, text), tmp_path / "out.nc")
+    status = ds["status"].values
+    assert status[0] == 0 and status[1] > 0
+    assert "not a whole multiple" in str(ds.attrs["reasons"])
+    assert np.isnan(ds["amplitude"].values[1]).all()

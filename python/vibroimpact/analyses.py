@@ -47,20 +47,38 @@ class AnalysisError(InvalidInputError):
 
 
 def forcing_period(data: Mapping[str, Any]) -> float:
-    """The period (s) of the first harmonic excitation of a scenario's sections."""
+    """The forcing period (s) of a scenario's sections: the first excitation's, every
+    excitation harmonic at a whole multiple of its frequency (other forcing has no
+    period for a periodic analysis to use)."""
+    first: float | None = None
     for j, excitation in enumerate(data.get("excitation", ()) or ()):
-        if isinstance(excitation, Mapping) and excitation.get("signal") == "harmonic":
-            frequency = excitation.get("frequency")
-            if not isinstance(frequency, int | float) or not frequency > 0:
-                raise AnalysisError(
-                    f"[[excitation]] {j} frequency: must be > 0 Hz for a periodic analysis, "
-                    f"got {frequency!r}"
-                )
-            return 1.0 / float(frequency)
-    raise AnalysisError(
-        "a periodic analysis needs a harmonic excitation ([[excitation]] with "
-        'signal = "harmonic"): its period is the forcing period'
-    )
+        if not isinstance(excitation, Mapping) or excitation.get("signal") != "harmonic":
+            raise AnalysisError(
+                f"[[excitation]] {j} signal: a periodic analysis needs every excitation "
+                'harmonic (signal = "harmonic"; the forcing period); use simulate for '
+                "other signals"
+            )
+        frequency = excitation.get("frequency")
+        if not isinstance(frequency, int | float) or not frequency > 0:
+            raise AnalysisError(
+                f"[[excitation]] {j} frequency: must be > 0 Hz for a periodic analysis, "
+                f"got {frequency!r}"
+            )
+        if first is None:
+            first = float(frequency)
+            continue
+        ratio = frequency / first
+        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * ratio:
+            raise AnalysisError(
+                f"[[excitation]] {j} frequency: {frequency} Hz is not a whole multiple of "
+                f"excitation 0's {first} Hz, so the forcing has no period"
+            )
+    if first is None:
+        raise AnalysisError(
+            "a periodic analysis needs a harmonic excitation ([[excitation]] with "
+            'signal = "harmonic"): its period is the forcing period'
+        )
+    return 1.0 / first
 
 
 def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str, Any]:

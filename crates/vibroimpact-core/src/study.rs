@@ -392,6 +392,11 @@ pub fn run_study(
     threads: usize,
     interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<RunMetrics>> {
+    if !matches!(settings.analysis, Analysis::Run { .. }) {
+        // Refused up front on the base scenario; an axis may still make a
+        // point aperiodic, which then fails alone.
+        forcing_period(spec)?;
+    }
     let width = parameters.len().max(1);
     let rows = if parameters.is_empty() {
         1
@@ -433,6 +438,46 @@ pub fn run_study(
             .collect::<Vec<Result<RunMetrics>>>()
     });
     results.into_iter().collect()
+}
+
+/// The forcing period of a steady-state or orbit study, s: the first
+/// excitation's, every excitation harmonic at a whole multiple of its
+/// frequency. Any other forcing (random, recorded, swept, or harmonics with
+/// no common period) repeats with no period for the strobe or the shooting
+/// to use.
+fn forcing_period(spec: &SystemSpec) -> Result<f64> {
+    let mut first: Option<f64> = None;
+    for (j, excitation) in spec.excitations.iter().enumerate() {
+        let frequency = match &excitation.signal {
+            Signal::Harmonic(h) if h.frequency > 0.0 => h.frequency,
+            _ => {
+                return Err(Error::Inconsistent(format!(
+                    "excitation {j}: a steady-state or orbit study needs every excitation \
+                     harmonic with a frequency > 0 (the forcing period); use analysis = \"run\" \
+                     for other signals"
+                )))
+            }
+        };
+        match first {
+            None => first = Some(frequency),
+            Some(base) => {
+                let ratio = frequency / base;
+                let whole = ratio.round();
+                if whole < 1.0 || (ratio - whole).abs() > 1e-9 * ratio {
+                    return Err(Error::Inconsistent(format!(
+                        "excitation {j}: frequency {frequency} Hz is not a whole multiple of \
+                         excitation 0's {base} Hz, so the forcing has no period for a \
+                         steady-state or orbit study"
+                    )));
+                }
+            }
+        }
+    }
+    first.map(|f| 1.0 / f).ok_or_else(|| {
+        Error::Inconsistent(
+            "a steady-state or orbit study needs a harmonic excitation (its period)".to_string(),
+        )
+    })
 }
 
 /// The study's `rows` runs as a lockstep ensemble of fixed RK4 steps.
@@ -674,20 +719,7 @@ fn measured_on(
     settings: &StudySettings,
 ) -> Result<RunMetrics> {
     let y0 = initial_state(system, &initial[0], &initial[1], &initial[2], &initial[3])?;
-    let period = || {
-        spec.excitations
-            .iter()
-            .find_map(|e| match &e.signal {
-                Signal::Harmonic(h) if h.frequency > 0.0 => Some(1.0 / h.frequency),
-                _ => None,
-            })
-            .ok_or_else(|| {
-                Error::Inconsistent(
-                    "a steady-state or orbit study needs a harmonic excitation (its period)"
-                        .to_string(),
-                )
-            })
-    };
+    let period = || forcing_period(spec);
     let (t_end, record_from, strobe_period) = match settings.analysis {
         Analysis::Run { t_end, record_from } => (t_end, record_from, f64::INFINITY),
         Analysis::SteadyState { settle, record, .. } => {
