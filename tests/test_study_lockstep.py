@@ -124,6 +124,35 @@ def test_a_run_that_blows_up_fails_alone(tmp_path: Path) -> None:
     assert np.isnan(ds["peak"].values[:, 1]).all()
 
 
+def test_a_run_that_creates_energy_fails_alone(tmp_path: Path) -> None:
+    # A linear contact of 1e6 N/m on the 0.25 kg mass (2000 rad/s) at dt = 1e-2 s:
+    # RK4 is unstable across the contact, which rebounds with thousands of times the
+    # energy it met, and the run ends (0.5 s) before a second contact could overflow
+    # it: the check finds growth, not a state no longer finite. At 100 N/m
+    # (20 rad/s) the step is stable. The single-run kernel refuses the same run.
+    text = BASE.replace('law = "hertz"', 'law = "linear"').replace(
+        f"dt = {DT}", "dt = 1e-2"
+    ).replace(f"t_end = {T_END}", "t_end = 0.5") + STUDY.replace(
+        '"damper.0.clearance" = [0.005, 0.01, 0.02]', '"damper.0.stiffness" = [100.0, 1e6]'
+    )
+    ds = st.run(load(tmp_path, text), tmp_path / "out.nc")
+    status = ds["status"].values
+    assert (status[:, 0] == 0).all() and (status[:, 1] > 0).all()
+    reasons = json.loads(ds.attrs["reasons"])
+    assert reasons and all("energy created" in r for r in reasons), reasons
+    assert np.isnan(ds["peak"].values[:, 1]).all()
+    with pytest.raises(vi.EnergyBalanceError):
+        vi.simulate(
+            vi.ImpactDamper(main_mass=M, stiffness=K, damping=C, impact_mass=MD, clearance=D),
+            vi.Contact("linear", stiffness=1e6, damping=C1),
+            vi.InitialState(impact_velocity=0.1),
+            method="rk4",
+            stepping="fixed",
+            dt=1e-2,
+            t_end=0.5,
+        )
+
+
 @pytest.mark.parametrize(
     ("change", "words"),
     [
