@@ -11,7 +11,9 @@ A system is described by the same sections as a TOML scenario (SI units):
   (a coordinate index, or m along a cantilever) with ``clearance`` on each side or
   ``lower_clearance`` and ``upper_clearance`` (m), and a ``law``.
 - ``stop`` (a list): the point ``at`` hits a stop fixed to the base; ``side = "upper"``
-  keeps it at or below ``+gap``, ``"lower"`` at or above ``-gap`` (m); a ``law``.
+  keeps it at or below ``+gap``, ``"lower"`` at or above ``-gap`` (m); a ``law``. With
+  ``against`` (a second point) the stop is carried by that point instead, so that the
+  two pound on each other: ``"upper"`` keeps ``x_at - x_against <= gap``.
 - Laws: ``"rigid"`` (Newton's restitution ``restitution`` in [0, 1], located
   instantaneous impacts, chattering summed to its accumulation instant, then
   sticking) or a compliant law of :class:`vibroimpact.Contact` (``stiffness``,
@@ -93,7 +95,13 @@ _DAMPER = {
     "upper_clearance": (_NUMBER, None),
     **_LAW,
 }
-_STOP = {"at": (_NUMBER, _REQ), "side": (_TEXT, _REQ), "gap": (_NUMBER, _REQ), **_LAW}
+_STOP = {
+    "at": (_NUMBER, _REQ),
+    "side": (_TEXT, _REQ),
+    "gap": (_NUMBER, _REQ),
+    "against": (_NUMBER, None),
+    **_LAW,
+}
 _GRAVITY = {"acceleration": (_NUMBER, 9.81)}
 _EXCITATION = {
     "kind": (_TEXT, _REQ),

@@ -66,6 +66,7 @@ fn main() {
             side: Side::Lower,
             gap: 1.0,
             law: PairLaw::rigid(0.8).unwrap(),
+            against: None,
         }],
         gravity: 9.81,
         excitations: vec![],

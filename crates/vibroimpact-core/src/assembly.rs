@@ -74,14 +74,18 @@ impl Side {
     }
 }
 
-/// A stop fixed to the base that a point of the structure hits.
+/// A stop that a point of the structure hits: fixed to the base, or carried
+/// by another point of the structure (`against`: pounding between the two).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stop {
     pub at: f64,
     pub side: Side,
-    /// m (>= 0).
+    /// m (>= 0): how far `at` may move past the stop's position (the base's,
+    /// or `against`'s displacement).
     pub gap: f64,
     pub law: PairLaw,
+    /// The point carrying the stop; `None`: the base.
+    pub against: Option<f64>,
 }
 
 /// Where an excitation acts.
@@ -284,7 +288,22 @@ impl Assembly {
         for (j, stop) in spec.stops.iter().enumerate() {
             let name = format!("stop {j}");
             let gap = non_negative_named(&name, "gap", stop.gap)?;
-            let point = s.point(&format!("{name} at"), stop.at)?;
+            let mut point = s.point(&format!("{name} at"), stop.at)?;
+            if let Some(against) = stop.against {
+                // Pounding: the gap closes with the displacement of `at`
+                // relative to `against`'s.
+                let carrier = s.point(&format!("{name} against"), against)?;
+                for (p, c) in point.iter_mut().zip(&carrier) {
+                    *p -= c;
+                }
+                if point.iter().all(|p| *p == 0.0) {
+                    return Err(Error::Inconsistent(format!(
+                        "{name} against: {against} moves as at = {} does, so the gap between \
+                         them never changes: choose another point",
+                        stop.at
+                    )));
+                }
+            }
             let law = interaction_law(&name, &stop.law)?;
             let sign = match stop.side {
                 Side::Upper => -1.0,

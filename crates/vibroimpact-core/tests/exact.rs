@@ -190,6 +190,7 @@ fn ball_on_a_floor_accumulates_at_the_zeno_time_then_rests() {
             side: Side::Lower,
             gap: h,
             law: PairLaw::rigid(e).unwrap(),
+            against: None,
         });
         let sol = exact(
             &s,
@@ -288,6 +289,7 @@ fn refuses_what_it_cannot_integrate_exactly() {
             side: Side::Upper,
             gap: 0.01,
             law: PairLaw::Compliant(Contact::new(LawKind::Hertz, 1e7, None, 0.5).unwrap()),
+            against: None,
         });
         let mut swept = base.clone();
         swept.excitations.push(Excitation {

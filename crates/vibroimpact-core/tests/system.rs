@@ -201,6 +201,7 @@ fn ball(height: f64, restitution: f64) -> SystemSpec {
         side: Side::Lower,
         gap: height,
         law: PairLaw::rigid(restitution).unwrap(),
+        against: None,
     });
     s
 }

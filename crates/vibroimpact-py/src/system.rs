@@ -231,6 +231,7 @@ fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
             side: Side::parse(&side).map_err(named(&place))?,
             gap: get(d, &place, "gap")?,
             law: pair_law(d, &place)?,
+            against: optional(d, &place, "against")?,
         });
     }
     let mut excitations = Vec::new();
