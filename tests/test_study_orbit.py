@@ -6,6 +6,7 @@ exp(-zeta wn T), amplitude |F / (K - w^2 M + i w C)|), and against
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,7 @@ from study_checks import FORCED_DAMPER, assert_refused, load_study  # noqa: E402
 from vibroimpact import study as st
 from vibroimpact.analyses import orbit, runner, with_parameter
 
+ROOT = Path(__file__).resolve().parents[1]
 M, K, ZETA, F0 = 1.0, 3947.8, 0.02, 5.0
 WN = math.sqrt(K / M)
 C = 2 * ZETA * WN * M
@@ -182,3 +184,29 @@ def test_a_point_an_axis_makes_aperiodic_fails_alone(tmp_path: Path) -> None:
     assert status[0] == 0 and status[1] > 0
     assert "not a whole multiple" in str(ds.attrs["reasons"])
     assert np.isnan(ds["amplitude"].values[1]).all()
+
+
+def test_points_with_no_orbit_near_their_start_fail_with_newtons_reason(tmp_path: Path) -> None:
+    # Holmes's ball shot for from its scenario's start at once (no settling), over a
+    # range of table accelerations where most period-one orbits are far away or unstable:
+    # Newton's method fails at some points. Each such point fails alone with that
+    # reason (before, a Newton step deep inside the table failed the point as an
+    # "initial state inside its wall", a start the user never gave).
+    text = (ROOT / "examples" / "bouncing_ball_table.toml").read_text(encoding="utf-8")
+    text += """
+[study]
+analysis = "orbit"
+settle_periods = 0
+metrics = ["amplitude", "impacts_per_period", "stable", "largest_multiplier"]
+
+[study.axes]
+"excitation.0.amplitude" = { start = 5.0, stop = 60.0, count = 12 }
+"""
+    ds = st.run(load(tmp_path, text), tmp_path / "out.nc")
+    status = ds["status"].values
+    reasons = json.loads(ds.attrs["reasons"])
+    assert (status == 0).any() and (status > 0).any(), status
+    assert reasons and all("no orbit of 1 forcing period(s) found" in r for r in reasons), reasons
+    failed = status > 0
+    assert np.isnan(ds["largest_multiplier"].values[failed]).all()
+    assert np.isfinite(ds["largest_multiplier"].values[~failed]).all()

@@ -72,18 +72,25 @@ pub fn shoot(
         let mut step: Vec<f64> = (0..size).map(|i| z[i] - image[i]).collect();
         linalg::solve_in_place(&mut system, &mut step, size);
         let mut factor = 1.0;
-        loop {
+        let stalled = loop {
             let trial: Vec<f64> = z.iter().zip(&step).map(|(z, s)| z + factor * s).collect();
             maps += 1;
             match map(&trial) {
                 Ok(next) => {
                     z = trial;
                     image = next;
-                    break;
+                    break false;
                 }
                 Err(e) if refused(&e) && factor > 1e-6 => factor *= 0.5,
+                // Even a millionth of the step is inside a wall: the step is
+                // Newton's breakdown (a nearly singular I - J), not a start
+                // the user gave; the shooting stops, not converged.
+                Err(e) if refused(&e) => break true,
                 Err(e) => return Err(e),
             }
+        };
+        if stalled {
+            break;
         }
     }
     if !converged {
@@ -137,4 +144,46 @@ fn jacobian(
         }
     }
     Ok(jac)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `P(z) = 2 z + 1` has its fixed point at z = -1, where the "wall" z[0] >= 0
+    /// refuses to start: each Newton step from z >= 0 points inside it.
+    fn walled(z: &[f64]) -> Result<Vec<f64>> {
+        if z[0] < 0.0 {
+            return Err(Error::Inconsistent("inside the wall".into()));
+        }
+        Ok(z.iter().map(|z| 2.0 * z + 1.0).collect())
+    }
+
+    #[test]
+    fn a_newton_step_that_stays_inside_a_wall_ends_the_shooting_unconverged() {
+        crate::testing::timeout(60, || {
+            let shot = shoot(&mut walled, &[1.0, 1.0], 1e-10, 40).unwrap();
+            assert!(!shot.converged);
+            // Halved to the wall (z[0] = 0, to the halvings' resolution), where no
+            // fraction of the next step is admissible.
+            assert!((0.0..1e-5).contains(&shot.state[0]), "{}", shot.state[0]);
+            assert!(shot.iterations < 40, "{}", shot.iterations);
+        });
+    }
+
+    #[test]
+    fn an_admissible_fixed_point_is_found() {
+        crate::testing::timeout(60, || {
+            // P(z) = 2 z - 1, nothing refused: the fixed point z = 1.
+            let mut map =
+                |z: &[f64]| -> Result<Vec<f64>> { Ok(z.iter().map(|z| 2.0 * z - 1.0).collect()) };
+            let shot = shoot(&mut map, &[3.0, 0.5], 1e-12, 40).unwrap();
+            assert!(shot.converged);
+            for z in &shot.state {
+                assert!((z - 1.0).abs() < 1e-12, "{z}");
+            }
+            // The monodromy of a linear map is its matrix: 2 I.
+            assert!((shot.monodromy[0] - 2.0).abs() < 1e-9 && shot.monodromy[1].abs() < 1e-9);
+        });
+    }
 }
