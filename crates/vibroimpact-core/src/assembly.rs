@@ -471,7 +471,30 @@ impl Assembly {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        let (n, d) = (self.n, self.dim);
+        // The loops over the coordinates are short: with their length known
+        // at compile time they unroll, their bounds checks vanish.
+        macro_rules! sized {
+            ($($d:literal)*) => {
+                match self.dim {
+                    $($d => self.rates_sized::<$d>(time, y, modes, scratch, out),)*
+                    _ => self.rates_sized::<0>(time, y, modes, scratch, out),
+                }
+            };
+        }
+        sized!(1 2 3 4 5 6 7 8)
+    }
+
+    /// [`Self::rates`] for `D` coordinates (0: any number, `self.dim`).
+    #[inline(always)]
+    fn rates_sized<const D: usize>(
+        &self,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+    ) {
+        let (n, d) = (self.n, if D == 0 { self.dim } else { D });
         let (x, v) = (&y[..d], &y[d..2 * d]);
         let (velocity, rest) = out[..self.state_len()].split_at_mut(d);
         let (acc, rest) = rest.split_at_mut(d);
@@ -550,18 +573,28 @@ impl Assembly {
             input -= base * momentum;
         }
         let mut sticking = 0;
-        for (i, ((it, mode), loss)) in self
+        // `h . x`, `h . v` of the last interaction whose products were taken:
+        // a damper's second wall has the first's row negated (see `gaps`).
+        let mut products: Option<(f64, f64)> = None;
+        for (i, (((it, mode), loss), mirror)) in self
             .interactions
             .iter()
             .zip(modes)
             .zip(losses.iter_mut())
+            .zip(&self.mirrors_previous)
             .enumerate()
         {
             *loss = 0.0;
+            // Only the interaction just before may lend its products.
+            let previous = products.take();
             match (mode, &it.law) {
                 (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
                     let (approach_rate, damping) = (*approach_rate, *damping);
-                    let (hx, hv) = dots(&it.h, x, v);
+                    let (hx, hv) = match previous {
+                        Some((hx, hv)) if *mirror => (-hx, -hv),
+                        _ => dots(&it.h[..d], x, v),
+                    };
+                    products = Some((hx, hv));
                     let (indentation, rate) = (-(it.offset + hx), -hv);
                     let (force, elastic) = if indentation > 0.0 {
                         law.force_and_elastic(indentation, rate, approach_rate)
@@ -569,8 +602,11 @@ impl Assembly {
                         (0.0, 0.0)
                     };
                     let total = force + damping * rate;
-                    for (a, p) in acc.iter_mut().zip(&it.push) {
-                        *a += p * total;
+                    // Apart with no contact damper there is no force to add.
+                    if total != 0.0 {
+                        for (a, p) in acc.iter_mut().zip(&it.push[..d]) {
+                            *a += p * total;
+                        }
                     }
                     *loss = (total - elastic) * rate;
                 }
