@@ -18,6 +18,7 @@ use crate::records::{
     Records, Solution,
 };
 use crate::settings::Settings;
+use crate::step_control::{rejects, StepControl};
 use crate::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
 use crate::system::State;
 
@@ -209,12 +210,6 @@ fn find_crossing<L: ContactLaw, X: Excitation>(
             }
         }
     }
-}
-
-/// Whether the error control rejects a step (a NaN error too).
-#[inline(always)]
-fn rejects(error: f64) -> bool {
-    error.is_nan() || error > 1.0
 }
 
 /// What locating an event found.
@@ -520,7 +515,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
     };
     records.keep(time, initial, force(&y, mode))?;
 
-    let mut h = match settings.dt {
+    let mut control = StepControl::new(match settings.dt {
         Some(dt) => dt,
         None => {
             let first =
@@ -532,21 +527,17 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 Mode::Free => first,
             }
         }
-    };
+    });
     let mut grid_index: u64 = 0;
-    let (mut accepted, mut rejected, mut grazes) = (0u64, 0u64, 0u64);
+    let (mut accepted, mut grazes) = (0u64, 0u64);
     let mut until_kept = every;
     let (mut last_event, mut close_events) = (f64::NEG_INFINITY, 0u64);
-    // After a rejection the next step may not grow (Hairer's rule), which
-    // stops the controller from oscillating where the solution is rough,
-    // as it is near contact onset (F ~ delta^1.5).
-    let mut just_rejected = false;
 
     while time < t_end {
         let mut length = if fixed {
             t0 + (grid_index + 1) as f64 * dt - time
         } else {
-            h.min(t_end - time)
+            control.h.min(t_end - time)
         };
         if fixed && length <= 0.0 {
             grid_index += 1;
@@ -594,9 +585,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                     });
                 }
                 Location::Reject(shorter) => {
-                    rejected += 1;
-                    h = 0.9 * shorter;
-                    just_rejected = true;
+                    control.retry(0.9 * shorter);
                     continue;
                 }
                 // Not confirmed: the stepper must hold the full step again.
@@ -613,39 +602,22 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 }
             }
         }
-        if S::ADAPTIVE {
-            let error = attempt.error;
-            if rejects(error) {
-                rejected += 1;
-                let factor = if error.is_finite() {
-                    (0.9 * S::shrink(error)).clamp(0.1, 0.9)
-                } else {
-                    0.1
-                };
-                h = taken * factor;
-                just_rejected = true;
-                if h <= 16.0 * f64::EPSILON * time.abs().max(t_end) {
-                    return Err(Error::StepSizeTooSmall { time, step: h });
-                }
-                if accepted + rejected >= settings.max_steps {
-                    return Err(Error::TooManySteps {
-                        time,
-                        max_steps: settings.max_steps,
-                    });
-                }
-                continue;
-            }
-            let most = if just_rejected { 1.0 } else { 5.0 };
-            let factor = if error > 0.0 {
-                (0.9 * S::shrink(error)).clamp(0.2, most)
-            } else {
-                most
-            };
-            // A cut step says little about the step the solution allows.
-            if switch_to.is_none() {
-                h = taken * factor;
-            }
-            just_rejected = false;
+        // After a rejection the next step may not grow (Hairer's rule), which
+        // stops the controller from oscillating where the solution is rough,
+        // as it is near contact onset (F ~ delta^1.5).
+        if S::ADAPTIVE
+            && !control.judge(
+                attempt.error,
+                taken,
+                S::shrink,
+                switch_to.is_none(),
+                time,
+                t_end,
+                accepted,
+                settings.max_steps,
+            )?
+        {
+            continue;
         }
         let end = attempt.end;
         let switched = switch_to.is_some();
@@ -725,7 +697,9 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
             }
             stepper.reset(model, time, &y, mode);
             if let (true, Mode::Contact { approach_rate, .. }) = (S::ADAPTIVE, mode) {
-                h = h.min(ONSET_STEP_FRACTION * contact_time_scale(model, approach_rate));
+                control.h = control
+                    .h
+                    .min(ONSET_STEP_FRACTION * contact_time_scale(model, approach_rate));
             }
             if time - last_event < chatter_interval(time) {
                 close_events += 1;
@@ -760,7 +734,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
                 }
             }
         }
-        if !done && accepted + rejected >= settings.max_steps {
+        if !done && accepted + control.rejected >= settings.max_steps {
             return Err(Error::TooManySteps {
                 time,
                 max_steps: settings.max_steps,
@@ -777,7 +751,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
         history: records.history,
         contacts: records.contacts,
         steps: accepted,
-        rejected_steps: rejected,
+        rejected_steps: control.rejected,
         grazing_contacts: grazes,
         rhs_evaluations: stepper.evaluations(),
         final_time: time,

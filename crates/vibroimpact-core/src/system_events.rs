@@ -24,6 +24,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 use crate::error::{Error, Result};
 use crate::hermite;
 use crate::reductions::{self, ReduceOptions, Reductions};
+use crate::step_control::{rejects, StepControl};
 use crate::system_steppers::SystemStepper;
 
 /// How to run and what to keep.
@@ -135,12 +136,6 @@ struct Open {
     max_indentation: f64,
     /// The contact-loss accumulator at onset (compliant), or the loss so far.
     dissipated: f64,
-}
-
-/// Whether the error control rejects a step (a NaN error too).
-#[inline(always)]
-fn rejects(error: f64) -> bool {
-    error.is_nan() || error > 1.0
 }
 
 impl Open {
@@ -681,12 +676,11 @@ pub fn integrate_system<S: SystemStepper>(
         keep(0.0, &y, &mut time_rows, &mut states);
     }
     let mut time = 0.0;
-    let mut h = options.dt.unwrap_or(1e-6 * t_end);
+    let mut control = StepControl::new(options.dt.unwrap_or(1e-6 * t_end));
     let mut grid: u64 = 0;
-    let (mut accepted, mut rejected, mut grazes) = (0u64, 0u64, 0u64);
+    let (mut accepted, mut grazes) = (0u64, 0u64);
     let mut until_kept = options.every;
     let (mut last_event, mut close_events) = (f64::NEG_INFINITY, 0u64);
-    let mut just_rejected = false;
     let mut stalled = 0u64;
     // Interactions whose dip in this step was checked and stays open.
     let mut unconfirmed = vec![false; count];
@@ -704,7 +698,7 @@ pub fn integrate_system<S: SystemStepper>(
             break;
         }
         let mut length = if adaptive {
-            h.min(t_end - time)
+            control.h.min(t_end - time)
         } else {
             ((grid + 1) as f64 * dt - time)
                 .min(t_end - time)
@@ -771,9 +765,7 @@ pub fn integrate_system<S: SystemStepper>(
                 // A step that straddled an event may have been accepted for
                 // an error measured across it; the cut step must pass too.
                 Location::Cut(cut, cut_error) if adaptive && rejects(cut_error) => {
-                    rejected += 1;
-                    h = 0.5 * cut;
-                    just_rejected = true;
+                    control.retry(0.5 * cut);
                     switched = None;
                     crossing = None;
                     taken = f64::NAN;
@@ -812,9 +804,7 @@ pub fn integrate_system<S: SystemStepper>(
                     }
                 }
                 Location::Reject(shorter) => {
-                    rejected += 1;
-                    h = 0.9 * shorter;
-                    just_rejected = true;
+                    control.retry(0.9 * shorter);
                     switched = None;
                     crossing = None;
                     taken = f64::NAN;
@@ -855,35 +845,20 @@ pub fn integrate_system<S: SystemStepper>(
         if taken.is_nan() {
             continue;
         }
-        if adaptive && switched.is_none() {
-            if rejects(error) {
-                rejected += 1;
-                let factor = if error.is_finite() {
-                    (0.9 * stepper.shrink(error)).clamp(0.1, 0.9)
-                } else {
-                    0.1
-                };
-                h = taken * factor;
-                just_rejected = true;
-                if h <= 16.0 * f64::EPSILON * time.abs().max(t_end) {
-                    return Err(Error::StepSizeTooSmall { time, step: h });
-                }
-                if accepted + rejected >= options.max_steps {
-                    return Err(Error::TooManySteps {
-                        time,
-                        max_steps: options.max_steps,
-                    });
-                }
-                continue;
-            }
-            let most = if just_rejected { 1.0 } else { 5.0 };
-            let factor = if error > 0.0 {
-                (0.9 * stepper.shrink(error)).clamp(0.2, most)
-            } else {
-                most
-            };
-            h = taken * factor;
-            just_rejected = false;
+        if adaptive
+            && switched.is_none()
+            && !control.judge(
+                error,
+                taken,
+                |e| stepper.shrink(e),
+                true,
+                time,
+                t_end,
+                accepted,
+                options.max_steps,
+            )?
+        {
+            continue;
         }
         if end[..row].iter().any(|v| !v.is_finite()) {
             return Err(Error::NumericalBlowUp {
@@ -998,7 +973,7 @@ pub fn integrate_system<S: SystemStepper>(
                 );
                 stepper.reset();
                 if adaptive {
-                    h = h.min(1e-3 * t_end);
+                    control.h = control.h.min(1e-3 * t_end);
                 }
                 if time - last_event < chatter_interval(time) {
                     close_events += 1;
@@ -1068,7 +1043,7 @@ pub fn integrate_system<S: SystemStepper>(
                 time,
             )?;
         }
-        if !done && accepted + rejected >= options.max_steps {
+        if !done && accepted + control.rejected >= options.max_steps {
             return Err(Error::TooManySteps {
                 time,
                 max_steps: options.max_steps,
@@ -1104,7 +1079,7 @@ pub fn integrate_system<S: SystemStepper>(
         final_time: time,
         energy,
         steps: accepted,
-        rejected_steps: rejected,
+        rejected_steps: control.rejected,
         rhs_evaluations: stepper.evaluations(),
         grazing_contacts: grazes,
         reductions,
