@@ -16,6 +16,27 @@ use crate::linalg;
 use crate::signals::Signal;
 use crate::structure::Structure;
 
+/// `$receiver.$method::<D>(args)` with `D = $dim` for 1 to 8 coordinates, and
+/// `D = 0` (any number) beyond: the loops over the coordinates are short,
+/// and with their length known at compile time they unroll and their bounds
+/// checks vanish.
+macro_rules! sized_by_dim {
+    ($dim:expr, $method:ident, $receiver:expr, $($arg:expr),*) => {
+        match $dim {
+            1 => $receiver.$method::<1>($($arg),*),
+            2 => $receiver.$method::<2>($($arg),*),
+            3 => $receiver.$method::<3>($($arg),*),
+            4 => $receiver.$method::<4>($($arg),*),
+            5 => $receiver.$method::<5>($($arg),*),
+            6 => $receiver.$method::<6>($($arg),*),
+            7 => $receiver.$method::<7>($($arg),*),
+            8 => $receiver.$method::<8>($($arg),*),
+            _ => $receiver.$method::<0>($($arg),*),
+        }
+    };
+}
+pub(crate) use sized_by_dim;
+
 /// What happens when a gap closes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PairLaw {
@@ -442,7 +463,13 @@ impl Assembly {
     /// Every interaction's gap and its rate at state `y` into `out`, as
     /// [`Self::gap`] gives them (a damper's two walls share their products).
     pub fn gaps(&self, y: &[f64], out: &mut [(f64, f64)]) {
-        let d = self.dim;
+        sized_by_dim!(self.dim, gaps_sized, self, y, out)
+    }
+
+    /// [`Self::gaps`] for `D` coordinates (0: any number).
+    #[inline(always)]
+    fn gaps_sized<const D: usize>(&self, y: &[f64], out: &mut [(f64, f64)]) {
+        let d = if D == 0 { self.dim } else { D };
         let (x, v) = (&y[..d], &y[d..2 * d]);
         let mut products = (0.0, 0.0);
         for ((it, mirror), out) in self
@@ -454,7 +481,7 @@ impl Assembly {
             products = if *mirror {
                 (-products.0, -products.1)
             } else {
-                dots(&it.h, x, v)
+                dots(&it.h[..d], x, v)
             };
             *out = (it.offset + products.0, products.1);
         }
@@ -471,17 +498,7 @@ impl Assembly {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        // The loops over the coordinates are short: with their length known
-        // at compile time they unroll, their bounds checks vanish.
-        macro_rules! sized {
-            ($($d:literal)*) => {
-                match self.dim {
-                    $($d => self.rates_sized::<$d>(time, y, modes, scratch, out),)*
-                    _ => self.rates_sized::<0>(time, y, modes, scratch, out),
-                }
-            };
-        }
-        sized!(1 2 3 4 5 6 7 8)
+        sized_by_dim!(self.dim, rates_sized, self, time, y, modes, scratch, out)
     }
 
     /// [`Self::rates`] for `D` coordinates (0: any number, `self.dim`).

@@ -4,7 +4,7 @@
 //! One generic stepper over a Butcher tableau serves RK4 (fixed step),
 //! Dormand-Prince 5(4) and DOP853 (error control, first same as last).
 
-use crate::assembly::{Assembly, Mode, Scratch};
+use crate::assembly::{sized_by_dim, Assembly, Mode, Scratch};
 use crate::error::{Error, Result};
 use crate::linalg;
 use crate::tableau::*;
@@ -241,7 +241,7 @@ impl ExplicitRk {
     /// order, in one pass.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn rk4_stages(
+    fn rk4_stages<const D: usize>(
         &mut self,
         system: &Assembly,
         time: f64,
@@ -251,7 +251,8 @@ impl ExplicitRk {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        let coordinates = 2 * system.dim;
+        // `D` coordinates (0: any number), for loops of a known length.
+        let coordinates = 2 * if D == 0 { system.dim } else { D };
         let len = out.len();
         let times = [0, 1, 2, 3].map(|i| if i == 0 { time } else { time + self.c[i] * h });
         // Each stage's one nonzero weight, on the stage before.
@@ -316,7 +317,7 @@ impl SystemStepper for ExplicitRk {
     ) -> Result<f64> {
         let s = self.stages;
         if self.rk4 {
-            self.rk4_stages(system, time, y, h, modes, scratch, out);
+            sized_by_dim!(system.dim, rk4_stages, self, system, time, y, h, modes, scratch, out);
             self.end_slot = None;
             return Ok(0.0);
         }
