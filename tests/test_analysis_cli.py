@@ -351,18 +351,27 @@ def test_orbit_needs_a_harmonic_excitation(run_cli: RunCli, tmp_path: Path) -> N
     )
     path = write(tmp_path, "swept.toml", swept)
     assert_one_line_error(
-        run_cli("orbit", str(path)), "[[excitation]] 0 signal", "every excitation harmonic"
+        run_cli("orbit", str(path)), 'excitation 0: a "sweep" signal has no period'
     )
 
 
 @pytest.mark.parametrize(
     ("second", "fragment"),
     [
-        ('signal = "harmonic"\namplitude = 1.0\nfrequency = 15.0', "not a whole multiple"),
-        ('signal = "harmonic"\namplitude = 1.0\nfrequency = 20.0', None),
-        ('signal = "recorded"\ntime = [0.0, 1.0]\nvalue = [0.0, 1.0]', "every excitation harmonic"),
+        (
+            'signal = "harmonic"\namplitude = 1.0\nfrequency = 14.142135623730951',
+            "has no common period with 10",
+        ),
+        ('signal = "harmonic"\namplitude = 1.0\nfrequency = 15.0', None),
+        ('signal = "harmonics"\namplitudes = [1.0, 0.5]\nfrequencies = [0.0, 20.0]', None),
+        ('signal = "recorded"\ntime = [0.0, 1.0]\nvalue = [0.0, 1.0]', '"recorded" signal has no'),
     ],
-    ids=["harmonics with no common period", "a whole multiple", "a recorded force"],
+    ids=[
+        "10 Hz and 10 sqrt(2) Hz: no common period",
+        "10 Hz and 15 Hz: a period of 0.2 s",
+        "a constant and 20 Hz beside 10 Hz",
+        "a recorded force",
+    ],
 )
 def test_orbit_needs_forcing_with_a_period(
     run_cli: RunCli, tmp_path: Path, second: str, fragment: str | None
@@ -372,11 +381,16 @@ def test_orbit_needs_forcing_with_a_period(
     head, tail = text.split("[solver]")
     extra = f'[[excitation]]\nkind = "force"\nat = 0\n{second}\n\n'
     path = write(tmp_path, "two.toml", head + extra + "[solver]" + tail)
-    done = run_cli("orbit", str(path))
+    done = run_cli("orbit", str(path), "--json")
     if fragment is None:
-        assert done.returncode != 2, done.stderr
+        assert done.returncode == 0, done.stderr
+        out = json.loads(done.stdout)
+        # The common period: 1 / 5 Hz with 15 Hz beside 10 Hz, else 1 / 10 Hz.
+        expected = 0.2 if "15.0" in second else 0.1
+        assert out["forcing_period"] == pytest.approx(expected, rel=1e-12)
+        assert "converged" in out
     else:
-        assert_one_line_error(done, "[[excitation]] 1", fragment)
+        assert_one_line_error(done, "excitation 1", fragment)
 
 
 @pytest.mark.parametrize(

@@ -157,6 +157,25 @@ def test_two_points_pounding_rigidly_follow_the_impact_law(method: str) -> None:
     assert sol.contacts.energy_dissipated[0] == pytest.approx(lost, rel=1e-12)
 
 
+def test_pounding_on_the_lower_side_closes_when_at_falls_below_against() -> None:
+    # side = "lower" keeps x_0 - x_1 >= -gap: closing as x_0 falls behind at 1.5 m/s.
+    e, gap = 0.6, 0.01
+    sol = simulate_system(
+        FREE_PAIR,
+        stop=[
+            {"at": 0, "against": 1, "side": "lower", "gap": gap, "law": "rigid", "restitution": e}
+        ],
+        initial={"structure_velocity": [-1.0, 0.5]},
+        t_end=0.05,
+        method="exact",
+    )
+    v = sol.final_state["structure_velocity"]
+    assert len(sol.contacts) == 1
+    assert sol.contacts.onset[0] == pytest.approx(gap / 1.5, rel=1e-12)
+    assert v[0] - v[1] == pytest.approx(e * 1.5, rel=1e-12)
+    assert 1.0 * v[0] + 3.0 * v[1] == pytest.approx(-1.0 + 1.5, abs=1e-12)
+
+
 def test_two_points_pounding_through_a_linear_law_last_half_a_period() -> None:
     # A linear contact of k between the free masses: half a period of the reduced mass,
     # pi sqrt(mu / k), indentation v sqrt(mu / k) at most, elastic (e = 1).
@@ -578,6 +597,15 @@ def test_values_nested_thousands_deep_are_invalid_input() -> None:
         )
 
 
+# An aluminium cantilever, 0.5 m long, 2 % damping in every mode.
+BEAM = {
+    "kind": "cantilever",
+    "length": 0.5,
+    "youngs_modulus": 7e10,
+    "second_moment": 1e-10,
+    "mass_per_length": 0.27,
+    "damping_ratio": 0.02,
+}
 EVERY_KIND = {
     "compliant damper, force": {
         "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 400.0, "damping": 0.5},
@@ -602,15 +630,7 @@ EVERY_KIND = {
         "excitation": [{"kind": "base", "signal": "harmonic", "amplitude": 20.0, "frequency": 3.0}],
     },
     "beam with a linear stop, two harmonics": {
-        "structure": {
-            "kind": "cantilever",
-            "length": 0.5,
-            "youngs_modulus": 7e10,
-            "second_moment": 1e-10,
-            "mass_per_length": 0.27,
-            "modes": 2,
-            "damping_ratio": 0.02,
-        },
+        "structure": BEAM | {"modes": 2},
         "stop": [{"at": 0.5, "side": "upper", "gap": 5e-4, "law": "linear", "stiffness": 2e4}],
         "excitation": [
             {
@@ -649,6 +669,22 @@ EVERY_KIND = {
         ],
         "excitation": [{"kind": "base", "signal": "harmonic", "amplitude": 20.0, "frequency": 3.0}],
     },
+    "beam tip pounding on mid-span (m along the beam)": {
+        "structure": BEAM | {"modes": 3},
+        "stop": [
+            {
+                "at": 0.5,
+                "against": 0.25,
+                "side": "upper",
+                "gap": 2e-4,
+                "law": "linear",
+                "stiffness": 1e4,
+            }
+        ],
+        "excitation": [
+            {"kind": "force", "at": 0.5, "signal": "harmonic", "amplitude": 0.5, "frequency": 8.0}
+        ],
+    },
 }
 # Each method at settings where it is accurate: (settings, tolerance on the end state
 # relative to its size, tolerance on the energy residual relative to the energies).
@@ -678,3 +714,52 @@ def test_every_method_gives_the_same_run_and_closes_its_energy_balance(kind: str
         e = sol.energy
         scale = abs(e["input_work"]) + e["dissipated"] + abs(e["stored_end"])
         assert abs(e["residual"]) < energy_tolerance * scale, (method, e)
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853"])
+def test_a_constant_force_as_a_0_hz_harmonic_does_its_work(method: str) -> None:
+    # A step force F0 on a damped oscillator from rest: x = F0/k (1 - e^(-z w t) (cos wd t +
+    # z / sqrt(1 - z^2) sin wd t)), and the force's work is F0 x (the exact flow used to
+    # count a 0 Hz force as a potential, like gravity, and failed its energy balance).
+    m, k, c, force, t = 0.05, 100.0, 0.01, 0.1, 0.5
+    w = math.sqrt(k / m)
+    zeta = c / (2 * math.sqrt(k * m))
+    wd = w * math.sqrt(1 - zeta * zeta)
+    decay = math.exp(-zeta * w * t)
+    x = (
+        force
+        / k
+        * (1 - decay * (math.cos(wd * t) + zeta / math.sqrt(1 - zeta**2) * math.sin(wd * t)))
+    )
+    settings = {"rtol": 1e-12, "atol": 1e-15} if method == "dop853" else {}
+    sol = simulate_system(
+        {"kind": "oscillator", "mass": m, "stiffness": k, "damping": c},
+        excitation=[
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": force, "frequency": 0.0}
+        ],
+        t_end=t,
+        method=method,
+        **settings,
+    )
+    assert sol.final_state["structure_displacement"][0] == pytest.approx(x, rel=1e-9)
+    assert sol.energy["input_work"] == pytest.approx(force * x, rel=1e-9)
+    assert abs(sol.energy["residual"]) < 1e-12 * sol.energy["input_work"]
+
+
+@pytest.mark.parametrize(("first", "second"), [(5.0, 15.0), (15.0, 5.0), (7.0, 15.0)])
+def test_the_exact_flow_takes_the_work_of_every_harmonic(first: float, second: float) -> None:
+    # Two harmonic forces at different frequencies on a damped oscillator: the exact flow's
+    # input work against DOP853 at rtol 1e-12 (its quadrature once took the first
+    # harmonic's power with the rates of the harmonics before it only, and 5 + 15 Hz
+    # failed its energy balance).
+    structure = {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513}
+    excitation = [
+        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 5.0, "frequency": first},
+        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": second},
+    ]
+    exact = simulate_system(structure, excitation=excitation, t_end=2.0, method="exact")
+    ref = simulate_system(
+        structure, excitation=excitation, t_end=2.0, method="dop853", rtol=1e-12, atol=1e-15
+    )
+    assert exact.energy["input_work"] == pytest.approx(ref.energy["input_work"], rel=1e-9)
+    assert abs(exact.energy["residual"]) < 1e-12 * exact.energy["input_work"]

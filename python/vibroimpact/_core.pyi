@@ -314,6 +314,9 @@ def check_solver(
     energy_tolerance: float | None = None,
     history: bool = True,
 ) -> None: ...
+
+# Internal: the periodic analyses' rule, public as vibroimpact.analyses.forcing_period.
+def _forcing_period(excitations: list[tuple[str, list[float] | None]]) -> float: ...
 def hertz_stiffness(
     radius: float,
     youngs_modulus: float,

@@ -1,8 +1,9 @@
 """Forced-response analyses of 0.2 systems: steady state, frequency response sweeps
 and periodic orbits with their Floquet multipliers.
 
-Every analysis runs whole periods ``T`` of the first harmonic excitation (the
-forcing is T-periodic, so a run of whole periods may restart its clock at 0) on
+Every analysis runs whole periods ``T`` of the forcing (the common period of its
+harmonics, :func:`forcing_period`; the forcing is T-periodic, so a run of whole periods
+may restart its clock at 0) on
 the core's event-driven kernel with the scenario's method; ``method = "exact"``
 (linear structure, rigid pairs, harmonic forcing) is exact between impacts and the
 fastest. Peaks are located by the kernel (where a velocity changes sign, or at an
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import InvalidInputError, PreparedSystem
+from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.system import (
     _NUMBER,
     _REQ,
@@ -47,38 +49,33 @@ class AnalysisError(InvalidInputError):
 
 
 def forcing_period(data: Mapping[str, Any]) -> float:
-    """The forcing period (s) of a scenario's sections: the first excitation's, every
-    excitation harmonic at a whole multiple of its frequency (other forcing has no
-    period for a periodic analysis to use)."""
-    first: float | None = None
-    for j, excitation in enumerate(data.get("excitation", ()) or ()):
-        if not isinstance(excitation, Mapping) or excitation.get("signal") != "harmonic":
-            raise AnalysisError(
-                f"[[excitation]] {j} signal: a periodic analysis needs every excitation "
-                'harmonic (signal = "harmonic"; the forcing period); use simulate for '
-                "other signals"
-            )
-        frequency = excitation.get("frequency")
-        if not isinstance(frequency, int | float) or not frequency > 0:
-            raise AnalysisError(
-                f"[[excitation]] {j} frequency: must be > 0 Hz for a periodic analysis, "
-                f"got {frequency!r}"
-            )
-        if first is None:
-            first = float(frequency)
+    """The forcing period (s) of a scenario's sections: every excitation a sum of
+    harmonics (``"harmonic"``, ``"harmonics"``; 0 Hz terms are constant), the period
+    ``1 / f0`` of the highest ``f0`` of which every frequency is a whole multiple (10 and
+    15 Hz: 0.2 s). The core's rule, the one studies apply."""
+    parts: list[tuple[str, list[float] | None]] = []
+    for excitation in data.get("excitation", ()) or ():
+        table = excitation if isinstance(excitation, Mapping) else {}
+        signal = str(table.get("signal"))
+        given: list[Any]
+        if signal == "harmonic":
+            given = [table.get("frequency")]
+        elif signal == "harmonics":
+            given = list(table.get("frequencies") or [])
+        else:
+            parts.append((signal, None))
             continue
-        ratio = frequency / first
-        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * ratio:
+        frequencies = [f for f in given if isinstance(f, int | float) and not isinstance(f, bool)]
+        if len(frequencies) != len(given):
             raise AnalysisError(
-                f"[[excitation]] {j} frequency: {frequency} Hz is not a whole multiple of "
-                f"excitation 0's {first} Hz, so the forcing has no period"
+                f"excitation {len(parts)}: frequencies must be numbers (Hz) for a periodic "
+                f"analysis, got {given!r:.60}"
             )
-    if first is None:
-        raise AnalysisError(
-            "a periodic analysis needs a harmonic excitation ([[excitation]] with "
-            'signal = "harmonic"): its period is the forcing period'
-        )
-    return 1.0 / first
+        parts.append((signal, [float(f) for f in frequencies]))
+    try:
+        return _core_forcing_period(parts)
+    except InvalidInputError as err:
+        raise AnalysisError(str(err)) from None
 
 
 def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str, Any]:

@@ -35,8 +35,9 @@ def add_commands(sub: Any) -> None:
         "orbit",
         help="shoot for a periodic orbit of a forced 0.2 scenario, with its stability",
         description=(
-            "Newton's method on the stroboscopic map over K periods of the first harmonic "
-            "excitation, from the scenario's [initial] state: prints whether it converged, "
+            "Newton's method on the stroboscopic map over K forcing periods (the common "
+            "period of the harmonic excitations), from the scenario's [initial] state: "
+            "prints whether it converged, "
             "the state on the orbit at t = 0 (the four arrays of [initial], SI), the Floquet "
             "multipliers (eigenvalues of the monodromy matrix, by finite differences through "
             "the impacts), stability, impacts per forcing period and the amplitude (largest "

@@ -138,7 +138,9 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
     if key == "stiffness" and section in ("damper", "stop"):
         law = entry.get("law")
         return "N m-1" if law == "linear" else "N m-1.5" if law in _HERTZ_LAWS else None
-    if key == "at" and section in ("damper", "stop", "excitation"):
+    if (key == "at" and section in ("damper", "stop", "excitation")) or (
+        key == "against" and section == "stop"
+    ):
         structure = data.get("structure")
         if isinstance(structure, Mapping):
             return _M if structure.get("kind") == "cantilever" else _ONE

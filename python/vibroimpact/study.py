@@ -59,9 +59,9 @@ central-difference monodromy, as :func:`vibroimpact.analyses.orbit`, in the core
 is 1 when it converged and every Floquet multiplier is inside the unit circle,
 ``largest_multiplier`` the largest multiplier's modulus, ``amplitude`` and
 ``impacts_per_period`` those of the orbit. A point whose shooting fails (no orbit near its
-settled state) is recorded with its reason. Both periodic analyses need every excitation
-harmonic at a whole multiple of the first's frequency (the forcing period is the first's):
-other forcing is refused, and a point an axis makes aperiodic fails with its reason.
+settled state) is recorded with its reason. Both periodic analyses use the common period
+of the excitations (see :func:`vibroimpact.analyses.forcing_period`): other forcing is
+refused, and a point an axis makes aperiodic fails with its reason.
 
 ``stepping = "fixed"`` runs a study of the two-mass impact damper (one mass on a spring,
 one ``[[damper]]`` with equal clearances and a compliant law, no stops, gravity or

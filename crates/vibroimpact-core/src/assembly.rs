@@ -1,6 +1,7 @@
 //! A 0.2 system: a structure, loose masses (dampers) rattling against its
-//! points, stops fixed to the base, gravity and excitations; assembled into
-//! the plain data the kernel integrates.
+//! points, stops fixed to the base or carried by another point (pounding),
+//! gravity and excitations; assembled into the plain data the kernel
+//! integrates.
 //!
 //! Coordinates `x = (q, z)`: the structure's `q` (n) and the dampers'
 //! displacements `z` (k), all relative to the base. Each wall of a pair is an

@@ -716,7 +716,8 @@ impl ExactFlow {
                 let (pqr, pqi) = (pr * qr - pi * qi, pr * qi + pi * qr);
                 work += 0.5 * h * (pr * qr + pi * qi) + 0.5 * (pqr * er - pqi * ei) * sin_turn / w;
             }
-            input += work;
+            // A constant the excitations drive works on the mode too.
+            input += work + cfg.driven[j] * (eta1 - eta0);
             if o.c > 0.0 {
                 let (de, dr) = (eta1 - eta0, rate1 - rate0);
                 let stored = 0.5 * dr * (rate1 + rate0) + 0.5 * o.w2 * de * (eta1 + eta0);
@@ -776,18 +777,29 @@ impl ExactFlow {
             let (ec, es) = self.node_modes[nodes * j + k];
             self.rate[j] = ec * r0 - es * (o.sigma * r0 + o.w2 * d0) + o.steady(t).1;
         }
-        let mut input = 0.0;
-        for (n, (h, (s0, c0))) in cfg.harmonics.iter().zip(&self.phasors).enumerate() {
+        // The rates take every harmonic's particular part before any
+        // harmonic's power is taken from them.
+        let turned = |n: usize, (s0, c0): (f64, f64)| {
             let (st, ct) = self.node_turns[nodes * n + k];
-            let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
+            (s0 * ct + c0 * st, c0 * ct - s0 * st)
+        };
+        for (n, (h, phasor)) in cfg.harmonics.iter().zip(&self.phasors).enumerate() {
+            let (s, c) = turned(n, *phasor);
             for j in 0..r {
                 let (zr, zi) = h.response[j];
                 self.rate[j] -= h.omega * (zr * s + zi * c);
             }
+        }
+        let mut input = 0.0;
+        for (n, (h, phasor)) in cfg.harmonics.iter().zip(&self.phasors).enumerate() {
+            let (s, c) = turned(n, *phasor);
             for j in 0..r {
                 let (pr, pi) = h.force[j];
                 input += (pr * c - pi * s) * self.rate[j];
             }
+        }
+        for j in 0..r {
+            input += cfg.driven[j] * self.rate[j];
         }
         // Mass-normalised modes with classical damping: the viscous power is
         // the sum of each mode's.

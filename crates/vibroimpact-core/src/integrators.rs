@@ -36,6 +36,8 @@ pub trait Integrator {
 /// The one RK4 of the two-mass system, for the fixed-step kernel ([`Rk4`])
 /// and the event-driven one ([`crate::steppers::Rk4Stepper`]) alike;
 /// `ensemble.rs` repeats these operations lane by lane (tested bit for bit).
+/// Systems of any size step with `system_steppers::ExplicitRk` on slices
+/// (the same tableau, summed as the other explicit methods are).
 #[inline(always)]
 pub fn rk4_step<const N: usize>(
     time: f64,
@@ -274,6 +276,8 @@ impl Integrator for Newmark {
         dt: f64,
         approach_rate: f64,
     ) {
+        // Made afresh: the integrator may be started again for another model.
+        self.method.dt = f64::NAN;
         self.method.prepare(model, dt);
         // Initial accelerations from the full equations of motion.
         self.accel = model.accelerations(time, s, approach_rate);

@@ -42,6 +42,9 @@ pub struct Configuration {
     pub damping: Vec<f64>,
     /// Each mode's constant force per unit modal mass, `F0`.
     pub constant: Vec<f64>,
+    /// The part of `constant` excitations drive (0 Hz harmonics): its work
+    /// is input, where gravity's and the stops' preloads are potential.
+    pub driven: Vec<f64>,
     pub harmonics: Vec<ModalHarmonic>,
 }
 
@@ -56,6 +59,7 @@ impl Configuration {
             stiffness: Vec::new(),
             damping: Vec::new(),
             constant: Vec::new(),
+            driven: Vec::new(),
             harmonics: Vec::new(),
         }
     }
@@ -198,11 +202,14 @@ impl Configuration {
         let mut constant = project(&static_load);
         let damping: Vec<f64> = (0..r).map(|i| cm[i * r + i].max(0.0)).collect();
         let mut harmonics: Vec<ModalHarmonic> = Vec::new();
+        let mut driven = vec![0.0; r];
         for load in &parts.harmonics {
             let shape = project(&load.shape);
             if load.omega == 0.0 {
-                for (c, s) in constant.iter_mut().zip(&shape) {
-                    *c += load.amplitude * load.phase.cos() * s;
+                for ((c, d), s) in constant.iter_mut().zip(&mut driven).zip(&shape) {
+                    let force = load.amplitude * load.phase.cos() * s;
+                    *c += force;
+                    *d += force;
                 }
                 continue;
             }
@@ -258,6 +265,7 @@ impl Configuration {
             stiffness: values,
             damping,
             constant,
+            driven,
             harmonics,
         }))
     }

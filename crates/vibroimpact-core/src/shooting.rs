@@ -19,6 +19,8 @@ pub struct Shot {
     pub residual: f64,
     /// Maps evaluated.
     pub maps: usize,
+    /// Why the last Newton step was given up (every fraction of it refused).
+    pub refusal: Option<String>,
 }
 
 /// A start the map refuses (inside a wall) is a bad Newton step, not a failure.
@@ -56,6 +58,7 @@ pub fn shoot(
             .fold(0.0f64, f64::max)
     };
     let (mut residual, mut converged, mut iterations) = (f64::INFINITY, false, 0);
+    let mut refusal = None;
     while iterations < max_iterations {
         iterations += 1;
         let scale = scales(&z, &image);
@@ -85,7 +88,10 @@ pub fn shoot(
                 // Even a millionth of the step is inside a wall: the step is
                 // Newton's breakdown (a nearly singular I - J), not a start
                 // the user gave; the shooting stops, not converged.
-                Err(e) if refused(&e) => break true,
+                Err(e) if refused(&e) => {
+                    refusal = Some(e.to_string());
+                    break true;
+                }
                 Err(e) => return Err(e),
             }
         };
@@ -107,6 +113,7 @@ pub fn shoot(
         iterations,
         residual,
         maps,
+        refusal,
     })
 }
 

@@ -218,7 +218,70 @@ impl Recipe {
     }
 }
 
+/// How many times below the lowest forcing frequency a common fundamental is
+/// looked for (20 and 30 Hz: 10 Hz, twice below).
+const MAX_SUBHARMONIC: u32 = 64;
+
+/// The period (s) of forcing that sums harmonics: `1 / f0` for the highest
+/// `f0` of which every frequency is a whole multiple (found at most
+/// [`MAX_SUBHARMONIC`] times below the lowest; 0 Hz terms, constant, fit any
+/// period). `excitations` gives, per excitation, its signal's name and its
+/// harmonic frequencies (Hz; `None` for a signal that is not a sum of
+/// harmonics). The periodic analyses' rule, one place for all of them.
+pub fn common_period(excitations: &[(&str, Option<Vec<f64>>)]) -> Result<f64> {
+    let mut all = Vec::new();
+    for (j, (name, frequencies)) in excitations.iter().enumerate() {
+        let Some(frequencies) = frequencies else {
+            return Err(Error::Inconsistent(format!(
+                "excitation {j}: a {name:?} signal has no period; a periodic analysis needs \
+                 harmonic forcing (\"harmonic\" or \"harmonics\"), or use simulate"
+            )));
+        };
+        all.extend(frequencies.iter().filter(|f| **f > 0.0).map(|f| (j, *f)));
+    }
+    let lowest = all.iter().map(|(_, f)| *f).fold(f64::INFINITY, f64::min);
+    if !lowest.is_finite() {
+        return Err(Error::Inconsistent(
+            "a periodic analysis needs a harmonic excitation (signal = \"harmonic\" with a \
+             frequency > 0): its period is the forcing period"
+                .to_string(),
+        ));
+    }
+    let whole = |ratio: f64| (ratio - ratio.round()).abs() <= 1e-9 * ratio;
+    for k in 1..=MAX_SUBHARMONIC {
+        let fundamental = lowest / f64::from(k);
+        if all.iter().all(|(_, f)| whole(f / fundamental)) {
+            return Ok(1.0 / fundamental);
+        }
+    }
+    let (j, f) = all
+        .iter()
+        .find(|(_, f)| !whole(f / lowest))
+        .copied()
+        .unwrap_or((0, lowest));
+    Err(Error::Inconsistent(format!(
+        "excitation {j}: frequency {f} Hz has no common period with {lowest} Hz (none within \
+         {MAX_SUBHARMONIC} periods of the lowest frequency), so the forcing has no period for \
+         a periodic analysis"
+    )))
+}
+
 impl Signal {
+    /// The signal's name (as in a scenario) and, for a sum of harmonics,
+    /// their frequencies (Hz): what [`common_period`] takes.
+    pub fn harmonic_frequencies(&self) -> (&'static str, Option<Vec<f64>>) {
+        match self {
+            Self::Harmonic(h) => ("harmonic", Some(vec![h.frequency])),
+            Self::Harmonics(list) => (
+                "harmonics",
+                Some(list.iter().map(|h| h.frequency).collect()),
+            ),
+            Self::Sweep { .. } => ("sweep", None),
+            Self::Recorded { .. } => ("recorded", None),
+            Self::Sampled { recipe, .. } => (recipe.as_ref().map_or("sampled", |r| r.name()), None),
+        }
+    }
+
     /// One harmonic, `amplitude cos(2 pi frequency t + phase)`.
     pub fn harmonic(amplitude: f64, frequency: f64, phase: f64) -> Result<Self> {
         Harmonic::new(amplitude, frequency, phase).map(Self::Harmonic)

@@ -440,44 +440,15 @@ pub fn run_study(
     results.into_iter().collect()
 }
 
-/// The forcing period of a steady-state or orbit study, s: the first
-/// excitation's, every excitation harmonic at a whole multiple of its
-/// frequency. Any other forcing (random, recorded, swept, or harmonics with
-/// no common period) repeats with no period for the strobe or the shooting
-/// to use.
+/// The forcing period of a steady-state or orbit study, s (see
+/// [`crate::signals::common_period`]).
 fn forcing_period(spec: &SystemSpec) -> Result<f64> {
-    let mut first: Option<f64> = None;
-    for (j, excitation) in spec.excitations.iter().enumerate() {
-        let frequency = match &excitation.signal {
-            Signal::Harmonic(h) if h.frequency > 0.0 => h.frequency,
-            _ => {
-                return Err(Error::Inconsistent(format!(
-                    "excitation {j}: a steady-state or orbit study needs every excitation \
-                     harmonic with a frequency > 0 (the forcing period); use analysis = \"run\" \
-                     for other signals"
-                )))
-            }
-        };
-        match first {
-            None => first = Some(frequency),
-            Some(base) => {
-                let ratio = frequency / base;
-                let whole = ratio.round();
-                if whole < 1.0 || (ratio - whole).abs() > 1e-9 * ratio {
-                    return Err(Error::Inconsistent(format!(
-                        "excitation {j}: frequency {frequency} Hz is not a whole multiple of \
-                         excitation 0's {base} Hz, so the forcing has no period for a \
-                         steady-state or orbit study"
-                    )));
-                }
-            }
-        }
-    }
-    first.map(|f| 1.0 / f).ok_or_else(|| {
-        Error::Inconsistent(
-            "a steady-state or orbit study needs a harmonic excitation (its period)".to_string(),
-        )
-    })
+    let parts: Vec<_> = spec
+        .excitations
+        .iter()
+        .map(|e| e.signal.harmonic_frequencies())
+        .collect();
+    crate::signals::common_period(&parts)
 }
 
 /// The study's `rows` runs as a lockstep ensemble of fixed RK4 steps.
@@ -828,10 +799,14 @@ fn orbit_metrics(
         ORBIT_ITERATIONS,
     )?;
     if !shot.converged {
+        let refused = shot
+            .refusal
+            .map(|r| format!("; its last step was refused: {r}"))
+            .unwrap_or_default();
         return Err(Error::Inconsistent(format!(
             "no orbit of {periods} forcing period(s) found near the settled state: Newton's \
-             method stopped after {} iterations at residual {:.1e} (settle longer, or look for \
-             an orbit of more periods)",
+             method stopped after {} iterations at residual {:.1e}{refused} (settle longer, or \
+             look for an orbit of more periods)",
             shot.iterations, shot.residual
         )));
     }

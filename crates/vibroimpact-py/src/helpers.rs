@@ -1,7 +1,7 @@
 //! Closed forms, materials and beam modes: plain functions of their arguments.
 
 use pyo3::prelude::*;
-use vibroimpact_core::{beam, closed_forms, materials};
+use vibroimpact_core::{beam, closed_forms, materials, signals};
 
 use crate::convert::*;
 use crate::errors::*;
@@ -30,6 +30,19 @@ pub(crate) fn hertz_stiffness(
         poisson_ratio: other_poisson_ratio,
     };
     materials::hertz_stiffness(radius, &a, &b, other_radius).map_err(to_py)
+}
+
+/// The forcing period (s) of excitations given as (signal name, harmonic
+/// frequencies in Hz or ``None``): the periodic analyses' rule (see the core's
+/// ``signals::common_period``); raises ``InvalidInputError`` naming the
+/// excitation that has no period.
+#[pyfunction]
+pub(crate) fn forcing_period(excitations: Vec<(String, Option<Vec<f64>>)>) -> PyResult<f64> {
+    let parts: Vec<(&str, Option<Vec<f64>>)> = excitations
+        .iter()
+        .map(|(name, frequencies)| (name.as_str(), frequencies.clone()))
+        .collect();
+    signals::common_period(&parts).map_err(to_py)
 }
 
 /// One cantilever mode reduced to a single degree of freedom (see
