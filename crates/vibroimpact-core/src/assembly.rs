@@ -14,6 +14,7 @@ use crate::contact::{AnyLaw, Contact, ContactLaw};
 use crate::error::{finite, non_negative, positive, within, Error, Result};
 use crate::linalg;
 use crate::signals::Signal;
+use crate::sized::by_size;
 use crate::structure::Structure;
 
 /// What happens when a gap closes.
@@ -423,7 +424,12 @@ impl Assembly {
     /// Every interaction's gap and its rate at state `y` into `out`, as
     /// [`Self::gap`] gives them (a damper's two walls share their products).
     pub fn gaps(&self, y: &[f64], out: &mut [(f64, f64)]) {
-        let d = self.dim;
+        by_size!(self, |n, k| self.gaps_in(n + k, y, out))
+    }
+
+    /// [`Self::gaps`] over `d` coordinates (a constant where inlined).
+    #[inline(always)]
+    pub(crate) fn gaps_in(&self, d: usize, y: &[f64], out: &mut [(f64, f64)]) {
         let (x, v) = (&y[..d], &y[d..2 * d]);
         let mut products = (0.0, 0.0);
         for ((it, mirror), out) in self
@@ -435,7 +441,7 @@ impl Assembly {
             products = if *mirror {
                 (-products.0, -products.1)
             } else {
-                dots(&it.h, x, v)
+                dots(&it.h[..d], x, v)
             };
             *out = (it.offset + products.0, products.1);
         }
@@ -452,9 +458,29 @@ impl Assembly {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        let (n, d) = (self.n, self.dim);
+        by_size!(self, |n, k| self
+            .rates_in(n, k, time, y, modes, scratch, out))
+    }
+
+    /// [`Self::rates`] for `n` structure coordinates and `k` dampers: inlined
+    /// where they are constants, every slice then has a length known at
+    /// compile time (loops unrolled, no bounds checks).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn rates_in(
+        &self,
+        n: usize,
+        k: usize,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+    ) {
+        let d = n + k;
+        let count = self.interactions.len();
         let (x, v) = (&y[..d], &y[d..2 * d]);
-        let (velocity, rest) = out[..self.state_len()].split_at_mut(d);
+        let (velocity, rest) = out[..2 * d + CONTACT + count].split_at_mut(d);
         let (acc, rest) = rest.split_at_mut(d);
         let (head, losses) = rest.split_at_mut(CONTACT);
         let mut base = 0.0;
@@ -503,9 +529,9 @@ impl Assembly {
                     - linalg::dot(&self.minv_c[row], &v[..n])
                     - self.influence[i] * inertial;
             }
-            (linalg::quadratic_form(&self.damping, &v[..n]), 0)
+            (linalg::quadratic_form(&self.damping[..n * n], &v[..n]), 0)
         };
-        for ((a, o), v) in acc[n..].iter_mut().zip(&mut velocity[n..]).zip(&v[n..]) {
+        for ((a, o), v) in acc[n..d].iter_mut().zip(&mut velocity[n..d]).zip(&v[n..d]) {
             *o = *v;
             *a = -inertial;
         }
@@ -514,18 +540,17 @@ impl Assembly {
             .zip(&mut scratch.force_values[fused..])
         {
             let value = cache.value(&f.signal, time);
-            for (a, p) in acc[..n].iter_mut().zip(&f.push) {
+            for (a, p) in acc[..n].iter_mut().zip(&f.push[..n]) {
                 *a += p * value;
             }
-            input += value * linalg::dot(&f.row, &v[..n]);
+            input += value * linalg::dot(&f.row[..n], &v[..n]);
         }
         if base != 0.0 {
             // The work of the inertial load -M r a of the base signals.
-            let momentum = linalg::dot(&self.mass_influence, &v[..n])
-                + self
-                    .damper_mass
+            let momentum = linalg::dot(&self.mass_influence[..n], &v[..n])
+                + self.damper_mass[..k]
                     .iter()
-                    .zip(&v[n..])
+                    .zip(&v[n..d])
                     .map(|(m, v)| m * v)
                     .sum::<f64>();
             input -= base * momentum;
@@ -534,7 +559,7 @@ impl Assembly {
         for (i, ((it, mode), loss)) in self
             .interactions
             .iter()
-            .zip(modes)
+            .zip(&modes[..count])
             .zip(losses.iter_mut())
             .enumerate()
         {
@@ -542,7 +567,7 @@ impl Assembly {
             match (mode, &it.law) {
                 (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
                     let (approach_rate, damping) = (*approach_rate, *damping);
-                    let (hx, hv) = dots(&it.h, x, v);
+                    let (hx, hv) = dots(&it.h[..d], x, v);
                     let (indentation, rate) = (-(it.offset + hx), -hv);
                     let (force, elastic) = if indentation > 0.0 {
                         law.force_and_elastic(indentation, rate, approach_rate)
@@ -550,7 +575,7 @@ impl Assembly {
                         (0.0, 0.0)
                     };
                     let total = force + damping * rate;
-                    for (a, p) in acc.iter_mut().zip(&it.push) {
+                    for (a, p) in acc.iter_mut().zip(&it.push[..d]) {
                         *a += p * total;
                     }
                     *loss = (total - elastic) * rate;
@@ -562,6 +587,18 @@ impl Assembly {
                 _ => {}
             }
         }
+        if sticking > 0 {
+            self.add_constraint_forces(sticking, acc, scratch);
+        }
+        scratch.count = sticking;
+        head[VISCOUS] = viscous;
+        head[INPUT] = input;
+    }
+
+    /// The constraint forces of the `sticking` interactions listed in
+    /// `scratch` into it and onto the accelerations (out of line: rare).
+    #[inline(never)]
+    fn add_constraint_forces(&self, sticking: usize, acc: &mut [f64], scratch: &mut Scratch) {
         if sticking == 1 {
             // One constraint: W lambda = -h . a with W = h M^-1 h^T, what
             // the elimination below gives for one row.
@@ -571,7 +608,7 @@ impl Assembly {
             for (a, p) in acc.iter_mut().zip(&it.push) {
                 *a += p * lambda;
             }
-        } else if sticking > 1 {
+        } else {
             self.constraint_forces(
                 &scratch.sticking[..sticking],
                 acc,
@@ -585,9 +622,6 @@ impl Assembly {
                 }
             }
         }
-        scratch.count = sticking;
-        head[VISCOUS] = viscous;
-        head[INPUT] = input;
     }
 
     /// The Jacobians of the accelerations (the middle `dim` rates) with

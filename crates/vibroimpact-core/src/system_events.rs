@@ -391,6 +391,26 @@ fn find_crossing(
     best
 }
 
+/// Whether [`find_crossing`] may find anything in the step whose `gaps` are
+/// given: a cheap test of every interaction that passes all those it could
+/// report (and some it will not), so that most steps skip it. A value ending
+/// on its wall's far side, or one whose rate turns from towards the wall to
+/// away (the dip test's `m0 < 0 < m1`: the rates' signs, which the step's
+/// length multiplies), or a sticking pair.
+#[inline(always)]
+fn may_cross(gaps: &Gaps, modes: &[Mode]) -> bool {
+    let mut any = false;
+    for ((start, end), mode) in gaps.start.iter().zip(&gaps.end).zip(modes) {
+        let ((_, r0), (g1, r1)) = (*start, *end);
+        any |= match mode {
+            Mode::Open => g1 < 0.0 || (r0 < 0.0 && r1 > 0.0),
+            Mode::Compliant { .. } => g1 > 0.0 || (r0 > 0.0 && r1 < 0.0),
+            Mode::Sticking => true,
+        };
+    }
+    any
+}
+
 /// The root `dt` near `-v / slope` of `v + slope dt + second dt^2 / 2 +
 /// third dt^3 / 6` (a value's Taylor polynomial about a trial): Newton's
 /// method on the polynomial from the tangent's root. Its error is that of the
@@ -736,19 +756,23 @@ pub fn integrate_system<S: SystemStepper>(
             unconfirmed.iter_mut().for_each(|u| *u = false);
             any_unconfirmed = false;
         }
-        let mut crossing = find_crossing(
-            system,
-            time,
-            &gaps,
-            &end,
-            length,
-            &modes,
-            graze,
-            &mut grazes,
-            &mut scratch,
-            &mut buffers.work,
-            &unconfirmed,
-        );
+        let mut crossing = if may_cross(&gaps, &modes) {
+            find_crossing(
+                system,
+                time,
+                &gaps,
+                &end,
+                length,
+                &modes,
+                graze,
+                &mut grazes,
+                &mut scratch,
+                &mut buffers.work,
+                &unconfirmed,
+            )
+        } else {
+            None
+        };
         // An event inside the step: locate it; another interaction that
         // turns out to have crossed before it is located in its turn.
         let mut rounds = 0;
