@@ -391,6 +391,11 @@ fn find_crossing(
     best
 }
 
+/// Whether any interaction is in a compliant contact.
+fn any_compliant(modes: &[Mode]) -> bool {
+    modes.iter().any(|m| matches!(m, Mode::Compliant { .. }))
+}
+
 /// Whether [`find_crossing`] may find anything in the step whose `gaps` are
 /// given: a cheap test of every interaction that passes all those it could
 /// report (and some it will not), so that most steps skip it. A value ending
@@ -711,6 +716,8 @@ pub fn integrate_system<S: SystemStepper>(
     // Interactions whose dip in this step was checked and stays open.
     let mut unconfirmed = vec![false; count];
     let mut any_unconfirmed = false;
+    // Whether a compliant contact is on (modes change only at events).
+    let mut compliant = any_compliant(&modes);
     let mut reductions = Reductions {
         peaks: vec![0.0; system.n],
         square_integrals: vec![0.0; system.n],
@@ -918,16 +925,18 @@ pub fn integrate_system<S: SystemStepper>(
             });
         }
         // Deepest indentation of each compliant contact within the step.
-        for (i, record) in open.iter_mut().enumerate() {
-            if let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), modes[i]) {
-                let ((g0, r0), (g1, r1)) = (gaps.start[i], gaps.end[i]);
-                let (m0, m1) = (r0 * taken, r1 * taken);
-                let mut deepest = -g1;
-                if m0 < 0.0 && m1 > 0.0 {
-                    let theta = cubic_argmax(-g0, -g1, -m0, -m1);
-                    deepest = deepest.max(hermite::eval(-g0, -g1, -m0, -m1, theta).0);
+        if compliant {
+            for (i, record) in open.iter_mut().enumerate() {
+                if let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), modes[i]) {
+                    let ((g0, r0), (g1, r1)) = (gaps.start[i], gaps.end[i]);
+                    let (m0, m1) = (r0 * taken, r1 * taken);
+                    let mut deepest = -g1;
+                    if m0 < 0.0 && m1 > 0.0 {
+                        let theta = cubic_argmax(-g0, -g1, -m0, -m1);
+                        deepest = deepest.max(hermite::eval(-g0, -g1, -m0, -m1, theta).0);
+                    }
+                    oc.max_indentation = oc.max_indentation.max(deepest);
                 }
-                oc.max_indentation = oc.max_indentation.max(deepest);
             }
         }
         if time >= options.reduce.record_from {
@@ -1042,6 +1051,7 @@ pub fn integrate_system<S: SystemStepper>(
             }
             // Impacts change the velocities.
             system.gaps(&y, &mut gaps.start);
+            compliant = any_compliant(&modes);
         }
 
         if time >= next_strobe - 1e-9 * options.reduce.strobe_period {
