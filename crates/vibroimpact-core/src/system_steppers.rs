@@ -133,10 +133,13 @@ pub struct ExplicitRk {
 #[inline(always)]
 fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], k: &[Vec<f64>]) {
     let mut first = true;
+    let (len, y) = (out.len(), &y[..out.len()]);
     for (weight, kj) in weights.iter().zip(k) {
         if *weight == 0.0 {
             continue;
         }
+        // Slices of the one length: a constant one unrolls.
+        let kj = &kj[..len];
         let hw = h * weight;
         if first {
             for ((o, y), k) in out.iter_mut().zip(y).zip(kj) {
@@ -317,6 +320,47 @@ impl ExplicitRk {
             out[e] = y[e] + w[0] * k0[e] + w[1] * k1[e] + w[2] * k2[e] + w[3] * k3[e];
         }
     }
+
+    /// The stages of a step `h` from `(time, y)` by the tableau, for `n`
+    /// structure coordinates and `k` dampers (constants where `by_size`
+    /// fixes them), the right-hand side inlined once in the loop.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn tableau_stages(
+        &mut self,
+        system: &Assembly,
+        n: usize,
+        k: usize,
+        time: f64,
+        y: &[f64],
+        h: f64,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        let s = self.stages;
+        // The stages' points need the coordinates and velocities only: the
+        // rates do not depend on the energy accumulators.
+        let coordinates = 2 * (n + k);
+        let parts = system.rates_parts(n, k);
+        let first = if self.start_valid { 1 } else { 0 };
+        for i in first..s {
+            let at = if i == 0 {
+                y
+            } else {
+                // y + h sum_j a_ij k_j over the nonzero weights only, the
+                // first term written over y (no copy), each pass a straight
+                // vector loop.
+                let row = &self.a[i * s..i * s + i];
+                let point = &mut self.point[..coordinates];
+                combine(point, &y[..coordinates], h, row, &self.k);
+                point
+            };
+            let time = if i == 0 { time } else { time + self.c[i] * h };
+            system.rates_with(&parts, time, at, modes, scratch, &mut self.k[i]);
+        }
+        self.evaluations += (s - first) as u64;
+        self.start_valid = true;
+    }
 }
 
 impl SystemStepper for ExplicitRk {
@@ -351,34 +395,9 @@ impl SystemStepper for ExplicitRk {
             self.end_slot = None;
             return Ok(0.0);
         }
-        if !self.start_valid {
-            system.rates(time, y, modes, scratch, &mut self.k[0]);
-            self.evaluations += 1;
-            self.start_valid = true;
-        }
-        // The stages' points need the coordinates and velocities only: the
-        // rates do not depend on the energy accumulators.
+        by_size!(system, |n, k| self
+            .tableau_stages(system, n, k, time, y, h, modes, scratch));
         let coordinates = 2 * system.dim;
-        for i in 1..s {
-            // y + h sum_j a_ij k_j over the nonzero weights only, the first
-            // term written over y (no copy), each pass a straight vector loop.
-            let row = &self.a[i * s..i * s + i];
-            combine(
-                &mut self.point[..coordinates],
-                &y[..coordinates],
-                h,
-                row,
-                &self.k,
-            );
-            system.rates(
-                time + self.c[i] * h,
-                &self.point,
-                modes,
-                scratch,
-                &mut self.k[i],
-            );
-            self.evaluations += 1;
-        }
         combine(out, y, h, &self.b, &self.k);
         let scale = |n: usize| self.atol + self.rtol * y[n].abs().max(out[n].abs());
         Ok(match &self.estimate {
