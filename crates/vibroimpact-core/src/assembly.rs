@@ -15,28 +15,8 @@ use crate::contact::{AnyLaw, Contact, ContactLaw};
 use crate::error::{finite, non_negative, positive, within, Error, Result};
 use crate::linalg;
 use crate::signals::Signal;
+use crate::sized::by_size;
 use crate::structure::Structure;
-
-/// `$receiver.$method::<D>(args)` with `D = $dim` for 1 to 8 coordinates, and
-/// `D = 0` (any number) beyond: the loops over the coordinates are short,
-/// and with their length known at compile time they unroll and their bounds
-/// checks vanish.
-macro_rules! sized_by_dim {
-    ($dim:expr, $method:ident, $receiver:expr, $($arg:expr),*) => {
-        match $dim {
-            1 => $receiver.$method::<1>($($arg),*),
-            2 => $receiver.$method::<2>($($arg),*),
-            3 => $receiver.$method::<3>($($arg),*),
-            4 => $receiver.$method::<4>($($arg),*),
-            5 => $receiver.$method::<5>($($arg),*),
-            6 => $receiver.$method::<6>($($arg),*),
-            7 => $receiver.$method::<7>($($arg),*),
-            8 => $receiver.$method::<8>($($arg),*),
-            _ => $receiver.$method::<0>($($arg),*),
-        }
-    };
-}
-pub(crate) use sized_by_dim;
 
 /// What happens when a gap closes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -214,6 +194,26 @@ pub struct Assembly {
     pub energy_floor: f64,
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
+}
+
+/// What [`Assembly::rates_with`] reads of the system, cut to the sizes `n`
+/// (structure coordinates) and `k` (dampers).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RatesParts<'a> {
+    n: usize,
+    k: usize,
+    /// `[M^-1 K, M^-1 C, C, r]` of each structure coordinate, for modal ones.
+    diagonals: Option<&'a [[f64; 4]]>,
+    /// The first force, added in the pass over modal coordinates: its
+    /// signal, push and row.
+    first: Option<(&'a Signal, &'a [f64], &'a [f64])>,
+    /// How many forces that pass adds (0 or 1), and whether there are more.
+    fused: usize,
+    unfused: bool,
+    /// Whether there are base signals.
+    base: bool,
+    interactions: &'a [Interaction],
+    gravity: f64,
 }
 
 /// Accumulators after the coordinates and velocities in the state vector:
@@ -464,13 +464,12 @@ impl Assembly {
     /// Every interaction's gap and its rate at state `y` into `out`, as
     /// [`Self::gap`] gives them (a damper's two walls share their products).
     pub fn gaps(&self, y: &[f64], out: &mut [(f64, f64)]) {
-        sized_by_dim!(self.dim, gaps_sized, self, y, out)
+        by_size!(self, |n, k| self.gaps_in(n + k, y, out))
     }
 
-    /// [`Self::gaps`] for `D` coordinates (0: any number).
+    /// [`Self::gaps`] over `d` coordinates (a constant where inlined).
     #[inline(always)]
-    fn gaps_sized<const D: usize>(&self, y: &[f64], out: &mut [(f64, f64)]) {
-        let d = if D == 0 { self.dim } else { D };
+    pub(crate) fn gaps_in(&self, d: usize, y: &[f64], out: &mut [(f64, f64)]) {
         let (x, v) = (&y[..d], &y[d..2 * d]);
         let mut products = (0.0, 0.0);
         for ((it, mirror), out) in self
@@ -499,43 +498,95 @@ impl Assembly {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        sized_by_dim!(self.dim, rates_sized, self, time, y, modes, scratch, out)
+        by_size!(self, |n, k| self
+            .rates_in(n, k, time, y, modes, scratch, out))
     }
 
-    /// [`Self::rates`] for `D` coordinates (0: any number, `self.dim`).
+    /// [`Self::rates`] for `n` structure coordinates and `k` dampers: inlined
+    /// where they are constants, every slice then has a length known at
+    /// compile time (loops unrolled, no bounds checks).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn rates_sized<const D: usize>(
+    pub(crate) fn rates_in(
         &self,
+        n: usize,
+        k: usize,
         time: f64,
         y: &[f64],
         modes: &[Mode],
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        let (n, d) = (self.n, if D == 0 { self.dim } else { D });
+        self.rates_with(&self.rates_parts(n, k), time, y, modes, scratch, out)
+    }
+
+    /// The parts of the system [`Self::rates_with`] reads, cut to their
+    /// sizes: a method that evaluates the rates several times a step (RK4)
+    /// makes them once, and the lengths are checked once.
+    #[inline(always)]
+    pub(crate) fn rates_parts(&self, n: usize, k: usize) -> RatesParts<'_> {
+        let (diagonals, first) = match (self.diagonal, self.forces.first()) {
+            (true, Some(f)) => (
+                Some(&self.diagonals[..n]),
+                Some((&f.signal, &f.push[..n], &f.row[..n])),
+            ),
+            (true, None) => (Some(&self.diagonals[..n]), None),
+            (false, _) => (None, None),
+        };
+        let fused = usize::from(first.is_some());
+        RatesParts {
+            n,
+            k,
+            diagonals,
+            fused,
+            unfused: self.forces.len() > fused,
+            base: !self.base.is_empty(),
+            first,
+            interactions: &self.interactions[..],
+            gravity: self.gravity,
+        }
+    }
+
+    /// [`Self::rates`] from its parts (see [`Self::rates_parts`]).
+    #[inline(always)]
+    pub(crate) fn rates_with(
+        &self,
+        parts: &RatesParts<'_>,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+    ) {
+        let (n, k) = (parts.n, parts.k);
+        let d = n + k;
+        let count = parts.interactions.len();
         let (x, v) = (&y[..d], &y[d..2 * d]);
-        let (velocity, rest) = out[..self.state_len()].split_at_mut(d);
+        let (velocity, rest) = out[..2 * d + CONTACT + count].split_at_mut(d);
         let (acc, rest) = rest.split_at_mut(d);
         let (head, losses) = rest.split_at_mut(CONTACT);
-        let mut base = 0.0;
-        for (signal, cache) in self.base.iter().zip(&mut scratch.base_values) {
-            base += cache.value(signal, time);
-        }
-        let inertial = base + self.gravity;
+        // What few systems have is out of line (its fields are then not
+        // loaded, nor kept, by a method's loop over the evaluations).
+        let base = if parts.base {
+            self.base_value(time, scratch)
+        } else {
+            0.0
+        };
+        let inertial = base + parts.gravity;
         // The velocities are copied inside the loops over the coordinates
         // (a lone copy of a handful of values becomes a call to memmove).
         let mut input = 0.0;
-        let (viscous, fused) = if self.diagonal {
+        let fused = parts.fused;
+        let viscous = if let Some(diagonals) = parts.diagonals {
             // Modal coordinates: the matrices are diagonal. The first force
             // is added in the same pass (each sum in the same order).
             let (x, v) = (&x[..n], &v[..n]);
-            let (acc, velocity, diagonals) =
-                (&mut acc[..n], &mut velocity[..n], &self.diagonals[..n]);
+            let (acc, velocity) = (&mut acc[..n], &mut velocity[..n]);
             let mut viscous = 0.0;
-            if let (Some(f), Some(cache)) = (self.forces.first(), scratch.force_values.first_mut())
+            if let (Some((signal, push, row)), Some(cache)) =
+                (parts.first, scratch.force_values.first_mut())
             {
-                let value = cache.value(&f.signal, time);
-                let (push, row) = (&f.push[..n], &f.row[..n]);
+                let value = cache.value(signal, time);
                 let mut power = -0.0;
                 for i in 0..n {
                     let [k, c, damping, r] = diagonals[i];
@@ -545,7 +596,6 @@ impl Assembly {
                     power += row[i] * v[i];
                 }
                 input += value * power;
-                (viscous, 1)
             } else {
                 for i in 0..n {
                     let [k, c, damping, r] = diagonals[i];
@@ -553,51 +603,29 @@ impl Assembly {
                     acc[i] = -(k * x[i] + c * v[i]) - r * inertial;
                     viscous += damping * v[i] * v[i];
                 }
-                (viscous, 0)
             }
+            viscous
         } else {
-            for (i, a) in acc[..n].iter_mut().enumerate() {
-                let row = i * n..(i + 1) * n;
-                velocity[i] = v[i];
-                *a = -linalg::dot(&self.minv_k[row.clone()], &x[..n])
-                    - linalg::dot(&self.minv_c[row], &v[..n])
-                    - self.influence[i] * inertial;
-            }
-            (linalg::quadratic_form(&self.damping, &v[..n]), 0)
+            self.coupled_rates(n, x, v, inertial, acc, velocity)
         };
-        for ((a, o), v) in acc[n..].iter_mut().zip(&mut velocity[n..]).zip(&v[n..]) {
+        for ((a, o), v) in acc[n..d].iter_mut().zip(&mut velocity[n..d]).zip(&v[n..d]) {
             *o = *v;
             *a = -inertial;
         }
-        for (f, cache) in self.forces[fused..]
-            .iter()
-            .zip(&mut scratch.force_values[fused..])
-        {
-            let value = cache.value(&f.signal, time);
-            for (a, p) in acc[..n].iter_mut().zip(&f.push) {
-                *a += p * value;
-            }
-            input += value * linalg::dot(&f.row, &v[..n]);
+        if parts.unfused {
+            input = self.unfused_forces(n, fused, time, v, input, acc, scratch);
         }
         if base != 0.0 {
-            // The work of the inertial load -M r a of the base signals.
-            let momentum = linalg::dot(&self.mass_influence, &v[..n])
-                + self
-                    .damper_mass
-                    .iter()
-                    .zip(&v[n..])
-                    .map(|(m, v)| m * v)
-                    .sum::<f64>();
-            input -= base * momentum;
+            input -= base * self.base_momentum(n, k, v);
         }
         let mut sticking = 0;
         // `h . x`, `h . v` of the last interaction whose products were taken:
         // a damper's second wall has the first's row negated (see `gaps`).
         let mut products: Option<(f64, f64)> = None;
-        for (i, (((it, mode), loss), mirror)) in self
+        for (i, (((it, mode), loss), mirror)) in parts
             .interactions
             .iter()
-            .zip(modes)
+            .zip(&modes[..count])
             .zip(losses.iter_mut())
             .zip(&self.mirrors_previous)
             .enumerate()
@@ -635,6 +663,89 @@ impl Assembly {
                 _ => {}
             }
         }
+        if sticking > 0 {
+            self.add_constraint_forces(sticking, acc, scratch);
+        }
+        scratch.count = sticking;
+        head[VISCOUS] = viscous;
+        head[INPUT] = input;
+    }
+
+    /// The sum of the base signals at `time`.
+    #[inline(never)]
+    fn base_value(&self, time: f64, scratch: &mut Scratch) -> f64 {
+        let mut base = 0.0;
+        for (signal, cache) in self.base.iter().zip(&mut scratch.base_values) {
+            base += cache.value(signal, time);
+        }
+        base
+    }
+
+    /// The momentum `v . M r` whose rate the base signals' inertial load
+    /// `-M r a` works on.
+    #[inline(never)]
+    fn base_momentum(&self, n: usize, k: usize, v: &[f64]) -> f64 {
+        linalg::dot(&self.mass_influence[..n], &v[..n])
+            + self.damper_mass[..k]
+                .iter()
+                .zip(&v[n..n + k])
+                .map(|(m, v)| m * v)
+                .sum::<f64>()
+    }
+
+    /// The structure's accelerations (and velocities) where its matrices
+    /// couple the coordinates; returns the viscous power.
+    #[inline(never)]
+    fn coupled_rates(
+        &self,
+        n: usize,
+        x: &[f64],
+        v: &[f64],
+        inertial: f64,
+        acc: &mut [f64],
+        velocity: &mut [f64],
+    ) -> f64 {
+        for (i, a) in acc[..n].iter_mut().enumerate() {
+            let row = i * n..(i + 1) * n;
+            velocity[i] = v[i];
+            *a = -linalg::dot(&self.minv_k[row.clone()], &x[..n])
+                - linalg::dot(&self.minv_c[row], &v[..n])
+                - self.influence[i] * inertial;
+        }
+        linalg::quadratic_form(&self.damping[..n * n], &v[..n])
+    }
+
+    /// The forces after the first `fused` onto the accelerations; returns
+    /// the input power with their work added to `input`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn unfused_forces(
+        &self,
+        n: usize,
+        fused: usize,
+        time: f64,
+        v: &[f64],
+        mut input: f64,
+        acc: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> f64 {
+        for (f, cache) in self.forces[fused..]
+            .iter()
+            .zip(&mut scratch.force_values[fused..])
+        {
+            let value = cache.value(&f.signal, time);
+            for (a, p) in acc[..n].iter_mut().zip(&f.push[..n]) {
+                *a += p * value;
+            }
+            input += value * linalg::dot(&f.row[..n], &v[..n]);
+        }
+        input
+    }
+
+    /// The constraint forces of the `sticking` interactions listed in
+    /// `scratch` into it and onto the accelerations (out of line: rare).
+    #[inline(never)]
+    fn add_constraint_forces(&self, sticking: usize, acc: &mut [f64], scratch: &mut Scratch) {
         if sticking == 1 {
             // One constraint: W lambda = -h . a with W = h M^-1 h^T, what
             // the elimination below gives for one row.
@@ -644,7 +755,7 @@ impl Assembly {
             for (a, p) in acc.iter_mut().zip(&it.push) {
                 *a += p * lambda;
             }
-        } else if sticking > 1 {
+        } else {
             self.constraint_forces(
                 &scratch.sticking[..sticking],
                 acc,
@@ -658,9 +769,6 @@ impl Assembly {
                 }
             }
         }
-        scratch.count = sticking;
-        head[VISCOUS] = viscous;
-        head[INPUT] = input;
     }
 
     /// The Jacobians of the accelerations (the middle `dim` rates) with

@@ -29,6 +29,7 @@ pub mod run;
 pub mod settings;
 pub mod shooting;
 pub mod signals;
+mod sized;
 pub mod step_control;
 pub mod steppers;
 pub mod structure;

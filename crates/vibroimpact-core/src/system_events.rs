@@ -386,6 +386,31 @@ fn find_crossing(
     best
 }
 
+/// Whether any interaction is in a compliant contact.
+fn any_compliant(modes: &[Mode]) -> bool {
+    modes.iter().any(|m| matches!(m, Mode::Compliant { .. }))
+}
+
+/// Whether [`find_crossing`] may find anything in the step whose `gaps` are
+/// given: a cheap test of every interaction that passes all those it could
+/// report (and some it will not), so that most steps skip it. A value ending
+/// on its wall's far side, or one whose rate turns from towards the wall to
+/// away (the dip test's `m0 < 0 < m1`: the rates' signs, which the step's
+/// length multiplies), or a sticking pair.
+#[inline(always)]
+fn may_cross(gaps: &Gaps, modes: &[Mode]) -> bool {
+    let mut any = false;
+    for ((start, end), mode) in gaps.start.iter().zip(&gaps.end).zip(modes) {
+        let ((_, r0), (g1, r1)) = (*start, *end);
+        any |= match mode {
+            Mode::Open => g1 < 0.0 || (r0 < 0.0 && r1 > 0.0),
+            Mode::Compliant { .. } => g1 > 0.0 || (r0 > 0.0 && r1 < 0.0),
+            Mode::Sticking => true,
+        };
+    }
+    any
+}
+
 /// The root `dt` near `-v / slope` of `v + slope dt + second dt^2 / 2 +
 /// third dt^3 / 6` (a value's Taylor polynomial about a trial): Newton's
 /// method on the polynomial from the tangent's root. Its error is that of the
@@ -685,6 +710,8 @@ pub fn integrate_system<S: SystemStepper>(
     // Interactions whose dip in this step was checked and stays open.
     let mut unconfirmed = vec![false; count];
     let mut any_unconfirmed = false;
+    // Whether a compliant contact is on (modes change only at events).
+    let mut compliant = any_compliant(&modes);
     let mut reductions = Reductions {
         peaks: vec![0.0; system.n],
         square_integrals: vec![0.0; system.n],
@@ -730,19 +757,23 @@ pub fn integrate_system<S: SystemStepper>(
             unconfirmed.iter_mut().for_each(|u| *u = false);
             any_unconfirmed = false;
         }
-        let mut crossing = find_crossing(
-            system,
-            time,
-            &gaps,
-            &end,
-            length,
-            &modes,
-            graze,
-            &mut grazes,
-            &mut scratch,
-            &mut buffers.work,
-            &unconfirmed,
-        );
+        let mut crossing = if may_cross(&gaps, &modes) {
+            find_crossing(
+                system,
+                time,
+                &gaps,
+                &end,
+                length,
+                &modes,
+                graze,
+                &mut grazes,
+                &mut scratch,
+                &mut buffers.work,
+                &unconfirmed,
+            )
+        } else {
+            None
+        };
         // An event inside the step: locate it; another interaction that
         // turns out to have crossed before it is located in its turn.
         let mut rounds = 0;
@@ -860,23 +891,27 @@ pub fn integrate_system<S: SystemStepper>(
         {
             continue;
         }
-        if end[..row].iter().any(|v| !v.is_finite()) {
+        // v * 0 is 0 for a finite v, NaN otherwise: one sum tells (and
+        // does not branch on every value).
+        if end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) != 0.0 {
             return Err(Error::NumericalBlowUp {
                 time: time + taken,
                 reason: "the state is no longer finite",
             });
         }
         // Deepest indentation of each compliant contact within the step.
-        for (i, record) in open.iter_mut().enumerate() {
-            if let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), modes[i]) {
-                let ((g0, r0), (g1, r1)) = (gaps.start[i], gaps.end[i]);
-                let (m0, m1) = (r0 * taken, r1 * taken);
-                let mut deepest = -g1;
-                if m0 < 0.0 && m1 > 0.0 {
-                    let theta = cubic_argmax(-g0, -g1, -m0, -m1);
-                    deepest = deepest.max(hermite::eval(-g0, -g1, -m0, -m1, theta).0);
+        if compliant {
+            for (i, record) in open.iter_mut().enumerate() {
+                if let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), modes[i]) {
+                    let ((g0, r0), (g1, r1)) = (gaps.start[i], gaps.end[i]);
+                    let (m0, m1) = (r0 * taken, r1 * taken);
+                    let mut deepest = -g1;
+                    if m0 < 0.0 && m1 > 0.0 {
+                        let theta = cubic_argmax(-g0, -g1, -m0, -m1);
+                        deepest = deepest.max(hermite::eval(-g0, -g1, -m0, -m1, theta).0);
+                    }
+                    oc.max_indentation = oc.max_indentation.max(deepest);
                 }
-                oc.max_indentation = oc.max_indentation.max(deepest);
             }
         }
         if time >= options.reduce.record_from {
@@ -991,6 +1026,7 @@ pub fn integrate_system<S: SystemStepper>(
             }
             // Impacts change the velocities.
             system.gaps(&y, &mut gaps.start);
+            compliant = any_compliant(&modes);
         }
 
         if time >= next_strobe - 1e-9 * options.reduce.strobe_period {

@@ -4,9 +4,10 @@
 //! One generic stepper over a Butcher tableau serves RK4 (fixed step),
 //! Dormand-Prince 5(4) and DOP853 (error control, first same as last).
 
-use crate::assembly::{sized_by_dim, Assembly, Mode, Scratch};
+use crate::assembly::{Assembly, Mode, Scratch};
 use crate::error::{Error, Result};
 use crate::linalg;
+use crate::sized::by_size;
 use crate::tableau::*;
 
 /// A method the 0.2 kernel can drive: it advances the state within one set of
@@ -132,10 +133,13 @@ pub struct ExplicitRk {
 #[inline(always)]
 fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], k: &[Vec<f64>]) {
     let mut first = true;
+    let (len, y) = (out.len(), &y[..out.len()]);
     for (weight, kj) in weights.iter().zip(k) {
         if *weight == 0.0 {
             continue;
         }
+        // Slices of the one length: a constant one unrolls.
+        let kj = &kj[..len];
         let hw = h * weight;
         if first {
             for ((o, y), k) in out.iter_mut().zip(y).zip(kj) {
@@ -241,7 +245,7 @@ impl ExplicitRk {
     /// order, in one pass.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn rk4_stages<const D: usize>(
+    fn rk4_stages(
         &mut self,
         system: &Assembly,
         time: f64,
@@ -251,41 +255,111 @@ impl ExplicitRk {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        // `D` coordinates (0: any number), for loops of a known length.
-        let coordinates = 2 * if D == 0 { system.dim } else { D };
-        let len = out.len();
-        let times = [0, 1, 2, 3].map(|i| if i == 0 { time } else { time + self.c[i] * h });
+        by_size!(system, |n, k| self
+            .rk4_in(system, n, k, time, y, h, modes, scratch, out))
+    }
+
+    /// [`Self::rk4_stages`] for `n` structure coordinates and `k` dampers,
+    /// the right-hand side inlined: where they are constants, the whole
+    /// step has sizes known at compile time.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn rk4_in(
+        &mut self,
+        system: &Assembly,
+        n: usize,
+        k: usize,
+        time: f64,
+        y: &[f64],
+        h: f64,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+    ) {
+        let coordinates = 2 * (n + k);
+        let len = system.state_len();
+        // The tableau's own constants (what `c`, `a` and `b` hold for RK4):
+        // the compiler folds them.
+        let times = [0, 1, 2, 3].map(|i| if i == 0 { time } else { time + RK4_C[i] * h });
         // Each stage's one nonzero weight, on the stage before.
-        let hw = [1, 2, 3].map(|i| h * self.a[i * 4 + i - 1]);
-        let w = [0, 1, 2, 3].map(|i| h * self.b[i]);
-        if !self.start_valid {
-            system.rates(time, y, modes, scratch, &mut self.k[0]);
-            self.evaluations += 1;
-            self.start_valid = true;
-        }
-        for i in 1..4 {
-            let (done, next) = self.k.split_at_mut(i);
-            let (point, y, k) = (
-                &mut self.point[..coordinates],
-                &y[..coordinates],
-                &done[i - 1][..coordinates],
-            );
-            let hw = hw[i - 1];
-            for e in 0..coordinates {
-                point[e] = y[e] + hw * k[e];
-            }
-            system.rates(times[i], &self.point, modes, scratch, &mut next[0]);
-            self.evaluations += 1;
-        }
-        let [k0, k1, k2, k3, ..] = &self.k[..] else {
+        let hw = [1, 2, 3].map(|i| h * RK4_A[i][i - 1]);
+        let w = [0, 1, 2, 3].map(|i| h * RK4_B[i]);
+        let [k0, k1, k2, k3, ..] = &mut self.k[..] else {
             unreachable!("RK4 has four stages")
         };
+        let mut stages = [
+            &mut k0[..len],
+            &mut k1[..len],
+            &mut k2[..len],
+            &mut k3[..len],
+        ];
+        let (point, y) = (&mut self.point[..coordinates], &y[..len]);
+        let parts = system.rates_parts(n, k);
+        // One call of the right-hand side in the loop: it is inlined once.
+        let first = if self.start_valid { 1 } else { 0 };
+        for i in first..4 {
+            let (done, next) = stages.split_at_mut(i);
+            let at: &[f64] = if i == 0 {
+                y
+            } else {
+                // The stage points need the coordinates and velocities only.
+                let (from, y) = (&done[i - 1][..coordinates], &y[..coordinates]);
+                for e in 0..coordinates {
+                    point[e] = y[e] + hw[i - 1] * from[e];
+                }
+                point
+            };
+            system.rates_with(&parts, times[i], at, modes, scratch, next[0]);
+        }
+        self.evaluations += 4 - first as u64;
+        self.start_valid = true;
+        let [k0, k1, k2, k3] = stages;
         // Indexed over slices of one length: a loop the compiler vectorises.
-        let (out, y) = (&mut out[..len], &y[..len]);
-        let (k0, k1, k2, k3) = (&k0[..len], &k1[..len], &k2[..len], &k3[..len]);
+        let out = &mut out[..len];
         for e in 0..len {
             out[e] = y[e] + w[0] * k0[e] + w[1] * k1[e] + w[2] * k2[e] + w[3] * k3[e];
         }
+    }
+
+    /// The stages of a step `h` from `(time, y)` by the tableau, for `n`
+    /// structure coordinates and `k` dampers (constants where `by_size`
+    /// fixes them), the right-hand side inlined once in the loop.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn tableau_stages(
+        &mut self,
+        system: &Assembly,
+        n: usize,
+        k: usize,
+        time: f64,
+        y: &[f64],
+        h: f64,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        let s = self.stages;
+        // The stages' points need the coordinates and velocities only: the
+        // rates do not depend on the energy accumulators.
+        let coordinates = 2 * (n + k);
+        let parts = system.rates_parts(n, k);
+        let first = if self.start_valid { 1 } else { 0 };
+        for i in first..s {
+            let at = if i == 0 {
+                y
+            } else {
+                // y + h sum_j a_ij k_j over the nonzero weights only, the
+                // first term written over y (no copy), each pass a straight
+                // vector loop.
+                let row = &self.a[i * s..i * s + i];
+                let point = &mut self.point[..coordinates];
+                combine(point, &y[..coordinates], h, row, &self.k);
+                point
+            };
+            let time = if i == 0 { time } else { time + self.c[i] * h };
+            system.rates_with(&parts, time, at, modes, scratch, &mut self.k[i]);
+        }
+        self.evaluations += (s - first) as u64;
+        self.start_valid = true;
     }
 }
 
@@ -317,38 +391,13 @@ impl SystemStepper for ExplicitRk {
     ) -> Result<f64> {
         let s = self.stages;
         if self.rk4 {
-            sized_by_dim!(system.dim, rk4_stages, self, system, time, y, h, modes, scratch, out);
+            self.rk4_stages(system, time, y, h, modes, scratch, out);
             self.end_slot = None;
             return Ok(0.0);
         }
-        if !self.start_valid {
-            system.rates(time, y, modes, scratch, &mut self.k[0]);
-            self.evaluations += 1;
-            self.start_valid = true;
-        }
-        // The stages' points need the coordinates and velocities only: the
-        // rates do not depend on the energy accumulators.
+        by_size!(system, |n, k| self
+            .tableau_stages(system, n, k, time, y, h, modes, scratch));
         let coordinates = 2 * system.dim;
-        for i in 1..s {
-            // y + h sum_j a_ij k_j over the nonzero weights only, the first
-            // term written over y (no copy), each pass a straight vector loop.
-            let row = &self.a[i * s..i * s + i];
-            combine(
-                &mut self.point[..coordinates],
-                &y[..coordinates],
-                h,
-                row,
-                &self.k,
-            );
-            system.rates(
-                time + self.c[i] * h,
-                &self.point,
-                modes,
-                scratch,
-                &mut self.k[i],
-            );
-            self.evaluations += 1;
-        }
         combine(out, y, h, &self.b, &self.k);
         let scale = |n: usize| self.atol + self.rtol * y[n].abs().max(out[n].abs());
         Ok(match &self.estimate {
@@ -689,22 +738,58 @@ mod tests {
         y
     }
 
+    /// Open, in compliant contact and sticking: each branch of the rates.
+    fn mode_sets(system: &Assembly) -> Vec<Vec<Mode>> {
+        let count = system.interactions.len();
+        let mut sets = vec![vec![Mode::Open; count]];
+        let mut compliant = vec![Mode::Open; count];
+        compliant[1] = Mode::Compliant {
+            approach_rate: 0.01,
+        };
+        sets.push(compliant.clone());
+        compliant[2] = Mode::Sticking;
+        sets.push(compliant);
+        sets
+    }
+
+    #[test]
+    fn bodies_for_constant_sizes_match_the_general_one_to_the_bit() {
+        crate::testing::timeout(60, || {
+            let system = beam();
+            let len = system.state_len();
+            // Sizes the compiler cannot see: the general body.
+            let (n, k) = std::hint::black_box((system.n, system.k));
+            let (mut s1, mut s2) = (Scratch::new(&system), Scratch::new(&system));
+            let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+            let count = system.interactions.len();
+            let (mut g1, mut g2) = (vec![(0.0, 0.0); count], vec![(0.0, 0.0); count]);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            for modes in &mode_sets(&system) {
+                for step in 0..100 {
+                    let (time, y) = (1e-5 * step as f64, state(&system, step as f64));
+                    system.rates(time, &y, modes, &mut s1, &mut a);
+                    system.rates_in(n, k, time, &y, modes, &mut s2, &mut b);
+                    assert_eq!(bits(&a), bits(&b), "step {step}, {modes:?}");
+                    assert_eq!(bits(&s1.forces), bits(&s2.forces));
+                    system.gaps(&y, &mut g1);
+                    system.gaps_in(n + k, &y, &mut g2);
+                    let pairs = |g: &[(f64, f64)]| {
+                        g.iter()
+                            .map(|p| (p.0.to_bits(), p.1.to_bits()))
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(pairs(&g1), pairs(&g2));
+                }
+            }
+        });
+    }
+
     #[test]
     fn rk4_own_loop_matches_its_tableau_to_the_bit() {
         crate::testing::timeout(60, || {
             let system = beam();
             let len = system.state_len();
-            let count = system.interactions.len();
-            // Open, in compliant contact and sticking: each branch of the rates.
-            let mut sets = vec![vec![Mode::Open; count]];
-            let mut compliant = vec![Mode::Open; count];
-            compliant[1] = Mode::Compliant {
-                approach_rate: 0.01,
-            };
-            sets.push(compliant.clone());
-            compliant[2] = Mode::Sticking;
-            sets.push(compliant);
-            for modes in &sets {
+            for modes in &mode_sets(&system) {
                 let mut own = ExplicitRk::rk4(len);
                 let mut tableau = ExplicitRk::build(
                     "rk4 by its tableau",
