@@ -61,19 +61,23 @@ def ours() -> tuple[float, tuple[float, float, float, float]]:
 
 def build() -> tuple[object, object]:
     """The kernel with the parameters as arguments, and with them frozen."""
-    return with_arguments(), frozen()
+    return kernel(frozen=False), kernel(frozen=True)
 
 
-def with_arguments() -> object:
-    """The kernel taking the system's parameters as a run-time argument."""
+def kernel(frozen: bool) -> object:
+    """The RK4 loop with the system's parameters taken at run time or, with
+    ``frozen``, captured as compile-time constants (the argument then unread)."""
     from numba import njit
+
+    params = (C / M, K / M, 1.0 / M, 1.0 / m, d, K_HZ, C1)
 
     @njit(cache=False)
     def accelerations(
         p: tuple[float, ...], w: float, wv: float, y: float, yv: float
     ) -> tuple[float, float]:
-        damping_per_mass, stiffness_per_mass, inverse_main, inverse_impact = p[:4]
-        clearance, hertz, contact_damping = p[4:]
+        damping_per_mass, stiffness_per_mass, inverse_main, inverse_impact, clearance, hertz, c1 = (
+            params if frozen else p
+        )
         main = -(damping_per_mass * wv + stiffness_per_mass * w)
         u = y - w
         if abs(u) > clearance:
@@ -81,13 +85,13 @@ def with_arguments() -> object:
             indentation = side * u - clearance
             rate = side * (yv - wv)
             law = hertz * indentation * math.sqrt(indentation) if indentation > 0.0 else 0.0
-            total = law + contact_damping * rate if indentation > 0.0 else 0.0
+            total = law + c1 * rate if indentation > 0.0 else 0.0
             push = side * total
             return main + push * inverse_main, -push * inverse_impact
         return main, 0.0
 
     @njit(cache=False)
-    def steps(p: tuple[float, ...], steps: int, dt: float) -> tuple[float, float, float, float]:
+    def run(p: tuple[float, ...], steps: int, dt: float) -> tuple[float, float, float, float]:
         w, wv, y, yv = 0.0, 0.0, d, 0.1
         half = 0.5 * dt
         sixth = dt / 6.0
@@ -112,65 +116,8 @@ def with_arguments() -> object:
             yv = yv + sixth * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3])
         return w, wv, y, yv
 
-    params = (C / M, K / M, 1.0 / M, 1.0 / m, d, K_HZ, C1)
-
-    @njit(cache=False)
-    def run(n: int, dt: float, p: tuple[float, ...]) -> tuple[float, float, float, float]:
-        return steps(p, n, dt)
-
-    run(10, DT, params)  # compile
-    return lambda n, dt: run(n, dt, params)
-
-
-def frozen() -> object:
-    """The same kernel with the parameters captured as compile-time constants."""
-    from numba import njit
-
-    damping_per_mass, stiffness_per_mass = C / M, K / M
-    inverse_main, inverse_impact = 1.0 / M, 1.0 / m
-
-    @njit(cache=False)
-    def accelerations(w: float, wv: float, y: float, yv: float) -> tuple[float, float]:
-        main = -(damping_per_mass * wv + stiffness_per_mass * w)
-        u = y - w
-        if abs(u) > d:
-            side = 1.0 if (u > 0.0 or (u == 0.0 and yv - wv >= 0.0)) else -1.0
-            indentation = side * u - d
-            rate = side * (yv - wv)
-            law = K_HZ * indentation * math.sqrt(indentation) if indentation > 0.0 else 0.0
-            total = law + C1 * rate if indentation > 0.0 else 0.0
-            push = side * total
-            return main + push * inverse_main, -push * inverse_impact
-        return main, 0.0
-
-    @njit(cache=False)
-    def run(steps: int, dt: float) -> tuple[float, float, float, float]:
-        w, wv, y, yv = 0.0, 0.0, d, 0.1
-        half = 0.5 * dt
-        sixth = dt / 6.0
-        for _ in range(steps):
-            a1w, a1y = accelerations(w, wv, y, yv)
-            k1 = (wv, a1w, yv, a1y)
-            a2w, a2y = accelerations(
-                w + half * k1[0], wv + half * k1[1], y + half * k1[2], yv + half * k1[3]
-            )
-            k2 = (wv + half * k1[1], a2w, yv + half * k1[3], a2y)
-            a3w, a3y = accelerations(
-                w + half * k2[0], wv + half * k2[1], y + half * k2[2], yv + half * k2[3]
-            )
-            k3 = (wv + half * k2[1], a3w, yv + half * k2[3], a3y)
-            a4w, a4y = accelerations(
-                w + dt * k3[0], wv + dt * k3[1], y + dt * k3[2], yv + dt * k3[3]
-            )
-            k4 = (wv + dt * k3[1], a4w, yv + dt * k3[3], a4y)
-            w = w + sixth * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0])
-            wv = wv + sixth * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1])
-            y = y + sixth * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2])
-            yv = yv + sixth * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3])
-        return w, wv, y, yv
-
-    run(10, DT)  # compile
-    return run
+    run(params, 10, DT)  # compile
+    return lambda n, dt: run(params, n, dt)
 
 
 def main() -> None:
