@@ -929,6 +929,40 @@ impl Assembly {
         }
         0.5 * (1.0 - restitution * restitution) * rate * rate / it.inverse_mass
     }
+
+    /// The scale of interaction `i`'s gap at state `y`, m: its offset and
+    /// the magnitudes of the terms `h . x` sums, whose round-off the gap
+    /// carries.
+    pub fn gap_scale(&self, i: usize, y: &[f64]) -> f64 {
+        let it = &self.interactions[i];
+        it.offset.abs()
+            + it.h
+                .iter()
+                .zip(&y[..self.dim])
+                .map(|(h, x)| (h * x).abs())
+                .sum::<f64>()
+    }
+
+    /// A sticking pair `i` released: held on its wall only to round-off, it
+    /// is put at rest relative to the wall (no approach left) with its gap
+    /// a few units of that round-off open, along `M^-1 h^T` (the momentum
+    /// and energy that moves are round-off too). Without it a gap a hair
+    /// below zero, slowly opening, reads as a new contact at every step
+    /// until the pair has moved away by more than the round-off.
+    pub fn release(&self, i: usize, y: &mut [f64]) {
+        let it = &self.interactions[i];
+        let d = self.dim;
+        let (gap, rate) = (
+            it.offset + linalg::dot(&it.h, &y[..d]),
+            linalg::dot(&it.h, &y[d..2 * d]),
+        );
+        let opening = (16.0 * f64::EPSILON * self.gap_scale(i, y) - gap) / it.inverse_mass;
+        let lift = -rate.min(0.0) / it.inverse_mass;
+        for (k, p) in it.push.iter().enumerate() {
+            y[k] += p * opening;
+            y[d + k] += p * lift;
+        }
+    }
 }
 
 /// `(h . x, h . v)` in one pass, each summed in order as [`linalg::dot`]

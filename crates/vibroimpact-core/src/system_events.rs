@@ -482,16 +482,7 @@ fn locate<S: SystemStepper>(
     buffers: &mut Buffers,
 ) -> Result<Location> {
     let mode = modes[c.i];
-    let d = system.dim;
-    let round_off = 8.0
-        * f64::EPSILON
-        * (system.interactions[c.i].offset.abs()
-            + system.interactions[c.i]
-                .h
-                .iter()
-                .zip(&y[..d])
-                .map(|(h, x)| (h * x).abs())
-                .sum::<f64>());
+    let round_off = 8.0 * f64::EPSILON * system.gap_scale(c.i, y);
     let value = |end: &[f64], at: f64, scratch: &mut Scratch, work: &mut [f64]| {
         event_value(system, c.i, mode, at, end, modes, scratch, work)
     };
@@ -1358,13 +1349,7 @@ fn switch(
                 // than 1e-9 of the gap's scale: below that the positions'
                 // round-off decides the impacts, not the dynamics.
                 let height = rebound * rebound / (-2.0 * pressing);
-                let scale = it.offset.abs()
-                    + it.h
-                        .iter()
-                        .zip(&y[..system.dim])
-                        .map(|(h, x)| (h * x).abs())
-                        .sum::<f64>();
-                if remaining <= resolution || height <= 1e-9 * scale {
+                if remaining <= resolution || height <= 1e-9 * system.gap_scale(i, y) {
                     let loss = system.impact(i, y, 0.0);
                     *impact_loss += loss;
                     modes[i] = Mode::Sticking;
@@ -1379,6 +1364,7 @@ fn switch(
             }
         }
         (Mode::Sticking, _) => {
+            system.release(i, y);
             modes[i] = Mode::Open;
             if let Some(oc) = open[i].take() {
                 contacts.push(oc.close(it.pair, time, 0.0, oc.dissipated));
