@@ -656,3 +656,56 @@ def test_exact_refuses_what_it_cannot_solve(name: str) -> None:
         run = an.runner({**refused, "solver": dict(EXACT)})
         with pytest.raises(vi.InvalidInputError, match="exact"):
             an.steady_state(run, settle_periods=1, record_periods=1)
+
+
+def _rattling(clearance: float) -> dict[str, Any]:
+    return {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513},
+        "damper": [
+            {"mass": 0.05, "at": 0, "clearance": clearance, "law": "rigid", "restitution": 0.6}
+        ],
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 5.0, "frequency": 10.0}
+        ],
+        "solver": {"method": "exact", "t_end": 1.0},
+    }
+
+
+@pytest.mark.parametrize("analysis", ["sweep", "bifurcation"])
+def test_a_clearance_swept_down_restarts_where_the_damper_would_start_inside_a_wall(
+    analysis: str,
+) -> None:
+    # Each point starts from the last one's state; sweeping a clearance down leaves
+    # the damper outside the new, narrower cavity. That point starts from [initial]
+    # instead (the whole sweep used to stop, blaming [initial]).
+    values = [0.002, 0.004, 0.006, 0.008, 0.010]
+    data = _rattling(0.005)
+    if analysis == "sweep":
+        points: list[Any] = an.sweep(
+            data,
+            "damper.0.clearance",
+            values,
+            direction="down",
+            settle_periods=20,
+            record_periods=5,
+        )
+        fresh = an.steady_state(
+            an.runner(_rattling(values[0])), None, settle_periods=20, record_periods=5
+        )
+        # The last point (0.002 m, the damper 4e-3 m or so off centre before it) restarted:
+        # it is the run from [initial], to the bit.
+        assert points[-1].value == values[0]
+        assert np.array_equal(points[-1].amplitude, fresh.amplitude)
+    else:
+        from vibroimpact.maps import bifurcation
+
+        points = bifurcation(
+            data,
+            "damper.0.clearance",
+            values,
+            direction="down",
+            settle_periods=20,
+            sample_periods=5,
+        )
+    assert len(points) == len(values)
+    assert all(p.error is None for p in points), [p.error for p in points]

@@ -16,8 +16,9 @@ import copy
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -41,6 +42,8 @@ _INITIAL = (
     "damper_displacement",
     "damper_velocity",
 )
+_T = TypeVar("_T")
+
 _SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
 
 
@@ -507,6 +510,18 @@ def sweep_values(settings: Mapping[str, Any]) -> np.ndarray:
     return np.linspace(settings["start"], settings["stop"], settings["count"])
 
 
+def from_carried(attempt: Callable[[np.ndarray | None], _T], state: np.ndarray | None) -> _T:
+    """``attempt(state)``, the state carried from the last point of a sweep; or
+    ``attempt(None)``, from the scenario's ``[initial]``, where that state is not
+    admissible at this point (a clearance swept down past where the damper was)."""
+    try:
+        return attempt(state)
+    except InvalidInputError:
+        if state is None:
+            raise
+        return attempt(None)
+
+
 def sweep(
     data: Mapping[str, Any],
     parameter: str,
@@ -522,8 +537,9 @@ def sweep(
     """A stepped sweep of ``parameter`` (a dotted path into the scenario's sections)
     over ``values`` (ascending, as given), ``"up"``, ``"down"`` or ``"both"`` (up, then
     down from where up ended), each point starting from the last one's state, so
-    that jumps and hysteresis show. A point whose run fails is reported with its
-    error (and the next starts from the last good state)."""
+    that jumps and hysteresis show (from ``[initial]`` where that state is not
+    admissible: see :func:`from_carried`). A point whose run fails is reported with
+    its error (and the next starts from the last good state)."""
     _choice("", "direction", direction, _DIRECTIONS)
     values = [float(v) for v in values]
     legs: list[tuple[str, list[float]]] = []
@@ -543,12 +559,15 @@ def sweep(
             except InvalidInputError as err:
                 raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
             try:
-                result = steady_state(
-                    run,
+                result = from_carried(
+                    partial(
+                        steady_state,
+                        run,
+                        settle_periods=settle_periods,
+                        record_periods=record_periods,
+                        tolerance=tolerance,
+                    ),
                     state,
-                    settle_periods=settle_periods,
-                    record_periods=record_periods,
-                    tolerance=tolerance,
                 )
             except InvalidInputError:
                 raise

@@ -17,6 +17,7 @@ import signal
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -253,6 +254,17 @@ def _terminate(signum: int, frame: Any) -> None:
     raise _Terminated
 
 
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    print(f"vibroimpact: warning: {message}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
@@ -261,6 +273,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     # earlier result stays whole.
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+    # Warnings as one line each, as errors are (not Python's file:line format).
+    shown = warnings.showwarning
+    warnings.showwarning = _show_warning
     try:
         if args.command == "paper":
             return run_paper(args.out)
@@ -288,5 +303,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     finally:
+        warnings.showwarning = shown
         if main_thread:
             signal.signal(signal.SIGTERM, previous)

@@ -8,13 +8,21 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.analyses import AnalysisError, Runner, runner, steady_state, with_parameter
+from vibroimpact.analyses import (
+    AnalysisError,
+    Runner,
+    from_carried,
+    runner,
+    steady_state,
+    with_parameter,
+)
 
 
 @dataclass
@@ -69,6 +77,17 @@ class BifurcationPoint:
     error: str | None = None
 
 
+def _sampled(
+    run: Runner, settle_periods: int, sample_periods: int, start: np.ndarray | None
+) -> dict[str, Any]:
+    """The run of ``sample_periods`` periods, with the strobe, after settling for
+    ``settle_periods`` from ``start`` (``None``: the scenario's ``[initial]``)."""
+    z = run.initial_state() if start is None else start
+    if settle_periods:
+        z = run.map(z, settle_periods)
+    return run.periods(z, sample_periods, strobe=True)
+
+
 def bifurcation(
     data: Mapping[str, Any],
     parameter: str,
@@ -82,7 +101,8 @@ def bifurcation(
 ) -> list[BifurcationPoint]:
     """A bifurcation diagram: for each value of ``parameter`` (a dotted path), in
     the order given (``"up"``), reversed (``"down"``) or both, settle from the last
-    point's state and keep ``sample_periods`` stroboscopic states."""
+    point's state (see :func:`~vibroimpact.analyses.from_carried`) and keep
+    ``sample_periods`` stroboscopic states."""
     _whole("settle_periods", settle_periods, 0)
     _whole("sample_periods", sample_periods, 1)
     legs = _legs(direction, [float(v) for v in values])
@@ -93,10 +113,7 @@ def bifurcation(
         for value in leg_values:
             run = _runner_at(data, parameter, value, base_dir)
             try:
-                z = run.initial_state() if state is None else state
-                if settle_periods:
-                    z = run.map(z, settle_periods)
-                raw = run.periods(z, sample_periods, strobe=True)
+                raw = from_carried(partial(_sampled, run, settle_periods, sample_periods), state)
             except InvalidInputError:
                 raise
             except Exception as err:  # a run that cannot complete: recorded
