@@ -409,7 +409,8 @@ fn derivative<L: ContactLaw>(lanes: &Lanes<L>, s: &Quad, approach: &[f64; LANES]
         yv: [0.0; LANES],
     };
     for l in 0..LANES {
-        let main = -(lanes.damping_per_mass[l] * s.wv[l] + lanes.stiffness_per_mass[l] * s.w[l]);
+        // As Model::structural_acceleration.
+        let main = (-lanes.damping_per_mass[l]) * s.wv[l] - lanes.stiffness_per_mass[l] * s.w[l];
         let u = s.y[l] - s.w[l];
         let touching = u.abs() > lanes.clearance[l];
         let side = if u > 0.0 { 1.0 } else { -1.0 };

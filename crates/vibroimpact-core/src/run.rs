@@ -30,6 +30,55 @@ struct OpenContact {
     power: f64,
 }
 
+impl OpenContact {
+    /// The gap function against this contact's wall and its slopes (times
+    /// the step `dt`) at the ends of the step `s0 -> s1`: `(g0, g1, m0, m1)`.
+    #[inline(always)]
+    fn gaps<L: ContactLaw, X: Excitation>(
+        &self,
+        model: &Model<L, X>,
+        s0: &State,
+        s1: &State,
+        dt: f64,
+    ) -> (f64, f64, f64, f64) {
+        let (side, d) = (self.side, model.clearance);
+        (
+            side * s0.relative_displacement() - d,
+            side * s1.relative_displacement() - d,
+            side * s0.relative_velocity() * dt,
+            side * s1.relative_velocity() * dt,
+        )
+    }
+
+    /// The deepest indentation with the step's gaps: its end, and where
+    /// located, the peak of its interpolant when the step passes one.
+    #[inline(always)]
+    fn deepest(&mut self, located: bool, (g0, g1, m0, m1): (f64, f64, f64, f64)) {
+        if located && m0 > 0.0 && m1 <= 0.0 {
+            let theta = hermite::argmax(g0, g1, m0, m1);
+            let peak = hermite::eval(g0, g1, m0, m1, theta).0;
+            self.max_indentation = self.max_indentation.max(peak);
+        }
+        self.max_indentation = self.max_indentation.max(g1);
+    }
+
+    /// A step of length `dt` that ends still in contact at `s1`: the
+    /// trapezoidal sum of the contact's dissipation.
+    #[inline(always)]
+    fn pressed<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        s1: &State,
+        dt: f64,
+        approach: f64,
+    ) {
+        let p0 = self.power;
+        let c = model.contact(s1, approach);
+        self.power = model.contact_dissipation(&c);
+        self.dissipated += 0.5 * dt * (p0 + self.power);
+    }
+}
+
 /// How often (in steps) the kernel asks whether to stop; a power of two, a
 /// multiple of `ENERGY_INTERVAL`.
 const INTERRUPT_INTERVAL: u64 = 1 << 16;
@@ -107,12 +156,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                 integrator.step(model, &s, t, dt, approach)
             }
         };
-        if !s1.is_finite() {
-            return Err(Error::NumericalBlowUp {
-                time: t1,
-                reason: "the state is no longer finite",
-            });
-        }
+        finite(&s1, t1)?;
         squares += s1.main_velocity * s1.main_velocity;
         ledger.external_step(model, t, dt, &s, &s1);
 
@@ -157,22 +201,12 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                 }
             }
             Some(oc) => {
-                let side = oc.side;
-                let g0 = side * s.relative_displacement() - d;
-                let g1 = side * s1.relative_displacement() - d;
-                let m0 = side * s.relative_velocity() * dt;
-                let m1 = side * s1.relative_velocity() * dt;
-                if located && m0 > 0.0 && m1 <= 0.0 {
-                    let theta = hermite::argmax(g0, g1, m0, m1);
-                    let peak = hermite::eval(g0, g1, m0, m1, theta).0;
-                    oc.max_indentation = oc.max_indentation.max(peak);
-                }
-                oc.max_indentation = oc.max_indentation.max(g1);
+                let gaps = oc.gaps(model, &s, &s1, dt);
+                let (g0, g1, m0, m1) = gaps;
+                oc.deepest(located, gaps);
                 let p0 = oc.power;
                 if g1 > 0.0 {
-                    let c = model.contact(&s1, approach);
-                    oc.power = model.contact_dissipation(&c);
-                    oc.dissipated += 0.5 * dt * (p0 + oc.power);
+                    oc.pressed(model, &s1, dt, approach);
                 } else {
                     let theta = if g0 > 0.0 {
                         hermite::root(g0, g1, m0, m1)
@@ -223,43 +257,54 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
             }
             if ledger.due(step, last) {
                 let open_dissipation = open.map_or(0.0, |oc| oc.dissipated);
-                let acceleration = model.accelerations(t1, &s, approach).0;
-                let damper = damper.corrected(squares, s.main_velocity, acceleration);
-                let losses = closed_dissipation + open_dissipation + damper - ledger.external();
-                ledger.check(model.energy(&s), losses, t1)?;
-                if step % INTERRUPT_INTERVAL == 0 && interrupt() {
-                    return Err(Error::Interrupted { time: t1 });
-                }
+                let mut check = Check {
+                    damper: &damper,
+                    closed: closed_dissipation,
+                    interrupt: &mut *interrupt,
+                };
+                let sums = (squares, open_dissipation);
+                check.run(model, &mut ledger, &s, sums, approach, step, t1)?;
             }
         }
         // No step count check: n_steps <= max_steps was checked up front.
 
-        if open.is_none() {
-            // Free flight ([`free_flight`]) until the next step with
-            // bookkeeping: a history row or an energy check.
-            let mut bound = ledger.next_due(n).min(n_steps);
-            if keep {
-                bound = bound.min(n + until_kept);
+        // The steps that need none of the above but the energy checks
+        // (made there): apart ([`free_flight`]) or in contact
+        // ([`contact_flight`]), until a step changes that or the next step
+        // with other bookkeeping: a history row or the last step.
+        let mut bound = n_steps;
+        if keep {
+            bound = bound.min(n + until_kept);
+        }
+        let start = n;
+        let flight = Flight {
+            state: s,
+            steps: n,
+            squares,
+            pending: None,
+            approach,
+        };
+        let check = Check {
+            damper: &damper,
+            closed: closed_dissipation,
+            interrupt: &mut *interrupt,
+        };
+        let flight = match open.as_mut() {
+            None => free_flight(model, integrator, &mut ledger, check, flight, bound, t0, dt)?,
+            Some(oc) => {
+                let ends = (bound, t0, dt, located);
+                contact_flight(model, integrator, &mut ledger, check, oc, flight, ends)?
             }
-            let start = n;
-            let flight = Flight {
-                state: s,
-                steps: n,
-                squares,
-                pending: None,
-                approach,
-            };
-            let flight = free_flight(model, integrator, &mut ledger, flight, bound, t0, dt);
-            (s, n, squares, pending, approach) = (
-                flight.state,
-                flight.steps,
-                flight.squares,
-                flight.pending,
-                flight.approach,
-            );
-            if keep {
-                until_kept -= n - start;
-            }
+        };
+        (s, n, squares, pending, approach) = (
+            flight.state,
+            flight.steps,
+            flight.squares,
+            flight.pending,
+            flight.approach,
+        );
+        if keep {
+            until_kept -= n - start;
         }
     }
 
@@ -299,43 +344,163 @@ struct Flight {
     approach: f64,
 }
 
-/// Free flight: the bodies apart, no history row and no check due before
-/// step `bound`: the step alone, with the trapezoidal sum of the damper's
-/// work, until a step ends with |y - w| > d (or not finite: the comparison
-/// fails for NaN), which is handed back to the full bookkeeping. A function
-/// of its own so that the state stays in registers (in the kernel it lives
-/// in memory, its address taken by the bookkeeping).
+/// The energy balance due at a step, and every `INTERRUPT_INTERVAL` steps
+/// the question whether to stop: what the kernel checks every
+/// `ENERGY_INTERVAL` steps, in free flight too.
+struct Check<'a> {
+    damper: &'a DamperWork,
+    /// The work of the contact's dissipative forces in the contacts closed
+    /// so far, J.
+    closed: f64,
+    interrupt: &'a mut dyn FnMut() -> bool,
+}
+
+impl Check<'_> {
+    /// The check after `step` steps, at `t1`, in state `s` with the sum of
+    /// squares and the open contact's dissipation so far (`sums`) and the
+    /// latch `approach`. Out of line: in a flight a call in a branch taken
+    /// every few tens of steps, leaving the loop's registers to the step.
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn run<L: ContactLaw, X: Excitation>(
+        &mut self,
+        model: &Model<L, X>,
+        ledger: &mut EnergyLedger,
+        s: &State,
+        (squares, open_dissipation): (f64, f64),
+        approach: f64,
+        step: u64,
+        t1: f64,
+    ) -> Result<()> {
+        finite(s, t1)?;
+        let acceleration = model.accelerations(t1, s, approach).0;
+        let damper = self
+            .damper
+            .corrected(squares, s.main_velocity, acceleration);
+        let losses = self.closed + open_dissipation + damper - ledger.external();
+        ledger.check(model.energy(s), losses, t1)?;
+        if step % INTERRUPT_INTERVAL == 0 && (self.interrupt)() {
+            return Err(Error::Interrupted { time: t1 });
+        }
+        Ok(())
+    }
+}
+
+/// A state no longer finite at `time` ends the run.
+#[inline(always)]
+fn finite(s: &State, time: f64) -> Result<()> {
+    if s.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::NumericalBlowUp {
+            time,
+            reason: "the state is no longer finite",
+        })
+    }
+}
+
+/// Free flight: the bodies apart, no history row due before step `bound`:
+/// the step alone, with the trapezoidal sum of the damper's work and the
+/// energy checks due (`check`, out of line), until a step ends with
+/// |y - w| > d (or not finite: the comparison fails for NaN), which is
+/// handed back to the full bookkeeping. A function of its own so that the
+/// state stays in registers (in the kernel it lives in memory, its address
+/// taken by the bookkeeping).
 #[inline(never)]
+#[allow(clippy::too_many_arguments)]
 fn free_flight<L: ContactLaw, X: Excitation, I: Integrator>(
     model: &Model<L, X>,
     integrator: &mut I,
     ledger: &mut EnergyLedger,
+    mut check: Check,
     mut flight: Flight,
     bound: u64,
     t0: f64,
     dt: f64,
-) -> Flight {
+) -> Result<Flight> {
     let d = model.clearance;
     let (mut s, mut n, mut squares) = (flight.state, flight.steps, flight.squares);
-    while n + 1 < bound {
-        let t = t0 + n as f64 * dt;
-        // The provisional latch (not computed where the law ignores it).
-        let latch = model.side(&s) * s.relative_velocity();
-        let s1 = integrator.step(model, &s, t, dt, latch);
-        // Fails for NaN too: a state no longer finite goes to the checks.
-        let apart = s1.relative_displacement().abs() <= d;
-        if !apart {
-            flight.pending = Some(s1);
-            flight.approach = latch;
-            break;
+    'flight: while n + 1 < bound {
+        // The steps to the next check (or to the step before the bound).
+        let until = ledger.next_due(n).min(bound - 1);
+        while n < until {
+            let t = t0 + n as f64 * dt;
+            // The provisional latch (not computed where the law ignores it).
+            let latch = model.side(&s) * s.relative_velocity();
+            let s1 = integrator.step(model, &s, t, dt, latch);
+            // Fails for NaN too: a state no longer finite goes to the checks.
+            let apart = s1.relative_displacement().abs() <= d;
+            if !apart {
+                flight.pending = Some(s1);
+                flight.approach = latch;
+                break 'flight;
+            }
+            squares += s1.main_velocity * s1.main_velocity;
+            ledger.external_step(model, t, dt, &s, &s1);
+            s = s1;
+            n += 1;
         }
-        squares += s1.main_velocity * s1.main_velocity;
-        ledger.external_step(model, t, dt, &s, &s1);
-        s = s1;
-        n += 1;
+        if ledger.due(n, false) {
+            // Not the last step (n < bound): as the kernel checks it. The
+            // bodies are apart, so the accelerations do not read the latch.
+            let t1 = t0 + n as f64 * dt;
+            let at = s;
+            let latch = model.side(&at) * at.relative_velocity();
+            check.run(model, ledger, &at, (squares, 0.0), latch, n, t1)?;
+        }
     }
     (flight.state, flight.steps, flight.squares) = (s, n, squares);
-    flight
+    Ok(flight)
+}
+
+/// Contact flight: the bodies in contact `oc`, no history row due before
+/// step `bound` (`ends` is `(bound, t0, dt, located)`): the step with the
+/// contact's sums ([`OpenContact`]) and the energy checks due, until a
+/// step ends the contact (or is not finite), which is handed back to the
+/// full bookkeeping. A function of its own for the reasons of
+/// [`free_flight`].
+#[inline(never)]
+fn contact_flight<L: ContactLaw, X: Excitation, I: Integrator>(
+    model: &Model<L, X>,
+    integrator: &mut I,
+    ledger: &mut EnergyLedger,
+    mut check: Check,
+    oc: &mut OpenContact,
+    mut flight: Flight,
+    (bound, t0, dt, located): (u64, f64, f64, bool),
+) -> Result<Flight> {
+    let approach = flight.approach;
+    let (mut s, mut n, mut squares) = (flight.state, flight.steps, flight.squares);
+    let mut contact = *oc;
+    'flight: while n + 1 < bound {
+        let until = ledger.next_due(n).min(bound - 1);
+        while n < until {
+            let t = t0 + n as f64 * dt;
+            let s1 = integrator.step(model, &s, t, dt, approach);
+            let gaps = contact.gaps(model, &s, &s1, dt);
+            // Fails for NaN too.
+            if !(gaps.1 > 0.0 && s1.is_finite()) {
+                flight.pending = Some(s1);
+                break 'flight;
+            }
+            squares += s1.main_velocity * s1.main_velocity;
+            ledger.external_step(model, t, dt, &s, &s1);
+            contact.deepest(located, gaps);
+            contact.pressed(model, &s1, dt, approach);
+            s = s1;
+            n += 1;
+        }
+        if ledger.due(n, false) {
+            // Not the last step (n < bound): as the kernel checks it.
+            let t1 = t0 + n as f64 * dt;
+            let at = s;
+            let sums = (squares, contact.dissipated);
+            check.run(model, ledger, &at, sums, approach, n, t1)?;
+        }
+    }
+    *oc = contact;
+    (flight.state, flight.steps, flight.squares) = (s, n, squares);
+    Ok(flight)
 }
 
 /// The non-conservative work outside the contact (main damper minus external
