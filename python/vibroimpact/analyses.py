@@ -91,10 +91,13 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
             f"parameter {path!r}: must be a dotted path into a section ({', '.join(_SECTIONS)}),"
             ' such as "excitation.0.frequency"'
         )
+    with_parameter_path_check(path, "")
     node: Any = out
     for depth, key in enumerate(parts[:-1]):
         try:
             if isinstance(node, list):
+                if not (key.isascii() and key.isdigit()):
+                    raise ValueError(key)  # an index counts from 0, never from the end
                 node = node[int(key)]
             else:
                 if key not in node and depth == 0 and key in ("gravity", "initial", "output"):
@@ -364,6 +367,12 @@ class SweepPoint:
         }
 
 
+#: The most values a ``[sweep]`` may step through (``count``), or a ``[continuation]``
+#: find (``max_points``): each is a point of the result kept in memory and hundreds of
+#: forcing periods of computing.
+MAX_POINTS = 100_000
+#: The most starts of ``[basins]`` (``x.count`` times ``y.count``).
+MAX_STARTS = 1_000_000
 _DIRECTIONS = ("up", "down", "both")
 _SPACINGS = ("linear", "log")
 _SWEEP = {
@@ -391,6 +400,8 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     for key, low in (("count", 1), ("settle_periods", 0), ("record_periods", 1)):
         if out[key] < low:
             raise AnalysisError(f"[sweep] {key}: must be >= {low}, got {out[key]}")
+    if out["count"] > MAX_POINTS:
+        raise AnalysisError(f"[sweep] count: must be at most {MAX_POINTS}, got {out['count']}")
     if not out["tolerance"] > 0:
         raise AnalysisError(f"[sweep] tolerance: must be > 0, got {out['tolerance']}")
     if out["spacing"] == "log" and not (out["start"] > 0 and out["stop"] > 0):
@@ -420,6 +431,10 @@ def continuation_settings(table: Any) -> dict[str, Any]:
     for key, low in (("periods", 1), ("max_points", 2)):
         if out[key] < low:
             raise AnalysisError(f"[continuation] {key}: must be >= {low}, got {out[key]}")
+    if out["max_points"] > MAX_POINTS:
+        raise AnalysisError(
+            f"[continuation] max_points: must be at most {MAX_POINTS}, got {out['max_points']}"
+        )
     for key in ("step", "tolerance"):
         if out[key] is not None and not out[key] > 0:
             raise AnalysisError(f"[continuation] {key}: must be > 0, got {out[key]}")
@@ -463,7 +478,7 @@ def basins_settings(table: Any) -> dict[str, Any]:
             raise AnalysisError(f"[basins] missing key {axis!r} ({{state, start, stop, count}})")
         checked = _table(f"[basins] {axis}.", table[axis], _AXIS)
         name, _, index = checked["state"].partition(".")
-        if name not in _STATE_KEYS or not index.isdigit():
+        if name not in _STATE_KEYS or not (index.isascii() and index.isdigit()):
             raise AnalysisError(
                 f"[basins] {axis}.state: must be one of {', '.join(_STATE_KEYS)} with an "
                 f'index, such as "structure_displacement.0", got {checked["state"]!r}'
@@ -471,6 +486,18 @@ def basins_settings(table: Any) -> dict[str, Any]:
         if checked["count"] < 1:
             raise AnalysisError(f"[basins] {axis}.count: must be >= 1, got {checked['count']}")
         out[axis] = checked
+    x, y = (out[a]["state"].partition(".") for a in ("x", "y"))
+    if (x[0], int(x[2])) == (y[0], int(y[2])):
+        raise AnalysisError(
+            f"[basins] y.state: must differ from x.state, both {out['y']['state']!r}: the "
+            "grid is over two entries of [initial]"
+        )
+    starts = out["x"]["count"] * out["y"]["count"]
+    if starts > MAX_STARTS:
+        raise AnalysisError(
+            f"[basins] x.count, y.count: {out['x']['count']} x {out['y']['count']} = {starts} "
+            f"starts, more than {MAX_STARTS}; lower the counts"
+        )
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
         if out[key] < low:
             raise AnalysisError(f"[basins] {key}: must be >= {low}, got {out[key]}")
@@ -494,13 +521,18 @@ def state_index(path: str, n: int, k: int) -> int:
 
 
 def with_parameter_path_check(path: str, section: str = "[sweep]") -> None:
-    """Refuse a ``parameter`` that is not a dotted path into a section."""
+    """Refuse a ``parameter`` that is not a dotted path into a section, or whose
+    index is not a whole number from 0 (``-1`` would count from the end)."""
     parts = path.split(".")
+    where = f"{section} parameter" if section else f"parameter {path!r}"
     if parts[0] not in _SECTIONS or len(parts) < 2 or "" in parts:
         raise AnalysisError(
-            f"{section} parameter: must be a dotted path into a section "
+            f"{where}: must be a dotted path into a section "
             f'({", ".join(_SECTIONS)}), such as "excitation.0.frequency", got {path!r}'
         )
+    for part in parts[1:]:
+        if part.lstrip("+-").isdigit() and not (part.isascii() and part.isdigit()):
+            raise AnalysisError(f"{where}: {part!r} in {path!r}: an index is a whole number from 0")
 
 
 def sweep_values(settings: Mapping[str, Any]) -> np.ndarray:

@@ -24,7 +24,7 @@ from vibroimpact.analyses import (
 )
 from vibroimpact.continuation import continue_orbit
 from vibroimpact.maps import basins, bifurcation, poincare
-from vibroimpact.output import UsageError, finite_or_none
+from vibroimpact.output import UsageError, check_output, finite_or_none
 from vibroimpact.scenario import load_scenario
 from vibroimpact.system_scenario import SystemScenario
 
@@ -478,6 +478,8 @@ def _naming_the_file(
     file as the errors of reading it are."""
 
     def run(args: argparse.Namespace) -> int:
+        if getattr(args, "plot", None):
+            check_output(args.plot, "--plot", [args.scenario])
         try:
             return command(args)
         except InvalidInputError as err:

@@ -30,7 +30,8 @@ from vibroimpact._core import (
     __version__,
 )
 from vibroimpact.analysis_commands import COMMANDS, add_commands
-from vibroimpact.output import UsageError, finite_or_none, written_whole
+from vibroimpact.messages import short_numbers
+from vibroimpact.output import UsageError, check_output, finite_or_none, written_whole
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
 from vibroimpact.study_commands import add_command as add_study
@@ -197,13 +198,15 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
     if args.json:
         print(json.dumps(system_summary(scenario, sol, cpu_time)))
         return 0
-    print("\n".join(system_lines(str(args.scenario), sol, cpu_time)))
+    print("\n".join(system_lines(str(args.scenario), sol, cpu_time, scenario.prepared.output)))
     if args.out:
         print(f"history ({len(sol.t)} rows) written to {args.out}")
     return 0
 
 
 def _simulate(args: argparse.Namespace) -> int:
+    if args.out:
+        check_output(args.out, "--out", [args.scenario] if args.scenario else [])
     scenario = load_scenario(args.scenario) if args.scenario else paper_collision()
     keeps = (
         scenario.prepared.output["history"]
@@ -285,11 +288,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             return run_study_command(args)
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
-        print(f"vibroimpact: error: {err}", file=sys.stderr)
+        print(f"vibroimpact: error: {short_numbers(str(err))}", file=sys.stderr)
         return 2
     except (NumericalBlowUpError, SimulationError) as err:
         # The input was valid but the run could not be completed.
-        print(f"vibroimpact: error: {err}", file=sys.stderr)
+        print(f"vibroimpact: error: {short_numbers(str(err))}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("vibroimpact: interrupted", file=sys.stderr)

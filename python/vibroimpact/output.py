@@ -11,7 +11,7 @@ import math
 import os
 import secrets
 import stat
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import IO, Any
 
@@ -27,6 +27,49 @@ class UsageError(Exception):
     path that cannot be written (exit status 2)."""
 
 
+def _regular_or_absent(path: Path) -> os.stat_result | None:
+    """The status of what ``path`` names (links followed), None when nothing does;
+    :class:`UsageError` when it is not a regular file (a device, a FIFO, a folder),
+    which writing a file there would replace or block on."""
+    try:
+        status = os.stat(path)
+    except FileNotFoundError:
+        return None
+    except OSError:
+        return None  # let the write say what is wrong
+    if not stat.S_ISREG(status.st_mode):
+        raise UsageError(
+            f"cannot write {str(path)!r}: it exists and is not a regular file (a folder, a "
+            "device or a FIFO); choose a file name"
+        )
+    return status
+
+
+def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
+    """Refuse, before anything runs, an output ``path`` given as ``flag`` (such as
+    ``--out``) that exists and is not a regular file, or that is one of the ``inputs``
+    (the scenario file: writing the output there would replace it)."""
+    try:
+        status = _regular_or_absent(path)
+    except UsageError:
+        raise UsageError(
+            f"{flag} {path}: exists and is not a regular file (a folder, a device or a "
+            "FIFO); give the path of a file to write"
+        ) from None
+    if status is None:
+        return
+    for source in inputs:
+        try:
+            same = os.path.samefile(path, source)
+        except OSError:
+            continue
+        if same:
+            raise UsageError(
+                f"{flag} {path}: is the scenario file {str(source)!r} itself, which the "
+                "output would replace; choose another name"
+            )
+
+
 @contextlib.contextmanager
 def written_whole(path: Path, binary: bool = False) -> Iterator[IO[Any]]:
     """Open a file to write ``path`` whole or not at all.
@@ -35,13 +78,16 @@ def written_whole(path: Path, binary: bool = False) -> Iterator[IO[Any]]:
     cross file systems), renamed over ``path`` only when the ``with`` block ends
     normally and the data is on disk. If the block raises, is interrupted, or
     the disk fills up, the temporary file is removed and an existing ``path`` is
-    left as it was. A file that cannot be written raises :class:`UsageError`
-    naming it; other errors propagate unchanged.
+    left as it was. A file that cannot be written, or a ``path`` that names
+    something other than a regular file (a device, a FIFO, a folder), raises
+    :class:`UsageError` naming it; other errors propagate unchanged.
     """
     temporary = None
     if path.is_symlink():
         # Write the file the link points to, as open() would, and keep the link.
         path = path.resolve()
+    # Never rename a file over a device, a FIFO or a folder.
+    _regular_or_absent(path)
     try:
         while True:
             # Named before it is created, so that an interrupt (SIGTERM, Ctrl-C)

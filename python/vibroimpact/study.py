@@ -14,6 +14,7 @@ The ``[study]`` section::
     metrics = ["peak", "rms", "impacts", "energy_dissipated",
                "amplitude", "impacts_per_period", "settled"]
                # orbit: "amplitude", "impacts_per_period", "stable", "largest_multiplier"
+               # default: "peak", "rms", "impacts"; for an orbit, its four
     chunk_size = 1024              # runs a chunk (what a resume can lose at most)
 
     samples = 100                  # Monte Carlo: runs of random draws at each grid point
@@ -157,9 +158,25 @@ class StudyError(AnalysisError):
     """A study that cannot be set up as asked (a ValueError)."""
 
 
-def study_settings(table: Any) -> dict[str, Any]:
+#: The most runs a study may hold (the product of its axes' counts, times ``samples``):
+#: its metrics and their reasons are gathered in memory at the end (about 100 bytes a
+#: run and metric), and ten million runs are hours of computing already.
+MAX_STUDY_RUNS = 10_000_000
+
+
+def checked_study_settings(table: Any) -> dict[str, Any]:
+    """The ``[study]`` section checked as :func:`study_settings` checks it, without
+    making its axes' values or its random draws: ``axes`` and ``random`` are left as
+    given. What reading a scenario does, so that a command other than ``study`` never
+    allocates them."""
+    return study_settings(table, build=False)
+
+
+def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
     """The ``[study]`` section checked, with its defaults; each axis as its list of
-    values (``axes``: a dict, path to array)."""
+    values (``axes``: a dict, path to array). Every count is checked, and the runs
+    bounded by :data:`MAX_STUDY_RUNS`, before any array is made; ``build=False``
+    makes none (see :func:`checked_study_settings`)."""
     if not isinstance(table, Mapping):
         raise StudyError(f"[study]: must be a table, got {table!r:.60}")
     sections = ("metrics", "axes", "random")
@@ -173,7 +190,9 @@ def study_settings(table: Any) -> dict[str, Any]:
     out = _table("[study] ", plain, _STUDY)
     _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
     _choice("[study] ", "stepping", out["stepping"], _STEPPINGS)
-    metrics = table.get("metrics", ["peak", "rms", "impacts"])
+    # By default what the analysis keeps (an orbit's own metrics, none of a run's).
+    default = _ANALYSIS_METRICS["orbit"] if out["analysis"] == "orbit" else _FIXED_METRICS
+    metrics = table.get("metrics", list(default))
     if isinstance(metrics, str) or not isinstance(metrics, Sequence) or not metrics:
         raise StudyError(f"[study] metrics: must be a list of names, got {metrics!r:.60}")
     for name in metrics:
@@ -218,10 +237,10 @@ def study_settings(table: Any) -> dict[str, Any]:
             "[study.axes]: required, a table of dotted paths to a list of values or "
             "{start, stop, count}"
         )
-    out["axes"] = {str(path): _axis_values(str(path), spec) for path, spec in axes.items()}
-    for path, values in out["axes"].items():
-        if _is_seed(path):
-            _check_seeds(f"[study.axes] {path!r}: ", values)
+    counts = {}
+    for path, spec in axes.items():
+        _check_path(f"[study.axes] {str(path)!r}: ", str(path))
+        counts[str(path)] = _axis_count(str(path), spec)
     random = table.get("random", {})
     if not isinstance(random, Mapping):
         raise StudyError("[study.random]: must be a table of dotted paths to distributions")
@@ -231,16 +250,71 @@ def study_settings(table: Any) -> dict[str, Any]:
         raise StudyError(
             "[study] samples: needs [study.random] (the parameters drawn for each sample)"
         )
+    for path, spec in random.items():
+        path = str(path)
+        _check_path(f"[study.random] {path!r}: ", path)
+        if path in counts:
+            raise StudyError(f"[study.random] {path!r}: is also an axis")
+        _distribution(path, spec, out["samples"])
+    runs = math.prod(counts.values()) * max(out["samples"], 1)
+    if runs > MAX_STUDY_RUNS:
+        sizes = " x ".join(f"{path} {count}" for path, count in counts.items())
+        keys = "[study.axes] count"
+        if out["samples"]:
+            sizes += f" x samples {out['samples']}"
+            keys = "[study] samples, [study.axes] count"
+        raise StudyError(
+            f"{keys}: the study would make {runs:.3g} runs ({sizes}), more than "
+            f"{MAX_STUDY_RUNS:,}; lower the counts or samples, or split the study"
+        )
+    if not build:
+        return {**out, "axes": dict(axes), "random": dict(random)}
+    out["axes"] = {str(path): _axis_values(str(path), spec) for path, spec in axes.items()}
+    for path, values in out["axes"].items():
+        if _is_seed(path):
+            _check_seeds(f"[study.axes] {path!r}: ", values)
     # Every distribution from one generator seeded by `seed`, in the order given:
     # the same draws on every platform (numpy's PCG64), the same for every grid point.
     generator = np.random.default_rng(out["seed"])
     out["random"] = {}
     for path, spec in random.items():
-        path = str(path)
-        if path in out["axes"]:
-            raise StudyError(f"[study.random] {path!r}: is also an axis")
-        out["random"][path] = _draws(path, spec, out["samples"], generator)
+        out["random"][str(path)] = _draws(str(path), spec, out["samples"], generator)
     return out
+
+
+def _check_path(where: str, path: str) -> None:
+    """Refuse a dotted path whose index is not a whole number from 0 (``-1``, ``+1``):
+    Python would read a negative one from the end."""
+    for part in path.split(".")[1:]:
+        if part.lstrip("+-").isdigit() and not (part.isascii() and part.isdigit()):
+            raise StudyError(f"{where}{part!r}: an index is a whole number from 0")
+
+
+def _axis_count(path: str, spec: Any) -> int:
+    """The number of values of an axis, checked (and a seed axis's values) without
+    making them."""
+    where = f"[study.axes] {path!r}: "
+    if not isinstance(spec, Mapping):
+        return len(_axis_values(path, spec))
+    axis = _table(where, spec, _AXIS)
+    _choice(where, "spacing", axis["spacing"], _SPACINGS)
+    count: int = axis["count"]
+    if count < 1:
+        raise StudyError(f"{where}count: must be >= 1, got {count}")
+    if count > MAX_STUDY_RUNS:
+        raise StudyError(f"{where}count: must be at most {MAX_STUDY_RUNS:,}, got {count}")
+    if axis["spacing"] == "log" and not (axis["start"] > 0 and axis["stop"] > 0):
+        raise StudyError(f'{where}start, stop: must be > 0 for spacing = "log"')
+    if _is_seed(path):
+        # The ends, and the step between them: all whole when these are.
+        step = (axis["stop"] - axis["start"]) / (count - 1) if count > 1 else 0.0
+        _check_seeds(where, np.array([axis["start"], axis["stop"]]))
+        if not float(step).is_integer():
+            raise StudyError(
+                f"{where}a seed must be a whole number in [0, 2^53]: start, stop and count "
+                f"give a step of {step!r}"
+            )
+    return count
 
 
 def _is_seed(path: str) -> bool:
@@ -259,7 +333,9 @@ def _check_seeds(where: str, values: np.ndarray) -> None:
         raise StudyError(f"{where}a seed must be a whole number in [0, 2^53], got {float(bad[0])}")
 
 
-def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -> np.ndarray:
+def _distribution(path: str, spec: Any, samples: int) -> tuple[str, float, float]:
+    """A ``[study.random]`` entry checked: its law and two numbers (``"from"``, the
+    first seed and the last, for a seed)."""
     where = f"[study.random] {path!r}: "
     if _is_seed(path):
         # A seed of its own for each sample: from, from + 1, ... (no draw taken).
@@ -268,10 +344,14 @@ def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -
             raise StudyError(
                 f"{where}a seed is given as {{from = N}}: seed N + k for sample k, got {spec!r:.40}"
             )
-        seeds = np.arange(samples, dtype=float) + first
-        _check_seeds(where, seeds)
-        return seeds
-    if not isinstance(spec, Mapping) or len(spec) != 1 or next(iter(spec)) not in _LAWS:
+        _check_seeds(where, np.array([first, first + max(samples - 1, 0)], dtype=float))
+        return "from", float(first), float(first + max(samples - 1, 0))
+    if (
+        not isinstance(spec, Mapping)
+        or len(spec) != 1
+        or not isinstance(next(iter(spec)), str)
+        or next(iter(spec)) not in _LAWS
+    ):
         raise StudyError(
             f"{where}must be one of {{uniform = [low, high]}}, {{normal = [mean, std]}} "
             "(or {from = N} for a seed)"
@@ -286,12 +366,20 @@ def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -
     ):
         raise StudyError(f"{where}{law} must be two finite numbers, got {bounds!r:.40}")
     a, b = float(bounds[0]), float(bounds[1])
-    if law == "uniform":
-        if not a < b:
-            raise StudyError(f"{where}uniform needs low < high, got [{a}, {b}]")
-        return generator.uniform(a, b, samples)
-    if not b >= 0:
+    if law == "uniform" and not a < b:
+        raise StudyError(f"{where}uniform needs low < high, got [{a}, {b}]")
+    if law == "normal" and not b >= 0:
         raise StudyError(f"{where}normal needs std >= 0, got {b}")
+    return law, a, b
+
+
+def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -> np.ndarray:
+    """A ``[study.random]`` entry's values for the samples (seeds: no draw taken)."""
+    law, a, b = _distribution(path, spec, samples)
+    if law == "from":
+        return np.arange(samples, dtype=float) + a
+    if law == "uniform":
+        return generator.uniform(a, b, samples)
     return generator.normal(a, b, samples)
 
 
@@ -301,13 +389,9 @@ _LAWS = ("uniform", "normal")
 def _axis_values(path: str, spec: Any) -> np.ndarray:
     where = f"[study.axes] {path!r}: "
     if isinstance(spec, Mapping):
+        _axis_count(path, spec)
         axis = _table(where, spec, _AXIS)
-        _choice(where, "spacing", axis["spacing"], _SPACINGS)
-        if axis["count"] < 1:
-            raise StudyError(f"{where}count: must be >= 1, got {axis['count']}")
         if axis["spacing"] == "log":
-            if not (axis["start"] > 0 and axis["stop"] > 0):
-                raise StudyError(f'{where}start, stop: must be > 0 for spacing = "log"')
             return np.geomspace(axis["start"], axis["stop"], axis["count"])
         return np.linspace(axis["start"], axis["stop"], axis["count"])
     if isinstance(spec, str) or not isinstance(spec, Sequence) or not spec:

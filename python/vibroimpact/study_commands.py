@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 from pathlib import Path
 from typing import Any
@@ -11,10 +12,14 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.output import UsageError
+from vibroimpact.output import UsageError, check_output
 from vibroimpact.scenario import load_scenario
 from vibroimpact.study import output_kind, run, study_of, terminal_progress
 from vibroimpact.system_scenario import SystemScenario
+
+#: The most threads (or Dask processes) a study may ask for: more than any machine's
+#: cores, far fewer than would exhaust its threads.
+MAX_WORKERS = 1024
 
 
 def add_command(sub: Any) -> None:
@@ -41,7 +46,12 @@ def add_command(sub: Any) -> None:
         help="NetCDF file (.nc) or Zarr store (.zarr; needs vibroimpact[zarr]) to write",
     )
     parser.add_argument(
-        "--workers", type=int, default=0, metavar="N", help="threads (default: all cores)"
+        "--workers",
+        type=int,
+        default=0,
+        metavar="N",
+        help=f"threads, or processes with --dask local (default 0: all cores; at most "
+        f"{MAX_WORKERS})",
     )
     parser.add_argument(
         "--dask",
@@ -63,10 +73,16 @@ def add_command(sub: Any) -> None:
 
 
 def run_study_command(args: argparse.Namespace) -> int:
-    if args.workers < 0:
-        raise UsageError(f"--workers must be >= 0 (0: all cores), got {args.workers}")
+    if not 0 <= args.workers <= MAX_WORKERS:
+        raise UsageError(
+            f"--workers must be in [0, {MAX_WORKERS}] (0: all cores, {os.cpu_count() or 1} "
+            f"here), got {args.workers}"
+        )
     # The output's suffix (and zarr, for a store) before anything runs.
-    output_kind(args.out)
+    if output_kind(args.out) != ".zarr":
+        check_output(args.out, "--out", [args.scenario])
+    if args.plot:
+        check_output(args.plot, "--plot", [args.scenario])
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
         raise UsageError(f"{args.scenario}: study takes a 0.2 scenario (a [structure] section)")

@@ -35,7 +35,9 @@ A system is described by the same sections as a TOML scenario (SI units):
 from __future__ import annotations
 
 import difflib
+import io
 import math
+import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,6 +53,7 @@ from vibroimpact._core import (
 )
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
+from vibroimpact.messages import short_numbers, shown
 
 __all__ = [
     "PreparedRun",
@@ -192,8 +195,14 @@ _SIGNAL_KEYS: dict[str, set[str]] = {
 
 
 def _choice(where: str, key: str, value: Any, choices: Sequence[str]) -> None:
+    """Refuse a ``value`` of ``key`` that is not one of the strings ``choices`` (or not a
+    string at all: a list or a table is named as such, never looked up)."""
+    listed = ", ".join(f'"{c}"' for c in choices)
+    if value is None:
+        raise _fail(where, f"missing key {key!r} (one of {listed})")
+    if not isinstance(value, str):
+        raise _fail(where, f"{key} must be one of {listed} (a string), got {shown(value)}")
     if value not in choices:
-        listed = ", ".join(f'"{c}"' for c in choices)
         raise _fail(where, f'{key} must be one of {listed}, got "{value}"')
 
 
@@ -203,8 +212,10 @@ def _check_law(where: str, d: Mapping[str, Any], given: Mapping[str, Any]) -> No
     ``given`` is the table as written, to tell a key left out from its default."""
     if d["law"] == "rigid":
         e = d["restitution"]
-        if e is None or not 0.0 <= e <= 1.0:
-            raise _fail(where, f'law "rigid" needs restitution in [0, 1], got {e}')
+        if e is None:
+            raise _fail(where, "missing key 'restitution' (law \"rigid\" needs one in [0, 1])")
+        if not 0.0 <= e <= 1.0:
+            raise _fail(where, f'law "rigid" needs restitution in [0, 1], got {e!r}')
         for key in ("stiffness", "damping"):
             if key in given:
                 raise _fail(where, f'{key} applies to compliant laws only, not to law "rigid"')
@@ -217,7 +228,9 @@ def _check_law(where: str, d: Mapping[str, Any], given: Mapping[str, Any]) -> No
             restitution=d["restitution"],
         )
     except InvalidInputError as err:
-        message = str(err).replace("law must be one of ", 'law must be one of "rigid", ')
+        message = short_numbers(str(err)).replace(
+            "law must be one of ", 'law must be one of "rigid", '
+        )
         raise _fail(where, message) from None
     if d["stiffness"] is None:
         raise _fail(where, f'law {d["law"]!r} needs a stiffness (N/m^1.5, N/m for "linear")')
@@ -227,44 +240,83 @@ def _fail(where: str, message: str) -> InvalidInputError:
     return InvalidInputError(f"{where}{message}")
 
 
+def real(value: Any) -> int | float | None:
+    """``value`` as a Python int or float when it is a real number: an int, a float, a
+    NumPy integer or floating scalar, or a 0-d array of one; None for anything else,
+    booleans (Python's or NumPy's) included."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value[()]
+    if isinstance(value, bool | np.bool_):
+        return None
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    if isinstance(value, int | float):
+        return value
+    return None
+
+
 def _value(where: str, kind: str, value: Any) -> Any:
-    """``value`` checked as ``kind``: numbers finite, whole numbers in 64 bits."""
+    """``value`` checked as ``kind``: numbers finite, whole numbers in 64 bits. NumPy
+    real scalars count as numbers; booleans never do."""
     if kind == _NUMBER:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise _fail(where, f"must be a number, got {value!r:.60}")
-        if isinstance(value, int) and value not in _INT64:
+        number = real(value)
+        if number is None:
+            if _too_deep(value):
+                # Arrays within arrays thousands deep: no structure has them.
+                raise _fail("", "a value is nested too deeply (arrays within arrays)")
+            raise _fail(where, f"must be a number, got {shown(value)}")
+        if isinstance(number, int) and number not in _INT64:
             raise _fail(where, "is an integer beyond 64 bits; write it as a float (e.g. 1e30)")
-        number = float(value)
+        number = float(number)
         if not math.isfinite(number):
             raise _fail(where, f"must be a finite number, got {number}")
         return number
     if kind == _WHOLE:
-        if isinstance(value, bool) or not isinstance(value, int) or value not in range(2**63):
-            raise _fail(where, f"must be a whole number (an int in 64 bits), got {value!r:.60}")
-        return value
+        whole = real(value)
+        if not isinstance(whole, int) or whole not in range(2**63):
+            raise _fail(where, f"must be a whole number in [0, 2^63 - 1], got {shown(value)}")
+        return whole
     if kind == _TEXT:
         if not isinstance(value, str):
-            raise _fail(where, f"must be a string, got {value!r:.60}")
+            raise _fail(where, f"must be a string, got {shown(value)}")
         return value
     if kind == "boolean":
-        if not isinstance(value, bool):
-            raise _fail(where, f"must be true or false, got {value!r:.60}")
-        return value
+        if not isinstance(value, bool | np.bool_):
+            raise _fail(where, f"must be true or false, got {shown(value)}")
+        return bool(value)
     if kind == _NUMBERS:
-        if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
-            raise _fail(where, f"must be an array of numbers, got {value!r:.60}")
+        if isinstance(value, str | bytes) or not _is_array(value, 1):
+            raise _fail(where, f"must be an array of numbers, got {shown(value)}")
         return [_value(f"{where[:-2]}[{i}]: ", _NUMBER, v) for i, v in enumerate(value)]
     # _MATRIX: an array of rows.
-    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
-        raise _fail(where, f"must be an array of rows (n x n), got {value!r:.60}")
+    if isinstance(value, str | bytes) or not _is_array(value, 2):
+        raise _fail(where, f"must be an array of rows (n x n), got {shown(value)}")
     return [_value(f"{where[:-2]}[{i}]: ", _NUMBERS, row) for i, row in enumerate(value)]
+
+
+def _too_deep(value: Any, limit: int = 32) -> bool:
+    """Whether ``value`` is arrays within arrays more than ``limit`` deep."""
+    for _ in range(limit):
+        if not isinstance(value, list | tuple) or not value:
+            return False
+        value = value[0]
+    return True
+
+
+def _is_array(value: Any, ndim: int) -> bool:
+    """Whether ``value`` is a sequence, or a NumPy array of ``ndim`` dimensions."""
+    if isinstance(value, np.ndarray):
+        return value.ndim == ndim
+    return isinstance(value, Sequence)
 
 
 def _table(where: str, table: Any, schema: Mapping[str, tuple[str, Any]]) -> dict[str, Any]:
     """A table checked against ``schema``: unknown keys refused (with a suggestion),
     types checked, defaults filled, required keys demanded."""
     if not isinstance(table, Mapping):
-        raise _fail(where, f"must be a table, got {table!r:.60}")
+        raise _fail(where, f"must be a table, got {shown(table)}")
     out: dict[str, Any] = {}
     for key, value in table.items():
         if key not in schema:
@@ -284,39 +336,118 @@ def _list(name: str, value: Any) -> list[Any]:
     if isinstance(value, Mapping):
         return [value]
     if isinstance(value, str | bytes) or not isinstance(value, Sequence):
-        raise _fail("", f"{name} must be a list of tables ([[{name}]]), got {value!r:.60}")
+        raise _fail("", f"{name} must be a list of tables ([[{name}]]), got {shown(value)}")
     return list(value)
 
 
-def _read_record(path: Path, where: str) -> tuple[list[float], list[float]]:
+#: The largest CSV file a recorded signal may read (bytes): a record of millions of
+#: samples fits, a wrong path (a disk image, /dev/zero) is refused before it fills the
+#: memory.
+MAX_RECORD_BYTES = 64 * 2**20
+
+
+def _read_record(path: Path, where: str) -> tuple[list[float], list[float], list[int]]:
     """Time and value columns of a CSV file (lines starting with # and a header
-    line are skipped)."""
+    line are skipped), with the line number of each row. ``where`` names the
+    excitation and its ``file`` key. Only a regular file of at most
+    :data:`MAX_RECORD_BYTES` is read; a row must hold exactly two numbers."""
+    name = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        # Checked before opening: opening a FIFO would wait for a writer.
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):
+            raise _fail(where, f"{name!r} is not a regular file (a CSV of time and value)")
+        if info.st_size > MAX_RECORD_BYTES:
+            raise _fail(
+                where,
+                f"{name!r} is larger than {MAX_RECORD_BYTES // 2**20} MiB, the limit of a "
+                "recorded signal",
+            )
+        with path.open("rb") as f:
+            data = f.read(MAX_RECORD_BYTES + 1)
+        if len(data) > MAX_RECORD_BYTES:
+            raise _fail(
+                where,
+                f"{name!r} is larger than {MAX_RECORD_BYTES // 2**20} MiB, the limit of a "
+                "recorded signal",
+            )
+        text = data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as err:
         reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
-        raise _fail(where, f"cannot read {str(path)!r}: {reason}") from None
+        raise _fail(where, f"cannot read {name!r}: {reason}") from None
+    del data
     times: list[float] = []
     values: list[float] = []
+    lines: list[int] = []
     first = True
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(io.StringIO(text), start=1):
         line = line.strip()
         if not line or line.startswith("#"):
             continue
         cells = [c.strip() for c in line.replace(";", ",").split(",")]
         header, first = first, False
-        if len(cells) < 2:
-            raise _fail(where, f"{path.name} line {number}: needs time and value, got {line!r:.60}")
         try:
-            times.append(float(cells[0]))
-            values.append(float(cells[1]))
+            row = [float(c) for c in cells]
         except ValueError:
             if header:  # the first line may name the columns
                 continue
             raise _fail(
                 where, f"{path.name} line {number}: not two numbers: {line!r:.60}"
             ) from None
-    return times, values
+        if len(row) != 2:
+            raise _fail(
+                where,
+                f"{path.name} line {number}: needs two columns, time and value, got "
+                f"{len(row)}: {line!r:.60}",
+            )
+        times.append(row[0])
+        values.append(row[1])
+        lines.append(number)
+    return times, values, lines
+
+
+def _check_record(where: str, times: list[float], values: list[float], rows: list[str]) -> None:
+    """A record's samples as the core needs them (at least two, finite, times
+    increasing strictly), refused here so that the error names the excitation and
+    ``rows`` (each sample's place: the file's line, or the arrays' index)."""
+    if len(times) != len(values):
+        raise _fail(
+            where,
+            f"time and value must have the same length, got {len(times)} and {len(values)}",
+        )
+    if len(times) < 2:
+        raise _fail(where, f"a recorded signal needs at least 2 samples, got {len(times)}")
+    for i, (t, v) in enumerate(zip(times, values, strict=True)):
+        if not (math.isfinite(t) and math.isfinite(v)):
+            raise _fail(where, f"{rows[i]}: must be finite numbers, got time {t!r} and value {v!r}")
+        if i and not t > times[i - 1]:
+            raise _fail(
+                where,
+                f"{rows[i]}: times must increase strictly, got {t!r} s after {times[i - 1]!r} s",
+            )
+
+
+def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) -> None:
+    """A point ``at`` on the structure: a coordinate index of an oscillator or of
+    matrices, a position along a cantilever (m); ``name`` such as ``"damper 0 at"``,
+    worded as the core words it. ``given`` is the value as written, quoted in the
+    error short and exact (the core would write 1e300 as 301 digits)."""
+    if structure["kind"] == "cantilever":
+        length = structure["length"]
+        if not 0.0 <= at <= length:
+            raise _fail(
+                "",
+                f"{name} must be a position along the beam in [0, {length!r}] m, got "
+                f"{shown(given)}",
+            )
+        return
+    size = 1 if structure["kind"] == "oscillator" else len(structure["mass"])
+    if size and not (at.is_integer() and 0 <= at < size):
+        raise _fail(
+            "",
+            f"{name} must be a coordinate index, a whole number in [0, {size - 1}], got "
+            f"{shown(given)}",
+        )
 
 
 def system_spec(
@@ -330,12 +461,10 @@ def system_spec(
     """The sections of a system, checked and with their defaults filled (see the module
     docstring); errors name the section and key."""
     if not isinstance(structure, Mapping):
-        raise _fail("", f"[structure] must be a table, got {structure!r:.60}")
+        raise _fail("", f"[structure] must be a table, got {shown(structure)}")
     kind = structure.get("kind")
-    if kind not in _STRUCTURE:
-        listed = ", ".join(f'"{k}"' for k in _STRUCTURE)
-        raise _fail("[structure] ", f'kind must be one of {listed}, got "{kind}"')
-    schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[kind]}
+    _choice("[structure] ", "kind", kind, tuple(_STRUCTURE))
+    schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[str(kind)]}
     spec: dict[str, Any] = {"structure": _table("[structure] ", structure, schema)}
     if kind == "cantilever" and not 1 <= spec["structure"]["modes"] <= 200:
         raise _fail(
@@ -360,6 +489,7 @@ def system_spec(
             elif both is not None:
                 raise _fail(f"[[damper]] {j}: ", f"give clearance or {side}, not both")
         del d["clearance"]
+        _check_point(f"damper {j} at", table["at"], d["at"], spec["structure"])
         _check_law(f"[[damper]] {j}: ", d, table)
         dampers.append(d)
     spec["damper"] = dampers
@@ -367,6 +497,9 @@ def system_spec(
     for j, table in enumerate(_list("stop", stop)):
         d = _table(f"[[stop]] {j}: ", table, _STOP)
         _choice(f"[[stop]] {j}: ", "side", d["side"], _SIDES)
+        for key in ("at", "against"):
+            if d[key] is not None:
+                _check_point(f"stop {j} {key}", table[key], d[key], spec["structure"])
         _check_law(f"[[stop]] {j}: ", d, table)
         stops.append(d)
     spec["stop"] = stops
@@ -390,6 +523,8 @@ def system_spec(
             raise _fail(where, 'kind "force" needs the point it acts at: at')
         if e["kind"] == "base" and e["at"] is not None:
             raise _fail(where, 'at applies to kind "force" only: a base motion moves every point')
+        if e["at"] is not None:
+            _check_point(f"excitation {j} at", table["at"], e["at"], spec["structure"])
         extra = sorted(set(table) - {"kind", "at", "signal"} - _SIGNAL_KEYS[e["signal"]])
         if extra:
             allowed = ", ".join(sorted(_SIGNAL_KEYS[e["signal"]]))
@@ -397,16 +532,44 @@ def system_spec(
                 where,
                 f"{', '.join(extra)} not used by signal {e['signal']!r} (it takes {allowed})",
             )
+        if e["signal"] == "harmonics":
+            _check_harmonics(where, e)
         if e["file"] is not None:
             if e["time"] is not None or e["value"] is not None:
                 raise _fail(where, "give file or time and value, not both")
             path = Path(e["file"])
             if base_dir is not None and not path.is_absolute():
                 path = base_dir / path
-            e["time"], e["value"] = _read_record(path, where)
+            times, values, lines = _read_record(path, f"{where}file: ")
+            _check_record(f"{where}file: ", times, values, [f"{path.name} line {n}" for n in lines])
+            e["time"], e["value"] = times, values
+        elif e["signal"] == "recorded" and e["time"] is not None and e["value"] is not None:
+            _check_record(
+                where, e["time"], e["value"], [f"time[{i}]" for i in range(len(e["time"]))]
+            )
         excitations.append({k: v for k, v in e.items() if v is not None and k != "file"})
     spec["excitation"] = excitations
     return spec
+
+
+def _check_harmonics(where: str, e: dict[str, Any]) -> None:
+    """A sum of harmonics: as many frequencies as amplitudes, and as many phases when
+    they are given (left out, each is 0)."""
+    amplitudes, frequencies, phases = e["amplitudes"], e["frequencies"], e["phases"]
+    if amplitudes is None or frequencies is None:
+        return  # the core names the key that is missing
+    if len(frequencies) != len(amplitudes):
+        raise _fail(
+            where,
+            f"amplitudes and frequencies must have the same length, got {len(amplitudes)} "
+            f"and {len(frequencies)}",
+        )
+    if phases is not None and len(phases) != len(amplitudes):
+        raise _fail(
+            where,
+            f"phases must have one entry per amplitude ({len(amplitudes)}), got "
+            f"{len(phases)}; or leave phases out (each 0)",
+        )
 
 
 @dataclass(frozen=True)
@@ -611,15 +774,19 @@ class PreparedRun:
     def run(self) -> SystemSolution:
         """Integrate it."""
         init, solver, output = self.initial, self.solver, self.output
-        raw = _simulate_system(
-            self.binding_spec(),
-            [init[k] for k in _INITIAL],
-            **self.method_arguments(),
-            every=output["every"],
-            history=output["history"],
-            record_from=output["record_from"],
-            strobe_period=output["strobe_period"],
-        )
+        try:
+            raw = _simulate_system(
+                self.binding_spec(),
+                [init[k] for k in _INITIAL],
+                **self.method_arguments(),
+                every=output["every"],
+                history=output["history"],
+                record_from=output["record_from"],
+                strobe_period=output["strobe_period"],
+            )
+        except InvalidInputError as err:
+            # The core writes its numbers in full: 1e300 as 301 digits.
+            raise type(err)(short_numbers(str(err))) from None
         return _solution(raw, solver["method"])
 
 

@@ -84,9 +84,10 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
         raise InvalidInputError(f"{source}: {err}") from None
     data = dict(data)
     from vibroimpact.analyses import SETTINGS
-    from vibroimpact.study import study_settings
+    from vibroimpact.study import checked_study_settings
 
-    for section, check in {**SETTINGS, "study": study_settings}.items():
+    # [study] is checked, its axes and draws left unmade (a study makes them).
+    for section, check in {**SETTINGS, "study": checked_study_settings}.items():
         if section in data:
             try:
                 data[section] = check(data[section])
@@ -99,8 +100,26 @@ def system_summary(
     scenario: SystemScenario, sol: SystemSolution, cpu_time: float
 ) -> dict[str, Any]:
     """The JSON-ready summary of a run (SI units): settings, statistics, the final state,
-    the energy balance and the contacts with the pair each belongs to."""
+    the energy balance, the contacts with the pair each belongs to and, when ``[output]``
+    asks for them, the reductions: from ``record_from`` the ``peak`` and ``rms`` of each
+    structure coordinate (m) over ``recorded_time`` (s), every ``strobe_period`` the
+    ``strobe`` states (rows of the history's columns but ``t``) at ``strobe_time``."""
     solver = scenario.solver
+    output = scenario.prepared.output
+    reductions: dict[str, Any] = {}
+    if output["record_from"] is not None:
+        reductions |= {
+            "record_from": output["record_from"],
+            "recorded_time": sol.recorded_time,
+            "peak": [finite_or_none(float(v)) for v in sol.peak],
+            "rms": [finite_or_none(float(v)) for v in sol.rms],
+        }
+    if output["strobe_period"] is not None:
+        reductions |= {
+            "strobe_period": output["strobe_period"],
+            "strobe_time": [float(v) for v in sol.strobe_time],
+            "strobe": [[float(v) for v in row] for row in sol.strobe],
+        }
     return {
         "method": sol.method,
         "dt": solver.get("dt"),
@@ -118,6 +137,7 @@ def system_summary(
             {k: (v if isinstance(v, str) else finite_or_none(v)) for k, v in row.items()}
             for row in sol.contacts.to_dicts()
         ],
+        **reductions,
     }
 
 
@@ -145,8 +165,11 @@ def write_system_history(path: Path, sol: SystemSolution) -> None:
             writer.writerow(repr(float(v)) for v in row)
 
 
-def system_lines(name: str, sol: SystemSolution, cpu_time: float) -> list[str]:
-    """What ``vibroimpact simulate`` prints for a 0.2 run."""
+def system_lines(
+    name: str, sol: SystemSolution, cpu_time: float, output: dict[str, Any] | None = None
+) -> list[str]:
+    """What ``vibroimpact simulate`` prints for a 0.2 run (with the reductions that
+    ``output``, the checked ``[output]`` section, asks for)."""
     e = sol.energy
     lines = [
         f"{name}: {sol.method}, {sol.steps} steps ({sol.rejected_steps} rejected, "
@@ -168,8 +191,21 @@ def system_lines(name: str, sol: SystemSolution, cpu_time: float) -> list[str]:
                 )
             )
         ),
-        f"{len(sol.contacts)} contact(s)",
     ]
+    output = output or {}
+    if output.get("record_from") is not None:
+        lines.append(
+            f"from t = {output['record_from']:g} s ({sol.recorded_time:g} s recorded): peak (m) "
+            + ", ".join(f"{v:.7g}" for v in sol.peak)
+            + "; rms (m) "
+            + ", ".join(f"{v:.7g}" for v in sol.rms)
+        )
+    if output.get("strobe_period") is not None:
+        lines.append(
+            f"{len(sol.strobe_time)} stroboscopic state(s), every {output['strobe_period']:g} s "
+            "(--json prints them: strobe, strobe_time)"
+        )
+    lines.append(f"{len(sol.contacts)} contact(s)")
     if len(sol.contacts):
         head = [
             "pair",
