@@ -480,3 +480,43 @@ def test_a_negative_seed_says_what_is_allowed() -> None:
 def test_a_missing_rigid_restitution_is_said_missing() -> None:
     message = parse_error(BASE.replace("restitution = 0.6\n", "", 1))
     assert "missing key 'restitution'" in message and "None" not in message
+
+
+@pytest.mark.parametrize(
+    ("make", "field"),
+    [
+        (
+            lambda: vi.ImpactDamper(main_mass="1", stiffness=1.0, impact_mass=0.25, clearance=0.01),
+            "main_mass",
+        ),
+        (
+            lambda: vi.ImpactDamper(
+                main_mass=True, stiffness=1.0, impact_mass=0.25, clearance=0.01
+            ),
+            "main_mass",
+        ),
+        (
+            lambda: vi.ImpactDamper(
+                main_mass=1.0, stiffness=[1.0], impact_mass=0.25, clearance=0.01
+            ),
+            "stiffness",
+        ),
+        (lambda: vi.Contact(None, stiffness=3000.0), "law"),  # type: ignore[arg-type]
+        (lambda: vi.Contact("hertz", stiffness="3e3"), "stiffness"),
+        (lambda: vi.InitialState(impact_velocity=None), "impact_velocity"),
+    ],
+)
+def test_the_compiled_constructors_name_the_field_of_a_wrong_type(
+    make: Callable[[], object], field: str
+) -> None:
+    # PyO3's own conversions raise a TypeError; the standard is a ValueError subclass
+    # naming the field (booleans are not numbers here, as in simulate_system).
+    with pytest.raises(ValueError, match=f"^{field} must be a"):
+        make()
+
+
+def test_the_compiled_constructors_take_numpy_reals() -> None:
+    damper = vi.ImpactDamper(
+        main_mass=np.float32(1.0), stiffness=np.int64(1), impact_mass=0.25, clearance=0.01
+    )
+    assert (damper.main_mass, damper.stiffness) == (1.0, 1.0)

@@ -2,6 +2,7 @@
 //! from Python ints of any size, as InvalidInputError naming the field.
 
 use pyo3::prelude::*;
+use pyo3::types::PyBool;
 
 use crate::errors::InvalidInputError;
 
@@ -44,12 +45,18 @@ pub(crate) fn history_arg(value: &Bound<'_, PyAny>) -> PyResult<bool> {
     })
 }
 
-/// A float argument (the `from_py_with` of every float parameter). A Python
-/// int beyond the range of a float (`10**400`) becomes an infinity of its
-/// sign, as a float computation beyond the range would, instead of an
-/// OverflowError: the core then refuses it like any non-finite value, in an
-/// InvalidInputError that names the field.
-pub(crate) fn real(value: &Bound<'_, PyAny>) -> PyResult<f64> {
+/// A float argument `field`: a Python float or int, or anything with
+/// `__float__` but a bool (NumPy's reals). A Python int beyond the range of a
+/// float (`10**400`) becomes an infinity of its sign, as a float computation
+/// beyond the range would, instead of an OverflowError: the core then refuses
+/// it like any non-finite value. Anything else is an InvalidInputError naming
+/// the field (PyO3's own would be a TypeError).
+pub(crate) fn real(field: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let refused =
+        || InvalidInputError::new_err(format!("{field} must be a number, got {}", shown(value)));
+    if value.is_instance_of::<PyBool>() || value.is_instance_of::<pyo3::types::PyString>() {
+        return Err(refused());
+    }
     match value.extract::<f64>() {
         Ok(v) => Ok(v),
         Err(err) if err.is_instance_of::<pyo3::exceptions::PyOverflowError>(value.py()) => {
@@ -59,18 +66,45 @@ pub(crate) fn real(value: &Bound<'_, PyAny>) -> PyResult<f64> {
                 f64::INFINITY
             })
         }
-        Err(err) => Err(err),
+        Err(_) => Err(refused()),
     }
 }
 
 /// [`real`] for a parameter that may be None.
-pub(crate) fn real_or_none(value: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+pub(crate) fn real_or_none(field: &str, value: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
     if value.is_none() {
         Ok(None)
     } else {
-        real(value).map(Some)
+        real(field, value).map(Some)
     }
 }
+
+/// A text argument `field` (a method's or a law's name), as an
+/// InvalidInputError naming the field when it is not a str.
+pub(crate) fn text(field: &str, value: &Bound<'_, PyAny>) -> PyResult<String> {
+    value.extract::<String>().map_err(|_| {
+        InvalidInputError::new_err(format!("{field} must be a str, got {}", shown(value)))
+    })
+}
+
+/// The `from_py_with` of each argument by its name: PyO3 passes no name to
+/// the conversion, and its own errors (TypeErrors) are the ones it names.
+macro_rules! by_name {
+    ($module:ident, $convert:ident -> $out:ty: $($name:ident),* $(,)?) => {
+        pub(crate) mod $module {
+            use pyo3::prelude::*;
+            $(
+                pub(crate) fn $name(value: &Bound<'_, PyAny>) -> PyResult<$out> {
+                    super::$convert(stringify!($name), value)
+                }
+            )*
+        }
+    };
+}
+
+by_name!(arg, real -> f64: approach_rate, approach_speed, area, atol, beta, clearance, cpu_time, damping, density, energy_tolerance, error, error_weight, gamma, hertz_stiffness, impact_displacement, impact_mass, impact_velocity, indentation, length, main_displacement, main_mass, main_velocity, max_cpu_time, max_error, other_poisson_ratio, other_youngs_modulus, poisson_ratio, radius, rate, record_from, rtol, second_moment, spectral_radius, stiffness, t_end, tolerance, x, youngs_modulus);
+by_name!(optional, real_or_none -> Option<f64>: dt, energy_tolerance, other_radius, position, record_from, restitution, strobe_period);
+by_name!(named_text, text -> String: law);
 
 pub(crate) fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
     whole("every", value)

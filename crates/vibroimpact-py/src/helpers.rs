@@ -13,12 +13,12 @@ use crate::errors::*;
 #[pyfunction]
 #[pyo3(signature = (radius, youngs_modulus, poisson_ratio, other_youngs_modulus, other_poisson_ratio, other_radius = None))]
 pub(crate) fn hertz_stiffness(
-    #[pyo3(from_py_with = real)] radius: f64,
-    #[pyo3(from_py_with = real)] youngs_modulus: f64,
-    #[pyo3(from_py_with = real)] poisson_ratio: f64,
-    #[pyo3(from_py_with = real)] other_youngs_modulus: f64,
-    #[pyo3(from_py_with = real)] other_poisson_ratio: f64,
-    #[pyo3(from_py_with = real_or_none)] other_radius: Option<f64>,
+    #[pyo3(from_py_with = arg::radius)] radius: f64,
+    #[pyo3(from_py_with = arg::youngs_modulus)] youngs_modulus: f64,
+    #[pyo3(from_py_with = arg::poisson_ratio)] poisson_ratio: f64,
+    #[pyo3(from_py_with = arg::other_youngs_modulus)] other_youngs_modulus: f64,
+    #[pyo3(from_py_with = arg::other_poisson_ratio)] other_poisson_ratio: f64,
+    #[pyo3(from_py_with = optional::other_radius)] other_radius: Option<f64>,
 ) -> PyResult<f64> {
     // Checked by the core, which names the second body's fields other_....
     let a = materials::Material {
@@ -81,13 +81,13 @@ impl BeamMode {
 #[pyfunction]
 #[pyo3(signature = (length, youngs_modulus, second_moment, density, area, mode = 1, position = None))]
 pub(crate) fn cantilever_mode(
-    #[pyo3(from_py_with = real)] length: f64,
-    #[pyo3(from_py_with = real)] youngs_modulus: f64,
-    #[pyo3(from_py_with = real)] second_moment: f64,
-    #[pyo3(from_py_with = real)] density: f64,
-    #[pyo3(from_py_with = real)] area: f64,
+    #[pyo3(from_py_with = arg::length)] length: f64,
+    #[pyo3(from_py_with = arg::youngs_modulus)] youngs_modulus: f64,
+    #[pyo3(from_py_with = arg::second_moment)] second_moment: f64,
+    #[pyo3(from_py_with = arg::density)] density: f64,
+    #[pyo3(from_py_with = arg::area)] area: f64,
     #[pyo3(from_py_with = mode_arg)] mode: u32,
-    #[pyo3(from_py_with = real_or_none)] position: Option<f64>,
+    #[pyo3(from_py_with = optional::position)] position: Option<f64>,
 ) -> PyResult<BeamMode> {
     let b = beam::cantilever_mode(
         length,
@@ -126,9 +126,9 @@ pub(crate) fn cantilever_root(#[pyo3(from_py_with = mode_arg)] mode: u32) -> PyR
 #[pyfunction]
 #[pyo3(signature = (length, mode, x, derivative = 0))]
 pub(crate) fn cantilever_mode_shape(
-    #[pyo3(from_py_with = real)] length: f64,
+    #[pyo3(from_py_with = arg::length)] length: f64,
     #[pyo3(from_py_with = mode_arg)] mode: u32,
-    #[pyo3(from_py_with = real)] x: f64,
+    #[pyo3(from_py_with = arg::x)] x: f64,
     #[pyo3(from_py_with = derivative_arg)] derivative: usize,
 ) -> PyResult<f64> {
     let values = beam::cantilever_mode_shape_derivatives(length, mode, x).map_err(to_py)?;
@@ -141,10 +141,10 @@ pub(crate) fn cantilever_mode_shape(
 #[pyfunction]
 #[pyo3(signature = (impact_mass, main_mass, hertz_stiffness, approach_speed, exact_constant = false))]
 pub(crate) fn goldsmith_contact_duration(
-    #[pyo3(from_py_with = real)] impact_mass: f64,
-    #[pyo3(from_py_with = real)] main_mass: f64,
-    #[pyo3(from_py_with = real)] hertz_stiffness: f64,
-    #[pyo3(from_py_with = real)] approach_speed: f64,
+    #[pyo3(from_py_with = arg::impact_mass)] impact_mass: f64,
+    #[pyo3(from_py_with = arg::main_mass)] main_mass: f64,
+    #[pyo3(from_py_with = arg::hertz_stiffness)] hertz_stiffness: f64,
+    #[pyo3(from_py_with = arg::approach_speed)] approach_speed: f64,
     exact_constant: bool,
 ) -> PyResult<f64> {
     closed_forms::goldsmith_contact_duration(
@@ -160,10 +160,10 @@ pub(crate) fn goldsmith_contact_duration(
 /// Goldsmith's maximum Hertz indentation (m): ``(5 v^2 / (4 K* K_hz))^(2/5)``.
 #[pyfunction]
 pub(crate) fn goldsmith_max_indentation(
-    #[pyo3(from_py_with = real)] impact_mass: f64,
-    #[pyo3(from_py_with = real)] main_mass: f64,
-    #[pyo3(from_py_with = real)] hertz_stiffness: f64,
-    #[pyo3(from_py_with = real)] approach_speed: f64,
+    #[pyo3(from_py_with = arg::impact_mass)] impact_mass: f64,
+    #[pyo3(from_py_with = arg::main_mass)] main_mass: f64,
+    #[pyo3(from_py_with = arg::hertz_stiffness)] hertz_stiffness: f64,
+    #[pyo3(from_py_with = arg::approach_speed)] approach_speed: f64,
 ) -> PyResult<f64> {
     closed_forms::goldsmith_max_indentation(impact_mass, main_mass, hertz_stiffness, approach_speed)
         .map_err(to_py)
@@ -174,10 +174,10 @@ pub(crate) fn goldsmith_max_indentation(
 #[pyfunction]
 #[pyo3(signature = (impact_mass, main_mass, stiffness, damping = 0.0))]
 pub(crate) fn linear_contact_duration(
-    #[pyo3(from_py_with = real)] impact_mass: f64,
-    #[pyo3(from_py_with = real)] main_mass: f64,
-    #[pyo3(from_py_with = real)] stiffness: f64,
-    #[pyo3(from_py_with = real)] damping: f64,
+    #[pyo3(from_py_with = arg::impact_mass)] impact_mass: f64,
+    #[pyo3(from_py_with = arg::main_mass)] main_mass: f64,
+    #[pyo3(from_py_with = arg::stiffness)] stiffness: f64,
+    #[pyo3(from_py_with = arg::damping)] damping: f64,
 ) -> PyResult<f64> {
     closed_forms::linear_contact_duration(impact_mass, main_mass, stiffness, damping).map_err(to_py)
 }
@@ -187,11 +187,11 @@ pub(crate) fn linear_contact_duration(
 /// with ``wf1 = error_weight``.
 #[pyfunction]
 pub(crate) fn adequacy(
-    #[pyo3(from_py_with = real)] error: f64,
-    #[pyo3(from_py_with = real)] max_error: f64,
-    #[pyo3(from_py_with = real)] cpu_time: f64,
-    #[pyo3(from_py_with = real)] max_cpu_time: f64,
-    #[pyo3(from_py_with = real)] error_weight: f64,
+    #[pyo3(from_py_with = arg::error)] error: f64,
+    #[pyo3(from_py_with = arg::max_error)] max_error: f64,
+    #[pyo3(from_py_with = arg::cpu_time)] cpu_time: f64,
+    #[pyo3(from_py_with = arg::max_cpu_time)] max_cpu_time: f64,
+    #[pyo3(from_py_with = arg::error_weight)] error_weight: f64,
 ) -> PyResult<f64> {
     closed_forms::adequacy(error, max_error, cpu_time, max_cpu_time, error_weight).map_err(to_py)
 }

@@ -19,11 +19,11 @@ impl ImpactDamper {
     #[new]
     #[pyo3(signature = (main_mass, stiffness, impact_mass, clearance, damping = 0.0))]
     fn new(
-        #[pyo3(from_py_with = real)] main_mass: f64,
-        #[pyo3(from_py_with = real)] stiffness: f64,
-        #[pyo3(from_py_with = real)] impact_mass: f64,
-        #[pyo3(from_py_with = real)] clearance: f64,
-        #[pyo3(from_py_with = real)] damping: f64,
+        #[pyo3(from_py_with = arg::main_mass)] main_mass: f64,
+        #[pyo3(from_py_with = arg::stiffness)] stiffness: f64,
+        #[pyo3(from_py_with = arg::impact_mass)] impact_mass: f64,
+        #[pyo3(from_py_with = arg::clearance)] clearance: f64,
+        #[pyo3(from_py_with = arg::damping)] damping: f64,
     ) -> PyResult<Self> {
         core::ImpactDamper::new(main_mass, stiffness, damping, impact_mass, clearance)
             .map(Self)
@@ -102,12 +102,12 @@ impl Contact {
     #[pyo3(signature = (law, stiffness, damping = 0.0, restitution = None))]
     fn new(
         py: Python<'_>,
-        law: &str,
-        #[pyo3(from_py_with = real)] stiffness: f64,
-        #[pyo3(from_py_with = real)] damping: f64,
-        #[pyo3(from_py_with = real_or_none)] restitution: Option<f64>,
+        #[pyo3(from_py_with = named_text::law)] law: String,
+        #[pyo3(from_py_with = arg::stiffness)] stiffness: f64,
+        #[pyo3(from_py_with = arg::damping)] damping: f64,
+        #[pyo3(from_py_with = optional::restitution)] restitution: Option<f64>,
     ) -> PyResult<Self> {
-        let kind = core::LawKind::parse(law).map_err(to_py)?;
+        let kind = core::LawKind::parse(&law).map_err(to_py)?;
         let contact = core::Contact::new(kind, stiffness, restitution, damping).map_err(to_py)?;
         if kind == core::LawKind::HysterHertz && contact.restitution < WARN_BELOW {
             let message = std::ffi::CString::new(format!(
@@ -156,9 +156,9 @@ impl Contact {
     #[pyo3(signature = (indentation, rate = 0.0, approach_rate = 1.0))]
     fn law_force(
         &self,
-        #[pyo3(from_py_with = real)] indentation: f64,
-        #[pyo3(from_py_with = real)] rate: f64,
-        #[pyo3(from_py_with = real)] approach_rate: f64,
+        #[pyo3(from_py_with = arg::indentation)] indentation: f64,
+        #[pyo3(from_py_with = arg::rate)] rate: f64,
+        #[pyo3(from_py_with = arg::approach_rate)] approach_rate: f64,
     ) -> PyResult<f64> {
         self.0
             .law_force(indentation, rate, approach_rate)
@@ -197,10 +197,10 @@ impl InitialState {
     #[new]
     #[pyo3(signature = (main_displacement = 0.0, main_velocity = 0.0, impact_displacement = 0.0, impact_velocity = 0.0))]
     fn new(
-        #[pyo3(from_py_with = real)] main_displacement: f64,
-        #[pyo3(from_py_with = real)] main_velocity: f64,
-        #[pyo3(from_py_with = real)] impact_displacement: f64,
-        #[pyo3(from_py_with = real)] impact_velocity: f64,
+        #[pyo3(from_py_with = arg::main_displacement)] main_displacement: f64,
+        #[pyo3(from_py_with = arg::main_velocity)] main_velocity: f64,
+        #[pyo3(from_py_with = arg::impact_displacement)] impact_displacement: f64,
+        #[pyo3(from_py_with = arg::impact_velocity)] impact_velocity: f64,
     ) -> PyResult<Self> {
         core::State::new(
             main_displacement,

@@ -17,7 +17,6 @@ use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::RunOptions;
 use vibroimpact_core::system_methods::AnyStepper;
 
-use crate::convert::real_or_none;
 use crate::errors::{released, to_py, InvalidInputError};
 
 /// `where key` must be present: the Python side fills defaults, so a missing
@@ -383,16 +382,16 @@ impl PreparedSystem {
     fn new(
         spec: &Bound<'_, PyDict>,
         method: &str,
-        #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
-        #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
-        #[pyo3(from_py_with = crate::convert::real)] rtol: f64,
-        #[pyo3(from_py_with = crate::convert::real)] atol: f64,
-        #[pyo3(from_py_with = crate::convert::real)] beta: f64,
-        #[pyo3(from_py_with = crate::convert::real)] gamma: f64,
-        #[pyo3(from_py_with = crate::convert::real)] spectral_radius: f64,
+        #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+        #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::arg::rtol)] rtol: f64,
+        #[pyo3(from_py_with = crate::convert::arg::atol)] atol: f64,
+        #[pyo3(from_py_with = crate::convert::arg::beta)] beta: f64,
+        #[pyo3(from_py_with = crate::convert::arg::gamma)] gamma: f64,
+        #[pyo3(from_py_with = crate::convert::arg::spectral_radius)] spectral_radius: f64,
         max_steps: u64,
         max_rows: u64,
-        #[pyo3(from_py_with = crate::convert::real)] energy_tolerance: f64,
+        #[pyo3(from_py_with = crate::convert::arg::energy_tolerance)] energy_tolerance: f64,
     ) -> PyResult<Self> {
         check_method(
             t_end,
@@ -433,9 +432,9 @@ impl PreparedSystem {
         &self,
         py: Python<'py>,
         state: Vec<f64>,
-        #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
-        #[pyo3(from_py_with = real_or_none)] record_from: Option<f64>,
-        #[pyo3(from_py_with = real_or_none)] strobe_period: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+        #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let mut ready = self.ready.lock().map_err(|_| {
             InvalidInputError::new_err("a run of this system failed; make it again")
@@ -475,8 +474,8 @@ impl PreparedSystem {
         &self,
         py: Python<'py>,
         state: Vec<f64>,
-        #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
-        #[pyo3(from_py_with = crate::convert::real)] tolerance: f64,
+        #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+        #[pyo3(from_py_with = crate::convert::arg::tolerance)] tolerance: f64,
         max_iterations: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         check("t_end", t_end, t_end > 0.0, "> 0 s")?;
@@ -583,8 +582,8 @@ pub fn simulate_system<'py>(
     max_steps: u64,
     max_rows: u64,
     energy_tolerance: f64,
-    #[pyo3(from_py_with = real_or_none)] record_from: Option<f64>,
-    #[pyo3(from_py_with = real_or_none)] strobe_period: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let limits = Limits {
         dt,
@@ -725,20 +724,20 @@ pub fn run_study<'py>(
     paths: Vec<String>,
     values: numpy::PyReadonlyArray1<'py, f64>,
     method: String,
-    #[pyo3(from_py_with = real_or_none)] dt: Option<f64>,
-    #[pyo3(from_py_with = crate::convert::real)] rtol: f64,
-    #[pyo3(from_py_with = crate::convert::real)] atol: f64,
-    #[pyo3(from_py_with = crate::convert::real)] beta: f64,
-    #[pyo3(from_py_with = crate::convert::real)] gamma: f64,
-    #[pyo3(from_py_with = crate::convert::real)] spectral_radius: f64,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::arg::rtol)] rtol: f64,
+    #[pyo3(from_py_with = crate::convert::arg::atol)] atol: f64,
+    #[pyo3(from_py_with = crate::convert::arg::beta)] beta: f64,
+    #[pyo3(from_py_with = crate::convert::arg::gamma)] gamma: f64,
+    #[pyo3(from_py_with = crate::convert::arg::spectral_radius)] spectral_radius: f64,
     max_steps: u64,
-    #[pyo3(from_py_with = crate::convert::real)] energy_tolerance: f64,
+    #[pyo3(from_py_with = crate::convert::arg::energy_tolerance)] energy_tolerance: f64,
     analysis: &str,
-    #[pyo3(from_py_with = crate::convert::real)] t_end: f64,
-    #[pyo3(from_py_with = crate::convert::real)] record_from: f64,
+    #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+    #[pyo3(from_py_with = crate::convert::arg::record_from)] record_from: f64,
     settle_periods: u64,
     record_periods: u64,
-    #[pyo3(from_py_with = crate::convert::real)] tolerance: f64,
+    #[pyo3(from_py_with = crate::convert::arg::tolerance)] tolerance: f64,
     threads: usize,
     mean_square: bool,
     stepping: &str,
