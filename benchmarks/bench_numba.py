@@ -4,7 +4,8 @@ The founding paper's Table 1 system with the Hertz law and the contact damper
 (no rate-dependent law, so the trajectory is the accelerations' alone), RK4 at
 dt = 1e-4 s for 1e7 steps from a 0.1 m/s collision. The numba kernel repeats the
 core's operations in the core's order (per-unit-mass coefficients, the side of
-the nearer wall, the law's force clamped at zero, RK4's stage sums), so the two
+the nearer wall, the law's force clamped at zero, the main mass's
+acceleration as (-C/M) w' - (K/M) w, RK4's stage sums), so the two
 final states must agree bit for bit; the speed ratio is printed with medians of
 repeated runs.
 
@@ -78,7 +79,7 @@ def kernel(frozen: bool) -> object:
         damping_per_mass, stiffness_per_mass, inverse_main, inverse_impact, clearance, hertz, c1 = (
             params if frozen else p
         )
-        main = -(damping_per_mass * wv + stiffness_per_mass * w)
+        main = (-damping_per_mass) * wv - stiffness_per_mass * w
         u = y - w
         if abs(u) > clearance:
             side = 1.0 if (u > 0.0 or (u == 0.0 and yv - wv >= 0.0)) else -1.0
