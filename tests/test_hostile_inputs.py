@@ -138,11 +138,11 @@ def test_a_recorded_signal_from_a_device_is_refused() -> None:
 def test_a_recorded_file_above_the_limit_is_refused(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    assert system.MAX_RECORD_BYTES == 64 * 2**20
+    assert system.MAX_RECORDED_FILE_BYTES == 64 * 2**20
     assert "64 MiB" in (ROOT / "README.md").read_text(encoding="utf-8")
     (tmp_path / "rec.csv").write_text("".join(f"{i},0\n" for i in range(100)))
     parse_scenario(RECORDED.format(file="rec.csv"), "s.toml", tmp_path)  # fits
-    monkeypatch.setattr(system, "MAX_RECORD_BYTES", 100)
+    monkeypatch.setattr(system, "MAX_RECORDED_FILE_BYTES", 100)
     message = parse_error(RECORDED.format(file="rec.csv"), tmp_path)
     assert "[[excitation]] 0: file:" in message and "larger than" in message
 

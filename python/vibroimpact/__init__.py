@@ -24,6 +24,7 @@ import numpy as _numpy  # noqa: F401
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_RECORD_BYTES,
     BeamMode,
     Contact,
     ContactTable,
@@ -76,6 +77,7 @@ __all__ = [
     "PreparedSystem",
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
+    "MAX_RECORD_BYTES",
     "BeamMode",
     "Contact",
     "ContactTable",

@@ -8,6 +8,7 @@ import numpy.typing as npt
 __all__ = [
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
+    "MAX_RECORD_BYTES",
     "BeamMode",
     "Contact",
     "ContactTable",
@@ -38,6 +39,7 @@ __all__ = [
 
 __version__: str
 DEFAULT_MAX_ROWS: int
+MAX_RECORD_BYTES: int
 DEFAULT_ENERGY_TOLERANCE: float
 
 _FloatArray = npt.NDArray[np.float64]

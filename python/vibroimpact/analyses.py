@@ -200,6 +200,7 @@ class Runner:
         self, state: np.ndarray, count: int, *, record: bool = False, strobe: bool = False
     ) -> dict[str, Any]:
         """Run ``count`` forcing periods from ``state``."""
+        check_periods("", "periods", count, 1)
         return self._run(state, count * self.period, record=record, strobe=strobe)
 
     def map(self, state: np.ndarray, count: int) -> np.ndarray:
@@ -211,6 +212,7 @@ class Runner:
     ) -> dict[str, Any]:
         """Newton's shooting over ``count`` periods from ``state``, in the core (see
         :func:`orbit`)."""
+        check_periods("", "periods", count, 1)
         if len(state) != 2 * (self.n + self.k):
             raise AnalysisError(
                 f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(state)}"
@@ -373,6 +375,21 @@ class SweepPoint:
 MAX_POINTS = 100_000
 #: The most starts of ``[basins]`` (``x.count`` times ``y.count``).
 MAX_STARTS = 1_000_000
+#: The most forcing periods one run of an analysis may settle or record: with a few
+#: impacts and tens of steps a period that is already minutes of computing, and every
+#: kept impact is memory; a longer run is a typo (1e12 for 1e2), refused before it starts.
+MAX_PERIODS = 10_000_000
+
+
+def check_periods(where: str, key: str, value: int, low: int) -> None:
+    """``value`` forcing periods must be a whole number in [``low``, MAX_PERIODS]; the
+    error names ``where`` (``"[sweep] "``, ``"--settle"``...) and ``key``."""
+    if not low <= value <= MAX_PERIODS:
+        raise AnalysisError(
+            f"{where}{key}: must be >= {low} and at most {MAX_PERIODS} forcing periods, got {value}"
+        )
+
+
 _DIRECTIONS = ("up", "down", "both")
 _SPACINGS = ("linear", "log")
 _SWEEP = {
@@ -397,9 +414,10 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     out = _table("[sweep] ", table, _SWEEP)
     _choice("[sweep] ", "direction", out["direction"], _DIRECTIONS)
     _choice("[sweep] ", "spacing", out["spacing"], _SPACINGS)
-    for key, low in (("count", 1), ("settle_periods", 0), ("record_periods", 1)):
-        if out[key] < low:
-            raise AnalysisError(f"[sweep] {key}: must be >= {low}, got {out[key]}")
+    if out["count"] < 1:
+        raise AnalysisError(f"[sweep] count: must be >= 1, got {out['count']}")
+    for key, low in (("settle_periods", 0), ("record_periods", 1)):
+        check_periods("[sweep] ", key, out[key], low)
     if out["count"] > MAX_POINTS:
         raise AnalysisError(f"[sweep] count: must be at most {MAX_POINTS}, got {out['count']}")
     if not out["tolerance"] > 0:
@@ -428,9 +446,9 @@ def continuation_settings(table: Any) -> dict[str, Any]:
     ``step`` (about, in the parameter's unit), ``max_points``, ``tolerance``."""
     out = _table("[continuation] ", table, _CONTINUATION)
     with_parameter_path_check(out["parameter"], "[continuation]")
-    for key, low in (("periods", 1), ("max_points", 2)):
-        if out[key] < low:
-            raise AnalysisError(f"[continuation] {key}: must be >= {low}, got {out[key]}")
+    check_periods("[continuation] ", "periods", out["periods"], 1)
+    if out["max_points"] < 2:
+        raise AnalysisError(f"[continuation] max_points: must be >= 2, got {out['max_points']}")
     if out["max_points"] > MAX_POINTS:
         raise AnalysisError(
             f"[continuation] max_points: must be at most {MAX_POINTS}, got {out['max_points']}"
@@ -499,8 +517,7 @@ def basins_settings(table: Any) -> dict[str, Any]:
             f"starts, more than {MAX_STARTS}; lower the counts"
         )
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
-        if out[key] < low:
-            raise AnalysisError(f"[basins] {key}: must be >= {low}, got {out[key]}")
+        check_periods("[basins] ", key, out[key], low)
     return out
 
 

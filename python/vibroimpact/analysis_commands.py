@@ -16,6 +16,7 @@ from vibroimpact import analysis_plots as plots
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analyses import (
     AnalysisError,
+    check_periods,
     orbit,
     runner,
     state_index,
@@ -152,8 +153,7 @@ def _system(path: Path) -> SystemScenario:
 
 def run_orbit(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario)
-    if args.periods < 1:
-        raise UsageError(f"--periods must be >= 1, got {args.periods}")
+    check_periods("", "--periods", args.periods, 1)
     if not args.tolerance > 0:
         raise UsageError(f"--tolerance must be > 0, got {args.tolerance}")
     run = runner(scenario.data, scenario.base_dir)
@@ -328,8 +328,8 @@ def run_bifurcation(args: argparse.Namespace) -> int:
 
 def run_poincare(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario)
-    if args.settle < 0 or args.periods < 1:
-        raise UsageError("--settle must be >= 0 and --periods >= 1")
+    check_periods("", "--settle", args.settle, 0)
+    check_periods("", "--periods", args.periods, 1)
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
     section = poincare(run, settle_periods=args.settle, periods=args.periods)

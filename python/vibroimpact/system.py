@@ -48,6 +48,7 @@ import numpy as np
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_RECORD_BYTES,
     Contact,
     InvalidInputError,
 )
@@ -343,32 +344,32 @@ def _list(name: str, value: Any) -> list[Any]:
 #: The largest CSV file a recorded signal may read (bytes): a record of millions of
 #: samples fits, a wrong path (a disk image, /dev/zero) is refused before it fills the
 #: memory.
-MAX_RECORD_BYTES = 64 * 2**20
+MAX_RECORDED_FILE_BYTES = 64 * 2**20
 
 
 def _read_record(path: Path, where: str) -> tuple[list[float], list[float], list[int]]:
     """Time and value columns of a CSV file (lines starting with # and a header
     line are skipped), with the line number of each row. ``where`` names the
     excitation and its ``file`` key. Only a regular file of at most
-    :data:`MAX_RECORD_BYTES` is read; a row must hold exactly two numbers."""
+    :data:`MAX_RECORDED_FILE_BYTES` is read; a row must hold exactly two numbers."""
     name = str(path)
     try:
         # Checked before opening: opening a FIFO would wait for a writer.
         info = path.stat()
         if not stat.S_ISREG(info.st_mode):
             raise _fail(where, f"{name!r} is not a regular file (a CSV of time and value)")
-        if info.st_size > MAX_RECORD_BYTES:
+        if info.st_size > MAX_RECORDED_FILE_BYTES:
             raise _fail(
                 where,
-                f"{name!r} is larger than {MAX_RECORD_BYTES // 2**20} MiB, the limit of a "
+                f"{name!r} is larger than {MAX_RECORDED_FILE_BYTES // 2**20} MiB, the limit of a "
                 "recorded signal",
             )
         with path.open("rb") as f:
-            data = f.read(MAX_RECORD_BYTES + 1)
-        if len(data) > MAX_RECORD_BYTES:
+            data = f.read(MAX_RECORDED_FILE_BYTES + 1)
+        if len(data) > MAX_RECORDED_FILE_BYTES:
             raise _fail(
                 where,
-                f"{name!r} is larger than {MAX_RECORD_BYTES // 2**20} MiB, the limit of a "
+                f"{name!r} is larger than {MAX_RECORDED_FILE_BYTES // 2**20} MiB, the limit of a "
                 "recorded signal",
             )
         text = data.decode("utf-8")
@@ -448,6 +449,21 @@ def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) ->
             f"{name} must be a coordinate index, a whole number in [0, {size - 1}], got "
             f"{shown(given)}",
         )
+
+
+def _coordinates(spec: dict[str, Any]) -> int:
+    """The coordinates of a checked system: the structure's (its DOFs or modes) and
+    one per damper."""
+    structure = spec["structure"]
+    kind = structure["kind"]
+    size = (
+        1
+        if kind == "oscillator"
+        else structure["modes"]
+        if kind == "cantilever"
+        else len(structure["mass"])
+    )
+    return int(size) + len(spec["damper"])
 
 
 def system_spec(
@@ -842,6 +858,27 @@ def prepare_system(
                 f"the history would keep {rows:.3e} rows (t_end / dt / every), more than "
                 f"max_rows = {solver['max_rows']}: raise every, set history = false, "
                 "shorten t_end or raise max_rows",
+            )
+        # A row is the time and 2 (n + k) values, 8 bytes each.
+        width = 1 + 2 * _coordinates(spec)
+        if rows * width * 8 > MAX_RECORD_BYTES:
+            raise _fail(
+                "[solver] ",
+                f"the history would keep {rows:.3e} rows of {width} values, "
+                f"{rows * width * 8 / 2**20:.0f} MiB, more than the {MAX_RECORD_BYTES >> 20} MiB "
+                "a run's records may take: raise every, set history = false or shorten t_end",
+            )
+    if output["strobe_period"] is not None and output["strobe_period"] > 0:
+        # Stroboscopic rows are known before any run starts, as fixed-step history is.
+        strobes = solver["t_end"] / output["strobe_period"]
+        width = 1 + 2 * _coordinates(spec)
+        if strobes > solver["max_rows"] or strobes * width * 8 > MAX_RECORD_BYTES:
+            raise _fail(
+                "[output] strobe_period: ",
+                f"t_end / strobe_period = {strobes:.3e} rows of {width} values, "
+                f"more than max_rows = {solver['max_rows']} or the "
+                f"{MAX_RECORD_BYTES >> 20} MiB a run's records may take: lengthen "
+                "strobe_period or shorten t_end",
             )
     if output["record_from"] is not None and not output["record_from"] >= 0:
         raise _fail("[output] record_from: ", f"must be >= 0 s, got {output['record_from']}")

@@ -188,10 +188,12 @@ pub struct Assembly {
     /// of the shortest natural or forcing period): how long an adaptive step
     /// may be while a pair sticks, whose release nothing else foretells.
     pub sticking_step: f64,
-    /// An energy (J) below which a balance residual is round-off: 1e-12 of
-    /// what the largest acceleration acting (gravity, base, force) gives the
-    /// total mass over the system's time scale.
-    pub energy_floor: f64,
+    /// The total mass times the square of the largest acceleration acting
+    /// (gravity, base, force), kg m^2/s^4, and the system's time scale (its
+    /// shortest period or signal's, infinite for none), s: see
+    /// [`Assembly::energy_floor`].
+    floor_mass_acceleration: f64,
+    time_scale: f64,
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
 }
@@ -397,11 +399,6 @@ impl Assembly {
             .find(|w| **w > 0.0)
             .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w);
         let time_scale = shortest.min(longest_period);
-        let energy_floor = if time_scale.is_finite() {
-            1e-12 * total_mass * (acceleration * time_scale).powi(2)
-        } else {
-            0.0
-        };
         let mirrors_previous = (0..interactions.len())
             .map(|i| {
                 i > 0
@@ -415,7 +412,8 @@ impl Assembly {
         Ok(Self {
             mirrors_previous,
             sticking_step: 0.1 * shortest,
-            energy_floor,
+            floor_mass_acceleration: total_mass * acceleration * acceleration,
+            time_scale,
             n,
             k,
             dim,
@@ -941,6 +939,15 @@ impl Assembly {
                 .zip(&y[..self.dim])
                 .map(|(h, x)| (h * x).abs())
                 .sum::<f64>()
+    }
+
+    /// An energy (J) below which a balance residual is round-off: 1e-12 of
+    /// what the largest acceleration acting (gravity, base, force) gives the
+    /// total mass over the system's time scale, or over the run's length
+    /// `t_end` (s) where that is shorter or there is none (a ball resting on
+    /// a floor has no period, and nearly no energy).
+    pub fn energy_floor(&self, t_end: f64) -> f64 {
+        1e-12 * self.floor_mass_acceleration * self.time_scale.min(t_end).powi(2)
     }
 
     /// A sticking pair `i` released: held on its wall only to round-off, it

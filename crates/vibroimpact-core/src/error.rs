@@ -65,6 +65,25 @@ pub enum Error {
         /// What to change.
         advice: &'static str,
     },
+    /// The records a run keeps (history, stroboscopic states, contacts) would
+    /// pass [`crate::memory::MAX_RECORD_BYTES`], or the machine refused the
+    /// memory for them.
+    #[error(
+        "the run's records ({rows} history rows and {strobes} stroboscopic rows of {columns} values, \
+         {contacts} contacts) reached \
+         {held_mib} MiB by t = {time:.6e} s and {cause}: raise every, set history = false or \
+         shorten t_end (or lengthen strobe_period)"
+    )]
+    MemoryLimit {
+        time: f64,
+        rows: u64,
+        strobes: u64,
+        columns: u64,
+        contacts: u64,
+        held_mib: u64,
+        /// "would pass the limit of 2048 MiB" or "the machine refused more".
+        cause: String,
+    },
     /// The energy balance does not close: stored energy plus the work of the
     /// dissipative forces minus the external work differs from the energy at
     /// the start by more than `tolerance` times the energy in play.

@@ -501,7 +501,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
     if fixed {
         settings.check_rows(rows)?;
     }
-    let mut records = Records::new(settings, rows);
+    let mut records = Records::new(settings, rows)?;
     let force = |y: &Vector, mode: Mode| match mode {
         Mode::Free => 0.0,
         Mode::Contact {

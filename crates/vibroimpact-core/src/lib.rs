@@ -21,6 +21,7 @@ pub mod integrators;
 pub mod linalg;
 pub mod materials;
 pub mod matrix_flow;
+pub mod memory;
 pub mod modal;
 pub mod model;
 pub mod records;
@@ -43,6 +44,7 @@ pub mod testing;
 
 pub use contact::{Contact, ContactLaw, LawKind};
 pub use error::{Error, Result};
+pub use memory::MAX_RECORD_BYTES;
 pub use records::{ContactRecord, History, Solution};
 pub use run::simulate;
 pub use settings::{

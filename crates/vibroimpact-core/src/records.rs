@@ -4,9 +4,11 @@
 
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
+use crate::memory::{self, NoRoom, MAX_RECORD_BYTES};
 use crate::model::{Excitation, Model};
 use crate::settings::Settings;
 use crate::system::State;
+use std::collections::TryReserveError;
 
 /// One contact, from onset to separation. Speeds are relative normal speeds
 /// (m/s, positive); a contact still open at the end has NaN separation,
@@ -54,24 +56,19 @@ pub struct History {
 }
 
 impl History {
-    fn with_capacity(rows: usize) -> Self {
-        Self {
-            time: Vec::with_capacity(rows),
-            main_displacement: Vec::with_capacity(rows),
-            main_velocity: Vec::with_capacity(rows),
-            impact_displacement: Vec::with_capacity(rows),
-            impact_velocity: Vec::with_capacity(rows),
-            contact_force: Vec::with_capacity(rows),
-        }
+    /// Room for `rows` more rows; Err when the machine refuses the memory.
+    fn try_reserve_exact(&mut self, rows: usize) -> std::result::Result<(), TryReserveError> {
+        self.time.try_reserve_exact(rows)?;
+        self.main_displacement.try_reserve_exact(rows)?;
+        self.main_velocity.try_reserve_exact(rows)?;
+        self.impact_displacement.try_reserve_exact(rows)?;
+        self.impact_velocity.try_reserve_exact(rows)?;
+        self.contact_force.try_reserve_exact(rows)
     }
 
-    fn reserve_exact(&mut self, rows: usize) {
-        self.time.reserve_exact(rows);
-        self.main_displacement.reserve_exact(rows);
-        self.main_velocity.reserve_exact(rows);
-        self.impact_displacement.reserve_exact(rows);
-        self.impact_velocity.reserve_exact(rows);
-        self.contact_force.reserve_exact(rows);
+    /// Bytes held.
+    fn held(&self) -> u64 {
+        6 * memory::held(&self.time)
     }
 
     #[inline(always)]
@@ -85,10 +82,11 @@ impl History {
     }
 }
 
-/// What a run keeps, within `max_rows`: the history (if kept) and the
-/// contacts. Storage grows only as far as `max_rows` allows, so the rows
-/// allocated never exceed it; a row or a contact beyond it stops the run with
-/// [`Error::RowLimit`].
+/// What a run keeps, within `max_rows` and [`MAX_RECORD_BYTES`]: the history
+/// (if kept) and the contacts. Storage grows only as far as both allow, and
+/// fallibly, so the rows allocated never exceed them; a row or a contact
+/// beyond them stops the run with [`Error::RowLimit`] or
+/// [`Error::MemoryLimit`].
 pub(crate) struct Records {
     pub(crate) history: History,
     pub(crate) contacts: Vec<ContactRecord>,
@@ -96,21 +94,30 @@ pub(crate) struct Records {
     max_rows: u64,
 }
 
+/// Bytes of a history row (six f64 columns).
+const ROW_BYTES: u64 = 48;
+
 impl Records {
     /// Room for `rows` history rows from the start (as far as `max_rows`
-    /// allows; an up-front check has refused a fixed-step history beyond it).
-    pub(crate) fn new(settings: &Settings, rows: u64) -> Self {
-        let rows = if settings.history {
-            rows.min(settings.max_rows)
-        } else {
-            0
-        };
-        Self {
-            history: History::with_capacity(rows as usize),
+    /// and the memory limit allow; an up-front check has refused a
+    /// fixed-step history beyond them).
+    pub(crate) fn new(settings: &Settings, rows: u64) -> Result<Self> {
+        let mut records = Self {
+            history: History::default(),
             contacts: Vec::new(),
             keep_history: settings.history,
             max_rows: settings.max_rows,
+        };
+        if settings.history {
+            let rows = rows
+                .min(settings.max_rows)
+                .min(MAX_RECORD_BYTES / ROW_BYTES);
+            records
+                .history
+                .try_reserve_exact(rows as usize)
+                .map_err(|_| records.no_room(NoRoom::Refused, 0.0))?;
         }
+        Ok(records)
     }
 
     /// Whether the history is kept at all.
@@ -133,12 +140,35 @@ impl Records {
         }
     }
 
-    /// How many more rows may be allocated: as many as the `current` length
-    /// (at least `least`), as far as `max_rows` allows.
-    fn growth(&self, current: usize, least: usize) -> usize {
+    fn no_room(&self, cause: NoRoom, time: f64) -> Error {
+        cause.error(
+            time,
+            (self.history.time.len() as u64, 0),
+            6,
+            self.contacts.len() as u64,
+            self.history.held() + memory::held(&self.contacts),
+        )
+    }
+
+    /// How many more rows (of `row_bytes` each) may be allocated: as many as
+    /// the `current` length (at least `least`), as far as `max_rows` and the
+    /// memory limit allow.
+    fn growth(&self, current: usize, least: usize, row_bytes: u64) -> usize {
         let allocated = (self.history.time.capacity() + self.contacts.capacity()) as u64;
         let room = self.max_rows.saturating_sub(allocated);
-        (current.max(least) as u64).min(room) as usize
+        let held = self.history.held() + memory::held(&self.contacts);
+        let fits = MAX_RECORD_BYTES.saturating_sub(held) / row_bytes;
+        (current.max(least) as u64).min(room).min(fits) as usize
+    }
+
+    /// The error of a run that found no room: the row limit, or the memory's.
+    fn limit(&self, time: f64) -> Error {
+        let allocated = (self.history.time.capacity() + self.contacts.capacity()) as u64;
+        if allocated >= self.max_rows {
+            self.full(time)
+        } else {
+            self.no_room(NoRoom::Limit(MAX_RECORD_BYTES), time)
+        }
     }
 
     /// Keeps one history row (when the history is kept).
@@ -157,23 +187,27 @@ impl Records {
     #[cold]
     #[inline(never)]
     fn grow_history(&mut self, time: f64) -> Result<()> {
-        let more = self.growth(self.history.time.len(), 64);
+        let more = self.growth(self.history.time.len(), 64, ROW_BYTES);
         if more == 0 {
-            return Err(self.full(time));
+            return Err(self.limit(time));
         }
-        self.history.reserve_exact(more);
-        Ok(())
+        self.history
+            .try_reserve_exact(more)
+            .map_err(|_| self.no_room(NoRoom::Refused, time))
     }
 
     /// Keeps one contact record; `time` is the run's time, for the message.
     pub(crate) fn contact(&mut self, record: ContactRecord, time: f64) -> Result<()> {
         if self.contacts.len() == self.contacts.capacity() {
             // Eight at first: a small allocation, as most runs have few contacts.
-            let more = self.growth(self.contacts.len(), 8);
+            let bytes = std::mem::size_of::<ContactRecord>() as u64;
+            let more = self.growth(self.contacts.len(), 8, bytes);
             if more == 0 {
-                return Err(self.full(time));
+                return Err(self.limit(time));
             }
-            self.contacts.reserve_exact(more);
+            self.contacts
+                .try_reserve_exact(more)
+                .map_err(|_| self.no_room(NoRoom::Refused, time))?;
         }
         self.contacts.push(record);
         Ok(())

@@ -105,7 +105,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
     let d = model.clearance;
     let c1 = model.contact_damping;
 
-    let mut records = Records::new(settings, rows);
+    let mut records = Records::new(settings, rows)?;
     let keep = records.keeps_history();
 
     let mut s = *initial;

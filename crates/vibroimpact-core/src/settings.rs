@@ -351,6 +351,14 @@ impl Settings {
                 self.max_rows
             )));
         }
+        // Six f64 columns a row.
+        if self.history && rows.saturating_mul(48) > crate::memory::MAX_RECORD_BYTES {
+            return Err(Error::Inconsistent(format!(
+                "the history would keep {rows} rows (t_end / dt / every) of 48 bytes, more than the \
+                 {} MiB a run's records may take: raise every, set history = false or shorten t_end",
+                crate::memory::MAX_RECORD_BYTES >> 20
+            )));
+        }
         Ok(())
     }
 

@@ -24,6 +24,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 use crate::error::{Error, Result};
 use crate::hermite;
 use crate::linalg;
+use crate::memory::{self, MAX_RECORD_BYTES};
 use crate::reductions::{self, ReduceOptions, Reductions};
 use crate::step_control::{rejects, StepControl};
 use crate::system_steppers::SystemStepper;
@@ -609,6 +610,28 @@ pub fn integrate_system<S: SystemStepper>(
     options: &RunOptions,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> Result<SystemSolution> {
+    integrate_system_within(
+        system,
+        stepper,
+        initial,
+        options,
+        interrupt,
+        MAX_RECORD_BYTES,
+    )
+}
+
+/// [`integrate_system`] with its records (history, stroboscopic states,
+/// contacts) kept within `record_limit` bytes instead of
+/// [`MAX_RECORD_BYTES`]: a run that would pass it stops with
+/// [`Error::MemoryLimit`].
+pub fn integrate_system_within<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    initial: &[f64],
+    options: &RunOptions,
+    interrupt: &mut dyn FnMut() -> bool,
+    record_limit: u64,
+) -> Result<SystemSolution> {
     let len = system.state_len();
     let d = system.dim;
     let count = system.interactions.len();
@@ -685,13 +708,28 @@ pub fn integrate_system<S: SystemStepper>(
     let row = 2 * d;
     let mut time_rows: Vec<f64> = Vec::new();
     let mut states: Vec<f64> = Vec::new();
-    let keep = |time: f64, y: &[f64], time_rows: &mut Vec<f64>, states: &mut Vec<f64>| {
-        time_rows.push(time);
-        states.extend_from_slice(&y[..row]);
+    // Bytes held by the records other than the history (strobes, contacts).
+    let others = |reductions: &Reductions, contacts: &Vec<PairContact>| {
+        memory::held(&reductions.strobe)
+            + memory::held(&reductions.strobe_time)
+            + memory::held(contacts)
     };
-    if options.keep_history {
-        keep(0.0, &y, &mut time_rows, &mut states);
-    }
+    // The error of a run whose records find no room, with what they hold.
+    let no_room = |cause: memory::NoRoom,
+                   time: f64,
+                   time_rows: &Vec<f64>,
+                   states: &Vec<f64>,
+                   reductions: &Reductions,
+                   contacts: &Vec<PairContact>| {
+        let held = others(reductions, contacts) + memory::held(time_rows) + memory::held(states);
+        cause.error(
+            time,
+            (time_rows.len() as u64, reductions.strobe_time.len() as u64),
+            row as u64 + 1,
+            contacts.len() as u64,
+            held,
+        )
+    };
     let mut time = 0.0;
     let mut control = StepControl::new(options.dt.unwrap_or(1e-6 * t_end));
     let mut grid: u64 = 0;
@@ -701,6 +739,8 @@ pub fn integrate_system<S: SystemStepper>(
     let mut stalled = 0u64;
     // Interactions whose dip in this step was checked and stays open.
     let mut unconfirmed = vec![false; count];
+    // Interactions switched at the event being handled.
+    let mut just_switched = vec![false; count];
     let mut any_unconfirmed = false;
     // Whether a compliant contact is on (modes change only at events).
     let mut compliant = any_compliant(&modes);
@@ -710,6 +750,17 @@ pub fn integrate_system<S: SystemStepper>(
         ..Reductions::default()
     };
     let mut next_strobe = options.reduce.strobe_period;
+    if options.keep_history {
+        memory::push_row(
+            &mut time_rows,
+            &mut states,
+            0.0,
+            &y[..row],
+            || 0,
+            record_limit,
+        )
+        .map_err(|cause| no_room(cause, 0.0, &time_rows, &states, &reductions, &contacts))?;
+    }
 
     while time < t_end {
         if !adaptive && t_end - time <= 1e-9 * dt {
@@ -992,6 +1043,7 @@ pub fn integrate_system<S: SystemStepper>(
         if switched.is_some() {
             // Every interaction on its wall at this instant switches.
             let mut any = false;
+            just_switched.iter_mut().for_each(|s| *s = false);
             for i in 0..count {
                 let v = event_value(
                     system,
@@ -1007,7 +1059,7 @@ pub fn integrate_system<S: SystemStepper>(
                 if !(located || v < 0.0) {
                     continue;
                 }
-                any |= switch(
+                just_switched[i] = switch(
                     system,
                     i,
                     time,
@@ -1017,10 +1069,11 @@ pub fn integrate_system<S: SystemStepper>(
                     &mut contacts,
                     &mut impact_loss,
                     &mut grazes,
-                    resolution,
+                    (resolution, chatter_interval(time)),
                     &mut scratch,
                     &mut buffers.work,
                 );
+                any |= just_switched[i];
             }
             if any {
                 settle_sticking(
@@ -1031,6 +1084,7 @@ pub fn integrate_system<S: SystemStepper>(
                     &mut open,
                     &mut contacts,
                     &mut impact_loss,
+                    &just_switched,
                 );
                 stepper.reset();
                 if adaptive {
@@ -1056,8 +1110,15 @@ pub fn integrate_system<S: SystemStepper>(
         }
 
         if time >= next_strobe - 1e-9 * options.reduce.strobe_period {
-            reductions.strobe.extend_from_slice(&y[..row]);
-            reductions.strobe_time.push(time);
+            memory::push_row(
+                &mut reductions.strobe_time,
+                &mut reductions.strobe,
+                time,
+                &y[..row],
+                || memory::held(&time_rows) + memory::held(&states) + memory::held(&contacts),
+                record_limit,
+            )
+            .map_err(|cause| no_room(cause, time, &time_rows, &states, &reductions, &contacts))?;
             next_strobe = (reductions.strobe_time.len() + 1) as f64 * options.reduce.strobe_period;
         }
         let done = time >= t_end || (!adaptive && t_end - time <= 1e-9 * dt);
@@ -1065,8 +1126,31 @@ pub fn integrate_system<S: SystemStepper>(
         until_kept = until_kept.saturating_sub(1);
         if options.keep_history && (until_kept == 0 || done) {
             until_kept = options.every;
-            keep(time, &y, &mut time_rows, &mut states);
+            memory::push_row(
+                &mut time_rows,
+                &mut states,
+                time,
+                &y[..row],
+                || others(&reductions, &contacts),
+                record_limit,
+            )
+            .map_err(|cause| no_room(cause, time, &time_rows, &states, &reductions, &contacts))?;
         }
+        // Room for the contacts the next step may close (a Vec's own
+        // doubling could pass the limit, or abort where memory is refused).
+        memory::make_room(
+            &mut contacts,
+            2 * count + 2,
+            8,
+            || {
+                memory::held(&reductions.strobe)
+                    + memory::held(&reductions.strobe_time)
+                    + memory::held(&time_rows)
+                    + memory::held(&states)
+            },
+            record_limit,
+        )
+        .map_err(|cause| no_room(cause, time, &time_rows, &states, &reductions, &contacts))?;
         if (time_rows.len() + contacts.len() + reductions.strobe_time.len()) as u64
             > options.max_rows
         {
@@ -1254,7 +1338,7 @@ fn check_balance(
     // losses can pass through states where every term is near zero.
     *scale = scale
         .max(magnitude + b.input_work.abs() + b.dissipated.abs())
-        .max(system.energy_floor)
+        .max(system.energy_floor(options.t_end))
         .max(f64::MIN_POSITIVE);
     if b.residual.abs() > options.energy_tolerance * *scale || !b.residual.is_finite() {
         return Err(Error::EnergyBalance {
@@ -1268,7 +1352,8 @@ fn check_balance(
 }
 
 /// Switch interaction `i` at `time`: start or end a contact, apply an
-/// impact, start or end sticking.
+/// impact, start or end sticking. `resolution` (s) is the time below which
+/// a chattering sequence is summed, `instant` (s) the round-off of the time.
 #[allow(clippy::too_many_arguments)]
 fn switch(
     system: &Assembly,
@@ -1280,7 +1365,7 @@ fn switch(
     contacts: &mut Vec<PairContact>,
     impact_loss: &mut f64,
     grazes: &mut u64,
-    resolution: f64,
+    (resolution, instant): (f64, f64),
     scratch: &mut Scratch,
     work: &mut [f64],
 ) -> bool {
@@ -1310,10 +1395,21 @@ fn switch(
         }
         (Mode::Open, InteractionLaw::Rigid { restitution }) => {
             let approach = -rate;
-            let speed_scale = y[system.dim..row]
-                .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()));
-            if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) {
+            let d = system.dim;
+            let speed_scale = y[d..row].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // Flights (or landings) that rise less than 1e-9 of the gap's
+            // scale are round-off: the positions' round-off decides such
+            // impacts, not the dynamics, and the pair is at rest on its wall.
+            let round_off = 1e-9 * system.gap_scale(i, y);
+            // The gap's acceleration with the pair free: < 0 presses it shut.
+            system.rates(time, y, modes, scratch, work);
+            let pressing = crate::linalg::dot(&it.h, &work[d..2 * d]);
+            // Landing at rest: an approach that the pressing gives within a
+            // rise of round-off, or within the round-off of the time.
+            let landing = pressing < 0.0
+                && (approach * approach <= -2.0 * pressing * round_off
+                    || approach <= -pressing * instant);
+            if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && !landing {
                 let loss = system.impact(i, y, restitution);
                 *impact_loss += loss;
                 contacts.push(PairContact {
@@ -1332,31 +1428,53 @@ fn switch(
                 // Located on the wall but leaving it (the start of a step
                 // just after an impact): no event.
                 return false;
-            } else {
+            } else if !landing {
                 *grazes += 1;
+                if pressing >= 0.0 && system.gap(i, y).0 < 0.0 {
+                    // Touching at rest, not pressed (a pair released at the
+                    // instant its force turns, a zero clearance): put it a
+                    // few units of round-off off the wall, or the same
+                    // touch is found again at once, without end.
+                    system.release(i, y);
+                    return true;
+                }
             }
             // Would the rest of a chattering sequence finish within the
-            // run's resolution? Then sum it and stick.
-            let rebound = system.gap(i, y).1;
-            system.rates(time, y, modes, scratch, work);
-            let d = system.dim;
-            let pressing = crate::linalg::dot(&it.h, &work[d..2 * d]);
-            if pressing < 0.0 && restitution < 1.0 {
-                let rebound = rebound.max(0.0);
-                let remaining = 2.0 * rebound / (-pressing * (1.0 - restitution));
+            // run's resolution? Then sum it and stick. A pair that lands at
+            // rest sticks at once, whatever its restitution (even 1: a ball
+            // resting on a floor stays there).
+            let rebound = system.gap(i, y).1.max(0.0);
+            let pressing = if landing {
+                pressing
+            } else {
+                system.rates(time, y, modes, scratch, work);
+                crate::linalg::dot(&it.h, &work[d..2 * d])
+            };
+            if pressing < 0.0 {
+                let remaining = if landing {
+                    0.0
+                } else {
+                    2.0 * rebound / (-pressing * (1.0 - restitution))
+                };
                 // The sequence is summed once it would finish within the
                 // step (fixed-step methods), or once its flights rise less
-                // than 1e-9 of the gap's scale: below that the positions'
-                // round-off decides the impacts, not the dynamics.
+                // than round-off.
                 let height = rebound * rebound / (-2.0 * pressing);
-                if remaining <= resolution || height <= 1e-9 * system.gap_scale(i, y) {
+                if remaining <= resolution || height <= round_off {
                     let loss = system.impact(i, y, 0.0);
                     *impact_loss += loss;
                     modes[i] = Mode::Sticking;
                     open[i] = Some(Open {
                         kind: ContactKind::Sticking,
-                        onset: time + remaining,
-                        approach_speed: rebound.max(0.0),
+                        // A sequence that never ends (restitution 1) is
+                        // cut where its flights fell to round-off: now.
+                        onset: time
+                            + if remaining.is_finite() {
+                                remaining
+                            } else {
+                                0.0
+                            },
+                        approach_speed: if landing { approach.max(0.0) } else { rebound },
                         max_indentation: 0.0,
                         dissipated: loss,
                     });
@@ -1377,7 +1495,10 @@ fn switch(
 /// After an impact elsewhere, a sticking pair whose gap now closes is held
 /// (a plastic impact keeps it stuck) and one whose gap now opens is
 /// released: the sequential answer to what is, exactly, a complementarity
-/// problem among the pairs.
+/// problem among the pairs. Pairs that switched at this instant
+/// (`just_switched`) are left as they are: one that has just stuck moves
+/// with its wall to round-off, which must not read as opening.
+#[allow(clippy::too_many_arguments)]
 fn settle_sticking(
     system: &Assembly,
     time: f64,
@@ -1386,12 +1507,13 @@ fn settle_sticking(
     open: &mut [Option<Open>],
     contacts: &mut Vec<PairContact>,
     impact_loss: &mut f64,
+    just_switched: &[bool],
 ) {
     let d = system.dim;
     let speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let tiny = 1e-9 * speed_scale;
     for i in 0..modes.len() {
-        if modes[i] != Mode::Sticking {
+        if modes[i] != Mode::Sticking || just_switched[i] {
             continue;
         }
         let (_, rate) = system.gap(i, y);

@@ -207,6 +207,41 @@ fn ball(height: f64, restitution: f64) -> SystemSpec {
 }
 
 #[test]
+fn a_ball_at_rest_on_the_floor_stays_there_whatever_its_restitution() {
+    common::timeout(20, || {
+        // Started on the floor at rest, the ball only presses on it: one
+        // sticking contact from the first instant, no impact, no release,
+        // even with e = 1 (whose impacts never accumulate: the round-off
+        // micro-bounces were once stopped as "chattering").
+        for (e, floor) in [(1.0, 0.0), (0.8, 0.0), (0.0, 0.0), (1.0, 1.0), (0.8, 1.0)] {
+            for (method, dt) in [
+                ("rk4", 1e-3),
+                ("dopri5", 0.0),
+                ("dop853", 0.0),
+                ("newmark-implicit", 1e-3),
+                ("generalized-alpha", 1e-3),
+            ] {
+                // The floor `floor` m below the origin, the ball on it.
+                let start = [vec![-floor], vec![], vec![], vec![]];
+                let sol = run(&ball(floor, e), &start, method, dt, 2.0);
+                assert_eq!(sol.contacts.len(), 1, "{method} e={e}: {:?}", sol.contacts);
+                let rest = &sol.contacts[0];
+                assert_eq!(rest.kind, ContactKind::Sticking, "{method} e={e}");
+                assert!(rest.onset < 1e-6, "{method} e={e}: {}", rest.onset);
+                assert!(rest.separation.is_nan(), "{method} e={e}: released");
+                assert_eq!(sol.final_time, 2.0);
+                let (x, v) = (sol.final_state[0], sol.final_state[1]);
+                assert!(
+                    (x + floor).abs() < 1e-12 && v.abs() < 1e-12,
+                    "{method} e={e}: {x} {v}"
+                );
+                assert!(sol.energy.impact.abs() < 1e-12, "{:?}", sol.energy);
+            }
+        }
+    });
+}
+
+#[test]
 fn bouncing_ball_comes_to_rest_at_its_accumulation_time() {
     common::timeout(20, || {
         // Impacts at t1 (1 + 2 e + 2 e^2 + ...), t1 = sqrt(2 h / g): they

@@ -53,7 +53,8 @@ pub(crate) fn to_py(err: core::Error) -> PyErr {
         | E::Chattering { .. }
         | E::StepSizeTooSmall { .. }
         | E::TooManySteps { .. }
-        | E::RowLimit { .. } => SimulationError::new_err(message),
+        | E::RowLimit { .. }
+        | E::MemoryLimit { .. } => SimulationError::new_err(message),
         E::InvalidParameter { .. } | E::UnknownChoice { .. } | E::Inconsistent(_) => {
             InvalidInputError::new_err(message)
         }

@@ -1,0 +1,111 @@
+//! What a 0.2 run keeps stays within its memory: rows of a wide system
+//! count by their bytes, not only their number, and a run whose records
+//! would pass the limit stops with a clear error, having never held more.
+
+mod common;
+
+use vibroimpact_core::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
+use vibroimpact_core::contact::{Contact, LawKind};
+use vibroimpact_core::error::Error;
+use vibroimpact_core::reductions::ReduceOptions;
+use vibroimpact_core::structure::Structure;
+use vibroimpact_core::system_events::{integrate_system_within, RunOptions, SystemSolution};
+use vibroimpact_core::system_steppers::ExplicitRk;
+use vibroimpact_core::MAX_RECORD_BYTES;
+
+/// A 40-mode cantilever with a damper at its tip, struck: rows of
+/// 1 + 2 (40 + 1) = 83 values.
+fn beam() -> (Assembly, Vec<f64>) {
+    let spec = SystemSpec {
+        structure: Structure::cantilever(1.0, 2.0e5, 1e-8, 1.0, 40, 0.01).unwrap(),
+        dampers: vec![Damper {
+            mass: 0.01,
+            at: 1.0,
+            lower_clearance: 1e-3,
+            upper_clearance: 1e-3,
+            law: PairLaw::Compliant(Contact::new(LawKind::Hertz, 1e5, None, 0.0).unwrap()),
+        }],
+        stops: vec![],
+        gravity: 0.0,
+        excitations: vec![],
+    };
+    let system = Assembly::new(&spec).unwrap();
+    let mut v = vec![0.0; 40];
+    v[0] = 0.1;
+    let y = initial_state(&system, &[], &v, &[], &[]).unwrap();
+    (system, y)
+}
+
+fn options(keep_history: bool, strobe_period: f64) -> RunOptions {
+    RunOptions {
+        dt: None,
+        t_end: 2.0,
+        every: 1,
+        keep_history,
+        max_steps: 100_000_000,
+        max_rows: 100_000_000,
+        energy_tolerance: 1e-3,
+        reduce: ReduceOptions {
+            strobe_period,
+            ..Default::default()
+        },
+    }
+}
+
+fn run(o: &RunOptions, limit: u64) -> vibroimpact_core::Result<SystemSolution> {
+    let (system, y) = beam();
+    let mut stepper = ExplicitRk::dopri5(system.state_len(), 1e-8, 1e-12);
+    integrate_system_within(&system, &mut stepper, &y, o, &mut || false, limit)
+}
+
+#[test]
+fn an_adaptive_history_stops_at_the_memory_limit_not_past_it() {
+    common::timeout(60, || {
+        // The whole run keeps thousands of rows of 83 values (> 1 MiB)...
+        let whole = run(&options(true, f64::INFINITY), MAX_RECORD_BYTES).unwrap();
+        let bytes = 8 * (whole.time.len() + whole.states.len());
+        assert!(bytes > 1 << 20, "{bytes}");
+        assert_eq!(whole.states.len(), 82 * whole.time.len());
+        // ...so under a 1 MiB limit it stops, with what it kept under it.
+        match run(&options(true, f64::INFINITY), 1 << 20) {
+            Err(Error::MemoryLimit {
+                rows,
+                columns,
+                held_mib,
+                time,
+                ref cause,
+                ..
+            }) => {
+                assert_eq!(columns, 83);
+                assert!(rows * columns * 8 <= 1 << 20, "{rows} rows");
+                // At least half the limit was used before stopping.
+                assert!(rows * columns * 8 >= 1 << 19, "{rows} rows");
+                assert!(held_mib <= 1);
+                assert!(time > 0.0 && time < 2.0);
+                assert_eq!(cause, "would pass the limit of 1 MiB");
+            }
+            other => panic!("expected MemoryLimit, got {other:?}"),
+        }
+        // Without a history it runs to the end under the same limit.
+        let bare = run(&options(false, f64::INFINITY), 1 << 20).unwrap();
+        assert_eq!(bare.final_time, 2.0);
+        assert_eq!(bare.final_state, whole.final_state);
+    });
+}
+
+#[test]
+fn stroboscopic_rows_count_against_the_memory_limit() {
+    common::timeout(60, || {
+        // 2 s / 1e-4 s = 20000 rows of 83 values: 13 MiB, past a 1 MiB limit.
+        let message = match run(&options(false, 1e-4), 1 << 20) {
+            Err(e @ Error::MemoryLimit { .. }) => e.to_string(),
+            other => panic!("expected MemoryLimit, got {other:?}"),
+        };
+        for words in ["stroboscopic rows of 83 values", "strobe_period", "t_end"] {
+            assert!(message.contains(words), "{message}");
+        }
+        // Under the real limit the same run keeps them all.
+        let kept = run(&options(false, 1e-4), MAX_RECORD_BYTES).unwrap();
+        assert_eq!(kept.reductions.strobe_time.len(), 20_000);
+    });
+}
