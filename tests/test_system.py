@@ -646,6 +646,12 @@ def test_keys_a_rigid_law_does_not_use_are_refused(change: dict[str, float], mes
         simulate_system(BALL, damper=[{**damper, **change}], t_end=0.1, method="rk4", dt=1e-3)
 
 
+def test_a_negative_clearance_is_refused_naming_the_key_given() -> None:
+    damper = {"mass": 0.1, "at": 0, "clearance": -0.005, "law": "rigid", "restitution": 0.5}
+    with pytest.raises(vi.InvalidInputError, match=r"\[\[damper\]\] 0: clearance must be >= 0"):
+        simulate_system(BALL, damper=[damper], t_end=0.1, method="rk4", dt=1e-3)
+
+
 def test_keys_an_excitation_does_not_use_are_refused() -> None:
     force = {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 2.0}
     with pytest.raises(vi.InvalidInputError, match="duration not used by signal 'harmonic'"):

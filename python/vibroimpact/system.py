@@ -494,6 +494,8 @@ def system_spec(
     for j, table in enumerate(_list("damper", damper)):
         d = _table(f"[[damper]] {j}: ", table, _DAMPER)
         both = d["clearance"]
+        if both is not None and not both >= 0:
+            raise _fail(f"[[damper]] {j}: ", f"clearance must be >= 0 m (each side), got {both}")
         for side in ("lower_clearance", "upper_clearance"):
             if d[side] is None:
                 if both is None:

@@ -398,7 +398,21 @@ impl Assembly {
             .iter()
             .find(|w| **w > 0.0)
             .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w);
-        let time_scale = shortest.min(longest_period);
+        // Without a period (a ball under gravity), the time to fall through
+        // the largest gap: a long run's length would make the floor of the
+        // energy check grow without bound.
+        let largest_gap = interactions
+            .iter()
+            .fold(0.0f64, |g, it| g.max(it.offset.abs()));
+        let fall_time = if acceleration > 0.0 && largest_gap > 0.0 {
+            (2.0 * largest_gap / acceleration).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let time_scale = match shortest.min(longest_period) {
+            period if period.is_finite() => period,
+            _ => fall_time,
+        };
         let mirrors_previous = (0..interactions.len())
             .map(|i| {
                 i > 0
@@ -943,9 +957,10 @@ impl Assembly {
 
     /// An energy (J) below which a balance residual is round-off: 1e-12 of
     /// what the largest acceleration acting (gravity, base, force) gives the
-    /// total mass over the system's time scale, or over the run's length
-    /// `t_end` (s) where that is shorter or there is none (a ball resting on
-    /// a floor has no period, and nearly no energy).
+    /// total mass over the system's time scale (its shortest period, or
+    /// without one the time to fall through its largest gap), or over the
+    /// run's length `t_end` (s) where that is shorter or there is neither (a
+    /// ball resting on a floor at the origin).
     pub fn energy_floor(&self, t_end: f64) -> f64 {
         1e-12 * self.floor_mass_acceleration * self.time_scale.min(t_end).powi(2)
     }

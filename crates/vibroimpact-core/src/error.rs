@@ -71,7 +71,7 @@ pub enum Error {
     #[error(
         "the run's records ({rows} history rows and {strobes} stroboscopic rows of {columns} values, \
          {contacts} contacts) reached \
-         {held_mib} MiB by t = {time:.6e} s and {cause}: raise every, set history = false or \
+         {held_mib:.1} MiB by t = {time:.6e} s and {cause}: raise every, set history = false or \
          shorten t_end (or lengthen strobe_period)"
     )]
     MemoryLimit {
@@ -80,7 +80,7 @@ pub enum Error {
         strobes: u64,
         columns: u64,
         contacts: u64,
-        held_mib: u64,
+        held_mib: f64,
         /// "would pass the limit of 2048 MiB" or "the machine refused more".
         cause: String,
     },

@@ -48,7 +48,7 @@ impl NoRoom {
             strobes,
             columns,
             contacts,
-            held_mib: held >> 20,
+            held_mib: held as f64 / (1u64 << 20) as f64,
             cause: match self {
                 Self::Limit(limit) => format!("would pass the limit of {} MiB", limit >> 20),
                 Self::Refused => "the machine refused more memory".to_string(),
@@ -58,9 +58,9 @@ impl NoRoom {
 }
 
 /// Makes room in `v` for `more` elements: as many again as it holds (at
-/// least `least`), but never so many that all the run's records, `v`'s and
-/// the `others` bytes held elsewhere (asked only when `v` must grow), pass
-/// `limit` bytes.
+/// least `least`), but at most half the room left under `limit` bytes for
+/// all the run's records, `v`'s and the `others` bytes held elsewhere
+/// (asked only when `v` must grow): records that grow in turn share it.
 #[inline(always)]
 pub(crate) fn make_room<T>(
     v: &mut Vec<T>,
@@ -88,18 +88,19 @@ fn grow<T>(
     // Elements that still fit, beyond those allocated.
     let fits = limit.saturating_sub(others + held(v)) / size;
     let spare = (v.capacity() - v.len()) as u64;
-    let wanted = (v.len().max(least) as u64).max(more as u64);
-    let reserve = (wanted.min(fits + spare)) as usize;
-    if reserve < more {
+    if fits + spare < more as u64 {
         return Err(NoRoom::Limit(limit));
     }
+    // At most half the room left, so that the other records can still grow.
+    let wanted = (v.len().max(least) as u64).max(more as u64);
+    let reserve = wanted.min(((fits + spare) / 2).max(more as u64)) as usize;
     v.try_reserve_exact(reserve).map_err(|_| NoRoom::Refused)
 }
 
 /// Appends a row, `time` to `times` and `values` to `rows`, growing both
-/// together (as many rows again as they hold, at least 64) within `limit`
-/// bytes of all the run's records, of which `others` are held elsewhere
-/// (asked only when they must grow).
+/// together (as many rows again as they hold, at least 64, at most half
+/// the room left) within `limit` bytes of all the run's records, of which
+/// `others` are held elsewhere (asked only when they must grow).
 #[inline(always)]
 pub(crate) fn push_row(
     times: &mut Vec<f64>,
@@ -128,10 +129,11 @@ fn grow_rows(
 ) -> Result<(), NoRoom> {
     let row_bytes = 8 * (width as u64 + 1);
     let fits = limit.saturating_sub(others + held(times) + held(rows)) / row_bytes;
-    let more = (times.len().max(64) as u64).min(fits) as usize;
-    if more == 0 {
+    if fits == 0 {
         return Err(NoRoom::Limit(limit));
     }
+    // At most half the room left, so that the other records can still grow.
+    let more = (times.len().max(64) as u64).min((fits / 2).max(1)) as usize;
     times.try_reserve_exact(more).map_err(|_| NoRoom::Refused)?;
     rows.try_reserve_exact(more * width)
         .map_err(|_| NoRoom::Refused)
@@ -150,12 +152,18 @@ mod tests {
             v.extend_from_slice(&[1.0; 4]);
             make_room(&mut v, 1, 4, || 0, 1 << 20).unwrap();
             assert_eq!(v.capacity(), 8, "as many again as it holds");
-            // With 40 bytes left (5 f64), it grows only to what fits.
+            // With 40 bytes left (5 f64), it takes half of what fits, then
+            // half of the rest, up to the limit and no further.
             v.extend_from_slice(&[1.0; 4]);
             let others = (1 << 20) - held(&v) - 40;
             make_room(&mut v, 1, 4, || others, 1 << 20).unwrap();
-            assert_eq!(v.capacity(), 8 + 5);
-            v.resize(13, 0.0);
+            assert_eq!(v.capacity(), 8 + 2);
+            while v.len() < 13 {
+                make_room(&mut v, 1, 4, || others, 1 << 20).unwrap();
+                v.push(0.0);
+                assert!(held(&v) + others <= 1 << 20);
+            }
+            assert_eq!(v.capacity(), 13);
             assert_eq!(
                 make_room(&mut v, 1, 4, || others, 1 << 20),
                 Err(NoRoom::Limit(1 << 20))
@@ -168,8 +176,9 @@ mod tests {
     fn rows_grow_together_within_the_limit() {
         crate::testing::timeout(60, || {
             let (mut times, mut rows) = (Vec::new(), Vec::new());
-            // Rows of 1 + 3 values (32 bytes): 64 at first, then 100 in all
-            // under a 3200-byte limit, then no more.
+            // Rows of 1 + 3 values (32 bytes): 50 at first (half the room
+            // of a 3200-byte limit), then half the rest each time, 100 in
+            // all, then no more.
             let limit = 3200;
             for i in 0..100 {
                 push_row(
@@ -191,6 +200,25 @@ mod tests {
             );
             assert_eq!((times.len(), rows.len()), (100, 300), "nothing half kept");
             assert_eq!(rows[297..], [1.0, 2.0, 3.0]);
+        });
+    }
+
+    #[test]
+    fn a_growing_history_leaves_room_for_the_other_records() {
+        crate::testing::timeout(60, || {
+            // 200 rows of 32 bytes and 37 contacts of 8 need 6696 bytes, 89 %
+            // of a 7500-byte limit. A history that took all the room its
+            // doubling wanted would leave 12 bytes and stop the contacts.
+            let limit = 7500;
+            let (mut times, mut rows) = (Vec::new(), Vec::new());
+            let mut contacts: Vec<f64> = Vec::new();
+            for i in 0..200 {
+                let others = held(&contacts);
+                push_row(&mut times, &mut rows, i as f64, &[0.0; 3], || others, limit).unwrap();
+            }
+            let others = held(&times) + held(&rows);
+            make_room(&mut contacts, 37, 8, || others, limit).unwrap();
+            assert!(held(&times) + held(&rows) + held(&contacts) <= limit);
         });
     }
 

@@ -1495,9 +1495,10 @@ fn switch(
 /// After an impact elsewhere, a sticking pair whose gap now closes is held
 /// (a plastic impact keeps it stuck) and one whose gap now opens is
 /// released: the sequential answer to what is, exactly, a complementarity
-/// problem among the pairs. Pairs that switched at this instant
-/// (`just_switched`) are left as they are: one that has just stuck moves
-/// with its wall to round-off, which must not read as opening.
+/// problem among the pairs. A pair that stuck at this instant
+/// (`just_switched`) is held but not released: it moves with its wall to
+/// round-off, which must not read as opening, but an impact of another
+/// pair after it may still close it.
 #[allow(clippy::too_many_arguments)]
 fn settle_sticking(
     system: &Assembly,
@@ -1513,7 +1514,7 @@ fn settle_sticking(
     let speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let tiny = 1e-9 * speed_scale;
     for i in 0..modes.len() {
-        if modes[i] != Mode::Sticking || just_switched[i] {
+        if modes[i] != Mode::Sticking {
             continue;
         }
         let (_, rate) = system.gap(i, y);
@@ -1523,7 +1524,7 @@ fn settle_sticking(
             if let Some(oc) = open[i].as_mut() {
                 oc.dissipated += loss;
             }
-        } else if rate > tiny {
+        } else if rate > tiny && !just_switched[i] {
             modes[i] = Mode::Open;
             if let Some(oc) = open[i].take() {
                 contacts.push(oc.close(system.interactions[i].pair, time, 0.0, oc.dissipated));

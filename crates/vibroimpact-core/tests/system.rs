@@ -242,6 +242,52 @@ fn a_ball_at_rest_on_the_floor_stays_there_whatever_its_restitution() {
 }
 
 #[test]
+fn a_pair_that_sticks_is_held_through_another_pairs_impact_at_the_same_instant() {
+    common::timeout(20, || {
+        // A structure reaching its stop with a loose mass on its cavity's
+        // lower wall, both moving down: at the first instant the damper
+        // lands (and sticks) and the stop strikes the structure back. The
+        // damper must be held by its wall (a plastic impact), not left to
+        // pass through it (it once sank 4.5 mm of its 10 mm clearance).
+        let (gap, clearance, v) = (0.05, 0.01, -0.3);
+        let mut s = spec(Structure::oscillator(1.0, 100.0, 0.0).unwrap());
+        s.stops.push(Stop {
+            at: 0.0,
+            side: Side::Lower,
+            gap,
+            law: PairLaw::rigid(0.5).unwrap(),
+            against: None,
+        });
+        s.dampers.push(Damper {
+            mass: 0.1,
+            at: 0.0,
+            lower_clearance: clearance,
+            upper_clearance: clearance,
+            law: PairLaw::rigid(0.5).unwrap(),
+        });
+        let start = [vec![-gap], vec![v], vec![-gap - clearance], vec![v]];
+        for (method, dt) in [("rk4", 1e-4), ("dopri5", 0.0), ("dop853", 0.0)] {
+            let sol = run(&s, &start, method, dt, 0.01);
+            for (row, t) in sol.time.iter().enumerate() {
+                let state = &sol.states[4 * row..4 * row + 4];
+                let (structure, damper) = (state[0], state[1]);
+                let inside = (structure - clearance) - damper;
+                assert!(inside < 1e-12, "{method}: {inside} m inside at {t} s");
+                assert!(
+                    structure >= -gap - 1e-12,
+                    "{method}: through the stop at {t} s"
+                );
+            }
+            assert!(
+                sol.energy.residual.abs() < 1e-9,
+                "{method}: {:?}",
+                sol.energy
+            );
+        }
+    });
+}
+
+#[test]
 fn bouncing_ball_comes_to_rest_at_its_accumulation_time() {
     common::timeout(20, || {
         // Impacts at t1 (1 + 2 e + 2 e^2 + ...), t1 = sqrt(2 h / g): they
