@@ -179,3 +179,18 @@ def test_a_ball_at_rest_on_the_floor_stays_there(restitution: float, method: str
     assert done.contacts.onset[0] < 1e-6
     assert abs(done.final_state["structure_displacement"][0] + 1.0) < 1e-12
     assert abs(done.energy["residual"]) < 1e-12
+
+
+def test_an_analysis_refuses_strobes_beyond_the_memory_limit(tmp_path: Path) -> None:
+    # Settling keeps a state a period: 1e7 periods of a 200-mode beam's 403 values
+    # would be 30 GiB, computed for minutes before the run stopped at the limit.
+    data = tomllib.loads(
+        WIDE_BEAM.replace("t_end = 1e4", "t_end = 0.01").replace(
+            "[[damper]]",
+            '[[excitation]]\nkind = "force"\n'
+            'at = 1.0\nsignal = "harmonic"\namplitude = 1.0\nfrequency = 1.0\n[[damper]]',
+        )
+    )
+    run = runner(data, tmp_path)
+    with pytest.raises(AnalysisError, match="settle fewer periods"):
+        run.periods(run.initial_state(), 10**7, strobe=True)

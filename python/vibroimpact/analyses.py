@@ -22,7 +22,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError, PreparedSystem
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem
 from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.system import (
     _NUMBER,
@@ -201,6 +201,14 @@ class Runner:
     ) -> dict[str, Any]:
         """Run ``count`` forcing periods from ``state``."""
         check_periods("", "periods", count, 1)
+        width = 1 + 2 * (self.n + self.k)
+        if strobe and count * width * 8 > MAX_RECORD_BYTES:
+            # A state a period: known before the run, as a fixed-step history is.
+            raise AnalysisError(
+                f"periods: {count} stroboscopic states of {width} values, "
+                f"{count * width * 8 / 2**20:.0f} MiB, more than the "
+                f"{MAX_RECORD_BYTES >> 20} MiB a run's records may take: settle fewer periods"
+            )
         return self._run(state, count * self.period, record=record, strobe=strobe)
 
     def map(self, state: np.ndarray, count: int) -> np.ndarray:

@@ -865,7 +865,7 @@ def prepare_system(
         width = 1 + 2 * _coordinates(spec)
         if rows * width * 8 > MAX_RECORD_BYTES:
             raise _fail(
-                "[solver] ",
+                "[output] history: ",
                 f"the history would keep {rows:.3e} rows of {width} values, "
                 f"{rows * width * 8 / 2**20:.0f} MiB, more than the {MAX_RECORD_BYTES >> 20} MiB "
                 "a run's records may take: raise every, set history = false or shorten t_end",

@@ -71,8 +71,7 @@ pub enum Error {
     #[error(
         "the run's records ({rows} history rows and {strobes} stroboscopic rows of {columns} values, \
          {contacts} contacts) reached \
-         {held_mib:.1} MiB by t = {time:.6e} s and {cause}: raise every, set history = false or \
-         shorten t_end (or lengthen strobe_period)"
+         {held_mib:.1} MiB by t = {time:.6e} s and {cause}: {advice}"
     )]
     MemoryLimit {
         time: f64,
@@ -83,6 +82,8 @@ pub enum Error {
         held_mib: f64,
         /// "would pass the limit of 2048 MiB" or "the machine refused more".
         cause: String,
+        /// What to change: for the records that hold the most.
+        advice: &'static str,
     },
     /// The energy balance does not close: stored energy plus the work of the
     /// dissipative forces minus the external work differs from the energy at

@@ -42,7 +42,17 @@ impl NoRoom {
         contacts: u64,
         held: u64,
     ) -> Error {
+        // Advice for what holds the most: a contact is about 11 values.
+        let (history, strobed) = (rows * columns, strobes * columns);
+        let advice = if history >= strobed && history >= 11 * contacts {
+            "raise every, set history = false or shorten t_end"
+        } else if strobed >= 11 * contacts {
+            "lengthen strobe_period or shorten t_end"
+        } else {
+            "the contacts fill it: shorten t_end"
+        };
         Error::MemoryLimit {
+            advice,
             time,
             rows,
             strobes,

@@ -104,6 +104,8 @@ fn stroboscopic_rows_count_against_the_memory_limit() {
         for words in ["stroboscopic rows of 83 values", "strobe_period", "t_end"] {
             assert!(message.contains(words), "{message}");
         }
+        // No history was kept: the advice is about what filled the memory.
+        assert!(!message.contains("history = false"), "{message}");
         // Under the real limit the same run keeps them all.
         let kept = run(&options(false, 1e-4), MAX_RECORD_BYTES).unwrap();
         assert_eq!(kept.reductions.strobe_time.len(), 20_000);
