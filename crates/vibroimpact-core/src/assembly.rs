@@ -1279,8 +1279,9 @@ fn state_from(assembly: &Assembly, arrays: [&[f64]; 4], resumed: bool) -> Result
         ("damper_velocity", damper_velocity, k, d + n),
     ] {
         if !values.is_empty() && values.len() != size {
+            let unit = if size == 1 { "value" } else { "values" };
             return Err(Error::Inconsistent(format!(
-                "initial.{key} must have {size} values (or none), got {}",
+                "initial.{key} must have {size} {unit} (or none), got {}",
                 values.len()
             )));
         }

@@ -484,7 +484,7 @@ fn bad_systems_are_refused_naming_the_input() {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("initial.structure_displacement must have 1 values"),
+            e.contains("initial.structure_displacement must have 1 value (or none)"),
             "{e}"
         );
         let e = initial_state(&system, &[], &[], &[0.02], &[])
