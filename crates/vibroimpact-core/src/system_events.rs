@@ -254,6 +254,30 @@ fn cubic_argmax(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
     }
 }
 
+/// The first local maximum of the cubic Hermite interpolant whose slope
+/// starts at `m0 > 0` and ends at `m1 >= 0`: the smaller root of its slope
+/// in [0, 1] when it falls below zero between them, else 0 (no maximum
+/// inside: it rises throughout).
+fn first_maximum(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
+    // slope(theta) = a theta^2 + b theta + m0, as in [`cubic_argmax`].
+    let a = 6.0 * (g0 - g1) + 3.0 * (m0 + m1);
+    let b = 6.0 * (g1 - g0) - 4.0 * m0 - 2.0 * m1;
+    let discriminant = b * b - 4.0 * a * m0;
+    if a <= 0.0 || discriminant <= 0.0 {
+        // A slope that opens downwards and ends >= 0 stays >= 0; one with
+        // no real roots never falls below zero.
+        return 0.0;
+    }
+    // Both roots positive (their product m0 / a > 0): the smaller one.
+    let q = -0.5 * (b - discriminant.sqrt());
+    let root = m0 / q;
+    if root > 0.0 && root < 1.0 {
+        root
+    } else {
+        0.0
+    }
+}
+
 /// A root of the cubic Hermite interpolant (see [`hermite::eval`]) between
 /// `lo` and `hi` in theta, where it has opposite signs (else `hi`): Newton's
 /// method on its power form, safeguarded by bisection, to 1e-10 in theta
@@ -351,6 +375,17 @@ fn find_crossing(
             // interpolant's maximum.
             let before = if v0 <= graze && m0 > 0.0 && m1 < 0.0 {
                 cubic_argmax(v0, v1, m0, m1)
+            } else if v0 <= graze && m0 > 0.0 {
+                // Rising again at the end (the wall's own motion turned
+                // within the step): the first maximum, where it turned back,
+                // if the interpolant rises there above a graze (a step far
+                // longer than the flight says nothing of it).
+                let top = first_maximum(v0, v1, m0, m1);
+                if hermite::eval(v0, v1, m0, m1, top).0 > graze {
+                    top
+                } else {
+                    0.0
+                }
             } else {
                 0.0
             };
@@ -1558,6 +1593,22 @@ mod tests {
             assert!((r - 0.3).abs() < 1e-14, "{r}");
             // No sign change in the bracket: its end.
             assert_eq!(cubic_root(g0, g1, m0, m1, 0.5, 1.0), 1.0);
+        });
+    }
+
+    #[test]
+    fn the_first_maximum_of_a_cubic_that_rises_again() {
+        crate::testing::timeout(30, || {
+            // p = 0.3 t - t^2 + t^3: p' = 0.3 - 2 t + 3 t^2 vanishes at
+            // (2 -+ sqrt(0.4)) / 6; the first, 0.2279, is its maximum.
+            let p = |t: f64| 0.3 * t - t * t + t * t * t;
+            let dp = |t: f64| 0.3 - 2.0 * t + 3.0 * t * t;
+            let (g0, g1, m0, m1) = data(p, dp);
+            let exact = (2.0 - 0.4f64.sqrt()) / 6.0;
+            assert!((first_maximum(g0, g1, m0, m1) - exact).abs() < 1e-15);
+            // One that rises throughout has none inside.
+            let (g0, g1, m0, m1) = data(|t| t + t * t * t, |t| 1.0 + 3.0 * t * t);
+            assert_eq!(first_maximum(g0, g1, m0, m1), 0.0);
         });
     }
 
