@@ -709,3 +709,11 @@ def test_a_clearance_swept_down_restarts_where_the_damper_would_start_inside_a_w
         )
     assert len(points) == len(values)
     assert all(p.error is None for p in points), [p.error for p in points]
+
+
+@pytest.mark.parametrize("path", ["solver.t_end", "output.every"])
+def test_a_sweep_of_a_key_the_analyses_do_not_use_is_refused(path: str) -> None:
+    # Accepted, it gave identical points (found by a user trial).
+    table = {"parameter": path, "start": 1.0, "stop": 2.0, "count": 2}
+    with pytest.raises(an.AnalysisError, match="not used by the analyses"):
+        an.sweep_settings(table)

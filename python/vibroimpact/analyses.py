@@ -558,6 +558,13 @@ def with_parameter_path_check(path: str, section: str = "[sweep]") -> None:
     for part in parts[1:]:
         if part.lstrip("+-").isdigit() and not (part.isascii() and part.isdigit()):
             raise AnalysisError(f"{where}: {part!r} in {path!r}: an index is a whole number from 0")
+    if path == "solver.t_end" or parts[0] == "output":
+        # The analyses run whole forcing periods and keep what they need: these
+        # keys would change nothing, point after point.
+        raise AnalysisError(
+            f"{where}: {path!r} is not used by the analyses (they run settle and record "
+            "periods, not [solver] t_end, and keep no [output]); choose a parameter of the system"
+        )
 
 
 def sweep_values(settings: Mapping[str, Any]) -> np.ndarray:
