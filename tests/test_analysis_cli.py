@@ -180,6 +180,26 @@ def test_orbit_prints_a_readable_summary(run_cli: RunCli) -> None:
     assert "|0.5|" in done.stdout and "structure_displacement = [" in done.stdout
 
 
+def test_an_orbit_not_found_says_its_figures_are_of_the_last_iterate(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from vibroimpact import analysis_commands, cli
+
+    real = analysis_commands.orbit
+    # One Newton iteration from a start off the orbit cannot converge.
+    monkeypatch.setattr(
+        analysis_commands, "orbit", lambda run, **kw: real(run, **kw, max_iterations=1)
+    )
+    assert cli.main(["orbit", str(BALL_TABLE)]) == 0
+    out = capsys.readouterr().out
+    assert "did NOT converge" in out
+    assert "last Newton iterate, not of an orbit" in out
+    # A converged one does not say so.
+    monkeypatch.setattr(analysis_commands, "orbit", real)
+    assert cli.main(["orbit", str(BALL_TABLE)]) == 0
+    assert "last Newton iterate" not in capsys.readouterr().out
+
+
 # ------------------------------------------------------------------------- sweep
 
 

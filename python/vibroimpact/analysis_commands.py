@@ -182,6 +182,11 @@ def run_orbit(args: argparse.Namespace) -> int:
         f"{args.scenario}: {'converged' if found.converged else 'did NOT converge'} to a "
         f"{args.periods}-period orbit in {found.iterations} Newton iterations "
         f"(residual {found.residual:.2e}), {cpu_time * 1e3:.2f} ms",
+        *(
+            []
+            if found.converged
+            else ["(what follows is of the last Newton iterate, not of an orbit)"]
+        ),
         f"stable: {found.stable}; impacts per forcing period: {found.impacts_per_period:g}",
         "Floquet multipliers: "
         + ", ".join(
