@@ -552,8 +552,12 @@ def test_continuation_turns_at_the_masri_caughey_fold_onto_the_unstable_root() -
     assert branch.stopped == "max_points" and len(branch.points) == 45
     (turn,) = [i for i, p in enumerate(branch.points) if "fold" in p.flags]
     assert [p.flags for p in branch.points if p.flags] == [["fold"]]
-    assert branch.points[turn].crossings["fold"] == pytest.approx(fold, rel=1e-3)
+    # The parameter's extremum along the arc (a cubic through the two points and their
+    # tangents): beyond both points, to 1e-7 (a linear interpolation stayed between
+    # them, 1e-3 off at this step).
+    assert branch.points[turn].crossings["fold"] == pytest.approx(fold, rel=1e-7)
     values = np.array([p.value for p in branch.points])
+    assert branch.points[turn].crossings["fold"] <= values.min()
     assert np.all(np.diff(values[:turn]) < 0)  # down to the fold,
     assert np.all(np.diff(values[turn:]) > 0)  # then back up
     assert values.min() == pytest.approx(fold, rel=1e-3)
@@ -567,6 +571,19 @@ def test_continuation_turns_at_the_masri_caughey_fold_onto_the_unstable_root() -
         assert np.prod(p.floquet_multipliers).real == pytest.approx(MC_E**4, rel=1e-6)
         assert p.impacts_per_period == 2
         assert p.stable == (i < turn), p.value
+
+
+def test_a_coarse_step_still_places_the_fold_beyond_the_branch() -> None:
+    # Holmes's ball on a table folds at Gamma g = pi g (1 - e) / (1 + e); at step 0.3
+    # the fold was reported at 10.3345, above the branch's lowest point (user trial).
+    text = edited(CONTINUATION, ("stop = 17.0", "stop = 10.0"))
+    data = tomllib.loads(text)
+    g, e = 9.81, 0.5
+    exact = math.pi * g * (1 - e) / (1 + e)
+    branch = continue_orbit(data, "excitation.0.amplitude", stop=10.0, step=0.3, max_points=40)
+    (fold,) = [p.crossings["fold"] for p in branch.points if "fold" in p.flags]
+    assert fold <= min(p.value for p in branch.points)
+    assert fold == pytest.approx(exact, rel=3e-4)
 
 
 def test_an_impact_crossing_the_section_is_not_flagged_as_a_fold() -> None:

@@ -49,7 +49,8 @@ class BranchPoint:
     flags: list[str] = field(default_factory=list)
     #: Where each flagged bifurcation lies between the last point and this one: the
     #: parameter at which the crossing multiplier's modulus reaches 1 (linear
-    #: interpolation), or at which the parameter turns (a fold).
+    #: interpolation), or at which the parameter turns (a fold: the extremum of its
+    #: cubic along the arc, see ``_fold``).
     crossings: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:
@@ -256,7 +257,9 @@ def continue_orbit(
         jac = jacobian(corrected)
         new_t = tangent(jac, t)
         candidate = point(corrected, jac[:, :size])
-        candidate.flags, candidate.crossings = _flags(points[-1], candidate, t, new_t, size)
+        candidate.flags, candidate.crossings = _flags(
+            points[-1], candidate, t, new_t, size, h * scale[size]
+        )
         points.append(candidate)
         u, t = clear_of_impacts(corrected, new_t)
         h = min(h * 1.5, 4 * ds / abs(span))
@@ -266,16 +269,38 @@ def continue_orbit(
     return Branch(parameter, periods, points, stopped, first_run.n, first_run.k)
 
 
+def _fold(p0: float, p1: float, m0: float, m1: float) -> float:
+    """Where the parameter turns between two points of a branch: the extremum of its
+    cubic Hermite interpolant along the arc (values ``p0``, ``p1``, rates along the arc
+    times its length ``m0``, ``m1`` of opposite signs). Beyond both points, on the side
+    they turn from, as a fold is (a linear interpolation stays between them)."""
+    a = 6.0 * (p0 - p1) + 3.0 * (m0 + m1)
+    b = 6.0 * (p1 - p0) - 4.0 * m0 - 2.0 * m1
+    roots = np.roots([a, b, m0]) if a != 0.0 else np.array([-m0 / b])
+    inside = [float(r.real) for r in roots if abs(r.imag) < 1e-12 and -1e-12 <= r.real <= 1.0]
+    theta = min(max(inside[0], 0.0), 1.0) if inside else m0 / (m0 - m1)
+    h00, h10 = 2 * theta**3 - 3 * theta**2 + 1, theta**3 - 2 * theta**2 + theta
+    h01, h11 = -2 * theta**3 + 3 * theta**2, theta**3 - theta**2
+    return h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
+
+
 def _flags(
-    before: BranchPoint, after: BranchPoint, t0: np.ndarray, t1: np.ndarray, size: int
+    before: BranchPoint,
+    after: BranchPoint,
+    t0: np.ndarray,
+    t1: np.ndarray,
+    size: int,
+    arc: float,
 ) -> tuple[list[str], dict[str, float]]:
+    """The bifurcations between ``before`` and ``after``, whose unit tangents are
+    ``t0`` and ``t1`` (scaled; the parameter's component at ``size``) and which lie
+    ``arc`` apart along the branch (in the parameter's unit)."""
     flags: list[str] = []
     crossings: dict[str, float] = {}
     if t0[size] * t1[size] < 0:
         flags.append("fold")
         # The parameter's rate along the branch is zero there.
-        w = t0[size] / (t0[size] - t1[size])
-        crossings["fold"] = before.value + w * (after.value - before.value)
+        crossings["fold"] = _fold(before.value, after.value, t0[size] * arc, t1[size] * arc)
     real = 1e-6
     classes: dict[str, Callable[[complex], bool]] = {
         "flip": lambda m: abs(m.imag) <= real and m.real < 0,
