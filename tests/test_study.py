@@ -151,6 +151,18 @@ def test_a_failed_run_is_recorded_with_its_reason_and_the_others_go_on(tmp_path:
     assert np.isnan(ds["peak"].values[1]).all() and np.isfinite(ds["peak"].values[[0, 2]]).all()
 
 
+def test_a_failed_runs_reason_names_the_axis_as_written(tmp_path: Path) -> None:
+    # It named lower_clearance, a key the scenario did not use (user trial).
+    text = BASE + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        '[study.axes]\n"damper.0.clearance" = [0.004, -0.004]\n'
+    )
+    ds = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    assert ds["status"].values.tolist() == [0, 1]
+    (reason,) = json.loads(ds.attrs["reasons"])
+    assert "damper.0.clearance" in reason and ">= 0" in reason and "lower" not in reason
+
+
 def test_the_netcdf_file_holds_the_dataset(tmp_path: Path) -> None:
     study = load(scenario(tmp_path, BASE + STEADY))
     out = tmp_path / "out.nc"

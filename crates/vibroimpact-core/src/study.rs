@@ -226,6 +226,13 @@ impl Parameter {
         match self.target {
             Target::DamperMass(i) => spec.dampers[i].mass = value,
             Target::DamperClearance(i) => {
+                // Checked here: the system would name the side it sets.
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(Error::Inconsistent(format!(
+                        "{}: a clearance must be a finite number >= 0 m, got {value}",
+                        self.path
+                    )));
+                }
                 spec.dampers[i].lower_clearance = value;
                 spec.dampers[i].upper_clearance = value;
             }
