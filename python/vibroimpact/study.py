@@ -138,13 +138,16 @@ _AXIS = {
 _DESCRIPTIONS = {
     "peak": ("largest |displacement| of each structure coordinate, recorded", "m"),
     "rms": ("RMS displacement of each structure coordinate, recorded", "m"),
-    "impacts": ("impacts and contacts recorded", "1"),
+    "impacts": ("impacts and compliant contacts recorded (sticking not counted)", "1"),
     "energy_dissipated": ("energy taken by each pair's contacts and impacts, recorded", "J"),
     "amplitude": (
         "largest |displacement| of each structure coordinate over the recorded periods",
         "m",
     ),
-    "impacts_per_period": ("impacts and contacts per forcing period, recorded", "1"),
+    "impacts_per_period": (
+        "impacts and compliant contacts per forcing period (sticking not counted)",
+        "1",
+    ),
     "settled": ("1 when the stroboscopic state repeats within tolerance, else 0", "1"),
     "stable": (
         "1 when the orbit converged and every Floquet multiplier is inside the unit circle",

@@ -374,7 +374,8 @@ pub struct RunMetrics {
     /// Per structure coordinate, m.
     pub peak: Vec<f64>,
     pub rms: Vec<f64>,
-    /// Contacts (impacts, compliant contacts and sticking) recorded.
+    /// Impacts and compliant contacts recorded (a sticking period is not
+    /// an impact: it is left out).
     pub impacts: f64,
     /// Per pair, J, over the recorded time.
     pub energy_dissipated: Vec<f64>,
