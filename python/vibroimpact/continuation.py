@@ -257,9 +257,10 @@ def continue_orbit(
         jac = jacobian(corrected)
         new_t = tangent(jac, t)
         candidate = point(corrected, jac[:, :size])
-        candidate.flags, candidate.crossings = _flags(
-            points[-1], candidate, t, new_t, size, h * scale[size]
-        )
+        # The arc between the points: their chord (the step h is only its projection
+        # on the tangent, up to a fifth shorter at a fold).
+        chord = float(np.linalg.norm(corrected - u)) * scale[size]
+        candidate.flags, candidate.crossings = _flags(points[-1], candidate, t, new_t, size, chord)
         points.append(candidate)
         u, t = clear_of_impacts(corrected, new_t)
         h = min(h * 1.5, 4 * ds / abs(span))
@@ -276,9 +277,16 @@ def _fold(p0: float, p1: float, m0: float, m1: float) -> float:
     they turn from, as a fold is (a linear interpolation stays between them)."""
     a = 6.0 * (p0 - p1) + 3.0 * (m0 + m1)
     b = 6.0 * (p1 - p0) - 4.0 * m0 - 2.0 * m1
-    roots = np.roots([a, b, m0]) if a != 0.0 else np.array([-m0 / b])
-    inside = [float(r.real) for r in roots if abs(r.imag) < 1e-12 and -1e-12 <= r.real <= 1.0]
-    theta = min(max(inside[0], 0.0), 1.0) if inside else m0 / (m0 - m1)
+    # The slope a theta^2 + b theta + m0 goes from m0 to m1, of opposite signs: its one
+    # root in [0, 1] by bisection (no choice between two roots to get wrong).
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if (a * mid * mid + b * mid + m0) * m0 > 0:
+            lo = mid
+        else:
+            hi = mid
+    theta = 0.5 * (lo + hi)
     h00, h10 = 2 * theta**3 - 3 * theta**2 + 1, theta**3 - 2 * theta**2 + theta
     h01, h11 = -2 * theta**3 + 3 * theta**2, theta**3 - theta**2
     return h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
@@ -293,8 +301,9 @@ def _flags(
     arc: float,
 ) -> tuple[list[str], dict[str, float]]:
     """The bifurcations between ``before`` and ``after``, whose unit tangents are
-    ``t0`` and ``t1`` (scaled; the parameter's component at ``size``) and which lie
-    ``arc`` apart along the branch (in the parameter's unit)."""
+    ``t0`` and ``t1`` (in the scaled coordinates; the parameter's component at ``size``)
+    and which lie ``arc`` apart along the branch (their scaled chord times the
+    parameter's scale: the rates ``t[size] * arc`` are then in the parameter's unit)."""
     flags: list[str] = []
     crossings: dict[str, float] = {}
     if t0[size] * t1[size] < 0:
