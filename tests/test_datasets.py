@@ -418,3 +418,17 @@ def test_parameter_units(ball: dict[str, Any], frf: dict[str, Any], beam: dict[s
     assert parameter_units("damper.0.at", frf) == "1"  # a coordinate's index
     assert parameter_units("damper.5.stiffness", beam) is None
     assert parameter_units("solver.max_steps") is None
+
+
+def test_plot_axes_take_their_units_from_the_datasets() -> None:
+    # The plots had a table of their own that labelled every amplitude "N or m/s^2"
+    # (user trial); one table now serves both, resolved with the scenario's sections.
+    from vibroimpact.analysis_plots import _unit
+
+    harmonic = {"signal": "harmonic", "amplitude": 1.0, "frequency": 1.0}
+    force = {"excitation": [{"kind": "force", "at": 0, **harmonic}]}
+    base = {"excitation": [{"kind": "base", **harmonic}]}
+    assert _unit("excitation.0.amplitude", force) == " (N)"
+    assert _unit("excitation.0.amplitude", base) == " (m s-2)"
+    assert _unit("damper.0.clearance") == " (m)"
+    assert _unit("excitation.0.amplitude") == ""  # unknown without the scenario

@@ -234,7 +234,7 @@ def run_sweep(args: argparse.Namespace) -> int:
             print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
-        plots.plot_sweep(args.plot, settings["parameter"], points)
+        plots.plot_sweep(args.plot, settings["parameter"], points, scenario.data)
     if args.json:
         print(
             json.dumps(
@@ -303,7 +303,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
-        plots.plot_bifurcation(args.plot, settings["parameter"], points)
+        plots.plot_bifurcation(args.plot, settings["parameter"], points, scenario.data)
     rows = [
         {
             "value": p.value,
@@ -443,7 +443,7 @@ def run_continue(args: argparse.Namespace) -> int:
         print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
-        plots.plot_branch(args.plot, branch)
+        plots.plot_branch(args.plot, branch, scenario.data)
     if args.json:
         print(
             json.dumps(

@@ -38,26 +38,19 @@ def _figure(
         plt.close(fig)
 
 
-def _unit(parameter: str) -> str:
-    last = parameter.rsplit(".", 1)[-1]
-    units = {
-        "frequency": "Hz",
-        "amplitude": "N or m/s^2",
-        "clearance": "m",
-        "lower_clearance": "m",
-        "upper_clearance": "m",
-        "gap": "m",
-        "mass": "kg",
-        "stiffness": "N/m",
-        "damping": "N s/m",
-        "restitution": "-",
-        "acceleration": "m/s^2",
-        "phase": "rad",
-    }
-    return f" ({units[last]})" if last in units else ""
+def _unit(parameter: str, data: Any = None) -> str:
+    """`` (unit)`` of a scenario parameter for an axis label, as the datasets give it
+    (resolved with the scenario's sections ``data`` where it depends on them: an
+    amplitude is N for a force, m s-2 for a base acceleration); empty where unknown."""
+    # Imported here: the datasets bring xarray, which the command line loads only
+    # when it writes one.
+    from vibroimpact.datasets import parameter_units
+
+    units = parameter_units(parameter, data)
+    return f" ({units})" if units else ""
 
 
-def plot_sweep(path: Path, parameter: str, points: list[SweepPoint]) -> None:
+def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any = None) -> None:
     """Amplitude of structure coordinate 0 against the parameter, each direction,
     with the linear structure's beside it."""
     with _figure(path) as (fig, ax):
@@ -76,7 +69,7 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint]) -> None:
                     lw=1,
                     label=f"with dampers, sweep {direction}",
                 )
-        ax.set_xlabel(f"{parameter}{_unit(parameter)}")
+        ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
         ax.set_ylabel("amplitude of structure coordinate 0 (m)")
         ax.legend()
         ax.grid(alpha=0.3)
@@ -152,7 +145,9 @@ def plot_section(path: Path, section: Section, period: float) -> None:
             ax.grid(alpha=0.3)
 
 
-def plot_bifurcation(path: Path, parameter: str, points: list[BifurcationPoint]) -> None:
+def plot_bifurcation(
+    path: Path, parameter: str, points: list[BifurcationPoint], data: Any = None
+) -> None:
     """Sampled stroboscopic displacements of structure coordinate 0 against the
     parameter, each direction."""
     with _figure(path) as (fig, ax):
@@ -165,7 +160,7 @@ def plot_bifurcation(path: Path, parameter: str, points: list[BifurcationPoint])
                     ys += list(p.strobe[:, 0])
             if xs:
                 ax.plot(xs, ys, ".", ms=1.5, color=colour, label=f"sweep {direction}")
-        ax.set_xlabel(f"{parameter}{_unit(parameter)}")
+        ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
         ax.set_ylabel("stroboscopic structure displacement 0 (m)")
         ax.legend(markerscale=6)
         ax.grid(alpha=0.3)
@@ -205,7 +200,7 @@ def plot_basins(path: Path, result: Basins, x_name: str, y_name: str) -> None:
         ax.set_ylabel(f"initial {y_name}{unit}")
 
 
-def plot_branch(path: Path, branch: Branch) -> None:
+def plot_branch(path: Path, branch: Branch, data: Any = None) -> None:
     """Amplitude of structure coordinate 0 along the branch: stable solid, unstable
     dashed, bifurcations marked."""
     with _figure(path) as (fig, ax):
@@ -226,7 +221,7 @@ def plot_branch(path: Path, branch: Branch) -> None:
                 ax.plot([p.value], [p.amplitude[0]], "ko", ms=3)
         ax.plot([], [], "-", color="tab:blue", label="stable")
         ax.plot([], [], "--", color="tab:red", label="unstable")
-        ax.set_xlabel(f"{branch.parameter}{_unit(branch.parameter)}")
+        ax.set_xlabel(f"{branch.parameter}{_unit(branch.parameter, data)}")
         ax.set_ylabel("amplitude of structure coordinate 0 (m)")
         ax.set_title(f"{branch.periods}-period orbits")
         ax.legend()
@@ -267,5 +262,6 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
                     np.diff(values), values[1] - values[0]
                 ):
                     (ax.set_xscale if axis is ax.xaxis else ax.set_yscale)("log")
-        ax.set_xlabel(f"{x}{_unit(x)}")
-        ax.set_ylabel(f"{y}{_unit(y)}")
+        for set_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
+            units = dataset[name].attrs.get("units")
+            set_label(f"{name} ({units})" if units else name)
