@@ -163,6 +163,30 @@ def test_a_failed_runs_reason_names_the_axis_as_written(tmp_path: Path) -> None:
     assert "damper.0.clearance" in reason and ">= 0" in reason and "lower" not in reason
 
 
+def test_axis_values_are_the_decimals_written(tmp_path: Path) -> None:
+    # linspace gave 0.004999999999999999 and 0.009000000000000001, and .sel(0.005)
+    # raised KeyError (user trial); the runs use the coordinates as they read.
+    text = BASE + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        '[study.axes]\n"damper.0.clearance" = { start = 0.002, stop = 0.011, count = 10 }\n'
+    )
+    ds = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    clearance = ds["damper.0.clearance"].values
+    assert clearance.tolist() == [
+        0.002,
+        0.003,
+        0.004,
+        0.005,
+        0.006,
+        0.007,
+        0.008,
+        0.009,
+        0.01,
+        0.011,
+    ]
+    assert ds.sel({"damper.0.clearance": 0.005})["peak"].notnull().all()
+
+
 def test_the_netcdf_file_holds_the_dataset(tmp_path: Path) -> None:
     study = load(scenario(tmp_path, BASE + STEADY))
     out = tmp_path / "out.nc"

@@ -389,14 +389,24 @@ def _draws(path: str, spec: Any, samples: int, generator: np.random.Generator) -
 _LAWS = ("uniform", "normal")
 
 
+def _tidy(values: np.ndarray) -> np.ndarray:
+    """Each of ``values`` that is a few units in the last place from a decimal of 12
+    significant digits replaced by it (0.005, not linspace's 0.004999999999999999, so
+    that ``.sel(0.005)`` finds it: the runs use these values); the others (2/3 of
+    something) as they are."""
+    short = np.array([float(f"{v:.12g}") for v in values])
+    close = np.abs(short - values) <= 4 * np.spacing(np.abs(values))
+    return np.where(close, short, values)
+
+
 def _axis_values(path: str, spec: Any) -> np.ndarray:
     where = f"[study.axes] {path!r}: "
     if isinstance(spec, Mapping):
         _axis_count(path, spec)
         axis = _table(where, spec, _AXIS)
         if axis["spacing"] == "log":
-            return np.geomspace(axis["start"], axis["stop"], axis["count"])
-        return np.linspace(axis["start"], axis["stop"], axis["count"])
+            return _tidy(np.geomspace(axis["start"], axis["stop"], axis["count"]))
+        return _tidy(np.linspace(axis["start"], axis["stop"], axis["count"]))
     if isinstance(spec, str) or not isinstance(spec, Sequence) or not spec:
         raise StudyError(f"{where}must be a list of numbers or {{start, stop, count}}")
     values = []
