@@ -138,12 +138,14 @@ def test_results_do_not_depend_on_the_number_of_threads(tmp_path: Path) -> None:
         assert np.array_equal(np.asarray(one[key]), np.asarray(two[key]), equal_nan=True), key
 
 
+def peak_study(tmp_path: Path, axis: str) -> Any:
+    """A "run" study of the peak along the one axis ``axis`` (a TOML line), as written."""
+    text = BASE + f'[study]\nanalysis = "run"\nmetrics = ["peak"]\n[study.axes]\n{axis}\n'
+    return st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+
+
 def test_a_failed_run_is_recorded_with_its_reason_and_the_others_go_on(tmp_path: Path) -> None:
-    text = BASE + (
-        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
-        '[study.axes]\n"damper.0.mass" = [0.05, -1.0, 0.1]\n'
-    )
-    ds = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    ds = peak_study(tmp_path, '"damper.0.mass" = [0.05, -1.0, 0.1]')
     status = ds["status"].values
     assert status.tolist() == [0, 1, 0]
     reasons = json.loads(ds.attrs["reasons"])
@@ -153,11 +155,7 @@ def test_a_failed_run_is_recorded_with_its_reason_and_the_others_go_on(tmp_path:
 
 def test_a_failed_runs_reason_names_the_axis_as_written(tmp_path: Path) -> None:
     # It named lower_clearance, a key the scenario did not use (user trial).
-    text = BASE + (
-        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
-        '[study.axes]\n"damper.0.clearance" = [0.004, -0.004]\n'
-    )
-    ds = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    ds = peak_study(tmp_path, '"damper.0.clearance" = [0.004, -0.004]')
     assert ds["status"].values.tolist() == [0, 1]
     (reason,) = json.loads(ds.attrs["reasons"])
     assert "damper.0.clearance" in reason and ">= 0" in reason and "lower" not in reason
@@ -166,11 +164,7 @@ def test_a_failed_runs_reason_names_the_axis_as_written(tmp_path: Path) -> None:
 def test_axis_values_are_the_decimals_written(tmp_path: Path) -> None:
     # linspace gave 0.004999999999999999 and 0.009000000000000001, and .sel(0.005)
     # raised KeyError (user trial); the runs use the coordinates as they read.
-    text = BASE + (
-        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
-        '[study.axes]\n"damper.0.clearance" = { start = 0.002, stop = 0.011, count = 10 }\n'
-    )
-    ds = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    ds = peak_study(tmp_path, '"damper.0.clearance" = { start = 0.002, stop = 0.011, count = 10 }')
     clearance = ds["damper.0.clearance"].values
     assert clearance.tolist() == [
         0.002,
