@@ -676,6 +676,30 @@ def test_sampling_every_period_does_not_change_whether_a_chattering_run_complete
     assert abs(len(strobed.contacts.kind) - len(plain.contacts.kind)) <= 2
 
 
+def test_two_dampers_on_one_point_rattle_to_the_end() -> None:
+    """Two rigid dampers on one oscillator (found by fuzzing): just after damper 0's
+    impact, damper 1's crossing later in the step was located, and damper 0, on its
+    wall to round-off and leaving it, was then 'located' at the step's start by
+    Newton's steps back down its rise: 'chattering ... 2.9e-17 s apart'. The event is
+    where a value reaches its wall moving towards it."""
+    dampers = [
+        {"mass": 0.1455, "at": 0, "clearance": 0.0005, "law": "rigid", "restitution": 0.6},
+        {"mass": 0.1888, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.9},
+    ]
+    force = {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 21.99}
+    done = simulate_system(
+        {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513},
+        damper=dampers,
+        excitation=[{**force, "frequency": 8.804753706433235}],
+        method="dop853",
+        t_end=10.0,
+        history=False,
+    )
+    assert done.final_time == 10.0 and len(done.contacts.kind) > 1000
+    energy = done.energy
+    assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
+
+
 def test_a_negative_clearance_is_refused_naming_the_key_given() -> None:
     damper = {"mass": 0.1, "at": 0, "clearance": -0.005, "law": "rigid", "restitution": 0.5}
     with pytest.raises(vi.InvalidInputError, match=r"\[\[damper\]\] 0: clearance must be >= 0"):

@@ -602,7 +602,12 @@ fn locate<S: SystemStepper>(
                 guess = trial + taylor_root(v, slope, second, third);
             }
         }
-        if v < 0.0 || v.abs() <= round_off || converged {
+        // The event is where the value reaches its wall moving towards it: a
+        // value within round-off of zero while moving away is the start's own
+        // touch (a pair just off its wall, or a dip's way back), the old side.
+        let arriving = !(slope > 0.0);
+        let at_event = (v.abs() <= round_off || converged) && arriving;
+        if v < 0.0 || at_event {
             hi = trial;
             v_hi = v;
             best_error = error;
@@ -619,7 +624,7 @@ fn locate<S: SystemStepper>(
             }
             kept = -1;
         }
-        if v.abs() <= round_off || converged {
+        if at_event {
             break;
         }
     }
