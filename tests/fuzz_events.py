@@ -1,0 +1,90 @@
+"""Stress the event kernel with random forced systems: an oscillator (10 Hz, 2 %
+damping) with one or two dampers (rigid or Hertz), maybe a stop and gravity, every
+method, each run with and without a stroboscopic sample every forcing period. Prints
+how many runs stopped, by method and error, and the first few scenarios that did.
+
+Not a test (no fixed expectation yet: some stops are legitimate, such as Newton's
+method failing on a stiff Hertz contact at a coarse step); a tool for finding event
+handling bugs, which show as "chattering" stops or as strobes changing the outcome.
+
+    python tests/fuzz_events.py [SEED] [SECONDS]
+"""
+
+from __future__ import annotations
+
+import collections
+import json
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+import vibroimpact as vi
+
+STRUCTURE = {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513}
+
+
+def scenario(rng: np.random.Generator) -> dict[str, Any]:
+    """One random system and method, as keyword arguments of simulate_system."""
+    method = str(rng.choice(["exact", "dop853", "dopri5", "rk4", "newmark-implicit"]))
+    dampers = []
+    for _ in range(int(rng.integers(1, 3))):
+        law: dict[str, Any] = {"law": "rigid", "restitution": float(rng.choice([0, 0.3, 0.6, 1]))}
+        if rng.random() < 0.4 and method != "exact":
+            law = {"law": "hertz", "stiffness": float(10 ** rng.uniform(5, 8))}
+        clearance = float(rng.choice([0.0005, 0.003, 0.01]))
+        dampers.append(
+            {"mass": float(rng.uniform(0.01, 0.2)), "at": 0, "clearance": clearance, **law}
+        )
+    stops = []
+    if rng.random() < 0.3:
+        gap = float(rng.uniform(0.001, 0.02))
+        stops.append({"at": 0, "side": "upper", "gap": gap, "law": "rigid", "restitution": 0.5})
+    force = {"kind": "force", "at": 0, "signal": "harmonic"}
+    frequency = float(rng.uniform(5, 15))
+    return {
+        "damper": dampers,
+        "stop": stops,
+        "gravity": {"acceleration": 9.81} if rng.random() < 0.3 else None,
+        "excitation": [{**force, "amplitude": float(rng.uniform(1, 30)), "frequency": frequency}],
+        "method": method,
+        "t_end": 10.0,
+        "history": False,
+        **({"dt": 1e-4} if method in ("rk4", "newmark-implicit") else {}),
+    }
+
+
+def outcome(kw: dict[str, Any], strobe: float | None) -> str:
+    """ "ok", or the error's class and first words."""
+    try:
+        vi.simulate_system(STRUCTURE, **kw, **({} if strobe is None else {"strobe_period": strobe}))
+    except Exception as err:  # every stop is what is counted
+        return f"{type(err).__name__}: {' '.join(str(err).split()[:3])}"
+    return "ok"
+
+
+def main(seed: int, seconds: float) -> None:
+    rng = np.random.default_rng(seed)
+    stops: list[tuple[dict[str, Any], tuple[str, str]]] = []
+    start, cases = time.perf_counter(), 0
+    while time.perf_counter() - start < seconds:
+        cases += 1
+        kw = scenario(rng)
+        period = 1.0 / kw["excitation"][0]["frequency"]
+        results = (outcome(kw, None), outcome(kw, period))
+        if results != ("ok", "ok"):
+            stops.append((kw, results))
+    print(f"{cases} cases in {time.perf_counter() - start:.0f} s, {len(stops)} with a stop")
+    counts = collections.Counter((kw["method"], results) for kw, results in stops)
+    for (method, results), count in counts.most_common():
+        print(f"{count:5d} {method:17s} plain: {results[0]} | strobed: {results[1]}")
+    for kw, results in stops[:5]:
+        print(json.dumps(kw), results)
+
+
+if __name__ == "__main__":
+    main(
+        int(sys.argv[1]) if len(sys.argv) > 1 else 0,
+        float(sys.argv[2]) if len(sys.argv) > 2 else 60,
+    )
