@@ -34,6 +34,7 @@ from vibroimpact.system import (
     _table,
     linear_parts,
     prepare_system,
+    structure_coordinates,
 )
 
 _INITIAL = (
@@ -142,14 +143,7 @@ class Runner:
     _prepared_system: PreparedSystem | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        structure = self.prepared.spec["structure"]
-        kind = structure["kind"]
-        if kind == "oscillator":
-            self.n = 1
-        elif kind == "matrices":
-            self.n = len(structure["mass"])
-        else:
-            self.n = int(structure["modes"])
+        self.n = structure_coordinates(self.prepared.spec["structure"])
         self.k = len(self.prepared.spec.get("damper", ()))
 
     def initial_state(self) -> np.ndarray:

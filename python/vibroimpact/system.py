@@ -442,7 +442,7 @@ def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) ->
                 f"{shown(given)}",
             )
         return
-    size = 1 if structure["kind"] == "oscillator" else len(structure["mass"])
+    size = structure_coordinates(structure)
     if size and not (at.is_integer() and 0 <= at < size):
         raise _fail(
             "",
@@ -451,19 +451,20 @@ def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) ->
         )
 
 
-def _coordinates(spec: dict[str, Any]) -> int:
-    """The coordinates of a checked system: the structure's (its DOFs or modes) and
-    one per damper."""
-    structure = spec["structure"]
+def structure_coordinates(structure: Mapping[str, Any]) -> int:
+    """The coordinates of a checked ``[structure]``: 1 for an oscillator, one per DOF
+    of matrices, one per mode of a cantilever."""
     kind = structure["kind"]
-    size = (
-        1
-        if kind == "oscillator"
-        else structure["modes"]
-        if kind == "cantilever"
-        else len(structure["mass"])
-    )
-    return int(size) + len(spec["damper"])
+    if kind == "oscillator":
+        return 1
+    if kind == "cantilever":
+        return int(structure["modes"])
+    return len(structure["mass"])
+
+
+def _coordinates(spec: dict[str, Any]) -> int:
+    """The coordinates of a checked system: the structure's and one per damper."""
+    return structure_coordinates(spec["structure"]) + len(spec["damper"])
 
 
 def system_spec(

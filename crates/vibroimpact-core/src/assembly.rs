@@ -514,6 +514,22 @@ impl Assembly {
             .rates_in(n, k, time, y, modes, scratch, out))
     }
 
+    /// The second derivative of interaction `i`'s gap at `time` and state `y`
+    /// in `modes` (m/s^2, < 0 pressing it shut): `h . a` from [`Self::rates`],
+    /// which `work` (the state's length) receives.
+    pub fn gap_acceleration(
+        &self,
+        i: usize,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        work: &mut [f64],
+    ) -> f64 {
+        self.rates(time, y, modes, scratch, work);
+        linalg::dot(&self.interactions[i].h, &work[self.dim..2 * self.dim])
+    }
+
     /// [`Self::rates`] for `n` structure coordinates and `k` dampers: inlined
     /// where they are constants, every slice then has a length known at
     /// compile time (loops unrolled, no bounds checks).

@@ -150,12 +150,16 @@ impl Records {
         )
     }
 
+    /// History rows plus contacts allocated.
+    fn allocated(&self) -> u64 {
+        (self.history.time.capacity() + self.contacts.capacity()) as u64
+    }
+
     /// How many more rows (of `row_bytes` each) may be allocated: as many as
     /// the `current` length (at least `least`), as far as `max_rows` and the
     /// memory limit allow.
     fn growth(&self, current: usize, least: usize, row_bytes: u64) -> usize {
-        let allocated = (self.history.time.capacity() + self.contacts.capacity()) as u64;
-        let room = self.max_rows.saturating_sub(allocated);
+        let room = self.max_rows.saturating_sub(self.allocated());
         let held = self.history.held() + memory::held(&self.contacts);
         let fits = MAX_RECORD_BYTES.saturating_sub(held) / row_bytes;
         (current.max(least) as u64).min(room).min(fits) as usize
@@ -163,8 +167,7 @@ impl Records {
 
     /// The error of a run that found no room: the row limit, or the memory's.
     fn limit(&self, time: f64) -> Error {
-        let allocated = (self.history.time.capacity() + self.contacts.capacity()) as u64;
-        if allocated >= self.max_rows {
+        if self.allocated() >= self.max_rows {
             self.full(time)
         } else {
             self.no_room(NoRoom::Limit(MAX_RECORD_BYTES), time)

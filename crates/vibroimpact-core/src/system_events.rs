@@ -23,7 +23,6 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 }
 use crate::error::{Error, Result};
 use crate::hermite;
-use crate::linalg;
 use crate::memory::{self, MAX_RECORD_BYTES};
 use crate::reductions::{self, ReduceOptions, Reductions};
 use crate::step_control::{rejects, StepControl};
@@ -605,7 +604,7 @@ fn locate<S: SystemStepper>(
         // The event is where the value reaches its wall moving towards it: a
         // value within round-off of zero while moving away is the start's own
         // touch (a pair just off its wall, or a dip's way back), the old side.
-        let arriving = !(slope > 0.0);
+        let arriving = slope.is_nan() || slope <= 0.0;
         let at_event = (v.abs() <= round_off || converged) && arriving;
         if v < 0.0 || at_event {
             hi = trial;
@@ -1011,15 +1010,14 @@ pub fn integrate_system_within<S: SystemStepper>(
                             if !newton {
                                 break;
                             }
-                            system.rates(
+                            let curvature = system.gap_acceleration(
+                                i,
                                 time + at,
                                 &buffers.probe,
                                 &modes,
                                 &mut scratch,
                                 &mut buffers.work,
                             );
-                            let h = &system.interactions[i].h;
-                            let curvature = linalg::dot(h, &buffers.work[d..2 * d]);
                             at -= rate / curvature;
                             if !(at > 0.0 && at < taken) {
                                 break;
@@ -1442,8 +1440,7 @@ fn switch(
             // impacts, not the dynamics, and the pair is at rest on its wall.
             let round_off = 1e-9 * system.gap_scale(i, y);
             // The gap's acceleration with the pair free: < 0 presses it shut.
-            system.rates(time, y, modes, scratch, work);
-            let pressing = crate::linalg::dot(&it.h, &work[d..2 * d]);
+            let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
             // Landing at rest: an approach that the pressing gives within a
             // rise of round-off, or within the round-off of the time.
             let landing = pressing < 0.0
@@ -1484,11 +1481,11 @@ fn switch(
             // rest sticks at once, whatever its restitution (even 1: a ball
             // resting on a floor stays there).
             let rebound = system.gap(i, y).1.max(0.0);
+            // After an impact the velocities changed (a damper's force does).
             let pressing = if landing {
                 pressing
             } else {
-                system.rates(time, y, modes, scratch, work);
-                crate::linalg::dot(&it.h, &work[d..2 * d])
+                system.gap_acceleration(i, time, y, modes, scratch, work)
             };
             if pressing < 0.0 {
                 let remaining = if landing {
