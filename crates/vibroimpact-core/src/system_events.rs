@@ -193,6 +193,27 @@ fn event_value(
     }
 }
 
+/// Whether interaction `i`, whose event value at state `y` is `v`, is at its
+/// event: past its wall, or on it to round-off and arriving. Pairs that
+/// reach their walls together (two dampers touching one point at rest) are
+/// all switched at the instant one of them is located; and a value a hair
+/// past its wall but leaving it (a contact started at a gap of round-off,
+/// its indentation growing) has not crossed back.
+fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
+    let sign = match mode {
+        Mode::Open => 1.0,
+        Mode::Compliant { .. } => -1.0,
+        Mode::Sticking => return v < 0.0,
+    };
+    let round_off = 8.0 * f64::EPSILON * system.gap_scale(i, y);
+    let arriving = sign * system.gap(i, y).1 <= 0.0;
+    if v.abs() <= round_off {
+        arriving
+    } else {
+        v < 0.0
+    }
+}
+
 /// An event found in a step: interaction `i`, first guessed at the fraction
 /// `guess` of the step; `interior` when both ends are on the old side.
 #[derive(Debug, Clone, Copy)]
@@ -943,7 +964,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                     &mut scratch,
                     &mut buffers.work,
                 );
-                if v < 0.0 {
+                if crossed(system, j, mode, v, &end) {
                     crossing = Some(Crossing {
                         i: j,
                         guess: 1.0,
@@ -1094,7 +1115,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                     &mut buffers.work,
                 );
                 let located = Some(i) == switched;
-                if !(located || v < 0.0) {
+                if !(located || crossed(system, i, modes[i], v, &y)) {
                     continue;
                 }
                 just_switched[i] = switch(
