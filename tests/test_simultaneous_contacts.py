@@ -109,3 +109,39 @@ def test_implicit_newmark_holds_a_sticking_damper_whose_accelerations_vanish() -
         )
     assert errors[0] < 1e-6
     assert errors[0] / errors[1] > 3.0  # second order: 4
+
+
+@pytest.mark.parametrize("restitution", [0.0, 0.5, 1.0])
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk4", "newmark-implicit"])
+def test_a_mass_striking_two_dampers_at_once_obeys_newtons_law_for_both(
+    method: str, restitution: float
+) -> None:
+    """A free 1 kg mass at 1 m/s reaches two resting 0.1 kg dampers at one instant.
+    Newton's law for both contacts at once (the complementarity problem) gives each
+    damper the impulse (1 + e) v / (1/m + 2/M): both leave at e v relative to the
+    mass. Applied one after the other, the first damper took (1 + e) v / (1/m + 1/M)
+    and the second less (1.36 and 1.18 m/s instead of 1.25 for e = 0.5)."""
+    big, small, speed, clearance = 1.0, 0.1, 1.0, 0.001
+    damper = {"mass": small, "at": 0, "clearance": clearance, "law": "rigid"}
+    run = simulate_system(
+        {"kind": "oscillator", "mass": big, "stiffness": 0.0},
+        damper=[{**damper, "restitution": restitution}] * 2,
+        initial={"structure_velocity": [speed]},
+        method=method,
+        # Before the dampers cross their clearances to the far walls.
+        t_end=clearance / speed + 1e-3,
+        history=False,
+        **({"dt": 1e-4} if method in ("rk4", "newmark-implicit") else {}),
+    )
+    impulse = (1 + restitution) * speed / (1 / small + 2 / big)
+    final = run.final_state
+    assert final["damper_velocity"] == pytest.approx([impulse / small] * 2, rel=1e-12)
+    assert final["structure_velocity"][0] == pytest.approx(speed - 2 * impulse / big, rel=1e-12)
+    kinds = list(run.contacts.kind)
+    assert kinds == ["impact", "impact"]
+    assert np.asarray(run.contacts.onset) == pytest.approx([clearance / speed] * 2, rel=1e-12)
+    before = 0.5 * big * speed**2
+    after = 0.5 * big * (speed - 2 * impulse / big) ** 2 + impulse**2 / small
+    lost = float(np.sum(run.contacts.energy_dissipated))
+    assert lost == pytest.approx(before - after, rel=1e-9, abs=1e-15)
+    assert np.asarray(run.contacts.restitution) == pytest.approx([restitution] * 2, abs=1e-12)

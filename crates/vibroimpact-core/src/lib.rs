@@ -17,6 +17,7 @@ pub mod error;
 pub mod events;
 pub mod exact;
 mod hermite;
+mod impacts;
 pub mod integrators;
 pub mod linalg;
 pub mod materials;

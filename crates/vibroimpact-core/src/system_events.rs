@@ -6,13 +6,9 @@
 //! Events: a gap closing (a compliant contact starts, or a rigid impact
 //! applies Newton's law with momentum conserved), a compliant contact
 //! opening, and a sticking pair's constraint force reaching zero (release).
-//! After a rigid impact whose remaining chattering sequence would finish
-//! within the run's time resolution, the sequence is summed: with the
-//! relative acceleration `a` pressing the pair together and rebound speed
-//! `u`, the flights `2 u e^n / |a|` add up to `2 u / (|a| (1 - e))`, after
-//! which the pair sticks (exact for a constant `a`, such as a ball on a
-//! floor). Simultaneous impacts are applied one after the other in the
-//! order of the interactions (dampers, then stops).
+//! Every pair past its wall or arriving on it at the instant switches; the
+//! rigid ones are resolved together, impacts, chattering sums and sticking,
+//! by [`crate::impacts`].
 
 use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
 
@@ -23,6 +19,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 }
 use crate::error::{Error, Result};
 use crate::hermite;
+use crate::impacts::Impacts;
 use crate::memory::{self, MAX_RECORD_BYTES};
 use crate::reductions::{self, ReduceOptions, Reductions};
 use crate::step_control::{rejects, StepControl};
@@ -130,19 +127,25 @@ pub struct SystemSolution {
 
 /// A contact being followed.
 #[derive(Debug, Clone, Copy)]
-struct Open {
-    kind: ContactKind,
-    onset: f64,
-    approach_speed: f64,
-    max_indentation: f64,
+pub(crate) struct Open {
+    pub(crate) kind: ContactKind,
+    pub(crate) onset: f64,
+    pub(crate) approach_speed: f64,
+    pub(crate) max_indentation: f64,
     /// The contact-loss accumulator at onset (compliant), or the loss so far.
-    dissipated: f64,
+    pub(crate) dissipated: f64,
 }
 
 impl Open {
     /// The record of this contact ending at `separation` (NaN: still open)
     /// with relative `rebound` speed (m/s) and `dissipated` energy (J).
-    fn close(&self, pair: usize, separation: f64, rebound: f64, dissipated: f64) -> PairContact {
+    pub(crate) fn close(
+        &self,
+        pair: usize,
+        separation: f64,
+        rebound: f64,
+        dissipated: f64,
+    ) -> PairContact {
         let restitution = match self.kind {
             // A sticking pair does not rebound.
             ContactKind::Sticking if separation.is_finite() => 0.0,
@@ -801,6 +804,7 @@ pub fn integrate_system_within<S: SystemStepper>(
     let mut unconfirmed = vec![false; count];
     // Interactions switched at the event being handled.
     let mut just_switched = vec![false; count];
+    let mut impacts = Impacts::new(system);
     let mut any_unconfirmed = false;
     // Whether a compliant contact is on (modes change only at events).
     let mut compliant = any_compliant(&modes);
@@ -1100,8 +1104,10 @@ pub fn integrate_system_within<S: SystemStepper>(
         accepted += 1;
 
         if switched.is_some() {
-            // Every interaction on its wall at this instant switches.
+            // Every interaction on its wall at this instant switches; the
+            // open rigid ones are resolved together with the sticking ones.
             let mut any = false;
+            let mut rigid = false;
             just_switched.iter_mut().for_each(|s| *s = false);
             for i in 0..count {
                 let v = event_value(
@@ -1118,9 +1124,24 @@ pub fn integrate_system_within<S: SystemStepper>(
                 if !(located || crossed(system, i, modes[i], v, &y)) {
                     continue;
                 }
+                if impacts.mark(system, i, modes[i]) {
+                    rigid = true;
+                    continue;
+                }
                 just_switched[i] = switch(
                     system,
                     i,
+                    time,
+                    &mut y,
+                    &mut modes,
+                    &mut open,
+                    &mut contacts,
+                );
+                any |= just_switched[i];
+            }
+            if rigid {
+                any |= impacts.resolve(
+                    system,
                     time,
                     &mut y,
                     &mut modes,
@@ -1131,20 +1152,10 @@ pub fn integrate_system_within<S: SystemStepper>(
                     (resolution, chatter_interval(time)),
                     &mut scratch,
                     &mut buffers.work,
+                    &mut just_switched,
                 );
-                any |= just_switched[i];
             }
             if any {
-                settle_sticking(
-                    system,
-                    time,
-                    &mut y,
-                    &mut modes,
-                    &mut open,
-                    &mut contacts,
-                    &mut impact_loss,
-                    &just_switched,
-                );
                 stepper.reset();
                 if adaptive {
                     control.h = control.h.min(1e-3 * t_end);
@@ -1410,10 +1421,9 @@ fn check_balance(
     Ok(())
 }
 
-/// Switch interaction `i` at `time`: start or end a contact, apply an
-/// impact, start or end sticking. `resolution` (s) is the time below which
-/// a chattering sequence is summed, `instant` (s) the round-off of the time.
-#[allow(clippy::too_many_arguments)]
+/// Switch interaction `i` at `time`: start or end a compliant contact, or
+/// release a sticking pair whose constraint force turned (the open rigid
+/// pairs are [`Impacts::resolve`]'s).
 fn switch(
     system: &Assembly,
     i: usize,
@@ -1422,17 +1432,11 @@ fn switch(
     modes: &mut [Mode],
     open: &mut [Option<Open>],
     contacts: &mut Vec<PairContact>,
-    impact_loss: &mut f64,
-    grazes: &mut u64,
-    (resolution, instant): (f64, f64),
-    scratch: &mut Scratch,
-    work: &mut [f64],
 ) -> bool {
     let it = &system.interactions[i];
-    let row = 2 * system.dim;
     let (_, rate) = system.gap(i, y);
-    match (modes[i], it.law) {
-        (Mode::Open, InteractionLaw::Compliant { .. }) => {
+    match modes[i] {
+        Mode::Open => {
             let approach = -rate;
             modes[i] = Mode::Compliant {
                 approach_rate: approach,
@@ -1445,101 +1449,14 @@ fn switch(
                 dissipated: y[loss_slot(system, i)],
             });
         }
-        (Mode::Compliant { .. }, _) => {
+        Mode::Compliant { .. } => {
             modes[i] = Mode::Open;
             if let Some(oc) = open[i].take() {
                 let dissipated = y[loss_slot(system, i)] - oc.dissipated;
                 contacts.push(oc.close(it.pair, time, rate, dissipated));
             }
         }
-        (Mode::Open, InteractionLaw::Rigid { restitution }) => {
-            let approach = -rate;
-            let d = system.dim;
-            let speed_scale = y[d..row].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            // Flights (or landings) that rise less than 1e-9 of the gap's
-            // scale are round-off: the positions' round-off decides such
-            // impacts, not the dynamics, and the pair is at rest on its wall.
-            let round_off = 1e-9 * system.gap_scale(i, y);
-            // The gap's acceleration with the pair free: < 0 presses it shut.
-            let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
-            // Landing at rest: an approach that the pressing gives within a
-            // rise of round-off, or within the round-off of the time.
-            let landing = pressing < 0.0
-                && (approach * approach <= -2.0 * pressing * round_off
-                    || approach <= -pressing * instant);
-            if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && !landing {
-                let loss = system.impact(i, y, restitution);
-                *impact_loss += loss;
-                contacts.push(PairContact {
-                    pair: it.pair,
-                    kind: ContactKind::Impact,
-                    onset: time,
-                    separation: time,
-                    duration: 0.0,
-                    max_indentation: 0.0,
-                    approach_speed: approach,
-                    rebound_speed: restitution * approach,
-                    restitution,
-                    energy_dissipated: loss,
-                });
-            } else if -approach > 1e-9 * speed_scale {
-                // Located on the wall but leaving it (the start of a step
-                // just after an impact): no event.
-                return false;
-            } else if !landing {
-                *grazes += 1;
-                if pressing >= 0.0 && system.gap(i, y).0 < 0.0 {
-                    // Touching at rest, not pressed (a pair released at the
-                    // instant its force turns, a zero clearance): put it a
-                    // few units of round-off off the wall, or the same
-                    // touch is found again at once, without end.
-                    system.release(i, y);
-                    return true;
-                }
-            }
-            // Would the rest of a chattering sequence finish within the
-            // run's resolution? Then sum it and stick. A pair that lands at
-            // rest sticks at once, whatever its restitution (even 1: a ball
-            // resting on a floor stays there).
-            let rebound = system.gap(i, y).1.max(0.0);
-            // After an impact the velocities changed (a damper's force does).
-            let pressing = if landing {
-                pressing
-            } else {
-                system.gap_acceleration(i, time, y, modes, scratch, work)
-            };
-            if pressing < 0.0 {
-                let remaining = if landing {
-                    0.0
-                } else {
-                    2.0 * rebound / (-pressing * (1.0 - restitution))
-                };
-                // The sequence is summed once it would finish within the
-                // step (fixed-step methods), or once its flights rise less
-                // than round-off.
-                let height = rebound * rebound / (-2.0 * pressing);
-                if remaining <= resolution || height <= round_off {
-                    let loss = system.impact(i, y, 0.0);
-                    *impact_loss += loss;
-                    modes[i] = Mode::Sticking;
-                    open[i] = Some(Open {
-                        kind: ContactKind::Sticking,
-                        // A sequence that never ends (restitution 1) is
-                        // cut where its flights fell to round-off: now.
-                        onset: time
-                            + if remaining.is_finite() {
-                                remaining
-                            } else {
-                                0.0
-                            },
-                        approach_speed: if landing { approach.max(0.0) } else { rebound },
-                        max_indentation: 0.0,
-                        dissipated: loss,
-                    });
-                }
-            }
-        }
-        (Mode::Sticking, _) => {
+        Mode::Sticking => {
             system.release(i, y);
             modes[i] = Mode::Open;
             if let Some(oc) = open[i].take() {
@@ -1548,47 +1465,6 @@ fn switch(
         }
     }
     true
-}
-
-/// After an impact elsewhere, a sticking pair whose gap now closes is held
-/// (a plastic impact keeps it stuck) and one whose gap now opens is
-/// released: the sequential answer to what is, exactly, a complementarity
-/// problem among the pairs. A pair that stuck at this instant
-/// (`just_switched`) is held but not released: it moves with its wall to
-/// round-off, which must not read as opening, but an impact of another
-/// pair after it may still close it.
-#[allow(clippy::too_many_arguments)]
-fn settle_sticking(
-    system: &Assembly,
-    time: f64,
-    y: &mut [f64],
-    modes: &mut [Mode],
-    open: &mut [Option<Open>],
-    contacts: &mut Vec<PairContact>,
-    impact_loss: &mut f64,
-    just_switched: &[bool],
-) {
-    let d = system.dim;
-    let speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let tiny = 1e-9 * speed_scale;
-    for i in 0..modes.len() {
-        if modes[i] != Mode::Sticking {
-            continue;
-        }
-        let (_, rate) = system.gap(i, y);
-        if rate < -tiny {
-            let loss = system.impact(i, y, 0.0);
-            *impact_loss += loss;
-            if let Some(oc) = open[i].as_mut() {
-                oc.dissipated += loss;
-            }
-        } else if rate > tiny && !just_switched[i] {
-            modes[i] = Mode::Open;
-            if let Some(oc) = open[i].take() {
-                contacts.push(oc.close(system.interactions[i].pair, time, 0.0, oc.dissipated));
-            }
-        }
-    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,540 @@
+//! The rigid pairs at an event instant, resolved together.
+//!
+//! Every rigid pair on its wall at the instant takes part: those arriving
+//! (impacts), those sticking, and those landing at rest. The impulses
+//! `P >= 0` are the solution of Newton's law for several contacts, the
+//! linear complementarity problem Siconos solves at an event:
+//!
+//! `u+ = u- + W P`, `W = H M^-1 H^T`, `0 <= P  _|_  u+ + e min(u-, 0) >= 0`
+//!
+//! (`u` the gaps' rates). An arriving pair leaves at `e` times its approach
+//! unless the others' impulses push it off faster. A sticking pair (`e = 0`)
+//! is held against impulses elsewhere, or lifted off by them. Where the pairs
+//! do not share a coordinate, `W` is diagonal and this is each pair's own
+//! Newton impact; where they do (two dampers on one point), one impact no
+//! longer re-closes the other, as it did when they were applied one after the
+//! other.
+//!
+//! Then a pair whose chattering sequence would finish within the run's
+//! resolution, or one landing at rest, sticks: it is solved again with
+//! `e = 0`, from the velocities before the instant. With the relative
+//! acceleration `a` pressing the pair together and rebound speed `r`, the
+//! flights `2 r e^n / |a|` add up to `2 r / (|a| (1 - e))` (exact for a
+//! constant `a`, such as a ball on a floor), which is when its sticking
+//! starts.
+
+use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch};
+use crate::linalg;
+use crate::system_events::{ContactKind, Open, PairContact};
+
+/// What a pair in the problem is doing at the instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Role {
+    /// Arriving at `approach` (m/s, > 0) with restitution `e`.
+    Impact { approach: f64, restitution: f64 },
+    /// Sticking from this instant (landing at rest, or pressed after a
+    /// graze), with the approach speed (m/s) it had.
+    Stick { approach: f64 },
+    /// Sticking before the instant.
+    Held,
+}
+
+/// The rigid pairs' problem at one instant: buffers sized once per run.
+#[derive(Debug, Clone)]
+pub(crate) struct Impacts {
+    /// Open rigid pairs at their walls, marked by the event handling.
+    touching: Vec<bool>,
+    members: Vec<usize>,
+    roles: Vec<Role>,
+    /// An impacting member found to stick: `(delay, rebound)`.
+    stuck: Vec<Option<(f64, f64)>>,
+    /// The members' rates before the instant (`u-`), m/s.
+    before: Vec<f64>,
+    /// Velocities before the instant.
+    velocities: Vec<f64>,
+    lcp: Complementarity,
+}
+
+impl Impacts {
+    pub(crate) fn new(system: &Assembly) -> Self {
+        let count = system.interactions.len();
+        Self {
+            touching: vec![false; count],
+            members: Vec::with_capacity(count),
+            roles: Vec::with_capacity(count),
+            stuck: Vec::with_capacity(count),
+            before: Vec::with_capacity(count),
+            velocities: vec![0.0; system.dim],
+            lcp: Complementarity::new(count),
+        }
+    }
+
+    /// Whether interaction `i` is an open rigid pair: it is then marked, to
+    /// be resolved with the others by [`Self::resolve`].
+    pub(crate) fn mark(&mut self, system: &Assembly, i: usize, mode: Mode) -> bool {
+        let rigid = matches!(system.interactions[i].law, InteractionLaw::Rigid { .. });
+        if rigid && mode == Mode::Open {
+            self.touching[i] = true;
+        }
+        rigid && mode == Mode::Open
+    }
+
+    /// Resolve the marked pairs and the sticking ones at `time`: impacts,
+    /// sticking, release of sticking pairs lifted off. `resolution` (s) is the
+    /// time below which a chattering sequence is summed, `instant` (s) the
+    /// round-off of the time. Sets `just_switched` for the pairs that
+    /// changed; returns whether any did or any impulse acted.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn resolve(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &mut [f64],
+        modes: &mut [Mode],
+        open: &mut [Option<Open>],
+        contacts: &mut Vec<PairContact>,
+        impact_loss: &mut f64,
+        grazes: &mut u64,
+        (resolution, instant): (f64, f64),
+        scratch: &mut Scratch,
+        work: &mut [f64],
+        just_switched: &mut [bool],
+    ) -> bool {
+        let d = system.dim;
+        let speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        self.members.clear();
+        self.roles.clear();
+        let mut any = false;
+        for i in 0..self.touching.len() {
+            if !std::mem::take(&mut self.touching[i]) {
+                continue;
+            }
+            let InteractionLaw::Rigid { restitution } = system.interactions[i].law else {
+                continue;
+            };
+            let (gap, rate) = system.gap(i, y);
+            let approach = -rate;
+            // Flights (or landings) that rise less than 1e-9 of the gap's
+            // scale are round-off: the positions' round-off decides such
+            // impacts, not the dynamics, and the pair is at rest on its wall.
+            let round_off = 1e-9 * system.gap_scale(i, y);
+            // The gap's acceleration with the pair free: < 0 presses it shut.
+            let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
+            // Landing at rest: an approach that the pressing gives within a
+            // rise of round-off, or within the round-off of the time.
+            let landing = pressing < 0.0
+                && (approach * approach <= -2.0 * pressing * round_off
+                    || approach <= -pressing * instant);
+            let role = if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && !landing {
+                Role::Impact {
+                    approach,
+                    restitution,
+                }
+            } else if -approach > 1e-9 * speed_scale {
+                // Located on the wall but leaving it (the start of a step
+                // just after an impact): no event.
+                continue;
+            } else {
+                just_switched[i] = true;
+                any = true;
+                if !landing {
+                    *grazes += 1;
+                }
+                if pressing >= 0.0 {
+                    if gap < 0.0 {
+                        // Touching at rest, not pressed (a pair released at
+                        // the instant its force turns, a zero clearance):
+                        // put it a few units of round-off off the wall, or
+                        // the same touch is found again at once, without end.
+                        system.release(i, y);
+                    }
+                    continue;
+                }
+                // At rest and pressed: a sequence whose flights would rise
+                // less than round-off. It sticks at once, whatever its
+                // restitution (even 1: a ball resting on a floor stays).
+                modes[i] = Mode::Sticking;
+                Role::Stick {
+                    approach: approach.max(0.0),
+                }
+            };
+            self.members.push(i);
+            self.roles.push(role);
+        }
+        if self.members.is_empty() {
+            return any;
+        }
+        for (i, mode) in modes.iter().enumerate() {
+            if *mode == Mode::Sticking && !self.members.contains(&i) {
+                self.members.push(i);
+                self.roles.push(Role::Held);
+            }
+        }
+        let m = self.members.len();
+        self.velocities.copy_from_slice(&y[d..2 * d]);
+        self.before.clear();
+        self.before
+            .extend(self.members.iter().map(|&i| system.gap(i, y).1));
+        self.lcp.set_matrix(system, &self.members);
+        self.stuck.clear();
+        self.stuck.resize(m, None);
+        // Each round may find more impacting pairs to stick: at most m.
+        for _ in 0..=m {
+            y[d..2 * d].copy_from_slice(&self.velocities);
+            for (s, role) in self.roles.iter().enumerate() {
+                let u = self.before[s];
+                let e = match role {
+                    Role::Impact { restitution, .. } if self.stuck[s].is_none() => *restitution,
+                    _ => 0.0,
+                };
+                self.lcp.q[s] = if u < 0.0 { (1.0 + e) * u } else { u };
+            }
+            self.lcp.solve();
+            for (s, &i) in self.members.iter().enumerate() {
+                let impulse = self.lcp.z[s];
+                if impulse != 0.0 {
+                    for (v, p) in y[d..2 * d].iter_mut().zip(&system.interactions[i].push) {
+                        *v += p * impulse;
+                    }
+                }
+            }
+            let mut more = false;
+            for s in 0..m {
+                let (Role::Impact { restitution, .. }, None) = (self.roles[s], self.stuck[s])
+                else {
+                    continue;
+                };
+                let i = self.members[s];
+                // Would the rest of a chattering sequence finish within the
+                // run's resolution (fixed-step methods: the step), or its
+                // flights rise less than round-off? Then sum it and stick.
+                let rebound = system.gap(i, y).1.max(0.0);
+                let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
+                if pressing >= 0.0 {
+                    continue;
+                }
+                let remaining = 2.0 * rebound / (-pressing * (1.0 - restitution));
+                let height = rebound * rebound / (-2.0 * pressing);
+                if remaining <= resolution || height <= 1e-9 * system.gap_scale(i, y) {
+                    // A sequence that never ends (restitution 1) is cut where
+                    // its flights fell to round-off: now.
+                    let delay = if remaining.is_finite() {
+                        remaining
+                    } else {
+                        0.0
+                    };
+                    self.stuck[s] = Some((delay, rebound));
+                    modes[i] = Mode::Sticking;
+                    more = true;
+                }
+            }
+            if !more {
+                break;
+            }
+        }
+        // Each pair's share of the energy the impulses take, J:
+        // -P (u- + u+) / 2, which sums to the kinetic energy lost.
+        for (s, &i) in self.members.iter().enumerate() {
+            let impulse = self.lcp.z[s];
+            let after = self.before[s] + self.lcp.w_minus_q(s);
+            let loss = -0.5 * impulse * (self.before[s] + after);
+            *impact_loss += loss;
+            let pair = system.interactions[i].pair;
+            any |= impulse != 0.0;
+            match (self.roles[s], self.stuck[s]) {
+                (
+                    Role::Impact {
+                        approach,
+                        restitution,
+                    },
+                    stuck,
+                ) => {
+                    if impulse == 0.0 {
+                        // Pushed off by the others' impulses before its own
+                        // acted: a touch, not an impact.
+                        *grazes += 1;
+                        continue;
+                    }
+                    just_switched[i] = true;
+                    // Newton's share of the loss, and with a sticking the
+                    // rest of the plastic impact's (the summed sequence's).
+                    let kept = if stuck.is_some() {
+                        restitution * restitution
+                    } else {
+                        0.0
+                    };
+                    contacts.push(PairContact {
+                        pair,
+                        kind: ContactKind::Impact,
+                        onset: time,
+                        separation: time,
+                        duration: 0.0,
+                        max_indentation: 0.0,
+                        approach_speed: approach,
+                        rebound_speed: if stuck.is_some() {
+                            restitution * approach
+                        } else {
+                            after
+                        },
+                        restitution: if stuck.is_some() {
+                            restitution
+                        } else {
+                            after / approach
+                        },
+                        energy_dissipated: (1.0 - kept) * loss,
+                    });
+                    if let Some((delay, rebound)) = stuck {
+                        open[i] = Some(Open {
+                            kind: ContactKind::Sticking,
+                            onset: time + delay,
+                            approach_speed: rebound,
+                            max_indentation: 0.0,
+                            dissipated: kept * loss,
+                        });
+                    }
+                }
+                (Role::Stick { approach }, _) => {
+                    open[i] = Some(Open {
+                        kind: ContactKind::Sticking,
+                        onset: time,
+                        approach_speed: approach,
+                        max_indentation: 0.0,
+                        dissipated: loss,
+                    });
+                }
+                (Role::Held, _) => {
+                    if impulse > 0.0 {
+                        if let Some(oc) = open[i].as_mut() {
+                            oc.dissipated += loss;
+                        }
+                    } else if after > 1e-9 * speed_scale && !just_switched[i] {
+                        // Lifted off its wall by the impulses elsewhere. (One
+                        // that stuck at this instant moves with its wall to
+                        // round-off, which must not read as lifting.)
+                        modes[i] = Mode::Open;
+                        any = true;
+                        if let Some(oc) = open[i].take() {
+                            contacts.push(oc.close(pair, time, 0.0, oc.dissipated));
+                        }
+                    }
+                }
+            }
+        }
+        any
+    }
+}
+
+/// A small linear complementarity problem `w = W z + q`, `w, z >= 0`, `w . z
+/// = 0` with `W` symmetric positive semi-definite: Murty's least-index
+/// principal pivoting (finite for a positive definite `W`), projected
+/// Gauss-Seidel where a singular `W` (two walls of one zero clearance)
+/// defeats it.
+#[derive(Debug, Clone)]
+struct Complementarity {
+    m: usize,
+    matrix: Vec<f64>,
+    q: Vec<f64>,
+    z: Vec<f64>,
+    active: Vec<bool>,
+    index: Vec<usize>,
+    sub: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl Complementarity {
+    fn new(capacity: usize) -> Self {
+        Self {
+            m: 0,
+            matrix: Vec::with_capacity(capacity * capacity),
+            q: Vec::with_capacity(capacity),
+            z: Vec::with_capacity(capacity),
+            active: Vec::with_capacity(capacity),
+            index: Vec::with_capacity(capacity),
+            sub: Vec::with_capacity(capacity * capacity),
+            rhs: Vec::with_capacity(capacity),
+        }
+    }
+
+    /// `W` of the interactions `members`: `h_a . M^-1 h_b^T`, 1/kg.
+    fn set_matrix(&mut self, system: &Assembly, members: &[usize]) {
+        let m = members.len();
+        self.m = m;
+        self.matrix.clear();
+        for &a in members {
+            for &b in members {
+                self.matrix.push(linalg::dot(
+                    &system.interactions[a].h,
+                    &system.interactions[b].push,
+                ));
+            }
+        }
+        self.q.clear();
+        self.q.resize(m, 0.0);
+        self.z.clear();
+        self.z.resize(m, 0.0);
+    }
+
+    /// `(W z)_s`: the change of member `s`'s rate, m/s.
+    fn w_minus_q(&self, s: usize) -> f64 {
+        let m = self.m;
+        (0..m).map(|k| self.matrix[s * m + k] * self.z[k]).sum()
+    }
+
+    /// Whether `z` (the impulses, N s) solves the problem to `tolerance`
+    /// (m/s); else the least index that violates it.
+    fn violation(&self, tolerance: f64) -> Option<usize> {
+        (0..self.m).find(|&s| {
+            let w = self.w_minus_q(s) + self.q[s];
+            if self.active[s] {
+                self.z[s] * self.matrix[s * self.m + s] < -tolerance
+            } else {
+                w < -tolerance
+            }
+        })
+    }
+
+    fn solve(&mut self) {
+        let m = self.m;
+        let scale = self.q.iter().fold(0.0f64, |a, q| a.max(q.abs()));
+        self.z.iter_mut().for_each(|z| *z = 0.0);
+        if scale == 0.0 {
+            return;
+        }
+        let tolerance = 1e-13 * scale;
+        self.active.clear();
+        self.active.resize(m, false);
+        for _ in 0..(20 * m + 20) {
+            let Some(s) = self.violation(tolerance) else {
+                self.z.iter_mut().for_each(|z| *z = z.max(0.0));
+                return;
+            };
+            self.active[s] = !self.active[s];
+            // z_A = -W_AA^-1 q_A, zero elsewhere.
+            self.index.clear();
+            self.index.extend((0..m).filter(|&s| self.active[s]));
+            let n = self.index.len();
+            self.sub.clear();
+            self.rhs.clear();
+            for &a in &self.index {
+                for &b in &self.index {
+                    self.sub.push(self.matrix[a * m + b]);
+                }
+                self.rhs.push(-self.q[a]);
+            }
+            linalg::solve_in_place(&mut self.sub, &mut self.rhs, n);
+            self.z.iter_mut().for_each(|z| *z = 0.0);
+            for (k, &a) in self.index.iter().enumerate() {
+                self.z[a] = self.rhs[k];
+            }
+        }
+        // Projected Gauss-Seidel from the last pivot's answer.
+        self.z.iter_mut().for_each(|z| *z = z.max(0.0));
+        for _ in 0..10_000 {
+            let mut change = 0.0f64;
+            for s in 0..m {
+                let diagonal = self.matrix[s * m + s];
+                if diagonal <= 0.0 {
+                    continue;
+                }
+                let w = self.w_minus_q(s) + self.q[s];
+                let z = (self.z[s] - w / diagonal).max(0.0);
+                change = change.max(((z - self.z[s]) * diagonal).abs());
+                self.z[s] = z;
+            }
+            if change <= tolerance {
+                break;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn problem(matrix: &[f64], q: &[f64]) -> Complementarity {
+        let m = q.len();
+        let mut lcp = Complementarity::new(m);
+        lcp.m = m;
+        lcp.matrix.extend_from_slice(matrix);
+        lcp.q.extend_from_slice(q);
+        lcp.z.resize(m, 0.0);
+        lcp
+    }
+
+    /// Every sign pattern's candidate, the one that is feasible: the
+    /// solution by enumeration, for a positive definite `W`.
+    fn by_enumeration(matrix: &[f64], q: &[f64]) -> Vec<f64> {
+        let m = q.len();
+        for pattern in 0..1u32 << m {
+            let index: Vec<usize> = (0..m).filter(|&s| pattern >> s & 1 == 1).collect();
+            let n = index.len();
+            let mut sub: Vec<f64> = index
+                .iter()
+                .flat_map(|&a| index.iter().map(move |&b| matrix[a * m + b]))
+                .collect();
+            let mut rhs: Vec<f64> = index.iter().map(|&a| -q[a]).collect();
+            linalg::solve_in_place(&mut sub, &mut rhs, n);
+            let mut z = vec![0.0; m];
+            for (k, &a) in index.iter().enumerate() {
+                z[a] = rhs[k];
+            }
+            let feasible = (0..m).all(|s| {
+                let w: f64 = q[s] + (0..m).map(|k| matrix[s * m + k] * z[k]).sum::<f64>();
+                z[s] >= -1e-12 && w >= -1e-12
+            });
+            if feasible {
+                return z;
+            }
+        }
+        panic!("no solution");
+    }
+
+    #[test]
+    fn principal_pivoting_matches_enumeration_on_random_problems() {
+        crate::testing::timeout(60, || {
+            let mut seed = 7u64;
+            let mut next = || {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+                (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            };
+            for m in 1..=6 {
+                for _ in 0..200 {
+                    // W = A A^T + a little: positive definite, coupled.
+                    let a: Vec<f64> = (0..m * m).map(|_| next()).collect();
+                    let mut w = vec![0.0; m * m];
+                    for r in 0..m {
+                        for c in 0..m {
+                            w[r * m + c] = (0..m).map(|k| a[r * m + k] * a[c * m + k]).sum::<f64>()
+                                + if r == c { 0.05 } else { 0.0 };
+                        }
+                    }
+                    let q: Vec<f64> = (0..m).map(|_| next()).collect();
+                    let mut lcp = problem(&w, &q);
+                    lcp.solve();
+                    let expected = by_enumeration(&w, &q);
+                    for (z, e) in lcp.z.iter().zip(&expected) {
+                        assert!((z - e).abs() <= 1e-9 * (1.0 + e.abs()), "{z} vs {e}");
+                    }
+                }
+            }
+        });
+    }
+
+    #[test]
+    fn a_singular_matrix_still_gets_a_complementary_answer() {
+        crate::testing::timeout(60, || {
+            // Two walls of one zero clearance: rows h and -h.
+            let w = [2.0, -2.0, -2.0, 2.0];
+            for q in [[-1.0, 1.0], [0.3, -0.3], [0.5, 0.5]] {
+                let mut lcp = problem(&w, &q);
+                lcp.solve();
+                for s in 0..2 {
+                    let ws = q[s] + lcp.w_minus_q(s);
+                    assert!(lcp.z[s] >= 0.0 && ws >= -1e-12, "{q:?}: {:?}", lcp.z);
+                    assert!((lcp.z[s] * ws).abs() <= 1e-12, "{q:?}: {:?}", lcp.z);
+                }
+            }
+        });
+    }
+}
