@@ -120,17 +120,17 @@ impl Impacts {
             let round_off = 1e-9 * system.gap_scale(i, y);
             // The gap's acceleration with the pair free: < 0 presses it shut.
             let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
-            // Landing at rest: an approach that the pressing gives within a
-            // rise of round-off, or within the round-off of the time.
+            // At rest: an approach (or a leaving) that the pressing gives
+            // within a rise of round-off, or within the round-off of the time.
             let landing = pressing < 0.0
                 && (approach * approach <= -2.0 * pressing * round_off
-                    || approach <= -pressing * instant);
+                    || approach.abs() <= -pressing * instant);
             let role = if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && !landing {
                 Role::Impact {
                     approach,
                     restitution,
                 }
-            } else if -approach > 1e-9 * speed_scale {
+            } else if -approach > 1e-9 * speed_scale && !landing {
                 // Located on the wall but leaving it (the start of a step
                 // just after an impact): no event.
                 continue;
@@ -178,8 +178,8 @@ impl Impacts {
         self.lcp.set_matrix(system, &self.members);
         self.stuck.clear();
         self.stuck.resize(m, None);
-        // Each round may find more impacting pairs to stick: at most m.
-        for _ in 0..=m {
+        // Each round may find more pairs to stick or to hold: at most 2 m.
+        for _ in 0..=2 * m {
             y[d..2 * d].copy_from_slice(&self.velocities);
             for (s, role) in self.roles.iter().enumerate() {
                 let u = self.before[s];
@@ -199,6 +199,36 @@ impl Impacts {
                 }
             }
             let mut more = false;
+            for s in 0..m {
+                if self.lcp.bilateral[s] || self.lcp.z[s] > 0.0 {
+                    continue;
+                }
+                let i = self.members[s];
+                let sticking = match self.roles[s] {
+                    Role::Impact { .. } => self.stuck[s].is_some(),
+                    _ => true,
+                };
+                // A sticking pair that the impulses elsewhere lift off its
+                // wall, but whose flight would rise less than round-off or
+                // land within the resolution (two dampers resting on one
+                // wall: each landing launches the other, the flights falling
+                // geometrically to an accumulation where both rest): the
+                // sequence summed, it is held, with an impulse of either sign.
+                let lift = system.gap(i, y).1;
+                if !sticking || lift <= 1e-9 * speed_scale {
+                    continue;
+                }
+                modes[i] = Mode::Open;
+                let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
+                modes[i] = Mode::Sticking;
+                if pressing < 0.0
+                    && (2.0 * lift <= -pressing * resolution
+                        || lift * lift <= -2.0 * pressing * 1e-9 * system.gap_scale(i, y))
+                {
+                    self.lcp.bilateral[s] = true;
+                    more = true;
+                }
+            }
             for s in 0..m {
                 let (Role::Impact { restitution, .. }, None) = (self.roles[s], self.stuck[s])
                 else {
@@ -293,6 +323,10 @@ impl Impacts {
                         });
                     }
                 }
+                (Role::Stick { .. }, _) if after > 1e-9 * speed_scale => {
+                    // Lifted off by the impulses elsewhere: a touch.
+                    modes[i] = Mode::Open;
+                }
                 (Role::Stick { approach }, _) => {
                     open[i] = Some(Open {
                         kind: ContactKind::Sticking,
@@ -303,7 +337,7 @@ impl Impacts {
                     });
                 }
                 (Role::Held, _) => {
-                    if impulse > 0.0 {
+                    if impulse != 0.0 {
                         if let Some(oc) = open[i].as_mut() {
                             oc.dissipated += loss;
                         }
@@ -335,6 +369,8 @@ struct Complementarity {
     matrix: Vec<f64>,
     q: Vec<f64>,
     z: Vec<f64>,
+    /// Rows held as equalities (`w = 0`, `z` of either sign).
+    bilateral: Vec<bool>,
     active: Vec<bool>,
     index: Vec<usize>,
     sub: Vec<f64>,
@@ -348,6 +384,7 @@ impl Complementarity {
             matrix: Vec::with_capacity(capacity * capacity),
             q: Vec::with_capacity(capacity),
             z: Vec::with_capacity(capacity),
+            bilateral: Vec::with_capacity(capacity),
             active: Vec::with_capacity(capacity),
             index: Vec::with_capacity(capacity),
             sub: Vec::with_capacity(capacity * capacity),
@@ -372,6 +409,8 @@ impl Complementarity {
         self.q.resize(m, 0.0);
         self.z.clear();
         self.z.resize(m, 0.0);
+        self.bilateral.clear();
+        self.bilateral.resize(m, false);
     }
 
     /// `(W z)_s`: the change of member `s`'s rate, m/s.
@@ -385,7 +424,9 @@ impl Complementarity {
     fn violation(&self, tolerance: f64) -> Option<usize> {
         (0..self.m).find(|&s| {
             let w = self.w_minus_q(s) + self.q[s];
-            if self.active[s] {
+            if self.bilateral[s] {
+                false
+            } else if self.active[s] {
                 self.z[s] * self.matrix[s * self.m + s] < -tolerance
             } else {
                 w < -tolerance
@@ -402,13 +443,21 @@ impl Complementarity {
         }
         let tolerance = 1e-13 * scale;
         self.active.clear();
-        self.active.resize(m, false);
+        self.active.extend_from_slice(&self.bilateral);
+        // With equalities, their solve comes first.
+        let mut solve_first = self.bilateral.contains(&true);
         for _ in 0..(20 * m + 20) {
-            let Some(s) = self.violation(tolerance) else {
-                self.z.iter_mut().for_each(|z| *z = z.max(0.0));
-                return;
-            };
-            self.active[s] = !self.active[s];
+            if !std::mem::take(&mut solve_first) {
+                let Some(s) = self.violation(tolerance) else {
+                    for (z, &b) in self.z.iter_mut().zip(&self.bilateral) {
+                        if !b {
+                            *z = z.max(0.0);
+                        }
+                    }
+                    return;
+                };
+                self.active[s] = !self.active[s];
+            }
             // z_A = -W_AA^-1 q_A, zero elsewhere.
             self.index.clear();
             self.index.extend((0..m).filter(|&s| self.active[s]));
@@ -428,7 +477,11 @@ impl Complementarity {
             }
         }
         // Projected Gauss-Seidel from the last pivot's answer.
-        self.z.iter_mut().for_each(|z| *z = z.max(0.0));
+        for (z, &b) in self.z.iter_mut().zip(&self.bilateral) {
+            if !b {
+                *z = z.max(0.0);
+            }
+        }
         for _ in 0..10_000 {
             let mut change = 0.0f64;
             for s in 0..m {
@@ -437,7 +490,8 @@ impl Complementarity {
                     continue;
                 }
                 let w = self.w_minus_q(s) + self.q[s];
-                let z = (self.z[s] - w / diagonal).max(0.0);
+                let z = self.z[s] - w / diagonal;
+                let z = if self.bilateral[s] { z } else { z.max(0.0) };
                 change = change.max(((z - self.z[s]) * diagonal).abs());
                 self.z[s] = z;
             }
@@ -459,6 +513,7 @@ mod tests {
         lcp.matrix.extend_from_slice(matrix);
         lcp.q.extend_from_slice(q);
         lcp.z.resize(m, 0.0);
+        lcp.bilateral.resize(m, false);
         lcp
     }
 
