@@ -174,3 +174,29 @@ def test_two_dampers_settling_on_one_wall_accumulate_and_rest_together() -> None
         assert "sticking" in kinds[pairs == name]
     energy = run.energy
     assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
+
+
+def test_a_rebound_too_short_for_the_step_is_found_after_another_pairs_event() -> None:
+    """dop853, two rigid dampers (found by fuzzing): damper 0 rebounds from a wall at
+    1.8 mm/s, a flight of microseconds in a step of 8.6 ms that the interpolant
+    cannot see. Damper 1's event cut the step later; damper 0, past its wall by
+    then, was located from the step's start, where it sat on the wall leaving it:
+    the event was put at the start again and again ('chattering at t = 2.0956 s').
+    Shorter probes now find a point of the flight to bracket its landing from."""
+    dampers = [
+        {"mass": 0.1445470700878202, "at": 0, "clearance": 0.0005, "law": "rigid"},
+        {"mass": 0.19805409785681555, "at": 0, "clearance": 0.003, "law": "rigid"},
+    ]
+    run = simulate_system(
+        OSCILLATOR,
+        damper=[{**dampers[0], "restitution": 0.6}, {**dampers[1], "restitution": 1.0}],
+        excitation=forced(29.143731101830376, 9.884406268804401),
+        method="dop853",
+        # The step's cap, 1e-3 t_end, is what made the rebound too short for it.
+        t_end=10.0,
+        history=False,
+    )
+    assert run.final_time == 10.0
+    assert len(run.contacts.kind) > 1000
+    energy = run.energy
+    assert abs(energy["residual"]) < 1e-6 * energy["input_work"]

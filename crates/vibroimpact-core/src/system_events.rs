@@ -546,13 +546,36 @@ fn locate<S: SystemStepper>(
         event_value(system, c.i, mode, at, end, modes, scratch, work)
     };
     let (mut lo, mut v_lo) = (0.0, value(y, time, scratch, &mut buffers.work));
-    if c.before > 0.0 {
-        let length = c.before * h;
-        stepper.attempt(system, time, y, length, modes, scratch, &mut buffers.probe)?;
-        let v = value(&buffers.probe, time + length, scratch, &mut buffers.work);
-        // Where the interpolant was wrong about the old side, start from 0.
-        if v > 0.0 {
-            (lo, v_lo) = (length, v);
+    let sign = match mode {
+        Mode::Open => 1.0,
+        Mode::Compliant { .. } => -1.0,
+        Mode::Sticking => f64::NAN,
+    };
+    // On the wall to round-off and moving away (a rebound): the event is
+    // where it comes back, after a stretch on the old side to start from.
+    let leaving = v_lo.abs() <= round_off && sign * system.gap(c.i, y).1 > 0.0;
+    if c.before > 0.0 || leaving {
+        let mut length = if c.before > 0.0 {
+            c.before * h
+        } else {
+            0.5 * h
+        };
+        // A flight far shorter than the step, which the interpolant cannot
+        // see (another pair's event cut the step later): shorter probes,
+        // down to the round-off of the time, find it.
+        while length > 4.0 * f64::EPSILON * (time.abs() + h) {
+            stepper.attempt(system, time, y, length, modes, scratch, &mut buffers.probe)?;
+            let v = value(&buffers.probe, time + length, scratch, &mut buffers.work);
+            if v > 0.0 {
+                (lo, v_lo) = (length, v);
+                break;
+            }
+            // Where the interpolant was wrong about the old side, start
+            // from 0.
+            if !leaving {
+                break;
+            }
+            length *= 0.125;
         }
     }
     let (mut hi, mut v_hi, mut best_error);
@@ -603,11 +626,6 @@ fn locate<S: SystemStepper>(
         }
         first = false;
         let v = value(&buffers.probe, time + trial, scratch, &mut buffers.work);
-        let sign = match mode {
-            Mode::Open => 1.0,
-            Mode::Compliant { .. } => -1.0,
-            Mode::Sticking => f64::NAN,
-        };
         let slope = sign * system.gap(c.i, &buffers.probe).1;
         let mut converged = false;
         if slope != 0.0 && slope.is_finite() {
