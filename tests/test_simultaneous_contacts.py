@@ -200,3 +200,29 @@ def test_a_rebound_too_short_for_the_step_is_found_after_another_pairs_event() -
     assert len(run.contacts.kind) > 1000
     energy = run.energy
     assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
+
+
+def test_a_plastic_landing_with_no_pressing_yet_is_not_found_again_without_end() -> None:
+    """Exact flow, a plastic damper, a second damper and a stop (found by fuzzing):
+    damper 0 lands plastically at an instant when its wall's pull turns, so it sits
+    exactly on the wall (gap 0, rate 0) neither pressed nor leaving. It was found
+    again at once at the same instant, without end ('chattering at t = 5.62 s'). A
+    touch at rest and not pressed, on the wall or past it, is now put a few units of
+    round-off off the wall; it lands at rest, and sticks, once pressed."""
+    dampers = [
+        {"mass": 0.06772191308601166, "at": 0, "clearance": 0.0005, "law": "rigid"},
+        {"mass": 0.09730589585434458, "at": 0, "clearance": 0.01, "law": "rigid"},
+    ]
+    stop = {"at": 0, "side": "upper", "gap": 0.0013707396460258272, "law": "rigid"}
+    run = simulate_system(
+        OSCILLATOR,
+        damper=[{**dampers[0], "restitution": 0.0}, {**dampers[1], "restitution": 0.6}],
+        stop=[{**stop, "restitution": 0.5}],
+        excitation=forced(8.279043125879216, 6.6121596473149635),
+        method="exact",
+        t_end=10.0,
+        history=False,
+    )
+    assert run.final_time == 10.0
+    energy = run.energy
+    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]

@@ -141,11 +141,12 @@ impl Impacts {
                     *grazes += 1;
                 }
                 if pressing >= 0.0 {
-                    if gap < 0.0 {
+                    if gap <= 0.0 {
                         // Touching at rest, not pressed (a pair released at
-                        // the instant its force turns, a zero clearance):
-                        // put it a few units of round-off off the wall, or
-                        // the same touch is found again at once, without end.
+                        // the instant its force turns, a zero clearance, a
+                        // plastic landing as its wall's pull turns): put it a
+                        // few units of round-off off the wall, or the same
+                        // touch is found again at once, without end.
                         system.release(i, y);
                     }
                     continue;
