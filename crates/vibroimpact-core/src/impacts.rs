@@ -442,6 +442,12 @@ impl Complementarity {
         if scale == 0.0 {
             return;
         }
+        if m == 1 {
+            // One pair: Newton's impulse (the pivoting's answer, directly).
+            let z = -self.q[0] / self.matrix[0];
+            self.z[0] = if self.bilateral[0] { z } else { z.max(0.0) };
+            return;
+        }
         let tolerance = 1e-13 * scale;
         self.active.clear();
         self.active.extend_from_slice(&self.bilateral);
