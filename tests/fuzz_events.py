@@ -1,6 +1,8 @@
 """Stress the event kernel with random forced systems: an oscillator (10 Hz, 2 %
-damping) with one or two dampers (rigid or Hertz), maybe a stop and gravity, every
-method, each run with and without a stroboscopic sample every forcing period. Prints
+damping), two storeys or a cantilever, with one to three dampers (rigid or Hertz),
+maybe a stop (or pounding between the storeys) and gravity, forced or shaken at the
+base, every method, each run with and without a stroboscopic sample every forcing
+period. Prints
 how many runs stopped, by method and error, and the first few scenarios that did.
 
 Not a test (no fixed expectation yet: some stops are legitimate, such as Newton's
@@ -23,42 +25,86 @@ import numpy as np
 import vibroimpact as vi
 
 STRUCTURE = {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513}
+TWO_STOREYS = {
+    "kind": "matrices",
+    "mass": [[1.0, 0.0], [0.0, 0.5]],
+    "stiffness": [[6000.0, -2000.0], [-2000.0, 2000.0]],
+    "damping": [[3.0, -1.0], [-1.0, 1.0]],
+}
+BEAM = {
+    "kind": "cantilever",
+    "length": 0.5,
+    "youngs_modulus": 7e10,
+    "second_moment": 1e-10,
+    "mass_per_length": 0.27,
+    "modes": 3,
+    "damping_ratio": 0.01,
+}
+
+
+def law(rng: np.random.Generator, method: str) -> dict[str, Any]:
+    """A random law: rigid (any restitution) or, except for exact, Hertz."""
+    if rng.random() < 0.4 and method != "exact":
+        return {"law": "hertz", "stiffness": float(10 ** rng.uniform(5, 8))}
+    return {"law": "rigid", "restitution": float(rng.choice([0, 0.3, 0.6, 1]))}
 
 
 def scenario(rng: np.random.Generator) -> dict[str, Any]:
-    """One random system and method, as keyword arguments of simulate_system."""
+    """One random system and method, as keyword arguments of simulate_system: an
+    oscillator (most often), two storeys (pounding between them) or a cantilever;
+    one to three dampers, maybe a stop, gravity, a force or base excitation."""
     method = str(rng.choice(["exact", "dop853", "dopri5", "rk4", "newmark-implicit"]))
+    kind = str(rng.choice(["oscillator"] * 3 + ["matrices", "cantilever"]))
+    structure = {"oscillator": STRUCTURE, "matrices": TWO_STOREYS, "cantilever": BEAM}[kind]
+    points = {"oscillator": [0], "matrices": [0, 1], "cantilever": [0.25, 0.5]}[kind]
+    scale = 0.1 if kind == "cantilever" else 1.0
     dampers = []
-    for _ in range(int(rng.integers(1, 3))):
-        law: dict[str, Any] = {"law": "rigid", "restitution": float(rng.choice([0, 0.3, 0.6, 1]))}
-        if rng.random() < 0.4 and method != "exact":
-            law = {"law": "hertz", "stiffness": float(10 ** rng.uniform(5, 8))}
-        clearance = float(rng.choice([0.0005, 0.003, 0.01]))
+    for _ in range(int(rng.choice([1, 2, 2, 3]))):
+        clearance = scale * float(rng.choice([0.0005, 0.003, 0.01]))
         dampers.append(
-            {"mass": float(rng.uniform(0.01, 0.2)), "at": 0, "clearance": clearance, **law}
+            {
+                "mass": scale * float(rng.uniform(0.01, 0.2)),
+                "at": rng.choice(points).item(),
+                "clearance": clearance,
+                **law(rng, method),
+            }
         )
     stops = []
     if rng.random() < 0.3:
-        gap = float(rng.uniform(0.001, 0.02))
-        stops.append({"at": 0, "side": "upper", "gap": gap, "law": "rigid", "restitution": 0.5})
-    force = {"kind": "force", "at": 0, "signal": "harmonic"}
+        gap = scale * float(rng.uniform(0.001, 0.02))
+        side = str(rng.choice(["upper", "lower"]))
+        stop = {"at": points[0], "side": side, "gap": gap, **law(rng, method)}
+        if kind == "matrices" and rng.random() < 0.5:
+            stop["against"] = 1  # pounding
+        stops.append(stop)
+    if rng.random() < 0.7:
+        excitation = {"kind": "force", "at": points[-1], "signal": "harmonic"}
+        amplitude = scale * float(rng.uniform(1, 30))
+    else:
+        excitation = {"kind": "base", "signal": "harmonic"}
+        amplitude = float(rng.uniform(1, 30))
     frequency = float(rng.uniform(5, 15))
     return {
+        "structure": structure,
         "damper": dampers,
         "stop": stops,
         "gravity": {"acceleration": 9.81} if rng.random() < 0.3 else None,
-        "excitation": [{**force, "amplitude": float(rng.uniform(1, 30)), "frequency": frequency}],
+        "excitation": [{**excitation, "amplitude": amplitude, "frequency": frequency}],
         "method": method,
-        "t_end": 10.0,
+        "t_end": 10.0 if kind != "cantilever" else 2.0,
         "history": False,
-        **({"dt": 1e-4} if method in ("rk4", "newmark-implicit") else {}),
+        **(
+            {"dt": 1e-4 if kind != "cantilever" else 2e-5}
+            if method in ("rk4", "newmark-implicit")
+            else {}
+        ),
     }
 
 
 def outcome(kw: dict[str, Any], strobe: float | None) -> str:
     """ "ok", or the error's class and first words."""
     try:
-        vi.simulate_system(STRUCTURE, **kw, **({} if strobe is None else {"strobe_period": strobe}))
+        vi.simulate_system(**kw, **({} if strobe is None else {"strobe_period": strobe}))
     except Exception as err:  # every stop is what is counted
         return f"{type(err).__name__}: {' '.join(str(err).split()[:3])}"
     return "ok"

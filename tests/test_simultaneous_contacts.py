@@ -226,3 +226,33 @@ def test_a_plastic_landing_with_no_pressing_yet_is_not_found_again_without_end()
     assert run.final_time == 10.0
     energy = run.energy
     assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
+
+
+def test_a_system_come_to_rest_on_its_walls_goes_on() -> None:
+    """Exact flow, a plastic damper and a plastic stop (found by fuzzing): the
+    structure stuck on its stop and the damper on its wall bring everything to rest
+    at once, every speed round-off (1e-16 m/s). A damper past its wall by round-off,
+    'leaving' or 'arriving' at such speeds, was found again at every step
+    ('chattering at t = 4.2 s', then at 8.43 s). A rate that would take the system's
+    time scale to move a gap by its round-off is now at rest, whatever the other
+    speeds."""
+    run = simulate_system(
+        OSCILLATOR,
+        damper=[
+            {"mass": 0.07193791018257657, "at": 0, "clearance": 0.0005, "law": "rigid"}
+            | {"restitution": 0.0}
+        ],
+        stop=[
+            {"at": 0, "side": "lower", "gap": 0.0010704076589561416, "law": "rigid"}
+            | {"restitution": 0.0}
+        ],
+        excitation=forced(11.751122402454829, 10.401324381194478),
+        method="exact",
+        t_end=10.0,
+        history=False,
+    )
+    assert run.final_time == 10.0
+    pairs, kinds = np.asarray(run.contacts.pair), np.asarray(run.contacts.kind)
+    assert "sticking" in kinds[pairs == "stop 0"] and "sticking" in kinds[pairs == "damper 0"]
+    energy = run.energy
+    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]

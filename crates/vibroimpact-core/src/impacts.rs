@@ -82,7 +82,7 @@ impl Impacts {
     /// Resolve the marked pairs and the sticking ones at `time`: impacts,
     /// sticking, release of sticking pairs lifted off. `resolution` (s) is the
     /// time below which a chattering sequence is summed, `instant` (s) the
-    /// round-off of the time. Sets `just_switched` for the pairs that
+    /// round-off of the time, `time_scale` (s) the system's. Sets `just_switched` for the pairs that
     /// changed; returns whether any did or any impulse acted.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn resolve(
@@ -95,7 +95,7 @@ impl Impacts {
         contacts: &mut Vec<PairContact>,
         impact_loss: &mut f64,
         grazes: &mut u64,
-        (resolution, instant): (f64, f64),
+        (resolution, instant, time_scale): (f64, f64, f64),
         scratch: &mut Scratch,
         work: &mut [f64],
         just_switched: &mut [bool],
@@ -122,17 +122,30 @@ impl Impacts {
             let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
             // At rest: an approach (or a leaving) that the pressing gives
             // within a rise of round-off, or within the round-off of the time.
+            // At rest whatever the pressing: a rate that would take the
+            // system's time scale to move the gap by its round-off (a system
+            // come to rest, where every speed is round-off and relative
+            // thresholds say nothing).
+            let at_rest = approach.abs() * time_scale <= round_off;
             let landing = pressing < 0.0
                 && (approach * approach <= -2.0 * pressing * round_off
-                    || approach.abs() <= -pressing * instant);
-            let role = if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && !landing {
+                    || approach.abs() <= -pressing * instant
+                    || at_rest);
+            let moving = !landing && !at_rest;
+            let role = if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && moving {
                 Role::Impact {
                     approach,
                     restitution,
                 }
-            } else if -approach > 1e-9 * speed_scale && !landing {
+            } else if -approach > 1e-9 * speed_scale && moving {
                 // Located on the wall but leaving it (the start of a step
-                // just after an impact): no event.
+                // just after an impact): no event. Still past it by
+                // round-off, it is put a few units of round-off off: leaving
+                // at a rate of round-off too (a system come to rest), it
+                // would be found there again at every step.
+                if gap <= 0.0 {
+                    system.release(i, y);
+                }
                 continue;
             } else {
                 just_switched[i] = true;

@@ -1167,7 +1167,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                     &mut contacts,
                     &mut impact_loss,
                     &mut grazes,
-                    (resolution, chatter_interval(time)),
+                    (resolution, chatter_interval(time), time_scale),
                     &mut scratch,
                     &mut buffers.work,
                     &mut just_switched,
