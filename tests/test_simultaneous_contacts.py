@@ -47,6 +47,17 @@ def first_reach(amplitude: float, frequency: float, level: float) -> float:
     return float(sol.t_events[0][0])
 
 
+def runs_to_the_end(method: str, t_end: float, residual: float, **kw: Any) -> Any:
+    """The oscillator with `kw` (dampers, stops, excitation) by `method` to `t_end`
+    (s), checked to get there with its energy balance closing to `residual` of the
+    input work."""
+    run = simulate_system(OSCILLATOR, method=method, t_end=t_end, history=False, **kw)
+    assert run.final_time == t_end
+    energy = run.energy
+    assert abs(energy["residual"]) < residual * energy["input_work"]
+    return run
+
+
 @pytest.mark.parametrize("method", ["rk4", "dop853", "dopri5", "newmark-implicit"])
 def test_two_hertz_dampers_touching_at_one_instant_both_start_their_contacts(
     method: str,
@@ -156,24 +167,20 @@ def test_two_dampers_settling_on_one_wall_accumulate_and_rest_together() -> None
     the resolution is now summed, the pair held, and the run goes on."""
     damper = {"mass": 0.1688, "at": 0, "clearance": 0.0005, "law": "rigid", "restitution": 0.3}
     stop = {"at": 0, "side": "upper", "gap": 0.00567497129924516, "law": "rigid"}
-    run = simulate_system(
-        OSCILLATOR,
+    run = runs_to_the_end(
+        "exact",
+        10.0,
+        1e-8,
         damper=[
             {**damper, "mass": 0.16884397816396696},
             {**damper, "mass": 0.15903138441417722},
         ],
         stop=[{**stop, "restitution": 0.5}],
         excitation=forced(26.35036061947917, 8.188928741641144),
-        method="exact",
-        t_end=10.0,
-        history=False,
     )
-    assert run.final_time == 10.0
     kinds, pairs = np.asarray(run.contacts.kind), np.asarray(run.contacts.pair)
     for name in ("damper 0", "damper 1"):
         assert "sticking" in kinds[pairs == name]
-    energy = run.energy
-    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
 
 
 def test_a_rebound_too_short_for_the_step_is_found_after_another_pairs_event() -> None:
@@ -187,19 +194,15 @@ def test_a_rebound_too_short_for_the_step_is_found_after_another_pairs_event() -
         {"mass": 0.1445470700878202, "at": 0, "clearance": 0.0005, "law": "rigid"},
         {"mass": 0.19805409785681555, "at": 0, "clearance": 0.003, "law": "rigid"},
     ]
-    run = simulate_system(
-        OSCILLATOR,
+    # The step's cap, 1e-3 t_end, is what made the rebound too short for it.
+    run = runs_to_the_end(
+        "dop853",
+        10.0,
+        1e-6,
         damper=[{**dampers[0], "restitution": 0.6}, {**dampers[1], "restitution": 1.0}],
         excitation=forced(29.143731101830376, 9.884406268804401),
-        method="dop853",
-        # The step's cap, 1e-3 t_end, is what made the rebound too short for it.
-        t_end=10.0,
-        history=False,
     )
-    assert run.final_time == 10.0
     assert len(run.contacts.kind) > 1000
-    energy = run.energy
-    assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
 
 
 def test_a_plastic_landing_with_no_pressing_yet_is_not_found_again_without_end() -> None:
@@ -214,18 +217,14 @@ def test_a_plastic_landing_with_no_pressing_yet_is_not_found_again_without_end()
         {"mass": 0.09730589585434458, "at": 0, "clearance": 0.01, "law": "rigid"},
     ]
     stop = {"at": 0, "side": "upper", "gap": 0.0013707396460258272, "law": "rigid"}
-    run = simulate_system(
-        OSCILLATOR,
+    runs_to_the_end(
+        "exact",
+        10.0,
+        1e-8,
         damper=[{**dampers[0], "restitution": 0.0}, {**dampers[1], "restitution": 0.6}],
         stop=[{**stop, "restitution": 0.5}],
         excitation=forced(8.279043125879216, 6.6121596473149635),
-        method="exact",
-        t_end=10.0,
-        history=False,
     )
-    assert run.final_time == 10.0
-    energy = run.energy
-    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
 
 
 def test_a_system_come_to_rest_on_its_walls_goes_on() -> None:
@@ -236,8 +235,10 @@ def test_a_system_come_to_rest_on_its_walls_goes_on() -> None:
     ('chattering at t = 4.2 s', then at 8.43 s). A rate that would take the system's
     time scale to move a gap by its round-off is now at rest, whatever the other
     speeds."""
-    run = simulate_system(
-        OSCILLATOR,
+    run = runs_to_the_end(
+        "exact",
+        10.0,
+        1e-8,
         damper=[
             {"mass": 0.07193791018257657, "at": 0, "clearance": 0.0005, "law": "rigid"}
             | {"restitution": 0.0}
@@ -247,12 +248,6 @@ def test_a_system_come_to_rest_on_its_walls_goes_on() -> None:
             | {"restitution": 0.0}
         ],
         excitation=forced(11.751122402454829, 10.401324381194478),
-        method="exact",
-        t_end=10.0,
-        history=False,
     )
-    assert run.final_time == 10.0
     pairs, kinds = np.asarray(run.contacts.pair), np.asarray(run.contacts.kind)
     assert "sticking" in kinds[pairs == "stop 0"] and "sticking" in kinds[pairs == "damper 0"]
-    energy = run.energy
-    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
