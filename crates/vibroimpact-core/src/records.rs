@@ -92,6 +92,8 @@ pub(crate) struct Records {
     pub(crate) contacts: Vec<ContactRecord>,
     keep_history: bool,
     max_rows: u64,
+    /// Bytes all the records may hold: [`MAX_RECORD_BYTES`] (less in tests).
+    limit: u64,
 }
 
 /// Bytes of a history row (six f64 columns).
@@ -102,22 +104,28 @@ impl Records {
     /// and the memory limit allow; an up-front check has refused a
     /// fixed-step history beyond them).
     pub(crate) fn new(settings: &Settings, rows: u64) -> Result<Self> {
-        let mut records = Self {
-            history: History::default(),
-            contacts: Vec::new(),
-            keep_history: settings.history,
-            max_rows: settings.max_rows,
-        };
+        let mut records = Self::within(settings.history, settings.max_rows, MAX_RECORD_BYTES);
         if settings.history {
             let rows = rows
                 .min(settings.max_rows)
-                .min(MAX_RECORD_BYTES / ROW_BYTES);
+                .min(MAX_RECORD_BYTES / ROW_BYTES / 2);
             records
                 .history
                 .try_reserve_exact(rows as usize)
                 .map_err(|_| records.no_room(NoRoom::Refused, 0.0))?;
         }
         Ok(records)
+    }
+
+    /// Empty records within `max_rows` and `limit` bytes.
+    fn within(keep_history: bool, max_rows: u64, limit: u64) -> Self {
+        Self {
+            history: History::default(),
+            contacts: Vec::new(),
+            keep_history,
+            max_rows,
+            limit,
+        }
     }
 
     /// Whether the history is kept at all.
@@ -156,13 +164,16 @@ impl Records {
     }
 
     /// How many more rows (of `row_bytes` each) may be allocated: as many as
-    /// the `current` length (at least `least`), as far as `max_rows` and the
-    /// memory limit allow.
+    /// the `current` length (at least `least`), as far as `max_rows` allows
+    /// and at most half the memory left, so that the other record can still
+    /// grow (the history taking all of it left no room for the contacts).
     fn growth(&self, current: usize, least: usize, row_bytes: u64) -> usize {
         let room = self.max_rows.saturating_sub(self.allocated());
         let held = self.history.held() + memory::held(&self.contacts);
-        let fits = MAX_RECORD_BYTES.saturating_sub(held) / row_bytes;
-        (current.max(least) as u64).min(room).min(fits) as usize
+        let fits = self.limit.saturating_sub(held) / row_bytes;
+        (current.max(least) as u64)
+            .min(room)
+            .min((fits / 2).max(fits.min(1))) as usize
     }
 
     /// The error of a run that found no room: the row limit, or the memory's.
@@ -170,7 +181,7 @@ impl Records {
         if self.allocated() >= self.max_rows {
             self.full(time)
         } else {
-            self.no_room(NoRoom::Limit(MAX_RECORD_BYTES), time)
+            self.no_room(NoRoom::Limit(self.limit), time)
         }
     }
 
@@ -517,5 +528,52 @@ pub(crate) fn open_record(
         restitution: f64::NAN,
         energy_dissipated,
         energy_change: f64::NAN,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contact() -> ContactRecord {
+        ContactRecord {
+            onset: 0.0,
+            separation: 0.0,
+            duration: 0.0,
+            max_indentation: 0.0,
+            approach_speed: 0.0,
+            rebound_speed: 0.0,
+            restitution: 0.0,
+            energy_dissipated: 0.0,
+            energy_change: 0.0,
+        }
+    }
+
+    #[test]
+    fn history_and_contacts_share_the_memory_limit() {
+        crate::testing::timeout(60, || {
+            // 1000 history rows' worth; a run that needs 60 % of it: 520
+            // rows, then 50 contacts (72 bytes each). The history's growth
+            // past 512 rows took all the room left, and the contacts, at
+            // their first growth, found none.
+            let limit = 1000 * ROW_BYTES;
+            let mut records = Records::within(true, u64::MAX, limit);
+            for step in 0..520 {
+                records.keep(step as f64, &State::default(), 0.0).unwrap();
+            }
+            for _ in 0..50 {
+                records.contact(contact(), 520.0).unwrap();
+            }
+            let held = records.history.held() + memory::held(&records.contacts);
+            assert!(held <= limit, "{held} > {limit}");
+            // Then it runs into the limit, and stops with the memory's error,
+            // never holding more.
+            let error = (600..100_000)
+                .find_map(|step| records.keep(step as f64, &State::default(), 0.0).err())
+                .unwrap();
+            assert!(matches!(error, Error::MemoryLimit { .. }), "{error:?}");
+            let held = records.history.held() + memory::held(&records.contacts);
+            assert!(held <= limit && 2 * held >= limit, "{held} of {limit}");
+        });
     }
 }
