@@ -251,3 +251,29 @@ def test_a_system_come_to_rest_on_its_walls_goes_on() -> None:
     )
     pairs, kinds = np.asarray(run.contacts.pair), np.asarray(run.contacts.kind)
     assert "sticking" in kinds[pairs == "stop 0"] and "sticking" in kinds[pairs == "damper 0"]
+
+
+def test_a_sticking_pair_with_no_force_left_is_released() -> None:
+    """dopri5, a Hertz and a plastic damper and a plastic stop, sampled every period
+    (found by fuzzing): the structure sticking on its stop was found to release
+    where its constraint force was exactly zero (-0.0) at the step's start, but
+    another pair's touch at the same instant took the event, and the stop, its
+    force not below zero, was kept sticking and found again at once, without end
+    ('chattering at t = 4.41 s'). A sticking pair with no force holding it is
+    released with the others at the instant."""
+    damper = {"at": 0, "clearance": 0.0005}
+    runs_to_the_end(
+        "dopri5",
+        10.0,
+        1e-6,
+        damper=[
+            {**damper, "mass": 0.11852494089604164, "law": "hertz", "stiffness": 2803170.870139846},
+            {**damper, "mass": 0.06677492790643907, "law": "rigid", "restitution": 0.0},
+        ],
+        stop=[
+            {"at": 0, "side": "lower", "gap": 0.008925610132667024, "law": "rigid"}
+            | {"restitution": 0.0}
+        ],
+        excitation=forced(24.59992253737289, 10.350754504853889),
+        strobe_period=0.0966113146177952,
+    )

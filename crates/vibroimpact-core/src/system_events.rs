@@ -206,7 +206,10 @@ fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
     let sign = match mode {
         Mode::Open => 1.0,
         Mode::Compliant { .. } => -1.0,
-        Mode::Sticking => return v < 0.0,
+        // No force holding it (exactly zero, a system at rest on its
+        // walls) is released too: it was found as an event, and kept
+        // sticking it would be found again at once, without end.
+        Mode::Sticking => return v <= 0.0,
     };
     let round_off = 8.0 * f64::EPSILON * system.gap_scale(i, y);
     let arriving = sign * system.gap(i, y).1 <= 0.0;
