@@ -958,6 +958,18 @@ impl Assembly {
         0.5 * (1.0 - restitution * restitution) * rate * rate / it.inverse_mass
     }
 
+    /// Whether interaction `i` is a wall whose other wall (of the same
+    /// damper) is sticking: its gap is then held too, at the sum of the
+    /// clearances (0 for a zero clearance, to round-off), and it has no
+    /// event of its own. Sticking it as well would make the constraints
+    /// dependent.
+    pub fn held_by_mirror(&self, i: usize, modes: &[Mode]) -> bool {
+        let before = self.mirrors_previous[i] && modes[i - 1] == Mode::Sticking;
+        let after =
+            self.mirrors_previous.get(i + 1) == Some(&true) && modes[i + 1] == Mode::Sticking;
+        before || after
+    }
+
     /// The scale of interaction `i`'s gap at state `y`, m: its offset and
     /// the magnitudes of the terms `h . x` sums, whose round-off the gap
     /// carries.

@@ -164,6 +164,10 @@ impl Impacts {
                     }
                     continue;
                 }
+                if system.held_by_mirror(i, modes) {
+                    // Its other wall (a zero clearance) took the touch.
+                    continue;
+                }
                 // At rest and pressed: a sequence whose flights would rise
                 // less than round-off. It sticks at once, whatever its
                 // restitution (even 1: a ball resting on a floor stays).

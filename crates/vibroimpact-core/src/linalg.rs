@@ -176,24 +176,94 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Solves `A x = b` in place (`b` becomes `x`) by Gaussian elimination with
-/// partial pivoting; `A` (row-major, `n x n`) is overwritten. A singular `A`
-/// (dependent rows, such as two constraints on the same gap) gives the
-/// dependent unknowns 0: the least-effort solution of a consistent system.
+/// complete pivoting (partial beyond 64 unknowns); `A` (row-major, `n x n`)
+/// is overwritten. A singular `A` (dependent rows, such as two constraints on
+/// the same gap) gives the unknowns of the columns left without a pivot 0: a
+/// solution of a consistent system. Partial pivoting alone could move an
+/// independent row into a dependent one's place and drop it.
 pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
+    const MOST: usize = 64;
+    if n > MOST {
+        return solve_partial(a, b, n);
+    }
+    let tiny = 1e-13 * max_abs(&a[..n * n]);
+    // Column k of the reduced system is column `columns[k]` of A's.
+    let mut columns = [0usize; MOST];
+    for (k, c) in columns[..n].iter_mut().enumerate() {
+        *c = k;
+    }
+    let mut rank = n;
+    for k in 0..n {
+        let (mut row, mut col, mut best) = (k, k, 0.0f64);
+        for r in k..n {
+            for c in k..n {
+                let value = a[r * n + c].abs();
+                if value > best {
+                    (row, col, best) = (r, c, value);
+                }
+            }
+        }
+        if best <= tiny {
+            rank = k;
+            break;
+        }
+        if row != k {
+            for c in 0..n {
+                a.swap(k * n + c, row * n + c);
+            }
+            b.swap(k, row);
+        }
+        if col != k {
+            for r in 0..n {
+                a.swap(r * n + k, r * n + col);
+            }
+            columns.swap(k, col);
+        }
+        let diagonal = a[k * n + k];
+        for r in k + 1..n {
+            let factor = a[r * n + k] / diagonal;
+            if factor != 0.0 {
+                for c in k..n {
+                    a[r * n + c] -= factor * a[k * n + c];
+                }
+                b[r] -= factor * b[k];
+            }
+        }
+    }
+    for k in (0..n).rev() {
+        if k >= rank {
+            b[k] = 0.0;
+            continue;
+        }
+        let sum: f64 = (k + 1..rank).map(|c| a[k * n + c] * b[c]).sum();
+        b[k] = (b[k] - sum) / a[k * n + k];
+    }
+    // Back to A's column order: unknown k of the reduced system is A's
+    // `columns[k]`.
+    let mut x = [0.0f64; MOST];
+    for k in 0..n {
+        x[columns[k]] = b[k];
+    }
+    b[..n].copy_from_slice(&x[..n]);
+}
+
+/// [`solve_in_place`] by partial pivoting, for systems too large for its
+/// stack arrays.
+fn solve_partial(a: &mut [f64], b: &mut [f64], n: usize) {
     let scale = max_abs(a);
     for col in 0..n {
         let pivot = (col..n)
             .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
             .unwrap_or(col);
+        let diagonal = a[pivot * n + col];
+        if diagonal.abs() <= 1e-13 * scale {
+            continue;
+        }
         if pivot != col {
             for c in 0..n {
                 a.swap(col * n + c, pivot * n + c);
             }
             b.swap(col, pivot);
-        }
-        let diagonal = a[col * n + col];
-        if diagonal.abs() <= 1e-13 * scale {
-            continue;
         }
         for row in col + 1..n {
             let factor = a[row * n + col] / diagonal;
@@ -623,6 +693,37 @@ pub fn quadratic_form(a: &[f64], x: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dependent_row_first_keeps_the_independent_one() {
+        crate::testing::timeout(60, || {
+            // Both walls of a zero-clearance damper (rows h and -h) and a
+            // second damper sticking: the forces must hold all three gaps.
+            // Partial pivoting swapped the third row into the dependent
+            // second's place and dropped it: forces [2.73, 0, 0].
+            let w = [11.0, -11.0, 1.0, -11.0, 11.0, -1.0, 1.0, -1.0, 21.0];
+            let x = [0.3, 0.0, -0.2];
+            let rhs: Vec<f64> = (0..3)
+                .map(|r| (0..3).map(|c| w[r * 3 + c] * x[c]).sum())
+                .collect();
+            let (mut a, mut b) = (w, rhs.clone());
+            solve_in_place(&mut a, &mut b, 3);
+            for r in 0..3 {
+                let got: f64 = (0..3).map(|c| w[r * 3 + c] * b[c]).sum();
+                assert!((got - rhs[r]).abs() < 1e-12, "row {r}: {got} vs {}", rhs[r]);
+            }
+            // A regular system: the solution itself.
+            let w = [4.0, 1.0, 0.5, 1.0, 3.0, -1.0, 0.5, -1.0, 2.0];
+            let rhs: Vec<f64> = (0..3)
+                .map(|r| (0..3).map(|c| w[r * 3 + c] * x[c]).sum())
+                .collect();
+            let (mut a, mut b) = (w, rhs);
+            solve_in_place(&mut a, &mut b, 3);
+            for (got, want) in b.iter().zip(x) {
+                assert!((got - want).abs() < 1e-14, "{got} vs {want}");
+            }
+        });
+    }
 
     #[test]
     fn eigenvalues_of_a_known_matrix() {

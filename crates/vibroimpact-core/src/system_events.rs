@@ -220,6 +220,15 @@ fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
     }
 }
 
+/// Whether interaction `i`, whose event value at state `y` is `v`, is past
+/// its wall by more than round-off (a sticking pair: its force below zero).
+fn past(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
+    match mode {
+        Mode::Sticking => v < 0.0,
+        _ => v < -8.0 * f64::EPSILON * system.gap_scale(i, y),
+    }
+}
+
 /// An event found in a step: interaction `i`, first guessed at the fraction
 /// `guess` of the step; `interior` when both ends are on the old side.
 #[derive(Debug, Clone, Copy)]
@@ -373,7 +382,7 @@ fn find_crossing(
         }
     };
     for (i, &mode) in modes.iter().enumerate() {
-        if skip[i] {
+        if skip[i] || (mode == Mode::Open && system.held_by_mirror(i, modes)) {
             continue;
         }
         let sign = match mode {
@@ -976,7 +985,7 @@ pub fn integrate_system_within<S: SystemStepper>(
             }
             // Another interaction on its new side at the cut came first.
             for (j, &mode) in modes.iter().enumerate() {
-                if Some(j) == switched {
+                if Some(j) == switched || system.held_by_mirror(j, &modes) {
                     continue;
                 }
                 let v = event_value(
@@ -989,7 +998,11 @@ pub fn integrate_system_within<S: SystemStepper>(
                     &mut scratch,
                     &mut buffers.work,
                 );
-                if crossed(system, j, mode, v, &end) {
+                // Past its wall beyond round-off: one on it to round-off (the
+                // located pair's simultaneous partner, or a pair at rest on
+                // its wall) switches with it, and must not hide one that
+                // crossed earlier behind it.
+                if past(system, j, mode, v, &end) {
                     crossing = Some(Crossing {
                         i: j,
                         guess: 1.0,
@@ -1142,7 +1155,9 @@ pub fn integrate_system_within<S: SystemStepper>(
                     &mut buffers.work,
                 );
                 let located = Some(i) == switched;
-                if !(located || crossed(system, i, modes[i], v, &y)) {
+                if !(located || crossed(system, i, modes[i], v, &y))
+                    || (modes[i] == Mode::Open && system.held_by_mirror(i, &modes))
+                {
                     continue;
                 }
                 if impacts.mark(system, i, modes[i]) {
