@@ -338,3 +338,36 @@ def test_a_crossing_behind_two_simultaneous_touches_is_located() -> None:
     )
     relative = np.asarray(run.damper_displacement) - np.asarray(run.structure_displacement)
     assert (np.abs(relative) - [0.003, 0.003, 0.0005]).max() < 1e-12
+
+
+def test_a_sticking_released_before_its_accumulation_instant_ends_there() -> None:
+    """rk4 at dt 1e-4, base-excited, a rigid and two Hertz dampers (found by a
+    review and by fuzzing): a summed chattering sequence's sticking starts at its
+    accumulation instant, up to a step after the impact where the sum is made; a
+    release before that instant gave a sticking record ending 8e-6 s before it
+    began. It now ends there, with no duration."""
+    damper = {"at": 0}
+    run = simulate_system(
+        OSCILLATOR,
+        damper=[
+            {**damper, "mass": 0.1521614122245563, "clearance": 0.01}
+            | {"law": "rigid", "restitution": 0.3},
+            {**damper, "mass": 0.18195048845544462, "clearance": 0.01}
+            | {"law": "hertz", "stiffness": 813817.0414405251},
+            {**damper, "mass": 0.19981491764154813, "clearance": 0.0005}
+            | {"law": "hertz", "stiffness": 35247925.79987347},
+        ],
+        excitation=[
+            {"kind": "base", "signal": "harmonic", "amplitude": 19.27921490786087}
+            | {"frequency": 8.626968570578484}
+        ],
+        method="rk4",
+        dt=1e-4,
+        t_end=10.0,
+        history=False,
+    )
+    onset, separation = np.asarray(run.contacts.onset), np.asarray(run.contacts.separation)
+    ended = np.isfinite(separation)
+    assert "sticking" in list(run.contacts.kind)
+    assert (separation[ended] >= onset[ended]).all()
+    assert (np.asarray(run.contacts.duration)[ended] >= 0).all()

@@ -37,6 +37,10 @@ enum Role {
     Stick { approach: f64 },
     /// Sticking before the instant.
     Held,
+    /// Touching at rest, not pressed: in the problem (`e = 0`) so that the
+    /// impulses elsewhere cannot drive it through its wall, then put a few
+    /// units of round-off off the wall.
+    Touch,
 }
 
 /// The rigid pairs' problem at one instant: buffers sized once per run.
@@ -153,27 +157,21 @@ impl Impacts {
                 if !landing {
                     *grazes += 1;
                 }
-                if pressing >= 0.0 {
-                    if gap <= 0.0 {
-                        // Touching at rest, not pressed (a pair released at
-                        // the instant its force turns, a zero clearance, a
-                        // plastic landing as its wall's pull turns): put it a
-                        // few units of round-off off the wall, or the same
-                        // touch is found again at once, without end.
-                        system.release(i, y);
-                    }
-                    continue;
-                }
                 if system.held_by_mirror(i, modes) {
                     // Its other wall (a zero clearance) took the touch.
                     continue;
                 }
-                // At rest and pressed: a sequence whose flights would rise
-                // less than round-off. It sticks at once, whatever its
-                // restitution (even 1: a ball resting on a floor stays).
-                modes[i] = Mode::Sticking;
-                Role::Stick {
-                    approach: approach.max(0.0),
+                if pressing >= 0.0 {
+                    Role::Touch
+                } else {
+                    // At rest and pressed: a sequence whose flights would
+                    // rise less than round-off. It sticks at once, whatever
+                    // its restitution (even 1: a ball resting on a floor
+                    // stays).
+                    modes[i] = Mode::Sticking;
+                    Role::Stick {
+                        approach: approach.max(0.0),
+                    }
                 }
             };
             self.members.push(i);
@@ -224,7 +222,8 @@ impl Impacts {
                 let i = self.members[s];
                 let sticking = match self.roles[s] {
                     Role::Impact { .. } => self.stuck[s].is_some(),
-                    _ => true,
+                    Role::Touch => false,
+                    Role::Stick { .. } | Role::Held => true,
                 };
                 // A sticking pair that the impulses elsewhere lift off its
                 // wall, but whose flight would rise less than round-off or
@@ -297,7 +296,7 @@ impl Impacts {
                     },
                     stuck,
                 ) => {
-                    if impulse == 0.0 {
+                    if impulse == 0.0 && stuck.is_none() {
                         // Pushed off by the others' impulses before its own
                         // acted: a touch, not an impact.
                         *grazes += 1;
@@ -306,31 +305,34 @@ impl Impacts {
                     just_switched[i] = true;
                     // Newton's share of the loss, and with a sticking the
                     // rest of the plastic impact's (the summed sequence's).
-                    let kept = if stuck.is_some() {
+                    let kept = if stuck.is_some() && impulse != 0.0 {
                         restitution * restitution
                     } else {
                         0.0
                     };
-                    contacts.push(PairContact {
-                        pair,
-                        kind: ContactKind::Impact,
-                        onset: time,
-                        separation: time,
-                        duration: 0.0,
-                        max_indentation: 0.0,
-                        approach_speed: approach,
-                        rebound_speed: if stuck.is_some() {
-                            restitution * approach
-                        } else {
-                            after
-                        },
-                        restitution: if stuck.is_some() {
-                            restitution
-                        } else {
-                            after / approach
-                        },
-                        energy_dissipated: (1.0 - kept) * loss,
-                    });
+                    // (Stuck with no impulse of its own: the others' held it.)
+                    if impulse != 0.0 {
+                        contacts.push(PairContact {
+                            pair,
+                            kind: ContactKind::Impact,
+                            onset: time,
+                            separation: time,
+                            duration: 0.0,
+                            max_indentation: 0.0,
+                            approach_speed: approach,
+                            rebound_speed: if stuck.is_some() {
+                                restitution * approach
+                            } else {
+                                after
+                            },
+                            restitution: if stuck.is_some() {
+                                restitution
+                            } else {
+                                after / approach
+                            },
+                            energy_dissipated: (1.0 - kept) * loss,
+                        });
+                    }
                     if let Some((delay, rebound)) = stuck {
                         open[i] = Some(Open {
                             kind: ContactKind::Sticking,
@@ -353,6 +355,16 @@ impl Impacts {
                         max_indentation: 0.0,
                         dissipated: loss,
                     });
+                }
+                (Role::Touch, _) => {
+                    // Touching at rest, not pressed (a pair released at the
+                    // instant its force turns, a zero clearance, a plastic
+                    // landing as its wall's pull turns): put it a few units
+                    // of round-off off the wall, or the same touch is found
+                    // again at once, without end.
+                    if system.gap(i, y).0 <= 0.0 {
+                        system.release(i, y);
+                    }
                 }
                 (Role::Held, _) => {
                     if impulse != 0.0 {

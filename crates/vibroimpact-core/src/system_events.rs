@@ -152,16 +152,24 @@ impl Open {
             _ if self.approach_speed > 0.0 => rebound / self.approach_speed,
             _ => f64::NAN,
         };
+        // A summed sequence's accumulation instant lies up to the resolution
+        // after the impact where it was summed: a release before it ends
+        // the sticking there, with no duration.
+        let onset = if separation < self.onset {
+            separation
+        } else {
+            self.onset
+        };
         PairContact {
             pair,
             kind: self.kind,
-            onset: self.onset,
+            onset,
             separation,
             // Still open: NaN (f64::max would turn it into 0).
             duration: if separation.is_nan() {
                 f64::NAN
             } else {
-                (separation - self.onset).max(0.0)
+                separation - onset
             },
             max_indentation: self.max_indentation,
             approach_speed: self.approach_speed,
