@@ -970,6 +970,25 @@ impl Assembly {
         before || after
     }
 
+    /// Whether interaction `i` is a wall of a damper with no clearance at
+    /// all (its two walls' offsets sum to zero): stuck, the damper is locked
+    /// to its point, its constraint force of either sign (the force passes
+    /// from one wall to the other without a release, which round-off would
+    /// otherwise turn into a release and a re-sticking, without end).
+    pub fn locked(&self, i: usize) -> bool {
+        let mirror = if self.mirrors_previous[i] {
+            Some(i - 1)
+        } else if self.mirrors_previous.get(i + 1) == Some(&true) {
+            Some(i + 1)
+        } else {
+            None
+        };
+        mirror.is_some_and(|j| {
+            let (a, b) = (self.interactions[i].offset, self.interactions[j].offset);
+            (a + b).abs() <= 4.0 * f64::EPSILON * (a.abs() + b.abs())
+        })
+    }
+
     /// The scale of interaction `i`'s gap at state `y`, m: its offset and
     /// the magnitudes of the terms `h . x` sums, whose round-off the gap
     /// carries.

@@ -217,7 +217,7 @@ fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
         // No force holding it (exactly zero, a system at rest on its
         // walls) is released too: it was found as an event, and kept
         // sticking it would be found again at once, without end.
-        Mode::Sticking => return v <= 0.0,
+        Mode::Sticking => return v <= 0.0 && !system.locked(i),
     };
     let round_off = 8.0 * f64::EPSILON * system.gap_scale(i, y);
     let arriving = sign * system.gap(i, y).1 <= 0.0;
@@ -232,7 +232,7 @@ fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
 /// its wall by more than round-off (a sticking pair: its force below zero).
 fn past(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
     match mode {
-        Mode::Sticking => v < 0.0,
+        Mode::Sticking => v < 0.0 && !system.locked(i),
         _ => v < -8.0 * f64::EPSILON * system.gap_scale(i, y),
     }
 }
@@ -396,6 +396,7 @@ fn find_crossing(
         let sign = match mode {
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
+            Mode::Sticking if system.locked(i) => continue,
             Mode::Sticking => {
                 let value = event_value(system, i, mode, time + h, end, modes, scratch, work);
                 if value < 0.0 {
