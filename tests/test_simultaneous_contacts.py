@@ -381,3 +381,76 @@ def test_a_sticking_released_before_its_accumulation_instant_ends_there() -> Non
     assert "sticking" in list(run.contacts.kind)
     assert (separation[ended] >= onset[ended]).all()
     assert (np.asarray(run.contacts.duration)[ended] >= 0).all()
+
+
+FIXED_STEP = {"rk4": 1e-4, "newmark-implicit": 1e-4}
+# Each method's error here, relative to the amplitude: exact to round-off, the
+# adaptive ones to their tolerance, the fixed steps to their order at dt 1e-4.
+ACCURACY = {"exact": 1e-9, "dop853": 1e-5, "dopri5": 1e-5, "rk4": 1e-6, "newmark-implicit": 1e-3}
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk4", "newmark-implicit"])
+def test_a_locked_damper_is_not_released_by_another_dampers_impact(method: str) -> None:
+    """A damper with no clearance is a mass fixed to its point (found by a review):
+    another damper's impact at the instant it stuck pulled the structure off its
+    sticking wall, and it was released, then struck its other wall zero away,
+    again and again ('chattering at t = 0.087 s' for e = 0.8; 16 impacts that
+    never were for e = 0). The run matches the 1.1 kg oscillator with only the
+    rattling damper."""
+    rattling = {"at": 0, "clearance": 0.003, "law": "rigid", "restitution": 0.8, "mass": 0.05}
+    excitation = forced(10.0, 8.0)
+    step = {"dt": FIXED_STEP[method]} if method in FIXED_STEP else {}
+    reference = simulate_system(
+        {**OSCILLATOR, "mass": 1.1},
+        damper=[rattling],
+        excitation=excitation,
+        method="exact",
+        t_end=1.0,
+        history=False,
+    )
+    for restitution in (0.8, 0.0):
+        locked = {"at": 0, "clearance": 0.0, "law": "rigid", "mass": 0.1}
+        run = simulate_system(
+            OSCILLATOR,
+            damper=[{**locked, "restitution": restitution}, rattling],
+            excitation=excitation,
+            method=method,
+            t_end=1.0,
+            history=False,
+            **step,
+        )
+        pairs, kinds = np.asarray(run.contacts.pair), np.asarray(run.contacts.kind)
+        assert list(kinds[pairs == "damper 0"]) == ["sticking"]
+        x, expected = (
+            state["structure_displacement"][0] for state in (run.final_state, reference.final_state)
+        )
+        # The amplitude is about 1 cm; newmark-implicit's error over 8 periods
+        # with the rattling damper's impacts, second order at dt 1e-4: 1 %.
+        tolerance = {"exact": 1e-9, "dop853": 1e-4, "rk4": 1e-6, "newmark-implicit": 2e-2}
+        assert abs(x - expected) < tolerance[method] * 0.01
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "dopri5", "rk4", "newmark-implicit"])
+def test_a_damper_with_no_clearance_started_moving_joins_its_structure_at_once(
+    method: str,
+) -> None:
+    """No clearance, e = 0.8, the damper started at 0.1 m/s relative to its
+    structure (found by a review): the rebounds between two walls zero apart add up
+    at t = 0, to moving together with momentum conserved, 0.015 / 1.15 m/s; it used
+    to stop as 'chattering at t = 4.9e-78 s'. The two then oscillate as one body:
+    x = v0 / w sin(w t), w = sqrt(k / 1.15)."""
+    stiffness, speed = 3947.8, 0.015 / 1.15
+    run = simulate_system(
+        {"kind": "oscillator", "mass": 1.0, "stiffness": stiffness, "damping": 0.0},
+        damper=[{"at": 0, "clearance": 0.0, "law": "rigid", "restitution": 0.8, "mass": 0.15}],
+        initial={"damper_velocity": [0.1]},
+        method=method,
+        t_end=0.5,
+        history=True,
+        **({"dt": FIXED_STEP[method]} if method in FIXED_STEP else {}),
+    )
+    w = np.sqrt(stiffness / 1.15)
+    x, t = np.asarray(run.structure_displacement)[:, 0], np.asarray(run.t)
+    assert np.abs(x - speed / w * np.sin(w * t)).max() < ACCURACY[method] * speed / w
+    assert list(run.contacts.kind) == ["sticking"]
+    assert run.contacts.onset[0] < 1e-12

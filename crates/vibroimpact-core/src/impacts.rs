@@ -1,7 +1,8 @@
 //! The rigid pairs at an event instant, resolved together.
 //!
 //! Every rigid pair on its wall at the instant takes part: those arriving
-//! (impacts), those sticking, and those landing at rest. The impulses
+//! (impacts), those sticking, and those landing or touching at rest. The
+//! impulses
 //! `P >= 0` are the solution of Newton's law for several contacts, the
 //! linear complementarity problem Siconos solves at an event:
 //!
@@ -21,7 +22,10 @@
 //! acceleration `a` pressing the pair together and rebound speed `r`, the
 //! flights `2 r e^n / |a|` add up to `2 r / (|a| (1 - e))` (exact for a
 //! constant `a`, such as a ball on a floor), which is when its sticking
-//! starts.
+//! starts. A sticking pair that the impulses elsewhere would lift off by a
+//! flight shorter than the resolution is held instead, as an equality (two
+//! dampers settling on one wall launch each other at every landing, the
+//! flights falling by the mass ratio: summed, both rest).
 
 use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 use crate::linalg;
@@ -136,7 +140,14 @@ impl Impacts {
                     || approach.abs() <= -pressing * instant
                     || at_rest);
             let moving = !landing && !at_rest;
-            let role = if approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE) && moving {
+            let arriving = approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE);
+            let role = if arriving && system.locked(i) {
+                // No clearance at all: the rebounds between two walls zero
+                // apart add up at once, to moving together (plastic).
+                just_switched[i] = true;
+                modes[i] = Mode::Sticking;
+                Role::Stick { approach }
+            } else if arriving && moving {
                 Role::Impact {
                     approach,
                     restitution,
@@ -192,6 +203,14 @@ impl Impacts {
         self.before
             .extend(self.members.iter().map(|&i| system.gap(i, y).1));
         self.lcp.set_matrix(system, &self.members);
+        // A damper with no clearance, stuck, is locked to its point: held
+        // with a force of either sign, never lifted off by impulses
+        // elsewhere (its other wall is zero away).
+        for (s, &i) in self.members.iter().enumerate() {
+            if matches!(self.roles[s], Role::Held | Role::Stick { .. }) && system.locked(i) {
+                self.lcp.bilateral[s] = true;
+            }
+        }
         self.stuck.clear();
         self.stuck.resize(m, None);
         // Each round may find more pairs to stick or to hold: at most 2 m.
