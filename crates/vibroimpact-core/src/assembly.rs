@@ -944,20 +944,6 @@ impl Assembly {
         )
     }
 
-    /// A rigid impact on interaction `i`: Newton's law with momentum
-    /// conserved, `v+ = v- - (1 + e) (h . v-) M^-1 h^T / (h M^-1 h^T)`.
-    /// Returns the energy it takes, J.
-    pub fn impact(&self, i: usize, y: &mut [f64], restitution: f64) -> f64 {
-        let it = &self.interactions[i];
-        let d = self.dim;
-        let rate = linalg::dot(&it.h, &y[d..2 * d]);
-        let impulse = -(1.0 + restitution) * rate / it.inverse_mass;
-        for (v, p) in y[d..2 * d].iter_mut().zip(&it.push) {
-            *v += p * impulse;
-        }
-        0.5 * (1.0 - restitution * restitution) * rate * rate / it.inverse_mass
-    }
-
     /// Whether interaction `i` is a wall whose other wall (of the same
     /// damper) is sticking: its gap is then held too, at the sum of the
     /// clearances (0 for a zero clearance, to round-off), and it has no

@@ -80,11 +80,10 @@ impl Impacts {
     /// Whether interaction `i` is an open rigid pair: it is then marked, to
     /// be resolved with the others by [`Self::resolve`].
     pub(crate) fn mark(&mut self, system: &Assembly, i: usize, mode: Mode) -> bool {
-        let rigid = matches!(system.interactions[i].law, InteractionLaw::Rigid { .. });
-        if rigid && mode == Mode::Open {
-            self.touching[i] = true;
-        }
-        rigid && mode == Mode::Open
+        let open_rigid = mode == Mode::Open
+            && matches!(system.interactions[i].law, InteractionLaw::Rigid { .. });
+        self.touching[i] |= open_rigid;
+        open_rigid
     }
 
     /// Resolve the marked pairs and the sticking ones at `time`: impacts,
@@ -122,19 +121,17 @@ impl Impacts {
             };
             let (gap, rate) = system.gap(i, y);
             let approach = -rate;
-            // Flights (or landings) that rise less than 1e-9 of the gap's
-            // scale are round-off: the positions' round-off decides such
-            // impacts, not the dynamics, and the pair is at rest on its wall.
-            let round_off = 1e-9 * system.gap_scale(i, y);
+            let round_off = flight_round_off(system, i, y);
             // The gap's acceleration with the pair free: < 0 presses it shut.
             let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
-            // At rest: an approach (or a leaving) that the pressing gives
-            // within a rise of round-off, or within the round-off of the time.
             // At rest whatever the pressing: a rate that would take the
             // system's time scale to move the gap by its round-off (a system
             // come to rest, where every speed is round-off and relative
             // thresholds say nothing).
             let at_rest = approach.abs() * time_scale <= round_off;
+            // Landing at rest: an approach (or a leaving) that the pressing
+            // gives within a rise of round-off, or within the round-off of
+            // the time.
             let landing = pressing < 0.0
                 && (approach * approach <= -2.0 * pressing * round_off
                     || approach.abs() <= -pressing * instant
@@ -257,10 +254,8 @@ impl Impacts {
                 modes[i] = Mode::Open;
                 let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
                 modes[i] = Mode::Sticking;
-                if pressing < 0.0
-                    && (2.0 * lift <= -pressing * resolution
-                        || lift * lift <= -2.0 * pressing * 1e-9 * system.gap_scale(i, y))
-                {
+                let round_off = flight_round_off(system, i, y);
+                if summed(lift, pressing, 0.0, resolution, round_off).is_some() {
                     self.lcp.bilateral[s] = true;
                     more = true;
                 }
@@ -276,19 +271,8 @@ impl Impacts {
                 // flights rise less than round-off? Then sum it and stick.
                 let rebound = system.gap(i, y).1.max(0.0);
                 let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
-                if pressing >= 0.0 {
-                    continue;
-                }
-                let remaining = 2.0 * rebound / (-pressing * (1.0 - restitution));
-                let height = rebound * rebound / (-2.0 * pressing);
-                if remaining <= resolution || height <= 1e-9 * system.gap_scale(i, y) {
-                    // A sequence that never ends (restitution 1) is cut where
-                    // its flights fell to round-off: now.
-                    let delay = if remaining.is_finite() {
-                        remaining
-                    } else {
-                        0.0
-                    };
+                let round_off = flight_round_off(system, i, y);
+                if let Some(delay) = summed(rebound, pressing, restitution, resolution, round_off) {
                     self.stuck[s] = Some((delay, rebound));
                     modes[i] = Mode::Sticking;
                     more = true;
@@ -405,6 +389,33 @@ impl Impacts {
         }
         any
     }
+}
+
+/// Flights (or landings) of interaction `i` that rise less than this (m,
+/// 1e-9 of its gap's scale at state `y`) are round-off: the positions'
+/// round-off decides such impacts, not the dynamics, and the pair is at rest
+/// on its wall.
+fn flight_round_off(system: &Assembly, i: usize, y: &[f64]) -> f64 {
+    1e-9 * system.gap_scale(i, y)
+}
+
+/// Whether a pair leaving its wall at `rebound` (m/s), `pressing` (m/s^2,
+/// < 0) pulling it back, with restitution `e`, ends its flights within the
+/// run's `resolution` (s) or rises less than `round_off` (m): then the
+/// sequence is summed, and its accumulation instant is `Some` delay (s)
+/// from now (0 for a sequence that never ends, restitution 1, cut where its
+/// flights fell to round-off: now).
+fn summed(rebound: f64, pressing: f64, e: f64, resolution: f64, round_off: f64) -> Option<f64> {
+    if pressing >= 0.0 {
+        return None;
+    }
+    let remaining = 2.0 * rebound / (-pressing * (1.0 - e));
+    let height = rebound * rebound / (-2.0 * pressing);
+    (remaining <= resolution || height <= round_off).then_some(if remaining.is_finite() {
+        remaining
+    } else {
+        0.0
+    })
 }
 
 /// A small linear complementarity problem `w = W z + q`, `w, z >= 0`, `w . z

@@ -211,21 +211,34 @@ fn event_value(
 /// past its wall but leaving it (a contact started at a gap of round-off,
 /// its indentation growing) has not crossed back.
 fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
-    let sign = match mode {
-        Mode::Open => 1.0,
-        Mode::Compliant { .. } => -1.0,
+    if mode == Mode::Sticking {
         // No force holding it (exactly zero, a system at rest on its
         // walls) is released too: it was found as an event, and kept
         // sticking it would be found again at once, without end.
-        Mode::Sticking => return v <= 0.0 && !system.locked(i),
-    };
-    let round_off = 8.0 * f64::EPSILON * system.gap_scale(i, y);
-    let arriving = sign * system.gap(i, y).1 <= 0.0;
-    if v.abs() <= round_off {
-        arriving
+        return v <= 0.0 && !system.locked(i);
+    }
+    if v.abs() <= wall_round_off(system, i, y) {
+        // Arriving.
+        side(mode) * system.gap(i, y).1 <= 0.0
     } else {
         v < 0.0
     }
+}
+
+/// The sign that turns interaction `i`'s gap into its event value in `mode`
+/// (NaN for a sticking pair, whose value is a force).
+fn side(mode: Mode) -> f64 {
+    match mode {
+        Mode::Open => 1.0,
+        Mode::Compliant { .. } => -1.0,
+        Mode::Sticking => f64::NAN,
+    }
+}
+
+/// The round-off of interaction `i`'s gap at state `y`, m: a value this
+/// close to zero is on its wall.
+fn wall_round_off(system: &Assembly, i: usize, y: &[f64]) -> f64 {
+    8.0 * f64::EPSILON * system.gap_scale(i, y)
 }
 
 /// Whether interaction `i`, whose event value at state `y` is `v`, is past
@@ -233,7 +246,7 @@ fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
 fn past(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
     match mode {
         Mode::Sticking => v < 0.0 && !system.locked(i),
-        _ => v < -8.0 * f64::EPSILON * system.gap_scale(i, y),
+        _ => v < -wall_round_off(system, i, y),
     }
 }
 
@@ -562,16 +575,12 @@ fn locate<S: SystemStepper>(
     buffers: &mut Buffers,
 ) -> Result<Location> {
     let mode = modes[c.i];
-    let round_off = 8.0 * f64::EPSILON * system.gap_scale(c.i, y);
+    let round_off = wall_round_off(system, c.i, y);
     let value = |end: &[f64], at: f64, scratch: &mut Scratch, work: &mut [f64]| {
         event_value(system, c.i, mode, at, end, modes, scratch, work)
     };
     let (mut lo, mut v_lo) = (0.0, value(y, time, scratch, &mut buffers.work));
-    let sign = match mode {
-        Mode::Open => 1.0,
-        Mode::Compliant { .. } => -1.0,
-        Mode::Sticking => f64::NAN,
-    };
+    let sign = side(mode);
     // On the wall to round-off and moving away (a rebound): the event is
     // where it comes back, after a stretch on the old side to start from.
     let leaving = v_lo.abs() <= round_off && sign * system.gap(c.i, y).1 > 0.0;
