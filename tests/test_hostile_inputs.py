@@ -178,6 +178,55 @@ def test_record_arrays_errors_name_the_excitation_and_the_index() -> None:
         vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
 
 
+def test_a_recorded_signal_without_samples_asks_for_a_file_or_the_arrays() -> None:
+    for given in ({}, {"time": [0.0, 1.0]}):
+        excitation = {"kind": "base", "signal": "recorded", **given}
+        with pytest.raises(
+            ValueError, match=r"\[\[excitation\]\] 0: .*needs file .*or time and value"
+        ):
+            vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
+
+
+def test_record_arrays_beyond_the_sample_limit_are_refused_before_they_are_read() -> None:
+    # Reading 2e8 values one by one took minutes; the length alone decides.
+    huge = np.broadcast_to(np.float64(0.0), (vi.MAX_SIGNAL_SAMPLES + 1,))
+    excitation = {"kind": "base", "signal": "recorded", "time": huge, "value": huge}
+    with pytest.raises(ValueError, match=r"0: time: holds 100000001 values; at most 100000000"):
+        vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
+    nan_inside = np.array([0.0, 1.0, np.nan])
+    excitation = {"kind": "base", "signal": "recorded", "time": nan_inside, "value": np.ones(3)}
+    with pytest.raises(ValueError, match=r"0: time\[2\]: must be a finite number, got nan"):
+        vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
+
+
+@pytest.mark.parametrize("record_from", [0.1, 0.5])
+def test_a_window_from_record_from_at_or_after_t_end_is_refused(record_from: float) -> None:
+    with pytest.raises(
+        ValueError, match=r"\[output\] record_from: must be before \[solver\] t_end"
+    ):
+        vi.simulate_system(STRUCTURE, t_end=0.1, method="dopri5", record_from=record_from)
+
+
+@pytest.mark.parametrize("rtol", [0.5, 10.0, 1e-16])
+def test_a_system_s_rtol_outside_its_range_is_refused(rtol: float) -> None:
+    # rtol = 10 ran, and stopped on its energy balance ("reduce dt").
+    with pytest.raises(ValueError, match=r"\[solver\] rtol: must be in \[1e-15, 0.1\]"):
+        vi.simulate_system(STRUCTURE, excitation=FORCE, t_end=0.1, method="dopri5", rtol=rtol)
+
+
+def test_a_scenario_without_its_structure_names_both_sections(tmp_path: Path, run_cli: Cli) -> None:
+    done = run_cli(
+        "simulate", str(write(tmp_path, '[solver]\nmethod = "rk4"\ndt = 1e-3\nt_end = 1.0\n'))
+    )
+    refused(done, "missing section [system] (or [structure]")
+
+
+def test_energies_beyond_floating_point_stop_the_run_saying_so() -> None:
+    force = [{**FORCE[0], "amplitude": 1e300}]
+    with pytest.raises(vi.NumericalBlowUpError, match="energies are no longer finite"):
+        vi.simulate_system(STRUCTURE, excitation=force, t_end=1.0, method="dopri5")
+
+
 # 3. Counts bounded before anything is allocated; a study's axes made only by a study.
 
 STUDY = (

@@ -9,6 +9,7 @@ __all__ = [
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
     "MAX_RECORD_BYTES",
+    "MAX_SIGNAL_SAMPLES",
     "BeamMode",
     "Contact",
     "ContactTable",
@@ -40,6 +41,7 @@ __all__ = [
 __version__: str
 DEFAULT_MAX_ROWS: int
 MAX_RECORD_BYTES: int
+MAX_SIGNAL_SAMPLES: int
 DEFAULT_ENERGY_TOLERANCE: float
 
 _FloatArray = npt.NDArray[np.float64]

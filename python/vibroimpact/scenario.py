@@ -231,7 +231,9 @@ def _sections(data: dict[str, Any], source: str) -> dict[str, dict[str, Any]]:
         sections[name] = values
     for name in _REQUIRED_SECTIONS:
         if name not in sections:
-            raise _fail(source, "", f"missing section [{name}]")
+            # A scenario is a two-mass damper ([system]) or any structure ([structure]).
+            either = " (or [structure], for a structure of any kind)" if name == "system" else ""
+            raise _fail(source, "", f"missing section [{name}]{either}")
     for name, schema in _SCHEMA.items():
         values = sections.setdefault(name, {})
         for key, (_, default) in schema.items():

@@ -37,6 +37,7 @@ from __future__ import annotations
 import difflib
 import io
 import math
+import re
 import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -49,6 +50,7 @@ from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
     MAX_RECORD_BYTES,
+    MAX_SIGNAL_SAMPLES,
     Contact,
     InvalidInputError,
 )
@@ -290,6 +292,18 @@ def _value(where: str, kind: str, value: Any) -> Any:
     if kind == _NUMBERS:
         if isinstance(value, str | bytes) or not _is_array(value, 1):
             raise _fail(where, f"must be an array of numbers, got {shown(value)}")
+        if len(value) > MAX_SIGNAL_SAMPLES:
+            # Refused before a value is read: checking each takes a while.
+            raise _fail(
+                where, f"holds {len(value)} values; at most {MAX_SIGNAL_SAMPLES} are allowed"
+            )
+        if isinstance(value, np.ndarray) and value.dtype.kind == "f":
+            # A float array at once (a recorded signal's samples).
+            bad = np.flatnonzero(~np.isfinite(value))
+            if bad.size:
+                i = int(bad[0])
+                raise _fail(f"{where[:-2]}[{i}]: ", f"must be a finite number, got {value[i]}")
+            return [float(v) for v in value.tolist()]
         return [_value(f"{where[:-2]}[{i}]: ", _NUMBER, v) for i, v in enumerate(value)]
     # _MATRIX: an array of rows.
     if isinstance(value, str | bytes) or not _is_array(value, 2):
@@ -385,7 +399,8 @@ def _read_record(path: Path, where: str) -> tuple[list[float], list[float], list
         line = line.strip()
         if not line or line.startswith("#"):
             continue
-        cells = [c.strip() for c in line.replace(";", ",").split(",")]
+        # Columns apart by commas, semicolons, tabs or spaces.
+        cells = re.split(r"\s*[,;]\s*|\s+", line)
         header, first = first, False
         try:
             row = [float(c) for c in cells]
@@ -565,6 +580,12 @@ def system_spec(
         elif e["signal"] == "recorded" and e["time"] is not None and e["value"] is not None:
             _check_record(
                 where, e["time"], e["value"], [f"time[{i}]" for i in range(len(e["time"]))]
+            )
+        elif e["signal"] == "recorded":
+            raise _fail(
+                where,
+                "a recorded signal needs file (a CSV of time and value), or time and value "
+                "(arrays of numbers)",
             )
         excitations.append({k: v for k, v in e.items() if v is not None and k != "file"})
     spec["excitation"] = excitations
@@ -835,6 +856,10 @@ def prepare_system(
     for key in ("t_end", "rtol", "atol", "energy_tolerance"):
         if not solver[key] > 0:
             raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
+    if not 1e-15 <= solver["rtol"] <= 0.1:
+        # An error control looser than a tenth controls nothing (the run would stop on
+        # its energy balance); tighter than 1e-15 is below round-off.
+        raise _fail("[solver] rtol: ", f"must be in [1e-15, 0.1], got {solver['rtol']}")
     if solver["dt"] is not None and not solver["dt"] > 0:
         raise _fail("[solver] dt: ", f"must be > 0, got {solver['dt']}")
     fixed = solver["method"] in _FIXED_STEP
@@ -885,6 +910,11 @@ def prepare_system(
             )
     if output["record_from"] is not None and not output["record_from"] >= 0:
         raise _fail("[output] record_from: ", f"must be >= 0 s, got {output['record_from']}")
+    if output["record_from"] is not None and not output["record_from"] < solver["t_end"]:
+        raise _fail(
+            "[output] record_from: ",
+            f"must be before [solver] t_end ({solver['t_end']!r} s), got {output['record_from']!r}",
+        )
     if output["strobe_period"] is not None and not output["strobe_period"] > 0:
         raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
     for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):

@@ -699,6 +699,23 @@ impl Assembly {
         head[INPUT] = input;
     }
 
+    fn signals(&self) -> impl Iterator<Item = &Signal> {
+        self.forces.iter().map(|f| &f.signal).chain(&self.base)
+    }
+
+    /// Whether any excitation's signal has kinks.
+    pub fn has_breakpoints(&self) -> bool {
+        self.signals().any(Signal::has_breakpoints)
+    }
+
+    /// The first kink of any excitation's signal after `time` (s; see
+    /// [`Signal::next_breakpoint`]), or infinity.
+    pub fn next_breakpoint(&self, time: f64) -> f64 {
+        self.signals()
+            .map(|signal| signal.next_breakpoint(time))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// The sum of the base signals at `time`.
     #[inline(never)]
     fn base_value(&self, time: f64, scratch: &mut Scratch) -> f64 {

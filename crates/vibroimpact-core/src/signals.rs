@@ -409,9 +409,22 @@ impl Signal {
             unreachable!("white_noise returns samples")
         };
         // The filter x'' + 2 zg wg x' + wg^2 x = -w(t) by RK4 on sub-steps of
-        // at most 1/20 of the ground period's radian (basic operations only:
-        // the result is the same on every platform); w is linear in between.
-        let substeps = (20.0 * ground * interval).ceil().max(1.0) as usize;
+        // at most 1/20 of its fastest time constant, the ground period's
+        // radian unless it is overdamped (basic operations only: the result
+        // is the same on every platform); w is linear in between.
+        let fastest = if zeta > 1.0 {
+            ground * (zeta + (zeta * zeta - 1.0).sqrt())
+        } else {
+            ground
+        };
+        let substeps = (20.0 * fastest * interval).ceil().max(1.0);
+        if substeps > MAX_SIGNAL_SAMPLES as f64 {
+            return Err(Error::Inconsistent(format!(
+                "ground_damping {ground_damping} makes the ground filter too stiff to integrate \
+                 ({substeps:.3e} steps per sample); a soil's damping ratio is below 1 or 2"
+            )));
+        }
+        let substeps = substeps as usize;
         let h = interval / substeps as f64;
         let (a, b) = (2.0 * zeta * ground, ground * ground);
         let rate = |x: f64, v: f64, w: f64| (v, -a * v - b * x - w);
@@ -484,6 +497,46 @@ impl Signal {
                 value.iter().fold(0.0, |m, v| m.max(v.abs())),
                 2.0 * interval,
             ),
+        }
+    }
+
+    /// Whether the signal has kinks (see [`Signal::next_breakpoint`]).
+    pub fn has_breakpoints(&self) -> bool {
+        !matches!(self, Self::Harmonic(_) | Self::Harmonics(_))
+    }
+
+    /// The first instant after `time` (s; beyond its round-off) at which the
+    /// signal has a kink (a sample of a recorded or generated signal, the end
+    /// of a sweep), or infinity. An adaptive method steps onto each: its error
+    /// estimate cannot see a kink ahead, and a system at rest under a signal
+    /// that is zero for a while would grow its steps past a whole pulse.
+    pub fn next_breakpoint(&self, time: f64) -> f64 {
+        // Instants closer than this to `time` are `time` itself.
+        let after = |t: f64| t > time + 1e-12 * time.abs().max(1e-300);
+        match self {
+            Self::Harmonic(_) | Self::Harmonics(_) => f64::INFINITY,
+            Self::Sweep { duration, .. } if after(*duration) => *duration,
+            Self::Sweep { .. } => f64::INFINITY,
+            Self::Recorded { time: times, .. } => {
+                let next = times.partition_point(|&t| t <= time);
+                times[next..]
+                    .iter()
+                    .copied()
+                    .find(|&t| after(t))
+                    .unwrap_or(f64::INFINITY)
+            }
+            Self::Sampled {
+                interval, value, ..
+            } => {
+                let last = (value.len() - 1) as f64;
+                let start = (time / interval).floor().max(-1.0);
+                (1..=2)
+                    .map(|k| (start + k as f64).max(0.0))
+                    .filter(|&index| index <= last)
+                    .map(|index| index * interval)
+                    .find(|&t| after(t))
+                    .unwrap_or(f64::INFINITY)
+            }
         }
     }
 
@@ -653,6 +706,40 @@ fn portable_ln(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn breakpoints_are_the_samples_after_the_time_and_the_sweep_s_end() {
+        crate::testing::timeout(60, || {
+            let recorded = Signal::recorded(vec![1.0, 2.0, 4.0], vec![0.0, 1.0, 0.0], 1.0).unwrap();
+            let sampled = Signal::Sampled {
+                interval: 0.1,
+                value: vec![0.0, 1.0, -1.0, 0.5],
+                recipe: None,
+            };
+            for (signal, time, next) in [
+                (&recorded, 0.0, 1.0),
+                (&recorded, 1.0, 2.0),
+                // Within round-off of a sample is on it.
+                (&recorded, 2.0 - 1e-15, 4.0),
+                (&recorded, 3.0, 4.0),
+                (&recorded, 4.0, f64::INFINITY),
+                (&sampled, -1.0, 0.0),
+                (&sampled, 0.0, 0.1),
+                (&sampled, 0.15, 0.2),
+                // 3 x 0.1 is 0.30000000000000004: the last sample, not the one after.
+                (&sampled, 0.2, 0.1 * 3.0),
+                (&sampled, 0.1 * 3.0, f64::INFINITY),
+            ] {
+                assert_eq!(signal.next_breakpoint(time), next, "{time}");
+            }
+            let sweep = Signal::sweep(1.0, 1.0, 5.0, 2.0, SweepLaw::Linear, 0.0).unwrap();
+            assert_eq!(sweep.next_breakpoint(1.0), 2.0);
+            assert_eq!(sweep.next_breakpoint(2.0), f64::INFINITY);
+            let harmonic = Signal::harmonic(1.0, 3.0, 0.0).unwrap();
+            assert!(!harmonic.has_breakpoints() && sweep.has_breakpoints());
+            assert_eq!(harmonic.next_breakpoint(0.0), f64::INFINITY);
+        });
+    }
 
     #[test]
     fn splitmix64_matches_its_reference_sequence() {

@@ -862,6 +862,7 @@ pub fn integrate_system_within<S: SystemStepper>(
         ..Reductions::default()
     };
     let mut next_strobe = options.reduce.strobe_period;
+    let kinked = system.has_breakpoints();
     if options.keep_history {
         memory::push_row(
             &mut time_rows,
@@ -897,6 +898,16 @@ pub fn integrate_system_within<S: SystemStepper>(
             // A sticking pair's release shows only as its constraint force
             // at a step's end: steps short enough not to pass over it.
             length = length.min(system.sticking_step);
+        }
+        if adaptive && kinked {
+            // Land on the signals' next kink (their samples).
+            length = length.min(system.next_breakpoint(time) - time);
+        }
+        let from = options.reduce.record_from;
+        if from - time < length && from - time > 1e-9 * length {
+            // Land on the start of the recorded window: a step across it
+            // would be left out of the peak and RMS, or counted whole.
+            length = from - time;
         }
         if next_strobe - time < length && next_strobe - time > 1e-9 * options.reduce.strobe_period {
             // Land on the stroboscopic instant.
@@ -1106,7 +1117,9 @@ pub fn integrate_system_within<S: SystemStepper>(
                 }
             }
         }
-        if time >= options.reduce.record_from {
+        // A step that starts within round-off of the window's start, which
+        // it was not cut to land on, is in the window.
+        if time + 1e-9 * taken >= options.reduce.record_from {
             let located = reduce_step(
                 system,
                 stepper,
@@ -1289,7 +1302,8 @@ pub fn integrate_system_within<S: SystemStepper>(
         // Steps within a thousand units of round-off of the time make no
         // progress: an event that recurs at once (a zero clearance, say)
         // would otherwise loop.
-        if taken <= chatter_interval(time) {
+        // (An adaptive method's own short steps, from a tiny first step, grow.)
+        if taken <= chatter_interval(time) && (switched.is_some() || !adaptive) {
             stalled += 1;
             if stalled >= STALLED_STEPS {
                 return Err(Error::Chattering {
@@ -1464,7 +1478,14 @@ fn check_balance(
         .max(magnitude + b.input_work.abs() + b.dissipated.abs())
         .max(system.energy_floor(options.t_end))
         .max(f64::MIN_POSITIVE);
-    if b.residual.abs() > options.energy_tolerance * *scale || !b.residual.is_finite() {
+    if !b.residual.is_finite() {
+        return Err(Error::NumericalBlowUp {
+            time,
+            reason: "the energies are no longer finite: a blow-up, or inputs (amplitudes, scale \
+                     factors) too large for floating point",
+        });
+    }
+    if b.residual.abs() > options.energy_tolerance * *scale {
         return Err(Error::EnergyBalance {
             time,
             residual: b.residual,

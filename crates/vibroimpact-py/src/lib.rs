@@ -53,6 +53,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_MAX_ROWS", core::DEFAULT_MAX_ROWS)?;
     m.add("MAX_RECORD_BYTES", core::MAX_RECORD_BYTES)?;
+    m.add("MAX_SIGNAL_SAMPLES", core::signals::MAX_SIGNAL_SAMPLES)?;
     m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
     Ok(())
 }
