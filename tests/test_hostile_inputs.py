@@ -187,6 +187,22 @@ def test_a_recorded_signal_without_samples_asks_for_a_file_or_the_arrays() -> No
             vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
 
 
+def test_an_unknown_excitation_key_lists_its_signal_s_keys_only() -> None:
+    excitation = {**FORCE[0], "amplitud": 1.0}
+    with pytest.raises(ValueError) as caught:
+        vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
+    assert str(caught.value) == (
+        "[[excitation]] 0: unknown key 'amplitud' (signal 'harmonic' takes kind, at, signal, "
+        "amplitude, frequency, phase); did you mean 'amplitude'?"
+    )
+
+
+def test_an_empty_file_name_is_refused_as_such() -> None:
+    excitation = {"kind": "base", "signal": "recorded", "file": " "}
+    with pytest.raises(ValueError, match=r"0: file: must name a CSV file .*empty string"):
+        vi.simulate_system(STRUCTURE, excitation=[excitation], t_end=0.1, method="dopri5")
+
+
 def test_record_arrays_beyond_the_sample_limit_are_refused_before_they_are_read() -> None:
     # Reading 2e8 values one by one took minutes; the length alone decides.
     huge = np.broadcast_to(np.float64(0.0), (vi.MAX_SIGNAL_SAMPLES + 1,))

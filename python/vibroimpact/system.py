@@ -548,6 +548,18 @@ def system_spec(
     excitations = []
     for j, table in enumerate(_list("excitation", excitation)):
         where = f"[[excitation]] {j}: "
+        signal = table.get("signal") if isinstance(table, Mapping) else None
+        if isinstance(signal, str) and signal in _SIGNAL_KEYS:
+            # An unknown key: the keys of this signal, not of every signal.
+            own = ["kind", "at", "signal", *sorted(_SIGNAL_KEYS[signal])]
+            for key in table:
+                if key not in _EXCITATION:
+                    close = difflib.get_close_matches(str(key), own, n=1)
+                    hint = f"; did you mean {close[0]!r}?" if close else ""
+                    raise _fail(
+                        where,
+                        f"unknown key {key!r} (signal {signal!r} takes {', '.join(own)}){hint}",
+                    )
         e = _table(where, table, _EXCITATION)
         _choice(where, "kind", e["kind"], _LOADS)
         _choice(where, "signal", e["signal"], _SIGNALS)
@@ -571,6 +583,10 @@ def system_spec(
         if e["file"] is not None:
             if e["time"] is not None or e["value"] is not None:
                 raise _fail(where, "give file or time and value, not both")
+            if not e["file"].strip():
+                raise _fail(
+                    where, "file: must name a CSV file of time and value, got an empty string"
+                )
             path = Path(e["file"])
             if base_dir is not None and not path.is_absolute():
                 path = base_dir / path
