@@ -1,8 +1,9 @@
 """Stress the event kernel with random forced systems: an oscillator (10 Hz, 2 %
 damping), two storeys or a cantilever, with one to three dampers (rigid or Hertz),
 maybe a stop (or pounding between the storeys) and gravity, forced or shaken at the
-base, every method, each run with and without a stroboscopic sample every forcing
-period. Prints
+base by a harmonic, a sweep, white noise or a record with quiet stretches, every method,
+sometimes recording peak and RMS from a random instant, each run with and without a
+stroboscopic sample every forcing period. Prints
 how many runs stopped, by method and error, and the first few scenarios that did.
 
 Not a test (no fixed expectation yet: some stops are legitimate, such as Newton's
@@ -49,6 +50,42 @@ def law(rng: np.random.Generator, method: str) -> dict[str, Any]:
     return {"law": "rigid", "restitution": float(rng.choice([0, 0.3, 0.6, 1]))}
 
 
+def signal(
+    rng: np.random.Generator, kind: str, amplitude: float, frequency: float, t_end: float
+) -> dict[str, Any]:
+    """A signal of about ``amplitude`` near ``frequency`` (Hz): harmonic, a sweep through
+    it, white noise up to four times it, or a record of random samples that begins and
+    ends with quiet stretches."""
+    if kind == "harmonic":
+        return {"signal": "harmonic", "amplitude": amplitude, "frequency": frequency}
+    if kind == "sweep":
+        return {
+            "signal": "sweep",
+            "amplitude": amplitude,
+            "start_frequency": 0.5 * frequency,
+            "end_frequency": 2.0 * frequency,
+            "sweep": str(rng.choice(["linear", "logarithmic"])),
+            "duration": 0.5 * t_end,
+        }
+    if kind == "noise":
+        cutoff = 4.0 * frequency
+        return {
+            "signal": "white-noise",
+            "intensity": amplitude**2 / (2 * np.pi * cutoff),
+            "cutoff_frequency": cutoff,
+            "seed": int(rng.integers(2**32)),
+        }
+    quiet = float(rng.uniform(0, 0.5 * t_end))
+    steps = quiet + np.cumsum(rng.uniform(0.02, 0.1, size=int(rng.integers(5, 60))) / frequency)
+    values = amplitude * rng.normal(size=steps.size)
+    values[-1] = 0.0
+    return {
+        "signal": "recorded",
+        "time": [0.0, *steps.tolist()],
+        "value": [0.0, *values.tolist()],
+    }
+
+
 def scenario(rng: np.random.Generator) -> dict[str, Any]:
     """One random system and method, as keyword arguments of simulate_system: an
     oscillator (most often), two storeys (pounding between them) or a cantilever;
@@ -78,20 +115,25 @@ def scenario(rng: np.random.Generator) -> dict[str, Any]:
             stop["against"] = 1  # pounding
         stops.append(stop)
     if rng.random() < 0.7:
-        excitation = {"kind": "force", "at": points[-1], "signal": "harmonic"}
+        excitation = {"kind": "force", "at": points[-1]}
         amplitude = scale * float(rng.uniform(1, 30))
     else:
-        excitation = {"kind": "base", "signal": "harmonic"}
+        excitation = {"kind": "base"}
         amplitude = float(rng.uniform(1, 30))
     frequency = float(rng.uniform(5, 15))
+    t_end = 10.0 if kind != "cantilever" else 2.0
+    # The exact flow takes harmonics only.
+    signals = ["harmonic"] if method == "exact" else ["harmonic"] * 3 + ["sweep", "noise", "record"]
+    excitation |= signal(rng, str(rng.choice(signals)), amplitude, frequency, t_end)
     return {
         "structure": structure,
         "damper": dampers,
         "stop": stops,
         "gravity": {"acceleration": 9.81} if rng.random() < 0.3 else None,
-        "excitation": [{**excitation, "amplitude": amplitude, "frequency": frequency}],
+        "excitation": [excitation],
         "method": method,
-        "t_end": 10.0 if kind != "cantilever" else 2.0,
+        "t_end": t_end,
+        **({"record_from": float(rng.uniform(0, t_end))} if rng.random() < 0.3 else {}),
         "history": False,
         **(
             {"dt": 1e-4 if kind != "cantilever" else 2e-5}
@@ -117,7 +159,7 @@ def main(seed: int, seconds: float) -> None:
     while time.perf_counter() - start < seconds:
         cases += 1
         kw = scenario(rng)
-        period = 1.0 / kw["excitation"][0]["frequency"]
+        period = 1.0 / kw["excitation"][0].get("frequency", 10.0)
         results = (outcome(kw, None), outcome(kw, period))
         if results != ("ok", "ok"):
             stops.append((kw, results))

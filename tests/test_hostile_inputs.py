@@ -197,6 +197,14 @@ def test_an_unknown_excitation_key_lists_its_signal_s_keys_only() -> None:
     )
 
 
+def test_a_scale_that_takes_a_record_beyond_floating_point_is_refused() -> None:
+    excitation = {"kind": "base", "signal": "recorded", "time": [0, 1, 2], "value": [0, 1e308, 0]}
+    with pytest.raises(ValueError, match=r"0: scale: 100.0 times the record's largest value"):
+        vi.simulate_system(
+            STRUCTURE, excitation=[{**excitation, "scale": 100.0}], t_end=0.1, method="dopri5"
+        )
+
+
 def test_an_empty_file_name_is_refused_as_such() -> None:
     excitation = {"kind": "base", "signal": "recorded", "file": " "}
     with pytest.raises(ValueError, match=r"0: file: must name a CSV file .*empty string"):

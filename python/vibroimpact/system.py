@@ -39,6 +39,7 @@ import io
 import math
 import re
 import stat
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -603,6 +604,14 @@ def system_spec(
                 "a recorded signal needs file (a CSV of time and value), or time and value "
                 "(arrays of numbers)",
             )
+        if e["signal"] == "recorded" and e["scale"] is not None:
+            # The core's bound: half the largest float, so that differences stay finite.
+            largest = max(abs(v) for v in e["value"]) * abs(e["scale"])
+            if not largest <= 0.5 * sys.float_info.max:
+                raise _fail(
+                    f"{where}scale: ",
+                    f"{e['scale']!r} times the record's largest value is beyond floating point",
+                )
         excitations.append({k: v for k, v in e.items() if v is not None and k != "file"})
     spec["excitation"] = excitations
     return spec

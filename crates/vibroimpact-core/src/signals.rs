@@ -348,7 +348,15 @@ impl Signal {
                 )));
             }
         }
-        let value = value.into_iter().map(|v| v * scale).collect();
+        let value: Vec<f64> = value.into_iter().map(|v| v * scale).collect();
+        // Half the largest float, so that the interpolation's differences are finite too.
+        if let Some(row) = value.iter().position(|v| v.is_nan() || v.abs() > 0.5 * f64::MAX) {
+            return Err(Error::Inconsistent(format!(
+                "a recorded signal's value times scale ({scale:e}) must stay within floating \
+                 point: row {row} gives {:e}",
+                value[row]
+            )));
+        }
         Ok(Self::Recorded { time, value })
     }
 
@@ -706,6 +714,15 @@ fn portable_ln(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_record_whose_scaled_values_overflow_is_refused() {
+        crate::testing::timeout(60, || {
+            let err = Signal::recorded(vec![0.0, 1.0], vec![0.0, 1e308], 100.0).unwrap_err();
+            assert!(err.to_string().contains("row 1 gives inf"), "{err}");
+            assert!(Signal::recorded(vec![0.0, 1.0], vec![0.0, 1e305], 100.0).is_ok());
+        });
+    }
 
     #[test]
     fn breakpoints_are_the_samples_after_the_time_and_the_sweep_s_end() {
