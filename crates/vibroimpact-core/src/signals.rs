@@ -350,7 +350,10 @@ impl Signal {
         }
         let value: Vec<f64> = value.into_iter().map(|v| v * scale).collect();
         // Half the largest float, so that the interpolation's differences are finite too.
-        if let Some(row) = value.iter().position(|v| v.is_nan() || v.abs() > 0.5 * f64::MAX) {
+        if let Some(row) = value
+            .iter()
+            .position(|v| v.is_nan() || v.abs() > 0.5 * f64::MAX)
+        {
             return Err(Error::Inconsistent(format!(
                 "a recorded signal's value times scale ({scale:e}) must stay within floating \
                  point: row {row} gives {:e}",
