@@ -462,9 +462,13 @@ fn find_crossing(
             });
         } else if m0 < 0.0 && m1 > 0.0 {
             // The value falls then rises within the step: a dip below zero?
+            // The interpolant errs by its fourth-order term (5e-5 of the
+            // swing at the exact flow's eighth of a period): a dip that it
+            // takes down to half of the ends' lower value is checked on the
+            // method's own solution (`locate` finds its lowest point there).
             let theta = cubic_argmax(-v0, -v1, -m0, -m1);
             let low = hermite::eval(v0, v1, m0, m1, theta).0;
-            if low < -graze {
+            if low < -graze || low < 0.5 * v0.min(v1) {
                 consider(Crossing {
                     i,
                     guess: theta,
@@ -616,6 +620,31 @@ fn locate<S: SystemStepper>(
             return Ok(Location::Reject(hi));
         }
         v_hi = value(&buffers.best, time + hi, scratch, &mut buffers.work);
+        // The dip's lowest point on the method's solution: Newton's steps on
+        // the value's rate from the interpolant's (each squares the error of
+        // the time, so a graze the interpolant hides is found or ruled out).
+        for _ in 0..4 {
+            if v_hi < 0.0 {
+                break;
+            }
+            let rate = sign * system.gap(c.i, &buffers.best).1;
+            let curvature = sign
+                * system.gap_acceleration(
+                    c.i,
+                    time + hi,
+                    &buffers.best,
+                    modes,
+                    scratch,
+                    &mut buffers.work,
+                );
+            let lowest = hi - rate / curvature;
+            if !(curvature > 0.0 && lowest > 0.0 && lowest < h) || lowest == hi {
+                break;
+            }
+            hi = lowest;
+            best_error = stepper.attempt(system, time, y, hi, modes, scratch, &mut buffers.best)?;
+            v_hi = value(&buffers.best, time + hi, scratch, &mut buffers.work);
+        }
         if v_hi >= 0.0 {
             return Ok(Location::Unconfirmed);
         }
