@@ -717,3 +717,30 @@ def test_a_sweep_of_a_key_the_analyses_do_not_use_is_refused(path: str) -> None:
     table = {"parameter": path, "start": 1.0, "stop": 2.0, "count": 2}
     with pytest.raises(an.AnalysisError, match="not used by the analyses"):
         an.sweep_settings(table)
+
+
+@pytest.mark.parametrize(
+    ("method", "options"), [("exact", {}), ("dop853", {}), ("rk4", {"dt": 1e-4})]
+)
+def test_a_sweep_restarts_from_a_state_with_its_damper_stuck_to_the_wall(
+    method: str, options: dict[str, float]
+) -> None:
+    # A damper of no clearance and no rebound rides with the structure: the added-mass
+    # closed form F / |K - w^2 (M + m) + i w C|. Each point starts from the last one's
+    # end, where the stuck pair sits round-off (to 1.7e-12 m) inside its wall: the sweep
+    # stopped there with "starts ... inside its wall" (exit 2).
+    sections = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513},
+        "damper": [{"mass": 0.05, "at": 0, "clearance": 0.0, "law": "rigid", "restitution": 0.0}],
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 5.0, "frequency": 10.0}
+        ],
+        "solver": {"method": method, **options},
+    }
+    frequencies = [9.0, 10.0, 11.0]
+    points = an.sweep(sections, "excitation.0.frequency", np.array(frequencies))
+    for point, f in zip(points, frequencies, strict=True):
+        w = 2 * math.pi * f
+        closed = 5.0 / abs(3947.8 - w * w * 1.05 + 1j * w * 2.513)
+        assert point.error is None
+        assert point.amplitude[0] == pytest.approx(closed, rel=1e-6)

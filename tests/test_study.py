@@ -144,6 +144,37 @@ def peak_study(tmp_path: Path, axis: str) -> Any:
     return st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
 
 
+def test_a_damped_hertz_law_s_restitution_is_an_axis(tmp_path: Path) -> None:
+    # Every run failed with "the pair's law has no restitution" (exit 0; user trial).
+    text = (
+        BASE.replace('law = "rigid"', 'law = "hertz-damped"\nstiffness = 1e7').replace(
+            'method = "exact"', 'method = "dop853"'
+        )
+        + '[study]\nanalysis = "run"\nmetrics = ["peak", "energy_dissipated"]\n'
+        + '[study.axes]\n"damper.0.restitution" = [0.3, 0.9]\n'
+    )
+    study = load(scenario(tmp_path, text))
+    ds = st.run(study, tmp_path / "out.nc")
+    assert ds["status"].values.tolist() == [0, 0]
+    losses = []
+    for restitution in (0.3, 0.9):
+        data = without_study(study, **{"damper.0.restitution": restitution})
+        sol = vi.simulate_system(
+            data["structure"],
+            damper=data["damper"],
+            excitation=data["excitation"],
+            method="dop853",
+            t_end=0.5,
+            history=False,
+            record_from=0.0,
+        )
+        point = ds.sel({"damper.0.restitution": restitution})
+        assert point["peak"].values.tolist() == sol.peak.tolist()
+        losses.append(point["energy_dissipated"].item())
+    # The less elastic law loses more.
+    assert losses[0] > losses[1] > 0
+
+
 def test_a_failed_run_is_recorded_with_its_reason_and_the_others_go_on(tmp_path: Path) -> None:
     ds = peak_study(tmp_path, '"damper.0.mass" = [0.05, -1.0, 0.1]')
     status = ds["status"].values

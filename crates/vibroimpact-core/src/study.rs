@@ -210,11 +210,16 @@ impl Parameter {
                     Ok(())
                 }
                 (PairLaw::Compliant(c), "stiffness") => {
-                    *c = rebuilt(c, value, c.damping)?;
+                    *c = rebuilt(c, value, c.restitution, c.damping)?;
                     Ok(())
                 }
                 (PairLaw::Compliant(c), "damping") => {
-                    *c = rebuilt(c, c.stiffness, value)?;
+                    *c = rebuilt(c, c.stiffness, c.restitution, value)?;
+                    Ok(())
+                }
+                // The damped Hertz laws' restitution (the others have none).
+                (PairLaw::Compliant(c), "restitution") if c.law.uses_restitution() => {
+                    *c = rebuilt(c, c.stiffness, value, c.damping)?;
                     Ok(())
                 }
                 _ => Err(Error::Inconsistent(format!(
@@ -315,8 +320,8 @@ fn in_section(section: &str, e: Error) -> Error {
     }
 }
 
-fn rebuilt(c: &Contact, stiffness: f64, damping: f64) -> Result<Contact> {
-    let restitution = c.law.uses_restitution().then_some(c.restitution);
+fn rebuilt(c: &Contact, stiffness: f64, restitution: f64, damping: f64) -> Result<Contact> {
+    let restitution = c.law.uses_restitution().then_some(restitution);
     Contact::new(c.law, stiffness, restitution, damping)
 }
 
