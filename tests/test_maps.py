@@ -21,6 +21,7 @@ acceleration is ``A cos(w t + p)``, i.e. the table's displacement is
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import re
@@ -963,3 +964,31 @@ def test_readme_map_commands_work_as_written(tmp_path: Path) -> None:
     assert len(plots) == 4
     for name in plots:
         assert_png(tmp_path / name)
+
+
+def test_continuation_through_grazing_flags_the_grazing_alone() -> None:
+    # A 1 Hz impact oscillator (1 % damping, rigid stop at 0.05 m, e = 0.8) forced at
+    # 0.8 Hz, continued from F = 2 N down: the impacting orbit flips near 1.04 N and
+    # meets the non-impacting orbit at grazing, F = 0.05 |K - w^2 M + i w C| = 0.7113 N.
+    # Across the grazing the two branches' multipliers and tangents were compared, and
+    # a fold and a flip were flagged that neither branch has.
+    k, c, f = (2 * math.pi) ** 2, 0.04 * math.pi, 0.8
+    w = 2 * math.pi * f
+    grazing = 0.05 * abs(k - w * w + 1j * c * w)
+    data = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": k, "damping": c},
+        "stop": [{"at": 0, "side": "upper", "gap": 0.05, "law": "rigid", "restitution": 0.8}],
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 2.0, "frequency": f}
+        ],
+        "initial": {"structure_displacement": [0.04023232], "structure_velocity": [-0.49373256]},
+        "solver": {"method": "exact", "t_end": 50.0},
+    }
+    branch = continue_orbit(data, "excitation.0.amplitude", stop=0.5, step=0.05)
+    for before, after in itertools.pairwise(branch.points):
+        if before.impacts_per_period != after.impacts_per_period:
+            assert after.flags == ["grazing"]
+            assert min(before.value, after.value) < grazing * (1 + 1e-3)
+    # Each branch's own flags: the impacting orbit's flip, nothing from the jump.
+    flags = [flag for p in branch.points for flag in p.flags]
+    assert "grazing" in flags and "fold" not in flags

@@ -59,6 +59,19 @@ def without_study(study: st.Study, **changes: Any) -> dict[str, Any]:
     return data
 
 
+def single_run(data: dict[str, Any], method: str, **options: Any) -> Any:
+    """The scenario ``data``'s structure, dampers and excitations run alone to 0.5 s."""
+    return vi.simulate_system(
+        data["structure"],
+        damper=data["damper"],
+        excitation=data["excitation"],
+        method=method,
+        t_end=0.5,
+        history=False,
+        **options,
+    )
+
+
 def test_a_run_study_equals_the_runs_made_one_by_one(tmp_path: Path) -> None:
     text = BASE + (
         '[study]\nanalysis = "run"\nrecord_from = 0.1\n'
@@ -159,15 +172,7 @@ def test_a_damped_hertz_law_s_restitution_is_an_axis(tmp_path: Path) -> None:
     losses = []
     for restitution in (0.3, 0.9):
         data = without_study(study, **{"damper.0.restitution": restitution})
-        sol = vi.simulate_system(
-            data["structure"],
-            damper=data["damper"],
-            excitation=data["excitation"],
-            method="dop853",
-            t_end=0.5,
-            history=False,
-            record_from=0.0,
-        )
+        sol = single_run(data, "dop853", record_from=0.0)
         point = ds.sel({"damper.0.restitution": restitution})
         assert point["peak"].values.tolist() == sol.peak.tolist()
         losses.append(point["energy_dissipated"].item())
@@ -439,15 +444,7 @@ def test_monte_carlo_samples_draw_from_the_seed_and_run_each_draw(tmp_path: Path
                     "excitation.0.phase": float(phase[k]),
                 },
             )
-            sol = vi.simulate_system(
-                data["structure"],
-                damper=data["damper"],
-                excitation=data["excitation"],
-                method="exact",
-                t_end=0.5,
-                history=False,
-                record_from=0.1,
-            )
+            sol = single_run(data, "exact", record_from=0.1)
             point = ds.sel({"damper.0.clearance": clearance, "sample": k})
             assert point["peak"].values.tolist() == sol.peak.tolist()
 

@@ -11,7 +11,8 @@ Floquet multipliers; between points the code flags a ``fold`` (the parameter's
 direction along the branch reverses), a ``flip`` (a multiplier crosses -1), a
 ``neimark-sacker`` (a complex pair leaves the unit circle), a ``branch`` (a real
 multiplier crosses +1 without a fold) and ``grazing`` (the number of impacts per
-period changes). SI units.
+period changes: then alone, since the two orbits lie on different smooth branches).
+SI units.
 """
 
 from __future__ import annotations
@@ -304,6 +305,11 @@ def _flags(
     ``t0`` and ``t1`` (in the scaled coordinates; the parameter's component at ``size``)
     and which lie ``arc`` apart along the branch (their scaled chord times the
     parameter's scale: the rates ``t[size] * arc`` are then in the parameter's unit)."""
+    if before.impacts_per_period != after.impacts_per_period:
+        # A grazing: the two orbits lie on two smooth branches, whose tangents and
+        # multipliers say nothing of each other (the multipliers jump there), so no
+        # fold, flip or other crossing is read between them.
+        return ["grazing"], {}
     flags: list[str] = []
     crossings: dict[str, float] = {}
     if t0[size] * t1[size] < 0:
@@ -329,8 +335,6 @@ def _flags(
         if (a > 0) != (b > 0):
             flags.append(name)
             crossings[name] = before.value + (after.value - before.value) * a / (a - b)
-    if before.impacts_per_period != after.impacts_per_period:
-        flags.append("grazing")
     return flags, crossings
 
 
