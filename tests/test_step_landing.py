@@ -194,3 +194,17 @@ def test_an_orbit_that_just_passes_its_stop_hits_it_whatever_the_phase(
         ):
             missed.append(round(float(start), 3))
     assert not missed
+
+
+def test_without_a_window_nothing_is_recorded_not_a_peak_of_zero() -> None:
+    # The peak read 0.0 (which looks like a measurement) while the RMS read NaN.
+    structure = {"kind": "oscillator", "mass": 1.0, "stiffness": 100.0}
+    sol = simulate_system(
+        structure,
+        initial={"structure_displacement": [0.01]},
+        t_end=0.2,
+        method="dop853",
+        history=False,
+    )
+    assert sol.recorded_time == 0.0
+    assert np.isnan(sol.peak).all() and np.isnan(sol.rms).all()

@@ -716,7 +716,8 @@ class SystemSolution:
     method: str
     pairs: list[str] = field(default_factory=list)
     #: Per structure coordinate, from ``record_from`` on: the largest |displacement|
-    #: (m, located where the velocity changes sign or at an impact) and the RMS (m).
+    #: (m, located where the velocity changes sign or at an impact) and the RMS (m);
+    #: NaN where nothing was recorded (no ``record_from``).
     peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
     recorded_time: float = 0.0
@@ -982,7 +983,8 @@ def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
         grazing_contacts=raw["grazing_contacts"],
         method=method,
         pairs=pairs,
-        peak=raw["peaks"],
+        # Nothing recorded (no record_from): no peak either, not a peak of 0.
+        peak=raw["peaks"] if raw["recorded_time"] > 0 else np.full(n, np.nan),
         rms=np.sqrt(raw["square_integrals"] / raw["recorded_time"])
         if raw["recorded_time"] > 0
         else np.full(n, np.nan),
