@@ -383,7 +383,9 @@ def test_linear_sweep_matches_closed_form(kind: str) -> None:
     points = an.sweep(
         linear_scenario(kind, values[0], EXACT),
         "excitation.0.frequency",
-        values,
+        # Given in any order: "up" is towards larger values (given from the top, a sweep
+        # going down was labelled "up"; trial of the analyses).
+        values[::-1],
         direction="both",
         settle_periods=200,
         record_periods=5,

@@ -593,13 +593,14 @@ def sweep(
     progress: Callable[[int, int], None] | None = None,
 ) -> list[SweepPoint]:
     """A stepped sweep of ``parameter`` (a dotted path into the scenario's sections)
-    over ``values`` (ascending, as given), ``"up"``, ``"down"`` or ``"both"`` (up, then
+    over ``values`` (sorted: ``"up"`` is towards larger values whatever their order as
+    given), ``"up"``, ``"down"`` or ``"both"`` (up, then
     down from where up ended), each point starting from the last one's state, so
     that jumps and hysteresis show (from ``[initial]`` where that state is not
     admissible: see :func:`from_carried`). A point whose run fails is reported with
     its error (and the next starts from the last good state)."""
     _choice("", "direction", direction, _DIRECTIONS)
-    values = [float(v) for v in values]
+    values = sorted(float(v) for v in values)
     legs: list[tuple[str, list[float]]] = []
     if direction in ("up", "both"):
         legs.append(("up", values))
