@@ -308,6 +308,18 @@ def test_bad_studies_exit_2_naming_the_key(
     assert_refused(done, words, tmp_path / "r.nc")
 
 
+def test_a_study_whose_every_run_fails_exits_1_with_its_file_written(tmp_path: Path) -> None:
+    # It exited 0 (trial of the analyses). One run failing of two still exits 0.
+    for masses, status in (("[-1.0, -2.0]", 1), ("[-1.0, 0.05]", 0)):
+        text = BASE + '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        text += f'[study.axes]\n"damper.0.mass" = {masses}\n'
+        out = tmp_path / f"r{status}.nc"
+        done = cli("study", str(scenario(tmp_path, text)), "--out", str(out))
+        assert done.returncode == status, done.stderr
+        assert out.exists() and "Traceback" not in done.stderr
+        assert ("every one of the 2 runs failed" in done.stderr) == bool(status)
+
+
 def test_the_readme_study_commands_work_as_written(tmp_path: Path) -> None:
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
     section = readme.split("## Studies", 1)[1].split("\n## ", 1)[0]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -138,15 +139,20 @@ def run_study_command(args: argparse.Namespace) -> int:
         "metrics": list(study.settings["metrics"]),
         "cpu_time": elapsed,
     }
+    # Every run failed: the file is written (its reasons say why), but nothing was
+    # computed, which the exit status says too.
+    status = 1 if failed == study.runs else 0
     if args.json:
         print(json.dumps(summary))
-        return 0
-    print(
-        f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, "
-        f"written to {args.out}"
-    )
-    if args.plot:
-        print(f"plot written to {args.plot}")
-    for reason in summary["reasons"]:
-        print(f"  failed: {reason}")
-    return 0
+    else:
+        print(
+            f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, "
+            f"written to {args.out}"
+        )
+        if args.plot:
+            print(f"plot written to {args.plot}")
+        for reason in summary["reasons"]:
+            print(f"  failed: {reason}")
+    if status:
+        print(f"vibroimpact: error: every one of the {study.runs} runs failed", file=sys.stderr)
+    return status
