@@ -304,7 +304,7 @@ def _value(where: str, kind: str, value: Any) -> Any:
             if bad.size:
                 i = int(bad[0])
                 raise _fail(f"{where[:-2]}[{i}]: ", f"must be a finite number, got {value[i]}")
-            return [float(v) for v in value.tolist()]
+            return list(value.tolist())
         return [_value(f"{where[:-2]}[{i}]: ", _NUMBER, v) for i, v in enumerate(value)]
     # _MATRIX: an array of rows.
     if isinstance(value, str | bytes) or not _is_array(value, 2):
@@ -336,9 +336,7 @@ def _table(where: str, table: Any, schema: Mapping[str, tuple[str, Any]]) -> dic
     out: dict[str, Any] = {}
     for key, value in table.items():
         if key not in schema:
-            close = difflib.get_close_matches(str(key), list(schema), n=1)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise _fail(where, f"unknown key {key!r} (allowed: {', '.join(schema)}){hint}")
+            raise _unknown_key(where, key, list(schema), "allowed:")
         out[key] = _value(f"{where}{key}: ", schema[key][0], value)
     for key, (_, default) in schema.items():
         if key not in out:
@@ -346,6 +344,14 @@ def _table(where: str, table: Any, schema: Mapping[str, tuple[str, Any]]) -> dic
                 raise _fail(where, f"missing key {key!r}")
             out[key] = default
     return out
+
+
+def _unknown_key(where: str, key: Any, names: list[str], intro: str) -> InvalidInputError:
+    """The error of an unknown ``key`` of a table: ``names`` (the keys allowed, after
+    ``intro``) and the closest of them as a suggestion."""
+    close = difflib.get_close_matches(str(key), names, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return _fail(where, f"unknown key {key!r} ({intro} {', '.join(names)}){hint}")
 
 
 def _list(name: str, value: Any) -> list[Any]:
@@ -555,12 +561,7 @@ def system_spec(
             own = ["kind", "at", "signal", *sorted(_SIGNAL_KEYS[signal])]
             for key in table:
                 if key not in _EXCITATION:
-                    close = difflib.get_close_matches(str(key), own, n=1)
-                    hint = f"; did you mean {close[0]!r}?" if close else ""
-                    raise _fail(
-                        where,
-                        f"unknown key {key!r} (signal {signal!r} takes {', '.join(own)}){hint}",
-                    )
+                    raise _unknown_key(where, key, own, f"signal {signal!r} takes")
         e = _table(where, table, _EXCITATION)
         _choice(where, "kind", e["kind"], _LOADS)
         _choice(where, "signal", e["signal"], _SIGNALS)
@@ -952,6 +953,7 @@ def prepare_system(
 
 def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
     n, k = raw["n"], raw["k"]
+    recorded = raw["recorded_time"] > 0
     width = 2 * (n + k)
     states = raw["states"].reshape(-1, width)
     final = raw["final_state"]
@@ -983,10 +985,10 @@ def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
         grazing_contacts=raw["grazing_contacts"],
         method=method,
         pairs=pairs,
-        # Nothing recorded (no record_from): no peak either, not a peak of 0.
-        peak=raw["peaks"] if raw["recorded_time"] > 0 else np.full(n, np.nan),
+        # Nothing recorded (no record_from): neither peak nor RMS, not a peak of 0.
+        peak=raw["peaks"] if recorded else np.full(n, np.nan),
         rms=np.sqrt(raw["square_integrals"] / raw["recorded_time"])
-        if raw["recorded_time"] > 0
+        if recorded
         else np.full(n, np.nan),
         recorded_time=raw["recorded_time"],
         strobe=raw["strobe"].reshape(-1, width),
