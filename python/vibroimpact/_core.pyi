@@ -10,6 +10,7 @@ __all__ = [
     "DEFAULT_MAX_ROWS",
     "MAX_RECORD_BYTES",
     "MAX_SIGNAL_SAMPLES",
+    "RTOL_RANGE",
     "BeamMode",
     "Contact",
     "ContactTable",
@@ -43,6 +44,7 @@ DEFAULT_MAX_ROWS: int
 MAX_RECORD_BYTES: int
 MAX_SIGNAL_SAMPLES: int
 DEFAULT_ENERGY_TOLERANCE: float
+RTOL_RANGE: tuple[float, float]
 
 _FloatArray = npt.NDArray[np.float64]
 

@@ -5,6 +5,14 @@
 use crate::error::{positive, within, Error, Result};
 use crate::steppers::Tolerances;
 
+/// The relative tolerance (`rtol`) a method with error control takes, and
+/// its description: an error control looser than a tenth controls nothing
+/// (the run would stop on its energy balance); tighter than 1e-15 is below
+/// round-off. Every check of an rtol (here, the binding's, the Python
+/// scenario's) reads these.
+pub const RTOL_RANGE: (f64, f64) = (1e-15, 0.1);
+pub const RTOL_ALLOWED: &str = "in [1e-15, 0.1]";
+
 /// How contact instants are reported.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactTiming {
@@ -93,7 +101,14 @@ impl Method {
             "in [0, 1]",
         )?;
         let tolerances = Tolerances {
-            rtol: within("rtol", options.rtol, 1e-15, 0.1, false, "in [1e-15, 0.1]")?,
+            rtol: within(
+                "rtol",
+                options.rtol,
+                RTOL_RANGE.0,
+                RTOL_RANGE.1,
+                false,
+                RTOL_ALLOWED,
+            )?,
             atol: positive("atol", options.atol)?,
         };
         match name {
@@ -376,5 +391,16 @@ impl Settings {
             Some(dt) => self.step_count(dt) as u64,
             None => 0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rtol_description_states_its_range() {
+        let stated = format!("in [{:e}, {}]", RTOL_RANGE.0, RTOL_RANGE.1);
+        assert_eq!(RTOL_ALLOWED, stated);
     }
 }

@@ -55,5 +55,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_RECORD_BYTES", core::MAX_RECORD_BYTES)?;
     m.add("MAX_SIGNAL_SAMPLES", core::signals::MAX_SIGNAL_SAMPLES)?;
     m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
+    m.add("RTOL_RANGE", core::settings::RTOL_RANGE)?;
     Ok(())
 }

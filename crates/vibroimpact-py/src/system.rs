@@ -526,13 +526,12 @@ fn check_method(
     for (field, value, ok, allowed) in [
         ("t_end", t_end, t_end > 0.0, "> 0 s"),
         ("dt", dt, dt > 0.0, "> 0 s or None"),
-        // As for the two-mass methods: an error control looser than a tenth
-        // controls nothing (the energy check then stops the run).
         (
             "rtol",
             rtol,
-            (1e-15..=0.1).contains(&rtol),
-            "in [1e-15, 0.1]",
+            (vibroimpact_core::settings::RTOL_RANGE.0..=vibroimpact_core::settings::RTOL_RANGE.1)
+                .contains(&rtol),
+            vibroimpact_core::settings::RTOL_ALLOWED,
         ),
         ("atol", atol, atol > 0.0, "> 0"),
         ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
