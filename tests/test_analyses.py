@@ -746,3 +746,33 @@ def test_a_sweep_restarts_from_a_state_with_its_damper_stuck_to_the_wall(
         closed = 5.0 / abs(3947.8 - w * w * 1.05 + 1j * w * 2.513)
         assert point.error is None
         assert point.amplitude[0] == pytest.approx(closed, rel=1e-6)
+
+
+def test_a_state_inside_its_wall_by_round_off_of_nothing_is_put_on_the_wall() -> None:
+    # A ball on a table at the origin (gap 0): a run's end can leave it 4e-31 m inside,
+    # a round-off of no length at all, which 1e-8 of its gap's scale (itself 4e-31 m)
+    # did not cover: the continuation stopped there with "starts 3.94e-31 m inside its
+    # wall". Resumed, such a state is on the wall: the same period as from the wall.
+    sections = {
+        "structure": {"kind": "oscillator", "mass": 0.05, "stiffness": 0.0},
+        "stop": [{"at": 0, "side": "lower", "gap": 0.0, "law": "rigid", "restitution": 0.5}],
+        "gravity": {"acceleration": 9.81},
+        "excitation": [
+            {"kind": "base", "signal": "harmonic", "amplitude": 11.772, "frequency": 10.0}
+        ],
+        "solver": {"method": "exact"},
+    }
+    run = an.runner(sections)
+    inside = run.map(np.array([-3.94e-31, 0.16]), 1)
+    on_wall = run.map(np.array([0.0, 0.16]), 1)
+    assert np.array_equal(inside, on_wall)
+    # A start the user gives is held to round-off of its own scale, as before.
+    with pytest.raises(ValueError, match="inside its wall"):
+        vi.simulate_system(
+            sections["structure"],
+            stop=sections["stop"],
+            gravity=sections["gravity"],
+            initial={"structure_displacement": [-3.94e-31], "structure_velocity": [0.16]},
+            t_end=0.1,
+            method="exact",
+        )

@@ -588,6 +588,65 @@ def test_a_coarse_step_still_places_the_fold_beyond_the_branch() -> None:
         assert fold == pytest.approx(exact, rel=tolerance), step
 
 
+def test_continuation_steps_by_the_orbits_size_not_its_state_at_t_0() -> None:
+    # A linear oscillator (a stop 10 m away) from 1 Hz through its resonance (3.18 Hz)
+    # to 5 Hz. At 1 Hz the state at t = 0 is near a turning point (velocity 2.7e-4 m/s
+    # against an amplitude's 0.03 m/s): scaled by it, every step was all velocity and
+    # 200 points reached 2.33 Hz (user trial). The amplitudes are the closed form's.
+    m, k, c, f0 = 2.0, 800.0, 1.2, 3.0
+    data = {
+        "structure": {"kind": "oscillator", "mass": m, "stiffness": k, "damping": c},
+        "stop": [{"at": 0, "side": "upper", "gap": 10.0, "law": "rigid", "restitution": 0.5}],
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": f0, "frequency": 1.0}
+        ],
+        "solver": {"method": "exact", "t_end": 1.0},
+    }
+    branch = continue_orbit(data, "excitation.0.frequency", stop=5.0, step=0.1, max_points=200)
+    assert branch.stopped == "reached stop"
+    for p in branch.points:
+        w = 2 * math.pi * p.value
+        closed = f0 / abs(k - m * w * w + 1j * w * c)
+        assert p.amplitude[0] == pytest.approx(closed, rel=1e-6), p.value
+        assert not p.flags
+
+
+def test_continuation_near_a_grazing_reads_the_orbits_own_multipliers() -> None:
+    # The FRF example's damper on its 5-impact orbit at 10 Hz (user trial): up to a
+    # Neimark-Sacker (a complex pair leaving the circle at 10.00102 Hz), a fold, then
+    # down the unstable branch to the grazing where the fifth impact vanishes, and on
+    # along the 4-impact branch. Near that grazing the difference step carried one
+    # side onto a trajectory touching the wall: the multiplier read +1636 instead of
+    # -6.2024 and a flip and a branch point were flagged that are not there; and a step
+    # passing the Neimark-Sacker and the pair's meeting on the real axis read as a
+    # branch point.
+    data = tomllib.loads((EXAMPLES / "frf_impact_damper.toml").read_text(encoding="utf-8"))
+    data.pop("sweep", None)
+    data["initial"] = {
+        "structure_displacement": [-0.01233765],
+        "damper_displacement": [-0.01463987],
+        "structure_velocity": [0.68714101],
+        "damper_velocity": [0.5027181],
+    }
+    branch = continue_orbit(data, "excitation.0.frequency", stop=12.0, step=0.05)
+    flagged = [(p.flags, p.crossings) for p in branch.points if p.flags]
+    assert [f for f, _ in flagged] == [["neimark-sacker"], ["fold"], ["grazing"]]
+    ns = flagged[0][1]["neimark-sacker"]
+    assert ns == pytest.approx(10.00102, abs=2e-5)
+    # Against the core's own shooting either side of it: stable below, unstable above.
+    for offset, stable in ((-1e-4, True), (1e-4, False)):
+        changed = an.with_parameter(data, "excitation.0.frequency", ns + offset)
+        near = min(branch.points[:2], key=lambda p: abs(p.value - ns))
+        found = an.orbit(an.runner(changed), near.state)
+        assert found.converged and found.stable == stable
+    four = [p for p in branch.points if p.impacts_per_period == 4]
+    assert four
+    for p in four:
+        # Its largest multiplier is -6.20 there (an independent difference monodromy).
+        largest = p.floquet_multipliers[np.argmax(np.abs(p.floquet_multipliers))]
+        assert largest.real == pytest.approx(-6.20, abs=0.05) and abs(largest.imag) < 1e-6
+
+
 def test_an_impact_crossing_the_section_is_not_flagged_as_a_fold() -> None:
     data, psi, clearance = mc_case()
     branch = continue_orbit(data, AMPLITUDE, stop=1.0, step=0.02, max_points=80)
@@ -687,7 +746,8 @@ def test_continue_command_on_its_example(run_cli: RunCli, tmp_path: Path) -> Non
         assert p["impacts_per_period"] == 1
     (flagged,) = [p for p in points if p["flags"]]
     assert flagged["flags"] == ["flip"] and set(flagged["crossings"]) == {"flip"}
-    assert flagged["crossings"]["flip"] == pytest.approx(flip, rel=5e-3)
+    # Located by bisection along the arc, to a thousandth of the step (1.2 m/s^2).
+    assert flagged["crossings"]["flip"] == pytest.approx(flip, abs=2e-3)
     text = run_cli("continue", str(CONTINUATION))
     assert text.returncode == 0 and "flip at" in text.stdout and "reached stop" in text.stdout
 

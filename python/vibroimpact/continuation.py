@@ -18,6 +18,7 @@ SI units.
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -49,9 +50,10 @@ class BranchPoint:
     amplitude: np.ndarray
     flags: list[str] = field(default_factory=list)
     #: Where each flagged bifurcation lies between the last point and this one: the
-    #: parameter at which the crossing multiplier's modulus reaches 1 (linear
-    #: interpolation), or at which the parameter turns (a fold: the extremum of its
-    #: cubic along the arc, see ``_fold``).
+    #: parameter at which the crossing multiplier's modulus reaches 1 (bisection along
+    #: the arc), or at which the parameter turns (a fold: where the stability changes
+    #: there, so located; otherwise the extremum of its cubic along the arc, see
+    #: ``_fold``).
     crossings: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:
@@ -140,8 +142,19 @@ def continue_orbit(
         )
     size = len(first.state)
     dim = size // 2
-    x_scale = max(float(np.max(np.abs(first.state[:dim]), initial=0.0)), 1e-12)
-    v_scale = max(float(np.max(np.abs(first.state[dim:]), initial=0.0)), 1e-12)
+    # The orbit's own size, not its state at t = 0 (which may be near a turning
+    # point, its velocity near zero): its largest displacement, and that turned at
+    # the forcing frequency for the velocities.
+    x_scale = max(
+        float(np.max(np.abs(first.state[:dim]), initial=0.0)),
+        float(np.max(first.amplitude, initial=0.0)),
+        1e-12,
+    )
+    v_scale = max(
+        float(np.max(np.abs(first.state[dim:]), initial=0.0)),
+        2 * math.pi / first_run.period * x_scale,
+        1e-12,
+    )
     scale = np.concatenate([np.full(dim, x_scale), np.full(dim, v_scale), [abs(span)]])
 
     def residual(u: np.ndarray) -> np.ndarray:
@@ -151,13 +164,43 @@ def continue_orbit(
         return out
 
     def jacobian(u: np.ndarray) -> np.ndarray:
+        # Central differences; where the forward and backward ones disagree beyond
+        # the map's curvature, the step straddles a grazing (one side touches a wall
+        # the orbit misses): that column again with steps a hundred times shorter,
+        # the most consistent kept (as the core's shooting does).
         jac = np.zeros((size, size + 1))
+        centre = residual(u)
         for j in range(size + 1):
             h = 1e-6 * max(abs(u[j]), 1e-3 if j == size else 1.0)
-            plus, minus = u.copy(), u.copy()
-            plus[j] += h
-            minus[j] -= h
-            jac[:, j] = (residual(plus) - residual(minus)) / (2 * h)
+            best: tuple[float, np.ndarray] | None = None
+            for _ in range(3):
+                sides: list[np.ndarray | None] = []
+                for sign in (1.0, -1.0):
+                    moved = u.copy()
+                    moved[j] += sign * h
+                    try:
+                        sides.append(residual(moved))
+                    except InvalidInputError:
+                        # That side starts inside a wall: one-sided from the other.
+                        sides.append(None)
+                up, down = sides
+                if up is None and down is None:
+                    raise AnalysisError("both sides of a difference step start inside a wall")
+                if up is None or down is None:
+                    one_sided = (up - centre) / h if down is None else (centre - down) / h
+                    best = (0.0, one_sided)
+                    break
+                forward, backward = (up - centre) / h, (centre - down) / h
+                size_of = float(np.max(np.abs(forward) + np.abs(backward)))
+                gap = float(np.max(np.abs(forward - backward)))
+                disagreement = gap / size_of if size_of > 0 else 0.0
+                if best is None or disagreement < best[0]:
+                    best = (disagreement, (up - down) / (2 * h))
+                if disagreement <= 1e-2:
+                    break
+                h *= 1e-2
+            assert best is not None  # one step at least is taken
+            jac[:, j] = best[1]
         return jac
 
     def tangent(jac: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
@@ -221,6 +264,57 @@ def continue_orbit(
         new_t = tangent(jacobian(u), None)
         return u, (new_t if new_t[size] * t[size] > 0 else -new_t)
 
+    def correct(predicted: np.ndarray, t: np.ndarray) -> np.ndarray | None:
+        """The orbit on the plane through ``predicted`` normal to ``t`` (Newton), or
+        None where the corrector fails."""
+        trial = predicted.copy()
+        try:
+            for _ in range(8):
+                f = residual(trial)
+                arc = float(np.dot(t, trial - predicted))
+                if max(float(np.max(np.abs(f))), abs(arc)) <= tolerance:
+                    return trial
+                jt = jacobian(trial)
+                system = np.vstack([jt, t[None, :]])
+                trial = trial - np.linalg.solve(system, np.concatenate([f, [arc]]))
+        except (InvalidInputError, np.linalg.LinAlgError):
+            return None
+        except Exception:  # a run that cannot complete near a bad point
+            return None
+        return None
+
+    def locate(
+        measure: Callable[[np.ndarray], float],
+        u: np.ndarray,
+        t: np.ndarray,
+        h: float,
+        ends: tuple[BranchPoint, BranchPoint],
+    ) -> tuple[float, np.ndarray] | None:
+        """Where ``measure`` of the multipliers changes sign between ``u`` (the point
+        ``ends[0]``) and the point ``h`` along ``t`` (``ends[1]``): bisection on the arc
+        (each trial an orbit and its multipliers) to a thousandth of the step. The
+        parameter there, and the multipliers on the side where ``measure`` > 0; None
+        where it does not change sign or a trial orbit cannot be found."""
+        first, last = (measure(p.floquet_multipliers) for p in ends)
+        if (first > 0) == (last > 0):
+            return None
+        lo, hi = 0.0, 1.0
+        (below, low), (above, high) = ((p.value, p.floquet_multipliers) for p in ends)
+        while hi - lo > 1e-3:
+            mid = 0.5 * (lo + hi)
+            found = correct(u + mid * h * t, t)
+            if found is None:
+                return None
+            jac_z = jacobian(found)[:, :size]
+            monodromy = (jac_z + np.eye(size)) * scale[:size, None] / scale[None, :size]
+            multipliers = np.linalg.eigvals(monodromy)
+            value = float(found[size] * scale[size])
+            if (measure(multipliers) > 0) == (first > 0):
+                lo, below, low = mid, value, multipliers
+            else:
+                hi, above, high = mid, value, multipliers
+        return 0.5 * (below + above), (high if last > 0 else low)
+
     u = np.concatenate([first.state, [start_value]]) / scale
     jac = jacobian(u)
     t = tangent(jac, None)
@@ -233,22 +327,7 @@ def continue_orbit(
             progress(len(points), max_points)
         corrected: np.ndarray | None = None
         while h >= 1e-6:
-            predicted = u + h * t
-            trial = predicted.copy()
-            try:
-                for _ in range(8):
-                    f = residual(trial)
-                    arc = float(np.dot(t, trial - predicted))
-                    if max(float(np.max(np.abs(f))), abs(arc)) <= tolerance:
-                        corrected = trial
-                        break
-                    jt = jacobian(trial)
-                    system = np.vstack([jt, t[None, :]])
-                    trial = trial - np.linalg.solve(system, np.concatenate([f, [arc]]))
-            except (InvalidInputError, np.linalg.LinAlgError):
-                corrected = None
-            except Exception:  # a run that cannot complete near a bad point
-                corrected = None
+            corrected = correct(u + h * t, t)
             if corrected is not None:
                 break
             h *= 0.5
@@ -258,11 +337,49 @@ def continue_orbit(
         jac = jacobian(corrected)
         new_t = tangent(jac, t)
         candidate = point(corrected, jac[:, :size])
+        # A step that lands on another number of impacts, or turns the tangent
+        # sharply, may have jumped past a fold onto another branch: shorter steps
+        # first, down to a thousandth of the asked one (where a grazing is then
+        # approached, and taken, from its own side).
+        turned = float(np.dot(t, new_t)) < 0.9
+        changed = candidate.impacts_per_period != points[-1].impacts_per_period
+        if (turned or changed) and h > 1e-3 * ds / abs(span):
+            h *= 0.5
+            continue
         # The arc between the points: their chord (the step h is only its projection
         # on the tangent, up to a fifth shorter at a fold).
         chord = float(np.linalg.norm(corrected - u)) * scale[size]
-        candidate.flags, candidate.crossings = _flags(points[-1], candidate, t, new_t, size, chord)
+        flags, crossings = _flags(points[-1], candidate, t, new_t, size, chord)
+        ends = (points[-1], candidate)
+        if candidate.stable != points[-1].stable and "grazing" not in flags:
+            # The stability changes: where the first multiplier crosses the circle,
+            # and which kind it is there (two crossings of one class-based reading
+            # may be one: a complex pair leaving the circle, then meeting on the real
+            # axis outside it, reads as a real one crossing +1).
+            found = locate(lambda m: float(np.max(np.abs(m))) - 1.0, u, t, h, ends)
+            if found is not None:
+                name = _kind(found[1], "fold" in flags)
+                flags = [f for f in flags if f not in _CLASSES and f != name] + [name]
+                crossings = {k: v for k, v in crossings.items() if k in flags}
+                crossings[name] = found[0]
+        else:
+            for name in [f for f in flags if f in _CLASSES]:
+                found = locate(functools.partial(_largest, name=name), u, t, h, ends)
+                if found is not None:
+                    crossings[name] = found[0]
+        candidate.flags, candidate.crossings = flags, crossings
         points.append(candidate)
+        # An orbit grown well beyond the scale (towards a resonance) rescales the
+        # unknowns: measured in the start's small amplitude, the arclength would be
+        # all state and the parameter would crawl.
+        grown = float(np.max(candidate.amplitude, initial=0.0))
+        if grown > 2 * scale[0]:
+            old = scale.copy()
+            scale[:dim] = grown
+            scale[dim:size] = np.maximum(scale[dim:size], 2 * math.pi / first_run.period * grown)
+            corrected = corrected * old / scale
+            new_t = new_t * old / scale
+            new_t /= np.linalg.norm(new_t)
         u, t = clear_of_impacts(corrected, new_t)
         h = min(h * 1.5, 4 * ds / abs(span))
         if (candidate.value - stop) * span >= 0:
@@ -293,6 +410,34 @@ def _fold(p0: float, p1: float, m0: float, m1: float) -> float:
     return h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
 
 
+# Below this imaginary part a multiplier is real.
+_REAL = 1e-6
+#: The multipliers whose crossing of the unit circle each flag reports.
+_CLASSES: dict[str, Callable[[complex], bool]] = {
+    "flip": lambda m: abs(m.imag) <= _REAL and m.real < 0,
+    "neimark-sacker": lambda m: abs(m.imag) > _REAL,
+    "branch": lambda m: abs(m.imag) <= _REAL and m.real > 0,
+}
+
+
+def _largest(multipliers: np.ndarray, name: str) -> float:
+    """The largest modulus of the multipliers of class ``name``, less 1 (-1 for none)."""
+    chosen = [abs(m) for m in multipliers if _CLASSES[name](m)]
+    return max(chosen) - 1.0 if chosen else -1.0
+
+
+def _kind(outside: np.ndarray, fold: bool) -> str:
+    """The bifurcation of the multiplier that has just left the unit circle (the
+    largest of ``outside``): a flip (real, negative), a Neimark-Sacker (complex) or, real
+    and positive, a fold where the parameter turns and a branch point otherwise."""
+    m = complex(outside[int(np.argmax(np.abs(outside)))])
+    if abs(m.imag) > _REAL:
+        return "neimark-sacker"
+    if m.real < 0:
+        return "flip"
+    return "fold" if fold else "branch"
+
+
 def _flags(
     before: BranchPoint,
     after: BranchPoint,
@@ -316,22 +461,11 @@ def _flags(
         flags.append("fold")
         # The parameter's rate along the branch is zero there.
         crossings["fold"] = _fold(before.value, after.value, t0[size] * arc, t1[size] * arc)
-    real = 1e-6
-    classes: dict[str, Callable[[complex], bool]] = {
-        "flip": lambda m: abs(m.imag) <= real and m.real < 0,
-        "neimark-sacker": lambda m: abs(m.imag) > real,
-        "branch": lambda m: abs(m.imag) <= real and m.real > 0,
-    }
-
-    def largest(multipliers: np.ndarray, member: Callable[[complex], bool]) -> float:
-        chosen = [abs(m) for m in multipliers if member(m)]
-        return max(chosen) - 1.0 if chosen else -1.0
-
-    for name, member in classes.items():
+    for name in _CLASSES:
         if name == "branch" and "fold" in flags:
             continue
-        a = largest(before.floquet_multipliers, member)
-        b = largest(after.floquet_multipliers, member)
+        a = _largest(before.floquet_multipliers, name)
+        b = _largest(after.floquet_multipliers, name)
         if (a > 0) != (b > 0):
             flags.append(name)
             crossings[name] = before.value + (after.value - before.value) * a / (a - b)

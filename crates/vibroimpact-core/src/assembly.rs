@@ -1318,6 +1318,10 @@ pub fn resumed_state(assembly: &Assembly, arrays: [&[f64]; 4]) -> Result<Vec<f64
     state_from(assembly, arrays, true)
 }
 
+/// A depth inside a wall (m) that no system resolves, ten orders below an
+/// atom's size: a resumed state that deep is on its wall whatever its scale.
+const NEGLIGIBLE_DEPTH: f64 = 1e-20;
+
 fn state_from(assembly: &Assembly, arrays: [&[f64]; 4], resumed: bool) -> Result<Vec<f64>> {
     let [structure_displacement, structure_velocity, damper_displacement, damper_velocity] = arrays;
     let (n, k, d) = (assembly.n, assembly.k, assembly.dim);
@@ -1348,11 +1352,12 @@ fn state_from(assembly: &Assembly, arrays: [&[f64]; 4], resumed: bool) -> Result
         // On the wall to round-off is at the wall.
         let scale = assembly.gap_scale(i, &y);
         let round_off = 8.0 * f64::EPSILON * scale;
-        if resumed && gap < -round_off && gap >= -1e-8 * scale {
+        if resumed && gap < -round_off && gap >= -(1e-8 * scale).max(NEGLIGIBLE_DEPTH) {
             // A run's end with a pair resting or stuck on its wall is inside
             // it by the drift of the method's solution (1e-12 m at dop853's
-            // default tolerances): put back on the wall, the least change of
-            // the coordinates along the gap's row.
+            // default tolerances; or a round-off of no length at all, where
+            // the wall and the point are both at the origin): put back on the
+            // wall, the least change of the coordinates along the gap's row.
             let norm: f64 = it.h.iter().map(|h| h * h).sum();
             for (x, h) in y[..d].iter_mut().zip(&it.h) {
                 *x -= gap * h / norm;
