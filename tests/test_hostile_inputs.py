@@ -100,6 +100,21 @@ def test_a_plot_onto_the_scenario_is_refused(tmp_path: Path, run_cli: Cli) -> No
     assert scenario.read_text(encoding="utf-8") == BASE
 
 
+@pytest.mark.parametrize("command", ["orbit", "continue", "poincare", "study"])
+def test_a_plot_not_named_png_is_refused_before_anything_runs(
+    tmp_path: Path, run_cli: Cli, command: str
+) -> None:
+    # The plots are PNG images: one written into branch.txt misleads its readers (user
+    # trial). Refused before the analysis runs, the file left as it was.
+    scenario = write(tmp_path, BASE)
+    target = tmp_path / "branch.txt"
+    target.write_text("kept", encoding="utf-8")
+    extra = ["--out", str(tmp_path / "s.nc")] if command == "study" else []
+    refused(run_cli(command, str(scenario), *extra, "--plot", str(target)), "--plot", ".png")
+    assert target.read_text(encoding="utf-8") == "kept"
+    assert not (tmp_path / "s.nc").exists()
+
+
 # 2. A recorded signal's file: regular, bounded, two columns, errors naming it.
 
 RECORDED = """

@@ -25,7 +25,7 @@ from vibroimpact.analyses import (
 )
 from vibroimpact.continuation import continue_orbit
 from vibroimpact.maps import basins, bifurcation, poincare
-from vibroimpact.output import UsageError, check_output, finite_or_none
+from vibroimpact.output import UsageError, check_plot, finite_or_none
 from vibroimpact.scenario import load_scenario
 from vibroimpact.system_scenario import SystemScenario
 
@@ -357,7 +357,8 @@ def run_poincare(args: argparse.Namespace) -> int:
         return 0
     print(
         f"{args.scenario}: {len(section.strobe)} stroboscopic points and "
-        f"{len(section.impact_phase)} impacts in {cpu_time:.3f} s"
+        # The impact section holds rigid impacts (a compliant contact has no instant).
+        f"{len(section.impact_phase)} rigid impacts in {cpu_time:.3f} s"
     )
     if args.plot:
         print(f"plot written to {args.plot}")
@@ -484,7 +485,7 @@ def _naming_the_file(
 
     def run(args: argparse.Namespace) -> int:
         if getattr(args, "plot", None):
-            check_output(args.plot, "--plot", [args.scenario])
+            check_plot(args.plot, [args.scenario])
         try:
             return command(args)
         except InvalidInputError as err:

@@ -70,6 +70,15 @@ def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
             )
 
 
+def check_plot(path: Path, inputs: Sequence[Path] = ()) -> None:
+    """Refuse, before anything runs, a ``--plot`` path that :func:`check_output`
+    refuses or that does not name a PNG image (the only format the plots are written
+    in: a PNG written under another suffix would mislead the file's readers)."""
+    if path.suffix.lower() != ".png":
+        raise UsageError(f"--plot {path}: plots are PNG images; give a file name ending in .png")
+    check_output(path, "--plot", inputs)
+
+
 @contextlib.contextmanager
 def written_whole(path: Path, binary: bool = False) -> Iterator[IO[Any]]:
     """Open a file to write ``path`` whole or not at all.

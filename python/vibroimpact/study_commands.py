@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.output import UsageError, check_output
+from vibroimpact.output import UsageError, check_output, check_plot
 from vibroimpact.scenario import load_scenario
 from vibroimpact.study import output_kind, run, study_of, terminal_progress
 from vibroimpact.system_scenario import SystemScenario
@@ -83,7 +83,7 @@ def run_study_command(args: argparse.Namespace) -> int:
     if output_kind(args.out) != ".zarr":
         check_output(args.out, "--out", [args.scenario])
     if args.plot:
-        check_output(args.plot, "--plot", [args.scenario])
+        check_plot(args.plot, [args.scenario])
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
         raise UsageError(f"{args.scenario}: study takes a 0.2 scenario (a [structure] section)")
