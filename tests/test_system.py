@@ -114,6 +114,36 @@ def test_rattling_damper_matches_a_scipy_event_oracle() -> None:
     np.testing.assert_allclose(ours[: len(impacts)], impacts, atol=1e-8)
 
 
+@pytest.mark.parametrize("method", ["dop853", "dopri5"])
+def test_an_adaptive_step_does_not_pass_over_a_short_flight(method: str) -> None:
+    # A vertical forced oscillator with a loose mass under gravity (user trial): after an
+    # impact at 0.5139695 s two flights of 0.4 ms and 0.5 ms follow, inside one 3 ms step
+    # of dop853 (its step after an event being 1e-3 t_end). A smooth flight gives the
+    # error control no reason to shorten it and the gap is open at both ends: the two
+    # impacts were missed at t_end = 3 s (not at 0.6 s), whatever the rtol. Against the
+    # exact flow (every rebound landed on its parabola), to 0.6 s whatever t_end.
+    sections: dict[str, Any] = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 4000.0, "damping": 2.0},
+        "damper": [{"mass": 0.1, "at": 0, "clearance": 0.002, "law": "rigid", "restitution": 0.6}],
+        "gravity": {"acceleration": 9.81},
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 30.0, "frequency": 8.0}
+        ],
+    }
+
+    def onsets(t_end: float, method: str, **options: float) -> np.ndarray:
+        sol = simulate_system(**sections, t_end=t_end, method=method, history=False, **options)
+        on = np.asarray(sol.contacts.onset)
+        return on[on < 0.6]
+
+    exact = onsets(0.6, "exact")
+    assert np.count_nonzero((exact > 0.5139) & (exact < 0.515)) == 3
+    for t_end in (0.6, 3.0):
+        ours = onsets(t_end, method, rtol=1e-12, atol=1e-14)
+        assert len(ours) == len(exact), t_end
+        np.testing.assert_allclose(ours, exact, atol=1e-8)
+
+
 def test_momentum_through_rigid_impacts_of_a_free_pair() -> None:
     sol = simulate_system(
         {"kind": "matrices", "mass": [[1.5]], "stiffness": [[0.0]]},

@@ -966,6 +966,16 @@ impl Assembly {
     /// clearances (0 for a zero clearance, to round-off), and it has no
     /// event of its own. Sticking it as well would make the constraints
     /// dependent.
+    /// When open interaction `i` at state `y`, its coordinates' accelerations
+    /// `acc` (m/s^2), would reach its wall on its gap's parabola (s after
+    /// now); None where the gap's acceleration does not close it.
+    pub fn landing_time(&self, i: usize, y: &[f64], acc: &[f64]) -> Option<f64> {
+        let (gap, rate) = self.gap(i, y);
+        let closing = -linalg::dot(&self.interactions[i].h, &acc[..self.dim]);
+        (closing > 0.0)
+            .then(|| (rate + (rate * rate + 2.0 * closing * gap.max(0.0)).sqrt()) / closing)
+    }
+
     pub fn held_by_mirror(&self, i: usize, modes: &[Mode]) -> bool {
         let before = self.mirrors_previous[i] && modes[i - 1] == Mode::Sticking;
         let after =

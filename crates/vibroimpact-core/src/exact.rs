@@ -858,15 +858,12 @@ impl SystemStepper for ExactFlow {
                 }
                 evaluated = true;
             }
-            let (gap, rate) = system.gap(i, y);
-            let closing = -crate::linalg::dot(&system.interactions[i].h, &rates[d..2 * d]);
-            if closing > 0.0 {
+            if let Some(hit) = system.landing_time(i, y, &rates[d..2 * d]) {
                 // The gap's parabola reaches the wall at `hit`: end the step a
                 // little after it, so that the step's end sees the gap shut
                 // even if the wall would draw away again later in the step.
                 // Rebounds that come back sooner than the floor come back
                 // within the next few steps, where their ends see them.
-                let hit = (rate + (rate * rate + 2.0 * closing * gap.max(0.0)).sqrt()) / closing;
                 limit = limit.min((1.5 * hit).max(step / APEX_STEPS));
             }
         }

@@ -923,6 +923,23 @@ pub fn integrate_system_within<S: SystemStepper>(
         if adaptive && (t_end - time - length) < 1e-3 * length {
             length = t_end - time;
         }
+        if adaptive && modes.contains(&Mode::Open) {
+            // A step that passes over a short flight (a rebound that lands and
+            // leaves again within it) shows the gap open at both ends, and a
+            // smooth flight gives the error control no reason to shorten it:
+            // end it a little after each open gap's parabola lands, no sooner
+            // than the resolution (shorter flights are a chattering sequence).
+            if let Some(rates) = stepper.start_rates(system, time, &y, &modes, &mut scratch) {
+                for (i, mode) in modes.iter().enumerate() {
+                    if *mode != Mode::Open || system.held_by_mirror(i, &modes) {
+                        continue;
+                    }
+                    if let Some(hit) = system.landing_time(i, &y, &rates[d..2 * d]) {
+                        length = length.min((1.5 * hit).max(resolution));
+                    }
+                }
+            }
+        }
         if adaptive && modes.contains(&Mode::Sticking) {
             // A sticking pair's release shows only as its constraint force
             // at a step's end: steps short enough not to pass over it.

@@ -34,6 +34,19 @@ pub trait SystemStepper {
     ) -> Result<f64> {
         Ok(f64::INFINITY)
     }
+    /// The state's rates at `(time, y)` where an adaptive method has them for
+    /// nothing (its first stage, kept for the attempt that follows), else
+    /// None: the kernel ends a step soon after an open gap's parabola lands.
+    fn start_rates(
+        &mut self,
+        _system: &Assembly,
+        _time: f64,
+        _y: &[f64],
+        _modes: &[Mode],
+        _scratch: &mut Scratch,
+    ) -> Option<&[f64]> {
+        None
+    }
     /// Forget data carried from the last step (the right-hand side jumped).
     fn reset(&mut self);
     /// Attempt a step `h` from `(time, y)` into `out`; the scaled error
@@ -375,6 +388,27 @@ impl SystemStepper for ExplicitRk {
     fn reset(&mut self) {
         self.start_valid = false;
         self.end_slot = None;
+    }
+
+    /// The first stage, `f(y)`: what the next attempt from `y` starts from
+    /// (computed now, and kept, where the last step's end did not give it).
+    fn start_rates(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) -> Option<&[f64]> {
+        if !self.is_adaptive() {
+            return None;
+        }
+        if !self.start_valid {
+            system.rates(time, y, modes, scratch, &mut self.k[0]);
+            self.evaluations += 1;
+            self.start_valid = true;
+        }
+        Some(&self.k[0])
     }
 
     /// The error control weighs the coordinates and velocities, not the
