@@ -144,6 +144,41 @@ def test_an_adaptive_step_does_not_pass_over_a_short_flight(method: str) -> None
         np.testing.assert_allclose(ours, exact, atol=1e-8)
 
 
+def test_a_cantilevers_deflection_at_a_point_is_the_static_closed_form() -> None:
+    # A constant tip force P on a heavily damped beam (10 modes, zeta 0.7: settled to
+    # 1e-11 in 0.5 s): the deflection at the tip is P L^3 / 3 EI and at mid-span
+    # 5 P L^3 / 48 EI (Euler-Bernoulli), to the modal truncation's 4e-5.
+    length, youngs, second, rho_a, p = 0.5, 7e10, 1e-10, 0.27, 0.3
+    ei = youngs * second
+    sol = simulate_system(
+        {
+            "kind": "cantilever",
+            "length": length,
+            "youngs_modulus": youngs,
+            "second_moment": second,
+            "mass_per_length": rho_a,
+            "modes": 10,
+            "damping_ratio": 0.7,
+        },
+        excitation=[
+            {"kind": "force", "at": length, "signal": "harmonic", "amplitude": p, "frequency": 0.0}
+        ],
+        t_end=0.5,
+        method="exact",
+    )
+    tip = sol.displacement_at(length)
+    assert tip[-1] == pytest.approx(p * length**3 / (3 * ei), rel=1e-4)
+    assert sol.displacement_at(length / 2)[-1] == pytest.approx(
+        5 * p * length**3 / (48 * ei), rel=1e-4
+    )
+    # The modal sum itself, and the velocity (at rest by then).
+    shape = [vi.cantilever_mode_shape(length, i + 1, length) for i in range(10)]
+    np.testing.assert_allclose(tip, sol.structure_displacement @ shape, rtol=1e-14)
+    assert abs(sol.velocity_at(length)[-1]) < 1e-9
+    with pytest.raises(ValueError, match="at must be a position along the beam in"):
+        sol.displacement_at(0.6)
+
+
 def test_momentum_through_rigid_impacts_of_a_free_pair() -> None:
     sol = simulate_system(
         {"kind": "matrices", "mass": [[1.5]], "stiffness": [[0.0]]},

@@ -55,6 +55,7 @@ from vibroimpact._core import (
     RTOL_RANGE,
     Contact,
     InvalidInputError,
+    cantilever_mode_shape,
 )
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
@@ -727,6 +728,39 @@ class SystemSolution:
     #: ``[initial]``, concatenated as the history's columns) and its times (s).
     strobe: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     strobe_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: The checked ``[structure]`` the run integrated.
+    structure: dict[str, Any] = field(default_factory=dict)
+
+    def shape_at(self, at: float) -> np.ndarray:
+        """The structure coordinates' weights at a point: the displacement there is
+        ``structure_displacement @ shape_at(at)``. For a cantilever ``at`` is a position
+        along the beam (m from the clamp) and the weights are the mode shapes there
+        (``cantilever_mode_shape(length, i + 1, at)``); otherwise ``at`` is a coordinate
+        index and the weights pick it."""
+        if not self.structure:
+            raise InvalidInputError("at: this solution does not hold its structure")
+        value = real(at)
+        if value is None:
+            raise _fail("", f"at must be a number, got {shown(at)}")
+        _check_point("at", at, float(value), self.structure)
+        n = structure_coordinates(self.structure)
+        if self.structure["kind"] == "cantilever":
+            length = float(self.structure["length"])
+            return np.array([cantilever_mode_shape(length, i + 1, float(value)) for i in range(n)])
+        weights = np.zeros(n)
+        weights[int(value)] = 1.0
+        return weights
+
+    def displacement_at(self, at: float) -> np.ndarray:
+        """The structure's displacement (m, relative to the base) at a point (see
+        :meth:`shape_at`: a cantilever's deflection at ``at`` m from the clamp), at each
+        kept time ``t``."""
+        return np.asarray(self.structure_displacement @ self.shape_at(at), dtype=float)
+
+    def velocity_at(self, at: float) -> np.ndarray:
+        """The structure's velocity (m/s, relative to the base) at a point (see
+        :meth:`shape_at`), at each kept time ``t``."""
+        return np.asarray(self.structure_velocity @ self.shape_at(at), dtype=float)
 
 
 def simulate_system(
@@ -855,7 +889,7 @@ class PreparedRun:
         except InvalidInputError as err:
             # The core writes its numbers in full: 1e300 as 301 digits.
             raise type(err)(short_numbers(str(err))) from None
-        return _solution(raw, solver["method"])
+        return _solution(raw, solver["method"], self.spec["structure"])
 
 
 def prepare_system(
@@ -952,7 +986,9 @@ def prepare_system(
     return PreparedRun(spec, init, solver, output)
 
 
-def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
+def _solution(
+    raw: dict[str, Any], method: str, structure: Mapping[str, Any] | None = None
+) -> SystemSolution:
     n, k = raw["n"], raw["k"]
     recorded = raw["recorded_time"] > 0
     width = 2 * (n + k)
@@ -994,6 +1030,7 @@ def _solution(raw: dict[str, Any], method: str) -> SystemSolution:
         recorded_time=raw["recorded_time"],
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],
+        structure=dict(structure or {}),
     )
 
 
