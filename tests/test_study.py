@@ -189,6 +189,23 @@ def test_a_failed_run_is_recorded_with_its_reason_and_the_others_go_on(tmp_path:
     assert np.isnan(ds["peak"].values[1]).all() and np.isfinite(ds["peak"].values[[0, 2]]).all()
 
 
+def test_more_distinct_failures_than_a_16_bit_code_holds_are_all_numbered(
+    tmp_path: Path,
+) -> None:
+    # 33000 runs each failing for its own reason (each quotes its mass): the status was
+    # int16 and the file's writing overflowed at the 32768th reason, every time it was
+    # resumed too (user trial).
+    ds = peak_study(tmp_path, '"damper.0.mass" = { start = -1.0, stop = -0.001, count = 33000 }')
+    reasons = json.loads(ds.attrs["reasons"])
+    assert len(reasons) == 33000
+    status = ds["status"].values
+    assert status.tolist() == list(range(1, 33001))
+    # Each code names its own run's reason.
+    masses = ds["damper.0.mass"].values
+    for i in (0, 32767, 32999):
+        assert f"{masses[i]:g}"[:5] in reasons[status[i] - 1]
+
+
 def test_a_failed_runs_reason_names_the_axis_as_written(tmp_path: Path) -> None:
     # It named lower_clearance, a key the scenario did not use (user trial).
     ds = peak_study(tmp_path, '"damper.0.clearance" = [0.004, -0.004]')
@@ -578,3 +595,49 @@ def test_newmark_peaks_do_not_depend_on_whether_rms_is_kept(tmp_path: Path) -> N
     with_rms = text.replace('metrics = ["peak"]', 'metrics = ["peak", "rms"]')
     other = st.run(load(scenario(tmp_path, with_rms, "b.toml")), tmp_path / "b.nc")
     assert peaks.tolist() == other["peak"].values.tolist()
+
+
+@pytest.mark.parametrize("key", ["settle_periods", "record_periods", "orbit_periods"])
+def test_forcing_periods_beyond_the_analyses_limit_are_refused_when_read(
+    tmp_path: Path, key: str
+) -> None:
+    # 1e11 settle periods ran for half a minute into gigabytes of contacts (user trial);
+    # the analyses' own settings are held to 1e7 periods.
+    analysis = "orbit" if key == "orbit_periods" else "steady-state"
+    text = BASE + (
+        f'[study]\nanalysis = "{analysis}"\n{key} = 100000000000\n'
+        '[study.axes]\n"damper.0.mass" = [0.05]\n'
+    )
+    with pytest.raises(ValueError, match=rf"\[study\] {key}: must be at most 10000000"):
+        load(scenario(tmp_path, text))
+
+
+STUDY_TAIL = (
+    '[study]\nanalysis = "run"\nmetrics = ["peak"]\n[study.axes]\n"damper.0.mass" = [0.05]\n'
+)
+
+
+def test_threads_out_of_range_are_refused(tmp_path: Path) -> None:
+    # threads=-1 overflowed in the binding; 100000 spawned that many threads (user trial).
+    study = load(scenario(tmp_path, BASE + STUDY_TAIL))
+    for threads in (-1, 100_000, 2.5, True):
+        with pytest.raises(st.StudyError, match="threads: must be"):
+            st.run(study, tmp_path / "out.nc", threads=threads)  # type: ignore[arg-type]
+    assert not (tmp_path / "out.nc").exists()
+
+
+def test_a_recorded_signals_file_is_part_of_the_studys_identity(tmp_path: Path) -> None:
+    # An interrupted study resumed after its CSV changed mixed the two signals in one
+    # file (user trial): the file's contents are in the input hash.
+    (tmp_path / "force.csv").write_text("0,0\n1,1\n", encoding="utf-8")
+    text = (
+        BASE.replace('signal = "harmonic"', 'signal = "recorded"\nfile = "force.csv"')
+        .replace("amplitude = 5.0\n", "")
+        .replace("frequency = 10.0\n", "")
+        .replace('method = "exact"', 'method = "dop853"')
+        + STUDY_TAIL
+    )
+    first = load(scenario(tmp_path, text)).fingerprint()
+    assert load(scenario(tmp_path, text)).fingerprint() == first
+    (tmp_path / "force.csv").write_text("0,0\n1,2\n", encoding="utf-8")
+    assert load(scenario(tmp_path, text)).fingerprint() != first

@@ -98,7 +98,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import __version__, run_study
-from vibroimpact.analyses import AnalysisError, _prepare
+from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
 
@@ -159,6 +159,11 @@ _DESCRIPTIONS = {
 
 class StudyError(AnalysisError):
     """A study that cannot be set up as asked (a ValueError)."""
+
+
+#: The most threads (or Dask processes) a study may ask for: more than any machine's
+#: cores, far fewer than would exhaust its threads.
+MAX_WORKERS = 1024
 
 
 #: The most runs a study may hold (the product of its axes' counts, times ``samples``):
@@ -230,6 +235,12 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
     ):
         if out[key] < low:
             raise StudyError(f"[study] {key}: must be >= {low}, got {out[key]}")
+        if key != "chunk_size" and out[key] > MAX_PERIODS:
+            # As the analyses' own settings: 1e11 periods ran for half a minute into
+            # gigabytes of contacts before failing (user trial).
+            raise StudyError(
+                f"[study] {key}: must be at most {MAX_PERIODS} forcing periods, got {out[key]}"
+            )
     if not out["record_from"] >= 0:
         raise StudyError(f"[study] record_from: must be >= 0 s, got {out['record_from']}")
     if not out["tolerance"] > 0:
@@ -442,12 +453,24 @@ class Study:
         return int(np.prod(self.shape))
 
     def fingerprint(self) -> str:
-        """A hash of everything that decides the results."""
-        canonical = json.dumps(
-            {"data": _plain(self.data), "version": __version__},
-            sort_keys=True,
-            default=str,
-        )
+        """A hash of everything that decides the results: the scenario, the version,
+        and the contents of the files it reads (a recorded signal changed between an
+        interrupted run and its resumption would otherwise mix two inputs)."""
+        content: dict[str, Any] = {"data": _plain(self.data), "version": __version__}
+        files: list[str | None] = []
+        for e in self.data.get("excitation", None) or ():
+            name = e.get("file") if isinstance(e, Mapping) else None
+            if isinstance(name, str):
+                path = Path(name)
+                if self.base_dir is not None and not path.is_absolute():
+                    path = self.base_dir / path
+                try:
+                    files.append(hashlib.sha256(path.read_bytes()).hexdigest())
+                except OSError:
+                    files.append(None)
+        if files:
+            content["files"] = files
+        canonical = json.dumps(content, sort_keys=True, default=str)
         return hashlib.sha256(canonical.encode()).hexdigest()
 
     def chunks(self) -> list[range]:
@@ -541,15 +564,16 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     pairs = list(parts[0]["pairs"]) if parts else []
     shape = study.shape
     dims = study.dims
-    reasons: list[str] = []
+    # Each distinct reason once, numbered in order of first failure (a dict: a study
+    # of millions of failures, each quoting its own value, is linear, not quadratic).
+    numbers: dict[str, int] = {}
     status = np.concatenate([np.asarray(p["status"], dtype=np.int16) for p in parts])
-    codes = np.zeros(len(status), dtype=np.int16)
+    codes = np.zeros(len(status), dtype=np.int32)
     flat_reasons = [r for p in parts for r in p["reason"]]
     for i, (s, reason) in enumerate(zip(status, flat_reasons, strict=True)):
         if s:
-            if reason not in reasons:
-                reasons.append(reason)
-            codes[i] = reasons.index(reason) + 1
+            codes[i] = numbers.setdefault(reason, len(numbers) + 1)
+    reasons = list(numbers)
     data_vars: dict[str, Any] = {
         "status": (
             dims,
@@ -666,6 +690,13 @@ def run(
     an uninterrupted run) and the parts removed. ``dask``: the address of a Dask
     scheduler, or ``"local"`` for a LocalCluster of ``threads`` processes (all cores for
     0), the chunks its tasks; the results are the same. Returns the Dataset."""
+    if isinstance(threads, bool) or not isinstance(threads, int):
+        raise StudyError(f"threads: must be a whole number, got {threads!r}")
+    if not 0 <= threads <= MAX_WORKERS:
+        raise StudyError(
+            f"threads: must be in [0, {MAX_WORKERS}] (0: all cores, {os.cpu_count() or 1} "
+            f"here), got {threads}"
+        )
     kind = output_kind(out)
     parts_dir = out.with_name(out.name + ".parts")
     fingerprint = study.fingerprint()

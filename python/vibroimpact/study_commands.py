@@ -15,12 +15,8 @@ import numpy as np
 from vibroimpact._core import InvalidInputError
 from vibroimpact.output import UsageError, check_output, check_plot
 from vibroimpact.scenario import load_scenario
-from vibroimpact.study import output_kind, run, study_of, terminal_progress
+from vibroimpact.study import MAX_WORKERS, output_kind, run, study_of, terminal_progress
 from vibroimpact.system_scenario import SystemScenario
-
-#: The most threads (or Dask processes) a study may ask for: more than any machine's
-#: cores, far fewer than would exhaust its threads.
-MAX_WORKERS = 1024
 
 
 def add_command(sub: Any) -> None:

@@ -446,7 +446,7 @@ pub fn run_study(
                 } else {
                     &values[row * width..(row + 1) * width]
                 };
-                Ok(one_run(spec, initial, parameters, row_values, settings))
+                one_run(spec, initial, parameters, row_values, settings, interrupt)
             })
             .collect::<Vec<Result<RunMetrics>>>()
     });
@@ -647,9 +647,14 @@ fn run_starts(
                         p.apply_start(spec, &mut start, *v);
                     }
                     let run = match stepper {
-                        Ok(method) => measured_on(spec, &system, method, &start, settings),
+                        Ok(method) => {
+                            measured_on(spec, &system, method, &start, settings, interrupt)
+                        }
                         Err(e) => Err(e.clone()),
                     };
+                    if let Err(e @ Error::Interrupted { .. }) = run {
+                        return Err(e);
+                    }
                     if run.is_err() {
                         // A run stopped part way may leave work in the method
                         // (the exact flow's pending energies): a fresh one next.
@@ -663,23 +668,27 @@ fn run_starts(
     results.into_iter().collect()
 }
 
+/// One run of the study at `values`: its metrics, or those of a failed run
+/// with its reason; an interrupt (which stops the run part way) is an error.
 fn one_run(
     spec: &SystemSpec,
     initial: &[Vec<f64>; 4],
     parameters: &[Parameter],
     values: &[f64],
     settings: &StudySettings,
-) -> RunMetrics {
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> Result<RunMetrics> {
     let mut spec = spec.clone();
     let mut initial = initial.clone();
     for (p, v) in parameters.iter().zip(values) {
         if let Err(e) = p.apply(&mut spec, &mut initial, *v) {
-            return failed_run(&spec, e.to_string());
+            return Ok(failed_run(&spec, e.to_string()));
         }
     }
-    match measured(&spec, &initial, settings) {
-        Ok(metrics) => metrics,
-        Err(e) => failed_run(&spec, e.to_string()),
+    match measured(&spec, &initial, settings, interrupt) {
+        Ok(metrics) => Ok(metrics),
+        Err(e @ Error::Interrupted { .. }) => Err(e),
+        Err(e) => Ok(failed_run(&spec, e.to_string())),
     }
 }
 
@@ -687,10 +696,11 @@ fn measured(
     spec: &SystemSpec,
     initial: &[Vec<f64>; 4],
     settings: &StudySettings,
+    interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<RunMetrics> {
     let system = Assembly::new(spec)?;
     let mut stepper = stepper_of(&system, settings)?;
-    measured_on(spec, &system, &mut stepper, initial, settings)
+    measured_on(spec, &system, &mut stepper, initial, settings, interrupt)
 }
 
 /// A run of `system` (made of `spec`) from `initial`, by `stepper` (which
@@ -701,6 +711,7 @@ fn measured_on(
     stepper: &mut AnyStepper,
     initial: &[Vec<f64>; 4],
     settings: &StudySettings,
+    interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<RunMetrics> {
     let y0 = initial_state(system, &initial[0], &initial[1], &initial[2], &initial[3])?;
     let period = || forcing_period(spec);
@@ -711,7 +722,14 @@ fn measured_on(
             ((settle + record) as f64 * t, settle as f64 * t, t)
         }
         Analysis::Orbit { settle, periods } => {
-            return orbit_metrics(system, stepper, &y0, settings, period()?, settle, periods);
+            return orbit_metrics(
+                system,
+                stepper,
+                &y0,
+                settings,
+                (period()?, settle, periods),
+                interrupt,
+            );
         }
     };
     let options = run_options(
@@ -724,7 +742,7 @@ fn measured_on(
             mean_square: settings.mean_square,
         },
     );
-    let sol = stepper.integrate(system, &y0, &options, &mut || false)?;
+    let sol = stepper.integrate(system, &y0, &options, &mut || interrupt())?;
     Ok(metrics_of(system, &sol, record_from, settings))
 }
 
@@ -766,9 +784,8 @@ fn orbit_metrics(
     stepper: &mut AnyStepper,
     y0: &[f64],
     settings: &StudySettings,
-    period: f64,
-    settle: u64,
-    periods: u64,
+    (period, settle, periods): (f64, u64, u64),
+    interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<RunMetrics> {
     let span = periods as f64 * period;
     let options = |t_end: f64, record: bool| {
@@ -790,14 +807,14 @@ fn orbit_metrics(
     let record_options = options(span, true);
     let mut z = if settle > 0 {
         stepper
-            .integrate(system, y0, &settle_options, &mut || false)?
+            .integrate(system, y0, &settle_options, &mut || interrupt())?
             .final_state
     } else {
         y0[..2 * d].to_vec()
     };
     let mut run_from = |z: &[f64], options: &RunOptions| -> Result<SystemSolution> {
         let y = resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..2 * d]])?;
-        let run = stepper.integrate(system, &y, options, &mut || false);
+        let run = stepper.integrate(system, &y, options, &mut || interrupt());
         if run.is_err() {
             // A run stopped part way may leave work in the method (the exact
             // flow's pending energies): the next starts with a fresh one.

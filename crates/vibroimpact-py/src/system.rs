@@ -3,6 +3,9 @@
 //! types by `vibroimpact.system`), integrated with the GIL released, and the
 //! results returned as flat NumPy arrays for the Python side to shape.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -818,16 +821,35 @@ pub fn run_study<'py>(
             }
         },
     };
-    let results = released(py, |_| {
-        study(
-            &system_spec,
-            &initial,
-            &parameters,
-            &values,
-            &settings,
-            threads,
-            &|| false,
-        )
+    let results = released(py, |interrupt| {
+        // The runs go on the study's threads, where Python's signals cannot be
+        // seen: this thread watches them and raises a flag every run checks
+        // (between its steps), so Ctrl-C stops the chunk within moments.
+        let stop = AtomicBool::new(false);
+        std::thread::scope(|scope| {
+            let worker = scope.spawn(|| {
+                study(
+                    &system_spec,
+                    &initial,
+                    &parameters,
+                    &values,
+                    &settings,
+                    threads,
+                    &|| stop.load(Ordering::Relaxed),
+                )
+            });
+            while !worker.is_finished() {
+                std::thread::sleep(Duration::from_millis(20));
+                if !stop.load(Ordering::Relaxed) && interrupt() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+            worker.join().unwrap_or_else(|_| {
+                Err(core::Error::Inconsistent(
+                    "the study's threads failed (an internal error); please report it".into(),
+                ))
+            })
+        })
     })?;
     let out = PyDict::new(py);
     out.set_item("n", base.n)?;
