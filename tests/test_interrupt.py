@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from study_checks import FORCED_DAMPER  # noqa: E402
+
 LONG_RUN = """
 import vibroimpact as vi
 system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01)
@@ -40,39 +42,10 @@ def test_sigint_interrupts_a_long_run_with_keyboard_interrupt() -> None:
     assert "KeyboardInterrupt" in err
 
 
-LONG_STUDY = """
-[structure]
-kind = "oscillator"
-mass = 1.0
-stiffness = 3947.8
-damping = 2.513
-
-[[damper]]
-mass = 0.05
-at = 0
-clearance = 0.005
-law = "rigid"
-restitution = 0.6
-
-[[excitation]]
-kind = "force"
-at = 0
-signal = "harmonic"
-amplitude = 5.0
-frequency = 10.0
-
-[solver]
-method = "dopri5"
-t_end = 1.0
-
-[study]
-analysis = "run"
-metrics = ["peak"]
-chunk_size = 4
-
-[study.axes]
-"excitation.0.frequency" = [9.0, 10.0, 11.0, 12.0]
-"""
+LONG_STUDY = FORCED_DAMPER.replace('method = "exact"', 'method = "dopri5"') + (
+    '[study]\nanalysis = "run"\nmetrics = ["peak"]\nchunk_size = 4\n'
+    '[study.axes]\n"excitation.0.frequency" = [9.0, 10.0, 11.0, 12.0]\n'
+)
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT semantics")
@@ -81,7 +54,7 @@ def test_sigint_stops_a_study_within_its_chunk(tmp_path: Path) -> None:
     # signal was never looked at, so Ctrl-C waited for the whole chunk (30 s, or for
     # ever; user trial). Now within moments, exit 130, no file written.
     scenario = tmp_path / "study.toml"
-    scenario.write_text(LONG_STUDY.replace("t_end = 1.0", "t_end = 1e6"), encoding="utf-8")
+    scenario.write_text(LONG_STUDY.replace("t_end = 0.5", "t_end = 1e6"), encoding="utf-8")
     out = tmp_path / "out.nc"
     proc = subprocess.Popen(
         [sys.executable, "-m", "vibroimpact", "study", str(scenario), "--out", str(out)],
