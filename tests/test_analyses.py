@@ -20,6 +20,8 @@ the stroboscopic map is smooth.
 from __future__ import annotations
 
 import math
+import tomllib
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -776,3 +778,31 @@ def test_a_state_inside_its_wall_by_round_off_of_nothing_is_put_on_the_wall() ->
             t_end=0.1,
             method="exact",
         )
+
+
+def test_a_whole_number_key_swept_stays_a_whole_number() -> None:
+    # A sweep's values are floats: structure.modes = 3.0 was refused by the check of
+    # a whole number ("got 3.0", user trial). A float key stays a float.
+    beam = Path(__file__).resolve().parents[1] / "examples" / "beam_two_dampers.toml"
+    data = {"structure": tomllib.loads(beam.read_text(encoding="utf-8"))["structure"]}
+    changed = an.with_parameter(data, "structure.modes", 4.0)
+    assert changed["structure"]["modes"] == 4 and isinstance(changed["structure"]["modes"], int)
+    length = an.with_parameter(data, "structure.length", 1.0)["structure"]["length"]
+    assert isinstance(length, float)
+    # And it runs, with 4 modes.
+    run = an.runner(
+        changed
+        | {
+            "excitation": [
+                {
+                    "kind": "force",
+                    "at": 0.5,
+                    "signal": "harmonic",
+                    "amplitude": 0.01,
+                    "frequency": 10.0,
+                }
+            ],
+            "solver": {"method": "exact"},
+        }
+    )
+    assert run.n == 4

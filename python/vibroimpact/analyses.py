@@ -112,6 +112,11 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
             raise AnalysisError(f"parameter {path!r}: {'.'.join(parts[: depth + 1])} is a value")
     if isinstance(node, list):
         raise AnalysisError(f"parameter {path!r}: ends on a list; name an entry's key")
+    current = node.get(parts[-1]) if isinstance(node, Mapping) else None
+    if isinstance(current, int) and not isinstance(current, bool) and float(value).is_integer():
+        # A whole-number key (a cantilever's modes, a seed) stays one: a sweep's
+        # values are floats, which its check refused ("got 3.0", user trial).
+        value = int(value)
     node[parts[-1]] = value
     return out
 
