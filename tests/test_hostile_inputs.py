@@ -608,3 +608,33 @@ def test_the_compiled_constructors_take_numpy_reals() -> None:
         main_mass=np.float32(1.0), stiffness=np.int64(1), impact_mass=0.25, clearance=0.01
     )
     assert (damper.main_mass, damper.stiffness) == (1.0, 1.0)
+
+
+@pytest.mark.parametrize("length", ["-1.0", "0.0"])
+def test_a_beam_of_no_length_is_named_before_the_points_on_it(length: str) -> None:
+    # "excitation 0 at must be a position along the beam in [0, -1.0] m": the point's
+    # range came first, the beam's own error only where nothing had an at (user trial).
+    text = """
+[structure]
+kind = "cantilever"
+length = LENGTH
+youngs_modulus = 7e10
+second_moment = 1e-10
+mass_per_length = 0.27
+modes = 3
+damping_ratio = 0.01
+
+[[excitation]]
+kind = "force"
+at = 0.5
+signal = "harmonic"
+amplitude = 0.5
+frequency = 8.0
+
+[solver]
+method = "dopri5"
+t_end = 0.1
+""".replace("LENGTH", length)
+    message = parse_error(text)
+    assert "structure.length must be a finite number > 0" in message
+    assert "at must be" not in message

@@ -459,6 +459,10 @@ def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) ->
     error short and exact (the core would write 1e300 as 301 digits)."""
     if structure["kind"] == "cantilever":
         length = structure["length"]
+        if not (math.isfinite(length) and length > 0):
+            # The beam's own error first, worded as the core's: a point cannot be
+            # placed on a beam of no length ("in [0, -1.0] m", user trial).
+            raise _fail("", f"structure.length must be a finite number > 0, got {shown(length)}")
         if not 0.0 <= at <= length:
             raise _fail(
                 "",
