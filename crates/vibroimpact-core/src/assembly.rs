@@ -961,11 +961,6 @@ impl Assembly {
         )
     }
 
-    /// Whether interaction `i` is a wall whose other wall (of the same
-    /// damper) is sticking: its gap is then held too, at the sum of the
-    /// clearances (0 for a zero clearance, to round-off), and it has no
-    /// event of its own. Sticking it as well would make the constraints
-    /// dependent.
     /// When open interaction `i` at state `y`, its coordinates' accelerations
     /// `acc` (m/s^2), would reach its wall on its gap's parabola (s after
     /// now); None where the gap's acceleration does not close it.
@@ -976,6 +971,11 @@ impl Assembly {
             .then(|| (rate + (rate * rate + 2.0 * closing * gap.max(0.0)).sqrt()) / closing)
     }
 
+    /// Whether interaction `i` is a wall whose other wall (of the same
+    /// damper) is sticking: its gap is then held too, at the sum of the
+    /// clearances (0 for a zero clearance, to round-off), and it has no
+    /// event of its own. Sticking it as well would make the constraints
+    /// dependent.
     pub fn held_by_mirror(&self, i: usize, modes: &[Mode]) -> bool {
         let before = self.mirrors_previous[i] && modes[i - 1] == Mode::Sticking;
         let after =
