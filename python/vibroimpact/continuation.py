@@ -163,13 +163,15 @@ def continue_orbit(
         out: np.ndarray = (run_at(p).map(z, periods) - z) / scale[:size]
         return out
 
-    def jacobian(u: np.ndarray) -> np.ndarray:
-        # Central differences; where the forward and backward ones disagree beyond
-        # the map's curvature, the step straddles a grazing (one side touches a wall
-        # the orbit misses): that column again with steps a hundred times shorter,
-        # the most consistent kept (as the core's shooting does).
+    def jacobian(u: np.ndarray, centre: np.ndarray | None = None) -> np.ndarray:
+        # ``centre``: the residual at ``u``, where the caller has it. Central
+        # differences; where the forward and backward ones disagree beyond the map's
+        # curvature, the step straddles a grazing (one side touches a wall the orbit
+        # misses): that column again with steps a hundred times shorter, the most
+        # consistent kept (as the core's shooting does).
         jac = np.zeros((size, size + 1))
-        centre = residual(u)
+        if centre is None:
+            centre = residual(u)
         for j in range(size + 1):
             h = 1e-6 * max(abs(u[j]), 1e-3 if j == size else 1.0)
             best: tuple[float, np.ndarray] | None = None
@@ -209,12 +211,16 @@ def continue_orbit(
             return t if t[size] * span > 0 else -t
         return t if float(np.dot(t, previous)) > 0 else -t
 
-    def point(u: np.ndarray, jac_z: np.ndarray) -> BranchPoint:
+    def multipliers_of(jac: np.ndarray) -> np.ndarray:
+        """The Floquet multipliers from the scaled Jacobian ``jac`` of the residual: the
+        monodromy D P = S (J_z + I) S^-1."""
+        monodromy = (jac[:, :size] + np.eye(size)) * scale[:size, None] / scale[None, :size]
+        return np.asarray(np.linalg.eigvals(monodromy))
+
+    def point(u: np.ndarray, jac: np.ndarray) -> BranchPoint:
         p = float(u[size] * scale[size])
         z = u[:size] * scale[:size]
-        # The monodromy from the scaled Jacobian: D P = S (J_z + I) S^-1.
-        monodromy = (jac_z + np.eye(size)) * scale[:size, None] / scale[None, :size]
-        multipliers = np.linalg.eigvals(monodromy)
+        multipliers = multipliers_of(jac)
         run = run_at(p)
         recorded = run.periods(z, periods, record=True)
         kinds = recorded["contacts"]["kind"]
@@ -264,17 +270,17 @@ def continue_orbit(
         new_t = tangent(jacobian(u), None)
         return u, (new_t if new_t[size] * t[size] > 0 else -new_t)
 
-    def correct(predicted: np.ndarray, t: np.ndarray) -> np.ndarray | None:
-        """The orbit on the plane through ``predicted`` normal to ``t`` (Newton), or
-        None where the corrector fails."""
+    def correct(predicted: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The orbit on the plane through ``predicted`` normal to ``t`` (Newton) and its
+        residual, or None where the corrector fails."""
         trial = predicted.copy()
         try:
             for _ in range(8):
                 f = residual(trial)
                 arc = float(np.dot(t, trial - predicted))
                 if max(float(np.max(np.abs(f))), abs(arc)) <= tolerance:
-                    return trial
-                jt = jacobian(trial)
+                    return trial, f
+                jt = jacobian(trial, f)
                 system = np.vstack([jt, t[None, :]])
                 trial = trial - np.linalg.solve(system, np.concatenate([f, [arc]]))
         except (InvalidInputError, np.linalg.LinAlgError):
@@ -305,10 +311,8 @@ def continue_orbit(
             found = correct(u + mid * h * t, t)
             if found is None:
                 return None
-            jac_z = jacobian(found)[:, :size]
-            monodromy = (jac_z + np.eye(size)) * scale[:size, None] / scale[None, :size]
-            multipliers = np.linalg.eigvals(monodromy)
-            value = float(found[size] * scale[size])
+            multipliers = multipliers_of(jacobian(*found))
+            value = float(found[0][size] * scale[size])
             if (measure(multipliers) > 0) == (first > 0):
                 lo, below, low = mid, value, multipliers
             else:
@@ -318,25 +322,26 @@ def continue_orbit(
     u = np.concatenate([first.state, [start_value]]) / scale
     jac = jacobian(u)
     t = tangent(jac, None)
-    points = [point(u, jac[:, :size])]
+    points = [point(u, jac)]
     u, t = clear_of_impacts(u, t)
     h = ds / abs(span)
     stopped = "max_points"
     while len(points) < max_points:
         if progress is not None:
             progress(len(points), max_points)
-        corrected: np.ndarray | None = None
+        solved: tuple[np.ndarray, np.ndarray] | None = None
         while h >= 1e-6:
-            corrected = correct(u + h * t, t)
-            if corrected is not None:
+            solved = correct(u + h * t, t)
+            if solved is not None:
                 break
             h *= 0.5
-        if corrected is None:
+        if solved is None:
             stopped = "corrector failed (the branch may end, or turn too sharply)"
             break
-        jac = jacobian(corrected)
+        corrected = solved[0]
+        jac = jacobian(*solved)
         new_t = tangent(jac, t)
-        candidate = point(corrected, jac[:, :size])
+        candidate = point(corrected, jac)
         # A step that lands on another number of impacts, or turns the tangent
         # sharply, may have jumped past a fold onto another branch: shorter steps
         # first, down to a thousandth of the asked one (where a grazing is then
