@@ -166,6 +166,18 @@ class StudyError(AnalysisError):
 MAX_WORKERS = 1024
 
 
+def check_threads(threads: Any, name: str) -> None:
+    """Refuse ``threads`` (given as ``name``: ``"threads:"``, ``"--workers"``) that is
+    not a whole number in [0, MAX_WORKERS] (0: all cores)."""
+    if isinstance(threads, bool) or not isinstance(threads, int):
+        raise StudyError(f"{name} must be a whole number, got {threads!r}")
+    if not 0 <= threads <= MAX_WORKERS:
+        raise StudyError(
+            f"{name} must be in [0, {MAX_WORKERS}] (0: all cores, {os.cpu_count() or 1} "
+            f"here), got {threads}"
+        )
+
+
 #: The most runs a study may hold (the product of its axes' counts, times ``samples``):
 #: its metrics and their reasons are gathered in memory at the end (about 100 bytes a
 #: run and metric), and ten million runs are hours of computing already.
@@ -690,13 +702,7 @@ def run(
     an uninterrupted run) and the parts removed. ``dask``: the address of a Dask
     scheduler, or ``"local"`` for a LocalCluster of ``threads`` processes (all cores for
     0), the chunks its tasks; the results are the same. Returns the Dataset."""
-    if isinstance(threads, bool) or not isinstance(threads, int):
-        raise StudyError(f"threads: must be a whole number, got {threads!r}")
-    if not 0 <= threads <= MAX_WORKERS:
-        raise StudyError(
-            f"threads: must be in [0, {MAX_WORKERS}] (0: all cores, {os.cpu_count() or 1} "
-            f"here), got {threads}"
-        )
+    check_threads(threads, "threads:")
     kind = output_kind(out)
     parts_dir = out.with_name(out.name + ".parts")
     fingerprint = study.fingerprint()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from pathlib import Path
@@ -15,7 +14,14 @@ import numpy as np
 from vibroimpact._core import InvalidInputError
 from vibroimpact.output import UsageError, check_output, check_plot
 from vibroimpact.scenario import load_scenario
-from vibroimpact.study import MAX_WORKERS, output_kind, run, study_of, terminal_progress
+from vibroimpact.study import (
+    MAX_WORKERS,
+    check_threads,
+    output_kind,
+    run,
+    study_of,
+    terminal_progress,
+)
 from vibroimpact.system_scenario import SystemScenario
 
 
@@ -70,11 +76,7 @@ def add_command(sub: Any) -> None:
 
 
 def run_study_command(args: argparse.Namespace) -> int:
-    if not 0 <= args.workers <= MAX_WORKERS:
-        raise UsageError(
-            f"--workers must be in [0, {MAX_WORKERS}] (0: all cores, {os.cpu_count() or 1} "
-            f"here), got {args.workers}"
-        )
+    check_threads(args.workers, "--workers")
     # The output's suffix (and zarr, for a store) before anything runs.
     if output_kind(args.out) != ".zarr":
         check_output(args.out, "--out", [args.scenario])

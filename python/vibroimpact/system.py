@@ -990,9 +990,7 @@ def prepare_system(
     return PreparedRun(spec, init, solver, output)
 
 
-def _solution(
-    raw: dict[str, Any], method: str, structure: Mapping[str, Any] | None = None
-) -> SystemSolution:
+def _solution(raw: dict[str, Any], method: str, structure: Mapping[str, Any]) -> SystemSolution:
     n, k = raw["n"], raw["k"]
     recorded = raw["recorded_time"] > 0
     width = 2 * (n + k)
@@ -1034,7 +1032,7 @@ def _solution(
         recorded_time=raw["recorded_time"],
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],
-        structure=dict(structure or {}),
+        structure=dict(structure),
     )
 
 
