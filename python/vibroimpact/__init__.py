@@ -24,6 +24,7 @@ import numpy as _numpy  # noqa: F401
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_POINTS,
     MAX_RECORD_BYTES,
     MAX_SIGNAL_SAMPLES,
     RTOL_RANGE,
@@ -79,6 +80,7 @@ __all__ = [
     "PreparedSystem",
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
+    "MAX_POINTS",
     "MAX_RECORD_BYTES",
     "MAX_SIGNAL_SAMPLES",
     "RTOL_RANGE",

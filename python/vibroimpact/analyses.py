@@ -33,6 +33,7 @@ from vibroimpact.system import (
     _choice,
     _table,
     linear_parts,
+    point_weights,
     prepare_system,
     structure_coordinates,
 )
@@ -124,6 +125,9 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
 def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
     solver = dict(data.get("solver", {}))
     solver.setdefault("t_end", 1.0)
+    output = data.get("output", {})
+    # Of [output], the analyses keep only the points whose amplitudes they report.
+    points = output.get("points", ()) if isinstance(output, Mapping) else ()
     return prepare_system(
         data["structure"],
         damper=data.get("damper", ()),
@@ -132,6 +136,7 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
         excitation=data.get("excitation", ()),
         initial=data.get("initial"),
         solver=solver,
+        output={"points": points},
         base_dir=base_dir,
     )
 
@@ -150,6 +155,22 @@ class Runner:
     def __post_init__(self) -> None:
         self.n = structure_coordinates(self.prepared.spec["structure"])
         self.k = len(self.prepared.spec.get("damper", ()))
+
+    @property
+    def points(self) -> np.ndarray:
+        """The points ``[output] points`` follows (m along a cantilever, or indices)."""
+        return np.asarray(self.prepared.output["points"], dtype=float)
+
+    def amplitudes(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+        """The located peaks of a recorded run (m): of each structure coordinate, and
+        of the structure at each point."""
+        peaks = np.asarray(recorded["peaks"], dtype=float)
+        return peaks[: self.n], peaks[self.n :]
+
+    def rms(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+        """The RMS displacements of a recorded run (m), as :meth:`amplitudes`."""
+        rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
+        return rms[: self.n], rms[self.n :]
 
     def initial_state(self) -> np.ndarray:
         """The scenario's ``[initial]`` as a flat state ``(x, v)``."""
@@ -258,8 +279,10 @@ def _scaled_distance(a: np.ndarray, b: np.ndarray, dim: int, reference: np.ndarr
 class SteadyState:
     """A steady response (SI units): per structure coordinate the located
     ``amplitude`` (largest |displacement|, m) and ``rms`` (m) over the recorded
-    periods; ``impacts_per_period``; ``settled`` and the ``period`` (in forcing
-    periods) after which the stroboscopic state repeats, or None."""
+    periods, and the same of the structure at each of ``[output] points``
+    (``point_amplitude``, ``point_rms``); ``impacts_per_period``; ``settled`` and the
+    ``period`` (in forcing periods) after which the stroboscopic state repeats, or
+    None."""
 
     settled: bool
     period: int | None
@@ -268,6 +291,8 @@ class SteadyState:
     impacts_per_period: float
     state: np.ndarray
     strobe: np.ndarray = field(repr=False)
+    point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def steady_state(
@@ -309,14 +334,18 @@ def steady_state(
                 period = p
                 break
     recorded = run.periods(x0, record_periods, record=True)
+    amplitude, point_amplitude = run.amplitudes(recorded)
+    rms, point_rms = run.rms(recorded)
     return SteadyState(
         settled=period is not None,
         period=period,
-        amplitude=np.asarray(recorded["peaks"], dtype=float),
-        rms=np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"]),
+        amplitude=amplitude,
+        rms=rms,
         impacts_per_period=_impacts(recorded) / record_periods,
         state=np.asarray(recorded["final_state"], dtype=float),
         strobe=strobe,
+        point_amplitude=point_amplitude,
+        point_rms=point_rms,
     )
 
 
@@ -325,12 +354,25 @@ def linear_amplitude(data: Mapping[str, Any], base_dir: Path | None = None) -> n
     (dampers and stops removed) under the scenario's harmonic excitations, from
     ``(K - w^2 M + i w C) Q = F``: exact for one frequency; for several, the sum of
     their amplitudes (a bound). NaN where a rigid-body mode makes it unbounded."""
+    return linear_response(data, base_dir)[0]
+
+
+def linear_response(
+    data: Mapping[str, Any], base_dir: Path | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`linear_amplitude`, and the same of the structure at each of ``[output]
+    points`` (m): ``|w . Q|``, ``w`` the coordinates' weights there (a cantilever's
+    mode shapes), summed over the harmonics as the coordinates' are."""
     parts = linear_parts(
         data["structure"], excitation=data.get("excitation", ()), base_dir=base_dir
     )
     n = parts["n"]
+    structure = _prepare(data, base_dir)
+    weights = np.array(
+        [point_weights(structure.spec["structure"], at) for at in structure.output["points"]]
+    ).reshape(-1, n)
     m, k, c = parts["mass"], parts["stiffness"], parts["damping"]
-    total = np.zeros(n)
+    total, at_points = np.zeros(n), np.zeros(len(weights))
     for h in parts["harmonics"]:
         w = h["omega"]
         force = h["amplitude"] * np.exp(1j * h["phase"]) * np.asarray(h["shape"])
@@ -338,9 +380,10 @@ def linear_amplitude(data: Mapping[str, Any], base_dir: Path | None = None) -> n
         try:
             q = np.linalg.solve(matrix, force)
         except np.linalg.LinAlgError:
-            return np.full(n, np.nan)
+            return np.full(n, np.nan), np.full(len(weights), np.nan)
         total += np.abs(q)
-    return total
+        at_points += np.abs(weights @ q[:n])
+    return total, at_points
 
 
 @dataclass
@@ -355,11 +398,24 @@ class SweepPoint:
     impacts_per_period: float
     linear_amplitude: np.ndarray
     error: str | None = None
+    #: At each of ``[output] points`` (m), as ``amplitude``, ``rms`` and
+    #: ``linear_amplitude`` per coordinate.
+    points: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    linear_point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def to_dict(self) -> dict[str, Any]:
         def floats(a: np.ndarray) -> list[float | None]:
             return [float(v) if math.isfinite(v) else None for v in a]
 
+        at_points = {
+            "points": [float(v) for v in self.points],
+            "point_amplitude": floats(self.point_amplitude),
+            "point_rms": floats(self.point_rms),
+            "linear_point_amplitude": floats(self.linear_point_amplitude),
+            "point_reduction": _reductions(self.point_amplitude, self.linear_point_amplitude),
+        }
         return {
             "value": self.value,
             "direction": self.direction,
@@ -368,12 +424,18 @@ class SweepPoint:
             "impacts_per_period": self.impacts_per_period,
             "settled": self.settled,
             "linear_amplitude": floats(self.linear_amplitude),
-            "reduction": [
-                (1.0 - a / b) if (b and math.isfinite(a) and math.isfinite(b)) else None
-                for a, b in zip(self.amplitude, self.linear_amplitude, strict=True)
-            ],
+            "reduction": _reductions(self.amplitude, self.linear_amplitude),
+            **(at_points if len(self.points) else {}),
             **({"error": self.error} if self.error else {}),
         }
+
+
+def _reductions(amplitude: np.ndarray, linear: np.ndarray) -> list[float | None]:
+    """``1 - amplitude / linear``, None where either is not finite or the linear is 0."""
+    return [
+        (1.0 - a / b) if (b and math.isfinite(a) and math.isfinite(b)) else None
+        for a, b in zip(amplitude, linear, strict=True)
+    ]
 
 
 #: The most values a ``[sweep]`` may step through (``count``), or a ``[continuation]``
@@ -562,7 +624,8 @@ def with_parameter_path_check(path: str, section: str = "[sweep]") -> None:
         # keys would change nothing, point after point.
         raise AnalysisError(
             f"{where}: {path!r} is not used by the analyses (they run settle and record "
-            "periods, not [solver] t_end, and keep no [output]); choose a parameter of the system"
+            "periods, not [solver] t_end, and of [output] follow its points only); choose a "
+            "parameter of the system"
         )
 
 
@@ -619,7 +682,7 @@ def sweep(
             changed = with_parameter(data, parameter, value)
             try:
                 run = runner(changed, base_dir)
-                linear = linear_amplitude(changed, base_dir)
+                linear, linear_at_points = linear_response(changed, base_dir)
             except InvalidInputError as err:
                 raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
             try:
@@ -636,8 +699,23 @@ def sweep(
             except InvalidInputError:
                 raise
             except Exception as err:  # a run that cannot be completed: record it
-                nan = np.full(len(linear), np.nan)
-                points.append(SweepPoint(value, leg, False, nan, nan, math.nan, linear, str(err)))
+                nan, none = np.full(len(linear), np.nan), np.full(len(run.points), np.nan)
+                points.append(
+                    SweepPoint(
+                        value,
+                        leg,
+                        False,
+                        nan,
+                        nan,
+                        math.nan,
+                        linear,
+                        str(err),
+                        run.points,
+                        none,
+                        none,
+                        linear_at_points,
+                    )
+                )
             else:
                 state = result.state
                 points.append(
@@ -649,6 +727,11 @@ def sweep(
                         result.rms,
                         result.impacts_per_period,
                         linear,
+                        None,
+                        run.points,
+                        result.point_amplitude,
+                        result.point_rms,
+                        linear_at_points,
                     )
                 )
             if progress is not None:
@@ -669,6 +752,8 @@ class Orbit:
     iterations: int
     residual: float
     monodromy: np.ndarray = field(repr=False)
+    #: The largest |displacement| (m) on the orbit at each of ``[output] points``.
+    point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def arrays(self, n: int, k: int) -> dict[str, list[float]]:
         """The state as the four arrays of ``[initial]``."""
@@ -711,16 +796,18 @@ def orbit(
     residual = float(shot["residual"])
     multipliers = np.linalg.eigvals(jac)
     recorded = run.periods(z, periods, record=True)
+    amplitude, point_amplitude = run.amplitudes(recorded)
     return Orbit(
         converged=converged,
         state=z,
         floquet_multipliers=multipliers,
         stable=bool(converged and np.all(np.abs(multipliers) < 1.0)),
         impacts_per_period=_impacts(recorded) / periods,
-        amplitude=np.asarray(recorded["peaks"], dtype=float),
+        amplitude=amplitude,
         iterations=iterations,
         residual=residual,
         monodromy=jac,
+        point_amplitude=point_amplitude,
     )
 
 

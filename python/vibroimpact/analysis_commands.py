@@ -71,8 +71,10 @@ def add_commands(sub: Any) -> None:
             '"excitation.0.frequency"), from start to stop in count steps, up, down or '
             "both: settle settle_periods forcing periods from the last point's state, then "
             "record record_periods; prints per point the amplitude (located peaks, m) and "
-            "RMS (m) per structure coordinate, impacts per period, whether the stroboscopic "
-            "state settled, and the structure's linear response without dampers and stops."
+            "RMS (m) per structure coordinate (of coordinate 0 in the table; with [output] "
+            "points, of the structure at the first point, and --json gives them all), "
+            "impacts per period, whether the stroboscopic state settled, and the "
+            "structure's linear response without dampers and stops."
         ),
     )
     sweep_parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [sweep]")
@@ -167,6 +169,14 @@ def run_orbit(args: argparse.Namespace) -> int:
         "stable": found.stable,
         "impacts_per_period": found.impacts_per_period,
         "amplitude": [float(a) for a in found.amplitude],
+        **(
+            {
+                "points": [float(v) for v in run.points],
+                "point_amplitude": [float(a) for a in found.point_amplitude],
+            }
+            if len(run.points)
+            else {}
+        ),
         "periods": args.periods,
         "forcing_period": run.period,
         "iterations": found.iterations,
@@ -193,6 +203,10 @@ def run_orbit(args: argparse.Namespace) -> int:
             f"{m.real:.6g}{m.imag:+.6g}i (|{abs(m):.6g}|)" for m in found.floquet_multipliers
         ),
         "amplitude (m): " + ", ".join(f"{a:.6g}" for a in found.amplitude),
+        *(
+            f"  at point {at:g}: amplitude {a:.6g} m"
+            for at, a in zip(run.points, found.point_amplitude, strict=True)
+        ),
     ]
     for key, values in summary["state"].items():
         lines.append(f"{key} = [{', '.join(f'{v:.12g}' for v in values)}]")
@@ -251,15 +265,34 @@ def run_sweep(args: argparse.Namespace) -> int:
         f"{cpu_time:.3f} s ({settings['settle_periods']} settle and "
         f"{settings['record_periods']} recorded periods each)"
     )
-    head = ["value", "direction", "amplitude_0", "linear_0", "rms_0", "impacts/period", "settled"]
+    # Coordinate 0's amplitudes, or the structure's at the first point where there are
+    # points (a cantilever's modal coordinates are no deflection).
+    at_point = len(points[0].points) > 0
+    name = f"@{points[0].points[0]:g}" if at_point else "_0"
+    head = [
+        "value",
+        "direction",
+        f"amplitude{name}",
+        f"linear{name}",
+        f"rms{name}",
+        "impacts/period",
+        "settled",
+    ]
+    if at_point:
+        print(f"(amplitudes at point {points[0].points[0]:g} of [output] points, m)")
     print("  ".join(f"{h:>14}" for h in head))
     for p in points:
+        amplitude, linear, rms = (
+            (p.point_amplitude, p.linear_point_amplitude, p.point_rms)
+            if at_point
+            else (p.amplitude, p.linear_amplitude, p.rms)
+        )
         cells = [
             f"{p.value:>14.6g}",
             f"{p.direction:>14}",
-            f"{p.amplitude[0]:>14.6g}",
-            f"{p.linear_amplitude[0]:>14.6g}",
-            f"{p.rms[0]:>14.6g}",
+            f"{amplitude[0]:>14.6g}",
+            f"{linear[0]:>14.6g}",
+            f"{rms[0]:>14.6g}",
             f"{p.impacts_per_period:>14.4g}",
             f"{str(p.settled):>14}",
         ]

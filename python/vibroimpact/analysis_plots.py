@@ -51,26 +51,38 @@ def _unit(parameter: str, data: Any = None) -> str:
 
 
 def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any = None) -> None:
-    """Amplitude of structure coordinate 0 against the parameter, each direction,
-    with the linear structure's beside it."""
+    """Amplitude of structure coordinate 0 (of the structure at the first of
+    ``[output] points``, where there are points) against the parameter, each
+    direction, with the linear structure's beside it."""
+    at_point = len(points[0].points) > 0
+
+    def amplitude(p: SweepPoint) -> float:
+        return float(p.point_amplitude[0] if at_point else p.amplitude[0])
+
     with _figure(path) as (fig, ax):
         values = np.array([p.value for p in points])
         order = np.argsort(values, kind="stable")
-        linear = np.array([p.linear_amplitude[0] for p in points])
+        linear = np.array(
+            [p.linear_point_amplitude[0] if at_point else p.linear_amplitude[0] for p in points]
+        )
         ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers (linear)")
         for direction, marker in (("up", "^"), ("down", "v")):
             chosen = [p for p in points if p.direction == direction]
             if chosen:
                 ax.plot(
                     [p.value for p in chosen],
-                    [p.amplitude[0] for p in chosen],
+                    [amplitude(p) for p in chosen],
                     marker=marker,
                     ms=3,
                     lw=1,
                     label=f"with dampers, sweep {direction}",
                 )
         ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
-        ax.set_ylabel("amplitude of structure coordinate 0 (m)")
+        ax.set_ylabel(
+            f"amplitude at point {points[0].points[0]:g} (m)"
+            if at_point
+            else "amplitude of structure coordinate 0 (m)"
+        )
         ax.legend()
         ax.grid(alpha=0.3)
 

@@ -240,7 +240,7 @@ def continue_orbit(
             floquet_multipliers=multipliers,
             stable=bool(np.all(np.abs(multipliers) < 1.0)),
             impacts_per_period=impacts,
-            amplitude=np.asarray(recorded["peaks"], dtype=float),
+            amplitude=run.amplitudes(recorded)[0],
         )
 
     def clear_of_impacts(u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -240,24 +240,60 @@ def sweep_dataset(
     ``linear_amplitude`` (m, the structure alone), ``reduction`` (``1 - amplitude /
     linear_amplitude``, NaN where either is not finite or the linear one is 0),
     all ``point`` x ``coordinate``; ``impacts_per_period``, ``settled`` (bool) and
-    ``error`` (the failed run's message, ``""`` where none) along ``point``.
-    Attributes: ``parameter``."""
+    ``error`` (the failed run's message, ``""`` where none) along ``point``. With
+    ``[output] points``, a dimension ``at`` (the points: m along a cantilever, else
+    coordinate indices) and the same four of the structure there, ``point x at``:
+    ``point_amplitude``, ``point_rms``, ``linear_point_amplitude``,
+    ``point_reduction``. Attributes: ``parameter``."""
     if not points:
         raise AnalysisError("sweep_dataset: no points")
     n = len(points[0].linear_amplitude)
+    at = np.asarray(points[0].points, dtype=np.float64)
 
-    def rows(name: str) -> NDArray[np.float64]:
-        out = np.array([getattr(p, name) for p in points], dtype=np.float64)
-        if out.shape != (len(points), n):
-            raise AnalysisError(f"sweep_dataset: every point's {name} must have {n} values")
+    def rows(name: str, size: int = n) -> NDArray[np.float64]:
+        out = np.array([getattr(p, name) for p in points], dtype=np.float64).reshape(
+            len(points), -1
+        )
+        if out.shape != (len(points), size):
+            raise AnalysisError(f"sweep_dataset: every point's {name} must have {size} values")
         return out
+
+    def reduction_of(amplitude: NDArray[np.float64], linear: NDArray[np.float64]) -> Any:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            reduction = 1.0 - amplitude / linear
+        reduction[~(np.isfinite(amplitude) & np.isfinite(linear) & (linear != 0))] = np.nan
+        return reduction
 
     amplitude = rows("amplitude")
     linear = rows("linear_amplitude")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reduction = 1.0 - amplitude / linear
-    reduction[~(np.isfinite(amplitude) & np.isfinite(linear) & (linear != 0))] = np.nan
     pc = ("point", "coordinate")
+    at_points: dict[str, Any] = {}
+    if len(at):
+        pa = ("point", "at")
+        point_amplitude = rows("point_amplitude", len(at))
+        linear_point = rows("linear_point_amplitude", len(at))
+        at_points = {
+            "point_amplitude": (
+                pa,
+                point_amplitude,
+                _attrs("steady amplitude of the structure at the point", _M),
+            ),
+            "point_rms": (
+                pa,
+                rows("point_rms", len(at)),
+                _attrs("steady root mean square displacement at the point", _M),
+            ),
+            "linear_point_amplitude": (
+                pa,
+                linear_point,
+                _attrs("steady amplitude at the point of the structure alone", _M),
+            ),
+            "point_reduction": (
+                pa,
+                reduction_of(point_amplitude, linear_point),
+                _attrs("amplitude reduction at the point", _ONE),
+            ),
+        }
     return xr.Dataset(
         data_vars={
             "amplitude": (pc, amplitude, _attrs("steady amplitude (largest |displacement|)", _M)),
@@ -269,9 +305,10 @@ def sweep_dataset(
             ),
             "reduction": (
                 pc,
-                reduction,
+                reduction_of(amplitude, linear),
                 _attrs("amplitude reduction, 1 - amplitude / linear_amplitude", _ONE),
             ),
+            **at_points,
             "impacts_per_period": (
                 "point",
                 np.array([p.impacts_per_period for p in points], dtype=np.float64),
@@ -299,6 +336,11 @@ def sweep_dataset(
                 "coordinate",
                 np.arange(n, dtype=np.int32),
                 _attrs("structure coordinate (index)"),
+            ),
+            **(
+                {"at": ("at", at, _attrs("point of the structure ([output] points)"))}
+                if len(at)
+                else {}
             ),
         },
         attrs={"parameter": parameter, "source": _SOURCE},

@@ -48,8 +48,10 @@ the threads, chunks or Dask workers. With ``samples``, ``"excitation.0.seed" = {
 in ``[study.random]`` gives sample ``k`` the seed ``N + k`` (no draw taken). In the
 Dataset each axis is a dimension named by its path, the metrics are data
 variables (with a ``coordinate`` dimension for per-structure-coordinate metrics and
-``pair`` for per-pair ones), and ``status`` is 0 for a run that completed, else
-``k``, the ``k``-th reason of the attribute ``reasons``. With ``samples``, a ``sample``
+``pair`` for per-pair ones; with ``[output] points``, ``peak``, ``rms`` and ``amplitude``
+of the structure at each point as ``point_peak``... over a dimension ``at``), and
+``status`` is 0 for a run that completed, else ``k``, the ``k``-th reason of the
+attribute ``reasons``. With ``samples``, a ``sample``
 dimension follows the axes, and each random parameter is a variable over it: the same
 draws (numpy's PCG64 from ``seed``, in the order of ``[study.random]``) at every grid
 point. SI units.
@@ -574,6 +576,8 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
 
     n = parts[0]["n"] if parts else 0
     pairs = list(parts[0]["pairs"]) if parts else []
+    output = study.data.get("output", {})
+    at = np.asarray(output.get("points", ()) if isinstance(output, Mapping) else (), dtype=float)
     shape = study.shape
     dims = study.dims
     # Each distinct reason once, numbered in order of first failure (a dict: a study
@@ -599,7 +603,20 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
         description, unit = _DESCRIPTIONS[name]
         attrs = {"long_name": description, "units": unit}
         if name in ("peak", "rms", "amplitude"):
-            data_vars[name] = ([*dims, "coordinate"], values.reshape(*shape, n), attrs)
+            # The core follows the coordinates, then the points.
+            values = values.reshape(*shape, n + len(at))
+            data_vars[name] = ([*dims, "coordinate"], values[..., :n], attrs)
+            if len(at):
+                data_vars[f"point_{name}"] = (
+                    [*dims, "at"],
+                    values[..., n:],
+                    {
+                        **attrs,
+                        "long_name": description.replace(
+                            "each structure coordinate", "the structure at each [output] point"
+                        ),
+                    },
+                )
         elif name == "energy_dissipated":
             data_vars[name] = ([*dims, "pair"], values.reshape(*shape, len(pairs)), attrs)
         else:
@@ -628,6 +645,8 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
                 },
             )
     coords["coordinate"] = ("coordinate", np.arange(n))
+    if len(at):
+        coords["at"] = ("at", at, {"long_name": "point of the structure ([output] points)"})
     coords["pair"] = ("pair", np.array(pairs, dtype=str))
     return xr.Dataset(
         data_vars,

@@ -50,6 +50,7 @@ import numpy as np
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_POINTS,
     MAX_RECORD_BYTES,
     MAX_SIGNAL_SAMPLES,
     RTOL_RANGE,
@@ -174,6 +175,7 @@ _OUTPUT = {
     "history": ("boolean", True),
     "record_from": (_NUMBER, None),
     "strobe_period": (_NUMBER, None),
+    "points": (_NUMBERS, ()),
 }
 _INT64 = range(-(2**63), 2**63)
 _METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha", "exact")
@@ -479,6 +481,25 @@ def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) ->
         )
 
 
+def point_weights(structure: Mapping[str, Any], at: Any, name: str = "at") -> np.ndarray:
+    """The weights of a checked ``[structure]``'s coordinates at a point: the
+    displacement there is ``weights @ coordinates``. For a cantilever ``at`` is a
+    position along the beam (m from the clamp) and the weights are the mode shapes
+    there; otherwise ``at`` is a coordinate index and the weights pick it. ``name``
+    names ``at`` in the error."""
+    value = real(at)
+    if value is None:
+        raise _fail("", f"{name} must be a number, got {shown(at)}")
+    _check_point(name, at, float(value), dict(structure))
+    n = structure_coordinates(structure)
+    if structure["kind"] == "cantilever":
+        length = float(structure["length"])
+        return np.array([cantilever_mode_shape(length, i + 1, float(value)) for i in range(n)])
+    weights = np.zeros(n)
+    weights[int(value)] = 1.0
+    return weights
+
+
 def structure_coordinates(structure: Mapping[str, Any]) -> int:
     """The coordinates of a checked ``[structure]``: 1 for an oscillator, one per DOF
     of matrices, one per mode of a cantilever."""
@@ -734,6 +755,13 @@ class SystemSolution:
     strobe_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: The checked ``[structure]`` the run integrated.
     structure: dict[str, Any] = field(default_factory=dict)
+    #: The points ``[output] points`` follows (as a damper's ``at``: m from a
+    #: cantilever's clamp, or a coordinate index), and from ``record_from`` on the
+    #: largest |displacement| (m, located) and the RMS (m) of the structure at each;
+    #: NaN where nothing was recorded.
+    points: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def shape_at(self, at: float) -> np.ndarray:
         """The structure coordinates' weights at a point: the displacement there is
@@ -743,17 +771,7 @@ class SystemSolution:
         index and the weights pick it."""
         if not self.structure:
             raise InvalidInputError("at: this solution does not hold its structure")
-        value = real(at)
-        if value is None:
-            raise _fail("", f"at must be a number, got {shown(at)}")
-        _check_point("at", at, float(value), self.structure)
-        n = structure_coordinates(self.structure)
-        if self.structure["kind"] == "cantilever":
-            length = float(self.structure["length"])
-            return np.array([cantilever_mode_shape(length, i + 1, float(value)) for i in range(n)])
-        weights = np.zeros(n)
-        weights[int(value)] = 1.0
-        return weights
+        return point_weights(self.structure, at)
 
     def displacement_at(self, at: float) -> np.ndarray:
         """The structure's displacement (m, relative to the base) at a point (see
@@ -791,6 +809,7 @@ def simulate_system(
     base_dir: Path | None = None,
     record_from: float | None = None,
     strobe_period: float | None = None,
+    points: Any = (),
 ) -> SystemSolution:
     """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
 
@@ -810,7 +829,9 @@ def simulate_system(
     ``max_steps`` steps, past ``max_rows`` history rows and contacts, or when its
     energy balance is off by more than ``energy_tolerance`` of the energies in play.
     From ``record_from`` (s) on, each structure coordinate's located peak and RMS
-    are kept (``peak``, ``rms``); every ``strobe_period`` (s) the state is kept
+    are kept (``peak``, ``rms``), and the structure's at each of ``points`` (as a
+    damper's ``at``: m from a cantilever's clamp, or a coordinate index; ``point_peak``,
+    ``point_rms``); every ``strobe_period`` (s) the state is kept
     (``strobe``; fixed steps are shortened to divide it). The GIL is released while
     integrating; Ctrl-C interrupts.
     """
@@ -839,6 +860,7 @@ def simulate_system(
             "history": history,
             **({} if record_from is None else {"record_from": record_from}),
             **({} if strobe_period is None else {"strobe_period": strobe_period}),
+            "points": points,
         },
         base_dir=base_dir,
     )
@@ -855,8 +877,13 @@ class PreparedRun:
     output: dict[str, Any]
 
     def binding_spec(self) -> dict[str, Any]:
-        """The sections as the binding takes them (gravity as a number)."""
-        return {**self.spec, "gravity": self.spec["gravity"]["acceleration"]}
+        """The sections as the binding takes them (gravity as a number, the points
+        ``[output]`` follows)."""
+        return {
+            **self.spec,
+            "gravity": self.spec["gravity"]["acceleration"],
+            "points": list(self.output["points"]),
+        }
 
     def method_arguments(self) -> dict[str, Any]:
         """The solver settings as the binding's keyword arguments."""
@@ -893,7 +920,7 @@ class PreparedRun:
         except InvalidInputError as err:
             # The core writes its numbers in full: 1e300 as 301 digits.
             raise type(err)(short_numbers(str(err))) from None
-        return _solution(raw, solver["method"], self.spec["structure"])
+        return _solution(raw, solver["method"], self.spec["structure"], output["points"])
 
 
 def prepare_system(
@@ -983,6 +1010,12 @@ def prepare_system(
         )
     if output["strobe_period"] is not None and not output["strobe_period"] > 0:
         raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
+    if len(output["points"]) > MAX_POINTS:
+        raise _fail(
+            "[output] points: ", f"holds {len(output['points'])}; at most {MAX_POINTS} are allowed"
+        )
+    for j, at in enumerate(output["points"]):
+        _check_point(f"[output] points[{j}]", at, float(at), spec["structure"])
     for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
         value = (output if section == "output" else solver)[key]
         if value < 1:
@@ -990,7 +1023,12 @@ def prepare_system(
     return PreparedRun(spec, init, solver, output)
 
 
-def _solution(raw: dict[str, Any], method: str, structure: Mapping[str, Any]) -> SystemSolution:
+def _solution(
+    raw: dict[str, Any],
+    method: str,
+    structure: Mapping[str, Any],
+    points: Sequence[float] = (),
+) -> SystemSolution:
     n, k = raw["n"], raw["k"]
     recorded = raw["recorded_time"] > 0
     width = 2 * (n + k)
@@ -998,6 +1036,13 @@ def _solution(raw: dict[str, Any], method: str, structure: Mapping[str, Any]) ->
     final = raw["final_state"]
     c = raw["contacts"]
     pairs = list(raw["pairs"])
+    observed = n + len(points)
+    peaks = raw["peaks"] if recorded else np.full(observed, np.nan)
+    rms = (
+        np.sqrt(raw["square_integrals"] / raw["recorded_time"])
+        if recorded
+        else np.full(observed, np.nan)
+    )
     contacts = SystemContacts(
         pair=[pairs[p] for p in c["pair"]],
         kind=list(c["kind"]),
@@ -1025,10 +1070,12 @@ def _solution(raw: dict[str, Any], method: str, structure: Mapping[str, Any]) ->
         method=method,
         pairs=pairs,
         # Nothing recorded (no record_from): neither peak nor RMS, not a peak of 0.
-        peak=raw["peaks"] if recorded else np.full(n, np.nan),
-        rms=np.sqrt(raw["square_integrals"] / raw["recorded_time"])
-        if recorded
-        else np.full(n, np.nan),
+        # The core follows the coordinates, then the points.
+        peak=peaks[:n],
+        rms=rms[:n],
+        points=np.asarray(points, dtype=float),
+        point_peak=peaks[n:],
+        point_rms=rms[n:],
         recorded_time=raw["recorded_time"],
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],

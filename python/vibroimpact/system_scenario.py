@@ -102,7 +102,8 @@ def system_summary(
     """The JSON-ready summary of a run (SI units): settings, statistics, the final state,
     the energy balance, the contacts with the pair each belongs to and, when ``[output]``
     asks for them, the reductions: from ``record_from`` the ``peak`` and ``rms`` of each
-    structure coordinate (m) over ``recorded_time`` (s), every ``strobe_period`` the
+    structure coordinate (m) over ``recorded_time`` (s), and ``point_peak`` and
+    ``point_rms`` (m) at each of ``points`` (``[output] points``), every ``strobe_period`` the
     ``strobe`` states (rows of the history's columns but ``t``) at ``strobe_time``."""
     solver = scenario.solver
     output = scenario.prepared.output
@@ -114,6 +115,12 @@ def system_summary(
             "peak": [finite_or_none(float(v)) for v in sol.peak],
             "rms": [finite_or_none(float(v)) for v in sol.rms],
         }
+        if len(sol.points):
+            reductions |= {
+                "points": [float(v) for v in sol.points],
+                "point_peak": [finite_or_none(float(v)) for v in sol.point_peak],
+                "point_rms": [finite_or_none(float(v)) for v in sol.point_rms],
+            }
     if output["strobe_period"] is not None:
         reductions |= {
             "strobe_period": output["strobe_period"],
@@ -200,6 +207,8 @@ def system_lines(
             + "; rms (m) "
             + ", ".join(f"{v:.7g}" for v in sol.rms)
         )
+        for at, peak, rms in zip(sol.points, sol.point_peak, sol.point_rms, strict=True):
+            lines.append(f"  at point {at:g}: peak {peak:.7g} m, rms {rms:.7g} m")
     if output.get("strobe_period") is not None:
         lines.append(
             f"{len(sol.strobe_time)} stroboscopic state(s), every {output['strobe_period']:g} s "

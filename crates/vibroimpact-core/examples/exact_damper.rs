@@ -57,6 +57,7 @@ fn main() {
             load: Load::Force { at: 0.0 },
             signal: Signal::harmonic(0.3 * k * 0.01 * 3.0, 8.0, 0.0).unwrap(),
         }],
+        points: vec![],
     };
     let ball = SystemSpec {
         structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
@@ -70,6 +71,7 @@ fn main() {
         }],
         gravity: 9.81,
         excitations: vec![],
+        points: vec![],
     };
     // One run, for callgrind: the damper ("once") or the ball ("ball").
     let one = match std::env::args().nth(1).as_deref() {

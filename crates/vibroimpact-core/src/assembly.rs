@@ -116,7 +116,15 @@ pub struct SystemSpec {
     /// m/s^2 (>= 0), along -x.
     pub gravity: f64,
     pub excitations: Vec<Excitation>,
+    /// Points of the structure whose displacement the reductions follow
+    /// beside its coordinates (each as a damper's `at`: a coordinate index,
+    /// or m from a beam's clamp); at most [`MAX_POINTS`].
+    pub points: Vec<f64>,
 }
+
+/// The most points a run may follow (each is a row of the structure's
+/// coordinates, a peak and a mean square).
+pub const MAX_POINTS: usize = 10_000;
 
 /// The law of one interaction, ready for the kernel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -196,6 +204,9 @@ pub struct Assembly {
     time_scale: f64,
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
+    /// The rows (over the structure coordinates, `n` each) of the points
+    /// the reductions follow (see [`SystemSpec::points`]).
+    pub point_rows: Vec<f64>,
 }
 
 /// What [`Assembly::rates_with`] reads of the system, cut to the sizes `n`
@@ -423,7 +434,18 @@ impl Assembly {
                         .all(|(a, b)| *a == -*b)
             })
             .collect();
+        if spec.points.len() > MAX_POINTS {
+            return Err(Error::Inconsistent(format!(
+                "points: at most {MAX_POINTS} points may be followed, got {}",
+                spec.points.len()
+            )));
+        }
+        let mut point_rows = Vec::with_capacity(spec.points.len() * n);
+        for (j, &at) in spec.points.iter().enumerate() {
+            point_rows.extend(s.point(&format!("point {j}"), at)?);
+        }
         Ok(Self {
+            point_rows,
             mirrors_previous,
             sticking_step: 0.1 * shortest,
             floor_mass_acceleration: total_mass * acceleration * acceleration,
@@ -455,6 +477,25 @@ impl Assembly {
     /// Length of the state vector: `x`, `v` and the accumulators.
     pub fn state_len(&self) -> usize {
         2 * self.dim + CONTACT + self.interactions.len()
+    }
+
+    /// The quantities the reductions follow: each structure coordinate, then
+    /// each point of [`SystemSpec::points`].
+    pub fn observed(&self) -> usize {
+        self.n + self.point_rows.len() / self.n
+    }
+
+    /// Observed quantity `j` (see [`Self::observed`]) of `block`, the
+    /// structure coordinates' displacements, velocities or accelerations.
+    #[inline]
+    pub fn observe(&self, j: usize, block: &[f64]) -> f64 {
+        let n = self.n;
+        if j < n {
+            block[j]
+        } else {
+            let row = (j - n) * n..(j - n + 1) * n;
+            linalg::dot(&self.point_rows[row], &block[..n])
+        }
     }
 
     /// Whether nothing forces the system (energy can then only fall).

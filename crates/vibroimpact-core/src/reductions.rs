@@ -1,5 +1,6 @@
 //! What a run can keep instead of (or beside) its history: each structure
-//! coordinate's peak |displacement| and mean square over a recording window,
+//! coordinate's (and each followed point's) peak |displacement| and mean
+//! square over a recording window,
 //! and the state at every multiple of a period (the stroboscopic map).
 //!
 //! Peaks are located, not read off step ends: where a coordinate's velocity
@@ -35,10 +36,11 @@ impl Default for ReduceOptions {
 /// The reductions of a run.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Reductions {
-    /// Per structure coordinate, the largest |displacement| (m) recorded.
+    /// Per observed quantity (each structure coordinate, then each point of
+    /// the spec's `points`), the largest |displacement| (m) recorded.
     pub peaks: Vec<f64>,
-    /// Per structure coordinate, the integral of the displacement squared
-    /// over the recorded time (m^2 s).
+    /// Per observed quantity, the integral of the displacement squared over
+    /// the recorded time (m^2 s).
     pub square_integrals: Vec<f64>,
     /// s.
     pub recorded_time: f64,

@@ -376,7 +376,8 @@ pub struct RunMetrics {
     /// 0 when the run completed, else 1 (the reason in `reason`).
     pub status: u8,
     pub reason: String,
-    /// Per structure coordinate, m.
+    /// Per observed quantity (each structure coordinate, then each of the
+    /// spec's points), m.
     pub peak: Vec<f64>,
     pub rms: Vec<f64>,
     /// Impacts and compliant contacts recorded (a sticking period is not
@@ -574,6 +575,12 @@ fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Member> {
     if !spec.stops.is_empty() || spec.gravity != 0.0 || !spec.excitations.is_empty() {
         return Err(unfit("the scenario has stops, gravity or an excitation"));
     }
+    if !spec.points.is_empty() {
+        // Its one coordinate is its one point: its peak and rms are already kept.
+        return Err(unfit(
+            "[output] points are followed by event-driven runs only",
+        ));
+    }
     if structure.point("damper.0.at", damper.at)? != [1.0] {
         return Err(unfit("the damper's point is not the coordinate itself"));
     }
@@ -599,7 +606,8 @@ fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Member> {
 
 /// The metrics of a run of `spec` that failed for `reason`: NaN.
 fn failed_run(spec: &SystemSpec, reason: String) -> RunMetrics {
-    let n = spec.structure.dofs();
+    // Each structure coordinate, then each followed point.
+    let n = spec.structure.dofs() + spec.points.len();
     let pairs = spec.dampers.len() + spec.stops.len();
     RunMetrics {
         status: 1,
@@ -859,7 +867,7 @@ fn orbit_metrics(
         status: 0,
         reason: String::new(),
         peak: orbit.reductions.peaks.clone(),
-        rms: vec![nan; n],
+        rms: vec![nan; system.observed()],
         impacts,
         energy_dissipated: vec![nan; system.pairs.len()],
         impacts_per_period: impacts / periods as f64,
@@ -979,6 +987,7 @@ mod tests {
                 load: Load::Base,
                 signal,
             }],
+            points: vec![],
         }
     }
 

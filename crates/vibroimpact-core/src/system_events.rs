@@ -886,8 +886,8 @@ pub fn integrate_system_within<S: SystemStepper>(
     // Whether a compliant contact is on (modes change only at events).
     let mut compliant = any_compliant(&modes);
     let mut reductions = Reductions {
-        peaks: vec![0.0; system.n],
-        square_integrals: vec![0.0; system.n],
+        peaks: vec![0.0; system.observed()],
+        square_integrals: vec![0.0; system.observed()],
         ..Reductions::default()
     };
     let mut next_strobe = options.reduce.strobe_period;
@@ -1434,7 +1434,11 @@ fn reduce_step<S: SystemStepper>(
     out: &mut Reductions,
     mean_square: bool,
 ) -> Result<bool> {
-    let d = system.dim;
+    let (n, d) = (system.n, system.dim);
+    let observed = system.observed();
+    // Each observed quantity (a coordinate or a point) of a block of the
+    // structure's displacements, velocities or accelerations.
+    let of = |j: usize, block: &[f64]| system.observe(j, block);
     // The exact flow's mean square from the flow itself at the quadrature's
     // nodes (its steps are long, the interpolant's error 1e-6 there).
     let on_flow = mean_square && stepper.is_exact();
@@ -1443,33 +1447,37 @@ fn reduce_step<S: SystemStepper>(
     if on_flow {
         for (x, w) in reductions::NODES.iter().zip(reductions::WEIGHTS) {
             stepper.attempt(system, time, y, x * h, modes, scratch, &mut buffers.probe)?;
-            for i in 0..system.n {
-                out.square_integrals[i] += h * w * buffers.probe[i] * buffers.probe[i];
+            for j in 0..observed {
+                let value = of(j, &buffers.probe[..n]);
+                out.square_integrals[j] += h * w * value * value;
             }
         }
         used = true;
     }
+    let (v0, v1) = (&y[d..d + n], &end[d..d + n]);
     // The accelerations at both ends only where the interpolant is needed:
     // for the mean square, or where a velocity changes sign (a peak inside).
-    let turning = (0..system.n).any(|i| y[d + i] * end[d + i] < 0.0);
+    let turning = (0..observed).any(|j| of(j, v0) * of(j, v1) < 0.0);
     if interpolated || turning {
         system.rates(time, y, modes, scratch, &mut buffers.start);
         system.rates(time + h, end, modes, scratch, &mut buffers.work);
     }
-    for i in 0..system.n {
-        let mut peak = y[i].abs().max(end[i].abs());
-        let inside = y[d + i] * end[d + i] < 0.0;
+    for j in 0..observed {
+        let (p0, p1) = (of(j, &y[..n]), of(j, &end[..n]));
+        let (s0, s1) = (of(j, v0), of(j, v1));
+        let mut peak = p0.abs().max(p1.abs());
+        let inside = s0 * s1 < 0.0;
         if interpolated || inside {
             let a = reductions::quintic(
-                y[i],
-                end[i],
-                h * y[d + i],
-                h * end[d + i],
-                h * h * buffers.start[d + i],
-                h * h * buffers.work[d + i],
+                p0,
+                p1,
+                h * s0,
+                h * s1,
+                h * h * of(j, &buffers.start[d..d + n]),
+                h * h * of(j, &buffers.work[d..d + n]),
             );
             if interpolated {
-                out.square_integrals[i] += h * reductions::square_integral(&a);
+                out.square_integrals[j] += h * reductions::square_integral(&a);
             }
             if inside {
                 let theta = reductions::derivative_root(&a);
@@ -1483,10 +1491,10 @@ fn reduce_step<S: SystemStepper>(
                     &mut buffers.probe,
                 )?;
                 used = true;
-                peak = peak.max(buffers.probe[i].abs());
+                peak = peak.max(of(j, &buffers.probe[..n]).abs());
             }
         }
-        out.peaks[i] = out.peaks[i].max(peak);
+        out.peaks[j] = out.peaks[j].max(peak);
     }
     out.recorded_time += h;
     Ok(used)

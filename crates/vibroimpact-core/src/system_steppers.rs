@@ -769,6 +769,7 @@ mod tests {
                     signal: Signal::harmonic(1.5, 5.0, 0.1).unwrap(),
                 },
             ],
+            points: vec![],
         };
         Assembly::new(&spec).unwrap()
     }

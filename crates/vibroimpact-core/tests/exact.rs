@@ -16,6 +16,7 @@ use vibroimpact_core::reductions::ReduceOptions;
 use vibroimpact_core::signals::{Signal, SweepLaw};
 use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
+use vibroimpact_core::system_steppers::ExplicitRk;
 
 fn spec(structure: Structure) -> SystemSpec {
     SystemSpec {
@@ -24,6 +25,7 @@ fn spec(structure: Structure) -> SystemSpec {
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],
+        points: vec![],
     }
 }
 
@@ -342,5 +344,109 @@ fn a_linear_contact_between_free_masses_lasts_half_its_damped_period() {
         assert!(close(momentum, small * v0, 1e-12));
         let lost = 0.5 * me * (v0 * v0 - rebound * rebound);
         assert!(close(sol.energy.contact, lost, 1e-9), "{:?}", sol.energy);
+    });
+}
+
+#[test]
+fn a_forced_cantilever_s_points_reduce_its_deflection_there() {
+    common::timeout(60, || {
+        // Three modes, 0.5 N at the tip at 8 Hz, from the steady state
+        // solved here mode by mode: Q_i = f_i / (K_ii - w^2 M_ii + i w C_ii).
+        let (length, force, f) = (0.5, 0.5, 8.0);
+        let beam = Structure::cantilever(length, 7e10, 1e-10, 0.27, 3, 0.01).unwrap();
+        let w = TAU * f;
+        let tip = beam.point("tip", length).unwrap();
+        let (m, k, c) = (beam.mass(), beam.stiffness(), beam.damping());
+        let q: Vec<(f64, f64)> = (0..3)
+            .map(|i| {
+                let d = i * 3 + i;
+                let (re, im) = (k[d] - w * w * m[d], w * c[d]);
+                let norm = re * re + im * im;
+                let fi = force * tip[i];
+                (fi * re / norm, -fi * im / norm)
+            })
+            .collect();
+        let mut s = spec(beam.clone());
+        s.excitations.push(Excitation {
+            load: Load::Force { at: length },
+            signal: Signal::harmonic(force, f, 0.0).unwrap(),
+        });
+        let points = [length, 0.3, 0.0];
+        s.points = points.to_vec();
+        let x0: Vec<f64> = q.iter().map(|(re, _)| *re).collect();
+        let v0: Vec<f64> = q.iter().map(|(_, im)| -w * im).collect();
+        let reduce = ReduceOptions {
+            record_from: 0.0,
+            strobe_period: f64::INFINITY,
+            mean_square: true,
+        };
+        let exact_run = exact(
+            &s,
+            &[x0.clone(), v0.clone(), vec![], vec![]],
+            10.0 / f,
+            reduce,
+        );
+        // And RK4's, which places peaks by its interpolant (fifth order).
+        let system = Assembly::new(&s).unwrap();
+        let y = initial_state(&system, &x0, &v0, &[], &[]).unwrap();
+        let mut rk4 = ExplicitRk::rk4(system.state_len());
+        let options = RunOptions {
+            dt: Some(1.0 / (400.0 * f)),
+            t_end: 10.0 / f,
+            every: 1,
+            keep_history: false,
+            max_steps: 100_000_000,
+            max_rows: 100_000_000,
+            energy_tolerance: 1e-6,
+            reduce,
+        };
+        let fixed = integrate_system(&system, &mut rk4, &y, &options, &mut || false).unwrap();
+        for (sol, tolerance) in [(&exact_run, 1e-9), (&fixed, 1e-7)] {
+            let r = &sol.reductions;
+            assert_eq!(r.peaks.len(), 3 + points.len());
+            for (j, &at) in points.iter().enumerate() {
+                // The deflection there is Re(sum_i row_i Q_i e^{i w t}).
+                let row = beam.point("point", at).unwrap();
+                let (re, im) = row
+                    .iter()
+                    .zip(&q)
+                    .fold((0.0, 0.0), |(a, b), (r, (qr, qi))| (a + r * qr, b + r * qi));
+                let amplitude = re.hypot(im);
+                let peak = r.peaks[3 + j];
+                let rms = (r.square_integrals[3 + j] / r.recorded_time).sqrt();
+                if at == 0.0 {
+                    // The clamp does not move.
+                    assert!(peak <= 1e-12 * r.peaks[3], "clamp {peak}");
+                    continue;
+                }
+                assert!(
+                    close(peak, amplitude, tolerance),
+                    "at {at}: peak {peak} vs {amplitude}"
+                );
+                assert!(
+                    close(rms, amplitude / 2f64.sqrt(), 1e-6),
+                    "at {at}: rms {rms}"
+                );
+            }
+            // A point is no coordinate: the tip's amplitude is not a mode's.
+            assert!(r.peaks[3] > 1.1 * r.peaks[0], "{:?}", r.peaks);
+        }
+    });
+}
+
+#[test]
+fn points_outside_the_structure_are_refused_by_name() {
+    common::timeout(10, || {
+        let mut s = spec(Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap());
+        s.points = vec![0.2, 0.7];
+        let err = Assembly::new(&s).unwrap_err().to_string();
+        assert!(
+            err.contains("point 1 must be a position along the beam in [0, 0.5] m"),
+            "{err}"
+        );
+        let mut s = spec(Structure::oscillator(1.0, 1.0, 0.0).unwrap());
+        s.points = vec![0.0; vibroimpact_core::assembly::MAX_POINTS + 1];
+        let err = Assembly::new(&s).unwrap_err().to_string();
+        assert!(err.contains("points: at most"), "{err}");
     });
 }

@@ -28,6 +28,7 @@ fn beam() -> (Assembly, Vec<f64>) {
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],
+        points: vec![],
     };
     let system = Assembly::new(&spec).unwrap();
     let mut v = vec![0.0; 40];

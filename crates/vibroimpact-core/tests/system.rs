@@ -36,6 +36,7 @@ fn spec(structure: Structure) -> SystemSpec {
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],
+        points: vec![],
     }
 }
 

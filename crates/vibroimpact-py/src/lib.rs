@@ -56,5 +56,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_SIGNAL_SAMPLES", core::signals::MAX_SIGNAL_SAMPLES)?;
     m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
     m.add("RTOL_RANGE", core::settings::RTOL_RANGE)?;
+    m.add("MAX_POINTS", core::assembly::MAX_POINTS)?;
     Ok(())
 }

@@ -1,0 +1,234 @@
+"""Amplitudes at points of the structure (``[output] points``): a cantilever's
+deflection where a user measures it, not its modal coordinates.
+
+References: the forced linear beam's steady deflection at a point, ``|w . Q|`` with
+``Q`` solved here from the modal equations (frequencies and shapes from the public
+mode functions, each mode's equation written here), and the RMS of a sinusoid,
+amplitude / sqrt 2. Where the beam carries dampers, the reductions at the tip are
+checked against the history's own deflection there, sampled densely.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import vibroimpact as vi
+from vibroimpact.analyses import orbit, runner, sweep
+from vibroimpact.datasets import sweep_dataset
+
+LENGTH, YOUNG, SECOND, MASS_PER_LENGTH, ZETA = 0.5, 7e10, 1e-10, 0.27, 0.01
+FORCE = 0.5
+
+BEAM: dict[str, Any] = {
+    "kind": "cantilever",
+    "length": LENGTH,
+    "youngs_modulus": YOUNG,
+    "second_moment": SECOND,
+    "mass_per_length": MASS_PER_LENGTH,
+    "modes": 3,
+    "damping_ratio": ZETA,
+}
+
+
+def tip_force(frequency: float) -> dict[str, Any]:
+    return {
+        "kind": "force",
+        "at": LENGTH,
+        "signal": "harmonic",
+        "amplitude": FORCE,
+        "frequency": frequency,
+    }
+
+
+def linear_deflection(frequency: float, at: float, modes: int = 3) -> float:
+    """The steady deflection amplitude (m) at ``at`` of the beam alone under the tip
+    force: each mode ``q_i'' + 2 zeta w_i q_i' + w_i^2 q_i = phi_i(L) F / (rho A L)``
+    with shapes normalised to ``int phi_i^2 dx = L`` (checked below)."""
+    w = 2 * math.pi * frequency
+    total = 0j
+    for i in range(1, modes + 1):
+        # Density MASS_PER_LENGTH over an area of 1 m^2: rho A is the mass per length.
+        mode = vi.cantilever_mode(LENGTH, YOUNG, SECOND, MASS_PER_LENGTH, 1.0, i)
+        assert mode.modal_mass == pytest.approx(MASS_PER_LENGTH * LENGTH, rel=1e-12)
+        wi = math.sqrt(mode.modal_stiffness / mode.modal_mass)
+        modal_force = vi.cantilever_mode_shape(LENGTH, i, LENGTH) * FORCE
+        q = modal_force / mode.modal_mass / (wi * wi - w * w + 2j * ZETA * wi * w)
+        total += vi.cantilever_mode_shape(LENGTH, i, at) * q
+    return abs(total)
+
+
+def test_the_shapes_normalisation_the_reference_assumes() -> None:
+    # int_0^L phi^2 dx = L: the modal mass is then rho A L, as linear_deflection takes it.
+    xs, ws = np.polynomial.legendre.leggauss(60)
+    x = 0.5 * LENGTH * (xs + 1)
+    for mode in (1, 2, 3):
+        phi = np.array([vi.cantilever_mode_shape(LENGTH, mode, float(v)) for v in x])
+        assert 0.5 * LENGTH * float(np.sum(ws * phi * phi)) == pytest.approx(LENGTH, rel=1e-10)
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk4"])
+def test_a_run_follows_the_deflection_at_its_points(method: str) -> None:
+    frequency, points = 9.0, [LENGTH, 0.3, 0.1]
+    sol = vi.simulate_system(
+        BEAM,
+        excitation=[tip_force(frequency)],
+        t_end=30.0,
+        method=method,
+        dt=1e-4 if method == "rk4" else None,
+        rtol=1e-10,
+        record_from=28.0,
+        points=points,
+        history=False,
+        max_steps=2_000_000,
+    )
+    assert list(sol.points) == points
+    for at, peak, rms in zip(points, sol.point_peak, sol.point_rms, strict=True):
+        expected = linear_deflection(frequency, at)
+        # Transients have decayed to e^-(zeta w1 28 s) ~ 1e-9 of the start.
+        assert peak == pytest.approx(expected, rel=1e-6), at
+        assert rms == pytest.approx(expected / math.sqrt(2), rel=1e-5), at
+    # The tip is no coordinate: its deflection is not the first mode's amplitude.
+    assert sol.point_peak[0] > 1.5 * sol.peak[0]
+
+
+def test_a_sweep_reports_and_stores_the_deflection_at_its_points() -> None:
+    data = {
+        "structure": BEAM,
+        "excitation": [tip_force(8.0)],
+        "solver": {"method": "exact", "t_end": 1.0},
+        "output": {"points": [LENGTH, 0.25]},
+    }
+    values = [8.0, 10.0, 14.0]
+    found = sweep(data, "excitation.0.frequency", values, settle_periods=400, record_periods=5)
+    for p in found:
+        for j, at in enumerate((LENGTH, 0.25)):
+            expected = linear_deflection(p.value, at)
+            assert p.linear_point_amplitude[j] == pytest.approx(expected, rel=1e-9)
+            assert p.point_amplitude[j] == pytest.approx(expected, rel=1e-6)
+            assert p.point_rms[j] == pytest.approx(expected / math.sqrt(2), rel=1e-5)
+        d = p.to_dict()
+        assert d["points"] == [LENGTH, 0.25]
+        assert d["point_reduction"][0] == pytest.approx(0.0, abs=1e-5)
+    ds = sweep_dataset(found, "excitation.0.frequency")
+    assert list(ds["at"].values) == [LENGTH, 0.25]
+    assert ds["point_amplitude"].dims == ("point", "at")
+    np.testing.assert_allclose(
+        ds["point_amplitude"].values, [p.point_amplitude for p in found], rtol=0
+    )
+
+
+def test_an_orbit_and_a_study_report_their_points(tmp_path: Path, run_cli: Any) -> None:
+    frequency = 11.0
+    data = {
+        "structure": BEAM,
+        "excitation": [tip_force(frequency)],
+        "solver": {"method": "exact", "t_end": 1.0},
+        "output": {"points": [LENGTH]},
+    }
+    found = orbit(runner(data))
+    assert found.converged
+    assert found.point_amplitude[0] == pytest.approx(linear_deflection(frequency, LENGTH), 1e-8)
+    scenario = tmp_path / "beam.toml"
+    scenario.write_text(
+        f"""
+[structure]
+kind = "cantilever"
+length = {LENGTH}
+youngs_modulus = {YOUNG}
+second_moment = {SECOND}
+mass_per_length = {MASS_PER_LENGTH}
+modes = 3
+damping_ratio = {ZETA}
+[[excitation]]
+kind = "force"
+at = {LENGTH}
+signal = "harmonic"
+amplitude = {FORCE}
+frequency = {frequency}
+[solver]
+method = "exact"
+t_end = 30.0
+[output]
+points = [{LENGTH}, 0.2]
+[study]
+analysis = "run"
+record_from = 28.0
+metrics = ["peak", "rms"]
+[study.axes]
+"excitation.0.frequency" = [7.0, {frequency}]
+""",
+        encoding="utf-8",
+    )
+    done = run_cli("study", str(scenario), "--out", "beam.nc")
+    assert done.returncode == 0, done.stderr
+    with xr.open_dataset(tmp_path / "beam.nc") as ds:
+        assert list(ds["at"].values) == [LENGTH, 0.2]
+        for f in (7.0, frequency):
+            for at in (LENGTH, 0.2):
+                peak = float(ds["point_peak"].sel({"excitation.0.frequency": f, "at": at}))
+                assert peak == pytest.approx(linear_deflection(f, at), rel=1e-6)
+        assert ds["peak"].sizes["coordinate"] == 3
+    shown = run_cli("orbit", str(scenario), "--json")
+    assert shown.returncode == 0, shown.stderr
+    summary = json.loads(shown.stdout)
+    assert summary["points"] == [LENGTH, 0.2]
+    assert summary["point_amplitude"][0] == pytest.approx(
+        linear_deflection(frequency, LENGTH), rel=1e-8
+    )
+
+
+def test_with_dampers_the_points_peaks_are_the_history_s(tmp_path: Path) -> None:
+    # Dampers at the tip and mid-span: no closed form, but the deflection there is
+    # the history's (sampled every step of a fine dop853 run), whose largest value
+    # the located peak may only exceed by what falls between samples.
+    sol = vi.simulate_system(
+        BEAM,
+        damper=[
+            {
+                "mass": 0.01,
+                "at": LENGTH,
+                "clearance": 2e-4,
+                "law": "hertz-damped",
+                "stiffness": 1e7,
+                "restitution": 0.6,
+            }
+        ],
+        excitation=[tip_force(8.0)],
+        t_end=1.0,
+        method="dop853",
+        rtol=1e-10,
+        record_from=0.5,
+        points=[LENGTH, 0.25],
+        max_steps=2_000_000,
+    )
+    recorded = sol.t >= 0.5
+    for j, at in enumerate((LENGTH, 0.25)):
+        sampled = float(np.max(np.abs(sol.displacement_at(at)[recorded])))
+        assert sampled <= sol.point_peak[j] <= sampled * (1 + 1e-4)
+        deflection = sol.displacement_at(at)[recorded]
+        times = sol.t[recorded]
+        mean_square = np.trapezoid(deflection**2, times) / (times[-1] - times[0])
+        assert sol.point_rms[j] == pytest.approx(math.sqrt(mean_square), rel=1e-3)
+
+
+def test_points_off_the_structure_are_refused_naming_the_key(run_cli: Any) -> None:
+    with pytest.raises(ValueError, match=r"\[output\] points\[1\] must be a position along"):
+        vi.simulate_system(BEAM, t_end=0.1, method="dop853", points=[0.1, 0.6])
+    with pytest.raises(ValueError, match=r"points\[0\] must be a coordinate index"):
+        vi.simulate_system(
+            {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0},
+            t_end=0.1,
+            method="dop853",
+            points=[1],
+        )
+    with pytest.raises(ValueError, match=r"\[output\] points: must be an array of numbers"):
+        vi.simulate_system(BEAM, t_end=0.1, method="dop853", points="tip")
+    with pytest.raises(ValueError, match=r"\[output\] points: holds 10001"):
+        vi.simulate_system(BEAM, t_end=0.1, method="dop853", points=[0.1] * (vi.MAX_POINTS + 1))
