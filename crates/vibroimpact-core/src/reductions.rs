@@ -21,6 +21,11 @@ pub struct ReduceOptions {
     pub strobe_period: f64,
     /// Whether to integrate the mean squares (the peaks cost less without).
     pub mean_square: bool,
+    /// Contacts whose onset is before this (s) are not kept: a run reduced
+    /// to metrics (a study's) counts only those from its recording window,
+    /// and its settling may be millions of periods. Minus infinity keeps
+    /// all (the default).
+    pub contacts_from: f64,
 }
 
 impl Default for ReduceOptions {
@@ -29,6 +34,7 @@ impl Default for ReduceOptions {
             record_from: f64::INFINITY,
             strobe_period: f64::INFINITY,
             mean_square: true,
+            contacts_from: f64::NEG_INFINITY,
         }
     }
 }

@@ -748,6 +748,8 @@ fn measured_on(
             record_from,
             strobe_period,
             mean_square: settings.mean_square,
+            // Only the recorded contacts are counted.
+            contacts_from: record_from,
         },
     );
     let sol = stepper.integrate(system, &y0, &options, &mut || interrupt())?;
@@ -797,10 +799,13 @@ fn orbit_metrics(
 ) -> Result<RunMetrics> {
     let span = periods as f64 * period;
     let options = |t_end: f64, record: bool| {
+        let from = if record { 0.0 } else { f64::INFINITY };
         let reduce = ReduceOptions {
-            record_from: if record { 0.0 } else { f64::INFINITY },
+            record_from: from,
             strobe_period: f64::INFINITY,
             mean_square: false,
+            // Settling and shooting count no contact.
+            contacts_from: from,
         };
         run_options(
             settings,

@@ -12,6 +12,11 @@
 
 use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
 
+/// Contacts held before those a run does not keep are dropped (see
+/// [`ReduceOptions::contacts_from`]): a few, so that dropping them costs as
+/// little as holding them.
+const COMPACTED_CONTACTS: usize = 64;
+
 /// The contact-loss accumulator of interaction `i` in a state vector.
 #[inline(always)]
 fn loss_slot(system: &Assembly, i: usize) -> usize {
@@ -1290,6 +1295,11 @@ pub fn integrate_system_within<S: SystemStepper>(
             // Impacts change the velocities.
             system.gaps(&y, &mut gaps.start);
             compliant = any_compliant(&modes);
+            if contacts.len() >= COMPACTED_CONTACTS && time < options.reduce.contacts_from {
+                // Before the contacts kept begin: what closed is dropped (a
+                // contact across their start may stay; it is dropped below).
+                contacts.retain(|c| c.onset >= options.reduce.contacts_from);
+            }
         }
 
         if time >= next_strobe - 1e-9 * options.reduce.strobe_period {
@@ -1392,6 +1402,9 @@ pub fn integrate_system_within<S: SystemStepper>(
             };
             contacts.push(oc.close(system.interactions[i].pair, f64::NAN, f64::NAN, dissipated));
         }
+    }
+    if options.reduce.contacts_from > f64::NEG_INFINITY {
+        contacts.retain(|c| c.onset >= options.reduce.contacts_from);
     }
     contacts.sort_by(|a, b| a.onset.total_cmp(&b.onset));
     let energy = balance(

@@ -128,6 +128,7 @@ fn forced_oscillator_stays_on_its_steady_state_and_reduces_it() {
                 record_from: 0.0,
                 strobe_period: 1.0 / f,
                 mean_square: true,
+                contacts_from: f64::NEG_INFINITY,
             },
         );
         let amplitude = (qr * qr + qi * qi).sqrt();
@@ -379,6 +380,7 @@ fn a_forced_cantilever_s_points_reduce_its_deflection_there() {
             record_from: 0.0,
             strobe_period: f64::INFINITY,
             mean_square: true,
+            contacts_from: f64::NEG_INFINITY,
         };
         let exact_run = exact(
             &s,

@@ -4,10 +4,13 @@
 
 mod common;
 
-use vibroimpact_core::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
+use vibroimpact_core::assembly::{
+    initial_state, Assembly, Damper, Excitation, Load, PairLaw, SystemSpec,
+};
 use vibroimpact_core::contact::{Contact, LawKind};
 use vibroimpact_core::error::Error;
 use vibroimpact_core::reductions::ReduceOptions;
+use vibroimpact_core::signals::Signal;
 use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::{integrate_system_within, RunOptions, SystemSolution};
 use vibroimpact_core::system_steppers::ExplicitRk;
@@ -134,5 +137,82 @@ fn a_limit_the_records_fit_within_changes_nothing() {
         let fitted =
             integrate_system_within(&system, &mut rk4(), &y, &o, &mut || false, limit).unwrap();
         assert_eq!(fitted.final_state, whole.final_state);
+    });
+}
+
+/// A harmonically forced oscillator with a rigid loose mass: 5,700 impacts
+/// in 200 s (1000 forcing periods).
+fn forced_damper() -> (Assembly, Vec<f64>) {
+    let spec = SystemSpec {
+        structure: Structure::oscillator(1.0, 1000.0, 0.0).unwrap(),
+        dampers: vec![Damper {
+            mass: 0.05,
+            at: 0.0,
+            lower_clearance: 0.005,
+            upper_clearance: 0.005,
+            law: PairLaw::rigid(0.6).unwrap(),
+        }],
+        stops: vec![],
+        gravity: 0.0,
+        excitations: vec![Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(1.0, 5.0, 0.0).unwrap(),
+        }],
+        points: vec![],
+    };
+    let system = Assembly::new(&spec).unwrap();
+    let y = initial_state(&system, &[], &[], &[], &[]).unwrap();
+    (system, y)
+}
+
+#[test]
+fn a_run_that_keeps_only_its_window_s_contacts_holds_no_others() {
+    common::timeout(60, || {
+        let (system, y) = forced_damper();
+        let run = |contacts_from: f64, limit: u64| {
+            let options = RunOptions {
+                dt: Some(1e-3),
+                t_end: 200.0,
+                every: 1,
+                keep_history: false,
+                max_steps: 100_000_000,
+                max_rows: 100_000_000,
+                energy_tolerance: 1e-2,
+                reduce: ReduceOptions {
+                    contacts_from,
+                    ..Default::default()
+                },
+            };
+            let mut stepper = ExplicitRk::rk4(system.state_len());
+            integrate_system_within(&system, &mut stepper, &y, &options, &mut || false, limit)
+        };
+        let all = run(f64::NEG_INFINITY, MAX_RECORD_BYTES).unwrap();
+        assert!(all.contacts.len() > 5000, "{}", all.contacts.len());
+        let from = 190.0;
+        let window: Vec<_> = all.contacts.iter().filter(|c| c.onset >= from).collect();
+        assert!(!window.is_empty() && window.len() < all.contacts.len() / 10);
+        // 100 kB: the window's contacts fit, the run's do not.
+        let limit = 100_000;
+        let size = std::mem::size_of_val(&all.contacts[0]) as u64;
+        assert!(
+            window.len() as u64 * size * 2 < limit && all.contacts.len() as u64 * size > limit,
+            "{} of {} contacts, {size} bytes each",
+            window.len(),
+            all.contacts.len()
+        );
+        assert!(matches!(
+            run(f64::NEG_INFINITY, limit),
+            Err(Error::MemoryLimit { .. })
+        ));
+        let kept = run(from, limit).unwrap();
+        // The same run (dropping records changes no step), the same window.
+        assert_eq!(kept.final_state, all.final_state);
+        assert_eq!(kept.contacts.len(), window.len());
+        for (a, b) in kept.contacts.iter().zip(&window) {
+            assert_eq!(a, *b);
+        }
+        let none = run(f64::INFINITY, limit).unwrap();
+        assert!(none.contacts.is_empty());
+        assert_eq!(none.final_state, all.final_state);
     });
 }

@@ -346,6 +346,7 @@ impl Ready {
                 record_from: record_from.unwrap_or(f64::INFINITY),
                 strobe_period,
                 mean_square: true,
+                contacts_from: f64::NEG_INFINITY,
             },
         };
         self.stepper
