@@ -232,3 +232,145 @@ def test_points_off_the_structure_are_refused_naming_the_key(run_cli: Any) -> No
         vi.simulate_system(BEAM, t_end=0.1, method="dop853", points="tip")
     with pytest.raises(ValueError, match=r"\[output\] points: holds 10001"):
         vi.simulate_system(BEAM, t_end=0.1, method="dop853", points=[0.1] * (vi.MAX_POINTS + 1))
+
+
+def test_loads_of_one_frequency_add_as_phasors_in_the_linear_reference() -> None:
+    # Two equal tip loads in quadrature: sqrt 2 of one; in opposition: nothing (user
+    # trial: their amplitudes were added, a 29 % "reduction" with no damper at all).
+    for phase, factor in ((math.pi / 2, math.sqrt(2)), (math.pi, 0.0)):
+        second = tip_force(10.0) | {"phase": phase}
+        data = {
+            "structure": BEAM,
+            "excitation": [tip_force(10.0), second],
+            "solver": {"method": "exact", "t_end": 1.0},
+            "output": {"points": [LENGTH]},
+        }
+        (found,) = sweep(data, "excitation.0.amplitude", [FORCE], settle_periods=300)
+        expected = factor * linear_deflection(10.0, LENGTH)
+        assert found.linear_point_amplitude[0] == pytest.approx(expected, rel=1e-9, abs=1e-15)
+        assert found.point_amplitude[0] == pytest.approx(expected, rel=1e-5, abs=1e-12)
+
+
+def test_points_without_a_window_record_the_whole_run(tmp_path: Path, run_cli: Any) -> None:
+    sol = vi.simulate_system(
+        BEAM,
+        excitation=[tip_force(9.0)],
+        t_end=0.5,
+        method="dop853",
+        rtol=1e-10,
+        points=[LENGTH],
+    )
+    sampled = float(np.max(np.abs(sol.displacement_at(LENGTH))))
+    assert sampled <= sol.point_peak[0] <= sampled * (1 + 1e-6)
+    assert sol.recorded_time == pytest.approx(0.5)
+    with pytest.raises(ValueError, match=r"\[output\] points: 0.25 is given twice"):
+        vi.simulate_system(BEAM, t_end=0.1, method="dop853", points=[0.25, 0.5, 0.25])
+    # The CSV carries the deflection at each point.
+    scenario = tmp_path / "beam.toml"
+    scenario.write_text(
+        BEAM_TOML + "[solver]\nmethod = 'dop853'\nt_end = 0.2\n[output]\npoints = [0.5, 0.2]\n",
+        encoding="utf-8",
+    )
+    done = run_cli("simulate", str(scenario), "--out", "h.csv")
+    assert done.returncode == 0, done.stderr
+    table = np.genfromtxt(tmp_path / "h.csv", delimiter=",", names=True)
+    assert table.dtype.names[-2:] == ("point_displacement_0", "point_displacement_1")
+    modes = np.column_stack([table[f"structure_displacement_{i}"] for i in range(3)])
+    shape = [vi.cantilever_mode_shape(LENGTH, i + 1, 0.2) for i in range(3)]
+    np.testing.assert_allclose(table["point_displacement_1"], modes @ shape, rtol=1e-12, atol=0)
+
+
+BEAM_TOML = f"""
+[structure]
+kind = "cantilever"
+length = {LENGTH}
+youngs_modulus = {YOUNG}
+second_moment = {SECOND}
+mass_per_length = {MASS_PER_LENGTH}
+modes = 3
+damping_ratio = {ZETA}
+[[excitation]]
+kind = "force"
+at = {LENGTH}
+signal = "harmonic"
+amplitude = {FORCE}
+frequency = 10.0
+"""
+
+
+def test_a_study_records_the_scenario_s_window_and_maps_a_point(
+    tmp_path: Path, run_cli: Any
+) -> None:
+    scenario = tmp_path / "beam.toml"
+    scenario.write_text(
+        BEAM_TOML
+        + """
+[solver]
+method = "exact"
+t_end = 2.0
+[output]
+record_from = 1.5
+points = [0.5]
+[study]
+analysis = "run"
+metrics = ["peak"]
+[study.axes]
+"excitation.0.frequency" = [9.0, 10.0]
+"excitation.0.amplitude" = [0.25, 0.5]
+""",
+        encoding="utf-8",
+    )
+    done = run_cli("study", str(scenario), "--out", "s.nc", "--plot", "map.png")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "map.png").stat().st_size > 0
+    # The run the study made at 10 Hz, 0.5 N is the scenario's own: the same window.
+    sol = vi.simulate_system(
+        BEAM,
+        excitation=[tip_force(10.0)],
+        t_end=2.0,
+        method="exact",
+        record_from=1.5,
+        points=[LENGTH],
+        history=False,
+    )
+    with xr.open_dataset(tmp_path / "s.nc") as ds:
+        peak = ds["point_peak"].sel(
+            {"excitation.0.frequency": 10.0, "excitation.0.amplitude": 0.5, "at": LENGTH}
+        )
+        assert float(peak) == sol.point_peak[0]
+    refused = run_cli("study", str(scenario), "--out", "t.nc", "--plot", "m.png", "--metric", "x")
+    assert refused.returncode == 2
+    assert "point_peak" in refused.stderr
+
+
+def test_a_failed_sweep_point_is_strict_json(tmp_path: Path, run_cli: Any) -> None:
+    # A step beyond RK4's stability for the third mode (200 Hz): the runs blow up.
+    scenario = tmp_path / "beam.toml"
+    scenario.write_text(
+        BEAM_TOML
+        + """
+[solver]
+method = "rk4"
+dt = 3e-3
+t_end = 1.0
+[output]
+points = [0.5]
+[sweep]
+parameter = "excitation.0.frequency"
+start = 9.0
+stop = 10.0
+count = 2
+settle_periods = 20
+record_periods = 5
+""",
+        encoding="utf-8",
+    )
+    done = run_cli("sweep", str(scenario), "--json")
+    assert done.returncode == 0, done.stderr
+
+    def refuse(constant: str) -> None:
+        raise AssertionError(f"{constant} is no JSON")
+
+    points = json.loads(done.stdout, parse_constant=refuse)["points"]
+    assert all(p["error"] for p in points)
+    assert points[0]["impacts_per_period"] is None

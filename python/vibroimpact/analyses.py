@@ -352,8 +352,9 @@ def steady_state(
 def linear_amplitude(data: Mapping[str, Any], base_dir: Path | None = None) -> np.ndarray:
     """Per structure coordinate, the steady amplitude (m) of the structure alone
     (dampers and stops removed) under the scenario's harmonic excitations, from
-    ``(K - w^2 M + i w C) Q = F``: exact for one frequency; for several, the sum of
-    their amplitudes (a bound). NaN where a rigid-body mode makes it unbounded."""
+    ``(K - w^2 M + i w C) Q = F``, the loads of one frequency summed as phasors: exact
+    for one frequency; for several, the sum of their amplitudes (a bound). NaN where a
+    rigid-body mode makes it unbounded."""
     return linear_response(data, base_dir)[0]
 
 
@@ -372,10 +373,14 @@ def linear_response(
         [point_weights(structure.spec["structure"], at) for at in structure.output["points"]]
     ).reshape(-1, n)
     m, k, c = parts["mass"], parts["stiffness"], parts["damping"]
-    total, at_points = np.zeros(n), np.zeros(len(weights))
+    # Loads of one frequency add as phasors (two equal loads in quadrature are
+    # sqrt 2 of one, in opposition nothing); the frequencies' amplitudes add.
+    phasors: dict[float, np.ndarray] = {}
     for h in parts["harmonics"]:
-        w = h["omega"]
         force = h["amplitude"] * np.exp(1j * h["phase"]) * np.asarray(h["shape"])
+        phasors[h["omega"]] = phasors.get(h["omega"], 0) + force
+    total, at_points = np.zeros(n), np.zeros(len(weights))
+    for w, force in phasors.items():
         matrix = k - w * w * m + 1j * w * c
         try:
             q = np.linalg.solve(matrix, force)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from collections.abc import Callable
@@ -25,7 +24,7 @@ from vibroimpact.analyses import (
 )
 from vibroimpact.continuation import continue_orbit
 from vibroimpact.maps import basins, bifurcation, poincare
-from vibroimpact.output import UsageError, check_plot, finite_or_none
+from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
 from vibroimpact.scenario import load_scenario
 from vibroimpact.system_scenario import SystemScenario
 
@@ -186,7 +185,7 @@ def run_orbit(args: argparse.Namespace) -> int:
     if args.plot:
         plots.plot_history(args.plot, plots.orbit_history(run, found.state, args.periods))
     if args.json:
-        print(json.dumps(summary))
+        print(json_text(summary))
         return 0
     lines = [
         f"{args.scenario}: {'converged' if found.converged else 'did NOT converge'} to a "
@@ -251,7 +250,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         plots.plot_sweep(args.plot, settings["parameter"], points, scenario.data)
     if args.json:
         print(
-            json.dumps(
+            json_text(
                 {
                     "parameter": settings["parameter"],
                     "points": [p.to_dict() for p in points],
@@ -347,9 +346,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         for p in points
     ]
     if args.json:
-        print(
-            json.dumps({"parameter": settings["parameter"], "points": rows, "cpu_time": cpu_time})
-        )
+        print(json_text({"parameter": settings["parameter"], "points": rows, "cpu_time": cpu_time}))
         return 0
     print(f"{args.scenario}: {len(points)} values of {settings['parameter']} in {cpu_time:.3f} s")
     for row in rows:
@@ -376,7 +373,7 @@ def run_poincare(args: argparse.Namespace) -> int:
         plots.plot_section(args.plot, section, run.period)
     if args.json:
         print(
-            json.dumps(
+            json_text(
                 {
                     "forcing_period": run.period,
                     "strobe": section.strobe.tolist(),
@@ -428,7 +425,7 @@ def run_basins(args: argparse.Namespace) -> int:
         plots.plot_basins(args.plot, result, settings["x"]["state"], settings["y"]["state"])
     if args.json:
         print(
-            json.dumps(
+            json_text(
                 {
                     "x": settings["x"]["state"],
                     "y": settings["y"]["state"],
@@ -480,7 +477,7 @@ def run_continue(args: argparse.Namespace) -> int:
         plots.plot_branch(args.plot, branch, scenario.data)
     if args.json:
         print(
-            json.dumps(
+            json_text(
                 {
                     "parameter": branch.parameter,
                     "periods": branch.periods,

@@ -88,12 +88,19 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
 
 
 def plot_history(path: Path, sol: SystemSolution) -> None:
-    """Time history of structure coordinate 0 (and each damper's displacement), its
-    phase portrait, and the impacts marked on both."""
+    """Time history of structure coordinate 0, or of the structure at the first of
+    ``[output] points`` (and each damper's displacement), its phase portrait, and the
+    impacts marked on both."""
     with _figure(path, 1, 2, (11, 4.5)) as (fig, (left, right)):
-        x = sol.structure_displacement[:, 0]
-        v = sol.structure_velocity[:, 0]
-        left.plot(sol.t, x, lw=1, label="structure coordinate 0")
+        if len(sol.points):
+            # A cantilever's coordinate 0 is a mode, not a deflection beside the dampers'.
+            x, v = sol.displacement_at(sol.points[0]), sol.velocity_at(sol.points[0])
+            name = f"structure at point {sol.points[0]:g}"
+        else:
+            x = sol.structure_displacement[:, 0]
+            v = sol.structure_velocity[:, 0]
+            name = "structure coordinate 0"
+        left.plot(sol.t, x, lw=1, label=name)
         for j in range(sol.damper_displacement.shape[1]):
             left.plot(sol.t, sol.damper_displacement[:, j], lw=0.8, label=f"damper {j}")
         right.plot(x, v, lw=1)
@@ -109,8 +116,8 @@ def plot_history(path: Path, sol: SystemSolution) -> None:
         left.set_xlabel("t (s)")
         left.set_ylabel("displacement (m, relative to the base)")
         left.legend(fontsize=8)
-        right.set_xlabel("structure displacement 0 (m)")
-        right.set_ylabel("structure velocity 0 (m/s)")
+        right.set_xlabel(f"{name}: displacement (m)")
+        right.set_ylabel(f"{name}: velocity (m/s)")
         for ax in (left, right):
             ax.grid(alpha=0.3)
 
@@ -242,11 +249,14 @@ def plot_branch(path: Path, branch: Branch, data: Any = None) -> None:
 
 def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
     """A heat map of ``metric`` over the axes ``x`` and ``y`` of a study's Dataset:
-    the other axes (and structure coordinates or pairs beyond the first) reduced to
-    their worst case, the largest value; the optimum, the smallest, marked."""
+    the other axes (and structure coordinates, points or pairs beyond the first)
+    reduced to their worst case, the largest value; the optimum, the smallest, marked."""
     values = dataset[metric]
-    for dim in ("coordinate", "pair"):
+    where = ""
+    for dim in ("coordinate", "pair", "at"):
         if dim in values.dims:
+            if dim == "at":
+                where = f" at point {float(values['at'][0]):g}"
             values = values.isel({dim: 0})
     others = [d for d in values.dims if d not in (x, y)]
     if others:
@@ -257,7 +267,7 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
             dataset[x].values, dataset[y].values, grid.values, shading="nearest", cmap="viridis"
         )
         units = dataset[metric].attrs.get("units", "")
-        label = metric + (f" ({units})" if units and units != "1" else "")
+        label = metric + where + (f" ({units})" if units and units != "1" else "")
         if others:
             label += ", worst over " + ", ".join(others)
         fig.colorbar(mesh, ax=ax, label=label)

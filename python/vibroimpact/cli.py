@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import json
 import math
 import os
 import signal
@@ -31,7 +30,13 @@ from vibroimpact._core import (
 )
 from vibroimpact.analysis_commands import COMMANDS, add_commands
 from vibroimpact.messages import short_numbers
-from vibroimpact.output import UsageError, check_output, finite_or_none, written_whole
+from vibroimpact.output import (
+    UsageError,
+    check_output,
+    finite_or_none,
+    json_text,
+    written_whole,
+)
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
 from vibroimpact.study_commands import add_command as add_study
@@ -196,7 +201,7 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
     if args.out:
         write_system_history(args.out, sol)
     if args.json:
-        print(json.dumps(system_summary(scenario, sol, cpu_time)))
+        print(json_text(system_summary(scenario, sol, cpu_time)))
         return 0
     print("\n".join(system_lines(str(args.scenario), sol, cpu_time, scenario.prepared.output)))
     if args.out:
@@ -227,7 +232,7 @@ def _simulate(args: argparse.Namespace) -> int:
         write_history(args.out, sol)
     summary = run_summary(scenario, sol, cpu_time)
     if args.json:
-        print(json.dumps(summary))
+        print(json_text(summary))
         return 0
     name = str(args.scenario) if args.scenario else "the paper's Table 1 collision"
     step = f"dt = {scenario.dt:g} s" if scenario.dt is not None else f"rtol = {scenario.rtol:g}"

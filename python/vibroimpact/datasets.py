@@ -35,8 +35,6 @@ amplitudes (m, the shapes being dimensionless).
 
 from __future__ import annotations
 
-import json
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -48,6 +46,7 @@ from vibroimpact._core import __version__
 from vibroimpact.analyses import AnalysisError, SweepPoint
 from vibroimpact.continuation import Branch
 from vibroimpact.maps import Basins, BifurcationPoint, Section
+from vibroimpact.output import json_text
 
 __all__ = [
     "basins_dataset",
@@ -516,7 +515,7 @@ def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
             f"basins_dataset: labels must have shape {(len(first), len(second))}, got "
             f"{labels.shape}"
         )
-    attractors = json.dumps([_json_safe(a) for a in result.attractors])
+    attractors = json_text(list(result.attractors))
     return xr.Dataset(
         data_vars={
             "label": (
@@ -551,21 +550,6 @@ def _state_unit(name: str) -> str | None:
     if "displacement" in name:
         return _M
     return None
-
-
-def _json_safe(value: Any) -> Any:
-    """A value JSON can write: NumPy numbers as Python ones, non-finite floats as None."""
-    if isinstance(value, Mapping):
-        return {str(key): _json_safe(v) for key, v in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, bool | np.bool_):
-        return bool(value)
-    if isinstance(value, int | np.integer):
-        return int(value)
-    if isinstance(value, float | np.floating):
-        return float(value) if math.isfinite(value) else None
-    return value
 
 
 def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:

@@ -7,19 +7,43 @@ neither imports the other.
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 import os
 import secrets
 import stat
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
+
+import numpy as np
 
 
 def finite_or_none(x: float) -> float | None:
     """``x``, or None where it is NaN or infinite (JSON's null: a quantity not
     defined, such as the separation of a contact still open at the end)."""
     return x if math.isfinite(x) else None
+
+
+def json_safe(value: Any) -> Any:
+    """A value JSON can write: NumPy numbers as Python ones, non-finite floats as None
+    (``NaN`` is no JSON: strict readers refuse the whole document)."""
+    if isinstance(value, Mapping):
+        return {str(key): json_safe(v) for key, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [json_safe(v) for v in value]
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def json_text(value: Any) -> str:
+    """``value`` as strict JSON (see :func:`json_safe`): what every ``--json`` prints."""
+    return json.dumps(json_safe(value), allow_nan=False)
 
 
 class UsageError(Exception):

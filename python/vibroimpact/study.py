@@ -120,7 +120,8 @@ _STUDY = {
     "settle_periods": (_WHOLE, 200),
     "record_periods": (_WHOLE, 50),
     "orbit_periods": (_WHOLE, 1),
-    "record_from": (_NUMBER, 0.0),
+    # None: [output] record_from, else 0 (see study()).
+    "record_from": (_NUMBER, None),
     "tolerance": (_NUMBER, 1e-6),
     "chunk_size": (_WHOLE, 1024),
     "samples": (_WHOLE, 0),
@@ -208,7 +209,8 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
             close = difflib.get_close_matches(str(key), allowed, n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""
             raise StudyError(f"[study] unknown key {key!r} (allowed: {', '.join(allowed)}){hint}")
-    plain = {k: v for k, v in table.items() if k not in sections}
+    # A None is a default left to fill (TOML has none): settings checked before.
+    plain = {k: v for k, v in table.items() if k not in sections and v is not None}
     out = _table("[study] ", plain, _STUDY)
     _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
     _choice("[study] ", "stepping", out["stepping"], _STEPPINGS)
@@ -255,7 +257,7 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
             raise StudyError(
                 f"[study] {key}: must be at most {MAX_PERIODS} forcing periods, got {out[key]}"
             )
-    if not out["record_from"] >= 0:
+    if out["record_from"] is not None and not out["record_from"] >= 0:
         raise StudyError(f"[study] record_from: must be >= 0 s, got {out['record_from']}")
     if not out["tolerance"] > 0:
         raise StudyError(f"[study] tolerance: must be > 0, got {out['tolerance']}")
@@ -564,6 +566,12 @@ def study_of(
         checked = dict(settings)
     else:
         checked = study_settings(settings)
+    if checked["record_from"] is None:
+        # The scenario's own window where [study] gives none, as a run of it records
+        # (user trial: a study and a run of one scenario disagreed on a peak).
+        output = data.get("output")
+        window = output.get("record_from") if isinstance(output, Mapping) else None
+        checked["record_from"] = 0.0 if window is None else float(window)
     study = Study(dict(data), checked, source, base_dir)
     # The base scenario and every axis path are checked by a run of none.
     study.run_chunk(range(0, 0))

@@ -6,13 +6,14 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.output import UsageError, check_output, check_plot
+from vibroimpact.output import UsageError, check_output, check_plot, json_text
 from vibroimpact.scenario import load_scenario
 from vibroimpact.study import (
     MAX_WORKERS,
@@ -93,7 +94,16 @@ def run_study_command(args: argparse.Namespace) -> int:
             text = f"{args.scenario}: {text}"
         raise InvalidInputError(text) from None
     axes = list(study.settings["axes"])
-    metric = args.metric or study.settings["metrics"][0]
+    output = study.data.get("output")
+    points = isinstance(output, Mapping) and bool(output.get("points"))
+    # With [output] points the per-coordinate metrics are also kept at each point.
+    allowed = list(study.settings["metrics"])
+    if points:
+        allowed += [f"point_{m}" for m in allowed if m in ("peak", "rms", "amplitude")]
+    first = study.settings["metrics"][0]
+    # A cantilever's coordinates are modes: where there are points, the map is of
+    # the first (user trial: the default map showed half the tip's deflection).
+    metric = args.metric or (f"point_{first}" if f"point_{first}" in allowed else first)
     x = args.x or axes[0]
     y = args.y or (axes[1] if len(axes) > 1 else None)
     if args.plot and len(axes) < 2:
@@ -102,8 +112,8 @@ def run_study_command(args: argparse.Namespace) -> int:
             "axis or drop --plot"
         )
     if args.plot:
-        metrics = ", ".join(study.settings["metrics"])
-        if metric not in study.settings["metrics"]:
+        metrics = ", ".join(allowed)
+        if metric not in allowed:
             raise UsageError(
                 f"--metric must be one of the study's metrics ({metrics}), got {metric!r}"
             )
@@ -141,7 +151,7 @@ def run_study_command(args: argparse.Namespace) -> int:
     # computed, which the exit status says too.
     status = 1 if failed == study.runs else 0
     if args.json:
-        print(json.dumps(summary))
+        print(json_text(summary))
     else:
         print(
             f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, "

@@ -1016,6 +1016,12 @@ def prepare_system(
         )
     for j, at in enumerate(output["points"]):
         _check_point(f"[output] points[{j}]", at, float(at), spec["structure"])
+        if at in output["points"][:j]:
+            raise _fail("[output] points: ", f"{shown(at)} is given twice")
+    if output["points"] and output["record_from"] is None:
+        # Points ask for their peaks: of the whole run where no window is given
+        # (user trial: they were silently left out).
+        output["record_from"] = 0.0
     for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
         value = (output if section == "output" else solver)[key]
         if value < 1:

@@ -149,7 +149,8 @@ def system_summary(
 
 
 def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
-    """The CSV columns: ``t``, then each coordinate's displacement and velocity."""
+    """The CSV columns: ``t``, then each coordinate's displacement and velocity, then
+    the structure's displacement at each of ``[output] points``."""
     columns: list[tuple[str, Any]] = [("t", sol.t)]
     for name in (
         "structure_displacement",
@@ -159,6 +160,9 @@ def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
     ):
         array = getattr(sol, name)
         columns += [(f"{name}_{i}", array[:, i]) for i in range(array.shape[1])]
+    columns += [
+        (f"point_displacement_{j}", sol.displacement_at(at)) for j, at in enumerate(sol.points)
+    ]
     return columns
 
 

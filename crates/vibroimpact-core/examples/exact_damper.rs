@@ -58,6 +58,7 @@ fn main() {
             signal: Signal::harmonic(0.3 * k * 0.01 * 3.0, 8.0, 0.0).unwrap(),
         }],
         points: vec![],
+        moments: vec![],
     };
     let ball = SystemSpec {
         structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
@@ -72,6 +73,7 @@ fn main() {
         gravity: 9.81,
         excitations: vec![],
         points: vec![],
+        moments: vec![],
     };
     // One run, for callgrind: the damper ("once") or the ball ("ball").
     let one = match std::env::args().nth(1).as_deref() {

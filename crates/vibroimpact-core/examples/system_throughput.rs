@@ -68,6 +68,7 @@ fn main() {
             signal: Signal::harmonic(0.5, 8.0, 0.0).unwrap(),
         }],
         points: vec![],
+        moments: vec![],
     };
     let contact = Contact::new(LawKind::HertzDamped, 1e7, Some(0.6), 0.0).unwrap();
     for at in [0.5, 0.25] {
@@ -107,6 +108,7 @@ fn main() {
         gravity: 9.81,
         excitations: vec![],
         points: vec![],
+        moments: vec![],
     };
     for (name, dt) in [("rk4 dt 1e-2", Some(1e-2)), ("dop853", None)] {
         let make: &dyn Fn(usize) -> ExplicitRk = match dt {
@@ -139,6 +141,7 @@ fn main() {
             signal: Signal::harmonic(1.0, 5.0, 0.0).unwrap(),
         }],
         points: vec![],
+        moments: vec![],
     };
     for (name, dt) in [("rk4 dt 1e-3", Some(1e-3)), ("dop853 rtol 1e-8", None)] {
         let make: &dyn Fn(usize) -> ExplicitRk = match dt {

@@ -118,8 +118,11 @@ pub struct SystemSpec {
     pub excitations: Vec<Excitation>,
     /// Points of the structure whose displacement the reductions follow
     /// beside its coordinates (each as a damper's `at`: a coordinate index,
-    /// or m from a beam's clamp); at most [`MAX_POINTS`].
+    /// or m from a beam's clamp); with `moments`, at most [`MAX_POINTS`].
     pub points: Vec<f64>,
+    /// Positions along a cantilever (m from the clamp) whose bending moment
+    /// the reductions follow after the points.
+    pub moments: Vec<f64>,
 }
 
 /// The most points a run may follow (each is a row of the structure's
@@ -205,7 +208,8 @@ pub struct Assembly {
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
     /// The rows (over the structure coordinates, `n` each) of the points
-    /// the reductions follow (see [`SystemSpec::points`]).
+    /// the reductions follow, then of the moments (see [`SystemSpec::points`]
+    /// and [`SystemSpec::moments`]).
     pub point_rows: Vec<f64>,
 }
 
@@ -434,15 +438,18 @@ impl Assembly {
                         .all(|(a, b)| *a == -*b)
             })
             .collect();
-        if spec.points.len() > MAX_POINTS {
+        let followed = spec.points.len() + spec.moments.len();
+        if followed > MAX_POINTS {
             return Err(Error::Inconsistent(format!(
-                "points: at most {MAX_POINTS} points may be followed, got {}",
-                spec.points.len()
+                "points: at most {MAX_POINTS} points and moments may be followed, got {followed}"
             )));
         }
-        let mut point_rows = Vec::with_capacity(spec.points.len() * n);
+        let mut point_rows = Vec::with_capacity(followed * n);
         for (j, &at) in spec.points.iter().enumerate() {
-            point_rows.extend(s.point(&format!("point {j}"), at)?);
+            point_rows.extend(s.point(&format!("[output] points[{j}]"), at)?);
+        }
+        for (j, &at) in spec.moments.iter().enumerate() {
+            point_rows.extend(s.moment_row(&format!("[output] moments[{j}]"), at)?);
         }
         Ok(Self {
             point_rows,
@@ -480,7 +487,7 @@ impl Assembly {
     }
 
     /// The quantities the reductions follow: each structure coordinate, then
-    /// each point of [`SystemSpec::points`].
+    /// each point of [`SystemSpec::points`], then each moment.
     pub fn observed(&self) -> usize {
         self.n + self.point_rows.len() / self.n
     }

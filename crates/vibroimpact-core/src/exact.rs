@@ -1072,6 +1072,7 @@ mod tests {
                 signal: Signal::harmonic(20.0, 7.0, 0.3).unwrap(),
             }],
             points: vec![],
+            moments: vec![],
         };
         let system = Assembly::new(&spec).unwrap();
         let y = initial_state(&system, &[0.004], &[-0.2], &[0.002], &[0.3]).unwrap();

@@ -346,6 +346,36 @@ impl Structure {
         }
     }
 
+    /// The row of the bending moment at `at` (m from a cantilever's clamp),
+    /// whose value is `row . q`, N m: `E I w''(x) = E I sum_i phi_i''(x) q_i`.
+    /// Only a cantilever bends; `key` names the input in the error.
+    pub fn moment_row(&self, key: &str, at: f64) -> Result<Vec<f64>> {
+        let (
+            Points::Beam { length, ref shapes },
+            Recipe::Cantilever {
+                youngs_modulus,
+                second_moment,
+                ..
+            },
+        ) = (&self.points, self.recipe)
+        else {
+            return Err(Error::Inconsistent(format!(
+                "{key}: only a cantilever has bending moments (structure.kind = \"cantilever\")"
+            )));
+        };
+        let length = *length;
+        if !(at.is_finite() && (0.0..=length).contains(&at)) {
+            return Err(Error::Inconsistent(format!(
+                "{key} must be a position along the beam in [0, {length}] m, got {at}"
+            )));
+        }
+        let stiffness = youngs_modulus * second_moment / (length * length);
+        shapes
+            .iter()
+            .map(|s| Ok(stiffness * s.derivatives(at / length)?[2]))
+            .collect()
+    }
+
     /// Kinetic plus strain energy at displacements `q` (m) and velocities
     /// `v` (m/s), J.
     pub fn energy(&self, q: &[f64], v: &[f64]) -> f64 {

@@ -575,10 +575,10 @@ fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Member> {
     if !spec.stops.is_empty() || spec.gravity != 0.0 || !spec.excitations.is_empty() {
         return Err(unfit("the scenario has stops, gravity or an excitation"));
     }
-    if !spec.points.is_empty() {
+    if !spec.points.is_empty() || !spec.moments.is_empty() {
         // Its one coordinate is its one point: its peak and rms are already kept.
         return Err(unfit(
-            "[output] points are followed by event-driven runs only",
+            "[output] points and moments are followed by event-driven runs only",
         ));
     }
     if structure.point("damper.0.at", damper.at)? != [1.0] {
@@ -606,8 +606,8 @@ fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Member> {
 
 /// The metrics of a run of `spec` that failed for `reason`: NaN.
 fn failed_run(spec: &SystemSpec, reason: String) -> RunMetrics {
-    // Each structure coordinate, then each followed point.
-    let n = spec.structure.dofs() + spec.points.len();
+    // Each structure coordinate, then each followed point and moment.
+    let n = spec.structure.dofs() + spec.points.len() + spec.moments.len();
     let pairs = spec.dampers.len() + spec.stops.len();
     RunMetrics {
         status: 1,
@@ -993,6 +993,7 @@ mod tests {
                 signal,
             }],
             points: vec![],
+            moments: vec![],
         }
     }
 

@@ -770,6 +770,7 @@ mod tests {
                 },
             ],
             points: vec![],
+            moments: vec![],
         };
         Assembly::new(&spec).unwrap()
     }

@@ -26,6 +26,7 @@ fn spec(structure: Structure) -> SystemSpec {
         gravity: 0.0,
         excitations: vec![],
         points: vec![],
+        moments: vec![],
     }
 }
 
@@ -443,12 +444,94 @@ fn points_outside_the_structure_are_refused_by_name() {
         s.points = vec![0.2, 0.7];
         let err = Assembly::new(&s).unwrap_err().to_string();
         assert!(
-            err.contains("point 1 must be a position along the beam in [0, 0.5] m"),
+            err.contains("[output] points[1] must be a position along the beam in [0, 0.5] m"),
             "{err}"
         );
         let mut s = spec(Structure::oscillator(1.0, 1.0, 0.0).unwrap());
         s.points = vec![0.0; vibroimpact_core::assembly::MAX_POINTS + 1];
         let err = Assembly::new(&s).unwrap_err().to_string();
         assert!(err.contains("points: at most"), "{err}");
+    });
+}
+
+#[test]
+fn a_cantilever_s_bending_moment_is_statics_and_its_peaks_reduce() {
+    common::timeout(60, || {
+        // Statics first: under a tip load P the modal deflections are
+        // q_i = phi_i(L) P / K_ii, and the moment E I w'' there must be
+        // P (L - x), the series converging as the modes are added.
+        let (length, ei, load) = (0.5, 7e10 * 1e-10, 2.0);
+        let beam = Structure::cantilever(length, 7e10, 1e-10, 0.27, 30, 0.01).unwrap();
+        let tip = beam.point("tip", length).unwrap();
+        let q: Vec<f64> = (0..30)
+            .map(|i| tip[i] * load / beam.stiffness()[i * 30 + i])
+            .collect();
+        for (x, tolerance) in [(0.0, 2e-3), (0.1, 2e-2), (0.25, 2e-2)] {
+            let row = beam.moment_row("moment", x).unwrap();
+            let moment: f64 = row.iter().zip(&q).map(|(r, q)| r * q).sum();
+            assert!(
+                close(moment, load * (length - x), tolerance),
+                "x {x}: {moment} vs {}",
+                load * (length - x)
+            );
+        }
+        // The root's curvature row is E I phi''(0) / L^2 = E I (2 b^2) / L^2.
+        let root = beam.moment_row("moment", 0.0).unwrap();
+        let b = 1.875104068711961;
+        assert!(close(root[0], ei * 2.0 * b * b / (length * length), 1e-12));
+        // Forced on its steady state (as the points above), the peak moment at
+        // the root is |row . Q|.
+        let beam = Structure::cantilever(length, 7e10, 1e-10, 0.27, 3, 0.01).unwrap();
+        let (f, force) = (8.0, 0.5);
+        let w = TAU * f;
+        let tip = beam.point("tip", length).unwrap();
+        let (m, k, c) = (beam.mass(), beam.stiffness(), beam.damping());
+        let q: Vec<(f64, f64)> = (0..3)
+            .map(|i| {
+                let d = i * 3 + i;
+                let (re, im) = (k[d] - w * w * m[d], w * c[d]);
+                let norm = re * re + im * im;
+                (force * tip[i] * re / norm, -force * tip[i] * im / norm)
+            })
+            .collect();
+        let mut s = spec(beam.clone());
+        s.excitations.push(Excitation {
+            load: Load::Force { at: length },
+            signal: Signal::harmonic(force, f, 0.0).unwrap(),
+        });
+        s.points = vec![length];
+        s.moments = vec![0.0, 0.2];
+        let x0: Vec<f64> = q.iter().map(|(re, _)| *re).collect();
+        let v0: Vec<f64> = q.iter().map(|(_, im)| -w * im).collect();
+        let reduce = ReduceOptions {
+            record_from: 0.0,
+            strobe_period: f64::INFINITY,
+            mean_square: true,
+            contacts_from: f64::NEG_INFINITY,
+        };
+        let sol = exact(&s, &[x0, v0, vec![], vec![]], 10.0 / f, reduce);
+        let r = &sol.reductions;
+        assert_eq!(r.peaks.len(), 3 + 1 + 2);
+        for (j, x) in [0.0, 0.2].into_iter().enumerate() {
+            let row = beam.moment_row("moment", x).unwrap();
+            let (re, im) = row
+                .iter()
+                .zip(&q)
+                .fold((0.0, 0.0), |(a, b), (r, (qr, qi))| (a + r * qr, b + r * qi));
+            let amplitude = re.hypot(im);
+            assert!(
+                close(r.peaks[4 + j], amplitude, 1e-9),
+                "x {x}: {} vs {amplitude}",
+                r.peaks[4 + j]
+            );
+        }
+        // Only a cantilever bends.
+        let mut s = spec(Structure::oscillator(1.0, 1.0, 0.0).unwrap());
+        s.moments = vec![0.0];
+        let err = Assembly::new(&s).unwrap_err().to_string();
+        assert!(
+            err.contains("[output] moments[0]: only a cantilever has bending moments"),
+            "{err}"
+        );
     });
 }

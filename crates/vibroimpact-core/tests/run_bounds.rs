@@ -32,6 +32,7 @@ fn beam() -> (Assembly, Vec<f64>) {
         gravity: 0.0,
         excitations: vec![],
         points: vec![],
+        moments: vec![],
     };
     let system = Assembly::new(&spec).unwrap();
     let mut v = vec![0.0; 40];
@@ -159,6 +160,7 @@ fn forced_damper() -> (Assembly, Vec<f64>) {
             signal: Signal::harmonic(1.0, 5.0, 0.0).unwrap(),
         }],
         points: vec![],
+        moments: vec![],
     };
     let system = Assembly::new(&spec).unwrap();
     let y = initial_state(&system, &[], &[], &[], &[]).unwrap();

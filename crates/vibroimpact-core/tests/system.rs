@@ -37,6 +37,7 @@ fn spec(structure: Structure) -> SystemSpec {
         gravity: 0.0,
         excitations: vec![],
         points: vec![],
+        moments: vec![],
     }
 }
 

@@ -263,6 +263,7 @@ fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<SystemSpec> {
         gravity: optional(spec, "system", "gravity")?.unwrap_or(0.0),
         excitations,
         points: optional(spec, "output", "points")?.unwrap_or_default(),
+        moments: optional(spec, "output", "moments")?.unwrap_or_default(),
     })
 }
 
