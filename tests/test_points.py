@@ -47,6 +47,26 @@ def tip_force(frequency: float) -> dict[str, Any]:
     }
 
 
+def beam_toml(frequency: float = 10.0) -> str:
+    """The beam and its tip force as TOML sections."""
+    return f"""
+[structure]
+kind = "cantilever"
+length = {LENGTH}
+youngs_modulus = {YOUNG}
+second_moment = {SECOND}
+mass_per_length = {MASS_PER_LENGTH}
+modes = 3
+damping_ratio = {ZETA}
+[[excitation]]
+kind = "force"
+at = {LENGTH}
+signal = "harmonic"
+amplitude = {FORCE}
+frequency = {frequency}
+"""
+
+
 def linear_deflection(frequency: float, at: float, modes: int = 3) -> float:
     """The steady deflection amplitude (m) at ``at`` of the beam alone under the tip
     force: each mode ``q_i'' + 2 zeta w_i q_i' + w_i^2 q_i = phi_i(L) F / (rho A L)``
@@ -137,21 +157,8 @@ def test_an_orbit_and_a_study_report_their_points(tmp_path: Path, run_cli: Any) 
     assert found.point_amplitude[0] == pytest.approx(linear_deflection(frequency, LENGTH), 1e-8)
     scenario = tmp_path / "beam.toml"
     scenario.write_text(
-        f"""
-[structure]
-kind = "cantilever"
-length = {LENGTH}
-youngs_modulus = {YOUNG}
-second_moment = {SECOND}
-mass_per_length = {MASS_PER_LENGTH}
-modes = 3
-damping_ratio = {ZETA}
-[[excitation]]
-kind = "force"
-at = {LENGTH}
-signal = "harmonic"
-amplitude = {FORCE}
-frequency = {frequency}
+        beam_toml(frequency)
+        + f"""
 [solver]
 method = "exact"
 t_end = 30.0
@@ -268,7 +275,7 @@ def test_points_without_a_window_record_the_whole_run(tmp_path: Path, run_cli: A
     # The CSV carries the deflection at each point.
     scenario = tmp_path / "beam.toml"
     scenario.write_text(
-        BEAM_TOML + "[solver]\nmethod = 'dop853'\nt_end = 0.2\n[output]\npoints = [0.5, 0.2]\n",
+        beam_toml() + "[solver]\nmethod = 'dop853'\nt_end = 0.2\n[output]\npoints = [0.5, 0.2]\n",
         encoding="utf-8",
     )
     done = run_cli("simulate", str(scenario), "--out", "h.csv")
@@ -280,30 +287,12 @@ def test_points_without_a_window_record_the_whole_run(tmp_path: Path, run_cli: A
     np.testing.assert_allclose(table["point_displacement_1"], modes @ shape, rtol=1e-12, atol=0)
 
 
-BEAM_TOML = f"""
-[structure]
-kind = "cantilever"
-length = {LENGTH}
-youngs_modulus = {YOUNG}
-second_moment = {SECOND}
-mass_per_length = {MASS_PER_LENGTH}
-modes = 3
-damping_ratio = {ZETA}
-[[excitation]]
-kind = "force"
-at = {LENGTH}
-signal = "harmonic"
-amplitude = {FORCE}
-frequency = 10.0
-"""
-
-
 def test_a_study_records_the_scenario_s_window_and_maps_a_point(
     tmp_path: Path, run_cli: Any
 ) -> None:
     scenario = tmp_path / "beam.toml"
     scenario.write_text(
-        BEAM_TOML
+        beam_toml()
         + """
 [solver]
 method = "exact"
@@ -347,7 +336,7 @@ def test_a_failed_sweep_point_is_strict_json(tmp_path: Path, run_cli: Any) -> No
     # A step beyond RK4's stability for the third mode (200 Hz): the runs blow up.
     scenario = tmp_path / "beam.toml"
     scenario.write_text(
-        BEAM_TOML
+        beam_toml()
         + """
 [solver]
 method = "rk4"
