@@ -67,10 +67,11 @@ frequency = {frequency}
 """
 
 
-def linear_deflection(frequency: float, at: float, modes: int = 3) -> float:
+def linear_deflection(frequency: float, at: float, modes: int = 3, derivative: int = 0) -> float:
     """The steady deflection amplitude (m) at ``at`` of the beam alone under the tip
-    force: each mode ``q_i'' + 2 zeta w_i q_i' + w_i^2 q_i = phi_i(L) F / (rho A L)``
-    with shapes normalised to ``int phi_i^2 dx = L`` (checked below)."""
+    force (of its ``derivative``-th derivative in x, 1/m^k): each mode ``q_i'' + 2 zeta
+    w_i q_i' + w_i^2 q_i = phi_i(L) F / (rho A L)`` with shapes normalised to ``int
+    phi_i^2 dx = L`` (checked below)."""
     w = 2 * math.pi * frequency
     total = 0j
     for i in range(1, modes + 1):
@@ -80,7 +81,7 @@ def linear_deflection(frequency: float, at: float, modes: int = 3) -> float:
         wi = math.sqrt(mode.modal_stiffness / mode.modal_mass)
         modal_force = vi.cantilever_mode_shape(LENGTH, i, LENGTH) * FORCE
         q = modal_force / mode.modal_mass / (wi * wi - w * w + 2j * ZETA * wi * w)
-        total += vi.cantilever_mode_shape(LENGTH, i, at) * q
+        total += vi.cantilever_mode_shape(LENGTH, i, at, derivative) * q
     return abs(total)
 
 
@@ -228,13 +229,15 @@ def test_with_dampers_the_points_peaks_are_the_history_s(tmp_path: Path) -> None
 def test_points_off_the_structure_are_refused_naming_the_key(run_cli: Any) -> None:
     with pytest.raises(ValueError, match=r"\[output\] points\[1\] must be a position along"):
         vi.simulate_system(BEAM, t_end=0.1, method="dop853", points=[0.1, 0.6])
-    with pytest.raises(ValueError, match=r"points\[0\] must be a coordinate index"):
-        vi.simulate_system(
-            {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0},
-            t_end=0.1,
-            method="dop853",
-            points=[1],
-        )
+    oscillator = {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0}
+    for key, given, message in (
+        ("points", [1], r"points\[0\] must be a coordinate index"),
+        ("moments", [0], r"\[output\] moments: only a cantilever"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            vi.simulate_system(oscillator, t_end=0.1, method="dop853", **{key: given})
+    with pytest.raises(ValueError, match=r"\[output\] moments\[0\] must be a position along"):
+        vi.simulate_system(BEAM, t_end=0.1, method="dop853", moments=[-0.1])
     with pytest.raises(ValueError, match=r"\[output\] points: must be an array of numbers"):
         vi.simulate_system(BEAM, t_end=0.1, method="dop853", points="tip")
     with pytest.raises(ValueError, match=r"\[output\] points: holds 10001"):
@@ -313,15 +316,7 @@ metrics = ["peak"]
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "map.png").stat().st_size > 0
     # The run the study made at 10 Hz, 0.5 N is the scenario's own: the same window.
-    sol = vi.simulate_system(
-        BEAM,
-        excitation=[tip_force(10.0)],
-        t_end=2.0,
-        method="exact",
-        record_from=1.5,
-        points=[LENGTH],
-        history=False,
-    )
+    sol = exact_run(10.0, 2.0, 1.5, points=[LENGTH])
     with xr.open_dataset(tmp_path / "s.nc") as ds:
         peak = ds["point_peak"].sel(
             {"excitation.0.frequency": 10.0, "excitation.0.amplitude": 0.5, "at": LENGTH}
@@ -363,3 +358,79 @@ record_periods = 5
     points = json.loads(done.stdout, parse_constant=refuse)["points"]
     assert all(p["error"] for p in points)
     assert points[0]["impacts_per_period"] is None
+
+
+def exact_run(frequency: float, t_end: float, record_from: float, **more: Any) -> Any:
+    """The beam alone under the tip force, by the exact flow, reduced from ``record_from``."""
+    return vi.simulate_system(
+        more.pop("structure", BEAM),
+        excitation=[tip_force(frequency)],
+        t_end=t_end,
+        method="exact",
+        record_from=record_from,
+        history=False,
+        **more,
+    )
+
+
+def linear_moment(frequency: float, at: float) -> float:
+    """The steady bending moment amplitude (N m) ``E I w''`` at ``at`` of the beam
+    alone under the tip force, mode by mode as :func:`linear_deflection`."""
+    return YOUNG * SECOND * linear_deflection(frequency, at, derivative=2)
+
+
+def test_bending_moments_are_followed_in_runs_sweeps_and_studies(
+    tmp_path: Path, run_cli: Any
+) -> None:
+    # Quasi-static first: at 0.2 Hz, far below the first mode (11.4 Hz), the root
+    # carries the tip force's moment F L, to the few percent that three modes and
+    # the dynamic factor 1/(1 - (0.2/11.4)^2) leave.
+    slow = exact_run(0.2, 60.0, 50.0, structure=BEAM | {"modes": 8}, moments=[0.0])
+    assert slow.moment_peak[0] == pytest.approx(FORCE * LENGTH, rel=2e-2)
+    sol = exact_run(9.0, 30.0, 28.0, points=[LENGTH], moments=[0.0, 0.2])
+    for at, peak, rms in zip((0.0, 0.2), sol.moment_peak, sol.moment_rms, strict=True):
+        assert peak == pytest.approx(linear_moment(9.0, at), rel=1e-6)
+        assert rms == pytest.approx(linear_moment(9.0, at) / math.sqrt(2), rel=1e-5)
+    assert sol.point_peak[0] == pytest.approx(linear_deflection(9.0, LENGTH), rel=1e-6)
+    data = {
+        "structure": BEAM,
+        "excitation": [tip_force(8.0)],
+        "solver": {"method": "exact", "t_end": 1.0},
+        "output": {"moments": [0.0]},
+    }
+    found = sweep(data, "excitation.0.frequency", [8.0, 14.0], settle_periods=400, record_periods=5)
+    for p in found:
+        assert p.linear_moment_amplitude[0] == pytest.approx(linear_moment(p.value, 0.0), 1e-9)
+        assert p.moment_amplitude[0] == pytest.approx(linear_moment(p.value, 0.0), rel=1e-5)
+        assert p.to_dict()["moments"] == [0.0]
+    ds = sweep_dataset(found, "excitation.0.frequency")
+    assert ds["moment_amplitude"].dims == ("point", "moment_at")
+    assert ds["moment_amplitude"].attrs["units"] == "N m"
+    scenario = tmp_path / "beam.toml"
+    scenario.write_text(
+        beam_toml(9.0)
+        + """
+[solver]
+method = "exact"
+t_end = 30.0
+[output]
+record_from = 28.0
+moments = [0.0]
+[study]
+analysis = "run"
+metrics = ["peak"]
+[study.axes]
+"excitation.0.frequency" = [9.0]
+""",
+        encoding="utf-8",
+    )
+    done = run_cli("study", str(scenario), "--out", "m.nc")
+    assert done.returncode == 0, done.stderr
+    with xr.open_dataset(tmp_path / "m.nc") as ds:
+        assert float(ds["moment_peak"].squeeze()) == pytest.approx(linear_moment(9.0, 0.0), 1e-6)
+    csv = run_cli("simulate", str(scenario), "--out", "h.csv")
+    assert csv.returncode == 0, csv.stderr
+    table = np.genfromtxt(tmp_path / "h.csv", delimiter=",", names=True)
+    assert float(np.max(np.abs(table["bending_moment_0"][table["t"] >= 28.0]))) == pytest.approx(
+        linear_moment(9.0, 0.0), rel=1e-3
+    )

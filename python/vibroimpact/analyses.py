@@ -33,6 +33,7 @@ from vibroimpact.system import (
     _choice,
     _table,
     linear_parts,
+    moment_weights,
     point_weights,
     prepare_system,
     structure_coordinates,
@@ -126,8 +127,12 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
     solver = dict(data.get("solver", {}))
     solver.setdefault("t_end", 1.0)
     output = data.get("output", {})
-    # Of [output], the analyses keep only the points whose amplitudes they report.
-    points = output.get("points", ()) if isinstance(output, Mapping) else ()
+    # Of [output], the analyses keep only the points and moments they report.
+    followed = {
+        key: output[key]
+        for key in ("points", "moments")
+        if isinstance(output, Mapping) and key in output
+    }
     return prepare_system(
         data["structure"],
         damper=data.get("damper", ()),
@@ -136,7 +141,7 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
         excitation=data.get("excitation", ()),
         initial=data.get("initial"),
         solver=solver,
-        output={"points": points},
+        output=followed,
         base_dir=base_dir,
     )
 
@@ -161,16 +166,27 @@ class Runner:
         """The points ``[output] points`` follows (m along a cantilever, or indices)."""
         return np.asarray(self.prepared.output["points"], dtype=float)
 
-    def amplitudes(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-        """The located peaks of a recorded run (m): of each structure coordinate, and
-        of the structure at each point."""
-        peaks = np.asarray(recorded["peaks"], dtype=float)
-        return peaks[: self.n], peaks[self.n :]
+    @property
+    def moments(self) -> np.ndarray:
+        """Where ``[output] moments`` follows a cantilever's bending moment (m)."""
+        return np.asarray(self.prepared.output["moments"], dtype=float)
 
-    def rms(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-        """The RMS displacements of a recorded run (m), as :meth:`amplitudes`."""
-        rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
-        return rms[: self.n], rms[self.n :]
+    def _split(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        # The core follows the coordinates, then the points, then the moments.
+        p = self.n + len(self.points)
+        return values[: self.n], values[self.n : p], values[p:]
+
+    def amplitudes(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The located peaks of a recorded run: of each structure coordinate and of the
+        structure at each point (m), and of the bending moment at each of the moments
+        (N m)."""
+        return self._split(np.asarray(recorded["peaks"], dtype=float))
+
+    def rms(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The RMS values of a recorded run, as :meth:`amplitudes`."""
+        return self._split(
+            np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
+        )
 
     def initial_state(self) -> np.ndarray:
         """The scenario's ``[initial]`` as a flat state ``(x, v)``."""
@@ -293,6 +309,9 @@ class SteadyState:
     strobe: np.ndarray = field(repr=False)
     point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: The bending moment's (N m) at each of ``[output] moments``.
+    moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def steady_state(
@@ -334,8 +353,8 @@ def steady_state(
                 period = p
                 break
     recorded = run.periods(x0, record_periods, record=True)
-    amplitude, point_amplitude = run.amplitudes(recorded)
-    rms, point_rms = run.rms(recorded)
+    amplitude, point_amplitude, moment_amplitude = run.amplitudes(recorded)
+    rms, point_rms, moment_rms = run.rms(recorded)
     return SteadyState(
         settled=period is not None,
         period=period,
@@ -346,6 +365,8 @@ def steady_state(
         strobe=strobe,
         point_amplitude=point_amplitude,
         point_rms=point_rms,
+        moment_amplitude=moment_amplitude,
+        moment_rms=moment_rms,
     )
 
 
@@ -360,18 +381,22 @@ def linear_amplitude(data: Mapping[str, Any], base_dir: Path | None = None) -> n
 
 def linear_response(
     data: Mapping[str, Any], base_dir: Path | None = None
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`linear_amplitude`, and the same of the structure at each of ``[output]
-    points`` (m): ``|w . Q|``, ``w`` the coordinates' weights there (a cantilever's
-    mode shapes), summed over the harmonics as the coordinates' are."""
+    points`` (m) and of its bending moment at each of ``[output] moments`` (N m):
+    ``|w . Q|``, ``w`` the coordinates' weights there (a cantilever's mode shapes, or
+    ``E I phi''``), summed over the frequencies as the coordinates' are."""
     parts = linear_parts(
         data["structure"], excitation=data.get("excitation", ()), base_dir=base_dir
     )
     n = parts["n"]
-    structure = _prepare(data, base_dir)
+    prepared = _prepare(data, base_dir)
+    beam = prepared.spec["structure"]
     weights = np.array(
-        [point_weights(structure.spec["structure"], at) for at in structure.output["points"]]
+        [point_weights(beam, at) for at in prepared.output["points"]]
+        + [moment_weights(beam, at) for at in prepared.output["moments"]]
     ).reshape(-1, n)
+    p = len(prepared.output["points"])
     m, k, c = parts["mass"], parts["stiffness"], parts["damping"]
     # Loads of one frequency add as phasors (two equal loads in quadrature are
     # sqrt 2 of one, in opposition nothing); the frequencies' amplitudes add.
@@ -385,10 +410,10 @@ def linear_response(
         try:
             q = np.linalg.solve(matrix, force)
         except np.linalg.LinAlgError:
-            return np.full(n, np.nan), np.full(len(weights), np.nan)
+            return np.full(n, np.nan), np.full(p, np.nan), np.full(len(weights) - p, np.nan)
         total += np.abs(q)
         at_points += np.abs(weights @ q[:n])
-    return total, at_points
+    return total, at_points[:p], at_points[p:]
 
 
 @dataclass
@@ -409,6 +434,11 @@ class SweepPoint:
     point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
     linear_point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: At each of ``[output] moments`` (m), the bending moment's (N m).
+    moments: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    linear_moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def to_dict(self) -> dict[str, Any]:
         def floats(a: np.ndarray) -> list[float | None]:
@@ -421,6 +451,13 @@ class SweepPoint:
             "linear_point_amplitude": floats(self.linear_point_amplitude),
             "point_reduction": _reductions(self.point_amplitude, self.linear_point_amplitude),
         }
+        at_moments = {
+            "moments": [float(v) for v in self.moments],
+            "moment_amplitude": floats(self.moment_amplitude),
+            "moment_rms": floats(self.moment_rms),
+            "linear_moment_amplitude": floats(self.linear_moment_amplitude),
+            "moment_reduction": _reductions(self.moment_amplitude, self.linear_moment_amplitude),
+        }
         return {
             "value": self.value,
             "direction": self.direction,
@@ -431,6 +468,7 @@ class SweepPoint:
             "linear_amplitude": floats(self.linear_amplitude),
             "reduction": _reductions(self.amplitude, self.linear_amplitude),
             **(at_points if len(self.points) else {}),
+            **(at_moments if len(self.moments) else {}),
             **({"error": self.error} if self.error else {}),
         }
 
@@ -687,7 +725,7 @@ def sweep(
             changed = with_parameter(data, parameter, value)
             try:
                 run = runner(changed, base_dir)
-                linear, linear_at_points = linear_response(changed, base_dir)
+                linear, linear_at_points, linear_moments = linear_response(changed, base_dir)
             except InvalidInputError as err:
                 raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
             try:
@@ -705,6 +743,7 @@ def sweep(
                 raise
             except Exception as err:  # a run that cannot be completed: record it
                 nan, none = np.full(len(linear), np.nan), np.full(len(run.points), np.nan)
+                no_moment = np.full(len(run.moments), np.nan)
                 points.append(
                     SweepPoint(
                         value,
@@ -719,6 +758,10 @@ def sweep(
                         none,
                         none,
                         linear_at_points,
+                        run.moments,
+                        no_moment,
+                        no_moment,
+                        linear_moments,
                     )
                 )
             else:
@@ -737,6 +780,10 @@ def sweep(
                         result.point_amplitude,
                         result.point_rms,
                         linear_at_points,
+                        run.moments,
+                        result.moment_amplitude,
+                        result.moment_rms,
+                        linear_moments,
                     )
                 )
             if progress is not None:
@@ -757,8 +804,10 @@ class Orbit:
     iterations: int
     residual: float
     monodromy: np.ndarray = field(repr=False)
-    #: The largest |displacement| (m) on the orbit at each of ``[output] points``.
+    #: The largest |displacement| (m) on the orbit at each of ``[output] points``, and
+    #: |bending moment| (N m) at each of ``[output] moments``.
     point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def arrays(self, n: int, k: int) -> dict[str, list[float]]:
         """The state as the four arrays of ``[initial]``."""
@@ -801,7 +850,7 @@ def orbit(
     residual = float(shot["residual"])
     multipliers = np.linalg.eigvals(jac)
     recorded = run.periods(z, periods, record=True)
-    amplitude, point_amplitude = run.amplitudes(recorded)
+    amplitude, point_amplitude, moment_amplitude = run.amplitudes(recorded)
     return Orbit(
         converged=converged,
         state=z,
@@ -813,6 +862,7 @@ def orbit(
         residual=residual,
         monodromy=jac,
         point_amplitude=point_amplitude,
+        moment_amplitude=moment_amplitude,
     )
 
 

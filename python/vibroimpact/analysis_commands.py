@@ -176,6 +176,14 @@ def run_orbit(args: argparse.Namespace) -> int:
             if len(run.points)
             else {}
         ),
+        **(
+            {
+                "moments": [float(v) for v in run.moments],
+                "moment_amplitude": [float(a) for a in found.moment_amplitude],
+            }
+            if len(run.moments)
+            else {}
+        ),
         "periods": args.periods,
         "forcing_period": run.period,
         "iterations": found.iterations,
@@ -205,6 +213,10 @@ def run_orbit(args: argparse.Namespace) -> int:
         *(
             f"  at point {at:g}: amplitude {a:.6g} m"
             for at, a in zip(run.points, found.point_amplitude, strict=True)
+        ),
+        *(
+            f"  bending moment at {at:g} m: amplitude {a:.6g} N m"
+            for at, a in zip(run.moments, found.moment_amplitude, strict=True)
         ),
     ]
     for key, values in summary["state"].items():

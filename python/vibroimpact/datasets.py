@@ -59,6 +59,7 @@ __all__ = [
 ]
 
 _M = "m"
+_NM = "N m"
 _M_S = "m s-1"
 _ONE = "1"
 
@@ -243,11 +244,15 @@ def sweep_dataset(
     ``[output] points``, a dimension ``at`` (the points: m along a cantilever, else
     coordinate indices) and the same four of the structure there, ``point x at``:
     ``point_amplitude``, ``point_rms``, ``linear_point_amplitude``,
-    ``point_reduction``. Attributes: ``parameter``."""
+    ``point_reduction``; with ``[output] moments``, a dimension ``moment_at`` (m along
+    the cantilever) and the bending moment's (N m): ``moment_amplitude``,
+    ``moment_rms``, ``linear_moment_amplitude``, ``moment_reduction``. Attributes:
+    ``parameter``."""
     if not points:
         raise AnalysisError("sweep_dataset: no points")
     n = len(points[0].linear_amplitude)
     at = np.asarray(points[0].points, dtype=np.float64)
+    moment_at = np.asarray(points[0].moments, dtype=np.float64)
 
     def rows(name: str, size: int = n) -> NDArray[np.float64]:
         out = np.array([getattr(p, name) for p in points], dtype=np.float64).reshape(
@@ -291,6 +296,32 @@ def sweep_dataset(
                 pa,
                 reduction_of(point_amplitude, linear_point),
                 _attrs("amplitude reduction at the point", _ONE),
+            ),
+        }
+    if len(moment_at):
+        pm = ("point", "moment_at")
+        moment = rows("moment_amplitude", len(moment_at))
+        linear_moment = rows("linear_moment_amplitude", len(moment_at))
+        at_points |= {
+            "moment_amplitude": (
+                pm,
+                moment,
+                _attrs("steady amplitude of the bending moment", _NM),
+            ),
+            "moment_rms": (
+                pm,
+                rows("moment_rms", len(moment_at)),
+                _attrs("steady root mean square bending moment", _NM),
+            ),
+            "linear_moment_amplitude": (
+                pm,
+                linear_moment,
+                _attrs("steady amplitude of the bending moment of the structure alone", _NM),
+            ),
+            "moment_reduction": (
+                pm,
+                reduction_of(moment, linear_moment),
+                _attrs("bending moment reduction", _ONE),
             ),
         }
     return xr.Dataset(
@@ -339,6 +370,17 @@ def sweep_dataset(
             **(
                 {"at": ("at", at, _attrs("point of the structure ([output] points)"))}
                 if len(at)
+                else {}
+            ),
+            **(
+                {
+                    "moment_at": (
+                        "moment_at",
+                        moment_at,
+                        _attrs("position of a bending moment ([output] moments)", _M),
+                    )
+                }
+                if len(moment_at)
                 else {}
             ),
         },

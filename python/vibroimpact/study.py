@@ -585,7 +585,9 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     n = parts[0]["n"] if parts else 0
     pairs = list(parts[0]["pairs"]) if parts else []
     output = study.data.get("output", {})
-    at = np.asarray(output.get("points", ()) if isinstance(output, Mapping) else (), dtype=float)
+    output = output if isinstance(output, Mapping) else {}
+    at = np.asarray(output.get("points", ()), dtype=float)
+    moment_at = np.asarray(output.get("moments", ()), dtype=float)
     shape = study.shape
     dims = study.dims
     # Each distinct reason once, numbered in order of first failure (a dict: a study
@@ -611,17 +613,29 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
         description, unit = _DESCRIPTIONS[name]
         attrs = {"long_name": description, "units": unit}
         if name in ("peak", "rms", "amplitude"):
-            # The core follows the coordinates, then the points.
-            values = values.reshape(*shape, n + len(at))
+            # The core follows the coordinates, then the points, then the moments.
+            values = values.reshape(*shape, n + len(at) + len(moment_at))
             data_vars[name] = ([*dims, "coordinate"], values[..., :n], attrs)
+            p = n + len(at)
             if len(at):
                 data_vars[f"point_{name}"] = (
                     [*dims, "at"],
-                    values[..., n:],
+                    values[..., n:p],
                     {
                         **attrs,
                         "long_name": description.replace(
                             "each structure coordinate", "the structure at each [output] point"
+                        ),
+                    },
+                )
+            if len(moment_at):
+                data_vars[f"moment_{name}"] = (
+                    [*dims, "moment_at"],
+                    values[..., p:],
+                    {
+                        "units": "N m",
+                        "long_name": description.replace("displacement", "bending moment").replace(
+                            "each structure coordinate", "each of [output] moments"
                         ),
                     },
                 )
@@ -655,6 +669,12 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
     coords["coordinate"] = ("coordinate", np.arange(n))
     if len(at):
         coords["at"] = ("at", at, {"long_name": "point of the structure ([output] points)"})
+    if len(moment_at):
+        coords["moment_at"] = (
+            "moment_at",
+            moment_at,
+            {"long_name": "position of a bending moment ([output] moments)", "units": "m"},
+        )
     coords["pair"] = ("pair", np.array(pairs, dtype=str))
     return xr.Dataset(
         data_vars,

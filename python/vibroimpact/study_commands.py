@@ -95,11 +95,13 @@ def run_study_command(args: argparse.Namespace) -> int:
         raise InvalidInputError(text) from None
     axes = list(study.settings["axes"])
     output = study.data.get("output")
-    points = isinstance(output, Mapping) and bool(output.get("points"))
-    # With [output] points the per-coordinate metrics are also kept at each point.
+    output = output if isinstance(output, Mapping) else {}
+    # With [output] points (moments) the per-coordinate metrics are also kept at each.
     allowed = list(study.settings["metrics"])
-    if points:
-        allowed += [f"point_{m}" for m in allowed if m in ("peak", "rms", "amplitude")]
+    per_coordinate = [m for m in allowed if m in ("peak", "rms", "amplitude")]
+    for key, prefix in (("points", "point_"), ("moments", "moment_")):
+        if output.get(key):
+            allowed += [prefix + m for m in per_coordinate]
     first = study.settings["metrics"][0]
     # A cantilever's coordinates are modes: where there are points, the map is of
     # the first (user trial: the default map showed half the tip's deflection).

@@ -176,6 +176,7 @@ _OUTPUT = {
     "record_from": (_NUMBER, None),
     "strobe_period": (_NUMBER, None),
     "points": (_NUMBERS, ()),
+    "moments": (_NUMBERS, ()),
 }
 _INT64 = range(-(2**63), 2**63)
 _METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha", "exact")
@@ -500,6 +501,24 @@ def point_weights(structure: Mapping[str, Any], at: Any, name: str = "at") -> np
     return weights
 
 
+def moment_weights(structure: Mapping[str, Any], at: Any, name: str = "at") -> np.ndarray:
+    """The weights of a checked cantilever's modal coordinates in its bending moment at
+    ``at`` m from the clamp (N m per unit coordinate): ``E I phi_i''(at)``."""
+    if structure["kind"] != "cantilever":
+        raise _fail(
+            "", f'{name}: only a cantilever has bending moments (structure.kind = "cantilever")'
+        )
+    point_weights(structure, at, name)
+    length, stiffness = (
+        float(structure["length"]),
+        structure["youngs_modulus"] * structure["second_moment"],
+    )
+    n = structure_coordinates(structure)
+    return np.array(
+        [stiffness * cantilever_mode_shape(length, i + 1, float(at), 2) for i in range(n)]
+    )
+
+
 def structure_coordinates(structure: Mapping[str, Any]) -> int:
     """The coordinates of a checked ``[structure]``: 1 for an oscillator, one per DOF
     of matrices, one per mode of a cantilever."""
@@ -762,6 +781,12 @@ class SystemSolution:
     points: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: The positions along a cantilever (m from the clamp) ``[output] moments``
+    #: follows, and from ``record_from`` on the largest |bending moment| (N m) and its
+    #: RMS (N m) at each.
+    moments: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def shape_at(self, at: float) -> np.ndarray:
         """The structure coordinates' weights at a point: the displacement there is
@@ -778,6 +803,15 @@ class SystemSolution:
         :meth:`shape_at`: a cantilever's deflection at ``at`` m from the clamp), at each
         kept time ``t``."""
         return np.asarray(self.structure_displacement @ self.shape_at(at), dtype=float)
+
+    def moment_at(self, at: float) -> np.ndarray:
+        """A cantilever's bending moment (N m) ``E I w''`` at ``at`` m from the clamp,
+        at each kept time ``t``."""
+        if not self.structure:
+            raise InvalidInputError("at: this solution does not hold its structure")
+        return np.asarray(
+            self.structure_displacement @ moment_weights(self.structure, at), dtype=float
+        )
 
     def velocity_at(self, at: float) -> np.ndarray:
         """The structure's velocity (m/s, relative to the base) at a point (see
@@ -810,6 +844,7 @@ def simulate_system(
     record_from: float | None = None,
     strobe_period: float | None = None,
     points: Any = (),
+    moments: Any = (),
 ) -> SystemSolution:
     """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
 
@@ -831,7 +866,8 @@ def simulate_system(
     From ``record_from`` (s) on, each structure coordinate's located peak and RMS
     are kept (``peak``, ``rms``), and the structure's at each of ``points`` (as a
     damper's ``at``: m from a cantilever's clamp, or a coordinate index; ``point_peak``,
-    ``point_rms``); every ``strobe_period`` (s) the state is kept
+    ``point_rms``), and a cantilever's bending moment at each of ``moments`` (m from the
+    clamp; ``moment_peak``, ``moment_rms``, N m); every ``strobe_period`` (s) the state is kept
     (``strobe``; fixed steps are shortened to divide it). The GIL is released while
     integrating; Ctrl-C interrupts.
     """
@@ -861,6 +897,7 @@ def simulate_system(
             **({} if record_from is None else {"record_from": record_from}),
             **({} if strobe_period is None else {"strobe_period": strobe_period}),
             "points": points,
+            "moments": moments,
         },
         base_dir=base_dir,
     )
@@ -883,6 +920,7 @@ class PreparedRun:
             **self.spec,
             "gravity": self.spec["gravity"]["acceleration"],
             "points": list(self.output["points"]),
+            "moments": list(self.output["moments"]),
         }
 
     def method_arguments(self) -> dict[str, Any]:
@@ -920,7 +958,9 @@ class PreparedRun:
         except InvalidInputError as err:
             # The core writes its numbers in full: 1e300 as 301 digits.
             raise type(err)(short_numbers(str(err))) from None
-        return _solution(raw, solver["method"], self.spec["structure"], output["points"])
+        return _solution(
+            raw, solver["method"], self.spec["structure"], output["points"], output["moments"]
+        )
 
 
 def prepare_system(
@@ -1010,15 +1050,23 @@ def prepare_system(
         )
     if output["strobe_period"] is not None and not output["strobe_period"] > 0:
         raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
-    if len(output["points"]) > MAX_POINTS:
+    followed = len(output["points"]) + len(output["moments"])
+    if followed > MAX_POINTS:
         raise _fail(
-            "[output] points: ", f"holds {len(output['points'])}; at most {MAX_POINTS} are allowed"
+            "[output] points: ",
+            f"holds {followed} with moments; at most {MAX_POINTS} are allowed",
         )
-    for j, at in enumerate(output["points"]):
-        _check_point(f"[output] points[{j}]", at, float(at), spec["structure"])
-        if at in output["points"][:j]:
-            raise _fail("[output] points: ", f"{shown(at)} is given twice")
-    if output["points"] and output["record_from"] is None:
+    for key in ("points", "moments"):
+        for j, at in enumerate(output[key]):
+            if key == "moments" and spec["structure"]["kind"] != "cantilever":
+                raise _fail(
+                    "[output] moments: ",
+                    'only a cantilever has bending moments (structure.kind = "cantilever")',
+                )
+            _check_point(f"[output] {key}[{j}]", at, float(at), spec["structure"])
+            if at in output[key][:j]:
+                raise _fail(f"[output] {key}: ", f"{shown(at)} is given twice")
+    if followed and output["record_from"] is None:
         # Points ask for their peaks: of the whole run where no window is given
         # (user trial: they were silently left out).
         output["record_from"] = 0.0
@@ -1034,6 +1082,7 @@ def _solution(
     method: str,
     structure: Mapping[str, Any],
     points: Sequence[float] = (),
+    moments: Sequence[float] = (),
 ) -> SystemSolution:
     n, k = raw["n"], raw["k"]
     recorded = raw["recorded_time"] > 0
@@ -1042,7 +1091,8 @@ def _solution(
     final = raw["final_state"]
     c = raw["contacts"]
     pairs = list(raw["pairs"])
-    observed = n + len(points)
+    observed = n + len(points) + len(moments)
+    p = n + len(points)
     peaks = raw["peaks"] if recorded else np.full(observed, np.nan)
     rms = (
         np.sqrt(raw["square_integrals"] / raw["recorded_time"])
@@ -1080,8 +1130,11 @@ def _solution(
         peak=peaks[:n],
         rms=rms[:n],
         points=np.asarray(points, dtype=float),
-        point_peak=peaks[n:],
-        point_rms=rms[n:],
+        point_peak=peaks[n:p],
+        point_rms=rms[n:p],
+        moments=np.asarray(moments, dtype=float),
+        moment_peak=peaks[p:],
+        moment_rms=rms[p:],
         recorded_time=raw["recorded_time"],
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],

@@ -103,7 +103,8 @@ def system_summary(
     the energy balance, the contacts with the pair each belongs to and, when ``[output]``
     asks for them, the reductions: from ``record_from`` the ``peak`` and ``rms`` of each
     structure coordinate (m) over ``recorded_time`` (s), and ``point_peak`` and
-    ``point_rms`` (m) at each of ``points`` (``[output] points``), every ``strobe_period`` the
+    ``point_rms`` (m) at each of ``points`` (``[output] points``) and ``moment_peak`` and
+    ``moment_rms`` (N m) at each of ``moments``, every ``strobe_period`` the
     ``strobe`` states (rows of the history's columns but ``t``) at ``strobe_time``."""
     solver = scenario.solver
     output = scenario.prepared.output
@@ -120,6 +121,12 @@ def system_summary(
                 "points": [float(v) for v in sol.points],
                 "point_peak": [finite_or_none(float(v)) for v in sol.point_peak],
                 "point_rms": [finite_or_none(float(v)) for v in sol.point_rms],
+            }
+        if len(sol.moments):
+            reductions |= {
+                "moments": [float(v) for v in sol.moments],
+                "moment_peak": [finite_or_none(float(v)) for v in sol.moment_peak],
+                "moment_rms": [finite_or_none(float(v)) for v in sol.moment_rms],
             }
     if output["strobe_period"] is not None:
         reductions |= {
@@ -150,7 +157,8 @@ def system_summary(
 
 def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
     """The CSV columns: ``t``, then each coordinate's displacement and velocity, then
-    the structure's displacement at each of ``[output] points``."""
+    the structure's displacement at each of ``[output] points`` and the bending moment
+    (N m) at each of ``moments``."""
     columns: list[tuple[str, Any]] = [("t", sol.t)]
     for name in (
         "structure_displacement",
@@ -163,6 +171,7 @@ def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
     columns += [
         (f"point_displacement_{j}", sol.displacement_at(at)) for j, at in enumerate(sol.points)
     ]
+    columns += [(f"bending_moment_{j}", sol.moment_at(at)) for j, at in enumerate(sol.moments)]
     return columns
 
 
@@ -213,6 +222,8 @@ def system_lines(
         )
         for at, peak, rms in zip(sol.points, sol.point_peak, sol.point_rms, strict=True):
             lines.append(f"  at point {at:g}: peak {peak:.7g} m, rms {rms:.7g} m")
+        for at, peak, rms in zip(sol.moments, sol.moment_peak, sol.moment_rms, strict=True):
+            lines.append(f"  bending moment at {at:g} m: peak {peak:.7g} N m, rms {rms:.7g} N m")
     if output.get("strobe_period") is not None:
         lines.append(
             f"{len(sol.strobe_time)} stroboscopic state(s), every {output['strobe_period']:g} s "
