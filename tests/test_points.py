@@ -434,3 +434,62 @@ metrics = ["peak"]
     assert float(np.max(np.abs(table["bending_moment_0"][table["t"] >= 28.0]))) == pytest.approx(
         linear_moment(9.0, 0.0), rel=1e-3
     )
+
+
+def test_a_study_moves_a_damper_and_the_force_along_the_beam(tmp_path: Path, run_cli: Any) -> None:
+    # Where to put the damper: each run is the scenario written with that position,
+    # bit for bit; a position off the beam fails its run alone, naming the key.
+    damper = {
+        "mass": 0.01,
+        "clearance": 2e-4,
+        "law": "hertz-damped",
+        "stiffness": 1e7,
+        "restitution": 0.6,
+    }
+    scenario = tmp_path / "beam.toml"
+    scenario.write_text(
+        beam_toml(11.0)
+        + """
+[[damper]]
+mass = 0.01
+at = 0.5
+clearance = 2e-4
+law = "hertz-damped"
+stiffness = 1e7
+restitution = 0.6
+[solver]
+method = "dopri5"
+t_end = 0.5
+[output]
+record_from = 0.25
+points = [0.5]
+[study]
+analysis = "run"
+# With the RMS, as the run below keeps it: the same evaluations, the same bits.
+metrics = ["peak", "rms"]
+[study.axes]
+"damper.0.at" = [0.2, 0.45, 0.6]
+"excitation.0.at" = [0.3, 0.5]
+""",
+        encoding="utf-8",
+    )
+    done = run_cli("study", str(scenario), "--out", "at.nc")
+    assert done.returncode == 0, done.stderr
+    assert "damper 0 at must be a position along the beam in [0, 0.5] m, got 0.6" in done.stdout
+    with xr.open_dataset(tmp_path / "at.nc") as ds:
+        assert ds["damper.0.at"].attrs["units"] == "m"
+        for at in (0.2, 0.45):
+            for force_at in (0.3, 0.5):
+                sol = vi.simulate_system(
+                    BEAM,
+                    damper=[damper | {"at": at}],
+                    excitation=[tip_force(11.0) | {"at": force_at}],
+                    t_end=0.5,
+                    method="dopri5",
+                    record_from=0.25,
+                    points=[LENGTH],
+                    history=False,
+                )
+                chosen = {"damper.0.at": at, "excitation.0.at": force_at, "at": LENGTH}
+                assert float(ds["point_peak"].sel(chosen)) == sol.point_peak[0]
+        assert np.isnan(ds["point_peak"].sel({"damper.0.at": 0.6})).all()

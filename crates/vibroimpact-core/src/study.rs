@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use crate::assembly::{initial_state, resumed_state, Assembly, PairLaw, SystemSpec};
+use crate::assembly::{initial_state, resumed_state, Assembly, Load, PairLaw, SystemSpec};
 use crate::contact::Contact;
 use crate::ensemble::{run_ensemble, EnsembleOptions, Member};
 use crate::error::{Error, Result};
@@ -25,6 +25,11 @@ use crate::{linalg, shooting};
 /// Which entry of the scenario a study varies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Target {
+    /// The point a damper, stop or force acts at (a coordinate index, or m
+    /// along a cantilever): the interaction's rows are made again.
+    DamperAt(usize),
+    StopAt(usize),
+    ExcitationAt(usize),
     DamperMass(usize),
     DamperClearance(usize),
     DamperLowerClearance(usize),
@@ -60,10 +65,10 @@ pub struct Parameter {
 /// The paths a study can vary, for error messages.
 pub const PATHS: &str = "structure.{mass, stiffness, damping} (kind \"oscillator\"), \
      structure.{length, youngs_modulus, second_moment, mass_per_length, damping_ratio} \
-     (kind \"cantilever\"; none of kind \"matrices\"), damper.N.{mass, clearance, \
-     lower_clearance, upper_clearance, restitution, stiffness, damping}, stop.N.{gap, \
-     restitution, stiffness, damping}, gravity.acceleration, excitation.N.{amplitude, \
-     frequency, phase} (harmonic signals), excitation.N.{seed, intensity, cutoff_frequency, \
+     (kind \"cantilever\"; none of kind \"matrices\"), damper.N.{at, mass, clearance, \
+     lower_clearance, upper_clearance, restitution, stiffness, damping}, stop.N.{at, gap, \
+     restitution, stiffness, damping}, gravity.acceleration, excitation.N.at (forces), \
+     excitation.N.{amplitude, frequency, phase} (harmonic signals), excitation.N.{seed, intensity, cutoff_frequency, \
      duration} (white-noise and kanai-tajimi signals; also ground_frequency, ground_damping \
      for kanai-tajimi), initial.{structure_displacement, structure_velocity, \
      damper_displacement, damper_velocity}.I";
@@ -110,6 +115,7 @@ impl Parameter {
             ["damper", i, key] => {
                 let i = index(i, spec.dampers.len(), "[[damper]]")?;
                 match *key {
+                    "at" => Target::DamperAt(i),
                     "mass" => Target::DamperMass(i),
                     "clearance" => Target::DamperClearance(i),
                     "lower_clearance" => Target::DamperLowerClearance(i),
@@ -123,6 +129,7 @@ impl Parameter {
             ["stop", i, key] => {
                 let i = index(i, spec.stops.len(), "[[stop]]")?;
                 match *key {
+                    "at" => Target::StopAt(i),
                     "gap" => Target::StopGap(i),
                     "restitution" => Target::StopRestitution(i),
                     "stiffness" => Target::StopStiffness(i),
@@ -148,6 +155,16 @@ impl Parameter {
                 }
                 let at = STRUCTURE_KEYS.iter().position(|k| k == key);
                 Target::Structure(at.expect("every recipe input is listed"))
+            }
+            ["excitation", i, "at"] => {
+                let i = index(i, spec.excitations.len(), "[[excitation]]")?;
+                if !matches!(spec.excitations[i].load, Load::Force { .. }) {
+                    return Err(Error::Inconsistent(format!(
+                        "study axis {path:?}: excitation {i} is a base excitation, which acts \
+                         at no point"
+                    )));
+                }
+                Target::ExcitationAt(i)
             }
             ["excitation", i, key] => {
                 let i = index(i, spec.excitations.len(), "[[excitation]]")?;
@@ -229,6 +246,14 @@ impl Parameter {
             }
         };
         match self.target {
+            // The system checks the point (the run fails, naming it).
+            Target::DamperAt(i) => spec.dampers[i].at = value,
+            Target::StopAt(i) => spec.stops[i].at = value,
+            Target::ExcitationAt(i) => {
+                if let Load::Force { at } = &mut spec.excitations[i].load {
+                    *at = value;
+                }
+            }
             Target::DamperMass(i) => spec.dampers[i].mass = value,
             Target::DamperClearance(i) => {
                 // Checked here: the system would name the side it sets.
