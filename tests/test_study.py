@@ -641,3 +641,14 @@ def test_a_recorded_signals_file_is_part_of_the_studys_identity(tmp_path: Path) 
     assert load(scenario(tmp_path, text)).fingerprint() == first
     (tmp_path / "force.csv").write_text("0,0\n1,2\n", encoding="utf-8")
     assert load(scenario(tmp_path, text)).fingerprint() != first
+
+
+def test_a_study_the_method_cannot_take_is_refused_before_any_run(tmp_path: Path) -> None:
+    # Every run would fail alike (no axis changes a signal's kind): it ran them all
+    # and exited 1 (user trial). The exact flow takes harmonic signals only.
+    noise = 'signal = "white-noise"\nintensity = 0.01\ncutoff_frequency = 50.0\nseed = 1'
+    text = BASE.replace('signal = "harmonic"\namplitude = 5.0\nfrequency = 10.0', noise)
+    assert text != BASE
+    text += '[study]\nanalysis = "run"\n[study.axes]\n"damper.0.mass" = [0.01, 0.02]\n'
+    done = cli("study", str(scenario(tmp_path, text)), "--out", str(tmp_path / "r.nc"))
+    assert_refused(done, ['method "exact" takes harmonic', "dop853"], tmp_path / "r.nc")

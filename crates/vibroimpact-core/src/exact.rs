@@ -310,23 +310,7 @@ impl ExactFlow {
     /// The flow of `system`, or an error saying what it cannot take
     /// (compliant laws, signals other than harmonics, non-classical damping).
     pub fn new(system: &Assembly) -> Result<Self> {
-        if let Some(it) = system.interactions.iter().find(|it| {
-            !matches!(
-                it.law,
-                InteractionLaw::Rigid { .. }
-                    | InteractionLaw::Compliant {
-                        law: AnyLaw::Linear(_),
-                        ..
-                    }
-            )
-        }) {
-            return Err(Error::Inconsistent(format!(
-                "method \"exact\" takes rigid and linear laws only (a piecewise-linear system), \
-                 and {} is not linear; use law = \"rigid\" or \"linear\", or method \"dop853\"",
-                system.pairs[it.pair]
-            )));
-        }
-        let parts = system.linear_parts("exact")?;
+        let parts = Self::takes(system)?;
         let free = Self::modes_of(&parts, system, &vec![OPEN; system.interactions.len()])?;
         let step = free.step;
         let dim = system.dim;
@@ -351,6 +335,29 @@ impl ExactFlow {
             step,
             evaluations: 0,
         })
+    }
+
+    /// The system's linear parts where the flow takes its kinds of laws and
+    /// signals (rigid and linear laws, harmonics), else why not: what no
+    /// value of theirs changes (a study refuses it before its runs).
+    pub fn takes(system: &Assembly) -> Result<LinearParts> {
+        if let Some(it) = system.interactions.iter().find(|it| {
+            !matches!(
+                it.law,
+                InteractionLaw::Rigid { .. }
+                    | InteractionLaw::Compliant {
+                        law: AnyLaw::Linear(_),
+                        ..
+                    }
+            )
+        }) {
+            return Err(Error::Inconsistent(format!(
+                "method \"exact\" takes rigid and linear laws only (a piecewise-linear system), \
+                 and {} is not linear; use law = \"rigid\" or \"linear\", or method \"dop853\"",
+                system.pairs[it.pair]
+            )));
+        }
+        system.linear_parts("exact")
     }
 
     /// The step the kernel should take (s; infinite when nothing in the

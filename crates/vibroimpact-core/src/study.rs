@@ -14,6 +14,7 @@ use crate::assembly::{initial_state, resumed_state, Assembly, Load, PairLaw, Sys
 use crate::contact::Contact;
 use crate::ensemble::{run_ensemble, EnsembleOptions, Member};
 use crate::error::{Error, Result};
+use crate::exact::ExactFlow;
 use crate::reductions::ReduceOptions;
 use crate::settings::{ContactTiming, Method, Settings, Stepping};
 use crate::signals::{RecipeKey, Signal};
@@ -435,6 +436,14 @@ pub fn run_study(
         // Refused up front on the base scenario; an axis may still make a
         // point aperiodic, which then fails alone.
         forcing_period(spec)?;
+    }
+    if settings.method == "exact" {
+        // Every run alike would fail on a law's or a signal's kind, which no
+        // axis changes: refused up front (a base whose values an axis
+        // replaces may be unfit to assemble; its runs then say so).
+        if let Ok(system) = Assembly::new(spec) {
+            ExactFlow::takes(&system)?;
+        }
     }
     let width = parameters.len().max(1);
     let rows = if parameters.is_empty() {
