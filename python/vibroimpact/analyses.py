@@ -473,12 +473,51 @@ class SweepPoint:
         }
 
 
+def shown_amplitudes(point: SweepPoint) -> tuple[str, str]:
+    """Which amplitudes a sweep's table and plot show, and their unit: those of the
+    structure at the first of ``[output] points`` (``"point"``, m), else of the first
+    bending moment (``"moment"``, N m), else of coordinate 0 (``"coordinate"``, m)."""
+    if len(point.points):
+        return "point", "m"
+    if len(point.moments):
+        return "moment", "N m"
+    return "coordinate", "m"
+
+
+def shown_values(point: SweepPoint, shown: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The amplitudes, linear amplitudes and RMS values of kind ``shown`` (see
+    :func:`shown_amplitudes`)."""
+    if shown == "point":
+        return point.point_amplitude, point.linear_point_amplitude, point.point_rms
+    if shown == "moment":
+        return point.moment_amplitude, point.linear_moment_amplitude, point.moment_rms
+    return point.amplitude, point.linear_amplitude, point.rms
+
+
+def shown_label(point: SweepPoint, shown: str) -> str:
+    """What the shown amplitudes are, in words."""
+    if shown == "point":
+        return f"amplitude at point {point.points[0]:g} of [output] points"
+    if shown == "moment":
+        return f"bending moment amplitude at {point.moments[0]:g} m"
+    return "amplitude of structure coordinate 0"
+
+
+def reductions(amplitude: Any, linear: Any) -> np.ndarray:
+    """``1 - amplitude / linear`` along the last axis, NaN where either is not finite or
+    the linear amplitude is round-off: at most 1e-9 of the largest of its row (a node of
+    the response, such as the moment at a free tip, where the ratio is of round-offs)."""
+    amplitude, linear = np.asarray(amplitude, dtype=float), np.asarray(linear, dtype=float)
+    finite = np.isfinite(amplitude) & np.isfinite(linear)
+    scale = np.max(np.abs(np.where(finite, linear, 0.0)), axis=-1, keepdims=True, initial=0.0)
+    defined = finite & (np.abs(linear) > 1e-9 * scale)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(defined, 1.0 - amplitude / np.where(defined, linear, 1.0), np.nan)
+
+
 def _reductions(amplitude: np.ndarray, linear: np.ndarray) -> list[float | None]:
-    """``1 - amplitude / linear``, None where either is not finite or the linear is 0."""
-    return [
-        (1.0 - a / b) if (b and math.isfinite(a) and math.isfinite(b)) else None
-        for a, b in zip(amplitude, linear, strict=True)
-    ]
+    """:func:`reductions` for JSON: None where undefined."""
+    return [float(r) if math.isfinite(r) else None for r in reductions(amplitude, linear)]
 
 
 #: The most values a ``[sweep]`` may step through (``count``), or a ``[continuation]``

@@ -18,6 +18,9 @@ from vibroimpact.analyses import (
     check_periods,
     orbit,
     runner,
+    shown_amplitudes,
+    shown_label,
+    shown_values,
     state_index,
     sweep,
     sweep_values,
@@ -277,9 +280,10 @@ def run_sweep(args: argparse.Namespace) -> int:
         f"{settings['record_periods']} recorded periods each)"
     )
     # Coordinate 0's amplitudes, or the structure's at the first point where there are
-    # points (a cantilever's modal coordinates are no deflection).
-    at_point = len(points[0].points) > 0
-    name = f"@{points[0].points[0]:g}" if at_point else "_0"
+    # points (a cantilever's modal coordinates are no deflection), else the first
+    # bending moment's.
+    shown, unit = shown_amplitudes(points[0])
+    name = {"coordinate": "_0", "point": "@point0"}.get(shown, "@moment0")
     head = [
         "value",
         "direction",
@@ -289,15 +293,11 @@ def run_sweep(args: argparse.Namespace) -> int:
         "impacts/period",
         "settled",
     ]
-    if at_point:
-        print(f"(amplitudes at point {points[0].points[0]:g} of [output] points, m)")
+    if shown != "coordinate":
+        print(f"({shown_label(points[0], shown)}, {unit})")
     print("  ".join(f"{h:>14}" for h in head))
     for p in points:
-        amplitude, linear, rms = (
-            (p.point_amplitude, p.linear_point_amplitude, p.point_rms)
-            if at_point
-            else (p.amplitude, p.linear_amplitude, p.rms)
-        )
+        amplitude, linear, rms = shown_values(p, shown)
         cells = [
             f"{p.value:>14.6g}",
             f"{p.direction:>14}",

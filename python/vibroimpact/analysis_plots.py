@@ -12,7 +12,13 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact.analyses import Runner, SweepPoint
+from vibroimpact.analyses import (
+    Runner,
+    SweepPoint,
+    shown_amplitudes,
+    shown_label,
+    shown_values,
+)
 from vibroimpact.continuation import Branch
 from vibroimpact.maps import Basins, BifurcationPoint, Section
 from vibroimpact.output import written_whole
@@ -52,19 +58,18 @@ def _unit(parameter: str, data: Any = None) -> str:
 
 def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any = None) -> None:
     """Amplitude of structure coordinate 0 (of the structure at the first of
-    ``[output] points``, where there are points) against the parameter, each
+    ``[output] points``, or else of the first bending moment of ``[output] moments``,
+    where there are: see :func:`shown_amplitudes`) against the parameter, each
     direction, with the linear structure's beside it."""
-    at_point = len(points[0].points) > 0
+    shown, unit = shown_amplitudes(points[0])
 
     def amplitude(p: SweepPoint) -> float:
-        return float(p.point_amplitude[0] if at_point else p.amplitude[0])
+        return float(shown_values(p, shown)[0][0])
 
     with _figure(path) as (fig, ax):
         values = np.array([p.value for p in points])
         order = np.argsort(values, kind="stable")
-        linear = np.array(
-            [p.linear_point_amplitude[0] if at_point else p.linear_amplitude[0] for p in points]
-        )
+        linear = np.array([shown_values(p, shown)[1][0] for p in points])
         ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers (linear)")
         for direction, marker in (("up", "^"), ("down", "v")):
             chosen = [p for p in points if p.direction == direction]
@@ -78,11 +83,7 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
                     label=f"with dampers, sweep {direction}",
                 )
         ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
-        ax.set_ylabel(
-            f"amplitude at point {points[0].points[0]:g} (m)"
-            if at_point
-            else "amplitude of structure coordinate 0 (m)"
-        )
+        ax.set_ylabel(f"{shown_label(points[0], shown)} ({unit})")
         ax.legend()
         ax.grid(alpha=0.3)
 
@@ -253,10 +254,10 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
     reduced to their worst case, the largest value; the optimum, the smallest, marked."""
     values = dataset[metric]
     where = ""
-    for dim in ("coordinate", "pair", "at"):
+    for dim in ("coordinate", "pair", "at", "moment_at"):
         if dim in values.dims:
-            if dim == "at":
-                where = f" at point {float(values['at'][0]):g}"
+            if dim in ("at", "moment_at"):
+                where = f" at {float(values[dim][0]):g}" + (" m" if dim == "moment_at" else "")
             values = values.isel({dim: 0})
     others = [d for d in values.dims if d not in (x, y)]
     if others:

@@ -43,6 +43,8 @@ from vibroimpact.study_commands import add_command as add_study
 from vibroimpact.study_commands import run_study_command
 from vibroimpact.system_scenario import (
     SystemScenario,
+    check_history_file,
+    expected_rows,
     system_lines,
     system_summary,
     write_system_history,
@@ -192,6 +194,9 @@ def contact_lines(sol: Solution) -> list[str]:
 
 
 def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
+    if args.out:
+        # Known before the run where its steps are fixed: refused before it starts.
+        check_history_file(scenario.prepared, expected_rows(scenario.prepared))
     start = time.perf_counter()
     try:
         sol = scenario.run()
@@ -199,7 +204,7 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
         raise ScenarioError(str(err)) from None
     cpu_time = time.perf_counter() - start
     if args.out:
-        write_system_history(args.out, sol)
+        write_system_history(args.out, sol, scenario.prepared)
     if args.json:
         print(json_text(system_summary(scenario, sol, cpu_time)))
         return 0

@@ -43,7 +43,7 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from vibroimpact._core import __version__
-from vibroimpact.analyses import AnalysisError, SweepPoint
+from vibroimpact.analyses import AnalysisError, SweepPoint, reductions
 from vibroimpact.continuation import Branch
 from vibroimpact.maps import Basins, BifurcationPoint, Section
 from vibroimpact.output import json_text
@@ -238,7 +238,8 @@ def sweep_dataset(
     :func:`parameter_units`), and ``direction`` (``"up"`` or ``"down"``).
     Variables: ``amplitude`` and ``rms`` (m, NaN where the point's run failed),
     ``linear_amplitude`` (m, the structure alone), ``reduction`` (``1 - amplitude /
-    linear_amplitude``, NaN where either is not finite or the linear one is 0),
+    linear_amplitude``, NaN where either is not finite or the linear one is round-off:
+    see :func:`vibroimpact.analyses.reductions`),
     all ``point`` x ``coordinate``; ``impacts_per_period``, ``settled`` (bool) and
     ``error`` (the failed run's message, ``""`` where none) along ``point``. With
     ``[output] points``, a dimension ``at`` (the points: m along a cantilever, else
@@ -261,12 +262,6 @@ def sweep_dataset(
         if out.shape != (len(points), size):
             raise AnalysisError(f"sweep_dataset: every point's {name} must have {size} values")
         return out
-
-    def reduction_of(amplitude: NDArray[np.float64], linear: NDArray[np.float64]) -> Any:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            reduction = 1.0 - amplitude / linear
-        reduction[~(np.isfinite(amplitude) & np.isfinite(linear) & (linear != 0))] = np.nan
-        return reduction
 
     amplitude = rows("amplitude")
     linear = rows("linear_amplitude")
@@ -294,7 +289,7 @@ def sweep_dataset(
             ),
             "point_reduction": (
                 pa,
-                reduction_of(point_amplitude, linear_point),
+                reductions(point_amplitude, linear_point),
                 _attrs("amplitude reduction at the point", _ONE),
             ),
         }
@@ -320,7 +315,7 @@ def sweep_dataset(
             ),
             "moment_reduction": (
                 pm,
-                reduction_of(moment, linear_moment),
+                reductions(moment, linear_moment),
                 _attrs("bending moment reduction", _ONE),
             ),
         }
@@ -335,7 +330,7 @@ def sweep_dataset(
             ),
             "reduction": (
                 pc,
-                reduction_of(amplitude, linear),
+                reductions(amplitude, linear),
                 _attrs("amplitude reduction, 1 - amplitude / linear_amplitude", _ONE),
             ),
             **at_points,

@@ -187,6 +187,24 @@ def check_threads(threads: Any, name: str) -> None:
 MAX_STUDY_RUNS = 10_000_000
 
 
+#: Metrics kept at each of [output] points and moments as well as per coordinate.
+_PER_COORDINATE = ("peak", "rms", "amplitude")
+_FOLLOWED = tuple(f"{kind}_{m}" for kind in ("point", "moment") for m in _PER_COORDINATE)
+
+
+def base_metrics(names: Sequence[str]) -> list[str]:
+    """The metrics the runs keep for ``names``: ``point_peak``, ``moment_rms``... are
+    the per-coordinate ``peak``, ``rms``... (kept at each of ``[output] points`` and
+    ``moments`` too, in the Dataset's ``point_*``, ``moment_*``); each once, in order."""
+    out = []
+    for name in names:
+        for kind in ("point_", "moment_"):
+            if name.startswith(kind) and name[len(kind) :] in _PER_COORDINATE:
+                name = name[len(kind) :]
+        out.append(name)
+    return list(dict.fromkeys(out))
+
+
 def checked_study_settings(table: Any) -> dict[str, Any]:
     """The ``[study]`` section checked as :func:`study_settings` checks it, without
     making its axes' values or its random draws: ``axes`` and ``random`` are left as
@@ -220,7 +238,8 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
     if isinstance(metrics, str) or not isinstance(metrics, Sequence) or not metrics:
         raise StudyError(f"[study] metrics: must be a list of names, got {metrics!r:.60}")
     for name in metrics:
-        _choice("[study] ", "metrics", name, METRICS)
+        _choice("[study] ", "metrics", name, METRICS + _FOLLOWED)
+    asked, metrics = metrics, base_metrics(metrics)
     if out["stepping"] == "fixed":
         if out["analysis"] != "run":
             raise StudyError(
@@ -242,7 +261,8 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
             f"[study] metrics: {', '.join(other)} not kept by analysis = "
             f'"{out["analysis"]}" (it keeps {", ".join(kept)}){hint}'
         )
-    out["metrics"] = list(dict.fromkeys(metrics))
+    # As asked (point_peak... among them: see base_metrics).
+    out["metrics"] = list(dict.fromkeys(asked))
     for key, low in (
         ("settle_periods", 0),
         ("record_periods", 1),
@@ -526,7 +546,7 @@ class Study:
             record_periods=s["record_periods"],
             tolerance=s["tolerance"],
             threads=threads,
-            mean_square="rms" in s["metrics"],
+            mean_square="rms" in base_metrics(s["metrics"]),
             stepping=s.get("stepping", "events"),
             orbit_periods=s.get("orbit_periods", 1),
         )
@@ -566,6 +586,14 @@ def study_of(
         checked = dict(settings)
     else:
         checked = study_settings(settings)
+    output = data.get("output")
+    output = output if isinstance(output, Mapping) else {}
+    for name in checked["metrics"]:
+        for kind in ("point", "moment"):
+            if name.startswith(f"{kind}_") and not output.get(f"{kind}s"):
+                raise StudyError(
+                    f"[study] metrics: {name} needs [output] {kind}s (where to follow it)"
+                )
     if checked["record_from"] is None:
         # The scenario's own window where [study] gives none, as a run of it records
         # (user trial: a study and a run of one scenario disagreed on a peak).
@@ -607,7 +635,7 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
             {"long_name": "0: run completed; k: failed for the k-th of attrs reasons"},
         )
     }
-    for name in study.settings["metrics"]:
+    for name in base_metrics(study.settings["metrics"]):
         key = "peak" if name == "amplitude" else name
         values = np.concatenate([np.asarray(p[key], dtype=float) for p in parts])
         description, unit = _DESCRIPTIONS[name]

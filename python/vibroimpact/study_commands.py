@@ -17,6 +17,7 @@ from vibroimpact.output import UsageError, check_output, check_plot, json_text
 from vibroimpact.scenario import load_scenario
 from vibroimpact.study import (
     MAX_WORKERS,
+    base_metrics,
     check_threads,
     output_kind,
     run,
@@ -97,15 +98,18 @@ def run_study_command(args: argparse.Namespace) -> int:
     output = study.data.get("output")
     output = output if isinstance(output, Mapping) else {}
     # With [output] points (moments) the per-coordinate metrics are also kept at each.
-    allowed = list(study.settings["metrics"])
-    per_coordinate = [m for m in allowed if m in ("peak", "rms", "amplitude")]
+    kept = base_metrics(study.settings["metrics"])
+    allowed = list(kept)
+    per_coordinate = [m for m in kept if m in ("peak", "rms", "amplitude")]
     for key, prefix in (("points", "point_"), ("moments", "moment_")):
         if output.get(key):
             allowed += [prefix + m for m in per_coordinate]
     first = study.settings["metrics"][0]
-    # A cantilever's coordinates are modes: where there are points, the map is of
-    # the first (user trial: the default map showed half the tip's deflection).
-    metric = args.metric or (f"point_{first}" if f"point_{first}" in allowed else first)
+    # A cantilever's coordinates are modes: where there are points (or moments) the
+    # map is of the first (user trial: the default map showed half the tip's
+    # deflection).
+    chosen = [f"{kind}_{first}" for kind in ("point", "moment")] + [first]
+    metric = args.metric or next(m for m in chosen if m in allowed)
     x = args.x or axes[0]
     y = args.y or (axes[1] if len(axes) > 1 else None)
     if args.plot and len(axes) < 2:

@@ -1053,8 +1053,8 @@ def prepare_system(
     followed = len(output["points"]) + len(output["moments"])
     if followed > MAX_POINTS:
         raise _fail(
-            "[output] points: ",
-            f"holds {followed} with moments; at most {MAX_POINTS} are allowed",
+            "[output] points, moments: ",
+            f"{followed} in all; at most {MAX_POINTS} are allowed (together)",
         )
     for key in ("points", "moments"):
         for j, at in enumerate(output[key]):

@@ -15,9 +15,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from vibroimpact._core import InvalidInputError
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
 from vibroimpact.output import finite_or_none, written_whole
-from vibroimpact.system import PreparedRun, SystemSolution, prepare_system
+from vibroimpact.system import (
+    _FIXED_STEP,
+    PreparedRun,
+    SystemSolution,
+    prepare_system,
+    structure_coordinates,
+)
 
 SECTIONS = (
     "structure",
@@ -175,8 +181,34 @@ def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
     return columns
 
 
-def write_system_history(path: Path, sol: SystemSolution) -> None:
-    """Write the history as CSV, whole or not at all."""
+def expected_rows(run: PreparedRun) -> float:
+    """The history rows a fixed-step run keeps (0 where the steps are not fixed)."""
+    solver, output = run.solver, run.output
+    if solver["dt"] is None or solver["method"] not in _FIXED_STEP or not output["history"]:
+        return 0.0
+    return float(solver["t_end"] / solver["dt"] / output["every"] + 2)
+
+
+def check_history_file(run: PreparedRun, rows: float) -> None:
+    """Refuse a CSV history of ``rows`` rows whose values (the state's columns and
+    one per point and moment) would pass what a run's records may hold: each point or
+    moment column is a whole array in memory, and the file ~25 bytes a value."""
+    output = run.output
+    columns = 1 + 2 * structure_coordinates(run.spec["structure"]) + 2 * len(run.spec["damper"])
+    derived = len(output["points"]) + len(output["moments"])
+    size = rows * (columns + derived) * 8
+    if size > MAX_RECORD_BYTES:
+        raise InvalidInputError(
+            f"--out: the history would hold {rows:.3g} rows of {columns + derived} columns "
+            f"({derived} for [output] points and moments), {size / 2**20:.0f} MiB, more than "
+            f"the {MAX_RECORD_BYTES >> 20} MiB a run's records may take: raise [output] every, "
+            "follow fewer points and moments, or shorten t_end"
+        )
+
+
+def write_system_history(path: Path, sol: SystemSolution, run: PreparedRun) -> None:
+    """Write the history as CSV, whole or not at all (see :func:`check_history_file`)."""
+    check_history_file(run, len(sol.t))
     columns = history_columns(sol)
     with written_whole(path) as f:
         writer = csv.writer(f)
