@@ -466,8 +466,8 @@ record_from = 0.25
 points = [0.5]
 [study]
 analysis = "run"
-# With the RMS, as the run below keeps it: the same evaluations, the same bits.
-metrics = ["peak", "rms"]
+# Without the RMS the run below keeps: the same bits all the same.
+metrics = ["peak"]
 [study.axes]
 "damper.0.at" = [0.2, 0.45, 0.6]
 "excitation.0.at" = [0.3, 0.5]

@@ -580,12 +580,6 @@ def test_a_study_of_starts_equals_the_runs_made_one_by_one(tmp_path: Path, metho
         assert point["impacts"].item() == sum(k != "sticking" for k in sol.contacts.kind)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known: with newmark-implicit the located peak differs in the last bit when the "
-    "RMS is not also integrated (the end rates the mean square evaluates change the "
-    "method's scratch state); found while testing studies of starts",
-)
 def test_newmark_peaks_do_not_depend_on_whether_rms_is_kept(tmp_path: Path) -> None:
     text = BASE.replace('method = "exact"\n', 'method = "newmark-implicit"\ndt = 1e-3\n') + (
         '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'

@@ -822,6 +822,10 @@ pub fn integrate_system_within<S: SystemStepper>(
         jerk: vec![0.0; d],
     };
     let mut scratch = Scratch::new(system);
+    // The reductions evaluate with their own: the signals' values the steps
+    // cache (a harmonic's rotated phasor) are then the same bits whatever is
+    // reduced (a peak differed in its last bit with the RMS kept or not).
+    let mut reduce_scratch = Scratch::new(system);
     let mut modes = vec![Mode::Open; count];
     let mut open: Vec<Option<Open>> = vec![None; count];
     // A compliant pair that starts in contact (a run continued from another's
@@ -1179,7 +1183,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                 &end,
                 taken,
                 &modes,
-                &mut scratch,
+                &mut reduce_scratch,
                 &mut buffers,
                 &mut reductions,
                 options.reduce.mean_square,
