@@ -284,7 +284,10 @@ def _value(where: str, kind: str, value: Any) -> Any:
         return number
     if kind == _WHOLE:
         whole = real(value)
-        if not isinstance(whole, int) or whole not in range(2**63):
+        if not isinstance(whole, int):
+            # The key's own range, if any, is checked after (modes: [1, 200]).
+            raise _fail(where, f"must be a whole number, got {shown(value)}")
+        if whole not in range(2**63):
             raise _fail(where, f"must be a whole number in [0, 2^63 - 1], got {shown(value)}")
         return whole
     if kind == _TEXT:
