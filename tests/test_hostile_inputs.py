@@ -638,3 +638,84 @@ t_end = 0.1
     message = parse_error(text)
     assert "structure.length must be a finite number > 0" in message
     assert "at must be" not in message
+
+
+# From the pounding trial: what a building engineer's scenarios ran into.
+
+BUILDINGS = """
+[structure]
+kind = "matrices"
+mass = [[1.0e5, 0.0], [0.0, 2.0e5]]
+stiffness = [[1.579e7, 0.0], [0.0, 7.896e6]]
+damping = [[1.2566e5, 0.0], [0.0, 1.2566e5]]
+[[stop]]
+at = 0
+against = 1
+side = "upper"
+gap = 0.01
+law = "rigid"
+restitution = 0.65
+[[excitation]]
+kind = "base"
+signal = "recorded"
+file = "quake.csv"
+[solver]
+method = "dop853"
+t_end = 1.0
+"""
+
+
+def test_out_refuses_a_record_the_scenario_reads(tmp_path: Path, run_cli: Cli) -> None:
+    record = tmp_path / "quake.csv"
+    record.write_text("time,value\n0,0\n0.5,1.0\n1.0,0\n", encoding="utf-8")
+    before = record.read_text(encoding="utf-8")
+    scenario = write(tmp_path, BUILDINGS)
+    refused(run_cli("simulate", str(scenario), "--out", str(record)), "--out", "quake.csv")
+    assert record.read_text(encoding="utf-8") == before
+
+
+def test_a_stop_given_twice_is_refused_naming_both(tmp_path: Path, run_cli: Cli) -> None:
+    # The second of two rigid stops on one gap was silently ignored, the result
+    # depending on their order; as "lower" from the other point it is the same gap.
+    record = tmp_path / "quake.csv"
+    record.write_text("time,value\n0,0\n0.5,1.0\n1.0,0\n", encoding="utf-8")
+    again = BUILDINGS + (
+        '[[stop]]\nat = 0\nagainst = 1\nside = "upper"\ngap = 0.01\nlaw = "rigid"\n'
+        "restitution = 0.3\n"
+    )
+    mirrored = BUILDINGS + (
+        '[[stop]]\nat = 1\nagainst = 0\nside = "lower"\ngap = 0.01\nlaw = "rigid"\n'
+        "restitution = 0.3\n"
+    )
+    for text in (again, mirrored):
+        refused(
+            run_cli("simulate", str(write(tmp_path, text))),
+            "stop 1 has the same gap as stop 0",
+        )
+    # Another gap is another wall.
+    other = again.replace("gap = 0.01\nlaw", "gap = 0.02\nlaw").replace(
+        "gap = 0.02\nlaw", "gap = 0.01\nlaw", 1
+    )
+    assert run_cli("simulate", str(write(tmp_path, other))).returncode == 0
+
+
+def test_pairs_beyond_the_limit_are_refused_before_they_are_read(
+    tmp_path: Path, run_cli: Cli
+) -> None:
+    # 70,000 stops aborted the process asking for 39 GB (the impact solver's matrix).
+    stop = '[[stop]]\nat = 0\nside = "upper"\ngap = 0.01\nlaw = "rigid"\nrestitution = 0.5\n'
+    text = BUILDINGS.split("[[stop]]")[0] + stop * (vi.MAX_PAIRS + 1)
+    text += '[solver]\nmethod = "dop853"\nt_end = 1.0\n'
+    refused(run_cli("simulate", str(write(tmp_path, text))), "at most 1000 pairs in all")
+
+
+def test_the_exact_flow_s_steps_are_counted_before_it_runs(tmp_path: Path, run_cli: Cli) -> None:
+    # dt = 1e-9 over 20 s ran for minutes: the exact flow steps at most dt.
+    text = BUILDINGS.replace(
+        'method = "dop853"\nt_end = 1.0', 'method = "exact"\ndt = 1e-9\nt_end = 20.0'
+    )
+    text = text.replace(
+        'signal = "recorded"\nfile = "quake.csv"',
+        'signal = "harmonic"\namplitude = 1.0\nfrequency = 1.0',
+    )
+    refused(run_cli("simulate", str(write(tmp_path, text))), "exceeds max_steps")

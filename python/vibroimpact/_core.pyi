@@ -8,6 +8,7 @@ import numpy.typing as npt
 __all__ = [
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
+    "MAX_PAIRS",
     "MAX_POINTS",
     "MAX_RECORD_BYTES",
     "MAX_SIGNAL_SAMPLES",
@@ -46,6 +47,7 @@ MAX_RECORD_BYTES: int
 MAX_SIGNAL_SAMPLES: int
 DEFAULT_ENERGY_TOLERANCE: float
 RTOL_RANGE: tuple[float, float]
+MAX_PAIRS: int
 MAX_POINTS: int
 
 _FloatArray = npt.NDArray[np.float64]

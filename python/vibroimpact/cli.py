@@ -45,6 +45,7 @@ from vibroimpact.system_scenario import (
     SystemScenario,
     check_history_file,
     expected_rows,
+    record_files,
     system_lines,
     system_summary,
     write_system_history,
@@ -195,6 +196,8 @@ def contact_lines(sol: Solution) -> list[str]:
 
 def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
     if args.out:
+        # Nor the records it reads (user trial: --out replaced the accelerogram).
+        check_output(args.out, "--out", [args.scenario, *record_files(scenario)])
         # Known before the run where its steps are fixed: refused before it starts.
         check_history_file(scenario.prepared, expected_rows(scenario.prepared))
     start = time.perf_counter()

@@ -72,7 +72,8 @@ def _regular_or_absent(path: Path) -> os.stat_result | None:
 def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
     """Refuse, before anything runs, an output ``path`` given as ``flag`` (such as
     ``--out``) that exists and is not a regular file, or that is one of the ``inputs``
-    (the scenario file: writing the output there would replace it)."""
+    (the scenario file, a recorded signal's file: writing the output there would
+    replace it)."""
     try:
         status = _regular_or_absent(path)
     except UsageError:
@@ -89,8 +90,8 @@ def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
             continue
         if same:
             raise UsageError(
-                f"{flag} {path}: is the scenario file {str(source)!r} itself, which the "
-                "output would replace; choose another name"
+                f"{flag} {path}: is the input file {str(source)!r} itself (the scenario, "
+                "or a record it reads), which the output would replace; choose another name"
             )
 
 

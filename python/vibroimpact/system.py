@@ -50,6 +50,7 @@ import numpy as np
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_PAIRS,
     MAX_POINTS,
     MAX_RECORD_BYTES,
     MAX_SIGNAL_SAMPLES,
@@ -562,8 +563,16 @@ def system_spec(
     if kind == "matrices" and spec["structure"]["damping"] is None:
         size = len(spec["structure"]["mass"])
         spec["structure"]["damping"] = [[0.0] * size for _ in range(size)]
+    damper_tables, stop_tables = _list("damper", damper), _list("stop", stop)
+    if len(damper_tables) + len(stop_tables) > MAX_PAIRS:
+        # Before any is read: simultaneous impacts solve over every pair, a matrix
+        # that grows as their square (70,000 stops aborted asking for 39 GB).
+        raise _fail(
+            "[[damper]], [[stop]]: ",
+            f"at most {MAX_PAIRS} pairs in all, got {len(damper_tables) + len(stop_tables)}",
+        )
     dampers = []
-    for j, table in enumerate(_list("damper", damper)):
+    for j, table in enumerate(damper_tables):
         d = _table(f"[[damper]] {j}: ", table, _DAMPER)
         both = d["clearance"]
         if both is not None and not both >= 0:
@@ -584,7 +593,7 @@ def system_spec(
         dampers.append(d)
     spec["damper"] = dampers
     stops = []
-    for j, table in enumerate(_list("stop", stop)):
+    for j, table in enumerate(stop_tables):
         d = _table(f"[[stop]] {j}: ", table, _STOP)
         _choice(f"[[stop]] {j}: ", "side", d["side"], _SIDES)
         for key in ("at", "against"):
@@ -1006,13 +1015,15 @@ def prepare_system(
     for key, low, high in (("beta", 0.0, 0.5), ("gamma", 0.5, 1.0), ("spectral_radius", 0.0, 1.0)):
         if not low <= solver[key] <= high:
             raise _fail(f"[solver] {key}: ", f"must be in [{low}, {high}], got {solver[key]}")
-    if fixed and solver["t_end"] / solver["dt"] > solver["max_steps"]:
+    # The exact flow steps at most dt where one is given: as many steps at least.
+    stepped = fixed or (solver["method"] == "exact" and solver["dt"] is not None)
+    if stepped and solver["t_end"] / solver["dt"] > solver["max_steps"]:
         raise _fail(
             "[solver] ",
             f"t_end / dt = {solver['t_end'] / solver['dt']:.3e} steps exceeds max_steps "
             f"({solver['max_steps']}): raise dt or max_steps, or shorten t_end",
         )
-    if fixed and output["history"]:
+    if stepped and output["history"]:
         # The history of a fixed-step run is known before it starts: refuse it
         # up front rather than stop at the cap.
         rows = solver["t_end"] / solver["dt"] / max(output["every"], 1) + 2

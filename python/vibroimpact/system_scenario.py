@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -181,10 +182,24 @@ def history_columns(sol: SystemSolution) -> list[tuple[str, Any]]:
     return columns
 
 
+def record_files(scenario: SystemScenario) -> list[Path]:
+    """The files of the scenario's recorded signals, as it reads them."""
+    files = []
+    excitations = scenario.data.get("excitation", ())
+    for e in [excitations] if isinstance(excitations, Mapping) else excitations:
+        if isinstance(e, Mapping) and isinstance(e.get("file"), str):
+            path = Path(e["file"])
+            base = scenario.base_dir
+            files.append(path if path.is_absolute() or base is None else base / path)
+    return files
+
+
 def expected_rows(run: PreparedRun) -> float:
-    """The history rows a fixed-step run keeps (0 where the steps are not fixed)."""
+    """The history rows a run of fixed steps keeps at least (the exact flow's steps are at
+    most its dt); 0 where the steps are not fixed."""
     solver, output = run.solver, run.output
-    if solver["dt"] is None or solver["method"] not in _FIXED_STEP or not output["history"]:
+    stepped = solver["method"] in (*_FIXED_STEP, "exact")
+    if solver["dt"] is None or not stepped or not output["history"]:
         return 0.0
     return float(solver["t_end"] / solver["dt"] / output["every"] + 2)
 

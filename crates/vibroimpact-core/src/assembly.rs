@@ -129,6 +129,11 @@ pub struct SystemSpec {
 /// coordinates, a peak and a mean square).
 pub const MAX_POINTS: usize = 10_000;
 
+/// The most pairs (dampers and stops) a system may have: simultaneous
+/// impacts and sticking solve a system over every interaction (its matrix
+/// grows as their square: 70,000 stops asked for 39 GB).
+pub const MAX_PAIRS: usize = 1_000;
+
 /// The law of one interaction, ready for the kernel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum InteractionLaw {
@@ -297,6 +302,12 @@ impl Assembly {
             }
             push
         };
+        let pairs_asked = spec.dampers.len() + spec.stops.len();
+        if pairs_asked > MAX_PAIRS {
+            return Err(Error::Inconsistent(format!(
+                "[[damper]], [[stop]]: at most {MAX_PAIRS} pairs in all, got {pairs_asked}"
+            )));
+        }
         for (j, d) in spec.dampers.iter().enumerate() {
             let name = format!("damper {j}");
             damper_mass.push(positive_named(&name, "mass", d.mass)?);
@@ -428,6 +439,7 @@ impl Assembly {
             period if period.is_finite() => period,
             _ => fall_time,
         };
+        duplicate_walls(&interactions, &pairs)?;
         let mirrors_previous = (0..interactions.len())
             .map(|i| {
                 i > 0
@@ -1107,6 +1119,35 @@ fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
         hv += h[i] * v[i];
     }
     (hx, hv)
+}
+
+/// Refuses two rigid walls with the same gap (the same points, side and
+/// offset, such as a stop given twice, or as `lower` from the other point):
+/// an impact resolves one of them, which one depending on their order.
+fn duplicate_walls(interactions: &[Interaction], pairs: &[String]) -> Result<()> {
+    let mut rigid: Vec<(u64, usize)> = interactions
+        .iter()
+        .enumerate()
+        .filter(|(_, it)| matches!(it.law, InteractionLaw::Rigid { .. }))
+        .map(|(i, it)| (it.offset.to_bits(), i))
+        .collect();
+    rigid.sort_unstable();
+    for group in rigid.chunk_by(|a, b| a.0 == b.0) {
+        for (k, &(_, i)) in group.iter().enumerate() {
+            for &(_, j) in &group[..k] {
+                let (a, b) = (&interactions[i], &interactions[j]);
+                if a.pair != b.pair && a.h == b.h {
+                    let (first, second) = (a.pair.min(b.pair), a.pair.max(b.pair));
+                    return Err(Error::Inconsistent(format!(
+                        "{} has the same gap as {} (the same points, side and gap): give it \
+                         once (with the restitution wanted)",
+                        pairs[second], pairs[first]
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// One harmonic load over all coordinates: `amplitude cos(omega t + phase)`

@@ -57,5 +57,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
     m.add("RTOL_RANGE", core::settings::RTOL_RANGE)?;
     m.add("MAX_POINTS", core::assembly::MAX_POINTS)?;
+    m.add("MAX_PAIRS", core::assembly::MAX_PAIRS)?;
     Ok(())
 }
