@@ -547,6 +547,6 @@ def test_moment_trial_fixes(tmp_path: Path, run_cli: Any) -> None:
     )
     done = run_cli("sweep", str(scenario))
     assert done.returncode == 0, done.stderr
-    assert "(bending moment amplitude at 0 m, N m)" in done.stdout
+    assert "(bending moment amplitude at [output] moments[0] = 0 m, N m)" in done.stdout
     row = next(line for line in done.stdout.splitlines() if line.strip().startswith("8 "))
     assert float(row.split()[2]) == pytest.approx(linear_moment(8.0, 0.0), rel=1e-4)

@@ -497,9 +497,9 @@ def shown_values(point: SweepPoint, shown: str) -> tuple[np.ndarray, np.ndarray,
 def shown_label(point: SweepPoint, shown: str) -> str:
     """What the shown amplitudes are, in words."""
     if shown == "point":
-        return f"amplitude at point {point.points[0]:g} of [output] points"
+        return f"amplitude at [output] points[0] = {point.points[0]:g}"
     if shown == "moment":
-        return f"bending moment amplitude at {point.moments[0]:g} m"
+        return f"bending moment amplitude at [output] moments[0] = {point.moments[0]:g} m"
     return "amplitude of structure coordinate 0"
 
 

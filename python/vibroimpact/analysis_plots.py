@@ -70,7 +70,7 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
         values = np.array([p.value for p in points])
         order = np.argsort(values, kind="stable")
         linear = np.array([shown_values(p, shown)[1][0] for p in points])
-        ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers (linear)")
+        ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers and stops (linear)")
         for direction, marker in (("up", "^"), ("down", "v")):
             chosen = [p for p in points if p.direction == direction]
             if chosen:
@@ -80,7 +80,7 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
                     marker=marker,
                     ms=3,
                     lw=1,
-                    label=f"with dampers, sweep {direction}",
+                    label=f"with them, sweep {direction}",
                 )
         ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
         ax.set_ylabel(f"{shown_label(points[0], shown)} ({unit})")
