@@ -70,7 +70,9 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
         values = np.array([p.value for p in points])
         order = np.argsort(values, kind="stable")
         linear = np.array([shown_values(p, shown)[1][0] for p in points])
-        ax.plot(values[order], linear[order], "k--", lw=1, label="without dampers and stops (linear)")
+        ax.plot(
+            values[order], linear[order], "k--", lw=1, label="without dampers and stops (linear)"
+        )
         for direction, marker in (("up", "^"), ("down", "v")):
             chosen = [p for p in points if p.direction == direction]
             if chosen:
