@@ -719,3 +719,22 @@ def test_the_exact_flow_s_steps_are_counted_before_it_runs(tmp_path: Path, run_c
         'signal = "harmonic"\namplitude = 1.0\nfrequency = 1.0',
     )
     refused(run_cli("simulate", str(write(tmp_path, text))), "exceeds max_steps")
+
+
+def test_a_sweep_point_the_exact_flow_cannot_take_fails_alone() -> None:
+    # An undamped oscillator forced at exactly its frequency grows as t between
+    # impacts, which the exact flow cannot hold: that point failed the whole sweep
+    # (exit 2) though a stop bounds the motion; it now fails alone, saying what to use.
+    from vibroimpact.analyses import sweep
+
+    data = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 4 * np.pi**2},
+        "stop": [{"at": 0, "side": "upper", "gap": 0.01, "law": "rigid", "restitution": 0.8}],
+        "excitation": [{"kind": "base", "signal": "harmonic", "amplitude": 1.0, "frequency": 1.0}],
+        "solver": {"method": "exact", "t_end": 1.0},
+    }
+    found = sweep(
+        data, "excitation.0.frequency", [0.5, 1.0, 1.5], settle_periods=5, record_periods=2
+    )
+    assert [p.error is None for p in found] == [True, False, True]
+    assert "1 Hz" in str(found[1].error) and "dop853" in str(found[1].error)

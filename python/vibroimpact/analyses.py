@@ -730,6 +730,10 @@ def from_carried(attempt: Callable[[np.ndarray | None], _T], state: np.ndarray |
         return attempt(None)
 
 
+class _PointFailure(Exception):
+    """A sweep point the method cannot take: recorded with its reason."""
+
+
 def sweep(
     data: Mapping[str, Any],
     parameter: str,
@@ -768,6 +772,17 @@ def sweep(
             except InvalidInputError as err:
                 raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
             try:
+                try:
+                    run.system()
+                except InvalidInputError as err:
+                    if not points:
+                        # At the first point: a kind the method never takes (a
+                        # compliant law for the exact flow), refused.
+                        raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
+                    # What the method cannot take at this value alone (the exact flow
+                    # and an undamped mode forced at its frequency): the point fails,
+                    # the sweep goes on (user trial: it ended the sweep).
+                    raise _PointFailure(str(err)) from None
                 result = from_carried(
                     partial(
                         steady_state,

@@ -230,8 +230,9 @@ impl Configuration {
                         continue;
                     }
                     return Err(Error::Inconsistent(format!(
-                        "{what}: an undamped mode at exactly the forcing frequency {} Hz grows \
-                         without bound; add damping or shift the frequency",
+                        "{what}: an undamped mode forced at exactly its frequency {} Hz grows \
+                         as t between contacts, which the flow's phasors cannot hold; add \
+                         damping, shift the frequency or use method \"dop853\"",
                         load.omega / std::f64::consts::TAU
                     )));
                 }
