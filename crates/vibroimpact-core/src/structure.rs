@@ -336,12 +336,8 @@ impl Structure {
                 Ok(row)
             }
             Points::Beam { length, ref shapes } => {
-                if !(at.is_finite() && (0.0..=length).contains(&at)) {
-                    return Err(Error::Inconsistent(format!(
-                        "{key} must be a position along the beam in [0, {length}] m, got {at}"
-                    )));
-                }
-                shapes.iter().map(|s| s.value(at / length)).collect()
+                let xi = beam_position(key, at, length)?;
+                shapes.iter().map(|s| s.value(xi)).collect()
             }
         }
     }
@@ -363,16 +359,11 @@ impl Structure {
                 "{key}: only a cantilever has bending moments (structure.kind = \"cantilever\")"
             )));
         };
-        let length = *length;
-        if !(at.is_finite() && (0.0..=length).contains(&at)) {
-            return Err(Error::Inconsistent(format!(
-                "{key} must be a position along the beam in [0, {length}] m, got {at}"
-            )));
-        }
+        let xi = beam_position(key, at, *length)?;
         let stiffness = youngs_modulus * second_moment / (length * length);
         shapes
             .iter()
-            .map(|s| Ok(stiffness * s.derivatives(at / length)?[2]))
+            .map(|s| Ok(stiffness * s.derivatives(xi)?[2]))
             .collect()
     }
 
@@ -414,4 +405,15 @@ fn square(key: &str, rows: &[Vec<f64>], n: usize) -> Result<Vec<f64>> {
         )));
     }
     Ok(flat)
+}
+
+/// `at` (m from the clamp, named `key` in the error) as a fraction of a
+/// beam's `length`: a point's and a bending moment's position alike.
+fn beam_position(key: &str, at: f64, length: f64) -> Result<f64> {
+    if !(at.is_finite() && (0.0..=length).contains(&at)) {
+        return Err(Error::Inconsistent(format!(
+            "{key} must be a position along the beam in [0, {length}] m, got {at}"
+        )));
+    }
+    Ok(at / length)
 }
