@@ -36,6 +36,7 @@ from vibroimpact.system import (
     moment_weights,
     point_weights,
     prepare_system,
+    split_observed,
     structure_coordinates,
 )
 
@@ -171,22 +172,16 @@ class Runner:
         """Where ``[output] moments`` follows a cantilever's bending moment (m)."""
         return np.asarray(self.prepared.output["moments"], dtype=float)
 
-    def _split(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        # The core follows the coordinates, then the points, then the moments.
-        p = self.n + len(self.points)
-        return values[: self.n], values[self.n : p], values[p:]
-
     def amplitudes(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The located peaks of a recorded run: of each structure coordinate and of the
         structure at each point (m), and of the bending moment at each of the moments
         (N m)."""
-        return self._split(np.asarray(recorded["peaks"], dtype=float))
+        return split_observed(np.asarray(recorded["peaks"], dtype=float), self.n, len(self.points))
 
     def rms(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The RMS values of a recorded run, as :meth:`amplitudes`."""
-        return self._split(
-            np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
-        )
+        rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
+        return split_observed(rms, self.n, len(self.points))
 
     def initial_state(self) -> np.ndarray:
         """The scenario's ``[initial]`` as a flat state ``(x, v)``."""
@@ -380,17 +375,18 @@ def linear_amplitude(data: Mapping[str, Any], base_dir: Path | None = None) -> n
 
 
 def linear_response(
-    data: Mapping[str, Any], base_dir: Path | None = None
+    data: Mapping[str, Any], base_dir: Path | None = None, prepared: PreparedRun | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`linear_amplitude`, and the same of the structure at each of ``[output]
     points`` (m) and of its bending moment at each of ``[output] moments`` (N m):
     ``|w . Q|``, ``w`` the coordinates' weights there (a cantilever's mode shapes, or
-    ``E I phi''``), summed over the frequencies as the coordinates' are."""
+    ``E I phi''``), summed over the frequencies as the coordinates' are. ``prepared``:
+    the sections already checked (a sweep's runner has them)."""
     parts = linear_parts(
         data["structure"], excitation=data.get("excitation", ()), base_dir=base_dir
     )
     n = parts["n"]
-    prepared = _prepare(data, base_dir)
+    prepared = prepared or _prepare(data, base_dir)
     beam = prepared.spec["structure"]
     weights = np.array(
         [point_weights(beam, at) for at in prepared.output["points"]]
@@ -444,20 +440,17 @@ class SweepPoint:
         def floats(a: np.ndarray) -> list[float | None]:
             return [float(v) if math.isfinite(v) else None for v in a]
 
-        at_points = {
-            "points": [float(v) for v in self.points],
-            "point_amplitude": floats(self.point_amplitude),
-            "point_rms": floats(self.point_rms),
-            "linear_point_amplitude": floats(self.linear_point_amplitude),
-            "point_reduction": _reductions(self.point_amplitude, self.linear_point_amplitude),
-        }
-        at_moments = {
-            "moments": [float(v) for v in self.moments],
-            "moment_amplitude": floats(self.moment_amplitude),
-            "moment_rms": floats(self.moment_rms),
-            "linear_moment_amplitude": floats(self.linear_moment_amplitude),
-            "moment_reduction": _reductions(self.moment_amplitude, self.linear_moment_amplitude),
-        }
+        followed: dict[str, Any] = {}
+        for kind, where in (("point", self.points), ("moment", self.moments)):
+            if len(where):
+                amplitude, linear, rms = shown_values(self, kind)
+                followed |= {
+                    f"{kind}s": [float(v) for v in where],
+                    f"{kind}_amplitude": floats(amplitude),
+                    f"{kind}_rms": floats(rms),
+                    f"linear_{kind}_amplitude": floats(linear),
+                    f"{kind}_reduction": _reductions(amplitude, linear),
+                }
         return {
             "value": self.value,
             "direction": self.direction,
@@ -467,8 +460,7 @@ class SweepPoint:
             "settled": self.settled,
             "linear_amplitude": floats(self.linear_amplitude),
             "reduction": _reductions(self.amplitude, self.linear_amplitude),
-            **(at_points if len(self.points) else {}),
-            **(at_moments if len(self.moments) else {}),
+            **followed,
             **({"error": self.error} if self.error else {}),
         }
 
@@ -768,7 +760,9 @@ def sweep(
             changed = with_parameter(data, parameter, value)
             try:
                 run = runner(changed, base_dir)
-                linear, linear_at_points, linear_moments = linear_response(changed, base_dir)
+                linear, linear_at_points, linear_moments = linear_response(
+                    changed, base_dir, run.prepared
+                )
             except InvalidInputError as err:
                 raise AnalysisError(f"{parameter} = {value:g}: {err}") from None
             try:
@@ -796,50 +790,47 @@ def sweep(
             except InvalidInputError:
                 raise
             except Exception as err:  # a run that cannot be completed: record it
-                nan, none = np.full(len(linear), np.nan), np.full(len(run.points), np.nan)
-                no_moment = np.full(len(run.moments), np.nan)
-                points.append(
-                    SweepPoint(
-                        value,
-                        leg,
-                        False,
-                        nan,
-                        nan,
-                        math.nan,
-                        linear,
-                        str(err),
-                        run.points,
-                        none,
-                        none,
-                        linear_at_points,
-                        run.moments,
-                        no_moment,
-                        no_moment,
-                        linear_moments,
-                    )
+                error: str | None = str(err)
+
+                def nan(size: int) -> np.ndarray:
+                    return np.full(size, np.nan)
+
+                result = SteadyState(
+                    settled=False,
+                    period=None,
+                    amplitude=nan(len(linear)),
+                    rms=nan(len(linear)),
+                    impacts_per_period=math.nan,
+                    state=np.zeros(0),
+                    strobe=np.zeros((0, 0)),
+                    point_amplitude=nan(len(run.points)),
+                    point_rms=nan(len(run.points)),
+                    moment_amplitude=nan(len(run.moments)),
+                    moment_rms=nan(len(run.moments)),
                 )
             else:
+                error = None
                 state = result.state
-                points.append(
-                    SweepPoint(
-                        value,
-                        leg,
-                        result.settled,
-                        result.amplitude,
-                        result.rms,
-                        result.impacts_per_period,
-                        linear,
-                        None,
-                        run.points,
-                        result.point_amplitude,
-                        result.point_rms,
-                        linear_at_points,
-                        run.moments,
-                        result.moment_amplitude,
-                        result.moment_rms,
-                        linear_moments,
-                    )
+            points.append(
+                SweepPoint(
+                    value=value,
+                    direction=leg,
+                    settled=result.settled,
+                    amplitude=result.amplitude,
+                    rms=result.rms,
+                    impacts_per_period=result.impacts_per_period,
+                    linear_amplitude=linear,
+                    error=error,
+                    points=run.points,
+                    point_amplitude=result.point_amplitude,
+                    point_rms=result.point_rms,
+                    linear_point_amplitude=linear_at_points,
+                    moments=run.moments,
+                    moment_amplitude=result.moment_amplitude,
+                    moment_rms=result.moment_rms,
+                    linear_moment_amplitude=linear_moments,
                 )
+            )
             if progress is not None:
                 progress(len(points), total)
     return points

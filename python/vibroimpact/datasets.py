@@ -267,56 +267,50 @@ def sweep_dataset(
     linear = rows("linear_amplitude")
     pc = ("point", "coordinate")
     at_points: dict[str, Any] = {}
-    if len(at):
-        pa = ("point", "at")
-        point_amplitude = rows("point_amplitude", len(at))
-        linear_point = rows("linear_point_amplitude", len(at))
-        at_points = {
-            "point_amplitude": (
-                pa,
-                point_amplitude,
-                _attrs("steady amplitude of the structure at the point", _M),
-            ),
-            "point_rms": (
-                pa,
-                rows("point_rms", len(at)),
-                _attrs("steady root mean square displacement at the point", _M),
-            ),
-            "linear_point_amplitude": (
-                pa,
-                linear_point,
-                _attrs("steady amplitude at the point of the structure alone", _M),
-            ),
-            "point_reduction": (
-                pa,
-                reductions(point_amplitude, linear_point),
-                _attrs("amplitude reduction at the point", _ONE),
-            ),
-        }
-    if len(moment_at):
-        pm = ("point", "moment_at")
-        moment = rows("moment_amplitude", len(moment_at))
-        linear_moment = rows("linear_moment_amplitude", len(moment_at))
+    positions: dict[str, Any] = {}
+    for kind, dim, where, unit, what, position in (
+        (
+            "point",
+            "at",
+            at,
+            _M,
+            ("the structure at the point", "displacement at the point"),
+            _attrs("point of the structure ([output] points)"),
+        ),
+        (
+            "moment",
+            "moment_at",
+            moment_at,
+            _NM,
+            ("the bending moment", "bending moment"),
+            _attrs("position of a bending moment ([output] moments)", _M),
+        ),
+    ):
+        if not len(where):
+            continue
+        positions[dim] = (dim, where, position)
+        followed = rows(f"{kind}_amplitude", len(where))
+        linear_followed = rows(f"linear_{kind}_amplitude", len(where))
+        pf = ("point", dim)
         at_points |= {
-            "moment_amplitude": (
-                pm,
-                moment,
-                _attrs("steady amplitude of the bending moment", _NM),
+            f"{kind}_amplitude": (pf, followed, _attrs(f"steady amplitude of {what[0]}", unit)),
+            f"{kind}_rms": (
+                pf,
+                rows(f"{kind}_rms", len(where)),
+                _attrs(f"steady root mean square {what[1]}", unit),
             ),
-            "moment_rms": (
-                pm,
-                rows("moment_rms", len(moment_at)),
-                _attrs("steady root mean square bending moment", _NM),
+            f"linear_{kind}_amplitude": (
+                pf,
+                linear_followed,
+                _attrs(
+                    f"steady amplitude of {what[0]}, the structure alone (no dampers, no stops)",
+                    unit,
+                ),
             ),
-            "linear_moment_amplitude": (
-                pm,
-                linear_moment,
-                _attrs("steady amplitude of the bending moment of the structure alone", _NM),
-            ),
-            "moment_reduction": (
-                pm,
-                reductions(moment, linear_moment),
-                _attrs("bending moment reduction", _ONE),
+            f"{kind}_reduction": (
+                pf,
+                reductions(followed, linear_followed),
+                _attrs(f"amplitude reduction of {what[0]}", _ONE),
             ),
         }
     return xr.Dataset(
@@ -362,22 +356,7 @@ def sweep_dataset(
                 np.arange(n, dtype=np.int32),
                 _attrs("structure coordinate (index)"),
             ),
-            **(
-                {"at": ("at", at, _attrs("point of the structure ([output] points)"))}
-                if len(at)
-                else {}
-            ),
-            **(
-                {
-                    "moment_at": (
-                        "moment_at",
-                        moment_at,
-                        _attrs("position of a bending moment ([output] moments)", _M),
-                    )
-                }
-                if len(moment_at)
-                else {}
-            ),
+            **positions,
         },
         attrs={"parameter": parameter, "source": _SOURCE},
     )

@@ -102,7 +102,7 @@ import numpy as np
 from vibroimpact._core import __version__, run_study
 from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare
 from vibroimpact.output import UsageError, written_whole
-from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
+from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
 # What each analysis keeps; every metric.
 _RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated")
@@ -188,8 +188,8 @@ MAX_STUDY_RUNS = 10_000_000
 
 
 #: Metrics kept at each of [output] points and moments as well as per coordinate.
-_PER_COORDINATE = ("peak", "rms", "amplitude")
-_FOLLOWED = tuple(f"{kind}_{m}" for kind in ("point", "moment") for m in _PER_COORDINATE)
+PER_COORDINATE = ("peak", "rms", "amplitude")
+_FOLLOWED = tuple(f"{kind}_{m}" for kind in ("point", "moment") for m in PER_COORDINATE)
 
 
 def base_metrics(names: Sequence[str]) -> list[str]:
@@ -199,7 +199,7 @@ def base_metrics(names: Sequence[str]) -> list[str]:
     out = []
     for name in names:
         for kind in ("point_", "moment_"):
-            if name.startswith(kind) and name[len(kind) :] in _PER_COORDINATE:
+            if name.startswith(kind) and name[len(kind) :] in PER_COORDINATE:
                 name = name[len(kind) :]
         out.append(name)
     return list(dict.fromkeys(out))
@@ -597,8 +597,7 @@ def study_of(
     if checked["record_from"] is None:
         # The scenario's own window where [study] gives none, as a run of it records
         # (user trial: a study and a run of one scenario disagreed on a peak).
-        output = data.get("output")
-        window = output.get("record_from") if isinstance(output, Mapping) else None
+        window = output.get("record_from")
         checked["record_from"] = 0.0 if window is None else float(window)
     study = Study(dict(data), checked, source, base_dir)
     # The base scenario and every axis path are checked by a run of none.
@@ -640,33 +639,36 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
         values = np.concatenate([np.asarray(p[key], dtype=float) for p in parts])
         description, unit = _DESCRIPTIONS[name]
         attrs = {"long_name": description, "units": unit}
-        if name in ("peak", "rms", "amplitude"):
-            # The core follows the coordinates, then the points, then the moments.
+        if name in PER_COORDINATE:
             values = values.reshape(*shape, n + len(at) + len(moment_at))
-            data_vars[name] = ([*dims, "coordinate"], values[..., :n], attrs)
-            p = n + len(at)
-            if len(at):
-                data_vars[f"point_{name}"] = (
-                    [*dims, "at"],
-                    values[..., n:p],
-                    {
-                        **attrs,
-                        "long_name": description.replace(
-                            "each structure coordinate", "the structure at each [output] point"
-                        ),
-                    },
-                )
-            if len(moment_at):
-                data_vars[f"moment_{name}"] = (
-                    [*dims, "moment_at"],
-                    values[..., p:],
-                    {
-                        "units": "N m",
-                        "long_name": description.replace("displacement", "bending moment").replace(
-                            "each structure coordinate", "each of [output] moments"
-                        ),
-                    },
-                )
+            coordinates, at_points, at_moments = split_observed(values, n, len(at))
+            data_vars[name] = ([*dims, "coordinate"], coordinates, attrs)
+            for kind, dim, part, units, long_name in (
+                (
+                    "point",
+                    "at",
+                    at_points,
+                    unit,
+                    description.replace(
+                        "each structure coordinate", "the structure at each [output] point"
+                    ),
+                ),
+                (
+                    "moment",
+                    "moment_at",
+                    at_moments,
+                    "N m",
+                    description.replace("displacement", "bending moment").replace(
+                        "each structure coordinate", "each of [output] moments"
+                    ),
+                ),
+            ):
+                if part.shape[-1]:
+                    data_vars[f"{kind}_{name}"] = (
+                        [*dims, dim],
+                        part,
+                        {"long_name": long_name, "units": units},
+                    )
         elif name == "energy_dissipated":
             data_vars[name] = ([*dims, "pair"], values.reshape(*shape, len(pairs)), attrs)
         else:

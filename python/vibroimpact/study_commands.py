@@ -17,6 +17,7 @@ from vibroimpact.output import UsageError, check_output, check_plot, json_text
 from vibroimpact.scenario import load_scenario
 from vibroimpact.study import (
     MAX_WORKERS,
+    PER_COORDINATE,
     base_metrics,
     check_threads,
     output_kind,
@@ -100,7 +101,7 @@ def run_study_command(args: argparse.Namespace) -> int:
     # With [output] points (moments) the per-coordinate metrics are also kept at each.
     kept = base_metrics(study.settings["metrics"])
     allowed = list(kept)
-    per_coordinate = [m for m in kept if m in ("peak", "rms", "amplitude")]
+    per_coordinate = [m for m in kept if m in PER_COORDINATE]
     for key, prefix in (("points", "point_"), ("moments", "moment_")):
         if output.get(key):
             allowed += [prefix + m for m in per_coordinate]

@@ -508,19 +508,35 @@ def point_weights(structure: Mapping[str, Any], at: Any, name: str = "at") -> np
 def moment_weights(structure: Mapping[str, Any], at: Any, name: str = "at") -> np.ndarray:
     """The weights of a checked cantilever's modal coordinates in its bending moment at
     ``at`` m from the clamp (N m per unit coordinate): ``E I phi_i''(at)``."""
-    if structure["kind"] != "cantilever":
-        raise _fail(
-            "", f'{name}: only a cantilever has bending moments (structure.kind = "cantilever")'
-        )
-    point_weights(structure, at, name)
+    value = real(at)
+    if value is None:
+        raise _fail("", f"{name} must be a number, got {shown(at)}")
+    _check_bends(name, structure)
+    _check_point(name, at, float(value), dict(structure))
     length, stiffness = (
         float(structure["length"]),
         structure["youngs_modulus"] * structure["second_moment"],
     )
     n = structure_coordinates(structure)
     return np.array(
-        [stiffness * cantilever_mode_shape(length, i + 1, float(at), 2) for i in range(n)]
+        [stiffness * cantilever_mode_shape(length, i + 1, float(value), 2) for i in range(n)]
     )
+
+
+def _check_bends(name: str, structure: Mapping[str, Any]) -> None:
+    """Only a cantilever has bending moments (``name`` asks for them)."""
+    if structure["kind"] != "cantilever":
+        raise _fail(
+            "", f'{name}: only a cantilever has bending moments (structure.kind = "cantilever")'
+        )
+
+
+def split_observed(
+    values: np.ndarray, n: int, points: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What the core reduces over its observed quantities (along the last axis), split:
+    the ``n`` structure coordinates, then the ``points`` points, then the moments."""
+    return values[..., :n], values[..., n : n + points], values[..., n + points :]
 
 
 def structure_coordinates(structure: Mapping[str, Any]) -> int:
@@ -1070,13 +1086,10 @@ def prepare_system(
             "[output] points, moments: ",
             f"{followed} in all; at most {MAX_POINTS} are allowed (together)",
         )
+    if output["moments"]:
+        _check_bends("[output] moments", spec["structure"])
     for key in ("points", "moments"):
         for j, at in enumerate(output[key]):
-            if key == "moments" and spec["structure"]["kind"] != "cantilever":
-                raise _fail(
-                    "[output] moments: ",
-                    'only a cantilever has bending moments (structure.kind = "cantilever")',
-                )
             _check_point(f"[output] {key}[{j}]", at, float(at), spec["structure"])
             if at in output[key][:j]:
                 raise _fail(f"[output] {key}: ", f"{shown(at)} is given twice")
@@ -1106,12 +1119,14 @@ def _solution(
     c = raw["contacts"]
     pairs = list(raw["pairs"])
     observed = n + len(points) + len(moments)
-    p = n + len(points)
     peaks = raw["peaks"] if recorded else np.full(observed, np.nan)
-    rms = (
+    peak, point_peak, moment_peak = split_observed(peaks, n, len(points))
+    rms, point_rms, moment_rms = split_observed(
         np.sqrt(raw["square_integrals"] / raw["recorded_time"])
         if recorded
-        else np.full(observed, np.nan)
+        else np.full(observed, np.nan),
+        n,
+        len(points),
     )
     contacts = SystemContacts(
         pair=[pairs[p] for p in c["pair"]],
@@ -1140,15 +1155,14 @@ def _solution(
         method=method,
         pairs=pairs,
         # Nothing recorded (no record_from): neither peak nor RMS, not a peak of 0.
-        # The core follows the coordinates, then the points.
-        peak=peaks[:n],
-        rms=rms[:n],
+        peak=peak,
+        rms=rms,
         points=np.asarray(points, dtype=float),
-        point_peak=peaks[n:p],
-        point_rms=rms[n:p],
+        point_peak=point_peak,
+        point_rms=point_rms,
         moments=np.asarray(moments, dtype=float),
-        moment_peak=peaks[p:],
-        moment_rms=rms[p:],
+        moment_peak=moment_peak,
+        moment_rms=moment_rms,
         recorded_time=raw["recorded_time"],
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],
