@@ -351,14 +351,16 @@ fn a_linear_contact_between_free_masses_lasts_half_its_damped_period() {
 
 /// A 3-mode aluminium cantilever driven by 0.5 N at its tip at 8 Hz, with
 /// its steady modal amplitudes solved mode by mode, `Q_i = f_i / (K_ii - w^2
-/// M_ii + i w C_ii)` (re, im), and the spec of that forcing.
-fn forced_beam() -> (Structure, Vec<(f64, f64)>, SystemSpec) {
+/// M_ii + i w C_ii)` (re, im), the spec of that forcing, and the state on
+/// that steady motion at t = 0 (displacements `Re Q`, velocities `-w Im Q`).
+#[allow(clippy::type_complexity)]
+fn forced_beam() -> (Structure, Vec<(f64, f64)>, SystemSpec, [Vec<f64>; 4]) {
     let (length, force, f) = (0.5, 0.5, 8.0);
     let beam = Structure::cantilever(length, 7e10, 1e-10, 0.27, 3, 0.01).unwrap();
     let w = TAU * f;
     let tip = beam.point("tip", length).unwrap();
     let (m, k, c) = (beam.mass(), beam.stiffness(), beam.damping());
-    let q = (0..3)
+    let q: Vec<(f64, f64)> = (0..3)
         .map(|i| {
             let d = i * 3 + i;
             let (re, im) = (k[d] - w * w * m[d], w * c[d]);
@@ -372,7 +374,19 @@ fn forced_beam() -> (Structure, Vec<(f64, f64)>, SystemSpec) {
         load: Load::Force { at: length },
         signal: Signal::harmonic(force, f, 0.0).unwrap(),
     });
-    (beam, q, s)
+    let x0 = q.iter().map(|(re, _)| *re).collect();
+    let v0 = q.iter().map(|(_, im)| -w * im).collect();
+    (beam, q, s, [x0, v0, vec![], vec![]])
+}
+
+/// Peaks and mean squares of the whole run, no strobe, every contact kept.
+fn recorded() -> ReduceOptions {
+    ReduceOptions {
+        record_from: 0.0,
+        strobe_period: f64::INFINITY,
+        mean_square: true,
+        contacts_from: f64::NEG_INFINITY,
+    }
 }
 
 /// The amplitude of `row . Q e^{i w t}`.
@@ -387,27 +401,15 @@ fn amplitude_of(row: &[f64], q: &[(f64, f64)]) -> f64 {
 #[test]
 fn a_forced_cantilever_s_points_reduce_its_deflection_there() {
     common::timeout(60, || {
-        let (beam, q, mut s) = forced_beam();
-        let (length, f, w) = (0.5, 8.0, TAU * 8.0);
+        let (beam, q, mut s, start) = forced_beam();
+        let (length, f) = (0.5, 8.0);
         let points = [length, 0.3, 0.0];
         s.points = points.to_vec();
-        let x0: Vec<f64> = q.iter().map(|(re, _)| *re).collect();
-        let v0: Vec<f64> = q.iter().map(|(_, im)| -w * im).collect();
-        let reduce = ReduceOptions {
-            record_from: 0.0,
-            strobe_period: f64::INFINITY,
-            mean_square: true,
-            contacts_from: f64::NEG_INFINITY,
-        };
-        let exact_run = exact(
-            &s,
-            &[x0.clone(), v0.clone(), vec![], vec![]],
-            10.0 / f,
-            reduce,
-        );
+        let reduce = recorded();
+        let exact_run = exact(&s, &start, 10.0 / f, reduce);
         // And RK4's, which places peaks by its interpolant (fifth order).
         let system = Assembly::new(&s).unwrap();
-        let y = initial_state(&system, &x0, &v0, &[], &[]).unwrap();
+        let y = initial_state(&system, &start[0], &start[1], &[], &[]).unwrap();
         let mut rk4 = ExplicitRk::rk4(system.state_len());
         let options = RunOptions {
             dt: Some(1.0 / (400.0 * f)),
@@ -492,19 +494,10 @@ fn a_cantilever_s_bending_moment_is_statics_and_its_peaks_reduce() {
         assert!(close(root[0], ei * 2.0 * b * b / (length * length), 1e-12));
         // Forced on its steady state (as the points above), the peak moment at
         // the root is |row . Q|.
-        let (beam, q, mut s) = forced_beam();
-        let (f, w) = (8.0, TAU * 8.0);
+        let (beam, q, mut s, start) = forced_beam();
         s.points = vec![length];
         s.moments = vec![0.0, 0.2];
-        let x0: Vec<f64> = q.iter().map(|(re, _)| *re).collect();
-        let v0: Vec<f64> = q.iter().map(|(_, im)| -w * im).collect();
-        let reduce = ReduceOptions {
-            record_from: 0.0,
-            strobe_period: f64::INFINITY,
-            mean_square: true,
-            contacts_from: f64::NEG_INFINITY,
-        };
-        let sol = exact(&s, &[x0, v0, vec![], vec![]], 10.0 / f, reduce);
+        let sol = exact(&s, &start, 10.0 / 8.0, recorded());
         let r = &sol.reductions;
         assert_eq!(r.peaks.len(), 3 + 1 + 2);
         for (j, x) in [0.0, 0.2].into_iter().enumerate() {
