@@ -11,6 +11,7 @@
 //! Gravity along -x and any base acceleration act on every mass as an
 //! inertial load `-M r a(t)` (`r`: the influence vector, 1 for each damper).
 
+use crate::compact::Compact;
 use crate::contact::{AnyLaw, Contact, ContactLaw};
 use crate::error::{finite, non_negative, positive, within, Error, Result};
 use crate::linalg;
@@ -216,6 +217,19 @@ pub struct Assembly {
     /// the reductions follow, then of the moments (see [`SystemSpec::points`]
     /// and [`SystemSpec::moments`]).
     pub point_rows: Vec<f64>,
+    /// The system in fixed-size arrays, where it is small and modal (RK4's
+    /// fast path, [`crate::compact`]).
+    pub(crate) compact: Option<Box<Compact>>,
+}
+
+/// What [`Compact::of`] reads of a modal system.
+pub(crate) struct CompactParts<'a> {
+    pub diagonals: &'a [[f64; 4]],
+    /// Each force's signal, `M^-1 row^T` and row.
+    pub forces: Vec<(&'a Signal, &'a [f64], &'a [f64])>,
+    pub has_base: bool,
+    pub gravity: f64,
+    pub mirrors: &'a [bool],
 }
 
 /// What [`Assembly::rates_with`] reads of the system, cut to the sizes `n`
@@ -256,6 +270,22 @@ pub enum Mode {
     /// A rigid pair moving together after a chattering sequence: the gap
     /// and its rate stay zero, held by a constraint force.
     Sticking,
+}
+
+impl Mode {
+    /// Whether an interaction in this mode may switch within a step whose
+    /// gap and rate are `start` and `end` at its ends: a cheap test that
+    /// passes every switch the event search could find (and some it will
+    /// not), so that most steps skip the search.
+    #[inline(always)]
+    pub fn may_cross(&self, start: (f64, f64), end: (f64, f64)) -> bool {
+        let ((_, r0), (g1, r1)) = (start, end);
+        match self {
+            Mode::Open => g1 < 0.0 || (r0 < 0.0 && r1 > 0.0),
+            Mode::Compliant { .. } => g1 > 0.0 || (r0 > 0.0 && r1 < 0.0),
+            Mode::Sticking => true,
+        }
+    }
 }
 
 impl Assembly {
@@ -463,7 +493,8 @@ impl Assembly {
         for (j, &at) in spec.moments.iter().enumerate() {
             point_rows.extend(s.moment_row(&format!("[output] moments[{j}]"), at)?);
         }
-        Ok(Self {
+        let mut assembly = Self {
+            compact: None,
             point_rows,
             mirrors_previous,
             sticking_step: 0.1 * shortest,
@@ -490,6 +521,23 @@ impl Assembly {
             interactions,
             longest_period,
             pairs,
+        };
+        assembly.compact = Compact::of(&assembly).map(Box::new);
+        Ok(assembly)
+    }
+
+    /// What [`Compact::of`] reads, for a system with diagonal matrices.
+    pub(crate) fn compact_parts(&self) -> Option<CompactParts<'_>> {
+        self.diagonal.then(|| CompactParts {
+            diagonals: &self.diagonals,
+            forces: self
+                .forces
+                .iter()
+                .map(|f| (&f.signal, &f.push[..], &f.row[..]))
+                .collect(),
+            has_base: !self.base.is_empty(),
+            gravity: self.gravity,
+            mirrors: &self.mirrors_previous,
         })
     }
 
@@ -1263,7 +1311,7 @@ impl Assembly {
 /// increments, so most values are a rotation (four multiplications), with a
 /// direct evaluation every `RESYNC` rotations to keep round-off from growing.
 #[derive(Debug, Clone, Copy)]
-struct Cached {
+pub(crate) struct Cached {
     time: f64,
     value: f64,
     cos: f64,
@@ -1351,6 +1399,19 @@ impl Scratch {
             forces: vec![0.0; m],
             count: 0,
         }
+    }
+
+    /// The first force's signal cache, which a step that is taken back
+    /// restores (the next values then come as they would have).
+    pub(crate) fn first_cache(&mut self) -> Option<&mut Cached> {
+        self.force_values.first_mut()
+    }
+
+    /// The first force's signal at `time`, through its cache (the value the
+    /// general right-hand side takes, to the bit).
+    #[inline(always)]
+    pub(crate) fn first_force_value(&mut self, signal: &Signal, time: f64) -> f64 {
+        self.force_values[0].value(signal, time)
     }
 
     /// The constraint force of interaction `i` in the last `rates` (N), or

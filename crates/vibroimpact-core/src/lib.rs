@@ -11,6 +11,7 @@
 pub mod assembly;
 pub mod beam;
 pub mod closed_forms;
+pub(crate) mod compact;
 pub mod contact;
 pub mod ensemble;
 pub mod error;

@@ -22,6 +22,7 @@ const COMPACTED_CONTACTS: usize = 64;
 fn loss_slot(system: &Assembly, i: usize) -> usize {
     2 * system.dim + CONTACT + i
 }
+use crate::compact::Stretch;
 use crate::error::{Error, Result};
 use crate::hermite;
 use crate::impacts::Impacts;
@@ -504,12 +505,7 @@ fn any_compliant(modes: &[Mode]) -> bool {
 fn may_cross(gaps: &Gaps, modes: &[Mode]) -> bool {
     let mut any = false;
     for ((start, end), mode) in gaps.start.iter().zip(&gaps.end).zip(modes) {
-        let ((_, r0), (g1, r1)) = (*start, *end);
-        any |= match mode {
-            Mode::Open => g1 < 0.0 || (r0 < 0.0 && r1 > 0.0),
-            Mode::Compliant { .. } => g1 > 0.0 || (r0 > 0.0 && r1 < 0.0),
-            Mode::Sticking => true,
-        };
+        any |= mode.may_cross(*start, *end);
     }
     any
 }
@@ -913,7 +909,79 @@ pub fn integrate_system_within<S: SystemStepper>(
         .map_err(|cause| no_room(cause, 0.0, &time_rows, &states, &reductions, &contacts))?;
     }
 
+    // Each compliant contact's deepest indentation, lent to stretches.
+    let mut deepest = vec![f64::NAN; count];
     while time < t_end {
+        if !adaptive {
+            // Plain steps in a row, where the stepper can take them at once
+            // (each as this loop would, to the bit): the step after them is
+            // this loop's.
+            for (d, record) in deepest.iter_mut().zip(&open) {
+                *d = record.as_ref().map_or(f64::NAN, |o| o.max_indentation);
+            }
+            let mut stretch = Stretch {
+                time,
+                grid,
+                accepted,
+                until_kept,
+                y: &mut y[..],
+                gaps: &mut gaps.start[..],
+                deepest: &mut deepest[..],
+                peaks: &mut reductions.peaks[..],
+                recorded_time: &mut reductions.recorded_time,
+                evaluations: 0,
+                steps: 0,
+                // Up to the next energy check, which is made here after it.
+                max_accepted: ((accepted / ENERGY_INTERVAL + 1) * ENERGY_INTERVAL)
+                    .min(options.max_steps.saturating_sub(control.rejected + 1)),
+                limited: false,
+                dt,
+                t_end,
+                record_from: options.reduce.record_from,
+                mean_square: options.reduce.mean_square,
+                next_strobe,
+                strobe_period: options.reduce.strobe_period,
+                keep_history: options.keep_history,
+                chatter_factor: CHATTER_ULPS * f64::EPSILON,
+                time_scale,
+            };
+            stepper.stretch(system, &mut stretch, &modes, &mut scratch);
+            let (steps, limited) = (stretch.steps, stretch.limited);
+            if steps > 0 {
+                (time, grid, accepted, until_kept) = (
+                    stretch.time,
+                    stretch.grid,
+                    stretch.accepted,
+                    stretch.until_kept,
+                );
+                stalled = 0;
+                for (d, record) in deepest.iter().zip(&mut open) {
+                    if let Some(o) = record {
+                        o.max_indentation = *d;
+                    }
+                }
+                // What the loop does after a plain step that it may have
+                // been: an energy check, an interrupt poll.
+                if accepted % ENERGY_INTERVAL == 0 {
+                    check_balance(
+                        system,
+                        &y,
+                        &modes,
+                        stored_start,
+                        &mut energy_scale,
+                        impact_loss,
+                        options,
+                        time,
+                    )?;
+                }
+                if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
+                    return Err(Error::Interrupted { time });
+                }
+                if limited {
+                    continue;
+                }
+            }
+        }
         if !adaptive && t_end - time <= 1e-9 * dt {
             // On t_end to the round-off of the grid's times.
             break;

@@ -5,6 +5,7 @@
 //! Dormand-Prince 5(4) and DOP853 (error control, first same as last).
 
 use crate::assembly::{Assembly, Mode, Scratch};
+use crate::compact::Stretch;
 use crate::error::{Error, Result};
 use crate::linalg;
 use crate::sized::by_size;
@@ -49,6 +50,16 @@ pub trait SystemStepper {
     }
     /// Forget data carried from the last step (the right-hand side jumped).
     fn reset(&mut self);
+    /// Plain fixed steps taken at once (see [`Stretch`]), where the method
+    /// can: each the step the kernel would take, to the bit. None by default.
+    fn stretch(
+        &mut self,
+        _system: &Assembly,
+        _stretch: &mut Stretch<'_>,
+        _modes: &[Mode],
+        _scratch: &mut Scratch,
+    ) {
+    }
     /// Attempt a step `h` from `(time, y)` into `out`; the scaled error
     /// (accept when <= 1), 0 for a fixed-step method.
     #[allow(clippy::too_many_arguments)]
@@ -132,6 +143,10 @@ pub struct ExplicitRk {
     stages: usize,
     /// Classical RK4 (a fixed step taken by a loop of its own).
     rk4: bool,
+    /// Whether RK4 takes the compact path where the system has one: its
+    /// steps in fixed-size arrays, plain ones in stretches (see
+    /// [`crate::compact`]; the same bits either way).
+    pub compact: bool,
     /// Stage derivatives, plus one slot for `f` at the new point.
     k: Vec<Vec<f64>>,
     point: Vec<f64>,
@@ -196,6 +211,7 @@ impl ExplicitRk {
             atol: 0.0,
             stages,
             rk4: name == "rk4",
+            compact: true,
             k: vec![vec![0.0; len]; stages + 1],
             point: vec![0.0; len],
             start_valid: false,
@@ -268,8 +284,27 @@ impl ExplicitRk {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) {
-        by_size!(system, |n, k| self
-            .rk4_in(system, n, k, time, y, h, modes, scratch, out))
+        by_size!(system, |n, k| match &system.compact {
+            // The fast path, the same bits (see `compact`).
+            Some(compact) if self.compact && compact.takes(modes) => {
+                let len = system.state_len();
+                compact.rk4(
+                    n,
+                    k,
+                    time,
+                    &y[..len],
+                    h,
+                    modes,
+                    scratch,
+                    &mut self.k[0],
+                    self.start_valid,
+                    &mut out[..len],
+                );
+                self.evaluations += if self.start_valid { 3 } else { 4 };
+                self.start_valid = true;
+            }
+            _ => self.rk4_in(system, n, k, time, y, h, modes, scratch, out),
+        })
     }
 
     /// [`Self::rk4_stages`] for `n` structure coordinates and `k` dampers,
@@ -388,6 +423,23 @@ impl SystemStepper for ExplicitRk {
     fn reset(&mut self) {
         self.start_valid = false;
         self.end_slot = None;
+    }
+
+    fn stretch(
+        &mut self,
+        system: &Assembly,
+        stretch: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        let Some(compact) = &system.compact else {
+            return;
+        };
+        if !(self.rk4 && self.compact && !self.start_valid && compact.takes(modes)) {
+            return;
+        }
+        compact.run_stretch(system, stretch, modes, scratch);
+        self.evaluations += stretch.evaluations;
     }
 
     /// The first stage, `f(y)`: what the next attempt from `y` starts from
