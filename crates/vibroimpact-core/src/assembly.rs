@@ -898,7 +898,12 @@ impl Assembly {
     /// The constraint forces of the `sticking` interactions listed in
     /// `scratch` into it and onto the accelerations (out of line: rare).
     #[inline(never)]
-    fn add_constraint_forces(&self, sticking: usize, acc: &mut [f64], scratch: &mut Scratch) {
+    pub(crate) fn add_constraint_forces(
+        &self,
+        sticking: usize,
+        acc: &mut [f64],
+        scratch: &mut Scratch,
+    ) {
         if sticking == 1 {
             // One constraint: W lambda = -h . a with W = h M^-1 h^T, what
             // the elimination below gives for one row.
@@ -1379,7 +1384,7 @@ impl Cached {
 pub struct Scratch {
     force_values: Vec<Cached>,
     base_values: Vec<Cached>,
-    sticking: Vec<usize>,
+    pub(crate) sticking: Vec<usize>,
     matrix: Vec<f64>,
     /// Constraint forces of the sticking interactions (N), after `rates`.
     pub forces: Vec<f64>,

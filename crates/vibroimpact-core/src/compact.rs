@@ -8,8 +8,7 @@
 //! coordinates a length fixed at compile time, which roughly halves the
 //! instructions of a step. The arithmetic is the general stages' and
 //! [`Assembly::rates_with`]'s, term for term and in the same order: the
-//! same bits (a test holds them to it). Steps with a sticking pair, whose
-//! constraint forces need a linear solve, take the general path.
+//! same bits (a test holds them to it).
 
 // Indexed loops over the fixed-size arrays, and copies written as loops:
 // what compiles to the tight code here (iterator chains and `copy_from_slice`
@@ -134,18 +133,14 @@ impl Compact {
         })
     }
 
-    /// Whether a step in `modes` can be taken here (no pair sticks).
-    #[inline(always)]
-    pub(crate) fn takes(&self, modes: &[Mode]) -> bool {
-        !modes.contains(&Mode::Sticking)
-    }
-
     /// [`Assembly::rates_with`] for `n` modes and `k` dampers (constants
-    /// where inlined) in no sticking mode.
+    /// where inlined); sticking pairs' constraint forces by `system`'s own
+    /// solve.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn rates(
+    fn rates<const STICKING: bool>(
         &self,
+        system: &Assembly,
         n: usize,
         k: usize,
         time: f64,
@@ -194,6 +189,7 @@ impl Compact {
         let count = self.count.min(MAX_WALLS);
         let modes = &modes[..count];
         let mut products: Option<(f64, f64)> = None;
+        let mut sticking = 0;
         for w in 0..count {
             let wall = &self.walls[w];
             let loss = 2 * d + CONTACT + w;
@@ -220,9 +216,15 @@ impl Compact {
                     }
                 }
                 out[loss] = (total - elastic) * rate;
+            } else if STICKING && modes[w] == Mode::Sticking {
+                scratch.sticking[sticking] = w;
+                sticking += 1;
             }
         }
-        scratch.count = 0;
+        if STICKING && sticking > 0 {
+            system.add_constraint_forces(sticking, &mut out[d..2 * d], scratch);
+        }
+        scratch.count = sticking;
         out[2 * d + VISCOUS] = viscous;
         out[2 * d + INPUT] = input;
     }
@@ -233,8 +235,9 @@ impl Compact {
     /// `start_valid`, and receives it where not.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn step(
+    fn step<const STICKING: bool>(
         &self,
+        system: &Assembly,
         n: usize,
         k: usize,
         time: f64,
@@ -261,22 +264,22 @@ impl Compact {
         let w = [h * RK4_B[0], h * RK4_B[1], h * RK4_B[2], h * RK4_B[3]];
         let [k0, k1, k2, k3] = stages;
         if !start_valid {
-            self.rates(n, k, times[0], start, modes, scratch, k0);
+            self.rates::<STICKING>(system, n, k, times[0], start, modes, scratch, k0);
         }
         // The stages written out (a loop over them keeps less in registers).
         let mut point = [0.0; MAX_LEN];
         for e in 0..coordinates {
             point[e] = start[e] + hw[0] * k0[e];
         }
-        self.rates(n, k, times[1], &point, modes, scratch, k1);
+        self.rates::<STICKING>(system, n, k, times[1], &point, modes, scratch, k1);
         for e in 0..coordinates {
             point[e] = start[e] + hw[1] * k1[e];
         }
-        self.rates(n, k, times[2], &point, modes, scratch, k2);
+        self.rates::<STICKING>(system, n, k, times[2], &point, modes, scratch, k2);
         for e in 0..coordinates {
             point[e] = start[e] + hw[2] * k2[e];
         }
-        self.rates(n, k, times[3], &point, modes, scratch, k3);
+        self.rates::<STICKING>(system, n, k, times[3], &point, modes, scratch, k3);
         for e in 0..len {
             out[e] = start[e] + w[0] * k0[e] + w[1] * k1[e] + w[2] * k2[e] + w[3] * k3[e];
         }
@@ -288,6 +291,7 @@ impl Compact {
     #[inline(always)]
     pub(crate) fn rk4(
         &self,
+        system: &Assembly,
         n: usize,
         k: usize,
         time: f64,
@@ -307,19 +311,37 @@ impl Compact {
             stages[0][..len].copy_from_slice(&first[..len]);
         }
         let mut end = [0.0; MAX_LEN];
-        self.step(
-            n,
-            k,
-            time,
-            &start,
-            len,
-            h,
-            modes,
-            scratch,
-            &mut stages,
-            start_valid,
-            &mut end,
-        );
+        if modes.contains(&Mode::Sticking) {
+            self.step::<true>(
+                system,
+                n,
+                k,
+                time,
+                &start,
+                len,
+                h,
+                modes,
+                scratch,
+                &mut stages,
+                start_valid,
+                &mut end,
+            );
+        } else {
+            self.step::<false>(
+                system,
+                n,
+                k,
+                time,
+                &start,
+                len,
+                h,
+                modes,
+                scratch,
+                &mut stages,
+                start_valid,
+                &mut end,
+            );
+        }
         if !start_valid {
             first[..len].copy_from_slice(&stages[0][..len]);
         }
@@ -372,7 +394,7 @@ impl Compact {
     /// cross, a compliant contact at its deepest, a peak inside the step, a
     /// state no longer finite) is taken back, for the general loop to take.
     #[inline(always)]
-    pub(crate) fn stretch(
+    pub(crate) fn stretch<const STICKING: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -394,6 +416,18 @@ impl Compact {
         let mut end = [0.0; MAX_LEN];
         let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
         let mut stages = [[0.0; MAX_LEN]; 4];
+        // Walls the event search passes over: the open wall of a sticking
+        // damper, and sticking walls of a damper without clearance; whether
+        // a sticking pair may release.
+        let mut held = [false; MAX_WALLS];
+        let mut locked = [false; MAX_WALLS];
+        let mut releasable = false;
+        for w in 0..count {
+            held[w] = modes[w] == Mode::Open && system.held_by_mirror(w, modes);
+            locked[w] = system.locked(w);
+            releasable |= modes[w] == Mode::Sticking && !locked[w];
+        }
+        let mut probe = [0.0; MAX_LEN];
         loop {
             if f.accepted >= f.max_accepted {
                 f.limited = true;
@@ -422,7 +456,8 @@ impl Compact {
                 break;
             }
             let cache = scratch.first_cache().copied();
-            self.step(
+            self.step::<STICKING>(
+                system,
                 n,
                 k,
                 time,
@@ -441,10 +476,31 @@ impl Compact {
             // a peak inside the step.
             let mut plain = end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
             for w in 0..count {
-                plain &= !modes[w].may_cross(start_gaps[w], end_gaps[w]);
-                if let Mode::Compliant { .. } = modes[w] {
-                    let (m0, m1) = (start_gaps[w].1 * length, end_gaps[w].1 * length);
-                    plain &= !(m0 < 0.0 && m1 > 0.0);
+                match modes[w] {
+                    // The event search passes over these (see `find_crossing`).
+                    Mode::Sticking => {}
+                    Mode::Open if held[w] => {}
+                    mode => {
+                        plain &= !mode.may_cross(start_gaps[w], end_gaps[w]);
+                        if let Mode::Compliant { .. } = mode {
+                            let (m0, m1) = (start_gaps[w].1 * length, end_gaps[w].1 * length);
+                            plain &= !(m0 < 0.0 && m1 > 0.0);
+                        }
+                    }
+                }
+            }
+            if plain && releasable {
+                // A sticking pair whose constraint force at the step's end
+                // pulls is released: the forces as the event search takes
+                // them.
+                self.rates::<true>(system, n, k, next, &end, modes, scratch, &mut probe);
+                for w in 0..count {
+                    if modes[w] == Mode::Sticking
+                        && !locked[w]
+                        && scratch.force_of(w).unwrap_or(0.0) < 0.0
+                    {
+                        plain = false;
+                    }
                 }
             }
             if in_window {
@@ -503,8 +559,14 @@ fn stretch_sized(
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
-    by_size!(system, |n, k| compact
-        .stretch(system, n, k, f, modes, scratch))
+    // Without a sticking pair, no constraint solve is compiled in.
+    if modes.contains(&Mode::Sticking) {
+        by_size!(system, |n, k| compact
+            .stretch::<true>(system, n, k, f, modes, scratch))
+    } else {
+        by_size!(system, |n, k| compact
+            .stretch::<false>(system, n, k, f, modes, scratch))
+    }
 }
 
 /// [`stretch_sized`] compiled for a processor feature.
@@ -573,7 +635,7 @@ mod tests {
     use crate::error::Result;
     use crate::reductions::ReduceOptions;
     use crate::structure::Structure;
-    use crate::system_events::{integrate_system, RunOptions, SystemSolution};
+    use crate::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
     use crate::system_steppers::{ExplicitRk, SystemStepper};
 
     /// The 3-mode cantilever of the throughput goal: two compliant dampers
@@ -694,9 +756,22 @@ mod tests {
             let mut spec = beam(9.81);
             spec.points = vec![0.1, 0.4];
             same(&both(&spec, &o, None));
-            // Impacts, a compliant stop and a rigid damper.
+            // Impacts, chatter and sticking: a compliant stop and a rigid
+            // damper; the beam of the example file (one damper rigid).
             let runs = both(&oscillator(), &options(1e-4, 3.0), None);
-            assert!(runs[0].as_ref().unwrap().contacts.len() > 20);
+            let contacts = &runs[0].as_ref().unwrap().contacts;
+            assert!(contacts.len() > 20);
+            assert!(contacts.iter().any(|c| c.kind == ContactKind::Sticking));
+            same(&runs);
+            let mut spec = beam(0.0);
+            (
+                spec.dampers[1].lower_clearance,
+                spec.dampers[1].upper_clearance,
+            ) = (1e-4, 3e-4);
+            spec.dampers[1].law = PairLaw::rigid(0.5).unwrap();
+            let runs = both(&spec, &options(1e-5, 0.3), None);
+            let contacts = &runs[0].as_ref().unwrap().contacts;
+            assert!(contacts.iter().any(|c| c.kind == ContactKind::Sticking));
             same(&runs);
             // A contact still pressing in at the end of the run (and a
             // rigid damper's impacts meanwhile).

@@ -286,9 +286,10 @@ impl ExplicitRk {
     ) {
         by_size!(system, |n, k| match &system.compact {
             // The fast path, the same bits (see `compact`).
-            Some(compact) if self.compact && compact.takes(modes) => {
+            Some(compact) if self.compact => {
                 let len = system.state_len();
                 compact.rk4(
+                    system,
                     n,
                     k,
                     time,
@@ -435,7 +436,7 @@ impl SystemStepper for ExplicitRk {
         let Some(compact) = &system.compact else {
             return;
         };
-        if !(self.rk4 && self.compact && !self.start_valid && compact.takes(modes)) {
+        if !(self.rk4 && self.compact && !self.start_valid) {
             return;
         }
         compact.run_stretch(system, stretch, modes, scratch);
