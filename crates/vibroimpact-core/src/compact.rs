@@ -41,6 +41,8 @@ struct Wall {
     law: Option<(AnyLaw, f64)>,
     /// Whether `h` is the previous wall's negated (a damper's second wall).
     mirror: bool,
+    /// `h M^-1 h^T`, 1/kg.
+    inverse_mass: f64,
 }
 
 impl Wall {
@@ -108,6 +110,7 @@ impl Compact {
             offset: 0.0,
             law: None,
             mirror: false,
+            inverse_mass: 0.0,
         };
         let mut walls = [empty; MAX_WALLS];
         for ((wall, it), mirror) in walls
@@ -119,6 +122,7 @@ impl Compact {
             wall.push[..d].copy_from_slice(&it.push[..d]);
             wall.offset = it.offset;
             wall.mirror = *mirror;
+            wall.inverse_mass = it.inverse_mass;
             wall.law = match it.law {
                 InteractionLaw::Compliant { law, damping } => Some((law, damping)),
                 InteractionLaw::Rigid { .. } => None,
@@ -221,7 +225,19 @@ impl Compact {
                 sticking += 1;
             }
         }
-        if STICKING && sticking > 0 {
+        if STICKING && sticking == 1 {
+            // One constraint, as `Assembly::add_constraint_forces` solves it.
+            let wall = &self.walls[scratch.sticking[0].min(MAX_WALLS - 1)];
+            let mut dot = -0.0;
+            for i in 0..d {
+                dot += wall.h[i] * out[d + i];
+            }
+            let lambda = -dot / wall.inverse_mass;
+            scratch.forces[0] = lambda;
+            for i in 0..d {
+                out[d + i] += wall.push[i] * lambda;
+            }
+        } else if STICKING && sticking > 1 {
             system.add_constraint_forces(sticking, &mut out[d..2 * d], scratch);
         }
         scratch.count = sticking;
@@ -427,7 +443,9 @@ impl Compact {
             locked[w] = system.locked(w);
             releasable |= modes[w] == Mode::Sticking && !locked[w];
         }
-        let mut probe = [0.0; MAX_LEN];
+        // Whether `stages[0]` holds the rates at the step's start (the last
+        // step's release test evaluated them there).
+        let mut start_valid = false;
         loop {
             if f.accepted >= f.max_accepted {
                 f.limited = true;
@@ -467,7 +485,7 @@ impl Compact {
                 modes,
                 scratch,
                 &mut stages,
-                false,
+                start_valid,
                 &mut end,
             );
             self.gaps(d, &end, &mut end_gaps);
@@ -493,7 +511,7 @@ impl Compact {
                 // A sticking pair whose constraint force at the step's end
                 // pulls is released: the forces as the event search takes
                 // them.
-                self.rates::<true>(system, n, k, next, &end, modes, scratch, &mut probe);
+                self.rates::<true>(system, n, k, next, &end, modes, scratch, &mut stages[0]);
                 for w in 0..count {
                     if modes[w] == Mode::Sticking
                         && !locked[w]
@@ -538,6 +556,8 @@ impl Compact {
             f.until_kept = f.until_kept.saturating_sub(1);
             f.evaluations += 4;
             f.steps += 1;
+            // Those rates are the next step's first stage.
+            start_valid = releasable;
             for e in 0..len {
                 y[e] = end[e];
             }
