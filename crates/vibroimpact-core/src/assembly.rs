@@ -193,7 +193,8 @@ pub struct Assembly {
     gravity: f64,
     forces: Vec<ForceLoad>,
     base: Vec<Signal>,
-    pub interactions: Vec<Interaction>,
+    /// Crate-private: [`Assembly::compact`] holds a copy made once.
+    pub(crate) interactions: Vec<Interaction>,
     /// Whether an interaction's `h` is the previous one's negated (the two
     /// walls of a damper): its products are then that one's negated, to the
     /// bit (round-to-nearest is symmetric).

@@ -73,6 +73,9 @@ pub(crate) struct Compact {
     modal: [[f64; 4]; MAX_MODES],
     force: Option<Force>,
     gravity: f64,
+    /// Whether `r * inertial` is +0 for every mode (no gravity, every `r`
+    /// >= +0), and so may be left out: `a - (+0) = a` to the bit.
+    inertial_free: bool,
     walls: [Wall; MAX_WALLS],
     count: usize,
 }
@@ -132,6 +135,8 @@ impl Compact {
             modal,
             force,
             gravity: parts.gravity,
+            inertial_free: parts.gravity == 0.0
+                && modal[..n].iter().all(|m| m[3].is_sign_positive()),
             walls,
             count: system.interactions.len(),
         })
@@ -165,9 +170,7 @@ impl Compact {
                 let [k, c, damping, r] = self.modal[i];
                 let (x, v) = (y[i], y[d + i]);
                 out[i] = v;
-                // Without gravity `r * inertial` is +0, and `a - 0 = a` to
-                // the bit (-0 included): the term is left out.
-                let elastic = if self.gravity == 0.0 {
+                let elastic = if self.inertial_free {
                     -(k * x + c * v)
                 } else {
                     -(k * x + c * v) - r * inertial
@@ -246,8 +249,8 @@ impl Compact {
     }
 
     /// One RK4 step `h` from `(time, start)` into `out`, the state's
-    /// `len` values, for `n` modes and `k` dampers, in no sticking mode:
-    /// the general stages' arithmetic. `stages[0]` holds `f(start)` where
+    /// `len` values, for `n` modes and `k` dampers (`STICKING`: whether a
+    /// pair may stick): the general stages' arithmetic. `stages[0]` holds `f(start)` where
     /// `start_valid`, and receives it where not.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -611,8 +614,11 @@ stretch_with!(stretch_avx2, "avx2");
 /// The event kernel's state that a stretch advances, and where it must stop:
 /// it takes a step only where the general loop would take it whole and do
 /// nothing after it but count it (no landing on the recording window's
-/// start or a strobe instant, no history row, energy check, interrupt
-/// poll, step limit or end of the run due).
+/// start or a strobe instant, no history row, step limit or end of the run
+/// due), or check the energy balance and poll for an interrupt, which the
+/// kernel then does (a stretch ends on that step). The memory and row limits
+/// the loop checks after each step hold through a stretch, which adds no
+/// contact and no row (the kernel starts none before its own first step).
 pub struct Stretch<'a> {
     pub time: f64,
     pub grid: u64,
@@ -653,9 +659,12 @@ mod tests {
     };
     use crate::contact::{Contact, LawKind};
     use crate::error::Result;
+    use crate::memory::MAX_RECORD_BYTES;
     use crate::reductions::ReduceOptions;
     use crate::structure::Structure;
-    use crate::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
+    use crate::system_events::{
+        integrate_system, integrate_system_within, ContactKind, RunOptions, SystemSolution,
+    };
     use crate::system_steppers::{ExplicitRk, SystemStepper};
 
     /// The 3-mode cantilever of the throughput goal: two compliant dampers
@@ -727,11 +736,13 @@ mod tests {
         }
     }
 
-    /// The run with RK4's compact path and without it.
-    fn both(
+    /// The run with RK4's compact path and without it (interrupted at the
+    /// `polls`-th poll, its records within `record_limit` bytes).
+    fn both_within(
         spec: &SystemSpec,
         options: &RunOptions,
         polls: Option<u32>,
+        record_limit: u64,
     ) -> [Result<SystemSolution>; 2] {
         let system = Assembly::new(spec).unwrap();
         assert!(system.compact.is_some(), "the system has a compact form");
@@ -744,8 +755,23 @@ mod tests {
                 left = left.saturating_sub(1);
                 left == 0
             };
-            integrate_system(&system, &mut stepper, &y, options, &mut interrupt)
+            integrate_system_within(
+                &system,
+                &mut stepper,
+                &y,
+                options,
+                &mut interrupt,
+                record_limit,
+            )
         })
+    }
+
+    fn both(
+        spec: &SystemSpec,
+        options: &RunOptions,
+        polls: Option<u32>,
+    ) -> [Result<SystemSolution>; 2] {
+        both_within(spec, options, polls, MAX_RECORD_BYTES)
     }
 
     /// Debug text tells every bit of every number apart (and -0 from 0).
@@ -827,6 +853,16 @@ mod tests {
             assert!(runs[0].is_err());
             same(&runs);
             let runs = both(&beam(0.0), &options(1e-5, 0.5), Some(2));
+            assert!(runs[0].is_err());
+            same(&runs);
+            // Records past their limits: bytes (the contacts' room, checked
+            // after the first step), and rows (the first kept after it).
+            let runs = both_within(&beam(0.0), &options(1e-5, 0.01), None, 200);
+            assert!(runs[0].is_err());
+            same(&runs);
+            let mut o = options(1e-5, 0.01);
+            (o.keep_history, o.every, o.max_rows) = (true, 10, 0);
+            let runs = both(&beam(0.0), &o, None);
             assert!(runs[0].is_err());
             same(&runs);
         });

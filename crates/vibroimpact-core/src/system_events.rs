@@ -791,7 +791,6 @@ pub fn integrate_system_within<S: SystemStepper>(
             .iter()
             .map(|it| it.offset.abs())
             .fold(1e-9, f64::max);
-    // The time resolution below which a chattering sequence is summed.
     // The time below which a chattering sequence is summed: the step, or a
     // millionth of the structure's longest period (of the run, without one).
     let resolution = if adaptive || stepper.is_exact() {
@@ -910,14 +909,17 @@ pub fn integrate_system_within<S: SystemStepper>(
     }
 
     // Each compliant contact's deepest indentation, lent to stretches.
+    let stretches = !adaptive && stepper.takes_stretches(system);
     let mut deepest = vec![f64::NAN; count];
     while time < t_end {
-        if !adaptive {
-            // Plain steps in a row, where the stepper can take them at once
-            // (each as this loop would, to the bit): the step after them is
-            // this loop's.
-            for (d, record) in deepest.iter_mut().zip(&open) {
-                *d = record.as_ref().map_or(f64::NAN, |o| o.max_indentation);
+        // Plain steps in a row, where the stepper can take them at once (each
+        // as this loop would, to the bit); the step after them is this
+        // loop's. Not before this loop's first step, after which the memory
+        // and row limits it checks stay as they were through a stretch (no
+        // contact or row is added there).
+        if stretches && accepted > 0 {
+            for (deep, record) in deepest.iter_mut().zip(&open) {
+                *deep = record.as_ref().map_or(f64::NAN, |o| o.max_indentation);
             }
             let mut stretch = Stretch {
                 time,
@@ -955,9 +957,9 @@ pub fn integrate_system_within<S: SystemStepper>(
                     stretch.until_kept,
                 );
                 stalled = 0;
-                for (d, record) in deepest.iter().zip(&mut open) {
+                for (deep, record) in deepest.iter().zip(&mut open) {
                     if let Some(o) = record {
-                        o.max_indentation = *d;
+                        o.max_indentation = *deep;
                     }
                 }
                 // What the loop does after a plain step that it may have

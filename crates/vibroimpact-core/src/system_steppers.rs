@@ -50,8 +50,15 @@ pub trait SystemStepper {
     }
     /// Forget data carried from the last step (the right-hand side jumped).
     fn reset(&mut self);
-    /// Plain fixed steps taken at once (see [`Stretch`]), where the method
-    /// can: each the step the kernel would take, to the bit. None by default.
+    /// Whether the method takes stretches of plain fixed steps of `system`
+    /// (see [`Self::stretch`]). No by default.
+    fn takes_stretches(&self, _system: &Assembly) -> bool {
+        false
+    }
+    /// Plain fixed steps taken at once (see [`Stretch`], a type of the
+    /// kernel's, not for callers), where the method can: each the step the
+    /// kernel would take, to the bit. None by default.
+    #[doc(hidden)]
     fn stretch(
         &mut self,
         _system: &Assembly,
@@ -424,6 +431,10 @@ impl SystemStepper for ExplicitRk {
     fn reset(&mut self) {
         self.start_valid = false;
         self.end_slot = None;
+    }
+
+    fn takes_stretches(&self, system: &Assembly) -> bool {
+        self.rk4 && self.compact && system.compact.is_some()
     }
 
     fn stretch(
