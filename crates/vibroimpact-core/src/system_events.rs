@@ -586,9 +586,11 @@ fn locate<S: SystemStepper>(
     };
     let (mut lo, mut v_lo) = (0.0, value(y, time, scratch, &mut buffers.work));
     let sign = side(mode);
-    // On the wall to round-off and moving away (a rebound): the event is
-    // where it comes back, after a stretch on the old side to start from.
-    let leaving = v_lo.abs() <= round_off && sign * system.gap(c.i, y).1 > 0.0;
+    // On the wall to round-off (or as far off it as a release puts a pair,
+    // twice that: `Assembly::release`) and moving away (a rebound): the
+    // event is where it comes back, after a stretch on the old side to
+    // start from.
+    let leaving = v_lo.abs() <= 4.0 * round_off && sign * system.gap(c.i, y).1 > 0.0;
     if c.before > 0.0 || leaving {
         let mut length = if c.before > 0.0 {
             c.before * h

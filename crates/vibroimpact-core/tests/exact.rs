@@ -222,6 +222,69 @@ fn ball_on_a_floor_accumulates_at_the_zeno_time_then_rests() {
     });
 }
 
+/// Two storeys that start touching (a gap of zero), shaken at the base from
+/// rest: their gap first closes as t^3, and the exact flow's first step (a
+/// millisecond) holds tiny rebounds whose landings are a microsecond away. It
+/// had located each landing at the step's start, again and again, and
+/// stopped with a chattering error after 5 us; the impacts of the pounding
+/// that follows are those of DOP853 at a tight tolerance.
+#[test]
+fn storeys_that_start_touching_pound_as_dop853_has_them() {
+    common::timeout(60, || {
+        let mut s = spec(
+            Structure::matrices(
+                &[vec![1e5, 0.0], vec![0.0, 2e5]],
+                &[vec![1.579e7, 0.0], vec![0.0, 7.896e6]],
+                &[vec![1.2566e5, 0.0], vec![0.0, 1.2566e5]],
+            )
+            .unwrap(),
+        );
+        s.stops.push(Stop {
+            at: 0.0,
+            side: Side::Upper,
+            gap: 0.0,
+            law: PairLaw::rigid(0.65).unwrap(),
+            against: Some(1.0),
+        });
+        s.excitations.push(Excitation {
+            load: Load::Base,
+            signal: Signal::harmonic(2.0, 1.5, 0.0).unwrap(),
+        });
+        let zero = [vec![], vec![], vec![], vec![]];
+        let sol = exact(&s, &zero, 3.0, ReduceOptions::default());
+        let system = Assembly::new(&s).unwrap();
+        let y = initial_state(&system, &[], &[], &[], &[]).unwrap();
+        let mut dop853 = ExplicitRk::dop853(system.state_len(), 1e-12, 1e-15);
+        let options = RunOptions {
+            dt: None,
+            t_end: 3.0,
+            every: 1,
+            keep_history: false,
+            max_steps: 10_000_000,
+            max_rows: 10_000_000,
+            energy_tolerance: 1e-6,
+            reduce: ReduceOptions::default(),
+        };
+        let reference =
+            integrate_system(&system, &mut dop853, &y, &options, &mut || false).unwrap();
+        // The pounding's impacts (faster than a millimetre per second).
+        let impacts = |sol: &SystemSolution| {
+            sol.contacts
+                .iter()
+                .filter(|c| c.kind == ContactKind::Impact && c.approach_speed > 1e-3)
+                .map(|c| (c.onset, c.approach_speed))
+                .collect::<Vec<_>>()
+        };
+        let (ours, theirs) = (impacts(&sol), impacts(&reference));
+        assert!(ours.len() >= 6, "{ours:?}");
+        assert_eq!(ours.len(), theirs.len());
+        for ((t, v), (t_ref, v_ref)) in ours.iter().zip(&theirs) {
+            assert!((t - t_ref).abs() < 1e-8, "{t} vs {t_ref}");
+            assert!(close(*v, *v_ref, 1e-6), "{v} vs {v_ref}");
+        }
+    });
+}
+
 fn sqrt_2gh(g: f64, h: f64) -> f64 {
     (2.0 * g * h).sqrt()
 }
