@@ -270,6 +270,11 @@ def real(value: Any) -> int | float | None:
 def _value(where: str, kind: str, value: Any) -> Any:
     """``value`` checked as ``kind``: numbers finite, whole numbers in 64 bits. NumPy
     real scalars count as numbers; booleans never do."""
+    # The common cases first, at once: a scenario's floats and whole numbers.
+    if kind == _NUMBER and type(value) is float and math.isfinite(value):
+        return value
+    if kind == _WHOLE and type(value) is int and 0 <= value < 2**63:
+        return value
     if kind == _NUMBER:
         number = real(value)
         if number is None:

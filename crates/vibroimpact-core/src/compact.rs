@@ -16,7 +16,9 @@
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
 use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
+use crate::balance::{check_balance, ENERGY_INTERVAL};
 use crate::contact::{AnyLaw, ContactLaw};
+use crate::error::Error;
 use crate::signals::Signal;
 use crate::sized::by_size;
 use crate::tableau::{RK4_A, RK4_B, RK4_C};
@@ -553,6 +555,22 @@ impl Compact {
             for w in 0..count {
                 start_gaps[w] = end_gaps[w];
             }
+            if f.accepted % ENERGY_INTERVAL == 0 {
+                if let Err(failure) = check_balance(
+                    system,
+                    &y[..len],
+                    modes,
+                    f.stored_start,
+                    &mut f.energy_scale,
+                    f.impact_loss,
+                    f.energy_tolerance,
+                    f.t_end,
+                    f.time,
+                ) {
+                    f.unbalanced = Some(failure);
+                    break;
+                }
+            }
         }
         f.y[..len].copy_from_slice(&y[..len]);
         f.gaps[..count].copy_from_slice(&start_gaps[..count]);
@@ -635,6 +653,14 @@ pub struct Stretch<'a> {
     /// no progress (the kernel's stall test).
     pub chatter_factor: f64,
     pub time_scale: f64,
+    /// The energy balance, checked every [`ENERGY_INTERVAL`] accepted steps
+    /// as the kernel checks it (the scale kept across checks); the error
+    /// where it failed, on which the stretch stops.
+    pub stored_start: f64,
+    pub energy_scale: f64,
+    pub impact_loss: f64,
+    pub energy_tolerance: f64,
+    pub unbalanced: Option<Error>,
 }
 
 #[cfg(test)]
@@ -867,6 +893,7 @@ mod tests {
             system.gaps(&y, &mut gaps);
             let (mut deepest, mut peaks, mut recorded) = (vec![f64::NAN; count], vec![0.0; 3], 0.0);
             let dt = 1e-5;
+            let (stored_start, energy_scale) = system.energy_terms(&y, &modes);
             let mut stretch = Stretch {
                 time: 0.0,
                 grid: 0,
@@ -890,6 +917,11 @@ mod tests {
                 keep_history: false,
                 chatter_factor: 1e3 * f64::EPSILON,
                 time_scale: 1.0,
+                stored_start,
+                energy_scale,
+                impact_loss: 0.0,
+                energy_tolerance: 1e-6,
+                unbalanced: None,
             };
             let mut scratch = Scratch::new(&system);
             compact.run_stretch(&system, &mut stretch, &modes, &mut scratch);

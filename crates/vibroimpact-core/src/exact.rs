@@ -19,6 +19,7 @@ use crate::contact::AnyLaw;
 use crate::error::{Error, Result};
 use crate::matrix_flow::MatrixFlow;
 use crate::modal::Configuration;
+use crate::series::{exp, sin_cos};
 use crate::system_steppers::SystemStepper;
 
 /// Steps per fastest period: the event kernel's cubic check of a gap between
@@ -121,60 +122,6 @@ impl Oscillator {
             (0.5 * self.constant * t * t, self.constant * t)
         }
     }
-}
-
-/// The largest angle (rad) [`sin_cos`] takes its series at: the steps turn
-/// every mode and harmonic by at most an eighth of a turn.
-const SERIES_ANGLE: f64 = std::f64::consts::FRAC_PI_4 * (1.0 + 1e-9);
-
-/// `(sin x, cos x)`: for `|x| <= pi/4` by their Taylor series to `x^17` and
-/// `x^16` (truncated below 1e-17 relative; a third of the library's cost),
-/// else the library's.
-#[inline(always)]
-fn sin_cos(x: f64) -> (f64, f64) {
-    if x.abs() <= SERIES_ANGLE {
-        sin_cos_series(x)
-    } else {
-        x.sin_cos()
-    }
-}
-
-#[inline(always)]
-fn sin_cos_series(x: f64) -> (f64, f64) {
-    let z = x * x;
-    let z2 = z * z;
-    let z4 = z2 * z2;
-    // Estrin's scheme: shorter chains of dependent operations than Horner's.
-    let s = (-1.0 / 6.0 + z * (1.0 / 120.0))
-        + z2 * (-1.0 / 5040.0 + z * (1.0 / 362_880.0))
-        + z4 * ((-1.0 / 39_916_800.0 + z * (1.0 / 6_227_020_800.0))
-            + z2 * (-1.0 / 1_307_674_368_000.0 + z * (1.0 / 355_687_428_096_000.0)));
-    let c = (-0.5 + z * (1.0 / 24.0))
-        + z2 * (-1.0 / 720.0 + z * (1.0 / 40_320.0))
-        + z4 * ((-1.0 / 3_628_800.0 + z * (1.0 / 479_001_600.0))
-            + z2 * (-1.0 / 87_178_291_200.0 + z * (1.0 / 20_922_789_888_000.0)));
-    (x + x * z * s, 1.0 + z * c)
-}
-
-/// `e^x`: for `|x| <= 1/16` (light damping over a step) by its Taylor
-/// series to `x^9` (truncated below 1e-18 relative), else the library's.
-#[inline(always)]
-fn exp(x: f64) -> f64 {
-    if x.abs() <= 0.0625 {
-        exp_series(x)
-    } else {
-        x.exp()
-    }
-}
-
-#[inline(always)]
-fn exp_series(x: f64) -> f64 {
-    let x2 = x * x;
-    let x4 = x2 * x2;
-    let low = (1.0 + x) + x2 * (0.5 + x * (1.0 / 6.0));
-    let high = (1.0 / 24.0 + x * (1.0 / 120.0)) + x2 * (1.0 / 720.0 + x * (1.0 / 5040.0));
-    let top = 1.0 / 40_320.0 + x * (1.0 / 362_880.0);
-    low + x4 * (high + x4 * top)
 }
 
 /// Mode `j`'s coordinate and rate in the state `y` (`x` then `v`, `dim`
@@ -1001,24 +948,6 @@ mod tests {
     use crate::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec};
     use crate::signals::Signal;
     use crate::structure::Structure;
-
-    fn ulps(a: f64, b: f64) -> f64 {
-        (a - b).abs() / (f64::EPSILON * b.abs().max(f64::MIN_POSITIVE))
-    }
-
-    #[test]
-    fn the_series_are_the_library_s_sine_cosine_and_exponential_to_an_ulp() {
-        crate::testing::timeout(30, || {
-            for k in -1000..=1000 {
-                let x = SERIES_ANGLE * k as f64 / 1000.0;
-                let ((s, c), (ls, lc)) = (sin_cos(x), x.sin_cos());
-                assert!(ulps(s, ls) <= 1.0 && ulps(c, lc) <= 1.0, "{x}");
-                let x = 0.0625 * k as f64 / 1000.0;
-                assert!(ulps(exp(x), x.exp()) <= 1.0, "{x}");
-            }
-            assert_eq!(sin_cos(2.0), 2f64.sin_cos());
-        });
-    }
 
     #[test]
     fn nodes_by_the_addition_theorems_are_the_factors_there() {

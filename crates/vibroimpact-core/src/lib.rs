@@ -9,6 +9,7 @@
 //! (see [`run::simulate`]).
 
 pub mod assembly;
+mod balance;
 pub mod beam;
 pub mod closed_forms;
 pub(crate) mod compact;
@@ -29,6 +30,7 @@ pub mod model;
 pub mod records;
 pub mod reductions;
 pub mod run;
+mod series;
 pub mod settings;
 pub mod shooting;
 pub mod signals;

@@ -10,7 +10,7 @@
 //! rigid ones are resolved together, impacts, chattering sums and sticking,
 //! by [`crate::impacts`].
 
-use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
+use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT};
 
 /// Contacts held before those a run does not keep are dropped (see
 /// [`ReduceOptions::contacts_from`]): a few, so that dropping them costs as
@@ -22,6 +22,8 @@ const COMPACTED_CONTACTS: usize = 64;
 fn loss_slot(system: &Assembly, i: usize) -> usize {
     2 * system.dim + CONTACT + i
 }
+pub use crate::balance::EnergyBalance;
+use crate::balance::{balance, check_balance, ENERGY_INTERVAL};
 use crate::compact::Stretch;
 use crate::error::{Error, Result};
 use crate::hermite;
@@ -95,21 +97,6 @@ pub struct PairContact {
     pub restitution: f64,
     /// Energy taken by the contact's dissipative forces or by the impacts, J.
     pub energy_dissipated: f64,
-}
-
-/// Where the energy went, J: `stored_end - stored_start = input_work -
-/// dissipated + residual`, the residual being numerical error.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct EnergyBalance {
-    pub input_work: f64,
-    /// Viscous, contact and impact losses together.
-    pub dissipated: f64,
-    pub viscous: f64,
-    pub contact: f64,
-    pub impact: f64,
-    pub stored_start: f64,
-    pub stored_end: f64,
-    pub residual: f64,
 }
 
 /// What a run returns.
@@ -740,9 +727,8 @@ const CHATTER_EVENTS: u64 = 16;
 const CHATTER_ULPS: f64 = 1e3;
 /// Steps in a row at the round-off of time that stop a run.
 const STALLED_STEPS: u64 = 64;
-/// How often (steps) the energy balance is checked and the caller asked
-/// whether to stop.
-const ENERGY_INTERVAL: u64 = 32;
+/// How often (steps) the caller is asked whether to stop (a multiple of
+/// [`ENERGY_INTERVAL`]).
 const INTERRUPT_INTERVAL: u64 = 1 << 14;
 
 /// Integrates `system` from `initial` (see [`crate::assembly::initial_state`]).
@@ -935,8 +921,8 @@ pub fn integrate_system_within<S: SystemStepper>(
                 recorded_time: &mut reductions.recorded_time,
                 evaluations: 0,
                 steps: 0,
-                // Up to the next energy check, which is made here after it.
-                max_accepted: ((accepted / ENERGY_INTERVAL + 1) * ENERGY_INTERVAL)
+                // Up to the next interrupt poll, made here after it.
+                max_accepted: ((accepted / INTERRUPT_INTERVAL + 1) * INTERRUPT_INTERVAL)
                     .min(options.max_steps.saturating_sub(control.rejected + 1)),
                 limited: false,
                 dt,
@@ -948,9 +934,18 @@ pub fn integrate_system_within<S: SystemStepper>(
                 keep_history: options.keep_history,
                 chatter_factor: CHATTER_ULPS * f64::EPSILON,
                 time_scale,
+                stored_start,
+                energy_scale,
+                impact_loss,
+                energy_tolerance: options.energy_tolerance,
+                unbalanced: None,
             };
             stepper.stretch(system, &mut stretch, &modes, &mut scratch);
             let (steps, limited) = (stretch.steps, stretch.limited);
+            energy_scale = stretch.energy_scale;
+            if let Some(failure) = stretch.unbalanced {
+                return Err(failure);
+            }
             if steps > 0 {
                 (time, grid, accepted, until_kept) = (
                     stretch.time,
@@ -965,19 +960,8 @@ pub fn integrate_system_within<S: SystemStepper>(
                     }
                 }
                 // What the loop does after a plain step that it may have
-                // been: an energy check, an interrupt poll.
-                if accepted % ENERGY_INTERVAL == 0 {
-                    check_balance(
-                        system,
-                        &y,
-                        &modes,
-                        stored_start,
-                        &mut energy_scale,
-                        impact_loss,
-                        options,
-                        time,
-                    )?;
-                }
+                // been, beyond the energy check the stretch made: an
+                // interrupt poll.
                 if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
                     return Err(Error::Interrupted { time });
                 }
@@ -1455,7 +1439,8 @@ pub fn integrate_system_within<S: SystemStepper>(
                 stored_start,
                 &mut energy_scale,
                 impact_loss,
-                options,
+                options.energy_tolerance,
+                t_end,
                 time,
             )?;
         }
@@ -1587,69 +1572,6 @@ fn reduce_step<S: SystemStepper>(
     }
     out.recorded_time += h;
     Ok(used)
-}
-
-fn balance(
-    system: &Assembly,
-    y: &[f64],
-    stored_end: f64,
-    stored_start: f64,
-    impact: f64,
-) -> EnergyBalance {
-    let at = 2 * system.dim;
-    let (viscous, input_work) = (y[at + VISCOUS], y[at + INPUT]);
-    let contact: f64 = y[at + CONTACT..].iter().sum();
-    let dissipated = viscous + contact + impact;
-    EnergyBalance {
-        input_work,
-        dissipated,
-        viscous,
-        contact,
-        impact,
-        stored_start,
-        stored_end,
-        residual: stored_end - stored_start - input_work + dissipated,
-    }
-}
-
-/// Energy cannot be created: a residual beyond the tolerance, relative to the
-/// energies in play, is a numerical failure, not a result.
-#[allow(clippy::too_many_arguments)]
-fn check_balance(
-    system: &Assembly,
-    y: &[f64],
-    modes: &[Mode],
-    stored_start: f64,
-    scale: &mut f64,
-    impact: f64,
-    options: &RunOptions,
-    time: f64,
-) -> Result<()> {
-    // One evaluation of the stored energy gives both its value and its scale.
-    let (stored, magnitude) = system.energy_terms(y, modes);
-    let b = balance(system, y, stored, stored_start, impact);
-    // The energy in play: the largest seen so far, since a system without
-    // losses can pass through states where every term is near zero.
-    *scale = scale
-        .max(magnitude + b.input_work.abs() + b.dissipated.abs())
-        .max(system.energy_floor(options.t_end))
-        .max(f64::MIN_POSITIVE);
-    if !b.residual.is_finite() {
-        return Err(Error::NumericalBlowUp {
-            time,
-            reason: "the energies are no longer finite: a blow-up, or inputs (amplitudes, scale \
-                     factors) too large for floating point",
-        });
-    }
-    if b.residual.abs() > options.energy_tolerance * *scale {
-        return Err(Error::EnergyBalance {
-            time,
-            residual: b.residual,
-            scale: *scale,
-            tolerance: options.energy_tolerance,
-        });
-    }
-    Ok(())
 }
 
 /// Switch interaction `i` at `time`: start or end a compliant contact, or
