@@ -1360,7 +1360,8 @@ impl Cached {
     /// (`rotate`) does not serve: the first repeat of an increment, whose
     /// rotation it computes, or a new increment or a resync, where the angle
     /// is evaluated directly (a value then depends on its time alone, as in
-    /// adaptive steps, whose increments do not repeat). Out of line.
+    /// adaptive steps, whose increments do not repeat). `same`: whether the
+    /// increment is the cached one. Out of line.
     #[cold]
     #[inline(never)]
     fn turn(&mut self, h: &Harmonic, time: f64, same: bool) {
@@ -1370,8 +1371,13 @@ impl Cached {
             self.rotate();
         } else {
             (self.sin, self.cos) = sin_cos_by_quadrant(omega * time + h.phase);
-            self.delta = time - self.time;
-            self.rotations = 0;
+            if same {
+                // A resync: the increment, and so its rotation, stands.
+                self.rotations = 1;
+            } else {
+                self.delta = time - self.time;
+                self.rotations = 0;
+            }
         }
     }
 
@@ -1391,7 +1397,7 @@ impl Cached {
                 if same && self.rotations > 0 && self.rotations < RESYNC {
                     self.rotate();
                 } else {
-                    self.turn(h, time, same && self.rotations < RESYNC);
+                    self.turn(h, time, same);
                 }
                 self.value = h.amplitude * self.cos;
             }

@@ -37,7 +37,11 @@ pub(crate) fn sin_cos_by_quadrant(x: f64) -> (f64, f64) {
     if x.abs() > REDUCED_ANGLE || x.is_nan() {
         return x.sin_cos();
     }
-    let k = (x * std::f64::consts::FRAC_2_PI).round();
+    // Rounded to the nearest whole number by adding and taking away 1.5
+    // 2^52 (a call to the library's `round` where the processor's is not
+    // assumed).
+    const SHIFTER: f64 = 6_755_399_441_055_744.0;
+    let k = (x * std::f64::consts::FRAC_2_PI + SHIFTER) - SHIFTER;
     let r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
     let (s, c) = sin_cos_series(r);
     match (k as i64) & 3 {
