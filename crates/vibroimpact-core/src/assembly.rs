@@ -776,7 +776,7 @@ impl Assembly {
                     let (approach_rate, damping) = (*approach_rate, *damping);
                     let (hx, hv) = match previous {
                         Some((hx, hv)) if *mirror => (-hx, -hv),
-                        _ => dots(&it.h[..d], x, v),
+                        _ => force_dots(&it.h[..d], x, v),
                     };
                     products = Some((hx, hv));
                     let (indentation, rate) = (-(it.offset + hx), -hv);
@@ -910,7 +910,7 @@ impl Assembly {
             // One constraint: W lambda = -h . a with W = h M^-1 h^T, what
             // the elimination below gives for one row.
             let it = &self.interactions[scratch.sticking[0]];
-            let lambda = -linalg::dot(&it.h, acc) / it.inverse_mass;
+            let lambda = -h_dot(&it.h, acc) / it.inverse_mass;
             scratch.forces[0] = lambda;
             for (a, p) in acc.iter_mut().zip(&it.push) {
                 *a += p * lambda;
@@ -958,8 +958,8 @@ impl Assembly {
         for (i, (it, mode)) in self.interactions.iter().zip(modes).enumerate() {
             match (*mode, it.law) {
                 (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
-                    let indentation = -(it.offset + linalg::dot(&it.h, x));
-                    let rate = -linalg::dot(&it.h, v);
+                    let indentation = -(it.offset + h_dot(&it.h, x));
+                    let rate = -h_dot(&it.h, v);
                     let (_, by_indentation, by_rate) = if indentation > 0.0 {
                         law.force_derivatives(indentation, rate, approach_rate)
                     } else {
@@ -1027,7 +1027,7 @@ impl Assembly {
                 matrix[r * m + c] =
                     linalg::dot(&self.interactions[i].h, &self.interactions[j].push);
             }
-            forces[r] = -linalg::dot(&self.interactions[i].h, acc);
+            forces[r] = -h_dot(&self.interactions[i].h, acc);
         }
         linalg::solve_in_place(&mut matrix[..m * m], &mut forces[..m], m);
     }
@@ -1064,7 +1064,7 @@ impl Assembly {
         for (it, mode) in self.interactions.iter().zip(modes) {
             if let (Mode::Compliant { .. }, InteractionLaw::Compliant { law, .. }) = (mode, it.law)
             {
-                let indentation = -(it.offset + linalg::dot(&it.h, x));
+                let indentation = -(it.offset + h_dot(&it.h, x));
                 if indentation > 0.0 {
                     contact += law.potential(indentation);
                 }
@@ -1163,7 +1163,7 @@ impl Assembly {
 }
 
 /// `(h . x, h . v)` in one pass, each summed in order as [`linalg::dot`]
-/// sums it (the same bits).
+/// sums it (the same bits): a wall's gap and rate as the events see them.
 #[inline(always)]
 fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
     let n = h.len();
@@ -1174,6 +1174,38 @@ fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
         hv += h[i] * v[i];
     }
     (hx, hv)
+}
+
+/// `(h . x, h . v)` as [`h_dot`] sums each: a compliant wall's indentation
+/// and rate for its force.
+#[inline(always)]
+fn force_dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
+    let n = h.len();
+    let (x, v) = (&x[..n], &v[..n]);
+    let (mut hx, mut hv) = ([-0.0; 2], [-0.0; 2]);
+    for i in 0..n {
+        hx[i % 2] += h[i] * x[i];
+        hv[i % 2] += h[i] * v[i];
+    }
+    (hx[0] + hx[1], hv[0] + hv[1])
+}
+
+/// A wall's `h` times a vector where the product leads to a force: a
+/// compliant wall's indentation and rate, and a sticking wall's `h . a` for
+/// its constraint. The even and the odd terms are summed apart, then
+/// together: two chains of half the length on a step's critical path (a
+/// stage's contact force waits on it). The gaps that the events watch are
+/// summed in order ([`dots`]); the two differ in the last bits at most, and
+/// every path sums each quantity the same way (the same bits).
+#[inline(always)]
+pub(crate) fn h_dot(h: &[f64], x: &[f64]) -> f64 {
+    let n = h.len();
+    let x = &x[..n];
+    let mut sum = [-0.0; 2];
+    for i in 0..n {
+        sum[i % 2] += h[i] * x[i];
+    }
+    sum[0] + sum[1]
 }
 
 /// Refuses two rigid walls with the same gap (the same points, side and

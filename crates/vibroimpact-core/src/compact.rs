@@ -48,15 +48,37 @@ struct Wall {
 }
 
 impl Wall {
-    /// `(h . x, h . v)` at `y`, summed as the general path sums them.
+    /// `(h . x, h . v)` at `y` for the gap the events watch, summed in
+    /// order as the general path sums them.
     #[inline(always)]
-    fn products(&self, d: usize, y: &[f64; MAX_LEN]) -> (f64, f64) {
+    fn gap_products(&self, d: usize, y: &[f64; MAX_LEN]) -> (f64, f64) {
         let (mut hx, mut hv) = (-0.0, -0.0);
         for i in 0..d {
             hx += self.h[i] * y[i];
             hv += self.h[i] * y[d + i];
         }
         (hx, hv)
+    }
+
+    /// `(h . x, h . v)` at `y` for a compliant wall's force, summed as the
+    /// general path sums them (see [`crate::assembly::h_dot`]).
+    #[inline(always)]
+    fn products(&self, d: usize, y: &[f64; MAX_LEN]) -> (f64, f64) {
+        let h = &self.h;
+        let (mut x0, mut x1, mut v0, mut v1) = (-0.0, -0.0, -0.0, -0.0);
+        let mut i = 0;
+        while i + 1 < d {
+            x0 += h[i] * y[i];
+            x1 += h[i + 1] * y[i + 1];
+            v0 += h[i] * y[d + i];
+            v1 += h[i + 1] * y[d + i + 1];
+            i += 2;
+        }
+        if i < d {
+            x0 += h[i] * y[i];
+            v0 += h[i] * y[d + i];
+        }
+        (x0 + x1, v0 + v1)
     }
 }
 
@@ -233,10 +255,11 @@ impl Compact {
         if STICKING && sticking == 1 {
             // One constraint, as `Assembly::add_constraint_forces` solves it.
             let wall = &self.walls[scratch.sticking[0].min(MAX_WALLS - 1)];
-            let mut dot = -0.0;
+            let mut sum = [-0.0; 2];
             for i in 0..d {
-                dot += wall.h[i] * out[d + i];
+                sum[i % 2] += wall.h[i] * out[d + i];
             }
+            let dot = sum[0] + sum[1];
             let lambda = -dot / wall.inverse_mass;
             scratch.forces[0] = lambda;
             for i in 0..d {
@@ -365,7 +388,7 @@ impl Compact {
             products = if wall.mirror {
                 (-products.0, -products.1)
             } else {
-                wall.products(d, y)
+                wall.gap_products(d, y)
             };
             out[w] = (wall.offset + products.0, products.1);
         }
