@@ -216,7 +216,9 @@ impl ContactLaw for HysterHertz {
         let elastic = self.elastic_force(indentation);
         if approach_rate > GRAZING_RATE {
             (
-                (elastic * (1.0 + self.hysteresis * rate / approach_rate)).max(0.0),
+                // The factor on the rate first: the division is off the
+                // path from the rate (the state) to the force.
+                (elastic * (1.0 + (self.hysteresis / approach_rate) * rate)).max(0.0),
                 elastic,
             )
         } else {
@@ -242,7 +244,7 @@ impl ContactLaw for HysterHertz {
         if approach_rate <= GRAZING_RATE {
             return (elastic, elastic_slope, 0.0);
         }
-        let factor = 1.0 + self.hysteresis * rate / approach_rate;
+        let factor = 1.0 + (self.hysteresis / approach_rate) * rate;
         if factor <= 0.0 {
             return (0.0, 0.0, 0.0);
         }
