@@ -273,6 +273,19 @@ def test_poincare_impact_section_of_holmes_orbit(path: Path) -> None:
         assert state_error(row, table.orbit_state(gamma)) < 1e-8
 
 
+def test_poincare_of_a_plastic_ball_goes_on_from_its_rest_on_the_table() -> None:
+    # e = 0: the ball lands and sticks to the table until it takes off again. The
+    # settled state, 4e-19 m inside the table by the constraint's drift, was refused
+    # as "starts inside its wall" (exit 2 from poincare, bifurcation and sweep; trial).
+    data = load(BALL_TABLE)
+    data["stop"][0]["restitution"] = 0.0
+    section = poincare(an.runner(data), settle_periods=50, periods=8)
+    assert section.strobe.shape == (8, 2)
+    # On or above the table at every strobe, and the ball does take off (Gamma > 1).
+    assert np.all(section.strobe[:, 0] >= -1e-15)
+    assert len(section.impact_speed) > 0
+
+
 def test_poincare_refuses_bad_counts() -> None:
     run = an.runner(load(BALL_TABLE))
     with pytest.raises(an.AnalysisError, match="settle_periods"):
@@ -972,6 +985,34 @@ def test_bad_bifurcation_sweep_and_poincare_arguments_exit_2(
     assert_one_line_error(run_cli("bifurcation", str(path)), str(path), "[sweep] direction")
     assert_one_line_error(run_cli("poincare", str(BALL_TABLE), "--settle", "-1"), "--settle")
     assert_one_line_error(run_cli("poincare", str(BALL_TABLE), "--periods", "0"), "--periods")
+    # Samples beyond a run's memory limit, refused before any run (1e5 points of 1e6
+    # periods had grown until the allocator aborted; trial).
+    huge = write(
+        tmp_path,
+        "huge.toml",
+        edited(
+            BIFURCATION,
+            ("count = ", "count = 100000 #"),
+            ("record_periods = ", "record_periods = 1000000 #"),
+        ),
+    )
+    assert_one_line_error(run_cli("bifurcation", str(huge)), "[sweep] record_periods", "MiB")
+
+
+def test_analyses_take_numpy_whole_numbers_and_refuse_bad_counts() -> None:
+    # NumPy integers were refused by every analysis but simulate_system, and basins took
+    # a bad count for a start inside a wall: every label -3, no error (trial).
+    run = an.runner(load(BALL_TABLE))
+    section = poincare(run, settle_periods=np.int64(10), periods=np.int64(3))
+    assert section.strobe.shape == (3, 2)
+    steady = an.steady_state(run, settle_periods=np.int64(200), record_periods=np.uint8(2))
+    assert steady.settled
+    grid = (0, np.array([0.01])), (1, np.array([0.1]))
+    for bad in (-5, 2.5, True):
+        with pytest.raises(an.AnalysisError, match="settle_periods"):
+            basins(run, *grid, settle_periods=bad, record_periods=5)
+    result = basins(run, *grid, settle_periods=np.int64(20), record_periods=np.int64(5))
+    assert result.labels.tolist() != [[-3]]
 
 
 def test_help_lists_the_new_commands(run_cli: RunCli) -> None:
@@ -1052,3 +1093,17 @@ def test_continuation_through_grazing_flags_the_grazing_alone() -> None:
     # Each branch's own flags: the impacting orbit's flip, nothing from the jump.
     flags = [flag for p in branch.points for flag in p.flags]
     assert "grazing" in flags and "fold" not in flags
+
+
+def test_the_basins_plot_of_starts_all_inside_the_wall(tmp_path: Path) -> None:
+    # No attractor at all (every start inside the table): the colour bar had one
+    # colour more than its labels, a matplotlib traceback from `basins --plot` (trial).
+    from vibroimpact.analysis_plots import plot_basins
+    from vibroimpact.maps import Basins
+
+    grid = np.array([-0.03, -0.02, -0.01])
+    result = Basins(grid, grid, np.full((3, 3), -3), [])
+    png = tmp_path / "b.png"
+    plot_basins(png, result, "structure_displacement 0", "structure_velocity 0")
+    data = png.read_bytes()
+    assert data[:8] == PNG_SIGNATURE and data.endswith(b"IEND\xaeB`\x82")

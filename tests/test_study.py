@@ -272,10 +272,16 @@ def test_an_interrupted_study_resumes_into_the_same_file(tmp_path: Path) -> None
         "chunk-000001.npz",
     ]
     assert not resumed.exists()
+    # A chunk damaged since it was written (cut short) is run again: it had ended
+    # the resumed study with a BadZipFile traceback (user trial).
+    damaged = parts / "chunk-000001.npz"
+    damaged.write_bytes(damaged.read_bytes()[:100])
     computed: list[int] = []
     st.run(study, resumed, progress=lambda done, total, rate: computed.append(done))
     assert resumed.read_bytes() == whole.read_bytes()
     assert not parts.exists()
+    # Every chunk but the intact first one was run: 3 runs were done at the start.
+    assert computed[0] == 6
 
 
 def test_chunks_of_another_study_are_refused(tmp_path: Path) -> None:
@@ -646,3 +652,18 @@ def test_a_study_the_method_cannot_take_is_refused_before_any_run(tmp_path: Path
     text += '[study]\nanalysis = "run"\n[study.axes]\n"damper.0.mass" = [0.01, 0.02]\n'
     done = cli("study", str(scenario(tmp_path, text)), "--out", str(tmp_path / "r.nc"))
     assert_refused(done, ['method "exact" takes harmonic', "dop853"], tmp_path / "r.nc")
+
+
+def test_the_heat_map_of_a_study_whose_every_run_failed(tmp_path: Path) -> None:
+    # np.nanargmin of an all-NaN map had ended `study --plot` with a traceback after
+    # the file was written (trial); the map is drawn empty and says why.
+    from vibroimpact.analysis_plots import plot_study
+
+    axes = {"damper.0.mass": [0.1, 0.2], "damper.0.clearance": [1e-3, 2e-3, 3e-3]}
+    dataset = xr.Dataset(
+        {"peak": (tuple(axes), np.full((2, 3), np.nan))},
+        coords={name: values for name, values in axes.items()},
+    )
+    png = tmp_path / "heat.png"
+    plot_study(png, dataset, "peak", "damper.0.mass", "damper.0.clearance")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -322,13 +322,9 @@ def steady_state(
     ``[initial]``), find the smallest p <= ``max_period`` with the stroboscopic state
     repeating after p periods within ``tolerance`` (relative to the largest
     displacement and velocity), then record ``record_periods`` periods."""
-    for name, value, low in (
-        ("settle_periods", settle_periods, 0),
-        ("record_periods", record_periods, 1),
-        ("max_period", max_period, 1),
-    ):
-        if not isinstance(value, int) or isinstance(value, bool) or value < low:
-            raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
+    settle_periods = whole_count("settle_periods", settle_periods, 0)
+    record_periods = whole_count("record_periods", record_periods, 1)
+    max_period = whole_count("max_period", max_period, 1)
     if not tolerance > 0:
         raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
     x0 = run.initial_state() if state is None else np.asarray(state, dtype=float)
@@ -522,6 +518,16 @@ MAX_STARTS = 1_000_000
 #: impacts and tens of steps a period that is already minutes of computing, and every
 #: kept impact is memory; a longer run is a typo (1e12 for 1e2), refused before it starts.
 MAX_PERIODS = 10_000_000
+
+
+def whole_count(name: str, value: Any, low: int) -> int:
+    """``value`` as a Python int when it is a whole number >= ``low`` (an int or a
+    NumPy integer, never a boolean); else :class:`AnalysisError` naming ``name``."""
+    if isinstance(value, np.integer):
+        value = int(value)
+    if not isinstance(value, int) or isinstance(value, bool) or value < low:
+        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
+    return value
 
 
 def check_periods(where: str, key: str, value: int, low: int) -> None:
@@ -881,8 +887,7 @@ def orbit(
     the Jacobian is the monodromy matrix; its eigenvalues are the Floquet multipliers
     and the orbit is stable when all lie inside the unit circle. Newton steps that
     would start inside a wall are halved."""
-    if not isinstance(periods, int) or isinstance(periods, bool) or periods < 1:
-        raise AnalysisError(f"periods: must be a whole number >= 1, got {periods!r}")
+    periods = whole_count("periods", periods, 1)
     if not tolerance > 0:
         raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)

@@ -333,16 +333,24 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     settings = _section(scenario, "sweep", args.scenario)
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()
-    points = bifurcation(
-        scenario.data,
-        settings["parameter"],
-        sweep_values(settings),
-        direction=settings["direction"],
-        settle_periods=settings["settle_periods"],
-        sample_periods=settings["record_periods"],
-        base_dir=scenario.base_dir,
-        progress=_progress(show),
-    )
+    try:
+        points = bifurcation(
+            scenario.data,
+            settings["parameter"],
+            sweep_values(settings),
+            direction=settings["direction"],
+            settle_periods=settings["settle_periods"],
+            sample_periods=settings["record_periods"],
+            base_dir=scenario.base_dir,
+            progress=_progress(show),
+        )
+    except AnalysisError as err:
+        # The function's sample_periods is the section's record_periods.
+        message = str(err)
+        if message.startswith("sample_periods:"):
+            message = f"{args.scenario}: [sweep] record_periods:" + message[15:]
+            raise AnalysisError(message) from None
+        raise
     if show:
         print(file=sys.stderr)
     cpu_time = time.perf_counter() - start

@@ -194,7 +194,7 @@ def plot_basins(path: Path, result: Basins, x_name: str, y_name: str) -> None:
     import matplotlib.colors as colors
 
     with _figure(path) as (fig, ax):
-        count = max(len(result.attractors), 1)
+        count = len(result.attractors)
         palette = ["#000000", "#dddddd", "#ffffff"] + [
             colors.to_hex(c)
             for c in __import__("matplotlib").colormaps["tab10"](np.arange(count) % 10)
@@ -274,10 +274,15 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
         if others:
             label += ", worst over " + ", ".join(others)
         fig.colorbar(mesh, ax=ax, label=label)
-        flat = np.nanargmin(grid.values)
-        iy, ix = np.unravel_index(flat, grid.shape)
-        ax.plot(dataset[x].values[ix], dataset[y].values[iy], "r*", ms=14, label="optimum")
-        ax.legend(loc="upper right")
+        if np.isnan(grid.values).all():
+            # Every run failed: the map is empty, and says so (the reasons are in
+            # the Dataset's attributes).
+            ax.set_title("every run failed")
+        else:
+            flat = np.nanargmin(grid.values)
+            iy, ix = np.unravel_index(flat, grid.shape)
+            ax.plot(dataset[x].values[ix], dataset[y].values[iy], "r*", ms=14, label="optimum")
+            ax.legend(loc="upper right")
         for axis, name in ((ax.xaxis, x), (ax.yaxis, y)):
             values = np.asarray(dataset[name].values, dtype=float)
             # An axis spaced logarithmically is drawn so.

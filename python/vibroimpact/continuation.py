@@ -34,6 +34,7 @@ from vibroimpact.analyses import (
     forcing_period,
     orbit,
     runner,
+    whole_count,
     with_parameter,
 )
 
@@ -110,8 +111,7 @@ def continue_orbit(
     start_value = _value_of(data, parameter)
     if not math.isfinite(stop) or stop == start_value:
         raise AnalysisError(f"stop: must be a finite value other than the start {start_value:g}")
-    if not isinstance(max_points, int) or max_points < 2:
-        raise AnalysisError(f"max_points: must be a whole number >= 2, got {max_points!r}")
+    max_points = whole_count("max_points", max_points, 2)
     span = stop - start_value
     ds = abs(span) / 50 if step is None else float(step)
     if not ds > 0:

@@ -14,13 +14,14 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
 from vibroimpact.analyses import (
     AnalysisError,
     Runner,
     from_carried,
     runner,
     steady_state,
+    whole_count,
     with_parameter,
 )
 
@@ -47,8 +48,8 @@ def poincare(
 ) -> Section:
     """Settle ``settle_periods`` forcing periods, then sample ``periods`` more: the
     stroboscopic section and the impact section."""
-    _whole("settle_periods", settle_periods, 0)
-    _whole("periods", periods, 1)
+    settle_periods = whole_count("settle_periods", settle_periods, 0)
+    periods = whole_count("periods", periods, 1)
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     if settle_periods:
         z = run.map(z, settle_periods)
@@ -103,12 +104,23 @@ def bifurcation(
     the order given (``"up"``), reversed (``"down"``) or both, settle from the last
     point's state (see :func:`~vibroimpact.analyses.from_carried`) and keep
     ``sample_periods`` stroboscopic states."""
-    _whole("settle_periods", settle_periods, 0)
-    _whole("sample_periods", sample_periods, 1)
+    settle_periods = whole_count("settle_periods", settle_periods, 0)
+    sample_periods = whole_count("sample_periods", sample_periods, 1)
     legs = _legs(direction, [float(v) for v in values])
     points: list[BifurcationPoint] = []
     state: np.ndarray | None = None
     total = sum(len(v) for _, v in legs)
+    if total:
+        # Every point's samples are kept: refused before any run where they would
+        # pass a run's memory limit (1e5 points of 1e6 periods had grown to an abort).
+        width = len(_runner_at(data, parameter, legs[0][1][0], base_dir).initial_state())
+        kept = 8.0 * total * sample_periods * width
+        if kept > MAX_RECORD_BYTES:
+            raise AnalysisError(
+                f"sample_periods: {total} points of {sample_periods} periods would keep "
+                f"{kept / 2**20:.0f} MiB of samples, more than the {MAX_RECORD_BYTES >> 20} "
+                "MiB a run's records may take: sample fewer periods or fewer values"
+            )
     for leg, leg_values in legs:
         for value in leg_values:
             run = _runner_at(data, parameter, value, base_dir)
@@ -156,6 +168,12 @@ def basins(
     state (x, v), values)``), starting from ``state`` (default ``[initial]``) with
     those two set, find the steady state and group the results into attractors:
     same period, same impacts per period and amplitudes within 1e-3 relative."""
+    # Checked here: each start's steady state would take a bad count for a start
+    # inside a wall (every label -3).
+    settle_periods = whole_count("settle_periods", settle_periods, 0)
+    record_periods = whole_count("record_periods", record_periods, 1)
+    if not tolerance > 0:
+        raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
     base = run.initial_state() if state is None else np.asarray(state, dtype=float)
     for name, (index, _) in (("first", first), ("second", second)):
         if not 0 <= index < len(base):
@@ -228,8 +246,3 @@ def _legs(direction: str, values: list[float]) -> list[tuple[str, list[float]]]:
     if direction in ("down", "both"):
         legs.append(("down", values[::-1]))
     return legs
-
-
-def _whole(name: str, value: Any, low: int) -> None:
-    if not isinstance(value, int) or isinstance(value, bool) or value < low:
-        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")

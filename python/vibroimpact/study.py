@@ -92,6 +92,7 @@ import secrets
 import shutil
 import sys
 import time
+import zipfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -755,7 +756,8 @@ def _save(path: Path, part: dict[str, Any]) -> None:
 
 
 def _load(path: Path) -> dict[str, Any]:
-    with np.load(path, allow_pickle=False) as data:
+    # The file opened here, closed here: np.load leaves a damaged one open.
+    with path.open("rb") as f, np.load(f, allow_pickle=False) as data:
         part = {key: data[key] for key in data.files}
     part["n"] = int(part["n"])
     part["pairs"] = [str(p) for p in part["pairs"]]
@@ -803,12 +805,22 @@ def run(
             f.write(json.dumps({"input_hash": fingerprint, "runs": study.runs}))
     chunks = study.chunks()
     path_of = [parts_dir / f"chunk-{number:06d}.npz" for number in range(len(chunks))]
-    pending = [number for number, path in enumerate(path_of) if not path.exists()]
+    parts: dict[int, dict[str, Any]] = {}
+    for number, path in enumerate(path_of):
+        if path.exists():
+            try:
+                parts[number] = _load(path)
+            except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+                # Written whole, so damaged since (a disk, a hand): run it again.
+                pass
+    pending = [number for number in range(len(path_of)) if number not in parts]
     start = time.perf_counter()
     state = {"computed": 0, "done": study.runs - sum(len(chunks[i]) for i in pending)}
 
     def finished(number: int, part: dict[str, Any]) -> None:
         _save(path_of[number], part)
+        # As a resumed study reads it (the same types).
+        parts[number] = _load(path_of[number])
         state["computed"] += len(chunks[number])
         state["done"] += len(chunks[number])
         if progress is not None:
@@ -827,8 +839,7 @@ def run(
         if not any(parts_dir.glob("chunk-*.npz")):
             shutil.rmtree(parts_dir, ignore_errors=True)
         raise
-    parts = [_load(path) for path in path_of]
-    dataset = assemble(study, parts)
+    dataset = assemble(study, [parts[number] for number in range(len(path_of))])
     if kind == ".zarr":
         _write_zarr(dataset, out)
     else:

@@ -90,17 +90,25 @@ impl Configuration {
         })?;
         let linv = linalg::inverse_lower(&l, r);
         // A = L^-1 K L^-T; Phi = L^-T V.
+        // As two products (`r^3` each, where the sum over both indices at
+        // once took `r^4`: minutes for a thousand dampers).
         let similar = |a: &[f64]| {
+            let mut left = vec![0.0; r * r];
+            for p in 0..r {
+                for i in 0..r {
+                    let factor = linv[p * r + i];
+                    if factor != 0.0 {
+                        for j in 0..r {
+                            left[p * r + j] += factor * a[i * r + j];
+                        }
+                    }
+                }
+            }
             let mut out = vec![0.0; r * r];
             for p in 0..r {
                 for q in 0..r {
-                    let mut sum = 0.0;
-                    for i in 0..r {
-                        for j in 0..r {
-                            sum += linv[p * r + i] * a[i * r + j] * linv[q * r + j];
-                        }
-                    }
-                    out[p * r + q] = sum;
+                    out[p * r + q] =
+                        linalg::dot(&left[p * r..(p + 1) * r], &linv[q * r..(q + 1) * r]);
                 }
             }
             out
@@ -114,16 +122,26 @@ impl Configuration {
                 phi[i * r + c] = (0..r).map(|k| linv[k * r + i] * vectors[k * r + c]).sum();
             }
         }
+        // Phi^T C Phi, as two products (`r^3` each).
         let modal_damping = |phi: &[f64]| {
-            let mut out = vec![0.0; r * r];
-            for p in 0..r {
-                for q in 0..r {
-                    let mut sum = 0.0;
-                    for i in 0..r {
-                        let row: f64 = (0..r).map(|j| cr[i * r + j] * phi[j * r + q]).sum();
-                        sum += phi[i * r + p] * row;
+            let mut damped = vec![0.0; r * r];
+            for i in 0..r {
+                for j in 0..r {
+                    let factor = cr[i * r + j];
+                    if factor != 0.0 {
+                        for q in 0..r {
+                            damped[i * r + q] += factor * phi[j * r + q];
+                        }
                     }
-                    out[p * r + q] = sum;
+                }
+            }
+            let mut out = vec![0.0; r * r];
+            for i in 0..r {
+                for p in 0..r {
+                    let factor = phi[i * r + p];
+                    for q in 0..r {
+                        out[p * r + q] += factor * damped[i * r + q];
+                    }
                 }
             }
             out
@@ -321,16 +339,23 @@ impl Reduced {
                 }
             }
         }
+        // N^T A N, as two products (`dim^2 r` and `dim r^2`, where the sum
+        // for each entry at once took `dim^2 r^2`: minutes for a thousand
+        // dampers).
         let reduce = |a: &[f64]| {
+            // A N, column q of N in row q of `an`.
+            let an: Vec<Vec<f64>> = null
+                .iter()
+                .map(|n| {
+                    (0..dim)
+                        .map(|i| linalg::dot(&a[i * dim..(i + 1) * dim], n))
+                        .collect()
+                })
+                .collect();
             let mut out = vec![0.0; r * r];
             for p in 0..r {
                 for q in 0..r {
-                    let mut sum = 0.0;
-                    for i in 0..dim {
-                        let row: f64 = (0..dim).map(|j| a[i * dim + j] * null[q][j]).sum();
-                        sum += null[p][i] * row;
-                    }
-                    out[p * r + q] = sum;
+                    out[p * r + q] = linalg::dot(&null[p], &an[q]);
                 }
             }
             out

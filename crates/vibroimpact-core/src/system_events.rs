@@ -727,9 +727,22 @@ const CHATTER_EVENTS: u64 = 16;
 const CHATTER_ULPS: f64 = 1e3;
 /// Steps in a row at the round-off of time that stop a run.
 const STALLED_STEPS: u64 = 64;
+/// The longest a system of more than 16 coordinates goes without asking
+/// whether to stop, s (its steps cost far more than reading the clock).
+const POLL_SECONDS: f64 = 0.2;
 /// How often (steps) the caller is asked whether to stop (a multiple of
 /// [`ENERGY_INTERVAL`]).
 const INTERRUPT_INTERVAL: u64 = 1 << 14;
+
+/// [`INTERRUPT_INTERVAL`] for a system of `dim` coordinates: shorter for
+/// large systems, whose steps cost as the square of their size (the exact
+/// flow's with 200 modes, a millisecond), so that a poll comes within a
+/// fraction of a second; a multiple of [`ENERGY_INTERVAL`].
+fn interrupt_interval(dim: usize) -> u64 {
+    // (Beyond 16 coordinates the clock is read at every step as well.)
+    let scale = (dim as u64 / 16).max(1);
+    (INTERRUPT_INTERVAL / (scale * scale) / ENERGY_INTERVAL).max(1) * ENERGY_INTERVAL
+}
 
 /// Integrates `system` from `initial` (see [`crate::assembly::initial_state`]).
 pub fn integrate_system<S: SystemStepper>(
@@ -898,6 +911,9 @@ pub fn integrate_system_within<S: SystemStepper>(
 
     // Each compliant contact's deepest indentation, lent to stretches.
     let stretches = !adaptive && stepper.takes_stretches(system);
+    let poll_every = interrupt_interval(system.dim);
+    let timed_polls = system.dim > 16;
+    let mut last_poll = std::time::Instant::now();
     let mut deepest = vec![f64::NAN; count];
     while time < t_end {
         // Plain steps in a row, where the stepper can take them at once (each
@@ -922,7 +938,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                 evaluations: 0,
                 steps: 0,
                 // Up to the next interrupt poll, made here after it.
-                max_accepted: ((accepted / INTERRUPT_INTERVAL + 1) * INTERRUPT_INTERVAL)
+                max_accepted: ((accepted / poll_every + 1) * poll_every)
                     .min(options.max_steps.saturating_sub(control.rejected + 1)),
                 limited: false,
                 dt,
@@ -962,7 +978,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                 // What the loop does after a plain step that it may have
                 // been, beyond the energy check the stretch made: an
                 // interrupt poll.
-                if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
+                if accepted % poll_every == 0 && interrupt() {
                     return Err(Error::Interrupted { time });
                 }
                 if limited {
@@ -1450,8 +1466,15 @@ pub fn integrate_system_within<S: SystemStepper>(
                 max_steps: options.max_steps,
             });
         }
-        if accepted % INTERRUPT_INTERVAL == 0 && interrupt() {
-            return Err(Error::Interrupted { time });
+        // Large systems poll by the clock too: a step of hundreds of sticking
+        // pairs (a constraint solve in each stage) takes a tenth of a second.
+        let due = accepted % poll_every == 0
+            || (timed_polls && last_poll.elapsed().as_secs_f64() >= POLL_SECONDS);
+        if due {
+            last_poll = std::time::Instant::now();
+            if interrupt() {
+                return Err(Error::Interrupted { time });
+            }
         }
     }
 

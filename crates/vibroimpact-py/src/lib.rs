@@ -20,6 +20,10 @@ use run::*;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // NumPy's C API is looked up (a Python import) on the first array made.
+    // Made here, not after a run: a Ctrl-C pending at the end of a run made
+    // that import fail, and the numpy crate panics where it fails.
+    numpy::PyArray1::<f64>::zeros(py, 0, false);
     m.add("InvalidInputError", py.get_type::<InvalidInputError>())?;
     m.add(
         "NumericalBlowUpError",
