@@ -93,17 +93,7 @@ impl Configuration {
         // As two products (`r^3` each, where the sum over both indices at
         // once took `r^4`: minutes for a thousand dampers).
         let similar = |a: &[f64]| {
-            let mut left = vec![0.0; r * r];
-            for p in 0..r {
-                for i in 0..r {
-                    let factor = linv[p * r + i];
-                    if factor != 0.0 {
-                        for j in 0..r {
-                            left[p * r + j] += factor * a[i * r + j];
-                        }
-                    }
-                }
-            }
+            let left = product(&linv, a, r);
             let mut out = vec![0.0; r * r];
             for p in 0..r {
                 for q in 0..r {
@@ -124,17 +114,7 @@ impl Configuration {
         }
         // Phi^T C Phi, as two products (`r^3` each).
         let modal_damping = |phi: &[f64]| {
-            let mut damped = vec![0.0; r * r];
-            for i in 0..r {
-                for j in 0..r {
-                    let factor = cr[i * r + j];
-                    if factor != 0.0 {
-                        for q in 0..r {
-                            damped[i * r + q] += factor * phi[j * r + q];
-                        }
-                    }
-                }
-            }
+            let damped = product(cr, phi, r);
             let mut out = vec![0.0; r * r];
             for i in 0..r {
                 for p in 0..r {
@@ -301,6 +281,26 @@ pub struct Reduced {
     pub mass: Vec<f64>,
     pub stiffness: Vec<f64>,
     pub damping: Vec<f64>,
+}
+
+/// `A B` of two `r x r` row-major matrices, the zeros of `A` skipped (the
+/// triangular `L^-1`, a sparse damping).
+fn product(a: &[f64], b: &[f64], r: usize) -> Vec<f64> {
+    let mut out = vec![0.0; r * r];
+    for p in 0..r {
+        for i in 0..r {
+            let factor = a[p * r + i];
+            if factor != 0.0 {
+                for (o, b) in out[p * r..(p + 1) * r]
+                    .iter_mut()
+                    .zip(&b[i * r..(i + 1) * r])
+                {
+                    *o += factor * b;
+                }
+            }
+        }
+    }
+    out
 }
 
 impl Reduced {
