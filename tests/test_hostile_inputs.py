@@ -760,3 +760,12 @@ def test_the_exact_flow_sets_up_hundreds_of_dampers_without_hanging() -> None:
     assert len(relative) == 300 and np.all(np.abs(relative) <= 0.005 * (1 + 1e-9))
     energy = sol.energy
     assert abs(energy["residual"]) <= 1e-9 * energy["input_work"]
+
+
+def test_a_fifo_given_as_the_scenario_is_refused_without_waiting(
+    run_cli: Cli, tmp_path: Path
+) -> None:
+    # Opening a FIFO waits for a writer: `simulate fifo` had waited for ever (trial).
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)
+    refused(run_cli("simulate", str(fifo)), "not a regular file", str(fifo))

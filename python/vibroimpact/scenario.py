@@ -11,6 +11,7 @@ import difflib
 import inspect
 import math
 import reprlib
+import stat
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -299,6 +300,11 @@ def load_scenario(path: str | Path) -> Scenario | SystemScenario:
     """Read and validate a TOML scenario file (UTF-8, at most ``MAX_SCENARIO_BYTES``)."""
     path = Path(path)
     try:
+        # Checked before opening: opening a FIFO waits for a writer, for ever.
+        if not stat.S_ISREG(path.stat().st_mode) and not path.is_dir():
+            raise ScenarioError(
+                f"cannot read scenario {str(path)!r}: not a regular file (a TOML scenario)"
+            )
         with path.open("rb") as f:
             data = f.read(MAX_SCENARIO_BYTES + 1)
         if len(data) > MAX_SCENARIO_BYTES:
