@@ -776,7 +776,7 @@ impl Assembly {
                     let (approach_rate, damping) = (*approach_rate, *damping);
                     let (hx, hv) = match previous {
                         Some((hx, hv)) if *mirror => (-hx, -hv),
-                        _ => force_dots(&it.h[..d], x, v),
+                        _ => (h_dot(&it.h[..d], x), h_dot(&it.h[..d], v)),
                     };
                     products = Some((hx, hv));
                     let (indentation, rate) = (-(it.offset + hx), -hv);
@@ -1174,20 +1174,6 @@ fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
         hv += h[i] * v[i];
     }
     (hx, hv)
-}
-
-/// `(h . x, h . v)` as [`h_dot`] sums each: a compliant wall's indentation
-/// and rate for its force.
-#[inline(always)]
-fn force_dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
-    let n = h.len();
-    let (x, v) = (&x[..n], &v[..n]);
-    let (mut hx, mut hv) = ([-0.0; 2], [-0.0; 2]);
-    for i in 0..n {
-        hx[i % 2] += h[i] * x[i];
-        hv[i % 2] += h[i] * v[i];
-    }
-    (hx[0] + hx[1], hv[0] + hv[1])
 }
 
 /// A wall's `h` times a vector where the product leads to a force: a

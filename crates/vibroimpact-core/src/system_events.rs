@@ -727,8 +727,10 @@ const CHATTER_EVENTS: u64 = 16;
 const CHATTER_ULPS: f64 = 1e3;
 /// Steps in a row at the round-off of time that stop a run.
 const STALLED_STEPS: u64 = 64;
-/// The longest a system of more than 16 coordinates goes without asking
-/// whether to stop, s (its steps cost far more than reading the clock).
+/// Systems of more coordinates than this also ask whether to stop by the
+/// clock (their steps cost far more than reading it).
+const TIMED_POLLS_BEYOND: usize = 16;
+/// The longest such a system goes without asking whether to stop, s.
 const POLL_SECONDS: f64 = 0.2;
 /// How often (steps) the caller is asked whether to stop (a multiple of
 /// [`ENERGY_INTERVAL`]).
@@ -739,8 +741,7 @@ const INTERRUPT_INTERVAL: u64 = 1 << 14;
 /// flow's with 200 modes, a millisecond), so that a poll comes within a
 /// fraction of a second; a multiple of [`ENERGY_INTERVAL`].
 fn interrupt_interval(dim: usize) -> u64 {
-    // (Beyond 16 coordinates the clock is read at every step as well.)
-    let scale = (dim as u64 / 16).max(1);
+    let scale = (dim / TIMED_POLLS_BEYOND).max(1) as u64;
     (INTERRUPT_INTERVAL / (scale * scale) / ENERGY_INTERVAL).max(1) * ENERGY_INTERVAL
 }
 
@@ -912,7 +913,7 @@ pub fn integrate_system_within<S: SystemStepper>(
     // Each compliant contact's deepest indentation, lent to stretches.
     let stretches = !adaptive && stepper.takes_stretches(system);
     let poll_every = interrupt_interval(system.dim);
-    let timed_polls = system.dim > 16;
+    let timed_polls = system.dim > TIMED_POLLS_BEYOND;
     let mut last_poll = std::time::Instant::now();
     let mut deepest = vec![f64::NAN; count];
     while time < t_end {
