@@ -24,6 +24,7 @@ import numpy as np
 
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem
 from vibroimpact._core import _forcing_period as _core_forcing_period
+from vibroimpact.summary import summarised
 from vibroimpact.system import (
     _NUMBER,
     _REQ,
@@ -286,6 +287,7 @@ def _scaled_distance(a: np.ndarray, b: np.ndarray, dim: int, reference: np.ndarr
     return max(dx, dv)
 
 
+@summarised
 @dataclass
 class SteadyState:
     """A steady response (SI units): per structure coordinate the located
@@ -408,6 +410,7 @@ def linear_response(
     return total, at_points[:p], at_points[p:]
 
 
+@summarised
 @dataclass
 class SweepPoint:
     """One point of a sweep (see :func:`sweep`)."""
@@ -842,6 +845,7 @@ def sweep(
     return points
 
 
+@summarised
 @dataclass
 class Orbit:
     """A periodic orbit of ``periods`` forcing periods found by shooting."""

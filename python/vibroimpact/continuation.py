@@ -37,8 +37,10 @@ from vibroimpact.analyses import (
     whole_count,
     with_parameter,
 )
+from vibroimpact.summary import summarised
 
 
+@summarised
 @dataclass
 class BranchPoint:
     """One orbit on a branch."""
@@ -79,6 +81,7 @@ class BranchPoint:
         }
 
 
+@summarised
 @dataclass
 class Branch:
     """A continued branch of K-period orbits, and why it stopped."""

@@ -24,8 +24,10 @@ from vibroimpact.analyses import (
     whole_count,
     with_parameter,
 )
+from vibroimpact.summary import summarised
 
 
+@summarised
 @dataclass
 class Section:
     """A Poincare section: ``strobe`` rows of the state ``(x, v)`` at each forcing
@@ -68,6 +70,7 @@ def poincare(
     )
 
 
+@summarised
 @dataclass
 class BifurcationPoint:
     """The sampled stroboscopic states at one parameter value."""
@@ -139,6 +142,7 @@ def bifurcation(
     return points
 
 
+@summarised
 @dataclass
 class Basins:
     """Basins of attraction over a grid of two initial values: ``labels[i, j]`` is

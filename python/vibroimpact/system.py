@@ -62,6 +62,7 @@ from vibroimpact._core import (
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
 from vibroimpact.messages import short_numbers, shown
+from vibroimpact.summary import contacts_repr, solution_repr
 
 __all__ = [
     "PreparedRun",
@@ -756,6 +757,9 @@ class SystemContacts:
     def __len__(self) -> int:
         return len(self.pair)
 
+    def __repr__(self) -> str:
+        return contacts_repr(self)
+
     def to_dicts(self) -> list[dict[str, Any]]:
         """One dict per contact, keyed by the column names."""
         return [
@@ -850,6 +854,9 @@ class SystemSolution:
         """The structure's velocity (m/s, relative to the base) at a point (see
         :meth:`shape_at`), at each kept time ``t``."""
         return np.asarray(self.structure_velocity @ self.shape_at(at), dtype=float)
+
+    def __repr__(self) -> str:
+        return solution_repr(self)
 
 
 def simulate_system(

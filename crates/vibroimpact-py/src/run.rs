@@ -255,14 +255,25 @@ impl Solution {
     fn contact_force(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
         self.history[5].get(py)
     }
+    /// One line: the run (method, stepping, time reached, steps), the contacts and
+    /// rows kept, and the fields (never the arrays themselves).
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
-            "Solution(method={:?}, stepping={:?}, steps={}, rows={}, contacts={})",
+            "Solution(two-body run, method={:?}, stepping={:?}, t_end={:?} s, steps={}, \
+             contacts={}, rows={}; fields: t, main_displacement, main_velocity, \
+             impact_displacement, impact_velocity, contact_force, contacts, steps, \
+             rejected_steps, rhs_evaluations, grazing_contacts, final_time, final_state, \
+             energy_growth, energy_residual)",
             self.method,
             self.stepping,
+            // Six significant digits: a fixed-step run's time is t_end rounded up to
+            // whole steps, with round-off digits not worth a line.
+            format!("{:.5e}", self.final_time)
+                .parse::<f64>()
+                .unwrap_or(self.final_time),
             self.steps,
+            self.contacts.bind(py).get().records.len(),
             self.rows,
-            self.contacts.bind(py).get().records.len()
         )
     }
 }

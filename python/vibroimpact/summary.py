@@ -1,0 +1,99 @@
+"""Short ``repr`` of the result classes: what a result is and what it holds, never
+its arrays in full (a run's solution printed whole had been 50 kB: every history
+row, and one ``'damper 0'`` per contact)."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Mapping
+from typing import Any, TypeVar
+
+import numpy as np
+
+_T = TypeVar("_T", bound=type)
+
+#: Arrays and lists of at most this many entries are shown whole.
+_SHOWN = 4
+
+
+def brief(value: Any) -> str:
+    """One short text for a field's value: scalars as they are (floats to 6
+    significant digits), small arrays and lists whole, larger ones by their shape
+    or length, dicts by their keys."""
+    if isinstance(value, np.ndarray):
+        if value.ndim <= 1 and value.size <= _SHOWN:
+            return "[" + ", ".join(brief(v.item()) for v in np.ravel(value)) + "]"
+        return f"<array {'x'.join(str(s) for s in value.shape)}>"
+    if isinstance(value, (list, tuple)):
+        if len(value) <= _SHOWN and all(isinstance(v, (int, float, str)) for v in value):
+            return "[" + ", ".join(brief(v) for v in value) + "]"
+        return f"<{len(value)} items>"
+    if isinstance(value, Mapping):
+        if len(value) <= _SHOWN and all(isinstance(v, (int, float)) for v in value.values()):
+            return "{" + ", ".join(f"{k}: {brief(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(str(k) for k in value) + "}"
+    if isinstance(value, complex):
+        return f"{value.real:.6g}{value.imag:+.6g}j"
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, (bool, int, str)) or value is None:
+        return repr(value)
+    return f"<{type(value).__name__}>"
+
+
+def _empty(value: Any) -> bool:
+    return value is None or (
+        isinstance(value, (np.ndarray, list, tuple, Mapping)) and len(value) == 0
+    )
+
+
+def fields_repr(obj: Any) -> str:
+    """``Name(field=brief value, ...)`` of a dataclass instance, leaving out fields
+    that are empty or None (an absent error, points not asked for)."""
+    parts = [
+        f"{f.name}={brief(getattr(obj, f.name))}"
+        for f in dataclasses.fields(obj)
+        if f.repr and not _empty(getattr(obj, f.name))
+    ]
+    return f"{type(obj).__name__}({', '.join(parts)})"
+
+
+def summarised(cls: _T) -> _T:
+    """Class decorator (above ``@dataclass``): a :func:`fields_repr` ``repr``."""
+    method: Callable[[Any], str] = fields_repr
+    cls.__repr__ = method  # type: ignore[assignment]
+    return cls
+
+
+def solution_repr(sol: Any) -> str:
+    """A 0.2 run's solution in one line: the structure, the method, the time
+    reached (s), the steps, the contacts (and the pairs they came from), the kept
+    rows and the names of the fields that hold something."""
+    kind = sol.structure.get("kind", "structure") if sol.structure else "structure"
+    n, k = sol.structure_displacement.shape[1], sol.damper_displacement.shape[1]
+    pairs = sorted(set(sol.contacts.pair))
+    shown = ", ".join(pairs[:_SHOWN]) + (", ..." if len(pairs) > _SHOWN else "")
+    held = [
+        f.name
+        for f in dataclasses.fields(sol)
+        if not _empty(getattr(sol, f.name)) and f.name not in ("structure", "pairs")
+    ]
+    return (
+        f"{type(sol).__name__}({kind} of {n} coordinate(s) and {k} damper(s), "
+        f"method={sol.method!r}, t_end={sol.final_time:.6g} s, steps={sol.steps}, "
+        f"contacts={len(sol.contacts)}" + (f" ({shown})" if pairs else "") + ", "
+        f"rows={len(sol.t)}; fields: {', '.join(held)})"
+    )
+
+
+def contacts_repr(contacts: Any) -> str:
+    """A contact table in one line: how many contacts, of which kinds, and the pairs."""
+    kinds = {kind: list(contacts.kind).count(kind) for kind in sorted(set(contacts.kind))}
+    pairs = sorted(set(contacts.pair))
+    return (
+        f"{type(contacts).__name__}({len(contacts)} contacts"
+        + "".join(f", {count} {kind}" for kind, count in kinds.items())
+        + (f"; pairs: {', '.join(pairs[:_SHOWN])}" if pairs else "")
+        + (", ..." if len(pairs) > _SHOWN else "")
+        + f"; columns: {', '.join(contacts.columns)})"
+    )
