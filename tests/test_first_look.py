@@ -9,9 +9,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 import vibroimpact as vi
-from vibroimpact import analyses, continuation, maps
+from vibroimpact import analyses, analysis_plots, continuation, maps
 from vibroimpact.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -84,3 +85,97 @@ def test_every_analysis_result_has_a_short_repr() -> None:
     branch = results[-1]
     assert f"<{len(branch.points)} items>" in repr(branch)
     assert len(repr(branch.points[0])) < SHORT
+
+
+# ------------------------------------------------------------------- plots
+
+
+@pytest.fixture
+def figures(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
+    """Figures drawn by analysis_plots, kept (and drawn) instead of written."""
+    kept: dict[str, Any] = {}
+
+    def keep(fig: Any, path: Path) -> None:
+        fig.canvas.draw()
+        kept[path.name] = fig
+
+    monkeypatch.setattr(analysis_plots, "_save", keep)
+    return kept
+
+
+def test_the_poincare_plot_of_a_period_one_orbit_shows_a_point_not_round_off(
+    figures: dict[str, Any],
+) -> None:
+    # Holmes's period-one orbit of the ball on the table: every strobe and impact the
+    # same to 1e-13, which the axes had spread over their whole width.
+    run = analyses.runner(_sections("bouncing_ball_table.toml"))
+    section = maps.poincare(run, settle_periods=200, periods=200)
+    assert np.ptp(section.strobe[:, 0]) < 1e-10
+    analysis_plots.plot_section(Path("section.png"), section, run.period)
+    left, right = figures["section.png"].axes
+    height = float(np.max(section.strobe[:, 0]))
+    for axis, value in (
+        (left.xaxis, section.strobe[0, 0]),
+        (left.yaxis, section.strobe[0, 1]),
+        (right.yaxis, section.impact_speed[0]),
+    ):
+        low, high = axis.get_view_interval()
+        # A range on the scale of the motion (the orbit is 16 mm high, 0.65 m/s at
+        # impact), with the point inside it, and no offset text.
+        assert low < value < high
+        assert high - low > 0.01 * max(abs(value), height)
+        assert axis.get_offset_text().get_text() == ""
+        for label in axis.get_ticklabels():
+            assert "e-" not in label.get_text() and "+" not in label.get_text()
+
+
+def _overlaps(box: Any, x: float, y: float) -> bool:
+    return bool(box.x0 <= x <= box.x1 and box.y0 <= y <= box.y1)
+
+
+def test_the_frf_plot_marks_unsettled_points_with_their_spread_and_keeps_the_legend_off_the_peaks(
+    figures: dict[str, Any],
+) -> None:
+    data = _sections("frf_impact_damper.toml")
+    points = analyses.sweep(
+        data, "excitation.0.frequency", np.linspace(7.0, 13.0, 61), direction="both"
+    )
+    unsettled = [p for p in points if not p.settled]
+    assert len(unsettled) >= 5  # around the resonance, impacts never settle
+    analysis_plots.plot_sweep(Path("frf.png"), "excitation.0.frequency", points, data)
+    fig = figures["frf.png"]
+    (ax,) = fig.axes
+    marked = [line for line in ax.lines if "not settled" in line.get_label()]
+    assert len(marked) == 1
+    np.testing.assert_array_equal(marked[0].get_xdata(), [p.value for p in unsettled])
+    (spread,) = [c for c in ax.collections if "spread" in c.get_label()]
+    segments = spread.get_segments()
+    assert len(segments) == len(unsettled)
+    for segment, p in zip(segments, unsettled, strict=True):
+        (x0, y0), (x1, y1) = segment
+        assert x0 == x1 == p.value
+        assert (y0, y1) == (p.least_period_peak[0], p.amplitude[0])
+        assert y0 <= y1
+    # Neither the linear peak nor the swept one under the legend.
+    legend = ax.get_legend().get_window_extent()
+    linear = max(points, key=lambda p: p.linear_amplitude[0])
+    swept = max(points, key=lambda p: p.amplitude[0])
+    for x, y in ((linear.value, linear.linear_amplitude[0]), (swept.value, swept.amplitude[0])):
+        assert not _overlaps(legend, *ax.transData.transform((x, y)))
+
+
+def test_the_spread_of_an_unsettled_response_is_its_periods_smallest_and_largest_peak() -> None:
+    # The ball on the table at Gamma 1.8: no period of at most 8. Independent values:
+    # each period's highest row of a dense history (200 rows a period) of the same run.
+    data = _sections("ball_table_bifurcation.toml")
+    data["excitation"][0]["amplitude"] = 18.0
+    run = analyses.runner(data)
+    start = run.map(run.initial_state(), 200)
+    result = analyses.steady_state(run, start, settle_periods=0, record_periods=30)
+    assert not result.settled
+    history = analysis_plots.orbit_history(run, start, 30)
+    t, x = history.t, history.structure_displacement[:, 0]
+    heights = [np.max(x[(t >= i * run.period) & (t <= (i + 1) * run.period)]) for i in range(30)]
+    assert result.amplitude[0] == pytest.approx(max(heights), rel=1e-3)
+    assert result.least_period_peak[0] == pytest.approx(min(heights), rel=1e-3)
+    assert min(heights) < 0.5 * max(heights)  # a real spread, not round-off

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import math
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
@@ -277,6 +278,39 @@ def _impacts(raw: Mapping[str, Any]) -> int:
     return sum(1 for kind in kinds if kind in ("impact", "compliant"))
 
 
+def _recorded_by_period(
+    run: Runner, state: np.ndarray, count: int
+) -> tuple[dict[str, Any], np.ndarray]:
+    """``count`` recorded forcing periods from ``state``, run one period at a time:
+    the window's record as one run gives it (the largest located peaks, the square
+    integrals, time and contacts summed, the final state) and the smallest of the
+    periods' located peaks (the spread of a response that does not repeat)."""
+    peaks: list[np.ndarray] = []
+    squares: Any = 0.0
+    time = 0.0
+    kinds: list[str] = []
+    z = state
+    for _ in range(count):
+        raw = run.periods(z, 1, record=True)
+        peaks.append(np.asarray(raw["peaks"], dtype=float))
+        squares = squares + np.asarray(raw["square_integrals"], dtype=float)
+        time += float(raw["recorded_time"])
+        kinds += list(raw["contacts"]["kind"])
+        z = np.asarray(raw["final_state"], dtype=float)
+    rows = np.array(peaks)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a quantity with no peak: NaN
+        largest, least = np.nanmax(rows, axis=0), np.nanmin(rows, axis=0)
+    merged = {
+        "peaks": largest,
+        "square_integrals": squares,
+        "recorded_time": time,
+        "contacts": {"kind": kinds},
+        "final_state": z,
+    }
+    return merged, least
+
+
 def _scaled_distance(a: np.ndarray, b: np.ndarray, dim: int, reference: np.ndarray) -> float:
     """|a - b| with displacements and velocities each scaled by their largest
     magnitude in ``reference`` (rows of states)."""
@@ -309,6 +343,11 @@ class SteadyState:
     #: The bending moment's (N m) at each of ``[output] moments``.
     moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: Where the response did not settle: the smallest of the recorded periods'
+    #: located peaks (m; N m for moments) of each coordinate, then of the structure
+    #: at each point, then of each moment (``amplitude`` is the largest); empty where
+    #: it settled.
+    least_period_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def steady_state(
@@ -345,7 +384,12 @@ def steady_state(
             if _scaled_distance(rows[-1], rows[-1 - p], dim, tail) <= tolerance:
                 period = p
                 break
-    recorded = run.periods(x0, record_periods, record=True)
+    least = np.zeros(0)
+    if period is None:
+        # Not periodic: each period's peak, for the spread of the amplitudes.
+        recorded, least = _recorded_by_period(run, x0, record_periods)
+    else:
+        recorded = run.periods(x0, record_periods, record=True)
     amplitude, point_amplitude, moment_amplitude = run.amplitudes(recorded)
     rms, point_rms, moment_rms = run.rms(recorded)
     return SteadyState(
@@ -360,6 +404,7 @@ def steady_state(
         point_rms=point_rms,
         moment_amplitude=moment_amplitude,
         moment_rms=moment_rms,
+        least_period_peak=least,
     )
 
 
@@ -434,6 +479,9 @@ class SweepPoint:
     moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
     linear_moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: Where the response did not settle, the smallest of the periods' peaks (see
+    #: :attr:`SteadyState.least_period_peak`).
+    least_period_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def to_dict(self) -> dict[str, Any]:
         def floats(a: np.ndarray) -> list[float | None]:
@@ -838,6 +886,7 @@ def sweep(
                     moment_amplitude=result.moment_amplitude,
                     moment_rms=result.moment_rms,
                     linear_moment_amplitude=linear_moments,
+                    least_period_peak=result.least_period_peak,
                 )
             )
             if progress is not None:

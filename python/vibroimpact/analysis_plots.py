@@ -22,7 +22,7 @@ from vibroimpact.analyses import (
 from vibroimpact.continuation import Branch
 from vibroimpact.maps import Basins, BifurcationPoint, Section
 from vibroimpact.output import written_whole
-from vibroimpact.system import SystemSolution
+from vibroimpact.system import SystemSolution, split_observed
 
 
 @contextmanager
@@ -38,10 +38,35 @@ def _figure(
     try:
         yield fig, axes
         fig.tight_layout()
-        with written_whole(path, binary=True) as f:
-            fig.savefig(f, format="png", dpi=120)
+        _save(fig, path)
     finally:
         plt.close(fig)
+
+
+def _save(fig: Any, path: Path) -> None:
+    with written_whole(path, binary=True) as f:
+        fig.savefig(f, format="png", dpi=120)
+
+
+#: The least half-width of an axis, relative to the size of the motion: points that
+#: coincide to round-off (a periodic orbit's) are drawn as the points they are, not
+#: spread over an axis of 1e-13 with an offset label.
+_LEAST_HALF_SPAN = 0.05
+
+
+def _span_at_least(ax: Any, axis: str, values: np.ndarray, size: float) -> None:
+    """Widen ``axis`` ("x" or "y") of ``ax`` about the middle of ``values`` to at
+    least ``_LEAST_HALF_SPAN * size`` either side, and show plain tick labels
+    (no offset text)."""
+    values = values[np.isfinite(values)]
+    (ax.xaxis if axis == "x" else ax.yaxis).get_major_formatter().set_useOffset(False)
+    if not values.size or not size > 0:
+        return
+    low, high = float(values.min()), float(values.max())
+    half = _LEAST_HALF_SPAN * size
+    if high - low < 2 * half:
+        middle = 0.5 * (low + high)
+        (ax.set_xlim if axis == "x" else ax.set_ylim)(middle - half, middle + half)
 
 
 def _unit(parameter: str, data: Any = None) -> str:
@@ -60,13 +85,17 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
     """Amplitude of structure coordinate 0 (of the structure at the first of
     ``[output] points``, or else of the first bending moment of ``[output] moments``,
     where there are: see :func:`shown_amplitudes`) against the parameter, each
-    direction, with the linear structure's beside it."""
+    direction, with the linear structure's beside it. Points whose response did not
+    settle (no period of at most 8 forcing periods: chaos, or a slow transient) are
+    marked, with the spread of their periods' peaks (smallest to largest); points
+    whose run failed are marked on the parameter axis. The legend sits beside the
+    axes, off the curves."""
     shown, unit = shown_amplitudes(points[0])
 
     def amplitude(p: SweepPoint) -> float:
         return float(shown_values(p, shown)[0][0])
 
-    with _figure(path) as (fig, ax):
+    with _figure(path, size=(8, 5.5)) as (fig, ax):
         values = np.array([p.value for p in points])
         order = np.argsort(values, kind="stable")
         linear = np.array([shown_values(p, shown)[1][0] for p in points])
@@ -84,10 +113,53 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
                     lw=1,
                     label=f"with them, sweep {direction}",
                 )
+        unsettled = [p for p in points if not p.settled and not p.error]
+        if unsettled:
+            least = [_least_shown(p, shown) for p in unsettled]
+            ax.vlines(
+                [p.value for p in unsettled],
+                least,
+                [amplitude(p) for p in unsettled],
+                colors="tab:red",
+                lw=2.5,
+                alpha=0.6,
+                label="not settled: spread of the periods' peaks",
+            )
+            ax.plot(
+                [p.value for p in unsettled],
+                [amplitude(p) for p in unsettled],
+                "o",
+                ms=6,
+                mfc="none",
+                mec="tab:red",
+                label="not settled (no period of at most 8 forcing periods)",
+            )
+        failed = [p.value for p in points if p.error]
+        if failed:
+            ax.plot(
+                failed,
+                [0.0] * len(failed),
+                "kx",
+                ms=7,
+                transform=ax.get_xaxis_transform(),
+                clip_on=False,
+                label="run failed (see the table or --json)",
+            )
         ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
         ax.set_ylabel(f"{shown_label(points[0], shown)} ({unit})")
-        ax.legend()
+        # Below the axes: inside, it had covered the peak.
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8)
         ax.grid(alpha=0.3)
+
+
+def _least_shown(point: SweepPoint, shown: str) -> float:
+    """The smallest of a not settled point's periods' peaks, of the quantity
+    ``shown`` (see :func:`shown_amplitudes`); its amplitude where unknown."""
+    coordinates, at_points, moments = split_observed(
+        point.least_period_peak, len(point.amplitude), len(point.points)
+    )
+    least = {"coordinate": coordinates, "point": at_points, "moment": moments}[shown]
+    return float(least[0]) if len(least) else float(shown_values(point, shown)[0][0])
 
 
 def plot_history(path: Path, sol: SystemSolution) -> None:
@@ -149,7 +221,14 @@ def plot_section(path: Path, section: Section, period: float) -> None:
     (impact phase against impact speed)."""
     with _figure(path, 1, 2, (11, 4.5)) as (fig, (left, right)):
         dim = section.strobe.shape[1] // 2
-        left.plot(section.strobe[:, 0], section.strobe[:, dim], ".", ms=3)
+        x, v = section.strobe[:, 0], section.strobe[:, dim]
+        left.plot(x, v, ".", ms=3)
+        # The size of the motion from the sampled states: the amplitude of a harmonic
+        # motion through each, sqrt(x^2 + (v / w)^2), and its speed w times that.
+        w = 2 * np.pi / period
+        amplitude = float(np.max(np.hypot(x, v / w), initial=0.0))
+        _span_at_least(left, "x", x, amplitude)
+        _span_at_least(left, "y", v, w * amplitude)
         left.set_xlabel("structure displacement 0 (m)")
         left.set_ylabel("structure velocity 0 (m/s)")
         left.set_title(f"stroboscopic, every {period:.6g} s")
@@ -161,6 +240,8 @@ def plot_section(path: Path, section: Section, period: float) -> None:
         right.set_xlabel("impact phase in the forcing period (rad)")
         right.set_ylabel("impact speed (m/s)")
         right.set_xlim(0, 2 * np.pi)
+        speeds = section.impact_speed
+        _span_at_least(right, "y", speeds, float(np.max(np.abs(speeds), initial=0.0)))
         if section.impact_pair:
             right.legend()
         for ax in (left, right):
