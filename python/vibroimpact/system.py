@@ -35,11 +35,7 @@ A system is described by the same sections as a TOML scenario (SI units):
 from __future__ import annotations
 
 import difflib
-import io
 import math
-import re
-import stat
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -63,6 +59,7 @@ from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.summary import contacts_repr, solution_repr
+from vibroimpact.record_file import check_record, read_record
 
 __all__ = [
     "PreparedRun",
@@ -377,94 +374,6 @@ def _list(name: str, value: Any) -> list[Any]:
     return list(value)
 
 
-#: The largest CSV file a recorded signal may read (bytes): a record of millions of
-#: samples fits, a wrong path (a disk image, /dev/zero) is refused before it fills the
-#: memory.
-MAX_RECORDED_FILE_BYTES = 64 * 2**20
-
-
-def _read_record(path: Path, where: str) -> tuple[list[float], list[float], list[int]]:
-    """Time and value columns of a CSV file (lines starting with # and a header
-    line are skipped), with the line number of each row. ``where`` names the
-    excitation and its ``file`` key. Only a regular file of at most
-    :data:`MAX_RECORDED_FILE_BYTES` is read; a row must hold exactly two numbers."""
-    name = str(path)
-    try:
-        # Checked before opening: opening a FIFO would wait for a writer.
-        info = path.stat()
-        if not stat.S_ISREG(info.st_mode):
-            raise _fail(where, f"{name!r} is not a regular file (a CSV of time and value)")
-        if info.st_size > MAX_RECORDED_FILE_BYTES:
-            raise _fail(
-                where,
-                f"{name!r} is larger than {MAX_RECORDED_FILE_BYTES // 2**20} MiB, the limit of a "
-                "recorded signal",
-            )
-        with path.open("rb") as f:
-            data = f.read(MAX_RECORDED_FILE_BYTES + 1)
-        if len(data) > MAX_RECORDED_FILE_BYTES:
-            raise _fail(
-                where,
-                f"{name!r} is larger than {MAX_RECORDED_FILE_BYTES // 2**20} MiB, the limit of a "
-                "recorded signal",
-            )
-        text = data.decode("utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
-        raise _fail(where, f"cannot read {name!r}: {reason}") from None
-    del data
-    times: list[float] = []
-    values: list[float] = []
-    lines: list[int] = []
-    first = True
-    for number, line in enumerate(io.StringIO(text), start=1):
-        line = line.strip()
-        if not line or line.startswith("#"):
-            continue
-        # Columns apart by commas, semicolons, tabs or spaces.
-        cells = re.split(r"\s*[,;]\s*|\s+", line)
-        header, first = first, False
-        try:
-            row = [float(c) for c in cells]
-        except ValueError:
-            if header:  # the first line may name the columns
-                continue
-            raise _fail(
-                where, f"{path.name} line {number}: not two numbers: {line!r:.60}"
-            ) from None
-        if len(row) != 2:
-            raise _fail(
-                where,
-                f"{path.name} line {number}: needs two columns, time and value, got "
-                f"{len(row)}: {line!r:.60}",
-            )
-        times.append(row[0])
-        values.append(row[1])
-        lines.append(number)
-    return times, values, lines
-
-
-def _check_record(where: str, times: list[float], values: list[float], rows: list[str]) -> None:
-    """A record's samples as the core needs them (at least two, finite, times
-    increasing strictly), refused here so that the error names the excitation and
-    ``rows`` (each sample's place: the file's line, or the arrays' index)."""
-    if len(times) != len(values):
-        raise _fail(
-            where,
-            f"time and value must have the same length, got {len(times)} and {len(values)}",
-        )
-    if len(times) < 2:
-        raise _fail(where, f"a recorded signal needs at least 2 samples, got {len(times)}")
-    for i, (t, v) in enumerate(zip(times, values, strict=True)):
-        if not (math.isfinite(t) and math.isfinite(v)):
-            raise _fail(where, f"{rows[i]}: must be finite numbers, got time {t!r} and value {v!r}")
-        if i and not t > times[i - 1]:
-            raise _fail(
-                where,
-                f"{rows[i]}: times must increase strictly, got {t!r} s after {times[i - 1]!r} s",
-            )
-
-
 def _check_point(name: str, given: Any, at: float, structure: dict[str, Any]) -> None:
     """A point ``at`` on the structure: a coordinate index of an oscillator or of
     matrices, a position along a cantilever (m); ``name`` such as ``"damper 0 at"``,
@@ -672,12 +581,17 @@ def system_spec(
             path = Path(e["file"])
             if base_dir is not None and not path.is_absolute():
                 path = base_dir / path
-            times, values, lines = _read_record(path, f"{where}file: ")
-            _check_record(f"{where}file: ", times, values, [f"{path.name} line {n}" for n in lines])
+            times, values, row = read_record(path, f"{where}file: ")
+            check_record(f"{where}file: ", times, values, row, e["scale"])
             e["time"], e["value"] = times, values
         elif e["signal"] == "recorded" and e["time"] is not None and e["value"] is not None:
-            _check_record(
-                where, e["time"], e["value"], [f"time[{i}]" for i in range(len(e["time"]))]
+            check_record(
+                where,
+                e["time"],
+                e["value"],
+                lambda i: f"time[{i}]",
+                e["scale"],
+                lambda i: f"value[{i}]",
             )
         elif e["signal"] == "recorded":
             raise _fail(
@@ -685,14 +599,6 @@ def system_spec(
                 "a recorded signal needs file (a CSV of time and value), or time and value "
                 "(arrays of numbers)",
             )
-        if e["signal"] == "recorded" and e["scale"] is not None:
-            # The core's bound: half the largest float, so that differences stay finite.
-            largest = max(abs(v) for v in e["value"]) * abs(e["scale"])
-            if not largest <= 0.5 * sys.float_info.max:
-                raise _fail(
-                    f"{where}scale: ",
-                    f"{e['scale']!r} times the record's largest value is beyond floating point",
-                )
         excitations.append({k: v for k, v in e.items() if v is not None and k != "file"})
     spec["excitation"] = excitations
     return spec
