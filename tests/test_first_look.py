@@ -4,6 +4,7 @@ impact samples against Holmes's closed form."""
 
 from __future__ import annotations
 
+import json
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -179,3 +180,84 @@ def test_the_spread_of_an_unsettled_response_is_its_periods_smallest_and_largest
     assert result.amplitude[0] == pytest.approx(max(heights), rel=1e-3)
     assert result.least_period_peak[0] == pytest.approx(min(heights), rel=1e-3)
     assert min(heights) < 0.5 * max(heights)  # a real spread, not round-off
+
+
+# ----------------------------------------------------- bifurcation samples
+
+
+def _holmes(data: dict[str, Any], big_a: float) -> tuple[float, float]:
+    """Holmes's period-one orbit of the ball on the table (forced-oracles.md): the
+    impact phase on the scenario's clock and the closing speed (m/s). The scenario's
+    base acceleration is ``A cos(w t + p)``: the table's displacement is ``a sin(w (t +
+    tm))`` with ``w tm = p - pi / 2``, so Holmes's phase ``phi`` is ``phi - w tm`` here."""
+    (stop,) = data["stop"]
+    (forcing,) = data["excitation"]
+    e, g = stop["restitution"], data["gravity"]["acceleration"]
+    w = 2 * np.pi * forcing["frequency"]
+    gamma = big_a / g
+    phi = float(np.arccos(np.pi * (1 - e) / ((1 + e) * gamma)))  # the branch sin > 0
+    phase = (phi - (forcing["phase"] - np.pi / 2)) % (2 * np.pi)
+    return phase, 2 * np.pi * g / (w * (1 + e))
+
+
+def test_bifurcation_samples_impact_velocity_and_phase_of_holmes_orbit() -> None:
+    data = _sections("ball_table_bifurcation.toml")
+    values = [11.772, 12.5, 13.5, 14.5]  # Gamma 1.2 to 1.48, below the flip at 1.5268
+    for sample in ("impact-velocity", "impact-phase"):
+        points = maps.bifurcation(
+            data,
+            "excitation.0.amplitude",
+            values,
+            settle_periods=300,
+            sample_periods=20,
+            sample=sample,
+            pair="stop 0",
+        )
+        for p in points:
+            phase, closing = _holmes(data, p.value)
+            assert p.error is None and len(p.samples) == 20  # one impact a period
+            if sample == "impact-velocity":
+                np.testing.assert_allclose(p.samples, closing, rtol=1e-7)
+            else:
+                gap = np.angle(np.exp(1j * (p.samples - phase)))
+                assert np.max(np.abs(gap)) < 1e-7, (p.value, p.samples[:3], phase)
+                assert np.all((p.samples >= 0) & (p.samples < 2 * np.pi))
+
+
+def test_bifurcation_sample_and_pair_are_checked() -> None:
+    data = _sections("ball_table_bifurcation.toml")
+    with pytest.raises(vi.InvalidInputError, match="^sample: must be one of"):
+        maps.bifurcation(data, "excitation.0.amplitude", [12.0], sample="speed")
+    with pytest.raises(vi.InvalidInputError, match=r"^pair: .*\(stop 0\), got 'stop 3'"):
+        maps.bifurcation(
+            data, "excitation.0.amplitude", [12.0], sample="impact-phase", pair="stop 3"
+        )
+    data["sweep"]["sample"] = "velocity"
+    with pytest.raises(vi.InvalidInputError, match=r"\[sweep\] sample"):
+        analyses.sweep_settings(data["sweep"])
+
+
+def test_the_bifurcation_command_samples_impacts_with_units(run_cli: Any, tmp_path: Path) -> None:
+    scenario = (EXAMPLES / "ball_table_bifurcation.toml").read_text(encoding="utf-8")
+    scenario = scenario.replace("count = 50", "count = 3").replace(
+        "record_periods = 32", 'record_periods = 10\nsample = "impact-phase"'
+    )
+    path = tmp_path / "phase.toml"
+    path.write_text(scenario, encoding="utf-8")
+    plot = tmp_path / "phase.png"
+    done = run_cli("bifurcation", str(path), "--json", "--plot", str(plot))
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert (out["sample"], out["sample_units"], out["pair"]) == ("impact-phase", "rad", None)
+    data = _sections("ball_table_bifurcation.toml")
+    phase, closing = _holmes(data, out["points"][0]["value"])
+    assert (
+        np.abs(np.angle(np.exp(1j * (np.array(out["points"][0]["samples"]) - phase)))).max() < 1e-7
+    )
+    # --sample overrides the section's, and the text names what it counted.
+    done = run_cli("bifurcation", str(path), "--sample", "impact-velocity", "--json")
+    first = json.loads(done.stdout)["points"][0]["samples"]
+    np.testing.assert_allclose(first, closing, rtol=1e-7)
+    done = run_cli("bifurcation", str(path), "--pair", "damper 0")
+    assert done.returncode == 2 and "--pair: must name one of" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1

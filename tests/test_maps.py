@@ -773,14 +773,16 @@ def test_bifurcation_command_on_its_example(run_cli: RunCli, tmp_path: Path) -> 
     plot = tmp_path / "bifurcation.png"
     out = run_json(run_cli, "bifurcation", str(BIFURCATION), "--plot", str(plot))
     assert_png(plot)
-    assert set(out) == {"parameter", "points", "cpu_time"}
+    assert set(out) == {"parameter", "sample", "sample_units", "pair", "points", "cpu_time"}
     assert out["parameter"] == AMPLITUDE
+    assert (out["sample"], out["sample_units"], out["pair"]) == ("displacement", "m", None)
     points = out["points"]
     assert len(points) == settings["count"]
     for p in points:
-        assert set(p) == {"value", "direction", "strobe_displacement"}
+        assert set(p) == {"value", "direction", "strobe_displacement", "samples"}
         assert p["direction"] == "up"
         assert len(p["strobe_displacement"]) == settings["record_periods"]
+        assert p["samples"] == p["strobe_displacement"]
     # (Within a percent of the flip a multiplier near -1 slows the settling down.)
     below = [p for p in points if p["value"] < 0.99 * flip]
     (first_above,) = [p for p in points if flip < p["value"] < 1.02 * flip]

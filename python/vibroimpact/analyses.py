@@ -602,17 +602,27 @@ _SWEEP = {
     "settle_periods": (_WHOLE, 200),
     "record_periods": (_WHOLE, 50),
     "tolerance": (_NUMBER, 1e-6),
+    # Read by bifurcation only: what it samples, and at which pair's impacts.
+    "sample": (_TEXT, "displacement"),
+    "pair": (_TEXT, None),
 }
+#: What a bifurcation diagram samples, and the unit of each: structure coordinate 0's
+#: displacement at each forcing period (stroboscopic), or at each impact (a rigid
+#: impact or a compliant contact's onset) its approach speed or its phase ``w t``
+#: modulo 2 pi in the forcing period (on the scenario's clock).
+BIFURCATION_SAMPLES = {"displacement": "m", "impact-velocity": "m/s", "impact-phase": "rad"}
 
 
 def sweep_settings(table: Any) -> dict[str, Any]:
     """The ``[sweep]`` section checked and with its defaults: ``parameter`` (a
     dotted path such as ``"excitation.0.frequency"``), ``start``, ``stop``, ``count``
     (>= 1), ``spacing`` (``"linear"`` or ``"log"``), ``direction`` (``"up"``,
-    ``"down"``, ``"both"``), ``settle_periods`` (>= 0), ``record_periods`` (>= 1) and
-    the stroboscopic ``tolerance`` of settling."""
+    ``"down"``, ``"both"``), ``settle_periods`` (>= 0), ``record_periods`` (>= 1),
+    the stroboscopic ``tolerance`` of settling, and for bifurcation ``sample`` (see
+    :data:`BIFURCATION_SAMPLES`) and ``pair`` (whose impacts it samples)."""
     out = _table("[sweep] ", table, _SWEEP)
     _choice("[sweep] ", "direction", out["direction"], _DIRECTIONS)
+    _choice("[sweep] ", "sample", out["sample"], tuple(BIFURCATION_SAMPLES))
     _choice("[sweep] ", "spacing", out["spacing"], _SPACINGS)
     if out["count"] < 1:
         raise AnalysisError(f"[sweep] count: must be >= 1, got {out['count']}")

@@ -14,6 +14,7 @@ import numpy as np
 from vibroimpact import analysis_plots as plots
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analyses import (
+    BIFURCATION_SAMPLES,
     AnalysisError,
     check_periods,
     orbit,
@@ -94,11 +95,25 @@ def add_commands(sub: Any) -> None:
         description=(
             "For each value of the [sweep] section's parameter (up, down or both, each "
             "point starting from the last one's state), settle settle_periods forcing "
-            "periods, then keep record_periods stroboscopic states; prints or plots the "
-            "sampled displacements of structure coordinate 0 (m)."
+            "periods, then sample the next record_periods: the stroboscopic displacement "
+            "of structure coordinate 0 (m, each period), or at each impact its approach "
+            "speed (m/s) or phase w t mod 2 pi (rad); prints or plots the samples."
         ),
     )
     _outputs(bif, "scenario file (.toml) with [sweep]", "plot the diagram")
+    bif.add_argument(
+        "--sample",
+        choices=list(BIFURCATION_SAMPLES),
+        help="what to sample: displacement (stroboscopic, m), impact-velocity (approach "
+        "speed at each impact, m/s) or impact-phase (w t mod 2 pi at each impact, rad); "
+        "default [sweep] sample, else displacement",
+    )
+    bif.add_argument(
+        "--pair",
+        metavar="PAIR",
+        help='the pair whose impacts are sampled ("stop 0", "damper 1"); default '
+        "[sweep] pair, else every pair",
+    )
 
     sec = sub.add_parser(
         "poincare",
@@ -331,6 +346,8 @@ def _section(scenario: SystemScenario, name: str, path: Path) -> dict[str, Any]:
 def run_bifurcation(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario)
     settings = _section(scenario, "sweep", args.scenario)
+    sample = args.sample or settings["sample"]
+    pair = args.pair if args.pair is not None else settings["pair"]
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()
     try:
@@ -341,40 +358,66 @@ def run_bifurcation(args: argparse.Namespace) -> int:
             direction=settings["direction"],
             settle_periods=settings["settle_periods"],
             sample_periods=settings["record_periods"],
+            sample=sample,
+            pair=pair,
             base_dir=scenario.base_dir,
             progress=_progress(show),
         )
     except AnalysisError as err:
-        # The function's sample_periods is the section's record_periods.
+        # The function's sample_periods is the section's record_periods; its pair,
+        # --pair or the section's.
         message = str(err)
         if message.startswith("sample_periods:"):
             message = f"{args.scenario}: [sweep] record_periods:" + message[15:]
             raise AnalysisError(message) from None
+        if message.startswith("pair:"):
+            where = "--pair" if args.pair is not None else "[sweep] pair"
+            raise AnalysisError(f"{args.scenario}: {where}:" + message[5:]) from None
         raise
     if show:
         print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
-        plots.plot_bifurcation(args.plot, settings["parameter"], points, scenario.data)
+        plots.plot_bifurcation(
+            args.plot, settings["parameter"], points, scenario.data, sample=sample, pair=pair
+        )
     rows = [
         {
             "value": p.value,
             "direction": p.direction,
             "strobe_displacement": [float(v) for v in p.strobe[:, 0]] if p.strobe.size else [],
+            "samples": [float(v) for v in p.samples],
             **({"error": p.error} if p.error else {}),
         }
         for p in points
     ]
     if args.json:
-        print(json_text({"parameter": settings["parameter"], "points": rows, "cpu_time": cpu_time}))
+        print(
+            json_text(
+                {
+                    "parameter": settings["parameter"],
+                    "sample": sample,
+                    "sample_units": BIFURCATION_SAMPLES[sample],
+                    "pair": pair,
+                    "points": rows,
+                    "cpu_time": cpu_time,
+                }
+            )
+        )
         return 0
     print(f"{args.scenario}: {len(points)} values of {settings['parameter']} in {cpu_time:.3f} s")
+    what = {
+        "displacement": "stroboscopic displacement(s)",
+        "impact-velocity": "impact velocities",
+        "impact-phase": "impact phases",
+    }[sample]
     for row in rows:
-        samples = np.asarray(row["strobe_displacement"])
-        distinct = len(np.unique(np.round(samples / (np.max(np.abs(samples)) or 1), 6)))
+        samples = np.asarray(row["samples"])
+        scale = float(np.max(np.abs(samples), initial=0.0)) or 1.0
+        distinct = len(np.unique(np.round(samples / scale, 6)))
         print(
-            f"{row['value']:>12.6g} {row['direction']:>5}: {distinct} distinct stroboscopic "
-            f"displacement(s) of {len(samples)}"
+            f"{row['value']:>12.6g} {row['direction']:>5}: {distinct} distinct {what} of "
+            f"{len(samples)}"
         )
     if args.plot:
         print(f"plot written to {args.plot}")

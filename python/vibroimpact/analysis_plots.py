@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact.analyses import (
+    BIFURCATION_SAMPLES,
     Runner,
     SweepPoint,
     shown_amplitudes,
@@ -249,23 +250,39 @@ def plot_section(path: Path, section: Section, period: float) -> None:
 
 
 def plot_bifurcation(
-    path: Path, parameter: str, points: list[BifurcationPoint], data: Any = None
+    path: Path,
+    parameter: str,
+    points: list[BifurcationPoint],
+    data: Any = None,
+    *,
+    sample: str = "displacement",
+    pair: str | None = None,
 ) -> None:
-    """Sampled stroboscopic displacements of structure coordinate 0 against the
-    parameter, each direction."""
+    """The samples of each point (see :func:`~vibroimpact.maps.bifurcation`: the
+    stroboscopic displacement of structure coordinate 0, or each impact's approach
+    speed or phase) against the parameter, each direction."""
     with _figure(path) as (fig, ax):
         for direction, colour in (("up", "tab:blue"), ("down", "tab:orange")):
             xs: list[float] = []
             ys: list[float] = []
             for p in points:
-                if p.direction == direction and p.strobe.size:
-                    xs += [p.value] * len(p.strobe)
-                    ys += list(p.strobe[:, 0])
+                if p.direction == direction and p.samples.size:
+                    xs += [p.value] * len(p.samples)
+                    ys += list(p.samples)
             if xs:
                 ax.plot(xs, ys, ".", ms=1.5, color=colour, label=f"sweep {direction}")
+        impacts = f"each impact of {pair}" if pair else "each impact"
+        label = {
+            "displacement": "stroboscopic structure displacement 0",
+            "impact-velocity": f"impact velocity: approach speed at {impacts}",
+            "impact-phase": f"impact phase $\\omega t$ mod $2\\pi$ at {impacts}",
+        }[sample]
         ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
-        ax.set_ylabel("stroboscopic structure displacement 0 (m)")
-        ax.legend(markerscale=6)
+        ax.set_ylabel(f"{label} ({BIFURCATION_SAMPLES[sample]})")
+        if sample == "impact-phase":
+            ax.set_ylim(0, 2 * np.pi)
+        if ax.lines:
+            ax.legend(markerscale=6)
         ax.grid(alpha=0.3)
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -16,6 +16,7 @@ import numpy as np
 
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
 from vibroimpact.analyses import (
+    BIFURCATION_SAMPLES,
     AnalysisError,
     Runner,
     from_carried,
@@ -73,12 +74,50 @@ def poincare(
 @summarised
 @dataclass
 class BifurcationPoint:
-    """The sampled stroboscopic states at one parameter value."""
+    """The sampled stroboscopic states at one parameter value, and the ``samples``
+    of the chosen quantity (see :data:`BIFURCATION_SAMPLES`): ``strobe[:, 0]`` for
+    ``"displacement"``, else one value per impact of the chosen pair."""
 
     value: float
     direction: str
     strobe: np.ndarray
     error: str | None = None
+    samples: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+def _impact_samples(
+    raw: Mapping[str, Any], sample: str, pair: str | None, period: float
+) -> np.ndarray:
+    """The approach speed (m/s) or phase (rad) of each impact of ``pair`` (every
+    pair's where None) in a run that starts at a multiple of the forcing period."""
+    contacts = raw["contacts"]
+    names = list(raw["pairs"])
+    chosen = np.array(
+        [
+            kind in ("impact", "compliant") and (pair is None or names[index] == pair)
+            for kind, index in zip(contacts["kind"], contacts["pair"], strict=True)
+        ],
+        dtype=bool,
+    )
+    if sample == "impact-velocity":
+        return np.asarray(contacts["approach_speed"], dtype=float)[chosen]
+    onset = np.asarray(contacts["onset"], dtype=float)[chosen]
+    return np.asarray((2 * math.pi * onset / period) % (2 * math.pi))
+
+
+def _check_pair(run: Runner, sample: str, pair: str | None) -> None:
+    if pair is not None:
+        spec = run.prepared.spec
+        names = [f"damper {j}" for j in range(len(spec.get("damper", ())))] + [
+            f"stop {j}" for j in range(len(spec.get("stop", ())))
+        ]
+        if pair not in names:
+            raise AnalysisError(
+                f"pair: must name one of the scenario's pairs ({', '.join(names) or 'none'}), "
+                f"got {pair!r}"
+            )
+        if sample == "displacement":
+            raise AnalysisError('pair: only for sample = "impact-velocity" or "impact-phase"')
 
 
 def _sampled(
@@ -100,15 +139,27 @@ def bifurcation(
     direction: str = "up",
     settle_periods: int = 200,
     sample_periods: int = 50,
+    sample: str = "displacement",
+    pair: str | None = None,
     base_dir: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[BifurcationPoint]:
     """A bifurcation diagram: for each value of ``parameter`` (a dotted path), in
     the order given (``"up"``), reversed (``"down"``) or both, settle from the last
-    point's state (see :func:`~vibroimpact.analyses.from_carried`) and keep
-    ``sample_periods`` stroboscopic states."""
+    point's state (see :func:`~vibroimpact.analyses.from_carried`), keep
+    ``sample_periods`` stroboscopic states and sample ``sample`` over those periods:
+    ``"displacement"`` (structure coordinate 0's stroboscopic displacement, m),
+    ``"impact-velocity"`` (each impact's approach speed, m/s) or ``"impact-phase"``
+    (each impact's ``w t`` modulo 2 pi, rad), the impacts of ``pair`` (``"stop 0"``,
+    ``"damper 1"``; every pair's where None)."""
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     sample_periods = whole_count("sample_periods", sample_periods, 1)
+    if not isinstance(sample, str) or sample not in BIFURCATION_SAMPLES:
+        raise AnalysisError(
+            "sample: must be one of "
+            + ", ".join(f'"{name}"' for name in BIFURCATION_SAMPLES)
+            + f", got {sample!r}"
+        )
     legs = _legs(direction, [float(v) for v in values])
     points: list[BifurcationPoint] = []
     state: np.ndarray | None = None
@@ -116,7 +167,9 @@ def bifurcation(
     if total:
         # Every point's samples are kept: refused before any run where they would
         # pass a run's memory limit (1e5 points of 1e6 periods had grown to an abort).
-        width = len(_runner_at(data, parameter, legs[0][1][0], base_dir).initial_state())
+        first = _runner_at(data, parameter, legs[0][1][0], base_dir)
+        _check_pair(first, sample, pair)
+        width = len(first.initial_state())
         kept = 8.0 * total * sample_periods * width
         if kept > MAX_RECORD_BYTES:
             raise AnalysisError(
@@ -136,7 +189,12 @@ def bifurcation(
             else:
                 state = np.asarray(raw["final_state"], dtype=float)
                 strobe = np.asarray(raw["strobe"]).reshape(-1, len(state))
-                points.append(BifurcationPoint(value, leg, strobe))
+                samples = (
+                    strobe[:, 0]
+                    if sample == "displacement"
+                    else _impact_samples(raw, sample, pair, run.period)
+                )
+                points.append(BifurcationPoint(value, leg, strobe, samples=samples))
             if progress is not None:
                 progress(len(points), total)
     return points
