@@ -100,7 +100,7 @@ def _impact_samples(
         dtype=bool,
     )
     if sample == "impact-velocity":
-        return np.asarray(contacts["approach_speed"], dtype=float)[chosen]
+        return np.asarray(np.asarray(contacts["approach_speed"], dtype=float)[chosen])
     onset = np.asarray(contacts["onset"], dtype=float)[chosen]
     return np.asarray((2 * math.pi * onset / period) % (2 * math.pi))
 
