@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
-from vibroimpact import analyses, analysis_plots, continuation, maps
+from vibroimpact import analyses, analysis_plots, beyond, continuation, maps, plots
 from vibroimpact.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -261,3 +261,63 @@ def test_the_bifurcation_command_samples_impacts_with_units(run_cli: Any, tmp_pa
     done = run_cli("bifurcation", str(path), "--pair", "damper 0")
     assert done.returncode == 2 and "--pair: must name one of" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+# ------------------------------------------------------------ work precision
+
+
+def _study_run(label: str, dt: float, error: float, cpu: float) -> beyond.StudyRun:
+    return beyond.StudyRun(label, f"dt={dt:g}", dt, None, 0.109, error, cpu, 0)
+
+
+def test_work_precision_draws_coinciding_lines_apart_and_says_why_rk4_fixed_is_order_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    kept: dict[str, Any] = {}
+    monkeypatch.setattr(plots, "_save", lambda fig, path: kept.__setitem__(path.name, fig))
+    steps = (4e-3, 1e-3, 1e-4)
+    # newmark-implicit and generalized-alpha err alike to a few per cent: one line.
+    study = [_study_run("generalized-alpha", dt, 1e-3 * dt / 4e-3, 1e-5 / dt) for dt in steps]
+    study += [_study_run("newmark-implicit", dt, 0.97e-3 * dt / 4e-3, 1e-5 / dt) for dt in steps]
+    study += [_study_run("rk4 (paper stepping)", dt, 4e-4 * dt, 1e-8 / dt) for dt in steps]
+    plots.work_precision(Path("wp.png"), study, [])
+    (ax,) = kept["wp.png"].axes
+    lines = {line.get_label().split(":")[0]: line for line in ax.lines}
+    alpha, newmark = lines["generalized-alpha"], lines["newmark-implicit"]
+    assert alpha.get_marker() != newmark.get_marker()
+    assert alpha.get_linestyle() != newmark.get_linestyle()
+    # The one drawn over the other is the thinner, and the one beneath shows round it.
+    assert newmark.get_zorder() > alpha.get_zorder() and newmark.get_lw() < alpha.get_lw()
+    assert alpha.get_markerfacecolor() == "none"
+    # Why RK4 with the paper's stepping is first order, on the figure, pointing at it.
+    rk4 = lines["rk4 (paper stepping)"]
+    assert "order 1" in rk4.get_label()
+    (note,) = [t for t in ax.texts if "rk4 (paper stepping)" in t.get_text()]
+    text = " ".join(note.get_text().split())
+    assert "order 1" in text and "jumps from 0 to 1e-3 N" in text and "onset" in text
+    assert note.xy in list(zip(rk4.get_xdata(), rk4.get_ydata(), strict=True))
+
+
+def test_rk4_with_the_papers_stepping_is_first_order_because_of_the_contact_dampers_jump() -> None:
+    # What the note says, measured: with the contact damper (c1 v = 1e-3 N at onset) the
+    # error halves with dt; without it (c1 = 0) it falls as RK4 with located events does.
+    system, _, start = beyond.table1()
+    ratios = {}
+    for c1 in (beyond.CONTACT_DAMPING, 0.0):
+        contact = vi.Contact(law="hertz", stiffness=beyond.HERTZ_STIFFNESS, damping=c1)
+        exact = vi.simulate(
+            system, contact, start, method="dop853", rtol=1e-13, atol=1e-16, t_end=0.15
+        ).contacts.duration[0]
+        errors = [
+            abs(
+                vi.simulate(
+                    system, contact, start, method="rk4", dt=dt, stepping="fixed", t_end=0.11
+                ).contacts.duration[0]
+                / exact
+                - 1
+            )
+            for dt in (2e-4, 1e-4)
+        ]
+        ratios[c1] = errors[0] / errors[1]
+    assert ratios[beyond.CONTACT_DAMPING] == pytest.approx(2.0, rel=0.05)
+    assert ratios[0.0] > 5.0
