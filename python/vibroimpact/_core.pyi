@@ -327,6 +327,9 @@ def check_solver(
 
 # Internal: the periodic analyses' rule, public as vibroimpact.analyses.forcing_period.
 def _forcing_period(excitations: list[tuple[str, list[float] | None]]) -> float: ...
+def _strobe_period(
+    strobe: npt.NDArray[np.float64], forcing_period: float, tolerance: float, max_period: int
+) -> int | None: ...
 def hertz_stiffness(
     radius: float,
     youngs_modulus: float,

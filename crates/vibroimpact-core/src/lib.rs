@@ -32,6 +32,7 @@ pub mod reductions;
 pub mod run;
 mod series;
 pub mod settings;
+pub mod settling;
 pub mod shooting;
 pub mod signals;
 mod sized;

@@ -17,6 +17,7 @@ use crate::error::{Error, Result};
 use crate::exact::ExactFlow;
 use crate::reductions::ReduceOptions;
 use crate::settings::{ContactTiming, Method, Settings, Stepping};
+use crate::settling::{self, MAX_PERIOD};
 use crate::signals::{RecipeKey, Signal};
 use crate::system::{ImpactDamper, State};
 use crate::system_events::{ContactKind, RunOptions, SystemSolution};
@@ -379,7 +380,7 @@ pub enum Analysis {
     Run { t_end: f64, record_from: f64 },
     /// `settle` then `record` periods of the first harmonic excitation;
     /// settled when the stroboscopic state repeats after p <= 8 periods
-    /// within `tolerance` (relative).
+    /// within `tolerance` (relative: see [`settling::strobe_period`]).
     SteadyState {
         settle: u64,
         record: u64,
@@ -787,7 +788,12 @@ fn measured_on(
         },
     );
     let sol = stepper.integrate(system, &y0, &options, &mut || interrupt())?;
-    Ok(metrics_of(system, &sol, record_from, settings))
+    Ok(metrics_of(
+        system,
+        &sol,
+        (record_from, strobe_period),
+        settings,
+    ))
 }
 
 /// A study run's options: no history, the study's limits.
@@ -916,10 +922,12 @@ fn orbit_metrics(
     })
 }
 
+/// The metrics of `sol`, recorded from `record_from` (s); `period` is the
+/// forcing period (s) of a steady-state study.
 fn metrics_of(
     system: &Assembly,
     sol: &SystemSolution,
-    record_from: f64,
+    (record_from, period): (f64, f64),
     settings: &StudySettings,
 ) -> RunMetrics {
     let r = &sol.reductions;
@@ -958,9 +966,24 @@ fn metrics_of(
             // Judged at the end of settling, as the analysis does.
             let width = 2 * system.dim;
             let rows = (settle as usize).min(r.strobe.len() / width);
+            let strobe = &r.strobe[..rows * width];
+            let repeats = settling::strobe_period(strobe, width, period, tolerance, MAX_PERIOD);
+            // Impacts counted over whole periods of the orbit (a window of
+            // 20 periods of a period-8 orbit counts part of one).
+            let orbit = repeats.map_or(1, |p| p as u64);
+            let whole = if record >= orbit {
+                record / orbit * orbit
+            } else {
+                record
+            };
+            let end = record_from + whole as f64 * period;
+            let counted = recorded
+                .iter()
+                .filter(|c| c.kind != ContactKind::Sticking && c.onset < end)
+                .count() as f64;
             (
-                impacts / record as f64,
-                settled(&r.strobe[..rows * width], width, tolerance),
+                counted / whole as f64,
+                f64::from(u8::from(repeats.is_some())),
             )
         }
         Analysis::Run { .. } | Analysis::Orbit { .. } => (f64::NAN, f64::NAN),
@@ -977,37 +1000,6 @@ fn metrics_of(
         stable: f64::NAN,
         largest_multiplier: f64::NAN,
     }
-}
-
-/// 1 when the stroboscopic states (rows of `width`) of the settling periods
-/// repeat after p <= 8 periods within `tolerance` of their scale, else 0.
-fn settled(strobe: &[f64], width: usize, tolerance: f64) -> f64 {
-    let rows: Vec<&[f64]> = strobe.chunks(width).collect();
-    let half = width / 2;
-    let tail = &rows[rows.len().saturating_sub(17)..];
-    let scale = |range: std::ops::Range<usize>| {
-        tail.iter()
-            .flat_map(|r| r[range.clone()].iter())
-            .fold(0.0f64, |m, v| m.max(v.abs()))
-            .max(1e-300)
-    };
-    let (xs, vs) = (scale(0..half), scale(half..width));
-    let Some(last) = rows.last() else {
-        return 0.0;
-    };
-    for p in 1..=8usize {
-        if rows.len() <= p {
-            break;
-        }
-        let other = rows[rows.len() - 1 - p];
-        let distance = (0..width)
-            .map(|i| (last[i] - other[i]).abs() / if i < half { xs } else { vs })
-            .fold(0.0f64, f64::max);
-        if distance <= tolerance {
-            return 1.0;
-        }
-    }
-    0.0
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Closed forms, materials and beam modes: plain functions of their arguments.
 
 use pyo3::prelude::*;
-use vibroimpact_core::{beam, closed_forms, materials, signals};
+use vibroimpact_core::{beam, closed_forms, materials, settling, signals};
 
 use crate::convert::*;
 use crate::errors::*;
@@ -43,6 +43,30 @@ pub(crate) fn forcing_period(excitations: Vec<(String, Option<Vec<f64>>)>) -> Py
         .map(|(name, frequencies)| (name.as_str(), frequencies.clone()))
         .collect();
     signals::common_period(&parts).map_err(to_py)
+}
+
+/// The fewest forcing periods p <= ``max_period`` after which the last row of
+/// ``strobe`` (stroboscopic states: n displacements, m, then n velocities, m/s)
+/// repeats within ``tolerance`` of the size of the motion, or ``None``: the
+/// steady-state criterion of the analyses and the studies (see the core's
+/// ``settling::strobe_period``). ``forcing_period`` in s.
+#[pyfunction]
+pub(crate) fn strobe_period(
+    strobe: numpy::PyReadonlyArray2<'_, f64>,
+    forcing_period: f64,
+    tolerance: f64,
+    max_period: usize,
+) -> PyResult<Option<usize>> {
+    let rows = strobe.as_array();
+    let width = rows.ncols();
+    let flat: Vec<f64> = rows.iter().copied().collect();
+    Ok(settling::strobe_period(
+        &flat,
+        width,
+        forcing_period,
+        tolerance,
+        max_period,
+    ))
 }
 
 /// One cantilever mode reduced to a single degree of freedom (see

@@ -47,6 +47,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
     // Internal (not in __all__): vibroimpact.analyses.forcing_period wraps it.
     m.setattr("_forcing_period", wrap_pyfunction!(forcing_period, m)?)?;
+    // Internal: vibroimpact.analyses.steady_state's criterion, the studies' own.
+    m.setattr("_strobe_period", wrap_pyfunction!(strobe_period, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_mode, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_root, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_mode_shape, m)?)?;
