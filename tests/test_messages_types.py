@@ -9,6 +9,7 @@ import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -179,3 +180,221 @@ def test_record_arrays_given_in_python_are_checked_the_same(tmp_path: Path) -> N
             method="dopri5",
         )
     assert np.isfinite(0.5 * sys.float_info.max)
+
+
+# 2. Every public function refuses an argument of the wrong type naming it.
+
+SECTIONS: dict[str, Any] = {
+    "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.5},
+    "damper": [{"mass": 0.05, "at": 0, "clearance": 0.005, "law": "rigid", "restitution": 0.6}],
+    "excitation": [
+        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 10.0}
+    ],
+    "solver": {"method": "exact", "t_end": 0.1},
+}
+NONE_FOR_NUMBER = [None, "1", [1.0], {}, True, np.zeros(2)]
+NOT_A_COUNT = [None, "5", 2.5, [5], {}, True]
+NOT_VALUES = [None, "abc", {"a": 1}, [[1.0, 2.0], [3.0, 4.0]], np.zeros((2, 2)), ["a"], 5.0, [None]]
+NOT_SECTIONS = [None, "x", [1], 5]
+NOT_TEXT = [None, 5, ["a"], {"a": 1}]
+NOT_A_STATE = ["x", {}, [[1.0]], [None], np.zeros((2, 2)), np.zeros(5), 5.0]
+NOT_A_FUNCTION = [5, "x"]
+NOT_A_FOLDER = [5, ["a"]]
+NOT_AN_AXIS = [None, 5, "x", (0,), (0, "abc"), ("a", [0.0]), (0, [[0.0, 1.0]]), (-1, [0.0])]
+
+
+def _calls() -> list[Any]:
+    """(function, valid keyword arguments, argument, bad values) over the public API."""
+    import vibroimpact as vi
+    from vibroimpact import analyses, continuation, maps, study
+
+    run = analyses.runner(SECTIONS)
+    sweep = {"data": SECTIONS, "parameter": "excitation.0.frequency", "values": [10.0]}
+    bifurcation = {**sweep, "settle_periods": 1, "sample_periods": 1}
+    basins = {"run": run, "first": (0, [0.0]), "second": (1, [0.0]), "settle_periods": 1}
+    system = vi.ImpactDamper(
+        main_mass=1.0, stiffness=1.0, damping=0.01, impact_mass=0.25, clearance=0.01
+    )
+    simulate = {
+        "system": system,
+        "contact": vi.Contact("hertz", stiffness=3000.0),
+        "initial": vi.InitialState(),
+        "method": "rk4",
+        "dt": 1e-3,
+        "t_end": 0.01,
+    }
+    structure = {"structure": SECTIONS["structure"], "t_end": 0.01, "method": "dopri5"}
+    table: list[tuple[Any, dict[str, Any], str, list[Any]]] = [
+        (analyses.sweep, sweep, "data", NOT_SECTIONS),
+        (analyses.sweep, sweep, "parameter", NOT_TEXT),
+        (analyses.sweep, sweep, "values", NOT_VALUES),
+        (analyses.sweep, sweep, "direction", [None, 5, "sideways"]),
+        (analyses.sweep, sweep, "settle_periods", NOT_A_COUNT),
+        (analyses.sweep, sweep, "record_periods", NOT_A_COUNT),
+        (analyses.sweep, sweep, "tolerance", NONE_FOR_NUMBER),
+        (analyses.sweep, sweep, "base_dir", NOT_A_FOLDER),
+        (analyses.sweep, sweep, "progress", NOT_A_FUNCTION),
+        (analyses.runner, {"data": SECTIONS}, "data", NOT_SECTIONS),
+        (analyses.runner, {"data": SECTIONS}, "base_dir", NOT_A_FOLDER),
+        (analyses.forcing_period, {"data": SECTIONS}, "data", NOT_SECTIONS),
+        (analyses.linear_amplitude, {"data": SECTIONS}, "data", NOT_SECTIONS),
+        (analyses.linear_response, {"data": SECTIONS}, "base_dir", NOT_A_FOLDER),
+        (analyses.steady_state, {"run": run}, "run", [None, "x", {}, SECTIONS]),
+        (analyses.steady_state, {"run": run}, "state", NOT_A_STATE),
+        (analyses.steady_state, {"run": run}, "settle_periods", NOT_A_COUNT),
+        (analyses.steady_state, {"run": run}, "record_periods", NOT_A_COUNT),
+        (analyses.steady_state, {"run": run}, "max_period", NOT_A_COUNT),
+        (analyses.steady_state, {"run": run}, "tolerance", NONE_FOR_NUMBER),
+        (analyses.orbit, {"run": run}, "run", [None, "x", SECTIONS]),
+        (analyses.orbit, {"run": run}, "state", NOT_A_STATE),
+        (analyses.orbit, {"run": run}, "periods", NOT_A_COUNT),
+        (analyses.orbit, {"run": run}, "tolerance", NONE_FOR_NUMBER),
+        (analyses.orbit, {"run": run}, "max_iterations", NOT_A_COUNT),
+        (
+            analyses.with_parameter,
+            {"data": SECTIONS, "path": "excitation.0.frequency", "value": 5.0},
+            "value",
+            NONE_FOR_NUMBER,
+        ),
+        (
+            analyses.with_parameter,
+            {"data": SECTIONS, "path": "x.y", "value": 5.0},
+            "path",
+            NOT_TEXT,
+        ),
+        (analyses.with_parameter, {"data": SECTIONS, "path": "x.y", "value": 5.0}, "data", [None]),
+        (analyses.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "path", NOT_TEXT),
+        (analyses.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "n", NOT_A_COUNT),
+        (analyses.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "k", NOT_A_COUNT),
+        (analyses.reductions, {"amplitude": [1.0], "linear": [2.0]}, "linear", [None, "x", {}]),
+        (maps.poincare, {"run": run, "periods": 1}, "run", [None, SECTIONS]),
+        (maps.poincare, {"run": run, "periods": 1}, "state", NOT_A_STATE),
+        (maps.poincare, {"run": run, "periods": 1}, "settle_periods", NOT_A_COUNT),
+        (maps.poincare, {"run": run, "periods": 1}, "periods", NOT_A_COUNT),
+        (maps.bifurcation, bifurcation, "data", NOT_SECTIONS),
+        (maps.bifurcation, bifurcation, "parameter", NOT_TEXT),
+        (maps.bifurcation, bifurcation, "values", NOT_VALUES),
+        (maps.bifurcation, bifurcation, "settle_periods", NOT_A_COUNT),
+        (maps.bifurcation, bifurcation, "sample_periods", NOT_A_COUNT),
+        (maps.bifurcation, bifurcation, "base_dir", NOT_A_FOLDER),
+        (maps.bifurcation, bifurcation, "progress", NOT_A_FUNCTION),
+        (maps.basins, basins, "run", [None, SECTIONS]),
+        (maps.basins, basins, "first", NOT_AN_AXIS),
+        (maps.basins, basins, "second", NOT_AN_AXIS),
+        (maps.basins, basins, "state", NOT_A_STATE),
+        (maps.basins, basins, "tolerance", NONE_FOR_NUMBER),
+        (maps.basins, basins, "progress", NOT_A_FUNCTION),
+        (
+            continuation.continue_orbit,
+            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            "data",
+            NOT_SECTIONS,
+        ),
+        (
+            continuation.continue_orbit,
+            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            "parameter",
+            NOT_TEXT,
+        ),
+        (
+            continuation.continue_orbit,
+            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            "stop",
+            NONE_FOR_NUMBER,
+        ),
+        (
+            continuation.continue_orbit,
+            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            "step",
+            ["1", [1.0], {}, True],
+        ),
+        (
+            continuation.continue_orbit,
+            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            "tolerance",
+            NONE_FOR_NUMBER,
+        ),
+        (
+            continuation.continue_orbit,
+            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            "progress",
+            NOT_A_FUNCTION,
+        ),
+        (vi.simulate, simulate, "system", [None, "x", {}]),
+        (vi.simulate, simulate, "contact", [None, "hertz"]),
+        (vi.simulate, simulate, "initial", [None, {}]),
+        (vi.simulate, simulate, "method", [None, 5, ["rk4"]]),
+        (vi.simulate, simulate, "contact_timing", [None, 5]),
+        (vi.simulate, simulate, "stepping", [5]),
+        (vi.simulate, simulate, "t_end", [None, "1", [1.0]]),
+        (vi.check_solver, {"t_end": 1.0, "method": "dopri5"}, "method", [None, 5]),
+        (vi.simulate_system, structure, "structure", [None, "x", 5]),
+        (vi.simulate_system, structure, "excitation", ["x", 5, [5]]),
+        (vi.simulate_system, structure, "method", [None, 5]),
+        (vi.simulate_system, structure, "base_dir", NOT_A_FOLDER),
+        (vi.cantilever_mode_shape, {"length": 1.0, "mode": 1, "x": 0.5}, "derivative", [None, "1"]),
+        (
+            vi.goldsmith_contact_duration,
+            {"impact_mass": 1.0, "main_mass": 1.0, "hertz_stiffness": 1.0, "approach_speed": 1.0},
+            "exact_constant",
+            [None, "yes"],
+        ),
+        (vi.parse_scenario, {"text": ""}, "text", [None, 5, b"x"]),
+        (vi.parse_scenario, {"text": ""}, "source", [None, 5]),
+        (vi.parse_scenario, {"text": ""}, "base_dir", NOT_A_FOLDER),
+        (vi.load_scenario, {"path": "s.toml"}, "path", [None, 5, ["a"]]),
+        (study.study_of, {"data": SECTIONS}, "data", NOT_SECTIONS),
+    ]
+    return [
+        pytest.param(function, kwargs, name, bad, id=f"{function.__name__}-{name}-{i}")
+        for function, kwargs, name, bads in table
+        for i, bad in enumerate(bads)
+    ]
+
+
+@pytest.mark.parametrize(("function", "kwargs", "name", "bad"), _calls())
+def test_a_public_function_refuses_a_wrong_type_naming_the_argument(
+    function: Callable[..., Any], kwargs: dict[str, Any], name: str, bad: Any
+) -> None:
+    import vibroimpact as vi
+
+    with pytest.raises(vi.InvalidInputError) as caught:
+        function(**{**kwargs, name: bad})
+    message = str(caught.value)
+    assert name in message and "\n" not in message, message
+
+
+def test_the_issue_s_calls_name_their_argument() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    with pytest.raises(vi.InvalidInputError, match=r"^parameter: must be a string, got 5"):
+        analyses.sweep(SECTIONS, 5, [1.0])  # type: ignore[arg-type]
+    with pytest.raises(vi.InvalidInputError, match=r"^values: must be a list or 1-D array"):
+        analyses.sweep(SECTIONS, "excitation.0.frequency", [[1.0, 2.0]])
+    with pytest.raises(vi.InvalidInputError, match=r"^data: must be a scenario's sections"):
+        analyses.runner(None)  # type: ignore[arg-type]
+
+
+# 3. Ranges: a key's real range, numbers written short.
+
+
+@pytest.mark.parametrize("step", [1e300, 2.0, 1e-300])
+def test_a_continuation_step_beyond_its_range_is_refused(step: float) -> None:
+    import vibroimpact as vi
+    from vibroimpact.continuation import continue_orbit
+
+    # From 10 Hz to 11 Hz: a step is at most the whole range, at least 1e-9 of it.
+    with pytest.raises(vi.InvalidInputError, match=r"^step: must be in \[1e-09, 1.0\]"):
+        continue_orbit(SECTIONS, "excitation.0.frequency", stop=11.0, step=step, max_points=3)
+
+
+def test_a_continuation_step_of_1e300_is_refused_on_the_command_line(
+    tmp_path: Path, run_cli: Cli
+) -> None:
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "ball_table_continuation.toml").read_text(encoding="utf-8")
+    lines = ["step = 1e300" if line.startswith("step =") else line for line in text.splitlines()]
+    assert "step = 1e300" in lines
+    (tmp_path / "c.toml").write_text("\n".join(lines) + "\n")
+    refused(run_cli("continue", "c.toml"), "c.toml: step: must be in [", "got 1e+300")

@@ -44,16 +44,17 @@ from vibroimpact._core import (
     __version__,
     adequacy,
     cantilever_mode,
-    cantilever_mode_shape,
     cantilever_root,
-    check_solver,
-    goldsmith_contact_duration,
     goldsmith_max_indentation,
     hertz_stiffness,
     linear_contact_duration,
     run_study,
-    simulate,
 )
+from vibroimpact._core import cantilever_mode_shape as _cantilever_mode_shape
+from vibroimpact._core import check_solver as _check_solver
+from vibroimpact._core import goldsmith_contact_duration as _goldsmith_contact_duration
+from vibroimpact._core import simulate as _simulate
+from vibroimpact.arguments import typed as _typed
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
 from vibroimpact.system import linear_parts, simulate_system
 
@@ -74,6 +75,13 @@ def _equality_only(*classes: type) -> None:
 
 
 _equality_only(ImpactDamper, Contact, InitialState)
+
+# Arguments of the wrong type named (PyO3's TypeError names none).
+_TEXTS = {"method": str, "contact_timing": str, "stepping": (str, type(None))}
+simulate = _typed(system=ImpactDamper, contact=Contact, initial=InitialState, **_TEXTS)(_simulate)
+check_solver = _typed(**_TEXTS)(_check_solver)
+cantilever_mode_shape = _typed(derivative=int)(_cantilever_mode_shape)
+goldsmith_contact_duration = _typed(exact_constant=bool)(_goldsmith_contact_duration)
 
 __all__ = [
     "run_study",

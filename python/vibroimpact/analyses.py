@@ -23,8 +23,10 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem, _strobe_period
+from vibroimpact import arguments
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem
 from vibroimpact._core import _forcing_period as _core_forcing_period
+from vibroimpact.messages import shown
 from vibroimpact.summary import summarised
 from vibroimpact.system import (
     _NUMBER,
@@ -62,6 +64,7 @@ def forcing_period(data: Mapping[str, Any]) -> float:
     harmonics (``"harmonic"``, ``"harmonics"``; 0 Hz terms are constant), the period
     ``1 / f0`` of the highest ``f0`` of which every frequency is a whole multiple (10 and
     15 Hz: 0.2 s). The core's rule, the one studies apply."""
+    arguments.sections("data", data)
     parts: list[tuple[str, list[float] | None]] = []
     for excitation in data.get("excitation", ()) or ():
         table = excitation if isinstance(excitation, Mapping) else {}
@@ -90,6 +93,9 @@ def forcing_period(data: Mapping[str, Any]) -> float:
 def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str, Any]:
     """A deep copy of a scenario's sections with the dotted ``path`` (such as
     ``"excitation.0.frequency"`` or ``"damper.0.clearance"``) set to ``value``."""
+    arguments.sections("data", data)
+    arguments.text("path", path)
+    value = arguments.number("value", value)
     out = copy.deepcopy(dict(data))
     parts = path.split(".")
     if parts[0] not in _SECTIONS or len(parts) < 2:
@@ -268,8 +274,27 @@ class Runner:
         return shot
 
 
+def checked_run(run: Any, state: Any) -> np.ndarray | None:
+    """``run`` checked as a :class:`Runner` and ``state`` as one of its flat states
+    (or None)."""
+    arguments.instance("run", run, Runner, "vibroimpact.analyses.runner(sections)")
+    return arguments.state("state", state, 2 * (run.n + run.k))
+
+
+def _floats(name: str, value: Any) -> np.ndarray:
+    """An array of numbers (any shape; NaN allowed: a run that failed)."""
+    try:
+        if value is None or isinstance(value, str | bytes | Mapping):
+            raise TypeError
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise AnalysisError(f"{name}: must be an array of numbers, got {shown(value)}") from None
+
+
 def runner(data: Mapping[str, Any], base_dir: Path | None = None) -> Runner:
     """A :class:`Runner` of a scenario's sections (as parsed from TOML)."""
+    arguments.sections("data", data)
+    base_dir = arguments.directory("base_dir", base_dir)
     return Runner(_prepare(data, base_dir), forcing_period(data))
 
 
@@ -309,6 +334,16 @@ def _recorded_by_period(
         "final_state": z,
     }
     return merged, least
+
+
+def _scaled_distance(a: np.ndarray, b: np.ndarray, dim: int, reference: np.ndarray) -> float:
+    """|a - b| with displacements and velocities each scaled by their largest
+    magnitude in ``reference`` (rows of states)."""
+    x_scale = max(float(np.max(np.abs(reference[:, :dim]), initial=0.0)), 1e-300)
+    v_scale = max(float(np.max(np.abs(reference[:, dim:]), initial=0.0)), 1e-300)
+    dx = float(np.max(np.abs(a[:dim] - b[:dim]), initial=0.0)) / x_scale
+    dv = float(np.max(np.abs(a[dim:] - b[dim:]), initial=0.0)) / v_scale
+    return max(dx, dv)
 
 
 @summarised
@@ -351,26 +386,29 @@ def steady_state(
 ) -> SteadyState:
     """Run ``settle_periods`` forcing periods from ``state`` (default the scenario's
     ``[initial]``), find the smallest p <= ``max_period`` with the stroboscopic state
-    repeating after p periods within ``tolerance`` (relative to the size of the
-    motion: each coordinate's state (x, v) counts as the amplitude ``hypot(x, v /
-    w)``, w the forcing's angular frequency), then record ``record_periods`` periods,
-    rounded up to a whole number of p (impacts counted over part of an orbit differ
-    with where the window ends)."""
+    repeating after p periods within ``tolerance`` (relative to the largest
+    displacement and velocity), then record ``record_periods`` periods."""
+    state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     record_periods = whole_count("record_periods", record_periods, 1)
     max_period = whole_count("max_period", max_period, 1)
-    if not tolerance > 0:
-        raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
+    arguments.positive("tolerance", tolerance)
     x0 = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    dim = len(x0) // 2
     period: int | None = None
     strobe = np.zeros((0, len(x0)))
     if settle_periods > 0:
         raw = run.periods(x0, settle_periods, strobe=True)
         strobe = np.asarray(raw["strobe"]).reshape(-1, len(x0))
         x0 = np.asarray(raw["final_state"], dtype=float)
-        period = _strobe_period(strobe, run.period, tolerance, max_period)
-    if period is not None:
-        record_periods = -(-record_periods // period) * period
+        rows = np.vstack([strobe, x0[None, :]]) if len(strobe) == 0 else strobe
+        tail = rows[-(2 * max_period + 1) :]
+        for p in range(1, max_period + 1):
+            if len(rows) <= p:
+                break
+            if _scaled_distance(rows[-1], rows[-1 - p], dim, tail) <= tolerance:
+                period = p
+                break
     least = np.zeros(0)
     if period is None:
         # Not periodic: each period's peak, for the spread of the amplitudes.
@@ -412,6 +450,8 @@ def linear_response(
     ``|w . Q|``, ``w`` the coordinates' weights there (a cantilever's mode shapes, or
     ``E I phi''``), summed over the frequencies as the coordinates' are. ``prepared``:
     the sections already checked (a sweep's runner has them)."""
+    arguments.sections("data", data)
+    base_dir = arguments.directory("base_dir", base_dir)
     parts = linear_parts(
         data["structure"], excitation=data.get("excitation", ()), base_dir=base_dir
     )
@@ -533,7 +573,7 @@ def reductions(amplitude: Any, linear: Any) -> np.ndarray:
     """``1 - amplitude / linear`` along the last axis, NaN where either is not finite or
     the linear amplitude is round-off: at most 1e-9 of the largest of its row (a node of
     the response, such as the moment at a free tip, where the ratio is of round-offs)."""
-    amplitude, linear = np.asarray(amplitude, dtype=float), np.asarray(linear, dtype=float)
+    amplitude, linear = _floats("amplitude", amplitude), _floats("linear", linear)
     finite = np.isfinite(amplitude) & np.isfinite(linear)
     scale = np.max(np.abs(np.where(finite, linear, 0.0)), axis=-1, keepdims=True, initial=0.0)
     defined = finite & (np.abs(linear) > 1e-9 * scale)
@@ -720,15 +760,23 @@ def basins_settings(table: Any) -> dict[str, Any]:
 
 def state_index(path: str, n: int, k: int) -> int:
     """The index in the flat state ``(x, v)`` of ``"structure_velocity.0"`` etc."""
+    arguments.text("path", path)
+    n, k = whole_count("n", n, 0), whole_count("k", k, 0)
     name, _, index = path.partition(".")
-    i = int(index)
     d = n + k
-    size, offset = {
+    places = {
         "structure_displacement": (n, 0),
         "damper_displacement": (k, n),
         "structure_velocity": (n, d),
         "damper_velocity": (k, d + n),
-    }[name]
+    }
+    if name not in places or not (index.isascii() and index.isdigit()):
+        raise AnalysisError(
+            f"path: must be one of {', '.join(places)} and an index from 0 (such as "
+            f'"structure_velocity.0"), got {path!r}'
+        )
+    i = int(index)
+    size, offset = places[name]
     if i >= size:
         raise AnalysisError(f"{path}: must index one of the system's {size} {name} values (from 0)")
     return offset + i
@@ -799,8 +847,12 @@ def sweep(
     that jumps and hysteresis show (from ``[initial]`` where that state is not
     admissible: see :func:`from_carried`). A point whose run fails is reported with
     its error (and the next starts from the last good state)."""
+    arguments.sections("data", data)
+    arguments.text("parameter", parameter)
+    values = sorted(arguments.numbers("values", values).tolist())
     _choice("", "direction", direction, _DIRECTIONS)
-    values = sorted(float(v) for v in values)
+    base_dir = arguments.directory("base_dir", base_dir)
+    arguments.callback("progress", progress)
     legs: list[tuple[str, list[float]]] = []
     if direction in ("up", "both"):
         legs.append(("up", values))
@@ -937,9 +989,10 @@ def orbit(
     the Jacobian is the monodromy matrix; its eigenvalues are the Floquet multipliers
     and the orbit is stable when all lie inside the unit circle. Newton steps that
     would start inside a wall are halved."""
+    state = checked_run(run, state)
     periods = whole_count("periods", periods, 1)
-    if not tolerance > 0:
-        raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
+    arguments.positive("tolerance", tolerance)
+    max_iterations = whole_count("max_iterations", max_iterations, 1)
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     shot = run.shoot(z, periods, tolerance, max_iterations)
     size = len(z)

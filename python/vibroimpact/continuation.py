@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analyses import (
     AnalysisError,
@@ -37,6 +38,7 @@ from vibroimpact.analyses import (
     whole_count,
     with_parameter,
 )
+from vibroimpact.messages import shown
 from vibroimpact.summary import summarised
 
 
@@ -94,6 +96,11 @@ class Branch:
     k: int
 
 
+#: A continuation's step (arclength, in the parameter's unit) as fractions of the range
+#: it continues over, ``|stop - start|``.
+STEP_RANGE = (1e-9, 1.0)
+
+
 def continue_orbit(
     data: Mapping[str, Any],
     parameter: str,
@@ -111,14 +118,27 @@ def continue_orbit(
     about ``step`` (in units of the parameter; default 1/50 of the range), at most
     ``max_points`` orbits. Stops at ``stop``, at ``max_points``, or when the
     corrector fails even with small steps."""
+    arguments.sections("data", data)
+    arguments.text("parameter", parameter)
+    stop = arguments.number("stop", stop)
+    periods = whole_count("periods", periods, 1)
+    arguments.positive("tolerance", tolerance)
+    base_dir = arguments.directory("base_dir", base_dir)
+    arguments.callback("progress", progress)
     start_value = _value_of(data, parameter)
-    if not math.isfinite(stop) or stop == start_value:
+    if stop == start_value:
         raise AnalysisError(f"stop: must be a finite value other than the start {start_value:g}")
     max_points = whole_count("max_points", max_points, 2)
     span = stop - start_value
-    ds = abs(span) / 50 if step is None else float(step)
-    if not ds > 0:
-        raise AnalysisError(f"step: must be > 0, got {step!r}")
+    ds = abs(span) / 50 if step is None else arguments.positive("step", step)
+    if not STEP_RANGE[0] * abs(span) <= ds <= STEP_RANGE[1] * abs(span):
+        # A step beyond the whole range leaves at once; one of 1e-9 of it never gets
+        # anywhere within max_points.
+        raise AnalysisError(
+            f"step: must be in [{shown(STEP_RANGE[0] * abs(span))}, {shown(abs(span))}] (from "
+            f"1e-9 of the range to the range |stop - start| = {shown(abs(span))}), got "
+            f"{shown(ds)}"
+        )
 
     # The stroboscopic section, as a fraction of the forcing period after t = 0: moved
     # away from the impacts when one comes near it, where the map jumps (an impact

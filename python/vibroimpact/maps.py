@@ -14,11 +14,13 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact import arguments
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
 from vibroimpact.analyses import (
     BIFURCATION_SAMPLES,
     AnalysisError,
     Runner,
+    checked_run,
     from_carried,
     runner,
     steady_state,
@@ -51,6 +53,7 @@ def poincare(
 ) -> Section:
     """Settle ``settle_periods`` forcing periods, then sample ``periods`` more: the
     stroboscopic section and the impact section."""
+    state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     periods = whole_count("periods", periods, 1)
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
@@ -152,6 +155,11 @@ def bifurcation(
     ``"impact-velocity"`` (each impact's approach speed, m/s) or ``"impact-phase"``
     (each impact's ``w t`` modulo 2 pi, rad), the impacts of ``pair`` (``"stop 0"``,
     ``"damper 1"``; every pair's where None)."""
+    arguments.sections("data", data)
+    arguments.text("parameter", parameter)
+    values = arguments.numbers("values", values)
+    base_dir = arguments.directory("base_dir", base_dir)
+    arguments.callback("progress", progress)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     sample_periods = whole_count("sample_periods", sample_periods, 1)
     if not isinstance(sample, str) or sample not in BIFURCATION_SAMPLES:
@@ -215,6 +223,21 @@ class Basins:
     attractors: list[dict[str, Any]]
 
 
+def _axis(name: str, value: Any) -> tuple[int, np.ndarray]:
+    """An axis of :func:`basins`: a pair (an index into the flat state, its values)."""
+    if isinstance(value, str | bytes | Mapping) or not isinstance(value, Sequence):
+        raise AnalysisError(
+            f"{name}: must be a pair (an index into the state, its values), got "
+            f"{arguments.shown(value)}"
+        )
+    if len(value) != 2:
+        raise AnalysisError(
+            f"{name}: must be a pair (an index into the state, its values), got {len(value)} items"
+        )
+    index = whole_count(f"{name}[0] (the state index)", value[0], 0)
+    return index, arguments.numbers(f"{name}[1] (the values)", value[1])
+
+
 def basins(
     run: Runner,
     first: tuple[int, np.ndarray],
@@ -232,10 +255,12 @@ def basins(
     same period, same impacts per period and amplitudes within 1e-3 relative."""
     # Checked here: each start's steady state would take a bad count for a start
     # inside a wall (every label -3).
+    state = checked_run(run, state)
+    first, second = _axis("first", first), _axis("second", second)
+    arguments.callback("progress", progress)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     record_periods = whole_count("record_periods", record_periods, 1)
-    if not tolerance > 0:
-        raise AnalysisError(f"tolerance: must be > 0, got {tolerance!r}")
+    arguments.positive("tolerance", tolerance)
     base = run.initial_state() if state is None else np.asarray(state, dtype=float)
     for name, (index, _) in (("first", first), ("second", second)):
         if not 0 <= index < len(base):

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from vibroimpact import arguments
 from vibroimpact._core import (
     Contact,
     ImpactDamper,
@@ -255,6 +256,9 @@ def parse_scenario(
     are read relative to ``base_dir``); one with ``[system]`` and ``[contact]``,
     the two-mass impact damper (:class:`Scenario`).
     """
+    arguments.text("text", text)
+    arguments.text("source", source)
+    base_dir = arguments.directory("base_dir", base_dir)
     try:
         data = tomllib.loads(text)
     except RecursionError:
@@ -298,7 +302,7 @@ def _validate_solver(scenario: Scenario, source: str) -> None:
 
 def load_scenario(path: str | Path) -> Scenario | SystemScenario:
     """Read and validate a TOML scenario file (UTF-8, at most ``MAX_SCENARIO_BYTES``)."""
-    path = Path(path)
+    path = arguments.path("path", path)
     try:
         # Checked before opening: opening a FIFO waits for a writer, for ever.
         if not stat.S_ISREG(path.stat().st_mode) and not path.is_dir():

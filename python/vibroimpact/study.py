@@ -100,6 +100,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact import arguments
 from vibroimpact._core import __version__, run_study
 from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare
 from vibroimpact.output import UsageError, written_whole
@@ -576,6 +577,9 @@ def study_of(
     data: Mapping[str, Any], source: str = "<study>", base_dir: Path | None = None
 ) -> Study:
     """A :class:`Study` of a scenario's sections with a ``[study]`` section."""
+    arguments.sections("data", data)
+    arguments.text("source", source)
+    base_dir = arguments.directory("base_dir", base_dir)
     if "study" not in data:
         raise StudyError(f"{source}: a study needs a [study] section with [study.axes]")
     settings = data["study"]
@@ -781,6 +785,11 @@ def run(
     an uninterrupted run) and the parts removed. ``dask``: the address of a Dask
     scheduler, or ``"local"`` for a LocalCluster of ``threads`` processes (all cores for
     0), the chunks its tasks; the results are the same. Returns the Dataset."""
+    arguments.instance("study", study, Study, "vibroimpact.study.study_of(sections)")
+    out = arguments.path("out", out)
+    arguments.callback("progress", progress)
+    if dask is not None:
+        arguments.text("dask", dask)
     check_threads(threads, "threads:")
     kind = output_kind(out)
     parts_dir = out.with_name(out.name + ".parts")

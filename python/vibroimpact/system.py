@@ -57,9 +57,10 @@ from vibroimpact._core import (
 )
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
+from vibroimpact.arguments import directory
 from vibroimpact.messages import short_numbers, shown
-from vibroimpact.summary import contacts_repr, solution_repr
 from vibroimpact.record_file import check_record, read_record
+from vibroimpact.summary import contacts_repr, solution_repr
 
 __all__ = [
     "PreparedRun",
@@ -923,6 +924,7 @@ def prepare_system(
 ) -> PreparedRun:
     """Check every section of a 0.2 run (the sections of a TOML scenario, as dicts)
     and fill their defaults; errors name the section and key."""
+    base_dir = directory("base_dir", base_dir)
     try:
         spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
     except RecursionError:
@@ -1104,6 +1106,7 @@ def linear_parts(
     weight, N) and ``harmonics``: each ``amplitude``, ``omega`` (rad/s), ``phase`` and
     ``shape`` (the load is ``amplitude cos(omega t + phase) shape``, N). Signals
     other than harmonics are refused."""
+    base_dir = directory("base_dir", base_dir)
     spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
     raw = _linear_parts({**spec, "gravity": spec["gravity"]["acceleration"]})
     dim = raw["n"] + raw["k"]

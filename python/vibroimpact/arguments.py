@@ -1,0 +1,194 @@
+"""The arguments of the public functions checked for their type, each refused with an
+:class:`~vibroimpact.InvalidInputError` (a ValueError) naming the argument and what it
+takes: ``None`` for a number, a string for a list, a dict for an array, a 2-D array for
+a list of values would otherwise fail deep inside as an AttributeError or a TypeError.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import math
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.messages import shown
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _real(value: Any) -> float | None:
+    """``value`` as a float when it is a real number (an int, a float, a NumPy real
+    scalar or 0-d array; never a boolean), else None."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value[()]
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        return None
+    if isinstance(value, np.complexfloating):
+        return None
+    try:
+        return float(value)
+    except OverflowError:
+        return math.copysign(math.inf, value)
+
+
+def sections(name: str, value: Any) -> Mapping[str, Any]:
+    """A scenario's sections: a mapping of section names to tables (as ``tomllib``
+    parses a scenario)."""
+    if not isinstance(value, Mapping):
+        raise InvalidInputError(
+            f"{name}: must be a scenario's sections (a dict of tables, as tomllib parses "
+            f"a scenario), got {shown(value)}"
+        )
+    return value
+
+
+def text(name: str, value: Any) -> str:
+    """A string."""
+    if not isinstance(value, str):
+        raise InvalidInputError(f"{name}: must be a string, got {shown(value)}")
+    return value
+
+
+def number(name: str, value: Any) -> float:
+    """A finite real number (an int, a float or a NumPy real; not a boolean)."""
+    real = _real(value)
+    if real is None:
+        raise InvalidInputError(f"{name}: must be a number, got {shown(value)}")
+    if not math.isfinite(real):
+        raise InvalidInputError(f"{name}: must be a finite number, got {shown(real)}")
+    return real
+
+
+def positive(name: str, value: Any) -> float:
+    """A finite number > 0."""
+    real = number(name, value)
+    if not real > 0:
+        raise InvalidInputError(f"{name}: must be > 0, got {shown(real)}")
+    return real
+
+
+def numbers(name: str, value: Any) -> np.ndarray:
+    """A one-dimensional array of finite numbers (a list, a tuple or a 1-D array)."""
+    if isinstance(value, str | bytes | Mapping) or not _sequence(value):
+        raise InvalidInputError(
+            f"{name}: must be a list or 1-D array of numbers, got {shown(value)}"
+        )
+    array = np.asarray(value, dtype=object) if not isinstance(value, np.ndarray) else value
+    if array.ndim != 1:
+        raise InvalidInputError(
+            f"{name}: must be a list or 1-D array of numbers, got {array.ndim} dimensions "
+            f"(shape {array.shape})"
+        )
+    if array.dtype.kind in "iuf":
+        out = np.asarray(array, dtype=float)
+    else:
+        out = np.empty(len(array))
+        for i, v in enumerate(array):
+            out[i] = number(f"{name}[{i}]", v)
+    bad = np.flatnonzero(~np.isfinite(out))
+    if bad.size:
+        i = int(bad[0])
+        raise InvalidInputError(f"{name}[{i}]: must be a finite number, got {shown(out[i])}")
+    return out
+
+
+def _sequence(value: Any) -> bool:
+    if isinstance(value, np.ndarray):
+        return True
+    try:
+        len(value)
+        iter(value)
+    except TypeError:
+        return False
+    return True
+
+
+def state(name: str, value: Any, size: int) -> np.ndarray | None:
+    """A flat state (x, v) of ``size`` finite numbers, or None (the scenario's
+    ``[initial]``)."""
+    if value is None:
+        return None
+    out = numbers(name, value)
+    if len(out) != size:
+        raise InvalidInputError(
+            f"{name}: must have {size} values (the displacements, then the velocities), "
+            f"got {len(out)}"
+        )
+    return out
+
+
+def callback(name: str, value: Any) -> Callable[..., Any] | None:
+    """A function to call, or None."""
+    if value is not None and not callable(value):
+        raise InvalidInputError(f"{name}: must be a function or None, got {shown(value)}")
+    return value  # type: ignore[no-any-return]
+
+
+def directory(name: str, value: Any) -> Path | None:
+    """A folder (a str or a path), or None."""
+    if value is None:
+        return None
+    if not isinstance(value, str | os.PathLike):
+        raise InvalidInputError(f"{name}: must be a folder (a str or a Path), got {shown(value)}")
+    return Path(value)
+
+
+def path(name: str, value: Any) -> Path:
+    """A file's path (a str or a path)."""
+    if not isinstance(value, str | os.PathLike):
+        raise InvalidInputError(f"{name}: must be a path (a str or a Path), got {shown(value)}")
+    return Path(value)
+
+
+def instance(name: str, value: Any, kind: type, made_by: str) -> Any:
+    """An instance of ``kind``, which ``made_by`` makes."""
+    if not isinstance(value, kind):
+        raise InvalidInputError(
+            f"{name}: must be {_article(kind)} (from {made_by}), got {shown(value)}"
+        )
+    return value
+
+
+def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
+    """A core function whose arguments of the wrong type (PyO3 raises a TypeError not
+    naming the argument) are refused naming it: on a TypeError the arguments are
+    checked against ``kinds`` (name: the types allowed), and the first wrong one is
+    an InvalidInputError. Valid calls cost nothing."""
+
+    def wrap(function: _F) -> _F:
+        signature = inspect.signature(function)
+
+        @functools.wraps(function)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            try:
+                return function(*args, **kwargs)
+            except TypeError:
+                try:
+                    bound = signature.bind(*args, **kwargs)
+                except TypeError:
+                    raise  # a missing or unknown argument: Python's own error says which
+                for key, allowed in kinds.items():
+                    if key in bound.arguments and not isinstance(bound.arguments[key], allowed):
+                        names = allowed if isinstance(allowed, tuple) else (allowed,)
+                        wanted = " or ".join(_article(t) for t in names)
+                        raise InvalidInputError(
+                            f"{key} must be {wanted}, got {shown(bound.arguments[key])}"
+                        ) from None
+                raise
+
+        return call  # type: ignore[return-value]
+
+    return wrap
+
+
+def _article(kind: type) -> str:
+    """``kind`` as a message names what it takes: "a str", "an ImpactDamper", "None"."""
+    if kind is type(None):
+        return "None"
+    return f"{'an' if kind.__name__[0] in 'AEIOU' else 'a'} {kind.__name__}"
