@@ -228,8 +228,9 @@ def test_basins_count_impacts_over_whole_orbits() -> None:
         for b in amplitudes[:i]:
             assert abs(a - b) > 1e-6 * abs(a), result.attractors
     # The start the orbit was counted from is on the grid: (0.015 m, 0.16 m/s).
-    i, j = np.argmin(np.abs(grid[0][1] - 0.015)), np.argmin(np.abs(grid[1][1] - 0.16))
-    reached = result.attractors[result.labels[i, j]]
+    row = int(np.argmin(np.abs(grid[0][1] - 0.015)))
+    column = int(np.argmin(np.abs(grid[1][1] - 0.16)))
+    reached = result.attractors[result.labels[row, column]]
     assert reached["period"] == 8
     assert reached["impacts_per_period"] == count / 24
 
