@@ -24,7 +24,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem, _strobe_period
 from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.messages import shown
 from vibroimpact.summary import summarised
@@ -336,16 +336,6 @@ def _recorded_by_period(
     return merged, least
 
 
-def _scaled_distance(a: np.ndarray, b: np.ndarray, dim: int, reference: np.ndarray) -> float:
-    """|a - b| with displacements and velocities each scaled by their largest
-    magnitude in ``reference`` (rows of states)."""
-    x_scale = max(float(np.max(np.abs(reference[:, :dim]), initial=0.0)), 1e-300)
-    v_scale = max(float(np.max(np.abs(reference[:, dim:]), initial=0.0)), 1e-300)
-    dx = float(np.max(np.abs(a[:dim] - b[:dim]), initial=0.0)) / x_scale
-    dv = float(np.max(np.abs(a[dim:] - b[dim:]), initial=0.0)) / v_scale
-    return max(dx, dv)
-
-
 @summarised
 @dataclass
 class SteadyState:
@@ -386,29 +376,26 @@ def steady_state(
 ) -> SteadyState:
     """Run ``settle_periods`` forcing periods from ``state`` (default the scenario's
     ``[initial]``), find the smallest p <= ``max_period`` with the stroboscopic state
-    repeating after p periods within ``tolerance`` (relative to the largest
-    displacement and velocity), then record ``record_periods`` periods."""
+    repeating after p periods within ``tolerance`` (relative to the size of the
+    motion: each coordinate's state (x, v) counts as the amplitude ``hypot(x, v /
+    w)``, w the forcing's angular frequency), then record ``record_periods`` periods,
+    rounded up to a whole number of p (impacts counted over part of an orbit differ
+    with where the window ends)."""
     state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     record_periods = whole_count("record_periods", record_periods, 1)
     max_period = whole_count("max_period", max_period, 1)
     arguments.positive("tolerance", tolerance)
     x0 = run.initial_state() if state is None else np.asarray(state, dtype=float)
-    dim = len(x0) // 2
     period: int | None = None
     strobe = np.zeros((0, len(x0)))
     if settle_periods > 0:
         raw = run.periods(x0, settle_periods, strobe=True)
         strobe = np.asarray(raw["strobe"]).reshape(-1, len(x0))
         x0 = np.asarray(raw["final_state"], dtype=float)
-        rows = np.vstack([strobe, x0[None, :]]) if len(strobe) == 0 else strobe
-        tail = rows[-(2 * max_period + 1) :]
-        for p in range(1, max_period + 1):
-            if len(rows) <= p:
-                break
-            if _scaled_distance(rows[-1], rows[-1 - p], dim, tail) <= tolerance:
-                period = p
-                break
+        period = _strobe_period(strobe, run.period, tolerance, max_period)
+    if period is not None:
+        record_periods = -(-record_periods // period) * period
     least = np.zeros(0)
     if period is None:
         # Not periodic: each period's peak, for the spread of the amplitudes.
