@@ -17,6 +17,7 @@ import xarray as xr
 
 from test_study import BASE, MONTE_CARLO, STEADY, Stop, cli, load, scenario
 from test_user_experience import one_line_error, run_main
+from vibroimpact import output
 from vibroimpact import study as st
 from vibroimpact.output import UsageError
 
@@ -127,24 +128,34 @@ def test_a_failed_write_leaves_no_partial_store_and_the_earlier_one_whole(
     assert tree(out) == before
     # Only the finished chunks are left, for the run that resumes.
     assert leftovers(tmp_path) == ["out.zarr.parts"]
+    written_again(study, out, monkeypatch, write)
+
+
+def written_again(study: st.Study, out: Path, monkeypatch: pytest.MonkeyPatch, write: Any) -> None:
+    """With the store's writer ``write`` back, the study run again writes its store and
+    leaves nothing beside it."""
     monkeypatch.setattr(xr.Dataset, "to_zarr", write)
     st.run(study, out)
     with xr.open_zarr(out) as back:
         assert back.attrs["input_hash"] == study.fingerprint()
-    assert leftovers(tmp_path) == []
+    assert leftovers(out.parent) == []
 
 
 def test_a_failed_rename_puts_the_earlier_store_back(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    # Where the store cannot be swapped in one step (no renameat2): it is moved aside,
+    # and the new one's rename fails. (The chunks' files are renamed too: only the
+    # store's folder is refused, so that the study gets as far as its store.)
     study, out, before = earlier_store(tmp_path)
     replace = os.replace
 
     def refused(source: Any, target: Any) -> None:
-        if Path(source).name.endswith(".tmp"):
+        if Path(source).name.endswith(".tmp") and Path(source).is_dir():
             raise OSError(errno.EIO, os.strerror(errno.EIO))
         replace(source, target)
 
+    monkeypatch.setattr(output, "exchange", lambda first, second: False)
     monkeypatch.setattr(os, "replace", refused)
     with pytest.raises(UsageError, match="cannot write"):
         st.run(study, out)

@@ -1,56 +1,49 @@
-"""A run that is terminated (SIGTERM, what `timeout` and batch schedulers send) while
-it writes --out leaves the earlier file whole and no temporary file behind; --out
-asks for a history, so a scenario that keeps none is refused; whole-number and
-boolean arguments of the Python API refuse floats and strings by name."""
+"""A run that is terminated (SIGTERM, what `timeout` and batch schedulers send) or hung
+up (SIGHUP, its terminal closed) while it writes --out leaves the earlier file whole and
+no temporary file behind; --out asks for a history, so a scenario that keeps none is
+refused; whole-number and boolean arguments of the Python API refuse floats and strings
+by name."""
 
 from __future__ import annotations
 
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
 
 import vibroimpact as vi
+from test_interrupted_writes import long_writer, wait_for
 from vibroimpact import _core
 
 ROOT = Path(__file__).resolve().parents[1]
-# 1.5e6 history rows: long enough to write that the signal lands during the write.
-LONG = (
-    (ROOT / "examples" / "rattling_damper.toml")
-    .read_text()
-    .replace("t_end = 60.0", "t_end = 1500.0")
-    .replace("every = 100", "every = 10")
-)
 
 
 @pytest.mark.timeout(120)
-def test_sigterm_while_writing_out_keeps_the_old_file_and_no_temporary(tmp_path: Path) -> None:
-    scenario = tmp_path / "long.toml"
-    scenario.write_text(LONG)
+@pytest.mark.parametrize(
+    ("ending", "status", "message"),
+    [("SIGTERM", 143, "terminated"), ("SIGHUP", 129, "hung up")],
+)
+def test_sigterm_or_sighup_while_writing_out_keeps_the_old_file_and_no_temporary(
+    tmp_path: Path, ending: str, status: int, message: str
+) -> None:
+    # SIGHUP (a closed terminal) left `.h.csv.*.tmp` (58 MB): it ends the run as
+    # SIGTERM and Ctrl-C do.
+    if not hasattr(signal, ending):
+        pytest.skip(f"no {ending} here")
     out = tmp_path / "history.csv"
     out.write_text("OLD CONTENT\n")
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "vibroimpact", "simulate", str(scenario), "--out", str(out)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = long_writer(tmp_path, out)
     try:
-        deadline = time.monotonic() + 90
-        while not list(tmp_path.glob(".history.csv.*")):
-            assert proc.poll() is None, proc.communicate()
-            assert time.monotonic() < deadline, "the temporary file never appeared"
-            time.sleep(0.01)
-        proc.send_signal(signal.SIGTERM)
+        wait_for(lambda: list(tmp_path.glob(".history.csv.*")), proc, "the temporary file")
+        proc.send_signal(getattr(signal, ending))
         _, stderr = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert proc.returncode == 143, stderr
-    assert "terminated" in stderr and "Traceback" not in stderr
+    assert proc.returncode == status, stderr
+    assert message in stderr and "Traceback" not in stderr
     assert out.read_text() == "OLD CONTENT\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["history.csv", "long.toml"]
 
@@ -93,3 +86,23 @@ def test_whole_and_boolean_arguments_refuse_other_types_by_name(field: str, valu
         # The binding's own function: the suite's fixture rewrites max_steps=1e9.
         _core.simulate(SYSTEM, CONTACT, START, method="rk4", dt=1e-4, t_end=1e-3, **{field: value})
     assert "\n" not in str(err.value) and len(str(err.value)) < 200
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGHUP"), reason="no SIGHUP here")
+def test_a_sighup_ignored_as_under_nohup_stays_ignored() -> None:
+    from vibroimpact import cli
+
+    before = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        previous = cli._handle_endings()
+        assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
+        assert signal.getsignal(signal.SIGTERM) == cli._terminate
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+        previous = cli._handle_endings()
+        assert signal.getsignal(signal.SIGHUP) == cli._terminate
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    finally:
+        signal.signal(signal.SIGHUP, before)

@@ -353,6 +353,9 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
     the other axes (and structure coordinates, points or pairs beyond the first)
     reduced to their worst case, the largest value; the optimum, the smallest, marked."""
     values = dataset[metric]
+    if values.dtype == bool:
+        # A yes-or-no metric (settled, stable) as 1 / 0, a failed run's blank.
+        values = values.astype(float).where(dataset["status"] == 0)
     where = ""
     for dim in ("coordinate", "pair", "at", "moment_at"):
         if dim in values.dims:

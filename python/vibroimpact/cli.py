@@ -263,11 +263,44 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 class _Terminated(BaseException):
-    """SIGTERM, raised where the program is, so that cleanups run."""
+    """SIGTERM or SIGHUP, raised where the program is, so that cleanups run."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
 
 
 def _terminate(signum: int, frame: Any) -> None:
-    raise _Terminated
+    raise _Terminated(signum)
+
+
+# What ends a run like Ctrl-C does: a termination request (SIGTERM, what `timeout` and
+# schedulers send) and a closed terminal (SIGHUP, where the system has it), each with
+# its message and exit status (128 + the signal's number).
+_ENDINGS = {
+    getattr(signal, name): message
+    for name, message in (("SIGTERM", "terminated"), ("SIGHUP", "hung up (terminal closed)"))
+    if hasattr(signal, name)
+}
+
+
+def _handle_endings() -> dict[int, Any]:
+    """Turn the signals of ``_ENDINGS`` into :class:`_Terminated` (a SIGHUP ignored, as
+    under nohup, stays ignored); returns the handlers they had."""
+    previous: dict[int, Any] = {}
+    for signum in _ENDINGS:
+        handler = signal.getsignal(signum)
+        if signum == getattr(signal, "SIGHUP", None) and handler == signal.SIG_IGN:
+            continue
+        previous[signum] = signal.signal(signum, _terminate)
+    return previous
+
+
+def _print_notes(stop: BaseException) -> None:
+    """What a stopped job added to its exception (a study: the chunks it kept, and the
+    command that resumes it), a line each."""
+    for note in getattr(stop, "__notes__", ()):
+        print(f"vibroimpact: {note}", file=sys.stderr)
 
 
 def _show_warning(
@@ -284,11 +317,10 @@ def _show_warning(
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
-    # A termination request (SIGTERM, what `timeout` and schedulers send) ends
-    # the run like Ctrl-C does, so that a file being written is removed and an
-    # earlier result stays whole.
+    # A termination request or a closed terminal ends the run like Ctrl-C does, so
+    # that a file being written is removed and an earlier result stays whole.
     main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+    previous = _handle_endings() if main_thread else {}
     # Warnings as one line each, as errors are (not Python's file:line format).
     shown = warnings.showwarning
     warnings.showwarning = _show_warning
@@ -302,17 +334,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
         print(f"vibroimpact: error: {short_numbers(str(err))}", file=sys.stderr)
+        _print_notes(err)
         return 2
     except (NumericalBlowUpError, SimulationError) as err:
         # The input was valid but the run could not be completed.
         print(f"vibroimpact: error: {short_numbers(str(err))}", file=sys.stderr)
+        _print_notes(err)
         return 1
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as stop:
         print("vibroimpact: interrupted", file=sys.stderr)
+        _print_notes(stop)
         return 130
-    except _Terminated:
-        print("vibroimpact: terminated", file=sys.stderr)
-        return 143
+    except _Terminated as ending:
+        print(f"vibroimpact: {_ENDINGS[ending.signum]}", file=sys.stderr)
+        _print_notes(ending)
+        return 128 + ending.signum
     except BrokenPipeError:
         # The reader (e.g. `| head`) left early: not an error of ours. Point
         # stdout at devnull so that Python's exit flush does not fail again.
@@ -320,5 +356,5 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     finally:
         warnings.showwarning = shown
-        if main_thread:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)

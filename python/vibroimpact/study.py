@@ -51,15 +51,15 @@ variables (with a ``coordinate`` dimension for per-structure-coordinate metrics 
 ``pair`` for per-pair ones; with ``[output] points``, ``peak``, ``rms`` and ``amplitude``
 of the structure at each point as ``point_peak``... over a dimension ``at``), and
 ``status`` is 0 for a run that completed, else ``k``, the ``k``-th reason of the
-attribute ``reasons``. With ``samples``, a ``sample``
-dimension follows the axes, and each random parameter is a variable over it: the same
-draws (numpy's PCG64 from ``seed``, in the order of ``[study.random]``) at every grid
-point. SI units.
+attribute ``reasons`` (a failed run's metrics are NaN; its ``settled`` and ``stable``,
+booleans, false). With ``samples``, a ``sample`` dimension follows the axes, and each
+random parameter is a variable over it: the same draws (numpy's PCG64 from ``seed``, in
+the order of ``[study.random]``) at every grid point. SI units.
 
 ``analysis = "orbit"`` settles each point for ``settle_periods`` forcing periods, then
 shoots for an orbit of ``orbit_periods`` periods from there (Newton's method with the
 central-difference monodromy, as :func:`vibroimpact.analyses.orbit`, in the core): ``stable``
-is 1 when it converged and every Floquet multiplier is inside the unit circle,
+is true when it converged and every Floquet multiplier is inside the unit circle,
 ``largest_multiplier`` the largest multiplier's modulus, ``amplitude`` and
 ``impacts_per_period`` those of the orbit. A point whose shooting fails (no orbit near its
 settled state) is recorded with its reason. Both periodic analyses use the common period
@@ -88,7 +88,6 @@ import json
 import logging
 import math
 import os
-import secrets
 import shutil
 import sys
 import time
@@ -103,7 +102,7 @@ import numpy as np
 from vibroimpact import arguments
 from vibroimpact._core import __version__, run_study
 from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare
-from vibroimpact.output import UsageError, written_whole
+from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
 # What each analysis keeps; every metric.
@@ -115,6 +114,8 @@ _ANALYSIS_METRICS = {
     "orbit": ("amplitude", "impacts_per_period", "stable", "largest_multiplier"),
 }
 METRICS = (*_STEADY_METRICS, "stable", "largest_multiplier")
+# The metrics that are yes or no: booleans in the Dataset.
+_FLAGS = ("settled", "stable")
 _ANALYSES = tuple(_ANALYSIS_METRICS)
 _SPACINGS = ("linear", "log")
 _STUDY = {
@@ -153,9 +154,14 @@ _DESCRIPTIONS = {
         "impacts and compliant contacts per forcing period (sticking not counted)",
         "1",
     ),
-    "settled": ("1 when the stroboscopic state repeats within tolerance, else 0", "1"),
+    "settled": (
+        "whether the stroboscopic state repeats within tolerance (false where the run "
+        "failed: see status)",
+        "1",
+    ),
     "stable": (
-        "1 when the orbit converged and every Floquet multiplier is inside the unit circle",
+        "whether the orbit converged and every Floquet multiplier is inside the unit "
+        "circle (false where the run failed: see status)",
         "1",
     ),
     "largest_multiplier": ("modulus of the orbit's largest Floquet multiplier", "1"),
@@ -644,6 +650,10 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
         values = np.concatenate([np.asarray(p[key], dtype=float) for p in parts])
         description, unit = _DESCRIPTIONS[name]
         attrs = {"long_name": description, "units": unit}
+        if name in _FLAGS:
+            # Kept as 1 / 0 in the chunks (NaN for a failed run, which status marks).
+            values = values == 1.0
+            attrs = {"long_name": description}
         if name in PER_COORDINATE:
             values = values.reshape(*shape, n + len(at) + len(moment_at))
             coordinates, at_points, at_moments = split_observed(values, n, len(at))
@@ -776,6 +786,8 @@ def run(
     threads: int = 0,
     progress: Callable[[int, int, float], None] | None = None,
     dask: str | None = None,
+    notice: Callable[[str], None] | None = None,
+    resume: str = "run the same study into the same output again",
 ) -> Any:
     """Run ``study`` into ``out``, by its suffix the NetCDF file ``RESULT.nc`` or the
     Zarr store ``RESULT.zarr`` (needs zarr; see :func:`output_kind`), chunk by chunk:
@@ -784,14 +796,21 @@ def run(
     where it stopped; the output is written whole at the end (the same file or store as
     an uninterrupted run) and the parts removed. ``dask``: the address of a Dask
     scheduler, or ``"local"`` for a LocalCluster of ``threads`` processes (all cores for
-    0), the chunks its tasks; the results are the same. Returns the Dataset."""
+    0), the chunks its tasks; the results are the same. A run that resumes says so to
+    ``notice`` (one line: the chunks kept before); a run that stops (interrupted, or
+    failed) with chunks kept gets a note (:meth:`BaseException.add_note`) saying how
+    many and how to resume (``resume``). Returns the Dataset."""
     arguments.instance("study", study, Study, "vibroimpact.study.study_of(sections)")
     out = arguments.path("out", out)
-    arguments.callback("progress", progress)
+    for name, function in (("progress", progress), ("notice", notice)):
+        arguments.callback(name, function)
     if dask is not None:
         arguments.text("dask", dask)
+    arguments.text("resume", resume)
     check_threads(threads, "threads:")
     kind = output_kind(out)
+    # What a killed write left: an earlier store moved aside is back before any run.
+    remove_stale(out.resolve() if out.is_symlink() else out)
     parts_dir = out.with_name(out.name + ".parts")
     fingerprint = study.fingerprint()
     manifest = parts_dir / "manifest.json"
@@ -823,6 +842,11 @@ def run(
                 # Written whole, so damaged since (a disk, a hand): run it again.
                 pass
     pending = [number for number in range(len(path_of)) if number not in parts]
+    if parts and notice is not None:
+        notice(
+            f"resuming from {parts_dir}: {_kept(study, chunks, path_of)} by an earlier run, "
+            f"{len(pending)} chunks to run"
+        )
     start = time.perf_counter()
     state = {"computed": 0, "done": study.runs - sum(len(chunks[i]) for i in pending)}
 
@@ -843,19 +867,31 @@ def run(
                 finished(number, chunk_part(study, runs.start, runs.stop, threads))
         else:
             _run_on_dask(study, chunks, pending, dask, threads, finished)
-    except BaseException:
-        # Nothing finished: leave nothing behind (a resume has nothing to go on).
-        if not any(parts_dir.glob("chunk-*.npz")):
+        dataset = assemble(study, [parts[number] for number in range(len(path_of))])
+        if kind == ".zarr":
+            _write_zarr(dataset, out)
+        else:
+            with written_whole(out, binary=True) as f:
+                f.write(dataset.to_netcdf(engine="scipy"))
+    except BaseException as stop:
+        if any(path.exists() for path in path_of):
+            stop.add_note(
+                f"{_kept(study, chunks, path_of)}, kept in {parts_dir}; to resume, {resume}"
+            )
+        else:
+            # Nothing finished: leave nothing behind (a resume has nothing to go on).
             shutil.rmtree(parts_dir, ignore_errors=True)
         raise
-    dataset = assemble(study, [parts[number] for number in range(len(path_of))])
-    if kind == ".zarr":
-        _write_zarr(dataset, out)
-    else:
-        with written_whole(out, binary=True) as f:
-            f.write(dataset.to_netcdf(engine="scipy"))
     shutil.rmtree(parts_dir, ignore_errors=True)
     return dataset
+
+
+def _kept(study: Study, chunks: list[range], path_of: list[Path]) -> str:
+    """How much of the study its kept chunks hold (``2 of 4 chunks (8 of 16 runs)
+    done``)."""
+    kept = [runs for runs, path in zip(chunks, path_of, strict=True) if path.exists()]
+    done = sum(len(runs) for runs in kept)
+    return f"{len(kept)} of {len(chunks)} chunks ({done} of {study.runs} runs) done"
 
 
 # What a study's output may end in, and what each suffix writes.
@@ -905,10 +941,11 @@ _STORE_MARKS = (".zgroup", ".zmetadata", "zarr.json")
 def _write_zarr(dataset: Any, out: Path) -> None:
     """Write ``dataset`` as the Zarr store ``out`` whole or not at all: built in a hidden
     folder beside ``out`` (so that the rename cannot cross file systems), its files on
-    disk, then renamed into place; an earlier store at ``out`` is moved aside for the
-    rename and removed only once the new one stands in its place (put back if the rename
-    fails). A write that fails or is interrupted removes the folder and leaves ``out`` as
-    it was; a killed one can leave the hidden folder, never a partial ``out``.
+    disk, then swapped in (:func:`vibroimpact.output.swap_in`: on Linux one atomic
+    exchange, ``out`` never missing), the earlier store removed once the new one stands
+    in its place. A write that fails or is interrupted removes the folder and leaves
+    ``out`` as it was; what a killed one leaves (the folder, or elsewhere an earlier
+    store moved aside) the next write removes (or puts back, where ``out`` is missing).
 
     Zarr format 2 with consolidated metadata: its specification covers every dtype of
     the Dataset (format 3 has none yet for fixed-width strings, and zarr warns), and
@@ -916,46 +953,26 @@ def _write_zarr(dataset: Any, out: Path) -> None:
     if out.is_symlink():
         # Replace the store the link points to, and keep the link.
         out = out.resolve()
+    remove_stale(out)
     _replaceable_store(out)
-    temporary: Path | None = None
-    earlier: Path | None = None
+    # The new store's folder until it is swapped in, then the earlier store's.
+    held: list[Path] = []
+    lock: int | None = None
     try:
-        temporary = _folder_beside(out, "tmp")
-        dataset.to_zarr(temporary, mode="w", zarr_format=2, consolidated=True)
-        _sync(temporary)
-        if out.exists():
-            earlier = _folder_beside(out, "old")
-            os.replace(out, earlier)
-        os.replace(temporary, out)
-        temporary = None
+        lock = claim_beside(out, held, folder=True)
+        # Into the empty folder made (and locked) above: "w" would make it again.
+        dataset.to_zarr(held[0], mode="w-", zarr_format=2, consolidated=True)
+        _sync(held[0])
+        earlier = swap_in(held[0], out)
+        held[:] = [] if earlier is None else [earlier]
         _sync_folder(out.parent)
     except OSError as err:
         raise UsageError(f"cannot write {str(out)!r}: {err.strerror or err}") from None
     finally:
-        if earlier is not None:
-            if temporary is None:
-                shutil.rmtree(earlier, ignore_errors=True)
-            else:
-                # The new store is not in place: the earlier one goes back.
-                os.replace(earlier, out)
-        if temporary is not None:
-            shutil.rmtree(temporary, ignore_errors=True)
-
-
-def _folder_beside(path: Path, tag: str) -> Path:
-    """A new, hidden, empty folder next to ``path``, created exclusively (``tag``
-    ``"old"``: a name only, for a folder renamed there)."""
-    while True:
-        folder = path.with_name(f".{path.name}.{secrets.token_hex(4)}.{tag}")
-        if tag == "old":
-            if not os.path.lexists(folder):
-                return folder
-            continue
-        try:
-            folder.mkdir()
-            return folder
-        except FileExistsError:
-            continue
+        if lock is not None:
+            os.close(lock)
+        for folder in held:
+            shutil.rmtree(folder, ignore_errors=True)
 
 
 def _sync(folder: Path) -> None:

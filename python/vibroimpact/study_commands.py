@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import sys
 import time
 from collections.abc import Mapping
@@ -138,6 +139,8 @@ def run_study_command(args: argparse.Namespace) -> int:
         threads=args.workers,
         progress=terminal_progress(),
         dask=args.dask,
+        notice=lambda line: print(f"vibroimpact: {line}", file=sys.stderr),
+        resume=f"run again: {_command(args)}",
     )
     if args.plot:
         from vibroimpact.analysis_plots import plot_study
@@ -171,3 +174,21 @@ def run_study_command(args: argparse.Namespace) -> int:
     if status:
         print(f"vibroimpact: error: every one of the {study.runs} runs failed", file=sys.stderr)
     return status
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The ``study`` command line of ``args`` (what resumes it), quoted for a shell."""
+    words = ["vibroimpact", "study", str(args.scenario), "--out", str(args.out)]
+    for flag, value in (
+        ("--workers", args.workers or None),
+        ("--dask", args.dask),
+        ("--plot", args.plot),
+        ("--metric", args.metric),
+        ("--x", args.x),
+        ("--y", args.y),
+    ):
+        if value is not None:
+            words += [flag, str(value)]
+    if args.json:
+        words.append("--json")
+    return shlex.join(words)
