@@ -149,6 +149,8 @@ def test_only_temporaries_of_our_naming_whose_writer_is_gone_are_removed(
         f".work_precision.png.{gone}-0123abcd.tmp.bak",
         f".other.png.{gone}-0123abcd.tmp",
         "work_precision.png.1-0123abcd.tmp",
+        # No process id a writer could have had (os.kill would overflow).
+        ".work_precision.png.99999999999999999999-0123abcd.tmp",
     ]
     for name in others:
         (tmp_path / name).write_text("keep")

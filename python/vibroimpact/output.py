@@ -171,8 +171,8 @@ def _gone(pid: int) -> bool:
         os.kill(pid, 0)
     except ProcessLookupError:
         return True
-    except OSError:
-        return False  # another user's process: alive
+    except (OSError, OverflowError):
+        return False  # another user's process (alive), or no process id we wrote
     return False
 
 
