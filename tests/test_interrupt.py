@@ -76,4 +76,7 @@ def test_sigint_stops_a_study_within_its_chunk(tmp_path: Path) -> None:
     assert time.monotonic() - sent < 5.0
     assert proc.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err
+    # It says that nothing was kept (no chunk had finished).
+    assert "vibroimpact: 0 of 1 chunks (0 of 4 runs) done: nothing kept" in err
     assert not out.exists()
+    assert not (tmp_path / "out.nc.parts").exists()

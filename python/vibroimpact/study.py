@@ -881,6 +881,10 @@ def run(
         else:
             # Nothing finished: leave nothing behind (a resume has nothing to go on).
             shutil.rmtree(parts_dir, ignore_errors=True)
+            if not isinstance(stop, Exception):  # interrupted, not an error's one line
+                stop.add_note(
+                    f"{_kept(study, chunks, path_of)}: nothing kept, run again it starts afresh"
+                )
         raise
     shutil.rmtree(parts_dir, ignore_errors=True)
     return dataset
