@@ -24,6 +24,7 @@ import numpy as _numpy  # noqa: F401
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_ENERGY_TOLERANCE,
     MAX_PAIRS,
     MAX_POINTS,
     MAX_RECORD_BYTES,
@@ -89,6 +90,7 @@ __all__ = [
     "PreparedSystem",
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
+    "MAX_ENERGY_TOLERANCE",
     "MAX_PAIRS",
     "MAX_POINTS",
     "MAX_RECORD_BYTES",

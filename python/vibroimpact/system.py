@@ -46,6 +46,7 @@ import numpy as np
 from vibroimpact._core import (
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
+    MAX_ENERGY_TOLERANCE,
     MAX_PAIRS,
     MAX_POINTS,
     MAX_RECORD_BYTES,
@@ -634,7 +635,13 @@ class SystemContacts:
     together from the accumulation instant of its chattering sequence to its
     release). ``energy_dissipated`` is the work of the contact's dissipative
     forces, or the kinetic energy an impact takes (J). A contact still open at the
-    end has NaN ``separation``, ``duration``, ``rebound_speed`` and ``restitution``.
+    end has NaN ``separation``, ``duration``, ``rebound_speed`` and ``restitution``; a
+    contact that started at rest (its approach, m/s, at round-off: a body set down on a
+    stop, an elastic contact ringing about its static indentation) was never an impact and
+    has NaN ``restitution``. A damped Hertz law (``"hyster-hertz"``, ``"hertz-damped"``)
+    takes its damping from the approach speed, but never from one slower than
+    ``sqrt(2 a delta_s)``, the speed the pressing ``a`` (m/s^2) gives over the static
+    indentation ``delta_s = (m a / K)^(2/3)`` (m): a body set down on it settles there.
     """
 
     pair: list[str]
@@ -809,7 +816,7 @@ def simulate_system(
     round-off. ``every`` keeps every N-th step; ``history=False`` keeps none (the
     contacts and the final state only). A run stops with a clear error past
     ``max_steps`` steps, past ``max_rows`` history rows and contacts, or when its
-    energy balance is off by more than ``energy_tolerance`` of the energies in play.
+    energy balance is off by more than ``energy_tolerance`` (in (0, 1]) of the energies in play.
     From ``record_from`` (s) on, each structure coordinate's located peak and RMS
     are kept (``peak``, ``rms``), and the structure's at each of ``points`` (as a
     damper's ``at``: m from a cantilever's clamp, or a coordinate index; ``point_peak``,
@@ -937,6 +944,12 @@ def prepare_system(
     for key in ("t_end", "rtol", "atol", "energy_tolerance"):
         if not solver[key] > 0:
             raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
+    if not solver["energy_tolerance"] <= MAX_ENERGY_TOLERANCE:
+        # The core's bound: beyond it the residual may exceed all the energy in play.
+        raise _fail(
+            "[solver] energy_tolerance: ",
+            f"must be in (0, {MAX_ENERGY_TOLERANCE:g}], got {solver['energy_tolerance']}",
+        )
     low, high = RTOL_RANGE
     if not low <= solver["rtol"] <= high:
         # The core's range (see its RTOL_RANGE), checked here to name the table.

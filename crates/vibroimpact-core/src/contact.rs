@@ -206,6 +206,30 @@ fn ratio_for(hysteresis: f64) -> f64 {
 /// which divides by the approach rate, is left out.
 const GRAZING_RATE: f64 = 1e-12;
 
+impl HysterHertz {
+    /// The approach rate (m/s) below which a contact's damping is taken from
+    /// the pressing instead: the speed `sqrt(2 a delta_s)` that the pressing
+    /// `a` (m/s^2, > 0 presses the bodies together) gives over the static
+    /// indentation `delta_s = (m a / K)^(2/3)` of the effective mass `m`
+    /// (kg). The law's damping `alpha delta' / delta'_minus` is fitted to an
+    /// indentation made by the approach; where the pressing makes it (a body
+    /// set down at rest, or landing slower than this), the indentation rate
+    /// is the pressing's and dividing by a slower approach makes the damping
+    /// grow without bound (a creep over hundreds of thousands of steps).
+    /// With this rate latched, a body resting on the contact oscillates
+    /// about `delta_s` with a damping ratio `alpha / (2 sqrt 3)` of its
+    /// linearised motion and settles there. 0 when nothing presses.
+    pub fn resting_approach_rate(&self, effective_mass: f64, pressing: f64) -> f64 {
+        let static_indentation = hertz_static_indentation(self.stiffness, effective_mass, pressing);
+        let rate = (2.0 * pressing.max(0.0) * static_indentation).sqrt();
+        if rate.is_finite() {
+            rate
+        } else {
+            0.0
+        }
+    }
+}
+
 impl ContactLaw for HysterHertz {
     #[inline(always)]
     fn force(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
@@ -452,6 +476,56 @@ impl Contact {
     }
 }
 
+/// A Hertz law's indentation `(m a / K)^(2/3)` (m) under the load of the
+/// effective mass `m` (kg) pressed at `a` (m/s^2, > 0 pressing); 0 when
+/// nothing presses.
+fn hertz_static_indentation(stiffness: f64, effective_mass: f64, pressing: f64) -> f64 {
+    let load = effective_mass * pressing;
+    if load > 0.0 && load.is_finite() {
+        (load / stiffness).powf(2.0 / 3.0)
+    } else {
+        0.0
+    }
+}
+
+impl AnyLaw {
+    /// The indentation (m) at which the law's elastic force holds the
+    /// effective mass `effective_mass` (kg) pressed at `pressing` (m/s^2, > 0
+    /// pressing the bodies together); 0 when nothing presses. The scale of a
+    /// contact at rest: a landing that would rise less than its round-off is
+    /// no impact.
+    pub fn static_indentation(&self, effective_mass: f64, pressing: f64) -> f64 {
+        match self {
+            AnyLaw::Hertz(Hertz { stiffness })
+            | AnyLaw::HysterHertz(HysterHertz { stiffness, .. }) => {
+                hertz_static_indentation(*stiffness, effective_mass, pressing)
+            }
+            AnyLaw::Linear(Linear { stiffness }) => {
+                let load = effective_mass * pressing;
+                if load > 0.0 && load.is_finite() {
+                    load / stiffness
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// The rate latched at the onset of a contact that approaches at
+    /// `approach` (m/s) with `pressing` (m/s^2, > 0 pressing the bodies
+    /// together) on the effective mass `effective_mass` (kg): the approach,
+    /// or for a law whose damping divides by it, at least
+    /// [`HysterHertz::resting_approach_rate`].
+    pub fn latched_approach_rate(&self, approach: f64, effective_mass: f64, pressing: f64) -> f64 {
+        match self {
+            AnyLaw::HysterHertz(law) => {
+                approach.max(law.resting_approach_rate(effective_mass, pressing))
+            }
+            _ => approach,
+        }
+    }
+}
+
 macro_rules! delegate {
     ($self:ident, $law:ident => $call:expr) => {
         match $self {
@@ -526,6 +600,27 @@ pub(crate) mod tests {
             // Finite arguments still give the law: 3000 (1e-4)^1.5 N with no rate.
             let force = contact.law_force(1e-4, 0.0, 1.0).unwrap();
             assert!((force - 3000.0 * 1e-6).abs() < 1e-18, "{force}");
+        });
+    }
+
+    #[test]
+    fn a_resting_contact_takes_its_damping_from_the_pressing() {
+        crate::testing::timeout(10, || {
+            // 0.2 kg under 9.81 m/s^2 on K = 1e7 N/m^1.5: delta_s = (m g /
+            // K)^(2/3), and the rate latched is sqrt(2 g delta_s).
+            let law = HysterHertz::exact(1e7, 0.5).unwrap();
+            let static_indentation = (0.2_f64 * 9.81 / 1e7).powf(2.0 / 3.0);
+            let floor = (2.0 * 9.81 * static_indentation).sqrt();
+            let rate = law.resting_approach_rate(0.2, 9.81);
+            assert!((rate - floor).abs() <= 1e-15 * floor, "{rate} vs {floor}");
+            let any = AnyLaw::HysterHertz(law);
+            assert_eq!(any.latched_approach_rate(1e-65, 0.2, 9.81), rate);
+            // An impact faster than it keeps its own approach; nothing
+            // pressing, or a law without damping, latches the approach.
+            assert_eq!(any.latched_approach_rate(2.0, 0.2, 9.81), 2.0);
+            assert_eq!(any.latched_approach_rate(1e-65, 0.2, -9.81), 1e-65);
+            let elastic = AnyLaw::Hertz(Hertz { stiffness: 1e7 });
+            assert_eq!(elastic.latched_approach_rate(1e-65, 0.2, 9.81), 1e-65);
         });
     }
 

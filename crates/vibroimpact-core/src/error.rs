@@ -106,17 +106,17 @@ pub enum Error {
     /// system's energy change plus the work of the contact's dissipative
     /// forces plus that of the main damper, minus the external work, is not
     /// zero to within `tolerance` of the energy in play. Positive, the
-    /// contact created energy, which no contact can.
+    /// contact created energy, which no contact can: `created` when that is
+    /// beyond the bound on creation that `energy_tolerance` cannot raise.
     #[error(
         "the contact from t = {onset:.6e} s to {separation:.6e} s does not balance its energy: the \
          system's energy changed by {change:.3e} J, the contact dissipated {dissipated:.3e} J and the \
          main damper and external force account for {work:.3e} J; these must sum to zero, but leave \
          {residual:.3e} J ({ratio:.2e} of the energy in play, {scale:.3e} J; rebound/approach speed \
-         {restitution:.4}; a positive residual is energy the contact created), more than \
-         energy_tolerance = {tolerance:e}; reduce dt, choose another method (e.g. \"dop853\") or \
-         tighten rtol/atol (raise energy_tolerance only to accept it)",
+         {restitution:.4}; a positive residual is energy the contact created), {limit}",
         residual = .change + .work + .dissipated,
-        ratio = (.change + .work + .dissipated).abs() / .scale
+        ratio = (.change + .work + .dissipated).abs() / .scale,
+        limit = contact_limit(*.tolerance, *.created)
     )]
     ContactEnergy {
         onset: f64,
@@ -127,10 +127,27 @@ pub enum Error {
         scale: f64,
         restitution: f64,
         tolerance: f64,
+        created: bool,
     },
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// The end of a contact energy error: the bound passed and what to change.
+fn contact_limit(tolerance: f64, created: bool) -> String {
+    if created {
+        format!(
+            "more than {tolerance:e}, the most a contact may create whatever energy_tolerance \
+             says (a contact can only lose energy: this is the method's error); reduce dt, choose \
+             another method (e.g. \"dop853\") or tighten rtol/atol"
+        )
+    } else {
+        format!(
+            "more than energy_tolerance = {tolerance:e}; reduce dt, choose another method (e.g. \
+             \"dop853\") or tighten rtol/atol (raise energy_tolerance only to accept it)"
+        )
+    }
+}
 
 /// `value` must be finite and strictly positive.
 pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64> {

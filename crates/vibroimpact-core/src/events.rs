@@ -474,7 +474,7 @@ pub fn integrate_events<L: ContactLaw, X: Excitation, S: Stepper>(
     let mut time = t0;
     let mut mode = initial_mode(model, &y);
     let energy = model.energy(initial);
-    let mut ledger = EnergyLedger::new(energy, X::IS_FREE, settings.energy_tolerance);
+    let mut ledger = EnergyLedger::new(energy, X::IS_FREE, settings);
     // The method integrates the non-conservative work (y[4]): the main
     // damper's less the external force's apart, the contact's in contact.
     // The damper's and the external force's work in contact are summed here

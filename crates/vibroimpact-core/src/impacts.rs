@@ -124,18 +124,7 @@ impl Impacts {
             let round_off = flight_round_off(system, i, y);
             // The gap's acceleration with the pair free: < 0 presses it shut.
             let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
-            // At rest whatever the pressing: a rate that would take the
-            // system's time scale to move the gap by its round-off (a system
-            // come to rest, where every speed is round-off and relative
-            // thresholds say nothing).
-            let at_rest = approach.abs() * time_scale <= round_off;
-            // Landing at rest: an approach (or a leaving) that the pressing
-            // gives within a rise of round-off, or within the round-off of
-            // the time.
-            let landing = pressing < 0.0
-                && (approach * approach <= -2.0 * pressing * round_off
-                    || approach.abs() <= -pressing * instant
-                    || at_rest);
+            let (landing, at_rest) = resting(approach, pressing, round_off, instant, time_scale);
             let moving = !landing && !at_rest;
             let arriving = approach > 1e-12 * speed_scale.max(f64::MIN_POSITIVE);
             let role = if arriving && system.locked(i) {
@@ -343,6 +332,7 @@ impl Impacts {
                             approach_speed: rebound,
                             max_indentation: 0.0,
                             dissipated: kept * loss,
+                            resting: false,
                         });
                     }
                 }
@@ -357,6 +347,7 @@ impl Impacts {
                         approach_speed: approach,
                         max_indentation: 0.0,
                         dissipated: loss,
+                        resting: false,
                     });
                 }
                 (Role::Touch, _) => {
@@ -391,11 +382,37 @@ impl Impacts {
     }
 }
 
+/// Whether a pair touching its wall at `approach` (m/s, > 0 closing), with
+/// `pressing` (m/s^2, < 0 presses it shut) lands at rest, and whether it is
+/// at rest whatever the pressing: `(landing, at_rest)`. `round_off` (m) is
+/// its flights' round-off ([`flight_round_off`]), `instant` (s) the time's,
+/// `time_scale` (s) the system's. Shared by the rigid pairs and the compliant
+/// contacts, whose resting onsets have no rebound ratio.
+pub(crate) fn resting(
+    approach: f64,
+    pressing: f64,
+    round_off: f64,
+    instant: f64,
+    time_scale: f64,
+) -> (bool, bool) {
+    // At rest whatever the pressing: a rate that would take the system's
+    // time scale to move the gap by its round-off (a system come to rest,
+    // where every speed is round-off and relative thresholds say nothing).
+    let at_rest = approach.abs() * time_scale <= round_off;
+    // Landing at rest: an approach (or a leaving) that the pressing gives
+    // within a rise of round-off, or within the round-off of the time.
+    let landing = pressing < 0.0
+        && (approach * approach <= -2.0 * pressing * round_off
+            || approach.abs() <= -pressing * instant
+            || at_rest);
+    (landing, at_rest)
+}
+
 /// Flights (or landings) of interaction `i` that rise less than this (m,
 /// 1e-9 of its gap's scale at state `y`) are round-off: the positions'
 /// round-off decides such impacts, not the dynamics, and the pair is at rest
 /// on its wall.
-fn flight_round_off(system: &Assembly, i: usize, y: &[f64]) -> f64 {
+pub(crate) fn flight_round_off(system: &Assembly, i: usize, y: &[f64]) -> f64 {
     1e-9 * system.gap_scale(i, y)
 }
 

@@ -382,6 +382,9 @@ pub(crate) struct EnergyLedger {
     largest: f64,
     free: bool,
     tolerance: f64,
+    /// The most a contact may create, relative (see
+    /// [`Settings::contact_creation_limit`]).
+    creation_limit: f64,
     /// Work of the external force so far, J.
     external: f64,
     /// Largest relative residual found.
@@ -389,12 +392,13 @@ pub(crate) struct EnergyLedger {
 }
 
 impl EnergyLedger {
-    pub(crate) fn new(initial: f64, free: bool, tolerance: f64) -> Self {
+    pub(crate) fn new(initial: f64, free: bool, settings: &Settings) -> Self {
         Self {
             initial,
             largest: initial,
             free,
-            tolerance,
+            tolerance: settings.energy_tolerance,
+            creation_limit: settings.contact_creation_limit(),
             external: 0.0,
             worst: f64::NAN,
         }
@@ -470,8 +474,11 @@ impl EnergyLedger {
 
     /// A closed contact's own balance: its energy change, plus the work of
     /// its dissipative forces, plus `work` (the main damper's minus the
-    /// external force's work over the contact), is zero to within the tolerance of the energy in play (`energy`
-    /// at onset and all that work). Positive, the contact created energy.
+    /// external force's work over the contact), is zero to within the
+    /// tolerance of the energy in play (`energy` at onset and all that
+    /// work). Positive, the contact created energy, which no raised
+    /// tolerance admits beyond the creation limit (a rebound ratio above 1
+    /// of two bodies alone is such a creation). Once per contact.
     pub(crate) fn check_contact(
         &self,
         record: &ContactRecord,
@@ -480,7 +487,8 @@ impl EnergyLedger {
     ) -> Result<()> {
         let residual = record.energy_change + record.energy_dissipated + work;
         let scale = energy + record.energy_dissipated + work.abs();
-        if residual.abs() > self.tolerance * scale || residual.is_nan() {
+        let created = residual > self.creation_limit * scale;
+        if created || residual.abs() > self.tolerance * scale || residual.is_nan() {
             return Err(Error::ContactEnergy {
                 onset: record.onset,
                 separation: record.separation,
@@ -489,7 +497,12 @@ impl EnergyLedger {
                 work,
                 scale,
                 restitution: record.restitution,
-                tolerance: self.tolerance,
+                tolerance: if created {
+                    self.creation_limit
+                } else {
+                    self.tolerance
+                },
+                created: created && self.creation_limit < self.tolerance,
             });
         }
         Ok(())

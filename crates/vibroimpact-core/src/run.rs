@@ -113,7 +113,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
     let mut approach = side0 * s.relative_velocity();
     let start = model.contact(&s, approach);
     records.keep(t0, &s, start.total_force)?;
-    let mut ledger = EnergyLedger::new(model.energy(&s), X::IS_FREE, settings.energy_tolerance);
+    let mut ledger = EnergyLedger::new(model.energy(&s), X::IS_FREE, settings);
     let mut open: Option<OpenContact> = if start.indentation > 0.0 {
         Some(OpenContact {
             side: start.side,

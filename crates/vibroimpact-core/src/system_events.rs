@@ -27,7 +27,7 @@ use crate::balance::{balance, check_balance, ENERGY_INTERVAL};
 use crate::compact::Stretch;
 use crate::error::{Error, Result};
 use crate::hermite;
-use crate::impacts::Impacts;
+use crate::impacts::{self, Impacts};
 use crate::memory::{self, MAX_RECORD_BYTES};
 use crate::reductions::{self, ReduceOptions, Reductions};
 use crate::step_control::{rejects, StepControl};
@@ -127,6 +127,8 @@ pub(crate) struct Open {
     pub(crate) max_indentation: f64,
     /// The contact-loss accumulator at onset (compliant), or the loss so far.
     pub(crate) dissipated: f64,
+    /// Started at rest (an approach at round-off): no rebound ratio.
+    pub(crate) resting: bool,
 }
 
 impl Open {
@@ -142,6 +144,9 @@ impl Open {
         let restitution = match self.kind {
             // A sticking pair does not rebound.
             ContactKind::Sticking if separation.is_finite() => 0.0,
+            // A contact that started at rest was never an impact: its
+            // rebound over a round-off approach would be any number (1e58).
+            _ if self.resting => f64::NAN,
             _ if self.approach_speed > 0.0 => rebound / self.approach_speed,
             _ => f64::NAN,
         };
@@ -826,20 +831,31 @@ pub fn integrate_system_within<S: SystemStepper>(
     let mut modes = vec![Mode::Open; count];
     let mut open: Vec<Option<Open>> = vec![None; count];
     // A compliant pair that starts in contact (a run continued from another's
-    // end) resumes it, its approach rate taken as the indentation rate now.
+    // end) resumes it, its approach rate taken as the indentation rate now
+    // (a damped law's at least the pressing's, as at any onset).
     for i in 0..count {
         let (gap, rate) = system.gap(i, &y);
         if gap < 0.0 && matches!(system.interactions[i].law, InteractionLaw::Compliant { .. }) {
             let approach = rate.abs().max(f64::MIN_POSITIVE);
-            modes[i] = Mode::Compliant {
-                approach_rate: approach,
-            };
+            let (approach_rate, resting) = compliant_onset(
+                system,
+                i,
+                0.0,
+                &y,
+                approach,
+                &modes,
+                &mut scratch,
+                &mut buffers.work,
+                (chatter_interval(0.0), time_scale),
+            );
+            modes[i] = Mode::Compliant { approach_rate };
             open[i] = Some(Open {
                 kind: ContactKind::Compliant,
                 onset: 0.0,
                 approach_speed: approach,
                 max_indentation: -gap,
                 dissipated: y[loss_slot(system, i)],
+                resting,
             });
         }
     }
@@ -1297,6 +1313,14 @@ pub fn integrate_system_within<S: SystemStepper>(
         accepted += 1;
 
         if switched.is_some() {
+            // An event located within the round-off of the run's start (a
+            // pair on its wall at t = 0: the value's round-off put the root
+            // at 1e-66 s) is at the start.
+            let event_time = if time <= f64::EPSILON * time_scale {
+                0.0
+            } else {
+                time
+            };
             // Every interaction on its wall at this instant switches; the
             // open rigid ones are resolved together with the sticking ones.
             let mut any = false;
@@ -1326,18 +1350,23 @@ pub fn integrate_system_within<S: SystemStepper>(
                 just_switched[i] = switch(
                     system,
                     i,
-                    time,
+                    event_time,
                     &mut y,
                     &mut modes,
                     &mut open,
                     &mut contacts,
+                    (
+                        &mut scratch,
+                        &mut buffers.work,
+                        (chatter_interval(time), time_scale),
+                    ),
                 );
                 any |= just_switched[i];
             }
             if rigid {
                 any |= impacts.resolve(
                     system,
-                    time,
+                    event_time,
                     &mut y,
                     &mut modes,
                     &mut open,
@@ -1598,9 +1627,46 @@ fn reduce_step<S: SystemStepper>(
     Ok(used)
 }
 
+/// The start of compliant interaction `i` (open in `modes`) at `time` and
+/// state `y`, approaching at `approach` (m/s): the rate its law latches (see
+/// [`crate::contact::AnyLaw::latched_approach_rate`]: a damped Hertz law's damping is taken
+/// from the pressing where the approach is slower) and whether it starts at
+/// rest (an approach the pressing gives within round-off, see
+/// [`impacts::resting`]: no impact, so no rebound ratio). `scales` are the
+/// time's round-off and the system's time scale, s. Once per onset.
+#[allow(clippy::too_many_arguments)]
+fn compliant_onset(
+    system: &Assembly,
+    i: usize,
+    time: f64,
+    y: &[f64],
+    approach: f64,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+    work: &mut [f64],
+    (instant, time_scale): (f64, f64),
+) -> (f64, bool) {
+    let it = &system.interactions[i];
+    let InteractionLaw::Compliant { law, .. } = it.law else {
+        return (approach, false);
+    };
+    // < 0 presses the pair shut.
+    let pressing = system.gap_acceleration(i, time, y, modes, scratch, work);
+    let mass = 1.0 / it.inverse_mass;
+    // A flight rising less than the round-off of the gap, or of the
+    // indentation the pressing holds (a stop at the origin has a gap scale
+    // of 0), is round-off: the ringing of a body set down on the contact.
+    let round_off =
+        impacts::flight_round_off(system, i, y).max(1e-9 * law.static_indentation(mass, -pressing));
+    let (landing, at_rest) = impacts::resting(approach, pressing, round_off, instant, time_scale);
+    let latched = law.latched_approach_rate(approach, mass, -pressing);
+    (latched, landing || at_rest)
+}
+
 /// Switch interaction `i` at `time`: start or end a compliant contact, or
 /// release a sticking pair whose constraint force turned (the open rigid
 /// pairs are [`Impacts::resolve`]'s).
+#[allow(clippy::too_many_arguments)]
 fn switch(
     system: &Assembly,
     i: usize,
@@ -1609,21 +1675,23 @@ fn switch(
     modes: &mut [Mode],
     open: &mut [Option<Open>],
     contacts: &mut Vec<PairContact>,
+    (scratch, work, scales): (&mut Scratch, &mut [f64], (f64, f64)),
 ) -> bool {
     let it = &system.interactions[i];
     let (_, rate) = system.gap(i, y);
     match modes[i] {
         Mode::Open => {
             let approach = -rate;
-            modes[i] = Mode::Compliant {
-                approach_rate: approach,
-            };
+            let (approach_rate, resting) =
+                compliant_onset(system, i, time, y, approach, modes, scratch, work, scales);
+            modes[i] = Mode::Compliant { approach_rate };
             open[i] = Some(Open {
                 kind: ContactKind::Compliant,
                 onset: time,
                 approach_speed: approach,
                 max_indentation: 0.0,
                 dissipated: y[loss_slot(system, i)],
+                resting,
             });
         }
         Mode::Compliant { .. } => {

@@ -551,8 +551,8 @@ fn check_method(
         (
             "energy_tolerance",
             energy_tolerance,
-            energy_tolerance > 0.0,
-            "> 0",
+            vibroimpact_core::settings::checked_energy_tolerance(energy_tolerance).is_ok(),
+            vibroimpact_core::settings::ENERGY_TOLERANCE_ALLOWED,
         ),
     ] {
         check(field, value, ok, allowed)?;
