@@ -398,3 +398,98 @@ def test_a_continuation_step_of_1e300_is_refused_on_the_command_line(
     assert "step = 1e300" in lines
     (tmp_path / "c.toml").write_text("\n".join(lines) + "\n")
     refused(run_cli("continue", "c.toml"), "c.toml: step: must be in [", "got 1e+300")
+
+
+@pytest.mark.parametrize(
+    ("section", "key", "value", "wanted"),
+    [
+        ("structure", "modes", -3, "[structure] modes: must be a whole number in [1, 200], got -3"),
+        ("output", "every", -1, "[output] every: must be a whole number in [1, 2^63 - 1], got -1"),
+        ("output", "every", 0, "[output] every: must be a whole number in [1, 2^63 - 1], got 0"),
+        ("solver", "max_steps", -5, "max_steps: must be a whole number in [1, 2^63 - 1], got -5"),
+    ],
+)
+def test_a_whole_number_out_of_range_is_refused_with_the_key_s_own_range(
+    section: str, key: str, value: int, wanted: str
+) -> None:
+    import vibroimpact as vi
+
+    beam = {
+        "kind": "cantilever",
+        "length": 1.0,
+        "youngs_modulus": 2e11,
+        "second_moment": 1e-8,
+        "mass_per_length": 1.0,
+        "modes": 3,
+    }
+    solver: dict[str, Any] = {"t_end": 0.01, "method": "dopri5"}
+    if section == "structure":
+        beam[key] = value
+    elif section == "output":
+        solver[key] = value
+    else:
+        solver[key] = value
+    with pytest.raises(vi.InvalidInputError) as caught:
+        vi.simulate_system(beam, **solver)
+    assert wanted in str(caught.value)
+
+
+def test_analysis_counts_out_of_range_name_their_real_range() -> None:
+    from vibroimpact.analyses import continuation_settings, sweep_settings
+
+    sweep = {"parameter": "excitation.0.frequency", "start": 1.0, "stop": 2.0, "count": 3}
+    with pytest.raises(ValueError, match=r"settle_periods: .* in \[0, 10000000\], got -1"):
+        sweep_settings({**sweep, "settle_periods": -1})
+    with pytest.raises(ValueError, match=r"\[sweep\] count: .* in \[1, 100000\], got -3"):
+        sweep_settings({**sweep, "count": -3})
+    with pytest.raises(ValueError, match=r"max_points: .* in \[2, 100000\], got -1"):
+        continuation_settings(
+            {"parameter": "excitation.0.frequency", "stop": 2.0, "max_points": -1}
+        )
+
+
+@pytest.mark.parametrize(
+    ("key", "shown"), [("rtol", "1e-300"), ("rtol", "1e+300"), ("beta", "-1e-300")]
+)
+def test_the_core_s_messages_write_numbers_short(key: str, shown: str) -> None:
+    import vibroimpact as vi
+
+    system = vi.ImpactDamper(
+        main_mass=1.0, stiffness=1.0, damping=0.01, impact_mass=0.25, clearance=0.01
+    )
+    with pytest.raises(vi.InvalidInputError) as caught:
+        vi.simulate(
+            system,
+            vi.Contact("hertz", stiffness=3000.0),
+            vi.InitialState(),
+            method="dopri5",
+            t_end=0.01,
+            **{key: float(shown)},
+        )
+    message = str(caught.value)
+    # Rust wrote 1e-300 as a fraction of 300 zeros, 1e300 as a 301-digit integer.
+    assert message.endswith(f"got {shown}") and len(message) < 80, message
+
+
+@pytest.mark.parametrize(
+    ("mass", "words"),
+    [
+        # Each mass positive: the smaller is round-off of the larger in double precision.
+        ([[1e308, 0.0], [0.0, 1e-308]], ["lightest mode (about 1e-308 kg)", "1e+308 kg", "units"]),
+        ([[1e20, 0.0], [0.0, 1.0]], ["below 1e-14 of its largest", "1e+20 kg"]),
+        ([[1.0, 0.0], [0.0, -0.5]], ["positive definite", "entry [1][1] is -0.5 kg"]),
+        ([[1.0, 2.0], [2.0, 1.0]], ["positive definite", "lowest eigenvalue is -1.0000"]),
+    ],
+)
+def test_a_mass_matrix_without_a_factor_says_what_is_wrong(
+    mass: list[list[float]], words: list[str]
+) -> None:
+    import vibroimpact as vi
+
+    structure = {"kind": "matrices", "mass": mass, "stiffness": [[1.0, 0.0], [0.0, 1.0]]}
+    with pytest.raises(vi.InvalidInputError) as caught:
+        vi.simulate_system(structure, t_end=0.01, method="dopri5")
+    message = str(caught.value)
+    for word in words:
+        assert word in message, message
+    assert "it is not" not in message

@@ -583,6 +583,14 @@ MAX_STARTS = 1_000_000
 #: impacts and tens of steps a period that is already minutes of computing, and every
 #: kept impact is memory; a longer run is a typo (1e12 for 1e2), refused before it starts.
 MAX_PERIODS = 10_000_000
+arguments.WHOLE_RANGES.update(
+    settle_periods=(0, MAX_PERIODS),
+    record_periods=(1, MAX_PERIODS),
+    periods=(1, MAX_PERIODS),
+    orbit_periods=(1, MAX_PERIODS),
+    max_points=(2, MAX_POINTS),
+)
+arguments.WHOLE_RANGES["[sweep] count"] = (1, MAX_POINTS)
 
 
 def whole_count(name: str, value: Any, low: int) -> int:

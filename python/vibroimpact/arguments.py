@@ -21,6 +21,33 @@ from vibroimpact.messages import shown
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
+#: The largest whole number a scenario may hold (64-bit signed).
+LARGEST_WHOLE = 2**63 - 1
+#: The range of each whole-number key of a scenario, by the key's name (or its section
+#: and name, ``"[sweep] count"``, where sections differ), as its error
+#: states it (a key not listed: [0, 2^63 - 1]); the modules that own keys with a bound
+#: of their own add them (analyses: the forcing periods of a run).
+WHOLE_RANGES: dict[str, tuple[int, int]] = {
+    "modes": (1, 200),  # a cantilever's: the core's most
+    "every": (1, LARGEST_WHOLE),
+    "max_steps": (1, LARGEST_WHOLE),
+    "max_rows": (1, LARGEST_WHOLE),
+}
+
+
+def whole_range(where: str) -> tuple[int, int]:
+    """The range of the whole-number key that ``where`` (``"[structure] modes: "``)
+    names: its entry in :data:`WHOLE_RANGES`, else [0, 2^63 - 1]."""
+    place = where.rstrip(": ")
+    if place in WHOLE_RANGES:  # a key of one section ("[sweep] count")
+        return WHOLE_RANGES[place]
+    return WHOLE_RANGES.get(place.rsplit(" ", 1)[-1], (0, LARGEST_WHOLE))
+
+
+def shown_range(low: int, high: int) -> str:
+    """``[low, high]`` as a message writes it (2^63 - 1 by name)."""
+    return f"[{low}, {'2^63 - 1' if high == LARGEST_WHOLE else high}]"
+
 
 def _real(value: Any) -> float | None:
     """``value`` as a float when it is a real number (an int, a float, a NumPy real

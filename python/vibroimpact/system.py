@@ -58,7 +58,7 @@ from vibroimpact._core import (
 )
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
-from vibroimpact.arguments import directory
+from vibroimpact.arguments import directory, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.record_file import check_record, read_record
 from vibroimpact.summary import contacts_repr, solution_repr
@@ -273,7 +273,7 @@ def _value(where: str, kind: str, value: Any) -> Any:
     # The common cases first, at once: a scenario's floats and whole numbers.
     if kind == _NUMBER and type(value) is float and math.isfinite(value):
         return value
-    if kind == _WHOLE and type(value) is int and 0 <= value < 2**63:
+    if kind == _WHOLE and type(value) is int and 2 <= value < 2**63:  # above every low
         return value
     if kind == _NUMBER:
         number = real(value)
@@ -293,8 +293,11 @@ def _value(where: str, kind: str, value: Any) -> Any:
         if not isinstance(whole, int):
             # The key's own range, if any, is checked after (modes: [1, 200]).
             raise _fail(where, f"must be a whole number, got {shown(value)}")
-        if whole not in range(2**63):
-            raise _fail(where, f"must be a whole number in [0, 2^63 - 1], got {shown(value)}")
+        low, high = whole_range(where)
+        if not low <= whole < 2**63:  # above high and below 2^63: the key's own check
+            raise _fail(
+                where, f"must be a whole number in {shown_range(low, high)}, got {shown(value)}"
+            )
         return whole
     if kind == _TEXT:
         if not isinstance(value, str):

@@ -171,10 +171,7 @@ impl Structure {
         let stiffness = square("stiffness", stiffness, n)?;
         let damping = square("damping", damping, n)?;
         if linalg::cholesky(&mass, n).is_none() {
-            return Err(Error::Inconsistent(
-                "structure.mass must be positive definite (every mode needs mass): it is not"
-                    .into(),
-            ));
+            return Err(Error::Inconsistent(why_not_positive_definite(&mass, n)));
         }
         for (key, matrix) in [("stiffness", &stiffness), ("damping", &damping)] {
             let values = linalg::symmetric_eigenvalues(matrix, n);
@@ -372,6 +369,39 @@ impl Structure {
     pub fn energy(&self, q: &[f64], v: &[f64]) -> f64 {
         0.5 * (linalg::quadratic_form(&self.mass, v) + linalg::quadratic_form(&self.stiffness, q))
     }
+}
+
+/// Why a mass matrix has no Cholesky factor (see [`linalg::cholesky`]): a coordinate
+/// without mass, coordinates that are dependent (a mode without mass: the matrix
+/// scaled to a unit diagonal has an eigenvalue of round-off or below), or masses
+/// further apart than the factor's 1e14 (a diagonal `[1e308, 1e-308]`: each
+/// positive, but the smaller is round-off of the larger in double precision).
+fn why_not_positive_definite(mass: &[f64], n: usize) -> String {
+    let head = "structure.mass must be positive definite (every mode needs mass)";
+    let diagonal: Vec<f64> = (0..n).map(|i| mass[i * n + i]).collect();
+    if let Some(i) = diagonal.iter().position(|&m| m <= 0.0) {
+        return format!("{head}: entry [{i}][{i}] is {} kg", diagonal[i]);
+    }
+    // D^-1/2 M D^-1/2: a unit diagonal, whatever the units of each coordinate.
+    let roots: Vec<f64> = diagonal.iter().map(|m| m.sqrt()).collect();
+    let scaled: Vec<f64> = (0..n * n)
+        .map(|k| mass[k] / roots[k / n] / roots[k % n])
+        .collect();
+    let lowest = linalg::symmetric_eigenvalues(&scaled, n)[0];
+    if lowest.is_nan() || lowest <= 1e-12 {
+        return format!(
+            "{head}: scaled to a unit diagonal, its lowest eigenvalue is {lowest:.4} (zero or \
+             below: a combination of the coordinates without mass)"
+        );
+    }
+    let smallest = diagonal.iter().copied().fold(f64::INFINITY, f64::min);
+    let largest = diagonal.iter().copied().fold(0.0, f64::max);
+    format!(
+        "structure.mass: its lightest mode (about {} kg) is below 1e-14 of its largest \
+         mass ({largest} kg), beyond what double precision resolves (the masses span \
+         {smallest} to {largest} kg): give the coordinates units of like size",
+        lowest * smallest
+    )
 }
 
 /// A square, finite, symmetric matrix from its rows, row-major.

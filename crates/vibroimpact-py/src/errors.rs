@@ -44,7 +44,7 @@ create_exception!(
 
 pub(crate) fn to_py(err: core::Error) -> PyErr {
     use core::Error as E;
-    let message = err.to_string();
+    let message = short_numbers(&err.to_string());
     match err {
         E::NumericalBlowUp { .. } => NumericalBlowUpError::new_err(message),
         E::EnergyBalance { .. } | E::ContactEnergy { .. } => EnergyBalanceError::new_err(message),
@@ -85,5 +85,72 @@ where
             Err(signal.take().expect("checked"))
         }
         Err(e) => Err(to_py(e)),
+    }
+}
+
+/// `text` with every number the core wrote in full (`{}` of 1e-300 is a fraction of
+/// 300 zeros, of 1e300 a 301-digit integer) rewritten as Python's repr writes it
+/// (`1e-300`, `1e+300`): a number standing alone (not part of a word or a longer
+/// number) of 21 or more integer digits, or a fraction with 6 or more leading zeros.
+/// The same rule as `vibroimpact.messages.short_numbers`.
+pub(crate) fn short_numbers(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let sign = usize::from(bytes[i] == b'-');
+        let alone = i == 0 || !(word(bytes[i - 1]) || bytes[i - 1] == b'.');
+        if alone && bytes.get(i + sign).is_some_and(u8::is_ascii_digit) {
+            let digits = i + sign;
+            let mut end = digits;
+            while bytes.get(end).is_some_and(u8::is_ascii_digit) {
+                end += 1;
+            }
+            let whole = end - digits;
+            let mut zeros = 0;
+            if bytes.get(end) == Some(&b'.') && bytes.get(end + 1).is_some_and(u8::is_ascii_digit) {
+                let mut k = end + 1;
+                while bytes.get(k) == Some(&b'0') {
+                    k += 1;
+                }
+                zeros = k - end - 1;
+                while bytes.get(k).is_some_and(u8::is_ascii_digit) {
+                    k += 1;
+                }
+                end = k;
+            }
+            let ends = match bytes.get(end) {
+                None => true,
+                Some(&b'.') => !bytes.get(end + 1).is_some_and(u8::is_ascii_digit),
+                Some(&b) => !word(b),
+            };
+            let long = whole >= 21 || (whole == 1 && bytes[digits] == b'0' && zeros >= 6);
+            match text[i..end].parse::<f64>() {
+                Ok(value) if ends && long => out.push_str(&python_repr(value)),
+                _ => out.push_str(&text[i..end]),
+            }
+            i = end;
+        } else {
+            let c = text[i..].chars().next().unwrap_or(' ');
+            out.push(c);
+            i += c.len_utf8();
+        }
+    }
+    out
+}
+
+/// A float in exponent form as Python's repr writes it: the shortest digits that
+/// read back the same, a sign and at least two digits in the exponent (`1e+300`,
+/// `1.5e-07`).
+fn python_repr(value: f64) -> String {
+    let text = format!("{value:e}");
+    match text.split_once('e') {
+        Some((mantissa, exponent)) => {
+            let power: i32 = exponent.parse().unwrap_or(0);
+            let sign = if power < 0 { '-' } else { '+' };
+            format!("{mantissa}e{sign}{:02}", power.unsigned_abs())
+        }
+        None => text,
     }
 }
