@@ -137,6 +137,37 @@ def test_a_contact_at_the_start_has_its_onset_at_zero(law: str, method: str) -> 
     assert c.approach_speed[0] == pytest.approx(0.1, rel=1e-12)
 
 
+@pytest.mark.parametrize(("method", "dt"), [("dop853", None), ("rk4", 1e-4)])
+def test_a_loose_mass_set_on_its_cavity_floor_touches_from_zero(
+    method: str, dt: float | None
+) -> None:
+    # Structure and damper fall together at first (the spring's force is zero at the start),
+    # so the gap closes as t^4 and reached its round-off at 1e-8 s (dop853), 1.3e-9 s (rk4):
+    # onsets that were the start's round-off, as the contact's rebound ratio would be.
+    sol = vi.simulate_system(
+        {"kind": "oscillator", "mass": 1.0, "stiffness": 1000.0},
+        damper=[
+            {
+                "mass": MASS,
+                "at": 0,
+                "lower_clearance": 0.0,
+                "upper_clearance": 0.01,
+                "law": "hertz-damped",
+                "stiffness": K,
+                "restitution": 0.5,
+            }
+        ],
+        gravity={"acceleration": G},
+        method=method,
+        dt=dt,
+        t_end=0.1,
+        history=False,
+    )
+    c = sol.contacts
+    assert c.onset[0] == 0.0, c.onset[0]
+    assert math.isnan(c.restitution[0])
+
+
 def test_energy_tolerance_above_one_is_refused(tmp_path: Path, run_cli: Callable[..., Any]) -> None:
     system = vi.ImpactDamper(
         main_mass=1.0, stiffness=1.0, damping=0.01, impact_mass=0.25, clearance=0.01

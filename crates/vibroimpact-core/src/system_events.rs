@@ -903,6 +903,14 @@ pub fn integrate_system_within<S: SystemStepper>(
     let mut unconfirmed = vec![false; count];
     // Interactions switched at the event being handled.
     let mut just_switched = vec![false; count];
+    // Open pairs on their walls at the start and not leaving them: their
+    // first events within the resolution are at t = 0.
+    let on_wall_at_start: Vec<bool> = (0..count)
+        .map(|i| {
+            let (gap, rate) = system.gap(i, &y);
+            modes[i] == Mode::Open && gap.abs() <= wall_round_off(system, i, &y) && rate <= 0.0
+        })
+        .collect();
     let mut impacts = Impacts::new(system);
     let mut any_unconfirmed = false;
     // Whether a compliant contact is on (modes change only at events).
@@ -1315,8 +1323,11 @@ pub fn integrate_system_within<S: SystemStepper>(
         if switched.is_some() {
             // An event located within the round-off of the run's start (a
             // pair on its wall at t = 0: the value's round-off put the root
-            // at 1e-66 s) is at the start.
-            let event_time = if time <= f64::EPSILON * time_scale {
+            // at 1e-66 s), or one of a pair on its wall from the start
+            // located within the run's resolution (not pressed at first, the
+            // gap reached its round-off only after 1e-8 s), is at the start.
+            let from_start = switched.is_some_and(|i| on_wall_at_start[i]) && time <= resolution;
+            let event_time = if time <= f64::EPSILON * time_scale || from_start {
                 0.0
             } else {
                 time
