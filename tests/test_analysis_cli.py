@@ -327,7 +327,7 @@ SWEEP_BAD = [
     ),
     (("count = 5", 'count = "ten"'), ["[sweep] count", "ten"]),
     (('direction = "both"', 'direction = "sideways"'), ["[sweep] direction", "sideways"]),
-    (("count = 5", "count = 0"), ["[sweep] count", ">= 1"]),
+    (("count = 5", "count = 0"), ["[sweep] count", "in [1, 100000]"]),
     (
         ('parameter = "excitation.0.frequency"', 'parameter = "nonsense"'),
         ["[sweep] parameter", "nonsense"],

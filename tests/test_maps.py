@@ -879,8 +879,11 @@ CONTINUATION_BAD = [
     (("periods = 1", "periods = 1.5"), ["[continuation] periods", "1.5"]),
     (("stop = 17.0 ", "# stop = 17.0 "), ["[continuation]", "stop"]),
     (("step = 0.3 ", "step = 0.0 "), ["[continuation] step", "> 0"]),
-    (("periods = 1", "periods = 0"), ["[continuation] periods", ">= 1"]),
-    (("periods = 1", "periods = 1\nmax_points = 1"), ["[continuation] max_points", ">= 2"]),
+    (("periods = 1", "periods = 0"), ["[continuation] periods", "in [1, 10000000]"]),
+    (
+        ("periods = 1", "periods = 1\nmax_points = 1"),
+        ["[continuation] max_points", "in [2, 100000]"],
+    ),
     (
         ('parameter = "excitation.0.amplitude"', 'parameter = "nonsense"'),
         ["[continuation] parameter", "nonsense"],
@@ -934,7 +937,7 @@ BASINS_BAD = [
     (("stop = 0.4, count = 3", 'stop = 0.4, count = "3"'), ["[basins] y.count", "'3'"]),
     (("stop = 0.4, count = 3", "stop = 0.4, count = 3, stpo = 1"), ["[basins] y", "stpo"]),
     (("start = -0.4, stop = 0.4, ", "start = -0.4, "), ["[basins] y", "stop"]),
-    (("record_periods = 5", "record_periods = 0"), ["[basins] record_periods", ">= 1"]),
+    (("record_periods = 5", "record_periods = 0"), ["[basins] record_periods", "in [1, 10000000]"]),
 ]
 
 

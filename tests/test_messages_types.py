@@ -493,3 +493,107 @@ def test_a_mass_matrix_without_a_factor_says_what_is_wrong(
     for word in words:
         assert word in message, message
     assert "it is not" not in message
+
+
+# 4. A run's forcing periods: settle and record together within the limit, up front.
+
+
+def test_poincare_settle_and_periods_beyond_the_limit_together_are_refused_up_front(
+    run_cli: Cli,
+) -> None:
+    root = Path(__file__).resolve().parents[1]
+    scenario = str(root / "examples" / "bouncing_ball_table.toml")
+    # Each within 10 million, together twice it: had run 21 s into 1.6 GB of contacts,
+    # then advised every, history, t_end and max_rows.
+    done = run_cli("poincare", scenario, "--settle", "10000000", "--periods", "10000000")
+    message = refused(done, "--settle 10000000", "--periods 10000000", "at most 10000000")
+    assert "max_rows" not in message and "every" not in message
+
+
+def _ball() -> dict[str, Any]:
+    import tomllib
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "bouncing_ball_table.toml").read_text(encoding="utf-8")
+    return tomllib.loads(text)
+
+
+@pytest.mark.parametrize("analysis", ["poincare", "steady_state", "bifurcation", "basins"])
+def test_every_analysis_refuses_settle_and_record_beyond_the_limit_together(
+    analysis: str,
+) -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses, maps
+
+    data = _ball()
+    run = analyses.runner(data)
+    half = analyses.MAX_PERIODS // 2 + 1
+    calls: dict[str, Callable[[], Any]] = {
+        "poincare": lambda: maps.poincare(run, settle_periods=half, periods=half),
+        "steady_state": lambda: analyses.steady_state(
+            run, settle_periods=half, record_periods=half
+        ),
+        "bifurcation": lambda: maps.bifurcation(
+            data, "excitation.0.amplitude", [12.0], settle_periods=half, sample_periods=half
+        ),
+        "basins": lambda: maps.basins(
+            run, (0, [0.01]), (1, [0.1]), settle_periods=half, record_periods=half
+        ),
+    }
+    with pytest.raises(vi.InvalidInputError, match=rf"settle_periods {half} and \w+ {half}: "):
+        calls[analysis]()
+
+
+@pytest.mark.parametrize("section", ["sweep", "basins", "study"])
+def test_settings_of_settle_and_record_beyond_the_limit_together_are_refused(
+    section: str,
+) -> None:
+    from vibroimpact.analyses import MAX_PERIODS, basins_settings, sweep_settings
+    from vibroimpact.study import study_settings
+
+    half = {"settle_periods": MAX_PERIODS // 2 + 1, "record_periods": MAX_PERIODS // 2 + 1}
+    tables: dict[str, Callable[[], Any]] = {
+        "sweep": lambda: sweep_settings(
+            {"parameter": "excitation.0.frequency", "start": 1.0, "stop": 2.0, "count": 2, **half}
+        ),
+        "basins": lambda: basins_settings(
+            {
+                "x": {"state": "structure_displacement.0", "start": 0.0, "stop": 1.0, "count": 2},
+                "y": {"state": "structure_velocity.0", "start": 0.0, "stop": 1.0, "count": 2},
+                **half,
+            }
+        ),
+        "study": lambda: study_settings(
+            {
+                "analysis": "steady-state",
+                "axes": {"damper.0.clearance": {"start": 0.01, "stop": 0.02, "count": 2}},
+                **half,
+            }
+        ),
+    }
+    with pytest.raises(ValueError, match=rf"\[{section}\] settle_periods \d+ and record_periods"):
+        tables[section]()
+
+
+def test_a_long_settling_map_keeps_no_contacts_beyond_its_chunk(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    data = _ball()
+    data["solver"]["max_rows"] = 60  # two impacts a period: 30 periods' contacts
+    run = analyses.runner(data)
+    z = run.initial_state()
+    # One run of 100 periods keeps 200 contacts: the row limit, worded for an analysis.
+    with pytest.raises(vi.SimulationError) as caught:
+        run.periods(z, 100)
+    message = str(caught.value)
+    assert "100 forcing periods" in message and "settle or record fewer" in message, message
+    assert "raise every" not in message
+    # Settling 100 periods 20 at a time never holds more than 40.
+    monkeypatch.setattr(analyses, "SETTLE_CHUNK", 20)
+    settled = run.map(z, 100)
+    reference = analyses.runner({**data, "solver": {**data["solver"], "max_rows": 10_000}})
+    whole = np.asarray(reference.periods(z, 100)["final_state"], dtype=float)  # one run
+    np.testing.assert_allclose(settled, whole, rtol=1e-9, atol=1e-12)

@@ -24,7 +24,13 @@ from typing import Any, TypeVar
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, PreparedSystem, _strobe_period
+from vibroimpact._core import (
+    MAX_RECORD_BYTES,
+    InvalidInputError,
+    PreparedSystem,
+    SimulationError,
+    _strobe_period,
+)
 from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.messages import shown
 from vibroimpact.summary import summarised
@@ -218,12 +224,23 @@ class Runner:
             raise AnalysisError(
                 f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(z)}"
             )
-        raw = self.system().run(
-            [float(v) for v in z],
-            t_end,
-            record_from=0.0 if record else None,
-            strobe_period=self.period if strobe else None,
-        )
+        try:
+            raw = self.system().run(
+                [float(v) for v in z],
+                t_end,
+                record_from=0.0 if record else None,
+                strobe_period=self.period if strobe else None,
+            )
+        except SimulationError as err:
+            if "max_rows" not in str(err):
+                raise
+            # The core's advice (every, history, t_end) is about a run's own keys: an
+            # analysis sets the periods.
+            raise SimulationError(
+                f"{round(t_end / self.period)} forcing periods in one run kept more contacts "
+                f"than [solver] max_rows ({str(err).partition(': ')[0]}): settle or record "
+                "fewer periods, or raise max_rows"
+            ) from None
         self.runs += 1
         return raw
 
@@ -251,8 +268,16 @@ class Runner:
         return self._run(state, count * self.period, record=record, strobe=strobe)
 
     def map(self, state: np.ndarray, count: int) -> np.ndarray:
-        """The stroboscopic map over ``count`` periods."""
-        return np.asarray(self.periods(state, count)["final_state"], dtype=float)
+        """The stroboscopic map over ``count`` periods, run :data:`SETTLE_CHUNK` periods
+        at a time: a run keeps its contacts, which settling never reads (ten million
+        periods of a bouncing ball had kept 20 million, 1.6 GB, up to the row limit)."""
+        check_periods("", "periods", count, 1)
+        z = state
+        for start in range(0, count, SETTLE_CHUNK):
+            z = np.asarray(
+                self.periods(z, min(SETTLE_CHUNK, count - start))["final_state"], dtype=float
+            )
+        return z
 
     def shoot(
         self, state: np.ndarray, count: int, tolerance: float, max_iterations: int
@@ -385,6 +410,7 @@ def steady_state(
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     record_periods = whole_count("record_periods", record_periods, 1)
     max_period = whole_count("max_period", max_period, 1)
+    check_total(("settle_periods", settle_periods), ("record_periods", record_periods))
     arguments.positive("tolerance", tolerance)
     x0 = run.initial_state() if state is None else np.asarray(state, dtype=float)
     period: int | None = None
@@ -603,6 +629,24 @@ def whole_count(name: str, value: Any, low: int) -> int:
     return value
 
 
+def check_total(settle: tuple[str, int], record: tuple[str, int]) -> None:
+    """A run that settles ``settle = (name, periods)`` and then records ``record``
+    spans at most MAX_PERIODS forcing periods in all: refused up front, naming both
+    (``("--settle", 10**7), ("--periods", 10**7)`` had run 21 s into 1.6 GB of
+    contacts before the row limit stopped it)."""
+    if settle[1] + record[1] > MAX_PERIODS:
+        raise AnalysisError(
+            f"{settle[0]} {settle[1]} and {record[0]} {record[1]}: a run settles and records "
+            f"at most {MAX_PERIODS} forcing periods in all, got {settle[1] + record[1]}; "
+            f"settle or record fewer"
+        )
+
+
+#: The forcing periods one run of a settling map covers (:meth:`Runner.map`): its
+#: contacts, a few per period, stay well within a run's rows.
+SETTLE_CHUNK = 100_000
+
+
 def check_periods(where: str, key: str, value: int, low: int) -> None:
     """``value`` forcing periods must be a whole number in [``low``, MAX_PERIODS]; the
     error names ``where`` (``"[sweep] "``, ``"--settle"``...) and ``key``."""
@@ -650,6 +694,9 @@ def sweep_settings(table: Any) -> dict[str, Any]:
         raise AnalysisError(f"[sweep] count: must be >= 1, got {out['count']}")
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
         check_periods("[sweep] ", key, out[key], low)
+    check_total(
+        ("[sweep] settle_periods", out["settle_periods"]), ("record_periods", out["record_periods"])
+    )
     if out["count"] > MAX_POINTS:
         raise AnalysisError(f"[sweep] count: must be at most {MAX_POINTS}, got {out['count']}")
     if not out["tolerance"] > 0:
@@ -750,6 +797,10 @@ def basins_settings(table: Any) -> dict[str, Any]:
         )
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
         check_periods("[basins] ", key, out[key], low)
+    check_total(
+        ("[basins] settle_periods", out["settle_periods"]),
+        ("record_periods", out["record_periods"]),
+    )
     return out
 
 

@@ -17,6 +17,7 @@ from vibroimpact.analyses import (
     BIFURCATION_SAMPLES,
     AnalysisError,
     check_periods,
+    check_total,
     orbit,
     runner,
     shown_amplitudes,
@@ -428,6 +429,7 @@ def run_poincare(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario)
     check_periods("", "--settle", args.settle, 0)
     check_periods("", "--periods", args.periods, 1)
+    check_total(("--settle", args.settle), ("--periods", args.periods))
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
     section = poincare(run, settle_periods=args.settle, periods=args.periods)

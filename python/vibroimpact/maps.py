@@ -20,6 +20,7 @@ from vibroimpact.analyses import (
     BIFURCATION_SAMPLES,
     AnalysisError,
     Runner,
+    check_total,
     checked_run,
     from_carried,
     runner,
@@ -56,6 +57,7 @@ def poincare(
     state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     periods = whole_count("periods", periods, 1)
+    check_total(("settle_periods", settle_periods), ("periods", periods))
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     if settle_periods:
         z = run.map(z, settle_periods)
@@ -162,6 +164,7 @@ def bifurcation(
     arguments.callback("progress", progress)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     sample_periods = whole_count("sample_periods", sample_periods, 1)
+    check_total(("settle_periods", settle_periods), ("sample_periods", sample_periods))
     if not isinstance(sample, str) or sample not in BIFURCATION_SAMPLES:
         raise AnalysisError(
             "sample: must be one of "
@@ -260,6 +263,7 @@ def basins(
     arguments.callback("progress", progress)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     record_periods = whole_count("record_periods", record_periods, 1)
+    check_total(("settle_periods", settle_periods), ("record_periods", record_periods))
     arguments.positive("tolerance", tolerance)
     base = run.initial_state() if state is None else np.asarray(state, dtype=float)
     for name, (index, _) in (("first", first), ("second", second)):

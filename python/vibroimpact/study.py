@@ -101,7 +101,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import __version__, run_study
-from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare
+from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare, check_total
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
@@ -285,6 +285,13 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
             raise StudyError(
                 f"[study] {key}: must be at most {MAX_PERIODS} forcing periods, got {out[key]}"
             )
+    try:
+        check_total(
+            ("[study] settle_periods", out["settle_periods"]),
+            ("record_periods", out["record_periods"]),
+        )
+    except AnalysisError as err:
+        raise StudyError(str(err)) from None
     if out["record_from"] is not None and not out["record_from"] >= 0:
         raise StudyError(f"[study] record_from: must be >= 0 s, got {out['record_from']}")
     if not out["tolerance"] > 0:
