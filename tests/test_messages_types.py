@@ -597,3 +597,40 @@ def test_a_long_settling_map_keeps_no_contacts_beyond_its_chunk(
     reference = analyses.runner({**data, "solver": {**data["solver"], "max_rows": 10_000}})
     whole = np.asarray(reference.periods(z, 100)["final_state"], dtype=float)  # one run
     np.testing.assert_allclose(settled, whole, rtol=1e-9, atol=1e-12)
+
+
+# 5. A forcing frequency whose period no run can step through.
+
+
+def test_a_forcing_period_beyond_what_a_run_can_step_through_is_refused_naming_it() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    # The oscillator's mode is 10 Hz: a run of max_steps = 1e9 steps covers 1e8 s.
+    for frequency in (1e-300, 1e-30, 5e-9):
+        changed = analyses.with_parameter(SECTIONS, "excitation.0.frequency", frequency)
+        with pytest.raises(vi.InvalidInputError) as caught:
+            analyses.runner(changed)
+        message = str(caught.value)
+        assert message.startswith(f"forcing frequency {frequency!r} Hz: its period"), message
+        assert "least 1e-08 Hz" in message and "reduce dt" not in message, message
+    analyses.runner(analyses.with_parameter(SECTIONS, "excitation.0.frequency", 2e-8))
+    # A body on no spring (a ball on a table) has no mode to bound the period by.
+    ball = _ball()
+    analyses.runner(analyses.with_parameter(ball, "excitation.0.frequency", 1e-6))
+
+
+def test_a_sweep_from_1e_300_hz_is_refused_naming_the_frequency(
+    tmp_path: Path, run_cli: Cli
+) -> None:
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "frf_impact_damper.toml").read_text(encoding="utf-8")
+    changed = []
+    for line in text.splitlines():
+        for key, value in (("start", "1e-300"), ("stop", "2e-300"), ("count", "2")):
+            if line.startswith(f"{key} = "):
+                line = f"{key} = {value}"
+        changed.append(line)
+    (tmp_path / "f.toml").write_text("\n".join(changed) + "\n")
+    message = refused(run_cli("sweep", "f.toml"), "forcing frequency 1e-300 Hz", "at least")
+    assert "reduce dt" not in message

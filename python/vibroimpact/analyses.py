@@ -32,6 +32,7 @@ from vibroimpact._core import (
     _strobe_period,
 )
 from vibroimpact._core import _forcing_period as _core_forcing_period
+from vibroimpact.forcing_limits import check_forcing_period
 from vibroimpact.messages import shown
 from vibroimpact.summary import summarised
 from vibroimpact.system import (
@@ -320,7 +321,9 @@ def runner(data: Mapping[str, Any], base_dir: Path | None = None) -> Runner:
     """A :class:`Runner` of a scenario's sections (as parsed from TOML)."""
     arguments.sections("data", data)
     base_dir = arguments.directory("base_dir", base_dir)
-    return Runner(_prepare(data, base_dir), forcing_period(data))
+    prepared, period = _prepare(data, base_dir), forcing_period(data)
+    check_forcing_period(data, period, prepared.solver["max_steps"], base_dir)
+    return Runner(prepared, period)
 
 
 def _impacts(raw: Mapping[str, Any]) -> int:

@@ -1,0 +1,52 @@
+"""The forcing periods an analysis can run: a run steps at least once in each period of
+the structure's fastest mode, so a forcing period of more than ``max_steps`` of those
+is beyond any run (a sweep from 1e-300 Hz had failed each point as a numerical blow-up
+advising a smaller dt). Refused when the analysis is set up, naming the frequency and
+the lowest one a run can take. SI units.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.messages import shown
+from vibroimpact.system import linear_parts
+
+
+def fastest_mode(data: Mapping[str, Any], base_dir: Path | None = None) -> float:
+    """The highest natural frequency (Hz) of the system between contacts (structure and
+    dampers, ``M x'' + K x = 0``); 0 where nothing is held by a spring."""
+    parts = linear_parts(
+        data["structure"],
+        damper=data.get("damper", ()),
+        stop=data.get("stop", ()),
+        gravity=data.get("gravity"),
+        excitation=data.get("excitation", ()),
+        base_dir=base_dir,
+    )
+    # M = L L^T: the eigenvalues of L^-1 K L^-T are w^2.
+    lower = np.linalg.cholesky(parts["mass"])
+    inverse = np.linalg.inv(lower)
+    squares = np.linalg.eigvalsh(inverse @ parts["stiffness"] @ inverse.T)
+    return math.sqrt(max(float(squares[-1]), 0.0)) / (2 * math.pi)
+
+
+def check_forcing_period(
+    data: Mapping[str, Any], period: float, max_steps: int, base_dir: Path | None = None
+) -> None:
+    """Refuse a forcing ``period`` (s) that spans more than ``max_steps`` periods of the
+    system's fastest mode: no run can step through one of them."""
+    highest = fastest_mode(data, base_dir)
+    if highest > 0 and period * highest > max_steps:
+        raise InvalidInputError(
+            f"forcing frequency {shown(1 / period)} Hz: its period, {period:.6g} s, spans "
+            f"{period * highest:.3g} periods of the system's fastest mode ({highest:.6g} Hz), "
+            f"more than a run's max_steps ({max_steps}) steps through; give a frequency of at "
+            f"least {highest / max_steps:.3g} Hz"
+        )
