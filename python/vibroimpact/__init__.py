@@ -78,7 +78,11 @@ def _equality_only(*classes: type) -> None:
 _equality_only(ImpactDamper, Contact, InitialState)
 
 # Arguments of the wrong type named (PyO3's TypeError names none).
-_TEXTS = {"method": str, "contact_timing": str, "stepping": (str, type(None))}
+_TEXTS: dict[str, type | tuple[type, ...]] = {
+    "method": str,
+    "contact_timing": str,
+    "stepping": (str, type(None)),
+}
 simulate = _typed(system=ImpactDamper, contact=Contact, initial=InitialState, **_TEXTS)(_simulate)
 check_solver = _typed(**_TEXTS)(_check_solver)
 cantilever_mode_shape = _typed(derivative=int)(_cantilever_mode_shape)

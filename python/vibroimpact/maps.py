@@ -28,6 +28,7 @@ from vibroimpact.analyses import (
     whole_count,
     with_parameter,
 )
+from vibroimpact.messages import shown
 from vibroimpact.summary import summarised
 
 
@@ -230,8 +231,7 @@ def _axis(name: str, value: Any) -> tuple[int, np.ndarray]:
     """An axis of :func:`basins`: a pair (an index into the flat state, its values)."""
     if isinstance(value, str | bytes | Mapping) or not isinstance(value, Sequence):
         raise AnalysisError(
-            f"{name}: must be a pair (an index into the state, its values), got "
-            f"{arguments.shown(value)}"
+            f"{name}: must be a pair (an index into the state, its values), got {shown(value)}"
         )
     if len(value) != 2:
         raise AnalysisError(
