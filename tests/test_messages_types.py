@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from test_hostile_inputs import refused
 from vibroimpact.record_file import MAX_RECORDED_FILE_BYTES
 from vibroimpact.scenario import ScenarioError, parse_scenario
 
@@ -35,16 +36,6 @@ signal = "recorded"
 file = "rec.csv"
 {extra}
 """
-
-
-def refused(done: subprocess.CompletedProcess[str], *words: str) -> str:
-    """The one-line error of a command refused with exit status 2, holding ``words``."""
-    assert done.returncode == 2, done.stdout + done.stderr
-    assert "Traceback" not in done.stderr, done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1, done.stderr
-    for word in words:
-        assert word in done.stderr, done.stderr
-    return done.stderr
 
 
 def record_error(tmp_path: Path, csv: str, extra: str = "") -> str:
@@ -224,6 +215,7 @@ def _calls() -> list[Any]:
         "t_end": 0.01,
     }
     structure = {"structure": SECTIONS["structure"], "t_end": 0.01, "method": "dopri5"}
+    continued = {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0}
     table: list[tuple[Any, dict[str, Any], str, list[Any]]] = [
         (analyses.sweep, sweep, "data", NOT_SECTIONS),
         (analyses.sweep, sweep, "parameter", NOT_TEXT),
@@ -286,37 +278,37 @@ def _calls() -> list[Any]:
         (maps.basins, basins, "progress", NOT_A_FUNCTION),
         (
             continuation.continue_orbit,
-            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            continued,
             "data",
             NOT_SECTIONS,
         ),
         (
             continuation.continue_orbit,
-            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            continued,
             "parameter",
             NOT_TEXT,
         ),
         (
             continuation.continue_orbit,
-            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            continued,
             "stop",
             NONE_FOR_NUMBER,
         ),
         (
             continuation.continue_orbit,
-            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            continued,
             "step",
             ["1", [1.0], {}, True],
         ),
         (
             continuation.continue_orbit,
-            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            continued,
             "tolerance",
             NONE_FOR_NUMBER,
         ),
         (
             continuation.continue_orbit,
-            {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0},
+            continued,
             "progress",
             NOT_A_FUNCTION,
         ),
