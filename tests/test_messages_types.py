@@ -14,34 +14,17 @@ from typing import Any
 import numpy as np
 import pytest
 
-from test_hostile_inputs import refused
+from test_hostile_inputs import RECORDED, refused
 from vibroimpact.record_file import MAX_RECORDED_FILE_BYTES
 from vibroimpact.scenario import ScenarioError, parse_scenario
 
 Cli = Callable[..., subprocess.CompletedProcess[str]]
 
-RECORDED = """
-[structure]
-kind = "oscillator"
-mass = 1.0
-stiffness = 100.0
-
-[solver]
-method = "dopri5"
-t_end = 0.1
-
-[[excitation]]
-kind = "base"
-signal = "recorded"
-file = "rec.csv"
-{extra}
-"""
-
 
 def record_error(tmp_path: Path, csv: str, extra: str = "") -> str:
     (tmp_path / "rec.csv").write_text(csv, encoding="utf-8")
     with pytest.raises(ScenarioError) as caught:
-        parse_scenario(RECORDED.format(extra=extra), "s.toml", tmp_path)
+        parse_scenario(RECORDED.format(file="rec.csv") + extra, "s.toml", tmp_path)
     message = str(caught.value)
     assert "\n" not in message
     return message
@@ -49,7 +32,7 @@ def record_error(tmp_path: Path, csv: str, extra: str = "") -> str:
 
 def record(tmp_path: Path, csv: str) -> tuple[list[float], list[float]]:
     (tmp_path / "rec.csv").write_text(csv, encoding="utf-8")
-    scenario = parse_scenario(RECORDED.format(extra=""), "s.toml", tmp_path)
+    scenario = parse_scenario(RECORDED.format(file="rec.csv"), "s.toml", tmp_path)
     excitation = scenario.prepared.spec["excitation"][0]
     return list(excitation["time"]), list(excitation["value"])
 
@@ -69,7 +52,7 @@ def test_a_cell_python_would_read_but_a_csv_does_not_hold_is_refused(
 
 def test_a_value_beyond_floating_point_names_the_file_line(tmp_path: Path, run_cli: Cli) -> None:
     (tmp_path / "rec.csv").write_text("time,value\n0,0\n1,1e308\n2,0\n")
-    (tmp_path / "s.toml").write_text(RECORDED.format(extra=""))
+    (tmp_path / "s.toml").write_text(RECORDED.format(file="rec.csv"))
     # The core said "row 1" (a 0-based index of the samples) for line 3.
     message = refused(run_cli("simulate", "s.toml"), "rec.csv line 3:", "1e+308")
     assert "row" not in message
@@ -125,7 +108,7 @@ def test_a_record_at_the_size_limit_is_parsed_within_bounded_memory(tmp_path: Pa
     assert MAX_RECORDED_FILE_BYTES * 0.9 < len(text) <= MAX_RECORDED_FILE_BYTES
     (tmp_path / "rec.csv").write_text(text)
     del text
-    (tmp_path / "s.toml").write_text(RECORDED.format(extra=""))
+    (tmp_path / "s.toml").write_text(RECORDED.format(file="rec.csv"))
     child = (
         "import sys\n"
         "from vibroimpact.scenario import load_scenario\n"
