@@ -609,3 +609,23 @@ def test_a_sweep_from_1e_300_hz_is_refused_naming_the_frequency(
     (tmp_path / "f.toml").write_text("\n".join(changed) + "\n")
     message = refused(run_cli("sweep", "f.toml"), "forcing frequency 1e-300 Hz", "at least")
     assert "reduce dt" not in message
+
+
+def test_study_and_runner_helpers_refuse_wrong_types_naming_the_argument() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses, study
+
+    run = analyses.runner(SECTIONS)
+    assert study.output_kind("x.nc") == ".nc"  # type: ignore[arg-type]  # a str is a path
+    calls: list[tuple[str, Callable[[], Any]]] = [
+        ("out", lambda: study.output_kind(None)),  # type: ignore[arg-type]
+        ("study", lambda: study.chunk_part(None, 0, 1)),  # type: ignore[arg-type]
+        ("periods", lambda: run.periods(run.initial_state(), None)),  # type: ignore[arg-type]
+        ("periods", lambda: run.periods(run.initial_state(), 2.5)),  # type: ignore[arg-type]
+        ("periods", lambda: run.map(run.initial_state(), "3")),  # type: ignore[arg-type]
+        ("state", lambda: run.periods("x", 1)),  # type: ignore[arg-type]
+        ("periods", lambda: run.shoot(run.initial_state(), None, 1e-9, 3)),  # type: ignore[arg-type]
+    ]
+    for name, call in calls:
+        with pytest.raises(vi.InvalidInputError, match=rf"^{name}: "):
+            call()

@@ -257,7 +257,8 @@ class Runner:
         self, state: np.ndarray, count: int, *, record: bool = False, strobe: bool = False
     ) -> dict[str, Any]:
         """Run ``count`` forcing periods from ``state``."""
-        check_periods("", "periods", count, 1)
+        state = arguments.state("state", state, 2 * (self.n + self.k))  # type: ignore[assignment]
+        check_periods("", "periods", whole_count("periods", count, 1), 1)
         width = 1 + 2 * (self.n + self.k)
         if strobe and count * width * 8 > MAX_RECORD_BYTES:
             # A state a period: known before the run, as a fixed-step history is.
@@ -272,7 +273,7 @@ class Runner:
         """The stroboscopic map over ``count`` periods, run :data:`SETTLE_CHUNK` periods
         at a time: a run keeps its contacts, which settling never reads (ten million
         periods of a bouncing ball had kept 20 million, 1.6 GB, up to the row limit)."""
-        check_periods("", "periods", count, 1)
+        check_periods("", "periods", whole_count("periods", count, 1), 1)
         z = state
         for start in range(0, count, SETTLE_CHUNK):
             z = np.asarray(
@@ -285,7 +286,7 @@ class Runner:
     ) -> dict[str, Any]:
         """Newton's shooting over ``count`` periods from ``state``, in the core (see
         :func:`orbit`)."""
-        check_periods("", "periods", count, 1)
+        check_periods("", "periods", whole_count("periods", count, 1), 1)
         if len(state) != 2 * (self.n + self.k):
             raise AnalysisError(
                 f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(state)}"

@@ -101,7 +101,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import __version__, run_study
-from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare, check_total
+from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare, check_total, whole_count
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
@@ -757,6 +757,9 @@ _METRIC_KEYS = (
 def chunk_part(study: Study, start: int, stop: int, threads: int = 0) -> dict[str, Any]:
     """The metrics of runs ``start`` to ``stop`` as arrays (what a chunk file holds and
     a Dask task returns)."""
+    arguments.instance("study", study, Study, "vibroimpact.study.study_of(sections)")
+    start, stop = whole_count("start", start, 0), whole_count("stop", stop, 0)
+    check_threads(threads, "threads:")
     raw = study.run_chunk(range(start, stop), threads)
     return {
         "n": np.int64(raw["n"]),
@@ -914,6 +917,7 @@ def output_kind(out: Path) -> str:
     before a study runs: another suffix, a Zarr store without the zarr package, or a
     ``.zarr`` path that holds something other than a Zarr store (which the store
     would replace) raise :class:`UsageError`."""
+    out = arguments.path("out", out)
     kind = out.suffix.lower()
     if kind not in OUTPUTS:
         allowed = " or ".join(f"{suffix} ({what})" for suffix, what in OUTPUTS.items())
