@@ -131,8 +131,13 @@ def test_sweep_periods_beyond_the_bound_are_refused(key: str) -> None:
     table[key] = 10**12
     with pytest.raises(AnalysisError, match=rf"\[sweep\] {key}: .*{MAX_PERIODS}"):
         sweep_settings(table)
-    table[key] = MAX_PERIODS
-    assert sweep_settings(table)[key] == MAX_PERIODS
+    # Settling and recording together (the other at its default, 200 or 50): the limit.
+    most = MAX_PERIODS - {"settle_periods": 50, "record_periods": 200}[key]
+    table[key] = most
+    assert sweep_settings(table)[key] == most
+    table[key] = most + 1
+    with pytest.raises(AnalysisError, match=rf"{MAX_PERIODS} forcing periods in all"):
+        sweep_settings(table)
 
 
 def test_a_runner_refuses_a_run_of_too_many_periods(tmp_path: Path) -> None:
