@@ -629,3 +629,23 @@ def test_study_and_runner_helpers_refuse_wrong_types_naming_the_argument() -> No
     for name, call in calls:
         with pytest.raises(vi.InvalidInputError, match=rf"^{name}: "):
             call()
+
+
+def test_a_study_axis_of_frequencies_no_run_can_step_through_is_refused() -> None:
+    import tomllib
+
+    import vibroimpact as vi
+    from vibroimpact.study import study_of
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "clearance_study.toml").read_text(encoding="utf-8")
+    data = tomllib.loads(text)
+    data["study"]["axes"] = {"excitation.0.frequency": [1e-300, 10.0]}
+    # Each run had failed as a numerical blow-up, its reason naming no frequency.
+    with pytest.raises(vi.InvalidInputError) as caught:
+        study_of(data, "s.toml", root / "examples")
+    message = str(caught.value)
+    assert message.startswith("s.toml: [study.axes] 'excitation.0.frequency': forcing frequency")
+    assert "1e-300 Hz" in message and "at least" in message, message
+    data["study"]["axes"] = {"excitation.0.frequency": [1e-6, 10.0]}
+    study_of(data, "s.toml", root / "examples")

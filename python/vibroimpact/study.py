@@ -100,8 +100,9 @@ from typing import Any
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact._core import __version__, run_study
+from vibroimpact._core import InvalidInputError, __version__, run_study
 from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare, check_total, whole_count
+from vibroimpact.forcing_limits import check_axis_frequencies
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
@@ -620,6 +621,11 @@ def study_of(
     study = Study(dict(data), checked, source, base_dir)
     # The base scenario and every axis path are checked by a run of none.
     study.run_chunk(range(0, 0))
+    if checked["analysis"] != "run":  # whole forcing periods
+        try:
+            check_axis_frequencies(data, checked["axes"], base_dir)
+        except InvalidInputError as err:
+            raise StudyError(f"{source}: {err}") from None
     return study
 
 
