@@ -649,3 +649,15 @@ def test_a_study_axis_of_frequencies_no_run_can_step_through_is_refused() -> Non
     assert "1e-300 Hz" in message and "at least" in message, message
     data["study"]["axes"] = {"excitation.0.frequency": [1e-6, 10.0]}
     study_of(data, "s.toml", root / "examples")
+
+
+@pytest.mark.parametrize("header", ["time,value\n", ""])
+def test_a_record_with_a_byte_order_mark_keeps_its_first_sample(
+    tmp_path: Path, header: str
+) -> None:
+    # A spreadsheet's UTF-8 CSV starts with U+FEFF: "\ufeff0" was no number, so the
+    # first sample was taken for a header and dropped.
+    assert record(tmp_path, "\ufeff" + header + "0,1\n0.5,2\n1,3\n") == (
+        [0.0, 0.5, 1.0],
+        [1.0, 2.0, 3.0],
+    )

@@ -69,7 +69,7 @@ def read_record(path: Path, where: str) -> tuple[np.ndarray, np.ndarray, Row]:
         comments = "#" if b"#" in data and not _TRAILING_COMMENT.search(data) else None
         try:
             table = np.loadtxt(
-                io.TextIOWrapper(io.BytesIO(data), encoding="utf-8"),
+                io.TextIOWrapper(io.BytesIO(data), encoding="utf-8-sig"),
                 dtype=float,
                 delimiter=separator,
                 comments=comments,
@@ -117,8 +117,9 @@ class _Rows:
         self.data, self.name = data, name
 
     def lines(self) -> Iterator[tuple[int, str]]:
-        """Each line that is neither blank nor a comment, stripped, with its number."""
-        text = io.TextIOWrapper(io.BytesIO(self.data), encoding="utf-8")
+        """Each line that is neither blank nor a comment, stripped, with its number (a
+        byte-order mark, as spreadsheets write one, is not part of the first line)."""
+        text = io.TextIOWrapper(io.BytesIO(self.data), encoding="utf-8-sig")
         for number, line in enumerate(text, start=1):
             line = line.strip()
             if line and not line.startswith("#"):
