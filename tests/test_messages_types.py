@@ -661,3 +661,11 @@ def test_a_record_with_a_byte_order_mark_keeps_its_first_sample(
         [0.0, 0.5, 1.0],
         [1.0, 2.0, 3.0],
     )
+
+
+def test_a_record_with_old_mac_line_ends_is_read_line_by_line(tmp_path: Path) -> None:
+    # "\r" alone ends a line as an editor counts it; with a comment between samples
+    # the file is read line by line (the arrays had been sized by "\n" alone).
+    assert record(tmp_path, "t,v\r0,1\r# pause\r0.5,2\r1,3\r") == ([0.0, 0.5, 1.0], [1.0, 2.0, 3.0])
+    message = record_error(tmp_path, "t,v\r0,1\r# pause\r1,2\r1,3\r")
+    assert "rec.csv line 5: times must increase" in message, message

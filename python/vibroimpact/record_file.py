@@ -12,6 +12,7 @@ it is read.
 from __future__ import annotations
 
 import io
+import itertools
 import re
 import stat
 import sys
@@ -137,7 +138,7 @@ class _Rows:
     def parse(self, where: str) -> tuple[np.ndarray, np.ndarray]:
         """The samples read line by line into arrays, or the error of the first line
         that does not hold two numbers."""
-        size = self.data.count(b"\n") + 1
+        size = self.data.count(b"\n") + self.data.count(b"\r") + 1  # lines at most
         time, value = np.empty(size), np.empty(size)
         count = 0
         for i, (number, line) in enumerate(self.lines()):
@@ -163,13 +164,9 @@ class _Rows:
 
     def __call__(self, index: int) -> str:
         """The place of sample ``index``: its line in the file."""
-        lines = self.lines()
-        number, line = next(lines)
-        if not all(_NUMBER.fullmatch(c) for c in _SEPARATOR.split(line)):
-            number, line = next(lines)  # a header
-        for _ in range(index):
-            number, line = next(lines)
-        return f"{self.name} line {number}"
+        first = self.first_data_line()
+        numbers = (n for n, _ in self.lines() if first is not None and n >= first[0])
+        return f"{self.name} line {next(itertools.islice(numbers, index, None))}"
 
 
 def check_record(
