@@ -669,3 +669,14 @@ def test_a_record_with_old_mac_line_ends_is_read_line_by_line(tmp_path: Path) ->
     assert record(tmp_path, "t,v\r0,1\r# pause\r0.5,2\r1,3\r") == ([0.0, 0.5, 1.0], [1.0, 2.0, 3.0])
     message = record_error(tmp_path, "t,v\r0,1\r# pause\r1,2\r1,3\r")
     assert "rec.csv line 5: times must increase" in message, message
+
+
+def test_the_binding_s_own_messages_write_numbers_short() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    system = analyses.runner(SECTIONS).system()
+    with pytest.raises(vi.InvalidInputError, match=r"strobe_period .* got -1e-300$"):
+        system.run([0.0] * 4, 1.0, strobe_period=-1e-300)
+    with pytest.raises(vi.InvalidInputError, match=r"tolerance .* got -1e\+300$"):
+        system.shoot([0.0] * 4, 1.0, tolerance=-1e300, max_iterations=3)

@@ -111,9 +111,10 @@ pub enum Error {
     #[error(
         "the contact from t = {onset:.6e} s to {separation:.6e} s does not balance its energy: the \
          system's energy changed by {change:.3e} J, the contact dissipated {dissipated:.3e} J and the \
-         main damper and external force account for {work:.3e} J; these must sum to zero, but leave \
-         {residual:.3e} J ({ratio:.2e} of the energy in play, {scale:.3e} J; rebound/approach speed \
-         {restitution:.4}; a positive residual is energy the contact created), {limit}",
+         other dampers and the external forces account for {work:.3e} J; these must sum to zero, \
+         but leave {residual:.3e} J ({ratio:.2e} of the energy in play, {scale:.3e} J; \
+         rebound/approach speed {restitution:.4}; a positive residual is energy the contact \
+         created), {limit}",
         residual = .change + .work + .dissipated,
         ratio = (.change + .work + .dissipated).abs() / .scale,
         limit = contact_limit(*.tolerance, *.created)

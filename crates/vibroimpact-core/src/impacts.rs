@@ -333,6 +333,7 @@ impl Impacts {
                             max_indentation: 0.0,
                             dissipated: kept * loss,
                             resting: false,
+                            balance: Default::default(),
                         });
                     }
                 }
@@ -348,6 +349,7 @@ impl Impacts {
                         max_indentation: 0.0,
                         dissipated: loss,
                         resting: false,
+                        balance: Default::default(),
                     });
                 }
                 (Role::Touch, _) => {

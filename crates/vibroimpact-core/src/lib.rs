@@ -14,6 +14,7 @@ pub mod beam;
 pub mod closed_forms;
 pub(crate) mod compact;
 pub mod contact;
+mod contact_balance;
 pub mod ensemble;
 pub mod error;
 pub mod events;

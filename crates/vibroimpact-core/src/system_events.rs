@@ -25,6 +25,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
 pub use crate::balance::EnergyBalance;
 use crate::balance::{balance, check_balance, ENERGY_INTERVAL};
 use crate::compact::Stretch;
+use crate::contact_balance::OnsetBalance;
 use crate::error::{Error, Result};
 use crate::hermite;
 use crate::impacts::{self, Impacts};
@@ -129,6 +130,8 @@ pub(crate) struct Open {
     pub(crate) dissipated: f64,
     /// Started at rest (an approach at round-off): no rebound ratio.
     pub(crate) resting: bool,
+    /// The run's balance at a compliant onset (see [`OnsetBalance`]).
+    pub(crate) balance: OnsetBalance,
 }
 
 impl Open {
@@ -856,6 +859,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                 max_indentation: -gap,
                 dissipated: y[loss_slot(system, i)],
                 resting,
+                balance: OnsetBalance::default(),
             });
         }
     }
@@ -865,6 +869,9 @@ pub fn integrate_system_within<S: SystemStepper>(
     };
     system.gaps(&y, &mut gaps.start);
     let (stored_start, mut energy_scale) = system.energy_terms(&y, &modes);
+    for record in open.iter_mut().flatten() {
+        record.balance = OnsetBalance::at(system, &y, &modes, stored_start, 0.0);
+    }
     let mut impact_loss = 0.0;
     let mut contacts: Vec<PairContact> = Vec::new();
     let row = 2 * d;
@@ -1358,6 +1365,7 @@ pub fn integrate_system_within<S: SystemStepper>(
                     rigid = true;
                     continue;
                 }
+                let (was, onset) = (modes[i], open[i].map(|o| o.balance));
                 just_switched[i] = switch(
                     system,
                     i,
@@ -1372,6 +1380,26 @@ pub fn integrate_system_within<S: SystemStepper>(
                         (chatter_interval(time), time_scale),
                     ),
                 );
+                // A compliant contact's own balance, from its onset to its
+                // separation: it must not create energy.
+                match (was, modes[i], open[i].as_mut(), onset, contacts.last()) {
+                    (Mode::Open, Mode::Compliant { .. }, Some(record), ..) => {
+                        record.balance =
+                            OnsetBalance::at(system, &y, &modes, stored_start, impact_loss);
+                    }
+                    (Mode::Compliant { .. }, Mode::Open, None, Some(onset), Some(record)) => {
+                        onset.check_separation(
+                            system,
+                            &y,
+                            &modes,
+                            (stored_start, impact_loss),
+                            energy_scale,
+                            options.energy_tolerance,
+                            record,
+                        )?;
+                    }
+                    _ => {}
+                }
                 any |= just_switched[i];
             }
             if rigid {
@@ -1703,6 +1731,7 @@ fn switch(
                 max_indentation: 0.0,
                 dissipated: y[loss_slot(system, i)],
                 resting,
+                balance: OnsetBalance::default(),
             });
         }
         Mode::Compliant { .. } => {

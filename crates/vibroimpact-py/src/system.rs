@@ -20,7 +20,7 @@ use vibroimpact_core::structure::Structure;
 use vibroimpact_core::system_events::RunOptions;
 use vibroimpact_core::system_methods::AnyStepper;
 
-use crate::errors::{released, to_py, InvalidInputError};
+use crate::errors::{released, short_numbers, to_py, InvalidInputError};
 
 /// `where key` must be present: the Python side fills defaults, so a missing
 /// key is a bug of the caller's dict, reported as bad input all the same.
@@ -54,7 +54,7 @@ fn optional<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
 fn named(place: &str) -> impl Fn(core::Error) -> PyErr + '_ {
     move |e| match e {
         core::Error::InvalidParameter { .. } | core::Error::UnknownChoice { .. } => {
-            InvalidInputError::new_err(format!("{place}.{e}"))
+            InvalidInputError::new_err(short_numbers(&format!("{place}.{e}")))
         }
         other => to_py(other),
     }
@@ -566,9 +566,9 @@ fn check(field: &str, value: f64, ok: bool, allowed: &str) -> PyResult<f64> {
     if value.is_finite() && ok {
         Ok(value)
     } else {
-        Err(InvalidInputError::new_err(format!(
+        Err(InvalidInputError::new_err(short_numbers(&format!(
             "{field} must be finite and {allowed}, got {value}"
-        )))
+        ))))
     }
 }
 

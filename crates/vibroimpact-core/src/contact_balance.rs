@@ -1,0 +1,93 @@
+//! A compliant contact's own energy balance in the event-driven kernel of the
+//! systems: the run's balance residual (stored energy + dissipated work -
+//! input work - the energy at the start) taken at the contact's onset and at
+//! its separation. A contact can only lose energy: what the residual gains
+//! across it is energy the method created there, and beyond
+//! [`CONTACT_CREATION_LIMIT`] of the energy in play (or `energy_tolerance`
+//! where that is smaller) it is an error whatever `energy_tolerance` says, as
+//! in the two-mass kernels. Evaluated at contact ends only, never per step.
+
+use crate::assembly::{Assembly, Mode};
+use crate::balance::balance;
+use crate::error::{Error, Result};
+use crate::settings::CONTACT_CREATION_LIMIT;
+use crate::system_events::PairContact;
+
+/// The balance at a compliant contact's onset: the stored energy and the
+/// run's residual there, J.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct OnsetBalance {
+    stored: f64,
+    residual: f64,
+}
+
+/// The stored energy, the residual and the energy in play (the magnitudes of
+/// the stored energy's terms and of the work so far) at state `y`, J.
+fn sample(
+    system: &Assembly,
+    y: &[f64],
+    modes: &[Mode],
+    stored_start: f64,
+    impact: f64,
+) -> (f64, f64, f64) {
+    let (stored, magnitude) = system.energy_terms(y, modes);
+    let b = balance(system, y, stored, stored_start, impact);
+    (
+        stored,
+        b.residual,
+        magnitude + b.input_work.abs() + b.dissipated.abs(),
+    )
+}
+
+impl OnsetBalance {
+    /// At a compliant onset, state `y` (the energy accumulators settled, as
+    /// at every event).
+    pub(crate) fn at(
+        system: &Assembly,
+        y: &[f64],
+        modes: &[Mode],
+        stored_start: f64,
+        impact: f64,
+    ) -> Self {
+        let (stored, residual, _) = sample(system, y, modes, stored_start, impact);
+        Self { stored, residual }
+    }
+
+    /// The contact `record` just closed at state `y`: an error if the residual
+    /// grew across it by more than the creation limit (`CONTACT_CREATION_LIMIT`,
+    /// or `energy_tolerance` where smaller) of the energy in play (the run's
+    /// largest so far, `energy_scale`, or now's).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn check_separation(
+        &self,
+        system: &Assembly,
+        y: &[f64],
+        modes: &[Mode],
+        (stored_start, impact): (f64, f64),
+        energy_scale: f64,
+        energy_tolerance: f64,
+        record: &PairContact,
+    ) -> Result<()> {
+        let (stored, residual, in_play) = sample(system, y, modes, stored_start, impact);
+        let created = residual - self.residual;
+        let scale = energy_scale.max(in_play);
+        let limit = energy_tolerance.min(CONTACT_CREATION_LIMIT);
+        if created > limit * scale {
+            let change = stored - self.stored;
+            return Err(Error::ContactEnergy {
+                onset: record.onset,
+                separation: record.separation,
+                change,
+                dissipated: record.energy_dissipated,
+                // The rest of what the residual moved: the other dampers'
+                // and contacts' losses less the input work over the contact.
+                work: created - change - record.energy_dissipated,
+                scale,
+                restitution: record.restitution,
+                tolerance: limit,
+                created: limit < energy_tolerance,
+            });
+        }
+        Ok(())
+    }
+}
