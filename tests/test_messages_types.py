@@ -680,3 +680,39 @@ def test_the_binding_s_own_messages_write_numbers_short() -> None:
         system.run([0.0] * 4, 1.0, strobe_period=-1e-300)
     with pytest.raises(vi.InvalidInputError, match=r"tolerance .* got -1e\+300$"):
         system.shoot([0.0] * 4, 1.0, tolerance=-1e300, max_iterations=3)
+
+
+@pytest.mark.parametrize(
+    ("name", "bad"), [("spec", None), ("max_steps", None), ("analysis", 5), ("values", "abc")]
+)
+def test_run_study_names_an_argument_of_the_wrong_type(name: str, bad: Any) -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    spec = analyses.runner(SECTIONS).prepared.binding_spec()
+    kwargs: dict[str, Any] = {
+        "spec": spec,
+        "initial": [[0.0], [0.0], [0.0], [0.0]],
+        "paths": ["damper.0.clearance"],
+        "values": np.array([0.005]),
+        "method": "exact",
+        "dt": None,
+        "rtol": 1e-8,
+        "atol": 1e-12,
+        "beta": 0.25,
+        "gamma": 0.5,
+        "spectral_radius": 0.9,
+        "max_steps": 10**6,
+        "energy_tolerance": 0.05,
+        "analysis": "run",
+        "t_end": 0.01,
+        "record_from": 0.0,
+        "settle_periods": 1,
+        "record_periods": 1,
+        "tolerance": 1e-6,
+        "threads": 1,
+    }
+    vi.run_study(**kwargs)  # valid as given
+    # PyO3's TypeError named the argument only in a note.
+    with pytest.raises(vi.InvalidInputError, match=rf"^{name} has the wrong type"):
+        vi.run_study(**{**kwargs, name: bad})

@@ -49,11 +49,11 @@ from vibroimpact._core import (
     goldsmith_max_indentation,
     hertz_stiffness,
     linear_contact_duration,
-    run_study,
 )
 from vibroimpact._core import cantilever_mode_shape as _cantilever_mode_shape
 from vibroimpact._core import check_solver as _check_solver
 from vibroimpact._core import goldsmith_contact_duration as _goldsmith_contact_duration
+from vibroimpact._core import run_study as _run_study
 from vibroimpact._core import simulate as _simulate
 from vibroimpact.arguments import typed as _typed
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
@@ -87,6 +87,7 @@ simulate = _typed(system=ImpactDamper, contact=Contact, initial=InitialState, **
 check_solver = _typed(**_TEXTS)(_check_solver)
 cantilever_mode_shape = _typed(derivative=int)(_cantilever_mode_shape)
 goldsmith_contact_duration = _typed(exact_constant=bool)(_goldsmith_contact_duration)
+run_study = _typed()(_run_study)
 
 __all__ = [
     "run_study",

@@ -10,6 +10,7 @@ import functools
 import inspect
 import math
 import os
+import re
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
@@ -183,10 +184,11 @@ def instance(name: str, value: Any, kind: type, made_by: str) -> Any:
 
 
 def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
-    """A core function whose arguments of the wrong type (PyO3 raises a TypeError not
-    naming the argument) are refused naming it: on a TypeError the arguments are
-    checked against ``kinds`` (name: the types allowed), and the first wrong one is
-    an InvalidInputError. Valid calls cost nothing."""
+    """A core function whose arguments of the wrong type (PyO3 raises a TypeError
+    naming the argument only in a note) are refused naming it: on a TypeError the
+    arguments are checked against ``kinds`` (name: the types allowed), and the first
+    wrong one is an InvalidInputError; else the argument PyO3's note names. Valid
+    calls cost nothing."""
 
     def wrap(function: _F) -> _F:
         signature = inspect.signature(function)
@@ -195,7 +197,7 @@ def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
         def call(*args: Any, **kwargs: Any) -> Any:
             try:
                 return function(*args, **kwargs)
-            except TypeError:
+            except TypeError as err:
                 try:
                     bound = signature.bind(*args, **kwargs)
                 except TypeError:
@@ -206,6 +208,14 @@ def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
                         wanted = " or ".join(_article(t) for t in names)
                         raise InvalidInputError(
                             f"{key} must be {wanted}, got {shown(bound.arguments[key])}"
+                        ) from None
+                # PyO3 names the argument it could not take in a note.
+                for note in getattr(err, "__notes__", ()):
+                    named = re.fullmatch(r"while processing '(\w+)'", note)
+                    if named and named[1] in bound.arguments:
+                        value = shown(bound.arguments[named[1]])
+                        raise InvalidInputError(
+                            f"{named[1]} has the wrong type ({err}), got {value}"
                         ) from None
                 raise
 
