@@ -1140,6 +1140,13 @@ impl Assembly {
         1e-12 * self.floor_mass_acceleration * self.time_scale.min(t_end).powi(2)
     }
 
+    /// The system's time scale (s): its shortest natural or forcing period,
+    /// or without one the time to fall through its largest gap (infinite
+    /// for neither).
+    pub(crate) fn time_scale(&self) -> f64 {
+        self.time_scale
+    }
+
     /// A sticking pair `i` released: held on its wall only to round-off, it
     /// is put at rest relative to the wall (no approach left) with its gap
     /// a few units of that round-off open, along `M^-1 h^T` (the momentum

@@ -16,7 +16,7 @@
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
 use crate::assembly::{h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
-use crate::balance::{check_balance, ENERGY_INTERVAL};
+use crate::balance::{check_balance, note_energy_in_play, EnergySampler, ENERGY_INTERVAL};
 use crate::contact::{AnyLaw, ContactLaw};
 use crate::error::Error;
 use crate::signals::Signal;
@@ -581,6 +581,15 @@ impl Compact {
                     f.unbalanced = Some(failure);
                     break;
                 }
+            } else if f.energy_sampler.due(f.time) {
+                note_energy_in_play(
+                    system,
+                    &y[..len],
+                    modes,
+                    f.stored_start,
+                    f.impact_loss,
+                    &mut f.energy_scale,
+                );
             }
         }
         f.y[..len].copy_from_slice(&y[..len]);
@@ -670,6 +679,8 @@ pub struct Stretch<'a> {
     /// where it failed, on which the stretch stops.
     pub stored_start: f64,
     pub energy_scale: f64,
+    /// When the energy in play is sampled between the checks.
+    pub energy_sampler: EnergySampler,
     pub impact_loss: f64,
     pub energy_tolerance: f64,
     pub unbalanced: Option<Error>,
@@ -931,6 +942,7 @@ mod tests {
                 time_scale: 1.0,
                 stored_start,
                 energy_scale,
+                energy_sampler: EnergySampler::new(&system, 1.0),
                 impact_loss: 0.0,
                 energy_tolerance: 1e-6,
                 unbalanced: None,

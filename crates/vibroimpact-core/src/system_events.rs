@@ -23,7 +23,9 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
     2 * system.dim + CONTACT + i
 }
 pub use crate::balance::EnergyBalance;
-use crate::balance::{balance, check_balance, ENERGY_INTERVAL};
+use crate::balance::{
+    balance, check_balance, note_energy_in_play, EnergySampler, ENERGY_INTERVAL,
+};
 use crate::compact::Stretch;
 use crate::contact_balance::OnsetBalance;
 use crate::error::{Error, Result};
@@ -872,6 +874,7 @@ pub fn integrate_system_within<S: SystemStepper>(
     for record in open.iter_mut().flatten() {
         record.balance = OnsetBalance::at(system, &y, &modes, stored_start, 0.0);
     }
+    let mut energy_sampler = EnergySampler::new(system, t_end);
     let mut impact_loss = 0.0;
     let mut contacts: Vec<PairContact> = Vec::new();
     let row = 2 * d;
@@ -984,13 +987,14 @@ pub fn integrate_system_within<S: SystemStepper>(
                 time_scale,
                 stored_start,
                 energy_scale,
+                energy_sampler,
                 impact_loss,
                 energy_tolerance: options.energy_tolerance,
                 unbalanced: None,
             };
             stepper.stretch(system, &mut stretch, &modes, &mut scratch);
             let (steps, limited) = (stretch.steps, stretch.limited);
-            energy_scale = stretch.energy_scale;
+            (energy_scale, energy_sampler) = (stretch.energy_scale, stretch.energy_sampler);
             if let Some(failure) = stretch.unbalanced {
                 return Err(failure);
             }
@@ -1528,6 +1532,8 @@ pub fn integrate_system_within<S: SystemStepper>(
                 t_end,
                 time,
             )?;
+        } else if energy_sampler.due(time) {
+            note_energy_in_play(system, &y, &modes, stored_start, impact_loss, &mut energy_scale);
         }
         if !done && accepted + control.rejected >= options.max_steps {
             return Err(Error::TooManySteps {
