@@ -129,7 +129,8 @@ def test_a_record_at_the_size_limit_is_parsed_within_bounded_memory(tmp_path: Pa
     )
     assert done.returncode == 0, done.stderr
     peak = int(done.stdout) * 1024  # bytes
-    assert peak < 8 * MAX_RECORDED_FILE_BYTES, f"{peak / 2**20:.0f} MiB"
+    # About 3 times the file, with Python and NumPy themselves (40 MB).
+    assert peak < 5 * MAX_RECORDED_FILE_BYTES, f"{peak / 2**20:.0f} MiB"
 
 
 def test_a_record_file_beyond_the_limit_is_refused_before_it_is_read(
