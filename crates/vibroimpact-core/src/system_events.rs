@@ -1680,6 +1680,8 @@ fn reduce_step<S: SystemStepper>(
 /// [`impacts::resting`]: no impact, so no rebound ratio). `scales` are the
 /// time's round-off and the system's time scale, s. Once per onset.
 #[allow(clippy::too_many_arguments)]
+#[cold]
+#[inline(never)]
 fn compliant_onset(
     system: &Assembly,
     i: usize,
