@@ -236,6 +236,10 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
         vi.linear_contact_duration,
         {"impact_mass": 0.25, "main_mass": 1.0, "stiffness": 49.05, "damping": 0.01},
     ),
+    "_strobe_period": (
+        _core._strobe_period,
+        {"strobe": np.ones((3, 2)), "forcing_period": 0.2, "tolerance": 1e-6, "max_period": 8},
+    ),
     "adequacy": (
         vi.adequacy,
         {

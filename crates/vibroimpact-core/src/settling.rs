@@ -2,8 +2,30 @@
 //! which its stroboscopic state repeats. The one criterion of the steady-state
 //! analyses (through the binding) and of steady-state studies.
 
+use crate::error::{positive, Result};
+
 /// The most forcing periods a settled response may take to repeat.
 pub const MAX_PERIOD: usize = 8;
+
+/// [`strobe_period`] for a caller whose `forcing_period` (s) and `tolerance`
+/// are not yet checked (the binding's): each must be finite and > 0.
+pub fn checked_strobe_period(
+    strobe: &[f64],
+    width: usize,
+    forcing_period: f64,
+    tolerance: f64,
+    max_period: usize,
+) -> Result<Option<usize>> {
+    positive("forcing_period", forcing_period)?;
+    positive("tolerance", tolerance)?;
+    Ok(strobe_period(
+        strobe,
+        width,
+        forcing_period,
+        tolerance,
+        max_period,
+    ))
+}
 
 /// The smallest p in 1..=`max_period` with the last stroboscopic state (rows
 /// of `width` = 2 n: n displacements, m, then n velocities, m/s) within
@@ -91,5 +113,20 @@ mod tests {
         assert_eq!(strobe_period(&strobe, 2, 0.1, 1e-9, 2), None);
         assert_eq!(strobe_period(&strobe[..2], 2, 0.1, 1e-9, MAX_PERIOD), None);
         assert_eq!(strobe_period(&[], 2, 0.1, 1e-9, MAX_PERIOD), None);
+    }
+
+    #[test]
+    fn a_period_or_tolerance_that_is_not_a_positive_number_is_refused() {
+        let strobe = strobed(0.0, 0.0, 5);
+        for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
+            let err = checked_strobe_period(&strobe, 2, bad, 1e-6, 8).unwrap_err();
+            assert!(
+                err.to_string().starts_with("forcing_period must be"),
+                "{err}"
+            );
+            let err = checked_strobe_period(&strobe, 2, 1.0, bad, 8).unwrap_err();
+            assert!(err.to_string().starts_with("tolerance must be"), "{err}");
+        }
+        assert_eq!(checked_strobe_period(&strobe, 2, 1.0, 1e-6, 8), Ok(Some(1)));
     }
 }

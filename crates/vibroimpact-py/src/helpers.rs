@@ -53,20 +53,15 @@ pub(crate) fn forcing_period(excitations: Vec<(String, Option<Vec<f64>>)>) -> Py
 #[pyfunction]
 pub(crate) fn strobe_period(
     strobe: numpy::PyReadonlyArray2<'_, f64>,
-    forcing_period: f64,
-    tolerance: f64,
+    #[pyo3(from_py_with = arg::forcing_period)] forcing_period: f64,
+    #[pyo3(from_py_with = arg::tolerance)] tolerance: f64,
     max_period: usize,
 ) -> PyResult<Option<usize>> {
     let rows = strobe.as_array();
     let width = rows.ncols();
     let flat: Vec<f64> = rows.iter().copied().collect();
-    Ok(settling::strobe_period(
-        &flat,
-        width,
-        forcing_period,
-        tolerance,
-        max_period,
-    ))
+    settling::checked_strobe_period(&flat, width, forcing_period, tolerance, max_period)
+        .map_err(to_py)
 }
 
 /// One cantilever mode reduced to a single degree of freedom (see
