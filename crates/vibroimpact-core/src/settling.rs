@@ -96,37 +96,43 @@ mod tests {
 
     #[test]
     fn a_response_in_quadrature_is_judged_on_its_amplitude() {
-        // Strobed at its zero crossing: displacements of round-off, drifting
-        // by 1e-14 m a period, 3e-13 of the amplitude.
-        let strobe = strobed(PI / 2.0, 1e-14, 30);
-        assert_eq!(strobe_period(&strobe, 2, 1.0, 1e-6, MAX_PERIOD), Some(1));
-        // A drift of 1e-7 m a period (2e-6 of the amplitude) is not settled.
-        let strobe = strobed(PI / 2.0, 1e-7, 30);
-        assert_eq!(strobe_period(&strobe, 2, 1.0, 1e-6, MAX_PERIOD), None);
+        crate::testing::timeout(60, || {
+            // Strobed at its zero crossing: displacements of round-off, drifting
+            // by 1e-14 m a period, 3e-13 of the amplitude.
+            let strobe = strobed(PI / 2.0, 1e-14, 30);
+            assert_eq!(strobe_period(&strobe, 2, 1.0, 1e-6, MAX_PERIOD), Some(1));
+            // A drift of 1e-7 m a period (2e-6 of the amplitude) is not settled.
+            let strobe = strobed(PI / 2.0, 1e-7, 30);
+            assert_eq!(strobe_period(&strobe, 2, 1.0, 1e-6, MAX_PERIOD), None);
+        });
     }
 
     #[test]
     fn the_fewest_periods_that_repeat() {
-        let states = [[0.1, 2.0], [0.3, -1.0], [0.2, 0.5]];
-        let strobe: Vec<f64> = (0..20).flat_map(|k| states[k % 3]).collect();
-        assert_eq!(strobe_period(&strobe, 2, 0.1, 1e-9, MAX_PERIOD), Some(3));
-        assert_eq!(strobe_period(&strobe, 2, 0.1, 1e-9, 2), None);
-        assert_eq!(strobe_period(&strobe[..2], 2, 0.1, 1e-9, MAX_PERIOD), None);
-        assert_eq!(strobe_period(&[], 2, 0.1, 1e-9, MAX_PERIOD), None);
+        crate::testing::timeout(60, || {
+            let states = [[0.1, 2.0], [0.3, -1.0], [0.2, 0.5]];
+            let strobe: Vec<f64> = (0..20).flat_map(|k| states[k % 3]).collect();
+            assert_eq!(strobe_period(&strobe, 2, 0.1, 1e-9, MAX_PERIOD), Some(3));
+            assert_eq!(strobe_period(&strobe, 2, 0.1, 1e-9, 2), None);
+            assert_eq!(strobe_period(&strobe[..2], 2, 0.1, 1e-9, MAX_PERIOD), None);
+            assert_eq!(strobe_period(&[], 2, 0.1, 1e-9, MAX_PERIOD), None);
+        });
     }
 
     #[test]
     fn a_period_or_tolerance_that_is_not_a_positive_number_is_refused() {
-        let strobe = strobed(0.0, 0.0, 5);
-        for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
-            let err = checked_strobe_period(&strobe, 2, bad, 1e-6, 8).unwrap_err();
-            assert!(
-                err.to_string().starts_with("forcing_period must be"),
-                "{err}"
-            );
-            let err = checked_strobe_period(&strobe, 2, 1.0, bad, 8).unwrap_err();
-            assert!(err.to_string().starts_with("tolerance must be"), "{err}");
-        }
-        assert_eq!(checked_strobe_period(&strobe, 2, 1.0, 1e-6, 8), Ok(Some(1)));
+        crate::testing::timeout(60, || {
+            let strobe = strobed(0.0, 0.0, 5);
+            for bad in [f64::NAN, f64::INFINITY, 0.0, -1.0] {
+                let err = checked_strobe_period(&strobe, 2, bad, 1e-6, 8).unwrap_err();
+                assert!(
+                    err.to_string().starts_with("forcing_period must be"),
+                    "{err}"
+                );
+                let err = checked_strobe_period(&strobe, 2, 1.0, bad, 8).unwrap_err();
+                assert!(err.to_string().starts_with("tolerance must be"), "{err}");
+            }
+            assert_eq!(checked_strobe_period(&strobe, 2, 1.0, 1e-6, 8), Ok(Some(1)));
+        });
     }
 }

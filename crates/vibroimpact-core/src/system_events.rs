@@ -23,9 +23,7 @@ fn loss_slot(system: &Assembly, i: usize) -> usize {
     2 * system.dim + CONTACT + i
 }
 pub use crate::balance::EnergyBalance;
-use crate::balance::{
-    balance, check_balance, note_energy_in_play, EnergySampler, ENERGY_INTERVAL,
-};
+use crate::balance::{balance, check_balance, note_energy_in_play, EnergySampler, ENERGY_INTERVAL};
 use crate::compact::Stretch;
 use crate::contact_balance::OnsetBalance;
 use crate::error::{Error, Result};
@@ -1533,7 +1531,14 @@ pub fn integrate_system_within<S: SystemStepper>(
                 time,
             )?;
         } else if energy_sampler.due(time) {
-            note_energy_in_play(system, &y, &modes, stored_start, impact_loss, &mut energy_scale);
+            note_energy_in_play(
+                system,
+                &y,
+                &modes,
+                stored_start,
+                impact_loss,
+                &mut energy_scale,
+            );
         }
         if !done && accepted + control.rejected >= options.max_steps {
             return Err(Error::TooManySteps {
