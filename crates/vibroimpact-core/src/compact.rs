@@ -16,7 +16,7 @@
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
 use crate::assembly::{h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
-use crate::balance::{check_balance, note_energy_in_play, EnergySampler, ENERGY_INTERVAL};
+use crate::balance::{check_balance, EnergySampler, ENERGY_INTERVAL};
 use crate::contact::{AnyLaw, ContactLaw};
 use crate::error::Error;
 use crate::signals::Signal;
@@ -566,7 +566,8 @@ impl Compact {
             for w in 0..count {
                 start_gaps[w] = end_gaps[w];
             }
-            if f.accepted % ENERGY_INTERVAL == 0 {
+            let check = f.accepted % ENERGY_INTERVAL == 0;
+            if check || f.energy_sampler.due(f.time) {
                 if let Err(failure) = check_balance(
                     system,
                     &y[..len],
@@ -574,22 +575,13 @@ impl Compact {
                     f.stored_start,
                     &mut f.energy_scale,
                     f.impact_loss,
-                    f.energy_tolerance,
+                    (f.energy_tolerance, check),
                     f.t_end,
                     f.time,
                 ) {
                     f.unbalanced = Some(failure);
                     break;
                 }
-            } else if f.energy_sampler.due(f.time) {
-                note_energy_in_play(
-                    system,
-                    &y[..len],
-                    modes,
-                    f.stored_start,
-                    f.impact_loss,
-                    &mut f.energy_scale,
-                );
             }
         }
         f.y[..len].copy_from_slice(&y[..len]);
