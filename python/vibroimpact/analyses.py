@@ -140,6 +140,14 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
 
 
 def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
+    # Refused here, naming the section (a KeyError or a TypeError had named nothing).
+    if "structure" not in data:
+        raise InvalidInputError(
+            "[structure] is required: the analyses take a 0.2 scenario (a [structure] "
+            "section, its dampers, stops and excitations)"
+        )
+    if not isinstance(data.get("solver", {}), Mapping):
+        raise InvalidInputError(f"[solver] must be a table, got {shown(data['solver'])}")
     solver = dict(data.get("solver", {}))
     solver.setdefault("t_end", 1.0)
     output = data.get("output", {})
@@ -469,11 +477,13 @@ def linear_response(
     the sections already checked (a sweep's runner has them)."""
     arguments.sections("data", data)
     base_dir = arguments.directory("base_dir", base_dir)
+    if prepared is not None and not isinstance(prepared, PreparedRun):
+        raise InvalidInputError(f"prepared: must be a PreparedRun or None, got {shown(prepared)}")
+    prepared = prepared or _prepare(data, base_dir)
     parts = linear_parts(
         data["structure"], excitation=data.get("excitation", ()), base_dir=base_dir
     )
     n = parts["n"]
-    prepared = prepared or _prepare(data, base_dir)
     beam = prepared.spec["structure"]
     weights = np.array(
         [point_weights(beam, at) for at in prepared.output["points"]]

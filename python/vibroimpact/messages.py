@@ -38,7 +38,8 @@ def shown(value: Any) -> str:
             return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
     if isinstance(value, float):
         return repr(value)
-    return _SHORT.repr(value)
+    # One line: a NumPy array's repr breaks its rows over lines.
+    return re.sub(r"\s*\n\s*", " ", _SHORT.repr(value))
 
 
 def short_numbers(text: str) -> str:

@@ -40,6 +40,9 @@ _NUMBER = re.compile(_CELL, re.IGNORECASE | re.ASCII)
 _TRAILING_COMMENT = re.compile(rb"^[ \t]*[^#\s][^\n#]*#", re.MULTILINE)
 # Columns apart by commas, semicolons, tabs or spaces.
 _SEPARATOR = re.compile(r"\s*[,;]\s*|\s+")
+# A cell meant as a number (a sign, a point or a digit first): a first line of such
+# cells is a sample, mistyped or not, never a header naming the columns.
+_MEANT_AS_NUMBER = re.compile(r"[+-]?\.?\d")
 
 # The largest magnitude a sample (times scale) may have: half the largest float, so
 # that the interpolation's differences stay finite (the core's bound).
@@ -130,7 +133,7 @@ class _Rows:
         """The first line of samples (after a header naming the columns, if any)."""
         lines = self.lines()
         for number, line in lines:
-            if all(_NUMBER.fullmatch(c) for c in _SEPARATOR.split(line)):
+            if not _names_columns(line):
                 return number, line
             return next(lines, None)  # the first line named the columns
         return None
@@ -145,7 +148,7 @@ class _Rows:
             cells = _SEPARATOR.split(line)
             wrong = [c for c in cells if not _NUMBER.fullmatch(c)]
             if wrong:
-                if i == 0:  # the first line may name the columns
+                if i == 0 and _names_columns(line):
                     continue
                 raise _fail(
                     where,
@@ -167,6 +170,14 @@ class _Rows:
         first = self.first_data_line()
         numbers = (n for n, _ in self.lines() if first is not None and n >= first[0])
         return f"{self.name} line {next(itertools.islice(numbers, index, None))}"
+
+
+def _names_columns(line: str) -> bool:
+    """Whether the first line names the columns: a cell that is not a number and not
+    meant as one (``time``, ``El Centro 1940 NS``; ``0,1_0`` is a mistyped sample)."""
+    return any(
+        not _NUMBER.fullmatch(c) and not _MEANT_AS_NUMBER.match(c) for c in _SEPARATOR.split(line)
+    )
 
 
 def check_record(
@@ -198,6 +209,16 @@ def check_record(
             where,
             f"{row(i)}: times must increase strictly, got {shown(t[i])} s after "
             f"{shown(t[i - 1])} s",
+        )
+    # Times, as values, within half the largest float: the interval between two samples
+    # (-1e308 to 1e308) had overflowed, and the interpolation taken the first value.
+    beyond = np.flatnonzero(~(np.abs(t) <= _LARGEST))
+    if beyond.size:
+        i = int(beyond[0])
+        raise _fail(
+            where,
+            f"{row(i)}: time {shown(t[i])} s is beyond what a run can take (|time| at most "
+            f"{_LARGEST:.3e} s, half the largest float)",
         )
     factor = 1.0 if scale is None else abs(scale)
     with np.errstate(over="ignore"):

@@ -1,0 +1,113 @@
+"""Issue 23, cases of the same kind as its items, found by an acceptance pass: a first
+line of a recorded CSV that is a mistyped sample (not a header), a time beyond what the
+interpolation can take, a wrong-typed argument quoted on one line, and sections an
+analysis cannot take refused naming what is wrong."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from test_hostile_inputs import RECORDED
+from vibroimpact.scenario import ScenarioError, parse_scenario
+
+
+def _record_error(tmp_path: Path, csv: str) -> str:
+    (tmp_path / "rec.csv").write_text(csv, encoding="utf-8")
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(RECORDED.format(file="rec.csv"), "s.toml", tmp_path)
+    message = str(caught.value)
+    assert "\n" not in message
+    return message
+
+
+@pytest.mark.parametrize("line", ["0,1_0", "1_0,5", "0x10,1", "0 1e", "\u0661,2"])
+def test_a_mistyped_first_sample_without_a_header_is_refused_not_dropped(
+    tmp_path: Path, line: str
+) -> None:
+    # Taken for a header naming the columns, the sample had been dropped silently (the
+    # run went on from the second line).
+    message = _record_error(tmp_path, f"{line}\n11,2\n12,3\n")
+    assert "rec.csv line 1:" in message and "not a number" in message, message
+
+
+@pytest.mark.parametrize("header", ["time,value", "El Centro 1940 NS", "t [s]; a [m/s2]"])
+def test_a_header_naming_the_columns_is_still_skipped(tmp_path: Path, header: str) -> None:
+    (tmp_path / "rec.csv").write_text(f"{header}\n0,1\n1,2\n", encoding="utf-8")
+    scenario = parse_scenario(RECORDED.format(file="rec.csv"), "s.toml", tmp_path)
+    excitation = scenario.prepared.spec["excitation"][0]
+    assert list(excitation["time"]) == [0.0, 1.0]
+    assert list(excitation["value"]) == [1.0, 2.0]
+
+
+@pytest.mark.parametrize("times", [("-1e308", "1e308"), ("0", "1.7e308")])
+def test_a_time_beyond_half_the_largest_float_names_the_line(
+    tmp_path: Path, times: tuple[str, str]
+) -> None:
+    # -1e308 to 1e308: the interval overflowed to inf and the force between the two
+    # samples was read as the first value (1 N instead of 1.5 N at t = 0).
+    message = _record_error(tmp_path, f"time,value\n{times[0]},1\n{times[1]},2\n")
+    line = 2 if abs(float(times[0])) > 0.5 * sys.float_info.max else 3
+    assert f"rec.csv line {line}:" in message and "time" in message, message
+
+
+def test_a_two_dimensional_array_is_quoted_on_one_line() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    with pytest.raises(vi.InvalidInputError) as caught:
+        analyses.with_parameter({"a": {}}, "a.b", np.zeros((2, 2)))
+    message = str(caught.value)
+    assert "\n" not in message and message.startswith("value:"), message
+
+
+@pytest.mark.parametrize(
+    ("sections", "words"),
+    [
+        ({}, "[structure]"),
+        (
+            {"structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0}, "solver": None},
+            "[solver]",
+        ),
+        (
+            {"structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0}, "solver": [1]},
+            "[solver]",
+        ),
+    ],
+)
+def test_an_analysis_refuses_sections_it_cannot_take_naming_them(
+    sections: dict[str, Any], words: str
+) -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    excitation = [
+        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 1.0}
+    ]
+    data = {**sections, "excitation": excitation}
+    for call in (
+        lambda: analyses.runner(data),
+        lambda: analyses.linear_amplitude(data),
+        lambda: analyses.sweep(data, "excitation.0.frequency", [1.0]),
+    ):
+        with pytest.raises(vi.InvalidInputError) as caught:
+            call()
+        assert words in str(caught.value) and "\n" not in str(caught.value), caught.value
+
+
+def test_linear_response_refuses_a_prepared_run_of_the_wrong_type() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    data = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0},
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 1.0}
+        ],
+    }
+    with pytest.raises(vi.InvalidInputError, match="^prepared: must be a PreparedRun"):
+        analyses.linear_response(data, prepared="x")  # type: ignore[arg-type]
