@@ -50,27 +50,3 @@ def check_forcing_period(
             f"more than a run's max_steps ({max_steps}) steps through; give a frequency of at "
             f"least {highest / max_steps:.3g} Hz"
         )
-
-
-def check_axis_frequencies(
-    data: Mapping[str, Any], axes: Mapping[str, Any], base_dir: Path | None = None
-) -> None:
-    """A study's axes of excitation frequencies (``"excitation.0.frequency"``): the
-    lowest value of each, in the study's base scenario, checked as
-    :func:`check_forcing_period` checks an analysis's (the error names the axis)."""
-    # Imported here: the analyses import this module.
-    from vibroimpact.analyses import _prepare, forcing_period, with_parameter
-
-    for path, values in axes.items():
-        parts = str(path).split(".")
-        if len(parts) != 3 or parts[0] != "excitation" or parts[2] != "frequency":
-            continue
-        lowest = float(np.min(np.asarray(values, dtype=float)))
-        changed = with_parameter(data, str(path), lowest)
-        try:
-            period = forcing_period(changed)
-            check_forcing_period(changed, period, _prepare(changed, base_dir).solver["max_steps"])
-        except InvalidInputError as err:
-            if not str(err).startswith("forcing frequency"):
-                continue  # the study's own check of the axis says what else is wrong
-            raise InvalidInputError(f"[study.axes] {path!r}: {err}") from None

@@ -101,8 +101,16 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError, __version__, run_study
-from vibroimpact.analyses import MAX_PERIODS, AnalysisError, _prepare, check_total, whole_count
-from vibroimpact.forcing_limits import check_axis_frequencies
+from vibroimpact.analyses import (
+    MAX_PERIODS,
+    AnalysisError,
+    _prepare,
+    check_total,
+    forcing_period,
+    whole_count,
+    with_parameter,
+)
+from vibroimpact.forcing_limits import check_forcing_period
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
@@ -627,6 +635,27 @@ def study_of(
         except InvalidInputError as err:
             raise StudyError(f"{source}: {err}") from None
     return study
+
+
+def check_axis_frequencies(
+    data: Mapping[str, Any], axes: Mapping[str, Any], base_dir: Path | None = None
+) -> None:
+    """A study's axes of excitation frequencies (``"excitation.0.frequency"``): the
+    lowest value of each, in the study's base scenario, checked as an analysis's forcing
+    period is (the error names the axis)."""
+    for path, values in axes.items():
+        parts = str(path).split(".")
+        if len(parts) != 3 or parts[0] != "excitation" or parts[2] != "frequency":
+            continue
+        lowest = float(np.min(np.asarray(values, dtype=float)))
+        changed = with_parameter(data, str(path), lowest)
+        try:
+            period = forcing_period(changed)
+            check_forcing_period(changed, period, _prepare(changed, base_dir).solver["max_steps"])
+        except InvalidInputError as err:
+            if not str(err).startswith("forcing frequency"):
+                continue  # the study's own check of the axis says what else is wrong
+            raise InvalidInputError(f"[study.axes] {path!r}: {err}") from None
 
 
 def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
