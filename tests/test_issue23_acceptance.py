@@ -111,3 +111,55 @@ def test_linear_response_refuses_a_prepared_run_of_the_wrong_type() -> None:
     }
     with pytest.raises(vi.InvalidInputError, match="^prepared: must be a PreparedRun"):
         analyses.linear_response(data, prepared="x")  # type: ignore[arg-type]
+
+
+def _dataset_calls() -> list[Any]:
+    from vibroimpact import datasets
+
+    bad = [None, "x", [[1.0]], 5.0, {}]
+    calls = [
+        (datasets.sweep_dataset, ["points", "parameter", "units"], 2),
+        (datasets.bifurcation_dataset, ["points", "parameter", "units"], 2),
+        (datasets.section_dataset, ["section", "n", "k"], 3),
+        (datasets.basins_dataset, ["result", "x_name", "y_name"], 3),
+        (datasets.branch_dataset, ["branch", "units"], 1),
+    ]
+    return [
+        pytest.param(function, names, positional, name, value, id=f"{function.__name__}-{name}-{i}")
+        for function, names, positional in calls
+        for name in names
+        for i, value in enumerate(bad)
+        # None is a valid units (told from the parameter); a str a valid name.
+        if not (name == "units" and value is None)
+        and not (name in ("parameter", "x_name", "y_name", "units") and value == "x")
+    ]
+
+
+@pytest.mark.parametrize(("function", "names", "positional", "name", "value"), _dataset_calls())
+def test_the_dataset_functions_refuse_a_wrong_type_naming_the_argument(
+    function: Any, names: list[str], positional: int, name: str, value: Any
+) -> None:
+    # Each had failed deep inside as an AttributeError or a TypeError naming nothing.
+    import vibroimpact as vi
+    from vibroimpact import analyses, continuation, maps
+
+    good: dict[str, Any] = {
+        "points": [],
+        "parameter": "excitation.0.frequency",
+        "units": "Hz",
+        "section": maps.Section(np.zeros((1, 2)), np.zeros(0), np.zeros(0), []),
+        "n": 1,
+        "k": 0,
+        "result": maps.Basins(np.zeros(1), np.zeros(1), np.zeros((1, 1), dtype=int), []),
+        "x_name": "structure_displacement.0",
+        "y_name": "structure_velocity.0",
+        "branch": continuation.Branch("p", 1, [], "max_points", 1, 0),
+    }
+    assert issubclass(analyses.AnalysisError, vi.InvalidInputError)
+    kwargs = {key: good[key] for key in names}
+    kwargs[name] = value
+    args = [kwargs.pop(key) for key in names[:positional]]
+    with pytest.raises(vi.InvalidInputError) as caught:
+        function(*args, **kwargs)
+    message = str(caught.value)
+    assert message.startswith(name) and "\n" not in message, message

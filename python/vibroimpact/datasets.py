@@ -42,10 +42,12 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
+from vibroimpact import arguments
 from vibroimpact._core import __version__
 from vibroimpact.analyses import AnalysisError, SweepPoint, reductions
 from vibroimpact.continuation import Branch
 from vibroimpact.maps import Basins, BifurcationPoint, Section
+from vibroimpact.messages import shown
 from vibroimpact.output import json_text
 
 __all__ = [
@@ -223,7 +225,23 @@ def _value_coord(
 
 def _count(name: str, value: int, low: int) -> None:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
-        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
+        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {shown(value)}")
+
+
+def _results(name: str, values: Any, kind: type, made_by: str) -> None:
+    """A list of an analysis's results, each a ``kind`` (an AttributeError deep inside
+    had named nothing)."""
+    if not isinstance(values, list | tuple):
+        raise AnalysisError(f"{name}: must be a list (from {made_by}), got {shown(values)}")
+    for i, value in enumerate(values):
+        arguments.instance(f"{name}[{i}]", value, kind, made_by)
+
+
+def _names(**given: Any) -> None:
+    """Parameter and state names: strings; units: a string or None."""
+    for name, value in given.items():
+        if name != "units" or value is not None:
+            arguments.text(name, value)
 
 
 def sweep_dataset(
@@ -249,6 +267,8 @@ def sweep_dataset(
     the cantilever) and the bending moment's (N m): ``moment_amplitude``,
     ``moment_rms``, ``linear_moment_amplitude``, ``moment_reduction``. Attributes:
     ``parameter``."""
+    _results("points", points, SweepPoint, "vibroimpact.analyses.sweep")
+    _names(parameter=parameter, units=units)
     if not points:
         raise AnalysisError("sweep_dataset: no points")
     n = len(points[0].linear_amplitude)
@@ -382,6 +402,8 @@ def bifurcation_dataset(
     ``state``, NaN-padded past a point's own samples and where its run failed),
     ``sample_count`` (each point's samples, 0 where its run failed) and ``error``
     (``""`` where none). Attributes: ``parameter``."""
+    _results("points", points, BifurcationPoint, "vibroimpact.maps.bifurcation")
+    _names(parameter=parameter, units=units)
     if not points:
         raise AnalysisError("bifurcation_dataset: no points")
     if (n is None) != (k is None):
@@ -454,6 +476,7 @@ def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
     name, such as ``"damper 0"``). Attributes: ``structure_coordinates`` (n) and
     ``dampers`` (k). With no impact the ``impact`` dimension has length 0 (NetCDF3
     writes it as its unlimited dimension)."""
+    arguments.instance("section", section, Section, "vibroimpact.maps.poincare")
     _count("n", n, 0)
     _count("k", k, 0)
     width = 2 * (n + k)
@@ -523,6 +546,8 @@ def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
     ``attractors`` (a JSON list of ``{period, impacts_per_period, amplitude}``:
     NetCDF attributes cannot hold a list of records), ``label_meanings`` (the
     labels in words), ``x_name``, ``y_name``."""
+    arguments.instance("result", result, Basins, "vibroimpact.maps.basins")
+    _names(x_name=x_name, y_name=y_name)
     first = np.asarray(result.first, dtype=np.float64)
     second = np.asarray(result.second, dtype=np.float64)
     labels = np.asarray(result.labels)
@@ -589,6 +614,8 @@ def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:
     flagged bifurcation lies, NaN where not flagged). Attributes: ``parameter``,
     ``periods`` (K), ``stopped`` (why the continuation stopped),
     ``structure_coordinates`` (n), ``dampers`` (k)."""
+    arguments.instance("branch", branch, Branch, "vibroimpact.continuation.continue_orbit")
+    _names(units=units)
     points = branch.points
     if not points:
         raise AnalysisError("branch_dataset: no points")
