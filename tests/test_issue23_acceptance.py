@@ -163,3 +163,38 @@ def test_the_dataset_functions_refuse_a_wrong_type_naming_the_argument(
         function(*args, **kwargs)
     message = str(caught.value)
     assert message.startswith(name) and "\n" not in message, message
+
+
+def test_a_fixed_step_method_is_bounded_by_its_steps_not_by_the_fastest_mode() -> None:
+    import vibroimpact as vi
+    from vibroimpact import analyses
+
+    # A 5e5 Hz mode beside a 5 Hz one, forced at 1e-4 Hz: 5e9 periods of the fast mode
+    # in one forcing period, but newmark-implicit takes 1e6 steps of 0.01 s (0.25 s),
+    # and had been refused as "more than a run's max_steps steps through".
+    structure = {
+        "kind": "matrices",
+        "mass": [[1.0, 0.0], [0.0, 1e-6]],
+        "stiffness": [[1e3 + 1e7, -1e7], [-1e7, 1e7]],
+        "damping": [[1.0, 0.0], [0.0, 1e-2]],
+    }
+    excitation = [
+        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 1e-4}
+    ]
+    for method in ("newmark-implicit", "generalized-alpha"):
+        data = {
+            "structure": structure,
+            "excitation": excitation,
+            "solver": {"method": method, "dt": 1e-2},
+        }
+        assert analyses.runner(data).period == pytest.approx(1e4)
+        # One forcing period of more than max_steps steps of dt: refused, naming both.
+        data["solver"]["max_steps"] = 999_999
+        with pytest.raises(vi.InvalidInputError) as caught:
+            analyses.runner(data)
+        message = str(caught.value)
+        assert message.startswith("forcing frequency 0.0001 Hz") and "dt = 0.01 s" in message
+    # An adaptive method still steps through each period of the fast mode: refused.
+    data = {"structure": structure, "excitation": excitation, "solver": {"method": "dop853"}}
+    with pytest.raises(vi.InvalidInputError, match="fastest mode"):
+        analyses.runner(data)

@@ -1,8 +1,10 @@
-"""The forcing periods an analysis can run: a run steps at least once in each period of
-the structure's fastest mode, so a forcing period of more than ``max_steps`` of those
-is beyond any run (a sweep from 1e-300 Hz had failed each point as a numerical blow-up
-advising a smaller dt). Refused when the analysis is set up, naming the frequency and
-the lowest one a run can take. SI units.
+"""The forcing periods an analysis can run: an adaptive or exact run steps at least once
+in each period of the structure's fastest mode, so a forcing period of more than
+``max_steps`` of those is beyond it (a sweep from 1e-300 Hz had failed each point as a
+numerical blow-up advising a smaller dt); a fixed-step run takes ``period / dt`` steps
+whatever the modes (an implicit method is stable on a mode far faster than its step).
+Refused when the analysis is set up, naming the frequency and the lowest one a run can
+take. SI units.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import numpy as np
 
 from vibroimpact._core import InvalidInputError
 from vibroimpact.messages import shown
-from vibroimpact.system import linear_parts
+from vibroimpact.system import _FIXED_STEP, linear_parts
 
 
 def fastest_mode(data: Mapping[str, Any], base_dir: Path | None = None) -> float:
@@ -41,7 +43,20 @@ def check_forcing_period(
     data: Mapping[str, Any], period: float, max_steps: int, base_dir: Path | None = None
 ) -> None:
     """Refuse a forcing ``period`` (s) that spans more than ``max_steps`` periods of the
-    system's fastest mode: no run can step through one of them."""
+    system's fastest mode (more than ``max_steps`` steps of ``dt`` for a fixed-step
+    method): no run can step through one of them."""
+    solver = data.get("solver", {})
+    if solver.get("method") in _FIXED_STEP:
+        # Checked by the run's own settings: a fixed step is given.
+        dt = float(solver["dt"])
+        if period / dt > max_steps:
+            raise InvalidInputError(
+                f"forcing frequency {shown(1 / period)} Hz: its period, {period:.6g} s, "
+                f"takes {period / dt:.3g} steps of dt = {shown(dt)} s, more than a run's "
+                f"max_steps ({max_steps}); give a frequency of at least "
+                f"{1 / (max_steps * dt):.3g} Hz"
+            )
+        return
     highest = fastest_mode(data, base_dir)
     if highest > 0 and period * highest > max_steps:
         raise InvalidInputError(
