@@ -198,3 +198,52 @@ def test_a_fixed_step_method_is_bounded_by_its_steps_not_by_the_fastest_mode() -
     data = {"structure": structure, "excitation": excitation, "solver": {"method": "dop853"}}
     with pytest.raises(vi.InvalidInputError, match="fastest mode"):
         analyses.runner(data)
+
+
+def test_an_orbit_at_exact_resonance_is_found_by_every_analysis_that_shoots(
+    tmp_path: Path,
+) -> None:
+    import math
+
+    from vibroimpact import analyses, continuation
+    from vibroimpact import study as st
+
+    # The oscillator at 5.00 Hz: strobed in quadrature, its displacement at
+    # the strobe is round-off (3e-10 m) and the shooting, scaled by it, had never
+    # converged (orbit: residual 1.4e-5 after 40 iterations, multipliers 0 and 0.939;
+    # continuation: no first orbit; an orbit study: the point failed).
+    data: dict[str, Any] = {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 986.96044, "damping": 0.6283},
+        "excitation": [
+            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 5.0}
+        ],
+        "solver": {"method": "exact"},
+    }
+    # Closed forms: X = F / |k - m w^2 + i c w|, multipliers of modulus exp(-c T / 2 m).
+    w = 2 * math.pi * 5.0
+    amplitude = 1.0 / abs(986.96044 - w * w + 1j * 0.6283 * w)
+    modulus = math.exp(-0.6283 * 0.2 / 2)
+    for method in ("exact", "dop853"):
+        data["solver"]["method"] = method
+        found = analyses.orbit(analyses.runner(data))
+        assert found.converged and found.stable
+        assert found.amplitude[0] == pytest.approx(amplitude, rel=1e-7)
+        assert np.abs(found.floquet_multipliers) == pytest.approx([modulus] * 2, rel=1e-7)
+    branch = continuation.continue_orbit(data, "excitation.0.amplitude", stop=2.0, max_points=3)
+    assert branch.points[0].amplitude[0] == pytest.approx(amplitude, rel=1e-7)
+    orbit_study = {
+        **data,
+        "study": {
+            "analysis": "orbit",
+            "settle_periods": 1000,
+            "metrics": ["largest_multiplier", "amplitude"],
+            "axes": {"excitation.0.frequency": [4.99, 5.0, 5.01]},
+        },
+    }
+    data["solver"]["method"] = "exact"
+    ds = st.run(st.study_of(orbit_study), tmp_path / "out.nc")
+    assert list(ds["status"].values) == [0, 0, 0]
+    assert float(ds["amplitude"].sel({"excitation.0.frequency": 5.0}).values[0]) == (
+        pytest.approx(amplitude, rel=1e-7)
+    )
+    assert float(ds["largest_multiplier"].values[1]) == pytest.approx(modulus, rel=1e-7)

@@ -284,7 +284,13 @@ class PreparedSystem:
         strobe_period: float | None = None,
     ) -> dict[str, Any]: ...
     def shoot(
-        self, state: list[float], t_end: float, *, tolerance: float, max_iterations: int
+        self,
+        state: list[float],
+        t_end: float,
+        *,
+        tolerance: float,
+        max_iterations: int,
+        forcing_period: float | None = None,
     ) -> dict[str, Any]: ...
 
 def simulate(

@@ -304,6 +304,7 @@ class Runner:
             count * self.period,
             tolerance=tolerance,
             max_iterations=max_iterations,
+            forcing_period=self.period,
         )
         self.runs += int(shot["maps"])
         return shot

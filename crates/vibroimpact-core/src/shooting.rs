@@ -14,8 +14,9 @@ pub struct Shot {
     pub monodromy: Vec<f64>,
     pub converged: bool,
     pub iterations: usize,
-    /// `max |P(z) - z|`, displacements and velocities each relative to their
-    /// largest magnitude.
+    /// `max |P(z) - z|`, displacements relative to the size of the motion
+    /// and velocities to that times the forcing's angular frequency (see
+    /// [`shoot`]).
     pub residual: f64,
     /// Maps evaluated.
     pub maps: usize,
@@ -29,24 +30,35 @@ fn refused(e: &Error) -> bool {
 }
 
 /// Shoot from `z0` (displacements then velocities) for `P(z) = z`.
+///
+/// The residual and the Jacobian's steps are scaled by the size of the motion,
+/// as settling judges it: each coordinate's `(x, v)` counts as the amplitude
+/// `hypot(x, v / w)`, w = 2 pi / `forcing_period` (s), displacements relative
+/// to the largest and velocities to that times w. Scaled by the strobed
+/// displacements alone, an orbit strobed at its zero crossing (a linear
+/// oscillator at resonance) had a scale of round-off and was never found.
 pub fn shoot(
     map: &mut dyn FnMut(&[f64]) -> Result<Vec<f64>>,
     z0: &[f64],
+    forcing_period: f64,
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<Shot> {
     let size = z0.len();
     let dim = size / 2;
     let mut maps = 0usize;
+    let slow = forcing_period / (2.0 * std::f64::consts::PI);
     let scales = |z: &[f64], image: &[f64]| {
-        let largest = |range: std::ops::Range<usize>| {
-            range
-                .flat_map(|i| [z[i].abs(), image[i].abs()])
-                .fold(1e-12f64, f64::max)
-        };
-        let (x, v) = (largest(0..dim), largest(dim..size));
+        let x = (0..dim)
+            .flat_map(|i| {
+                [
+                    z[i].hypot(z[dim + i] * slow),
+                    image[i].hypot(image[dim + i] * slow),
+                ]
+            })
+            .fold(1e-12f64, f64::max);
         (0..size)
-            .map(|i| if i < dim { x } else { v })
+            .map(|i| if i < dim { x } else { x / slow })
             .collect::<Vec<f64>>()
     };
     let mut z = z0.to_vec();
@@ -206,6 +218,7 @@ fn difference(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::TAU;
 
     /// `P(z) = 2 z + 1` has its fixed point at z = -1, where the "wall" z[0] >= 0
     /// refuses to start: each Newton step from z >= 0 points inside it.
@@ -219,7 +232,7 @@ mod tests {
     #[test]
     fn a_newton_step_that_stays_inside_a_wall_ends_the_shooting_unconverged() {
         crate::testing::timeout(60, || {
-            let shot = shoot(&mut walled, &[1.0, 1.0], 1e-10, 40).unwrap();
+            let shot = shoot(&mut walled, &[1.0, 1.0], TAU, 1e-10, 40).unwrap();
             assert!(!shot.converged);
             // Halved to the wall (z[0] = 0, to the halvings' resolution), where no
             // fraction of the next step is admissible.
@@ -239,7 +252,7 @@ mod tests {
                 let kink = 100.0 * (z[0] - (1.0 + 1e-7)).max(0.0);
                 Ok(vec![2.0 * z[0] - 1.0 + kink, 0.5 * z[1]])
             };
-            let shot = shoot(&mut map, &[1.0, 0.0], 1e-12, 40).unwrap();
+            let shot = shoot(&mut map, &[1.0, 0.0], TAU, 1e-12, 40).unwrap();
             assert!(shot.converged);
             assert!(
                 (shot.monodromy[0] - 2.0).abs() < 1e-6,
@@ -260,13 +273,43 @@ mod tests {
             // P(z) = 2 z - 1, nothing refused: the fixed point z = 1.
             let mut map =
                 |z: &[f64]| -> Result<Vec<f64>> { Ok(z.iter().map(|z| 2.0 * z - 1.0).collect()) };
-            let shot = shoot(&mut map, &[3.0, 0.5], 1e-12, 40).unwrap();
+            let shot = shoot(&mut map, &[3.0, 0.5], TAU, 1e-12, 40).unwrap();
             assert!(shot.converged);
             for z in &shot.state {
                 assert!((z - 1.0).abs() < 1e-12, "{z}");
             }
             // The monodromy of a linear map is its matrix: 2 I.
             assert!((shot.monodromy[0] - 2.0).abs() < 1e-9 && shot.monodromy[1].abs() < 1e-9);
+        });
+    }
+
+    #[test]
+    fn an_orbit_strobed_at_its_zero_crossing_is_found() {
+        crate::testing::timeout(60, || {
+            // A damped oscillator forced at resonance (w = 2 pi rad/s), strobed
+            // where its displacement crosses zero: about z* = (1e-10 m, 1 m/s) the
+            // map turns (x, v / w) by 0.01 rad and shrinks it by a = 0.939, its
+            // displacement computed, as a flow computes it, from terms of the
+            // motion's size (0.16 m), whose round-off it keeps. Scaled by the
+            // displacements alone (1e-10 m) that round-off was a residual of 1e-7
+            // and Newton never converged.
+            let (a, angle, fixed, slow) = (0.939, 0.01f64, [1e-10, 1.0], 1.0 / TAU);
+            let mut map = |z: &[f64]| -> Result<Vec<f64>> {
+                let (dx, dv) = (z[0] - fixed[0], (z[1] - fixed[1]) * slow);
+                let x = a * (angle.cos() * dx + angle.sin() * dv);
+                let v = a * (angle.cos() * dv - angle.sin() * dx);
+                let size = 0.16;
+                Ok(vec![(fixed[0] + x + size) - size, fixed[1] + v / slow])
+            };
+            let shot = shoot(&mut map, &[0.0, 0.0], 1.0, 1e-10, 40).unwrap();
+            assert!(shot.converged, "{}", shot.residual);
+            assert!(shot.iterations <= 3, "{}", shot.iterations);
+            assert!((shot.state[1] - 1.0).abs() < 1e-8, "{}", shot.state[1]);
+            // The multipliers a e^(+-0.01 i): trace 2 a cos 0.01, determinant a^2.
+            let m = &shot.monodromy;
+            let (trace, det) = (m[0] + m[3], m[0] * m[3] - m[1] * m[2]);
+            assert!((trace - 2.0 * a * angle.cos()).abs() < 1e-6, "{trace}");
+            assert!((det - a * a).abs() < 1e-6, "{det}");
         });
     }
 }

@@ -878,6 +878,7 @@ fn orbit_metrics(
     let shot = shooting::shoot(
         &mut |z| Ok(run_from(z, &span_options)?.final_state),
         &z,
+        period,
         ORBIT_TOLERANCE,
         ORBIT_ITERATIONS,
     )?;

@@ -473,9 +473,10 @@ impl PreparedSystem {
     /// Shoot for a periodic orbit over `t_end` s (whole forcing periods) from
     /// the flat state `state` (see `vibroimpact.analyses.orbit`): Newton's
     /// method with a central-difference Jacobian, all in the core with the GIL
-    /// released. Returns `state`, `monodromy` (flat, row-major), `converged`,
-    /// `iterations`, `residual`.
-    #[pyo3(signature = (state, t_end, *, tolerance, max_iterations))]
+    /// released. `forcing_period` (s, default `t_end`) sets the scale of the
+    /// motion (see `core::shooting::shoot`). Returns `state`, `monodromy`
+    /// (flat, row-major), `converged`, `iterations`, `residual`.
+    #[pyo3(signature = (state, t_end, *, tolerance, max_iterations, forcing_period = None))]
     fn shoot<'py>(
         &self,
         py: Python<'py>,
@@ -483,9 +484,17 @@ impl PreparedSystem {
         #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
         #[pyo3(from_py_with = crate::convert::arg::tolerance)] tolerance: f64,
         max_iterations: usize,
+        forcing_period: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         check("t_end", t_end, t_end > 0.0, "> 0 s")?;
         check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
+        let forcing_period = forcing_period.unwrap_or(t_end);
+        check(
+            "forcing_period",
+            forcing_period,
+            forcing_period.is_finite() && forcing_period > 0.0,
+            "> 0 s",
+        )?;
         let mut ready = self.ready.lock().map_err(|_| {
             InvalidInputError::new_err("a run of this system failed; make it again")
         })?;
@@ -501,6 +510,7 @@ impl PreparedSystem {
             core::shooting::shoot(
                 &mut |z| ready.map(z, t_end, interrupt),
                 &state,
+                forcing_period,
                 tolerance,
                 max_iterations,
             )
