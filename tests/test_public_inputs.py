@@ -198,7 +198,10 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
             "tolerance": 1e-6,
         },
     ),
-    "PreparedSystem.shoot": (_prepared_shoot, {"t_end": 1e-2, "tolerance": 1e-10}),
+    "PreparedSystem.shoot": (
+        _prepared_shoot,
+        {"t_end": 1e-2, "tolerance": 1e-10, "forcing_period": 1e-2},
+    ),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (
         vi.hertz_stiffness,
