@@ -247,3 +247,25 @@ def test_an_orbit_at_exact_resonance_is_found_by_every_analysis_that_shoots(
         pytest.approx(amplitude, rel=1e-7)
     )
     assert float(ds["largest_multiplier"].values[1]) == pytest.approx(modulus, rel=1e-7)
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (
+            lambda bad: __import__("vibroimpact").hertz_stiffness(bad, 2e11, 0.3, 2e11, 0.3),
+            "radius",
+        ),
+        (lambda bad: __import__("vibroimpact").cantilever_root(bad), "mode"),
+        (lambda bad: __import__("vibroimpact").check_solver(t_end=bad, method="dopri5"), "t_end"),
+        (lambda bad: __import__("vibroimpact").linear_contact_duration(1.0, bad, 1e6), "main_mass"),
+    ],
+)
+def test_the_core_quotes_a_two_dimensional_array_on_one_line(call: Any, name: str) -> None:
+    import vibroimpact as vi
+
+    # The binding quoted NumPy's repr as it is, its rows on two lines.
+    with pytest.raises(vi.InvalidInputError) as caught:
+        call(np.zeros((2, 2)))
+    message = str(caught.value)
+    assert name in message and "\n" not in message, message

@@ -6,18 +6,31 @@ use pyo3::types::PyBool;
 
 use crate::errors::InvalidInputError;
 
-/// `value` as Python shows it, cut short for a one-line message.
+/// `value` as Python shows it, cut short for a one-line message (a NumPy
+/// array's repr breaks its rows over lines: joined by one space).
 fn shown(value: &Bound<'_, PyAny>) -> String {
     let text = value
         .repr()
         .map(|r| r.to_string())
         .unwrap_or_else(|_| "?".into());
+    let text = one_line(&text);
     if text.chars().count() > 60 {
         let head: String = text.chars().take(57).collect();
         format!("{head}...")
     } else {
         text
     }
+}
+
+/// `text` with each line break, and the blanks around it, as one space.
+fn one_line(text: &str) -> String {
+    if !text.contains('\n') {
+        return text.to_string();
+    }
+    text.split('\n')
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// A whole number >= 1 from a Python int; one too large or too small for the
