@@ -269,3 +269,37 @@ def test_the_core_quotes_a_two_dimensional_array_on_one_line(call: Any, name: st
         call(np.zeros((2, 2)))
     message = str(caught.value)
     assert name in message and "\n" not in message, message
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda bad: __import__("vibroimpact.analyses").analyses.whole_count("n", bad, 1), "n"),
+        (
+            lambda bad: __import__("vibroimpact.maps").maps.bifurcation(
+                {"structure": {}}, "a.b", [1.0], sample=bad
+            ),
+            "sample",
+        ),
+        (
+            lambda bad: __import__("vibroimpact").simulate_system(
+                {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0},
+                method="dopri5",
+                t_end=0.1,
+                initial=bad,
+            ),
+            "[initial]",
+        ),
+    ],
+)
+def test_an_array_for_a_count_a_choice_or_a_table_is_one_line_naming_it(
+    call: Any, name: str
+) -> None:
+    import vibroimpact as vi
+
+    # A count or a choice quoted NumPy's repr over two lines; [initial] as an array
+    # had raised NumPy's "truth value of an array is ambiguous" (a bare ValueError).
+    with pytest.raises(vi.InvalidInputError) as caught:
+        call(np.zeros((2, 2)))
+    message = str(caught.value)
+    assert message.startswith(name) and "\n" not in message, message

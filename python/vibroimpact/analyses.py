@@ -640,7 +640,7 @@ def whole_count(name: str, value: Any, low: int) -> int:
     if isinstance(value, np.integer):
         value = int(value)
     if not isinstance(value, int) or isinstance(value, bool) or value < low:
-        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {value!r}")
+        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {shown(value)}")
     return value
 
 

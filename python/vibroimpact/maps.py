@@ -120,7 +120,7 @@ def _check_pair(run: Runner, sample: str, pair: str | None) -> None:
         if pair not in names:
             raise AnalysisError(
                 f"pair: must name one of the scenario's pairs ({', '.join(names) or 'none'}), "
-                f"got {pair!r}"
+                f"got {shown(pair)}"
             )
         if sample == "displacement":
             raise AnalysisError('pair: only for sample = "impact-velocity" or "impact-phase"')
@@ -170,7 +170,7 @@ def bifurcation(
         raise AnalysisError(
             "sample: must be one of "
             + ", ".join(f'"{name}"' for name in BIFURCATION_SAMPLES)
-            + f", got {sample!r}"
+            + f", got {shown(sample)}"
         )
     legs = _legs(direction, [float(v) for v in values])
     points: list[BifurcationPoint] = []

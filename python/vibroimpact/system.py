@@ -940,9 +940,10 @@ def prepare_system(
     except RecursionError:
         # Arrays nested thousands deep: no structure has them.
         raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
-    init = _table("[initial] ", initial or {}, _INITIAL)
+    # "is None", not "or": an array given for a table has no truth value.
+    init = _table("[initial] ", {} if initial is None else initial, _INITIAL)
     solver = _table("[solver] ", solver, _SOLVER)
-    output = _table("[output] ", output or {}, _OUTPUT)
+    output = _table("[output] ", {} if output is None else output, _OUTPUT)
     _choice("[solver] ", "method", solver["method"], _METHODS)
     for key in ("t_end", "rtol", "atol", "energy_tolerance"):
         if not solver[key] > 0:
