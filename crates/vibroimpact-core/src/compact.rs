@@ -448,6 +448,8 @@ impl Compact {
         // Whether `stages[0]` holds the rates at the step's start (the last
         // step's release test evaluated them there).
         let mut start_valid = false;
+        // In a register through the loop, written back after it.
+        let mut sampler = f.energy_sampler;
         loop {
             if f.accepted >= f.max_accepted {
                 f.limited = true;
@@ -567,7 +569,7 @@ impl Compact {
                 start_gaps[w] = end_gaps[w];
             }
             let check = f.accepted % ENERGY_INTERVAL == 0;
-            if check || f.energy_sampler.due(f.time) {
+            if check || sampler.due(f.time) {
                 if let Err(failure) = check_balance(
                     system,
                     &y[..len],
@@ -584,6 +586,7 @@ impl Compact {
                 }
             }
         }
+        f.energy_sampler = sampler;
         f.y[..len].copy_from_slice(&y[..len]);
         f.gaps[..count].copy_from_slice(&start_gaps[..count]);
     }
