@@ -20,23 +20,28 @@ from vibroimpact._core import InvalidInputError
 from vibroimpact.messages import shown
 from vibroimpact.system import _FIXED_STEP, linear_parts
 
+# Fastest modes by the sections that fix M and K (see fastest_mode), a few at a time.
+_FASTEST: dict[str, float] = {}
+
 
 def fastest_mode(data: Mapping[str, Any], base_dir: Path | None = None) -> float:
     """The highest natural frequency (Hz) of the system between contacts (structure and
     dampers, ``M x'' + K x = 0``); 0 where nothing is held by a spring."""
-    parts = linear_parts(
-        data["structure"],
-        damper=data.get("damper", ()),
-        stop=data.get("stop", ()),
-        gravity=data.get("gravity"),
-        excitation=data.get("excitation", ()),
-        base_dir=base_dir,
-    )
-    # M = L L^T: the eigenvalues of L^-1 K L^-T are w^2.
-    lower = np.linalg.cholesky(parts["mass"])
-    inverse = np.linalg.inv(lower)
-    squares = np.linalg.eigvalsh(inverse @ parts["stiffness"] @ inverse.T)
-    return math.sqrt(max(float(squares[-1]), 0.0)) / (2 * math.pi)
+    structure, damper, stop = data["structure"], data.get("damper", ()), data.get("stop", ())
+    # M and K come from these sections alone (no file), and a sweep asks at every point
+    # for the same ones: parsing them again had been a tenth of an FRF's time. Only
+    # plain values are keyed by their repr (NumPy's rounds and elides).
+    key = repr((structure, damper, stop))
+    if "array(" in key or key not in _FASTEST:
+        parts = linear_parts(structure, damper=damper, stop=stop, base_dir=base_dir)
+        # M = L L^T: the eigenvalues of L^-1 K L^-T are w^2.
+        lower = np.linalg.cholesky(parts["mass"])
+        inverse = np.linalg.inv(lower)
+        squares = np.linalg.eigvalsh(inverse @ parts["stiffness"] @ inverse.T)
+        if len(_FASTEST) >= 64:
+            _FASTEST.clear()
+        _FASTEST[key] = math.sqrt(max(float(squares[-1]), 0.0)) / (2 * math.pi)
+    return _FASTEST[key]
 
 
 def check_forcing_period(
