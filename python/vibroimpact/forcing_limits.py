@@ -2,9 +2,14 @@
 in each period of the structure's fastest mode, so a forcing period of more than
 ``max_steps`` of those is beyond it (a sweep from 1e-300 Hz had failed each point as a
 numerical blow-up advising a smaller dt); a fixed-step run takes ``period / dt`` steps
-whatever the modes (an implicit method is stable on a mode far faster than its step).
-Refused when the analysis is set up, naming the frequency and the lowest one a run can
-take. SI units.
+whatever the modes (an implicit method is stable on a mode far faster than its step),
+and needs two steps a period to see the forcing at all. An adaptive or exact run judges
+positions to ``atol``: a forcing that moves the structure by less than ``atol`` a period
+is not resolved (a 5 Hz oscillator forced at 1e9 Hz had failed its energy balance), and a
+body on no spring is resolved only while the round-off of the run's times stays below
+the time its largest acceleration takes to move it by ``atol`` (a ball on a table at
+1e-20 Hz had failed as 'step size too small', at 1e-300 Hz as a blow-up). Refused when
+the analysis is set up, naming the frequency and the range a run can take. SI units.
 """
 
 from __future__ import annotations
@@ -18,55 +23,120 @@ import numpy as np
 
 from vibroimpact._core import InvalidInputError
 from vibroimpact.messages import shown
+from vibroimpact.run_scales import highest_frequency
 from vibroimpact.system import _FIXED_STEP, linear_parts
 
-# Fastest modes by the sections that fix M and K (see fastest_mode), a few at a time.
-_FASTEST: dict[str, float] = {}
+# The relative round-off of a run's times (float64).
+_TIME_ROUND_OFF = float(np.finfo(float).eps)
+
+
+def _parts(data: Mapping[str, Any], base_dir: Path | None) -> dict[str, Any]:
+    return linear_parts(
+        data["structure"],
+        damper=data.get("damper", ()),
+        stop=data.get("stop", ()),
+        gravity=data.get("gravity"),
+        excitation=data.get("excitation", ()),
+        base_dir=base_dir,
+    )
 
 
 def fastest_mode(data: Mapping[str, Any], base_dir: Path | None = None) -> float:
     """The highest natural frequency (Hz) of the system between contacts (structure and
     dampers, ``M x'' + K x = 0``); 0 where nothing is held by a spring."""
-    structure, damper, stop = data["structure"], data.get("damper", ()), data.get("stop", ())
-    # M and K come from these sections alone (no file), and a sweep asks at every point
-    # for the same ones: parsing them again had been a tenth of an FRF's time. Only
-    # plain values are keyed by their repr (NumPy's rounds and elides).
-    key = repr((structure, damper, stop))
-    if "array(" in key or key not in _FASTEST:
-        parts = linear_parts(structure, damper=damper, stop=stop, base_dir=base_dir)
-        # M = L L^T: the eigenvalues of L^-1 K L^-T are w^2.
-        lower = np.linalg.cholesky(parts["mass"])
-        inverse = np.linalg.inv(lower)
-        squares = np.linalg.eigvalsh(inverse @ parts["stiffness"] @ inverse.T)
-        if len(_FASTEST) >= 64:
-            _FASTEST.clear()
-        _FASTEST[key] = math.sqrt(max(float(squares[-1]), 0.0)) / (2 * math.pi)
-    return _FASTEST[key]
+    parts = _parts(data, base_dir)
+    return highest_frequency(parts["mass"], parts["stiffness"])
+
+
+def _accelerations(parts: Mapping[str, Any]) -> tuple[float, float]:
+    """The largest acceleration amplitude (m/s^2) the harmonic loads give a coordinate
+    (``M^-1`` times the load) and the largest the constant load (gravity) gives."""
+    inverse = np.linalg.inv(parts["mass"])
+    forcing = 0.0
+    for load in parts["harmonics"]:
+        if load["omega"] > 0:
+            shape = np.asarray(load["shape"], dtype=float)
+            forcing = max(forcing, abs(load["amplitude"]) * float(np.max(np.abs(inverse @ shape))))
+    constant = np.asarray(parts["constant"], dtype=float)
+    weight = float(np.max(np.abs(inverse @ constant))) if constant.size else 0.0
+    return forcing, weight
+
+
+def _refuse(period: float, reason: str, advice: str) -> InvalidInputError:
+    return InvalidInputError(f"forcing frequency {shown(1 / period)} Hz: {reason}; {advice}")
+
+
+def _check_fixed_step(period: float, dt: float, max_steps: int) -> None:
+    if period / dt > max_steps:
+        raise _refuse(
+            period,
+            f"its period, {period:.6g} s, takes {period / dt:.3g} steps of dt = {shown(dt)} s, "
+            f"more than a run's max_steps ({max_steps})",
+            f"set the [[excitation]] frequency to at least {1 / (max_steps * dt):.3g} Hz",
+        )
+    if period < 2 * dt:
+        # Fewer than two steps a period: the steps sample the forcing below its Nyquist rate.
+        raise _refuse(
+            period,
+            f"its period, {period:.6g} s, is shorter than two steps of dt = {shown(dt)} s",
+            f"set the [[excitation]] frequency to at most {1 / (2 * dt):.3g} Hz, or reduce "
+            f"dt below {period / 20:.3g} s",
+        )
 
 
 def check_forcing_period(
     data: Mapping[str, Any], period: float, max_steps: int, base_dir: Path | None = None
 ) -> None:
-    """Refuse a forcing ``period`` (s) that spans more than ``max_steps`` periods of the
-    system's fastest mode (more than ``max_steps`` steps of ``dt`` for a fixed-step
-    method): no run can step through one of them."""
+    """Refuse a forcing ``period`` (s) no run can step through: for a fixed-step method,
+    more than ``max_steps`` steps of ``dt`` or fewer than two; for an adaptive or exact
+    one, more than ``max_steps`` periods of the system's fastest mode, a forcing moving
+    the structure less than ``atol`` a period, or (a body on no spring) a period whose
+    times' round-off exceeds the time its largest acceleration takes to move it by
+    ``atol``."""
     solver = data.get("solver", {})
     if solver.get("method") in _FIXED_STEP:
         # Checked by the run's own settings: a fixed step is given.
-        dt = float(solver["dt"])
-        if period / dt > max_steps:
-            raise InvalidInputError(
-                f"forcing frequency {shown(1 / period)} Hz: its period, {period:.6g} s, "
-                f"takes {period / dt:.3g} steps of dt = {shown(dt)} s, more than a run's "
-                f"max_steps ({max_steps}); give a frequency of at least "
-                f"{1 / (max_steps * dt):.3g} Hz"
-            )
+        _check_fixed_step(period, float(solver["dt"]), max_steps)
         return
-    highest = fastest_mode(data, base_dir)
+    parts = _parts(data, base_dir)
+    highest = highest_frequency(parts["mass"], parts["stiffness"])
+    atol = float(solver.get("atol", 1e-12))
+    forcing, weight = _accelerations(parts)
+    largest = max(forcing, weight)
+    # A free body: no mode sets its time scale, so the one the run must resolve is the
+    # time its largest acceleration takes to move it by atol.
+    resolved = math.sqrt(2 * atol / largest) if highest == 0 and largest > 0 else math.inf
+    lowest = max(highest / max_steps, _TIME_ROUND_OFF / resolved)
+    top = math.sqrt(forcing / atol) / (2 * math.pi) if forcing > 0 else math.inf
+    works = (
+        f"set the [[excitation]] frequency to at least {lowest:.3g} Hz"
+        if top == math.inf
+        else f"set the [[excitation]] frequency to at least {lowest:.3g} Hz and at most "
+        f"{top:.3g} Hz"
+    )
     if highest > 0 and period * highest > max_steps:
-        raise InvalidInputError(
-            f"forcing frequency {shown(1 / period)} Hz: its period, {period:.6g} s, spans "
-            f"{period * highest:.3g} periods of the system's fastest mode ({highest:.6g} Hz), "
-            f"more than a run's max_steps ({max_steps}) steps through; give a frequency of at "
-            f"least {highest / max_steps:.3g} Hz"
+        raise _refuse(
+            period,
+            f"its period, {period:.6g} s, spans {period * highest:.3g} periods of the "
+            f"system's fastest mode ({highest:.6g} Hz), more than a run's max_steps "
+            f"({max_steps}) steps through",
+            works,
+        )
+    if _TIME_ROUND_OFF * period > resolved:
+        raise _refuse(
+            period,
+            f"a body on no spring: the round-off of the run's times, {_TIME_ROUND_OFF:.3g} "
+            f"of the period {period:.3g} s, exceeds the {resolved:.3g} s its largest "
+            f"acceleration ({largest:.3g} m/s^2) takes to move it by atol ({shown(atol)} m)",
+            works,
+        )
+    omega = 2 * math.pi / period
+    # Divided twice: omega^2 overflows beyond 1e154 Hz.
+    moved = forcing / omega / omega
+    if forcing > 0 and moved < atol:
+        raise _refuse(
+            period,
+            f"the forcing ({forcing:.3g} m/s^2) moves the structure by {moved:.3g} m a "
+            f"period, below the atol ({shown(atol)} m) a run resolves",
+            works,
         )

@@ -1,0 +1,140 @@
+"""Forcing frequencies and natural periods a run cannot resolve are refused up front,
+naming what to change (issue 23: a sweep from 1e-300 Hz had failed each point as a
+blow-up advising a smaller dt; a free body had no bound at all)."""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from vibroimpact import InvalidInputError
+from vibroimpact.analyses import runner
+from vibroimpact.system import prepare_system
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def _ball(frequency: float, method: str) -> dict[str, Any]:
+    data = tomllib.loads((EXAMPLES / "bouncing_ball_table.toml").read_text())
+    data["excitation"][0]["frequency"] = frequency
+    data["solver"]["method"] = method
+    return data
+
+
+def _oscillator(frequency: float, method: str) -> dict[str, Any]:
+    """The issue's 5 Hz oscillator, forced by 1 N."""
+    return {
+        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 986.96044, "damping": 0.6283},
+        "excitation": [
+            {
+                "kind": "force",
+                "signal": "harmonic",
+                "amplitude": 1.0,
+                "frequency": frequency,
+                "at": 0,
+            }
+        ],
+        "solver": {"method": method, "t_end": 2.0, "dt": 1e-3},
+    }
+
+
+@pytest.mark.parametrize("method", ["dop853", "exact"])
+@pytest.mark.parametrize("frequency", [1e-300, 1e-100, 1e-20, 1e-12])
+def test_a_free_body_forced_too_slowly_is_refused_naming_the_frequency(
+    frequency: float, method: str
+) -> None:
+    # The ball's time scale: gravity and the table (11.772 m/s^2) move it by atol = 1e-12 m
+    # in sqrt(2e-12 / 11.772) = 4.12e-7 s; the run's times keep that to 4.12e-7 / 2.22e-16
+    # s, 5.39e-10 Hz. dop853 had failed as "step size too small" at 1e-20 Hz.
+    with pytest.raises(
+        InvalidInputError,
+        match=rf"frequency {frequency!r} Hz.*at least 5\.39e-10 Hz and at most 5\.46e\+05 Hz",
+    ):
+        runner(_ball(frequency, method))
+
+
+@pytest.mark.parametrize("method", ["dop853", "exact"])
+def test_a_free_body_forced_too_fast_is_refused(method: str) -> None:
+    # 11.772 / (2 pi 1e6)^2 = 2.98e-13 m a period, below atol.
+    with pytest.raises(InvalidInputError, match=r"forcing frequency 1000000\.0 Hz.*2\.98e-13 m"):
+        runner(_ball(1e6, method))
+
+
+@pytest.mark.parametrize("frequency", [1e-9, 10.0, 1e5])
+def test_a_free_body_in_range_is_accepted(frequency: float) -> None:
+    assert runner(_ball(frequency, "dop853")).period == pytest.approx(1 / frequency)
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "dopri5", "rk4"])
+@pytest.mark.parametrize("frequency", [1e9, 1e300])
+def test_an_oscillator_forced_beyond_what_the_method_resolves_is_refused(
+    frequency: float, method: str
+) -> None:
+    # exact had blown up advising "reduce dt", dop853 and rk4 failed the energy balance.
+    with pytest.raises(InvalidInputError, match=r"forcing frequency \S+ Hz: .*(atol|two steps)"):
+        runner(_oscillator(frequency, method))
+
+
+def test_an_oscillator_forced_in_range_is_accepted() -> None:
+    for method in ("exact", "dop853", "rk4"):
+        assert runner(_oscillator(5.0, method)).period == pytest.approx(0.2)
+    assert runner(_oscillator(1e4, "dop853")).period == pytest.approx(1e-4)
+
+
+def test_the_sweep_command_refuses_a_free_body_at_1e_300_hz(tmp_path: Path) -> None:
+    text = (EXAMPLES / "bouncing_ball_table.toml").read_text()
+    text = text.replace("frequency = 10.0", "frequency = 1e-300").replace(
+        'method = "exact"', 'method = "dop853"'
+    )
+    text += (
+        '\n[sweep]\nparameter = "excitation.0.frequency"\nstart = 1e-300\nstop = 1e-300\n'
+        "count = 1\nsettle_periods = 10\nrecord_periods = 5\n"
+    )
+    path = tmp_path / "ball.toml"
+    path.write_text(text)
+    for command in ("sweep", "bifurcation"):
+        done = subprocess.run(
+            [sys.executable, "-m", "vibroimpact", command, str(path)],
+            capture_output=True,
+            text=True,
+            timeout=50,
+        )
+        assert done.returncode == 2, done.stdout + done.stderr
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and "forcing frequency 1e-300 Hz" in lines[0]
+
+
+@pytest.mark.parametrize("method", ["dop853", "rk4"])
+@pytest.mark.parametrize("change", [{"mass": 1e-300}, {"stiffness": 1e308}])
+def test_a_natural_period_the_run_cannot_resolve_is_refused(
+    change: dict[str, float], method: str
+) -> None:
+    # mass 1e-300 kg: a 5e150 Hz mode; dop853 had blown up advising "reduce dt", or filled
+    # max_rows after seconds.
+    data = _oscillator(5.0, method)
+    data["structure"].update(change)
+    key = r"\[solver\] dt: the fastest mode" if method == "rk4" else r"\[solver\] t_end = 2\.0 s"
+    with pytest.raises(InvalidInputError, match=key + r".*max_steps|" + key + r".*below dt"):
+        prepare_system(
+            data["structure"],
+            excitation=data["excitation"],
+            solver={**data["solver"], "method": method},
+        )
+
+
+def test_a_resolvable_natural_period_runs() -> None:
+    # 5 Hz for 2 s: 10 periods; rk4 at dt = 1e-3 s takes 200 steps a period.
+    data = _oscillator(5.0, "rk4")
+    prepare_system(data["structure"], excitation=data["excitation"], solver=data["solver"])
+    copy.deepcopy(data)["solver"]["method"] = "dop853"
+    prepare_system(
+        data["structure"],
+        excitation=data["excitation"],
+        solver={**data["solver"], "method": "dop853"},
+    )
