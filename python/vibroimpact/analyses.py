@@ -235,7 +235,7 @@ class Runner:
             )
         try:
             raw = self.system().run(
-                [float(v) for v in z],
+                np.asarray(z, dtype=float).tolist(),
                 t_end,
                 record_from=0.0 if record else None,
                 strobe_period=self.period if strobe else None,
@@ -267,6 +267,13 @@ class Runner:
         """Run ``count`` forcing periods from ``state``."""
         state = arguments.state("state", state, 2 * (self.n + self.k))  # type: ignore[assignment]
         check_periods("", "periods", whole_count("periods", count, 1), 1)
+        return self._periods(state, count, record=record, strobe=strobe)
+
+    def _periods(
+        self, state: np.ndarray | None, count: int, *, record: bool = False, strobe: bool = False
+    ) -> dict[str, Any]:
+        """:meth:`periods` of a state and count already checked (the loops of
+        :meth:`map` and of a response recorded period by period)."""
         width = 1 + 2 * (self.n + self.k)
         if strobe and count * width * 8 > MAX_RECORD_BYTES:
             # A state a period: known before the run, as a fixed-step history is.
@@ -282,11 +289,12 @@ class Runner:
         at a time: a run keeps its contacts, which settling never reads (ten million
         periods of a bouncing ball had kept 20 million, 1.6 GB, up to the row limit)."""
         check_periods("", "periods", whole_count("periods", count, 1), 1)
-        z = state
+        z = arguments.state("state", state, 2 * (self.n + self.k))
         for start in range(0, count, SETTLE_CHUNK):
             z = np.asarray(
-                self.periods(z, min(SETTLE_CHUNK, count - start))["final_state"], dtype=float
+                self._periods(z, min(SETTLE_CHUNK, count - start))["final_state"], dtype=float
             )
+        assert z is not None  # count >= 1: the loop ran
         return z
 
     def shoot(
@@ -354,7 +362,7 @@ def _recorded_by_period(
     kinds: list[str] = []
     z = state
     for _ in range(count):
-        raw = run.periods(z, 1, record=True)
+        raw = run._periods(z, 1, record=True)
         peaks.append(np.asarray(raw["peaks"], dtype=float))
         squares = squares + np.asarray(raw["square_integrals"], dtype=float)
         time += float(raw["recorded_time"])

@@ -103,6 +103,15 @@ def positive(name: str, value: Any) -> float:
 
 def numbers(name: str, value: Any) -> np.ndarray:
     """A one-dimensional array of finite numbers (a list, a tuple or a 1-D array)."""
+    if (
+        type(value) is np.ndarray
+        and value.dtype == np.float64
+        and value.ndim == 1
+        and math.isfinite(value.sum())
+    ):
+        # The analyses' own states, checked once a run (a finite sum has no NaN or
+        # infinity in it; an overflowing one goes the long way).
+        return value
     if isinstance(value, str | bytes | Mapping) or not _sequence(value):
         raise InvalidInputError(
             f"{name}: must be a list or 1-D array of numbers, got {shown(value)}"
@@ -119,9 +128,9 @@ def numbers(name: str, value: Any) -> np.ndarray:
         out = np.empty(len(array))
         for i, v in enumerate(array):
             out[i] = number(f"{name}[{i}]", v)
-    bad = np.flatnonzero(~np.isfinite(out))
-    if bad.size:
-        i = int(bad[0])
+    finite = np.isfinite(out)
+    if not finite.all():
+        i = int(np.flatnonzero(~finite)[0])
         raise InvalidInputError(f"{name}[{i}]: must be a finite number, got {shown(out[i])}")
     return out
 
