@@ -261,3 +261,49 @@ def test_a_study_counts_impacts_over_whole_orbits(tmp_path: Path) -> None:
             k == "impact" and 200 <= t < 216 for k, t in zip(contacts["kind"], onsets, strict=True)
         ]
         assert per_period == sum(whole) / 16, x0
+
+
+@pytest.mark.parametrize("record", [1, 7])
+def test_a_study_recording_less_than_an_orbit_counts_a_whole_one(
+    tmp_path: Path, record: int
+) -> None:
+    # record_periods below the orbit's 8 periods had counted part of it: 1.857 to
+    # 3.571 a period from one attractor with 7, 1 to 14 with 1. A steady-state study
+    # records at least 8 periods; its count is the one steady_state gives.
+    text = (
+        BASINS.read_text().split("[basins]")[0].replace("amplitude = 11.772", "amplitude = 16.677")
+    )
+    starts = [0.0, 0.0015, 0.003, 0.015]
+    text += (
+        '[study]\nanalysis = "steady-state"\nsettle_periods = 200\n'
+        f'record_periods = {record}\nmetrics = ["amplitude", "impacts_per_period", "settled"]\n'
+        f'[study.axes]\n"initial.structure_displacement.0" = {starts}\n'
+        '"initial.structure_velocity.0" = [0.16]\n'
+    )
+    study = load_study(tmp_path / "s.toml", text)
+    ds = st.run(study, tmp_path / "s.nc")
+    run = an.runner({k: v for k, v in study.data.items() if k != "study"})
+    amplitudes = ds["amplitude"].values.ravel()
+    assert np.ptp(amplitudes) < 1e-9 * amplitudes[0]  # one orbit
+    for x0, per_period in zip(starts, ds["impacts_per_period"].values.ravel(), strict=True):
+        steady = an.steady_state(
+            run, np.array([x0, 0.16]), settle_periods=200, record_periods=record
+        )
+        assert steady.period == 8
+        assert per_period == steady.impacts_per_period, x0
+
+
+def test_a_free_bodys_impacts_do_not_depend_on_the_runs_length() -> None:
+    # A ball on no spring: the time below which its chatter is summed had been a
+    # millionth of the run's length, so the same period-8 orbit (its strobe the same
+    # to 1e-15) counted 31, 30 and 28 impacts per 8 periods in runs of 8, 16 and 56.
+    data = tomllib.loads(BASINS.read_text())
+    data["excitation"][0]["amplitude"] = 16.677
+    run = an.runner(data)
+    z = run.map(np.array([0.015, 0.16]), 200)
+    assert np.allclose(run.map(z, 8), z, rtol=0, atol=1e-12)  # a period-8 orbit
+    counts = set()
+    for orbits in (1, 2, 7, 20):
+        kinds = run.periods(z, 8 * orbits)["contacts"]["kind"]
+        counts.add(sum(kind == "impact" for kind in kinds) / orbits)
+    assert len(counts) == 1, counts

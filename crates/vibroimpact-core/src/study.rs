@@ -762,6 +762,7 @@ fn measured_on(
         Analysis::Run { t_end, record_from } => (t_end, record_from, f64::INFINITY),
         Analysis::SteadyState { settle, record, .. } => {
             let t = period()?;
+            let record = recorded_periods(record);
             ((settle + record) as f64 * t, settle as f64 * t, t)
         }
         Analysis::Orbit { settle, periods } => {
@@ -923,6 +924,14 @@ fn orbit_metrics(
     })
 }
 
+/// The forcing periods a steady-state run records for `record` asked: at
+/// least MAX_PERIOD, so that one whole orbit of any period it may find fits
+/// (impacts per period counted over part of an orbit depend on where the
+/// window ends: a period-8 orbit had given 1, 2, 3 or 14 over one period).
+fn recorded_periods(record: u64) -> u64 {
+    record.max(MAX_PERIOD as u64)
+}
+
 /// The metrics of `sol`, recorded from `record_from` (s); `period` is the
 /// forcing period (s) of a steady-state study.
 fn metrics_of(
@@ -972,11 +981,7 @@ fn metrics_of(
             // Impacts counted over whole periods of the orbit (a window of
             // 20 periods of a period-8 orbit counts part of one).
             let orbit = repeats.map_or(1, |p| p as u64);
-            let whole = if record >= orbit {
-                record / orbit * orbit
-            } else {
-                record
-            };
+            let whole = recorded_periods(record) / orbit * orbit;
             let end = record_from + whole as f64 * period;
             let counted = recorded
                 .iter()

@@ -802,9 +802,17 @@ pub fn integrate_system_within<S: SystemStepper>(
             .map(|it| it.offset.abs())
             .fold(1e-9, f64::max);
     // The time below which a chattering sequence is summed: the step, or a
-    // millionth of the structure's longest period (of the run, without one).
+    // millionth of the structure's longest period; without one (a body on
+    // no spring), of the system's time scale (its forcing period or fall
+    // time), not of the run: a cut-off growing with t_end had counted one
+    // orbit's impacts differently in runs of different lengths.
     let resolution = if adaptive || stepper.is_exact() {
-        1e-6 * t_end.min(system.longest_period)
+        let longest = if system.longest_period.is_finite() {
+            system.longest_period
+        } else {
+            system.time_scale()
+        };
+        1e-6 * t_end.min(longest)
     } else {
         dt
     };
