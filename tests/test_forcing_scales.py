@@ -12,8 +12,9 @@ from typing import Any
 
 import pytest
 
-from vibroimpact import InvalidInputError
+from vibroimpact import InvalidInputError, SimulationError
 from vibroimpact.analyses import runner
+from vibroimpact.maps import bifurcation
 from vibroimpact.system import prepare_system
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -135,3 +136,12 @@ def test_a_resolvable_natural_period_runs() -> None:
             data["structure"], excitation=data["excitation"], solver=data["solver"]
         ).run()
         assert solution.t[-1] == pytest.approx(2.0)
+
+
+def test_a_bifurcation_whose_every_run_fails_is_an_error() -> None:
+    # max_steps = 10: every point's run stops at it; the command had printed
+    # "0 distinct stroboscopic displacement(s) of 0" for each, exit 0.
+    data = _ball(10.0, "dop853")
+    data["solver"]["max_steps"] = 10
+    with pytest.raises(SimulationError, match=r"failed at every value of .*\(2\).*max_steps"):
+        bifurcation(data, "excitation.0.frequency", [10.0, 11.0], settle_periods=1)

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, SimulationError
 from vibroimpact.analyses import (
     BIFURCATION_SAMPLES,
     AnalysisError,
@@ -209,6 +209,14 @@ def bifurcation(
                 points.append(BifurcationPoint(value, leg, strobe, samples=samples))
             if progress is not None:
                 progress(len(points), total)
+    failed = [point for point in points if point.error is not None]
+    if points and len(failed) == len(points):
+        # No point of the diagram: an error, not a diagram of nothing (the command had
+        # printed "0 distinct ... of 0" for each).
+        raise SimulationError(
+            f"bifurcation: the run failed at every value of {parameter} ({len(points)}); "
+            f"at {failed[0].value:g}: {failed[0].error}"
+        )
     return points
 
 
