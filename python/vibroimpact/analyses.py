@@ -665,6 +665,29 @@ def check_total(settle: tuple[str, int], record: tuple[str, int]) -> None:
         )
 
 
+#: The forcing periods a long recording's first stretch runs to estimate its contacts
+#: (:func:`check_kept`); only recordings of ten times as many are estimated.
+PROBE_PERIODS = 1000
+
+
+def check_kept(run: Runner, state: np.ndarray, count: int, name: str) -> None:
+    """Refuse up front a recording of ``count`` periods from ``state`` whose contacts,
+    at the rate of its first :data:`PROBE_PERIODS`, would pass ``[solver] max_rows``
+    (``poincare --settle 0 --periods 10000000`` of a bouncing ball had run 15 s into
+    1.2 GB before the row limit stopped it). ``name`` is the count's name."""
+    if count < 10 * PROBE_PERIODS:
+        return
+    seen = len(run.periods(state, PROBE_PERIODS)["contacts"]["onset"])
+    expected = seen * (count / PROBE_PERIODS)
+    limit = run.prepared.solver["max_rows"]
+    if expected > limit:
+        raise AnalysisError(
+            f"{name} {count}: would keep about {expected:.3g} contacts ({seen / PROBE_PERIODS:g}"
+            f" a period over the first {PROBE_PERIODS}), more than [solver] max_rows ({limit});"
+            f" record at most {int(limit / seen * PROBE_PERIODS)} periods, or raise max_rows"
+        )
+
+
 #: The forcing periods one run of a settling map covers (:meth:`Runner.map`): its
 #: contacts, a few per period, stay well within a run's rows.
 SETTLE_CHUNK = 100_000

@@ -432,7 +432,13 @@ def run_poincare(args: argparse.Namespace) -> int:
     check_total(("--settle", args.settle), ("--periods", args.periods))
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
-    section = poincare(run, settle_periods=args.settle, periods=args.periods)
+    try:
+        section = poincare(run, settle_periods=args.settle, periods=args.periods)
+    except AnalysisError as err:
+        # The recording's contacts refused by the name the command line gives it.
+        if str(err).startswith("periods "):
+            raise AnalysisError(f"--{err}") from None
+        raise
     cpu_time = time.perf_counter() - start
     if args.plot:
         plots.plot_section(args.plot, section, run.period)

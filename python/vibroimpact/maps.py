@@ -20,6 +20,7 @@ from vibroimpact.analyses import (
     BIFURCATION_SAMPLES,
     AnalysisError,
     Runner,
+    check_kept,
     check_total,
     checked_run,
     from_carried,
@@ -62,6 +63,7 @@ def poincare(
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     if settle_periods:
         z = run.map(z, settle_periods)
+    check_kept(run, z, periods, "periods")
     raw = run.periods(z, periods, strobe=True)
     contacts = raw["contacts"]
     onset = np.asarray(contacts["onset"])
