@@ -77,7 +77,9 @@ def test_an_oscillator_forced_beyond_what_the_method_resolves_is_refused(
     frequency: float, method: str
 ) -> None:
     # exact had blown up advising "reduce dt", dop853 and rk4 failed the energy balance.
-    with pytest.raises(InvalidInputError, match=r"forcing frequency \S+ Hz: .*(atol|two steps)"):
+    with pytest.raises(
+        InvalidInputError, match=r"frequency \S+ Hz.*(atol|two steps|exact flow steps)"
+    ):
         runner(_oscillator(frequency, method))
 
 
@@ -145,3 +147,25 @@ def test_a_bifurcation_whose_every_run_fails_is_an_error() -> None:
     data["solver"]["max_steps"] = 10
     with pytest.raises(SimulationError, match=r"failed at every value of .*\(2\).*max_steps"):
         bifurcation(data, "excitation.0.frequency", [10.0, 11.0], settle_periods=1)
+
+
+@pytest.mark.parametrize("method", ["rk4", "newmark-implicit", "generalized-alpha", "exact"])
+def test_simulate_refuses_a_forcing_its_steps_cannot_follow(method: str) -> None:
+    # The 5 Hz oscillator forced at 1e9 Hz: rk4 at dt = 1e-3 s had reported 1.1e-4 J stored
+    # (aliased; the truth is ~1e-40 J), exact filled max_rows by t = 2.5e-3 s.
+    data = _oscillator(1e9, method)
+    if method == "exact":
+        del data["solver"]["dt"]
+    expected = r"t_end = 2\.0 s spans 2e\+09" if method == "exact" else r"below two steps"
+    with pytest.raises(
+        InvalidInputError, match=r"\[\[excitation\]\] 0: frequency 1000000000\.0 Hz.*" + expected
+    ):
+        prepare_system(data["structure"], excitation=data["excitation"], solver=data["solver"])
+
+
+def test_simulate_keeps_an_adaptive_first_step_and_a_followed_forcing() -> None:
+    # dop853's dt is only its first step; 400 Hz at dt = 1e-3 s has 2.5 steps a period.
+    for method, frequency in (("dop853", 1e9), ("rk4", 400.0), ("exact", 4e8)):
+        data = _oscillator(frequency, method)
+        data["solver"].pop("dt") if method == "exact" else None
+        prepare_system(data["structure"], excitation=data["excitation"], solver=data["solver"])

@@ -72,3 +72,46 @@ def check_natural_period(
             f"{solver['max_steps'] / frequency:.3g} s, raise max_steps, or check mass and "
             "stiffness",
         )
+
+
+def _harmonic_frequencies(excitation: Any) -> list[tuple[int, float]]:
+    """Each checked excitation's harmonic frequencies (Hz), with its index."""
+    found: list[tuple[int, float]] = []
+    for index, table in enumerate(excitation or ()):
+        if table.get("signal") == "harmonic":
+            found.append((index, float(table["frequency"])))
+        elif table.get("signal") == "harmonics":
+            found.extend((index, float(f)) for f in table["frequencies"])
+    return found
+
+
+def check_forcing_steps(
+    solver: Mapping[str, Any],
+    excitation: Any,
+    fixed_step: bool,
+    fail: Callable[[str, str], Exception],
+) -> None:
+    """Refuse a harmonic forcing the run's steps cannot follow: a fixed step samples it
+    below two steps a period (its result aliased: rk4 at dt = 1e-3 s had reported 1e-4 J
+    stored from a 1e9 Hz force whose true response holds 1e-40 J), and the exact flow
+    steps at least once in each of its periods, so ``t_end`` spanning more than
+    ``max_steps`` of them is beyond it (it had filled max_rows by t = 2.5e-3 s).
+    ``fixed_step``: the method steps by ``dt`` (an adaptive method's is its first step)."""
+    method = solver["method"]
+    for index, frequency in _harmonic_frequencies(excitation):
+        where = f"[[excitation]] {index}: "
+        if fixed_step and frequency * 2 * solver["dt"] > 1:
+            raise fail(
+                where,
+                f"frequency {shown(frequency)} Hz is sampled below two steps of dt = "
+                f"{shown(solver['dt'])} s a period: give at most {1 / (2 * solver['dt']):.3g} "
+                f"Hz, or reduce dt below {1 / (20 * frequency):.3g} s",
+            )
+        if method == "exact" and frequency * solver["t_end"] > solver["max_steps"]:
+            raise fail(
+                where,
+                f"frequency {shown(frequency)} Hz: t_end = {shown(solver['t_end'])} s spans "
+                f"{frequency * solver['t_end']:.3g} of its periods, and the exact flow steps "
+                f"at least once in each: more than max_steps ({solver['max_steps']}); give at "
+                f"most {solver['max_steps'] / solver['t_end']:.3g} Hz or shorten t_end",
+            )

@@ -61,7 +61,7 @@ from vibroimpact._core import simulate_system as _simulate_system
 from vibroimpact.arguments import directory, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.record_file import check_record, read_record
-from vibroimpact.run_scales import check_natural_period, highest_frequency
+from vibroimpact.run_scales import check_forcing_steps, check_natural_period, highest_frequency
 from vibroimpact.summary import contacts_repr, solution_repr
 
 __all__ = [
@@ -978,6 +978,7 @@ def prepare_system(
             f"({solver['max_steps']}): raise dt or max_steps, or shorten t_end",
         )
     check_natural_period(solver, lambda: _fastest_mode(spec), _fail)
+    check_forcing_steps(solver, spec["excitation"], fixed, _fail)
     if stepped and output["history"]:
         # The history of a fixed-step run is known before it starts: refuse it
         # up front rather than stop at the cap.
