@@ -303,3 +303,82 @@ def test_an_array_for_a_count_a_choice_or_a_table_is_one_line_naming_it(
         call(np.zeros((2, 2)))
     message = str(caught.value)
     assert message.startswith(name) and "\n" not in message, message
+
+
+# Follow-up: inputs a verification pass found accepted or wrongly named.
+
+
+def test_an_absurd_atol_is_refused_with_its_range() -> None:
+    import vibroimpact as vi
+
+    oscillator = {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0}
+    for atol in (1e300, 1.5):
+        with pytest.raises(vi.InvalidInputError, match=r"^\[solver\] atol: must be in \(0, 1\]"):
+            vi.simulate_system(oscillator, t_end=1.0, method="dop853", atol=atol)
+        # The two-body run's (the core's settings).
+        with pytest.raises(vi.InvalidInputError, match=r"atol.*in \(0, 1\]"):
+            vi.simulate(
+                vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01),
+                vi.Contact("hertz", stiffness=3000.0, damping=0.01),
+                vi.InitialState(impact_displacement=0.01, impact_velocity=0.1),
+                t_end=0.01,
+                method="dop853",
+                atol=atol,
+            )
+    assert vi.simulate_system(oscillator, t_end=0.1, method="dop853", atol=1.0).t[-1] == 0.1
+
+
+def _ball_runner() -> Any:
+    import tomllib
+
+    from vibroimpact import analyses as an
+
+    root = Path(__file__).resolve().parents[1]
+    return an.runner(tomllib.loads((root / "examples" / "ball_table_basins.toml").read_text()))
+
+
+@pytest.mark.parametrize(
+    ("call", "wanted"),
+    [
+        (lambda run, z: run.periods(z, None), r"^count: must be a whole number >= 1, got None"),
+        (lambda run, z: run.periods(z, True), r"^count: must be a whole number >= 1, got True"),
+        (lambda run, z: run.map(z, None), r"^count: must be a whole number >= 1, got None"),
+        (lambda run, z: run.shoot(z, None, 1e-9, 5), r"^count: must be a whole number"),
+        (lambda run, z: run.periods(z, 1, record="x"), r"^record: must be True or False, got 'x'"),
+        (lambda run, z: run.periods(z, 1, strobe=1), r"^strobe: must be True or False, got 1"),
+        (lambda run, z: run.amplitudes(None), r"^recorded: must be a Mapping"),
+        (lambda run, z: run.rms(None), r"^recorded: must be a Mapping"),
+    ],
+)
+def test_a_runners_arguments_are_refused_by_their_names(call: Any, wanted: str) -> None:
+    import vibroimpact as vi
+
+    run = _ball_runner()
+    with pytest.raises(vi.InvalidInputError, match=wanted):
+        call(run, run.initial_state())
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda vi: vi.cantilever_root(True),
+        lambda vi: vi.cantilever_mode_shape(1.0, True, 0.5),
+        lambda vi: vi.cantilever_mode_shape(1.0, 1, 0.5, derivative=True),
+        lambda vi: vi.cantilever_mode(1.0, 1.0, 1.0, 1.0, 1.0, mode=True),
+    ],
+)
+def test_a_boolean_is_not_a_whole_number(call: Any) -> None:
+    # True is the int 1 to Python: it had been taken as mode 1 (or derivative 1).
+    import vibroimpact as vi
+
+    with pytest.raises(vi.InvalidInputError, match=r"(mode|derivative) must be .*got True"):
+        call(vi)
+
+
+@pytest.mark.parametrize("csv", ["0,1\n1e-320,1\n", "-1e-320,0\n0,1\n5,0\n"])
+def test_samples_too_close_to_interpolate_are_refused_naming_the_line(
+    tmp_path: Path, csv: str
+) -> None:
+    # 0 then 1e-320 s (a subnormal interval) had failed the run's energy ledger (exit 1).
+    message = _record_error(tmp_path, "time,value\n" + csv)
+    assert "rec.csv line 3:" in message and "samples must be at least 2.23e-308 s apart" in message

@@ -374,7 +374,9 @@ def test_a_continuation_step_of_1e300_is_refused_on_the_command_line(
     lines = ["step = 1e300" if line.startswith("step =") else line for line in text.splitlines()]
     assert "step = 1e300" in lines
     (tmp_path / "c.toml").write_text("\n".join(lines) + "\n")
-    refused(run_cli("continue", "c.toml"), "c.toml: step: must be in [", "got 1e+300")
+    refused(
+        run_cli("continue", "c.toml"), "c.toml: [continuation] step: must be in [", "got 1e+300"
+    )
 
 
 @pytest.mark.parametrize(
@@ -622,11 +624,11 @@ def test_study_and_runner_helpers_refuse_wrong_types_naming_the_argument() -> No
     calls: list[tuple[str, Callable[[], Any]]] = [
         ("out", lambda: study.output_kind(None)),  # type: ignore[arg-type]
         ("study", lambda: study.chunk_part(None, 0, 1)),  # type: ignore[arg-type]
-        ("periods", lambda: run.periods(run.initial_state(), None)),  # type: ignore[arg-type]
-        ("periods", lambda: run.periods(run.initial_state(), 2.5)),  # type: ignore[arg-type]
-        ("periods", lambda: run.map(run.initial_state(), "3")),  # type: ignore[arg-type]
+        ("count", lambda: run.periods(run.initial_state(), None)),  # type: ignore[arg-type]
+        ("count", lambda: run.periods(run.initial_state(), 2.5)),  # type: ignore[arg-type]
+        ("count", lambda: run.map(run.initial_state(), "3")),  # type: ignore[arg-type]
         ("state", lambda: run.periods("x", 1)),  # type: ignore[arg-type]
-        ("periods", lambda: run.shoot(run.initial_state(), None, 1e-9, 3)),  # type: ignore[arg-type]
+        ("count", lambda: run.shoot(run.initial_state(), None, 1e-9, 3)),  # type: ignore[arg-type]
     ]
     for name, call in calls:
         with pytest.raises(vi.InvalidInputError, match=rf"^{name}: "):

@@ -13,6 +13,7 @@ __all__ = [
     "MAX_RECORD_BYTES",
     "MAX_SIGNAL_SAMPLES",
     "RTOL_RANGE",
+    "ATOL_MAX",
     "MAX_ENERGY_TOLERANCE",
     "BeamMode",
     "Contact",
@@ -48,6 +49,7 @@ MAX_RECORD_BYTES: int
 MAX_SIGNAL_SAMPLES: int
 DEFAULT_ENERGY_TOLERANCE: float
 RTOL_RANGE: tuple[float, float]
+ATOL_MAX: float
 MAX_ENERGY_TOLERANCE: float
 MAX_PAIRS: int
 MAX_POINTS: int

@@ -199,10 +199,12 @@ class Runner:
         """The located peaks of a recorded run: of each structure coordinate and of the
         structure at each point (m), and of the bending moment at each of the moments
         (N m)."""
+        arguments.instance("recorded", recorded, Mapping, "Runner.periods(..., record=True)")
         return split_observed(np.asarray(recorded["peaks"], dtype=float), self.n, len(self.points))
 
     def rms(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The RMS values of a recorded run, as :meth:`amplitudes`."""
+        arguments.instance("recorded", recorded, Mapping, "Runner.periods(..., record=True)")
         rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
         return split_observed(rms, self.n, len(self.points))
 
@@ -266,7 +268,8 @@ class Runner:
     ) -> dict[str, Any]:
         """Run ``count`` forcing periods from ``state``."""
         state = arguments.state("state", state, 2 * (self.n + self.k))  # type: ignore[assignment]
-        check_periods("", "periods", whole_count("periods", count, 1), 1)
+        check_periods("", "count", whole_count("count", count, 1), 1)
+        record, strobe = arguments.flag("record", record), arguments.flag("strobe", strobe)
         return self._periods(state, count, record=record, strobe=strobe)
 
     def _periods(
@@ -288,7 +291,7 @@ class Runner:
         """The stroboscopic map over ``count`` periods, run :data:`SETTLE_CHUNK` periods
         at a time: a run keeps its contacts, which settling never reads (ten million
         periods of a bouncing ball had kept 20 million, 1.6 GB, up to the row limit)."""
-        check_periods("", "periods", whole_count("periods", count, 1), 1)
+        check_periods("", "count", whole_count("count", count, 1), 1)
         z = arguments.state("state", state, 2 * (self.n + self.k))
         for start in range(0, count, SETTLE_CHUNK):
             z = np.asarray(
@@ -302,7 +305,7 @@ class Runner:
     ) -> dict[str, Any]:
         """Newton's shooting over ``count`` periods from ``state``, in the core (see
         :func:`orbit`)."""
-        check_periods("", "periods", whole_count("periods", count, 1), 1)
+        check_periods("", "count", whole_count("count", count, 1), 1)
         if len(state) != 2 * (self.n + self.k):
             raise AnalysisError(
                 f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(state)}"

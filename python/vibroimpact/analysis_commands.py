@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -425,6 +426,18 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     return 0
 
 
+@contextmanager
+def _named_as(argument: str, key: str) -> Iterator[None]:
+    """An analysis's refusal of its ``argument`` (the text its message begins with)
+    named as the scenario or command line gives it, ``key``."""
+    try:
+        yield
+    except AnalysisError as err:
+        if str(err).startswith(argument):
+            raise AnalysisError(key + str(err)[len(argument) :]) from None
+        raise
+
+
 def run_poincare(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario)
     check_periods("", "--settle", args.settle, 0)
@@ -432,13 +445,8 @@ def run_poincare(args: argparse.Namespace) -> int:
     check_total(("--settle", args.settle), ("--periods", args.periods))
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
-    try:
+    with _named_as("periods ", "--periods "):
         section = poincare(run, settle_periods=args.settle, periods=args.periods)
-    except AnalysisError as err:
-        # The recording's contacts refused by the name the command line gives it.
-        if str(err).startswith("periods "):
-            raise AnalysisError(f"--{err}") from None
-        raise
     cpu_time = time.perf_counter() - start
     if args.plot:
         plots.plot_section(args.plot, section, run.period)
@@ -530,17 +538,18 @@ def run_continue(args: argparse.Namespace) -> int:
     settings = _section(scenario, "continuation", args.scenario)
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()
-    branch = continue_orbit(
-        scenario.data,
-        settings["parameter"],
-        stop=settings["stop"],
-        periods=settings["periods"],
-        step=settings["step"],
-        max_points=settings["max_points"],
-        tolerance=settings["tolerance"],
-        base_dir=scenario.base_dir,
-        progress=_progress(show),
-    )
+    with _named_as("step: ", "[continuation] step: "):
+        branch = continue_orbit(
+            scenario.data,
+            settings["parameter"],
+            stop=settings["stop"],
+            periods=settings["periods"],
+            step=settings["step"],
+            max_points=settings["max_points"],
+            tolerance=settings["tolerance"],
+            base_dir=scenario.base_dir,
+            progress=_progress(show),
+        )
     if show:
         print(file=sys.stderr)
     cpu_time = time.perf_counter() - start

@@ -93,6 +93,13 @@ def number(name: str, value: Any) -> float:
     return real
 
 
+def flag(name: str, value: Any) -> bool:
+    """True or False (a Python or NumPy boolean; not a string or a number)."""
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidInputError(f"{name}: must be True or False, got {shown(value)}")
+    return bool(value)
+
+
 def positive(name: str, value: Any) -> float:
     """A finite number > 0."""
     real = number(name, value)

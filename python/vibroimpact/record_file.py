@@ -47,6 +47,10 @@ _MEANT_AS_NUMBER = re.compile(r"[+-]?\.?\d")
 # The largest magnitude a sample (times scale) may have: half the largest float, so
 # that the interpolation's differences stay finite (the core's bound).
 _LARGEST = 0.5 * sys.float_info.max
+# The shortest interval between two samples: the smallest normal float (s); only
+# times within _NEAR_ZERO of zero have floats closer than it.
+_SHORTEST = sys.float_info.min
+_NEAR_ZERO = 1e-280
 
 Row = Callable[[int], str]
 
@@ -230,5 +234,21 @@ def check_record(
             where,
             f"{(value_row or row)(i)}: value {shown(v[i])}{scaled} is beyond what a run can take "
             f"(|value{' x scale' if scaled else ''}| at most {_LARGEST:.3e}, half the largest "
+            "float)",
+        )
+    # An interval a normal float: 0 then 1e-320 s (subnormal, two significant digits)
+    # had failed the run's energy ledger. Only times near zero can be so close (an
+    # interval is at least the spacing of floats at its ends); looked for there alone,
+    # so that a long record takes no more memory.
+    near = np.flatnonzero((t > -_NEAR_ZERO) & (t < _NEAR_ZERO))
+    ends = np.union1d(near, near + 1)
+    ends = ends[(ends >= 1) & (ends < len(t))]
+    close = ends[t[ends] - t[ends - 1] < _SHORTEST]
+    if close.size:
+        i = int(close[0])
+        raise _fail(
+            where,
+            f"{row(i)}: time {shown(t[i])} s is {shown(t[i] - t[i - 1])} s after "
+            f"{shown(t[i - 1])} s: samples must be at least {_SHORTEST:.3g} s apart (a normal "
             "float)",
         )

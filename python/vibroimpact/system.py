@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import (
+    ATOL_MAX,
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
     MAX_ENERGY_TOLERANCE,
@@ -954,6 +955,11 @@ def prepare_system(
         raise _fail(
             "[solver] energy_tolerance: ",
             f"must be in (0, {MAX_ENERGY_TOLERANCE:g}], got {solver['energy_tolerance']}",
+        )
+    if not solver["atol"] <= ATOL_MAX:
+        # The core's bound (see its ATOL_MAX): a looser error control controls nothing.
+        raise _fail(
+            "[solver] atol: ", f"must be in (0, {ATOL_MAX:g}] (m, m/s), got {solver['atol']}"
         )
     low, high = RTOL_RANGE
     if not low <= solver["rtol"] <= high:

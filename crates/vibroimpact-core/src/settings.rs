@@ -13,6 +13,13 @@ use crate::steppers::Tolerances;
 pub const RTOL_RANGE: (f64, f64) = (1e-15, 0.1);
 pub const RTOL_ALLOWED: &str = "in [1e-15, 0.1]";
 
+/// The absolute tolerance (`atol`, m and m/s) a method with error control
+/// takes, and its description: an error of a metre (a metre a second)
+/// allowed in every coordinate controls nothing a vibro-impact run could
+/// resolve (1e300 had been accepted). Every check of an atol reads these.
+pub const ATOL_MAX: f64 = 1.0;
+pub const ATOL_ALLOWED: &str = "in (0, 1] (m, m/s)";
+
 /// The largest `energy_tolerance`, and its description. The balance's
 /// residual is measured against the energy in play (all the energy there was
 /// and all the work done); a tolerance of 1 already accepts a residual as
@@ -143,7 +150,7 @@ impl Method {
                 false,
                 RTOL_ALLOWED,
             )?,
-            atol: positive("atol", options.atol)?,
+            atol: within("atol", options.atol, 0.0, ATOL_MAX, true, ATOL_ALLOWED)?,
         };
         match name {
             "newmark" => Ok(Self::Newmark { beta, gamma }),

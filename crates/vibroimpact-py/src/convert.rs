@@ -37,9 +37,15 @@ fn one_line(text: &str) -> String {
 /// core is an InvalidInputError naming the field, not an OverflowError.
 pub(crate) fn whole(field: &str, value: &Bound<'_, PyAny>) -> PyResult<u64> {
     // A float (1e9, 2.5, nan), a string or an int out of range: all invalid
-    // input naming the field, never a bare TypeError or OverflowError.
-    match value.extract::<i64>() {
-        Ok(v) if v >= 1 => Ok(v as u64),
+    // input naming the field, never a bare TypeError or OverflowError. A
+    // bool is an int to Python, but True for a count is a mistake.
+    let count = if value.is_instance_of::<PyBool>() {
+        None
+    } else {
+        value.extract::<i64>().ok()
+    };
+    match count {
+        Some(v) if v >= 1 => Ok(v as u64),
         _ => Err(InvalidInputError::new_err(format!(
             "{field} must be a whole number in [1, {}] (an int, not a float), got {}",
             i64::MAX,
@@ -145,6 +151,11 @@ pub(crate) fn mode_arg(value: &Bound<'_, PyAny>) -> PyResult<u32> {
 /// Which derivative of a mode shape: 0, 1, 2 or 3 (a huge int is invalid
 /// input, not an OverflowError).
 pub(crate) fn derivative_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    if value.is_instance_of::<PyBool>() {
+        return Err(InvalidInputError::new_err(format!(
+            "derivative must be 0, 1, 2 or 3 (an int), got {value}"
+        )));
+    }
     match value.extract::<i64>() {
         Ok(k @ 0..=3) => Ok(k as usize),
         Ok(_) => Err(InvalidInputError::new_err(format!(

@@ -62,6 +62,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_SIGNAL_SAMPLES", core::signals::MAX_SIGNAL_SAMPLES)?;
     m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
     m.add("RTOL_RANGE", core::settings::RTOL_RANGE)?;
+    m.add("ATOL_MAX", core::settings::ATOL_MAX)?;
     m.add("MAX_ENERGY_TOLERANCE", core::settings::MAX_ENERGY_TOLERANCE)?;
     m.add("MAX_POINTS", core::assembly::MAX_POINTS)?;
     m.add("MAX_PAIRS", core::assembly::MAX_PAIRS)?;

@@ -549,7 +549,12 @@ fn check_method(
                 .contains(&rtol),
             vibroimpact_core::settings::RTOL_ALLOWED,
         ),
-        ("atol", atol, atol > 0.0, "> 0"),
+        (
+            "atol",
+            atol,
+            atol > 0.0 && atol <= vibroimpact_core::settings::ATOL_MAX,
+            vibroimpact_core::settings::ATOL_ALLOWED,
+        ),
         ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
         ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
         (
