@@ -22,6 +22,7 @@ with contact events located to round-off. SI units throughout.
 import numpy as _numpy  # noqa: F401
 
 from vibroimpact._core import (
+    ATOL_MAX,
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
     MAX_ENERGY_TOLERANCE,
@@ -101,6 +102,7 @@ __all__ = [
     "MAX_RECORD_BYTES",
     "MAX_SIGNAL_SAMPLES",
     "RTOL_RANGE",
+    "ATOL_MAX",
     "BeamMode",
     "Contact",
     "ContactTable",
