@@ -9,7 +9,7 @@ The ``[study]`` section::
     [study]
     analysis = "steady-state"      # or "run" (to [solver] t_end; record_from, s), "orbit"
     settle_periods = 200           # steady-state, orbit: forcing periods to settle
-    record_periods = 50            # steady-state: periods to record
+    record_periods = 50            # steady-state: periods to record (at least 8 run)
     orbit_periods = 1              # orbit: its period, in forcing periods
     metrics = ["peak", "rms", "impacts", "energy_dissipated",
                "amplitude", "impacts_per_period", "settled"]
