@@ -379,7 +379,8 @@ pub enum Analysis {
     /// A run to `t_end`, metrics from `record_from` on.
     Run { t_end: f64, record_from: f64 },
     /// `settle` then `record` periods (at least MAX_PERIOD: see
-    /// `recorded_periods`) of the first harmonic excitation; settled when the stroboscopic state repeats after p <= 8 periods
+    /// `recorded_periods`) of the first harmonic excitation; settled when
+    /// the stroboscopic state repeats after p <= 8 periods
     /// within `tolerance` (relative: see [`settling::strobe_period`]).
     SteadyState {
         settle: u64,
