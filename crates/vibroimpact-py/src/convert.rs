@@ -122,7 +122,7 @@ macro_rules! by_name {
 }
 
 by_name!(arg, real -> f64: approach_rate, approach_speed, area, atol, beta, clearance, cpu_time, damping, density, energy_tolerance, error, error_weight, forcing_period, gamma, hertz_stiffness, impact_displacement, impact_mass, impact_velocity, indentation, length, main_displacement, main_mass, main_velocity, max_cpu_time, max_error, other_poisson_ratio, other_youngs_modulus, poisson_ratio, radius, rate, record_from, rtol, second_moment, spectral_radius, stiffness, t_end, tolerance, x, youngs_modulus);
-by_name!(optional, real_or_none -> Option<f64>: dt, energy_tolerance, other_radius, position, record_from, restitution, strobe_period);
+by_name!(optional, real_or_none -> Option<f64>: dt, energy_tolerance, forcing_period, other_radius, position, record_from, restitution, strobe_period);
 by_name!(named_text, text -> String: law);
 
 pub(crate) fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {

@@ -484,7 +484,9 @@ impl PreparedSystem {
         #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
         #[pyo3(from_py_with = crate::convert::arg::tolerance)] tolerance: f64,
         max_iterations: usize,
-        forcing_period: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::optional::forcing_period)] forcing_period: Option<
+            f64,
+        >,
     ) -> PyResult<Bound<'py, PyDict>> {
         check("t_end", t_end, t_end > 0.0, "> 0 s")?;
         check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
