@@ -1115,3 +1115,26 @@ def test_the_basins_plot_of_starts_all_inside_the_wall(tmp_path: Path) -> None:
     plot_basins(png, result, "structure_displacement 0", "structure_velocity 0")
     data = png.read_bytes()
     assert data[:8] == PNG_SIGNATURE and data.endswith(b"IEND\xaeB`\x82")
+
+
+def test_the_bifurcation_command_prints_a_failed_points_error(
+    run_cli: RunCli, tmp_path: Path
+) -> None:
+    # With max_steps = 60 the runs at the middle amplitude fail and the others do not:
+    # the failed point had been printed as "0 distinct stroboscopic displacement(s) of 0".
+    text = BALL_TABLE.read_text().replace("[solver]", "[solver]\nmax_steps = 60", 1)
+    text += (
+        '\n[sweep]\nparameter = "excitation.0.amplitude"\nstart = 5.0\nstop = 20.0\n'
+        "count = 3\nsettle_periods = 4\nrecord_periods = 4\n"
+    )
+    path = tmp_path / "failing.toml"
+    path.write_text(text)
+    result = run_cli("bifurcation", str(path))
+    assert result.returncode == 0, result.stderr
+    lines = [line for line in result.stdout.splitlines() if " up: " in line]
+    assert len(lines) == 3, result.stdout
+    failed = lines[1]
+    assert "failed: " in failed and "max_steps" in failed, failed
+    assert "distinct" not in failed
+    for line in (lines[0], lines[2]):
+        assert "distinct stroboscopic displacement(s) of 4" in line, line

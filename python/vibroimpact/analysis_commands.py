@@ -414,6 +414,10 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         "impact-phase": "impact phases",
     }[sample]
     for row in rows:
+        if "error" in row:
+            # A failed point has no samples: its error, not "0 distinct ... of 0".
+            print(f"{row['value']:>12.6g} {row['direction']:>5}: failed: {row['error']}")
+            continue
         samples = np.asarray(row["samples"])
         scale = float(np.max(np.abs(samples), initial=0.0)) or 1.0
         distinct = len(np.unique(np.round(samples / scale, 6)))
