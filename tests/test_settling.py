@@ -235,18 +235,21 @@ def test_basins_count_impacts_over_whole_orbits() -> None:
     assert reached["impacts_per_period"] == count / 24
 
 
-def test_a_study_counts_impacts_over_whole_orbits(tmp_path: Path) -> None:
-    # The same period-8 orbit from four starts: its impacts over the 20 recorded
-    # periods were 2.95 to 3.6 a period, with where the orbit stood when recording
-    # began; over the 16 periods of two whole orbits they are one number.
+# Four starts on the period-8 orbit of Holmes's ball at Gamma 1.7.
+_STARTS = [0.0, 0.0015, 0.003, 0.015]
+
+
+def _period_eight_study(tmp_path: Path, record: int) -> tuple[Any, an.Runner]:
+    """A steady-state study of the period-8 orbit from :data:`_STARTS`, recording
+    ``record`` periods, and a runner of its scenario; checks that every start reached
+    the one orbit."""
     text = (
         BASINS.read_text().split("[basins]")[0].replace("amplitude = 11.772", "amplitude = 16.677")
     )
-    starts = [0.0, 0.0015, 0.003, 0.015]
     text += (
-        '[study]\nanalysis = "steady-state"\nsettle_periods = 200\nrecord_periods = 20\n'
-        'metrics = ["amplitude", "impacts_per_period", "settled"]\n[study.axes]\n'
-        f'"initial.structure_displacement.0" = {starts}\n'
+        '[study]\nanalysis = "steady-state"\nsettle_periods = 200\n'
+        f'record_periods = {record}\nmetrics = ["amplitude", "impacts_per_period", "settled"]\n'
+        f'[study.axes]\n"initial.structure_displacement.0" = {_STARTS}\n'
         '"initial.structure_velocity.0" = [0.16]\n'
     )
     study = load_study(tmp_path / "s.toml", text)
@@ -254,7 +257,15 @@ def test_a_study_counts_impacts_over_whole_orbits(tmp_path: Path) -> None:
     run = an.runner({k: v for k, v in study.data.items() if k != "study"})
     amplitudes = ds["amplitude"].values.ravel()
     assert np.ptp(amplitudes) < 1e-9 * amplitudes[0]  # one orbit
-    for x0, per_period in zip(starts, ds["impacts_per_period"].values.ravel(), strict=True):
+    return ds, run
+
+
+def test_a_study_counts_impacts_over_whole_orbits(tmp_path: Path) -> None:
+    # The same period-8 orbit from four starts: its impacts over the 20 recorded
+    # periods were 2.95 to 3.6 a period, with where the orbit stood when recording
+    # began; over the 16 periods of two whole orbits they are one number.
+    ds, run = _period_eight_study(tmp_path, 20)
+    for x0, per_period in zip(_STARTS, ds["impacts_per_period"].values.ravel(), strict=True):
         contacts = run.periods(np.array([x0, 0.16]), 220)["contacts"]
         onsets = np.asarray(contacts["onset"]) / run.period
         whole = [
@@ -270,22 +281,8 @@ def test_a_study_recording_less_than_an_orbit_counts_a_whole_one(
     # record_periods below the orbit's 8 periods had counted part of it: 1.857 to
     # 3.571 a period from one attractor with 7, 1 to 14 with 1. A steady-state study
     # records at least 8 periods; its count is the one steady_state gives.
-    text = (
-        BASINS.read_text().split("[basins]")[0].replace("amplitude = 11.772", "amplitude = 16.677")
-    )
-    starts = [0.0, 0.0015, 0.003, 0.015]
-    text += (
-        '[study]\nanalysis = "steady-state"\nsettle_periods = 200\n'
-        f'record_periods = {record}\nmetrics = ["amplitude", "impacts_per_period", "settled"]\n'
-        f'[study.axes]\n"initial.structure_displacement.0" = {starts}\n'
-        '"initial.structure_velocity.0" = [0.16]\n'
-    )
-    study = load_study(tmp_path / "s.toml", text)
-    ds = st.run(study, tmp_path / "s.nc")
-    run = an.runner({k: v for k, v in study.data.items() if k != "study"})
-    amplitudes = ds["amplitude"].values.ravel()
-    assert np.ptp(amplitudes) < 1e-9 * amplitudes[0]  # one orbit
-    for x0, per_period in zip(starts, ds["impacts_per_period"].values.ravel(), strict=True):
+    ds, run = _period_eight_study(tmp_path, record)
+    for x0, per_period in zip(_STARTS, ds["impacts_per_period"].values.ravel(), strict=True):
         steady = an.steady_state(
             run, np.array([x0, 0.16]), settle_periods=200, record_periods=record
         )
