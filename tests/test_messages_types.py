@@ -5,7 +5,6 @@ keys' ranges, sizes and steps refused with their real range, numbers written sho
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 from collections.abc import Callable
@@ -720,17 +719,3 @@ def test_run_study_names_an_argument_of_the_wrong_type(name: str, bad: Any) -> N
     # PyO3's TypeError named the argument only in a note.
     with pytest.raises(vi.InvalidInputError, match=rf"^{name} has the wrong type"):
         vi.run_study(**{**kwargs, name: bad})
-
-
-def test_the_fastest_mode_is_the_systems_own_whatever_was_asked_before() -> None:
-    # fastest_mode keeps its answers by the sections' repr, which NumPy's arrays round:
-    # two stiffness matrices differing past their printed digits must not share one.
-    from vibroimpact.forcing_limits import fastest_mode
-
-    def matrices(k: float, kind: Any) -> dict[str, Any]:
-        return {"structure": {"kind": "matrices", "mass": kind([[1.0]]), "stiffness": kind([[k]])}}
-
-    for kind in (lambda rows: rows, np.array):
-        for k in (39.478, 39.478 * (1 + 1e-11), 4 * 39.478):
-            expected = math.sqrt(k) / (2 * math.pi)
-            assert fastest_mode(matrices(k, kind)) == pytest.approx(expected, rel=1e-13)

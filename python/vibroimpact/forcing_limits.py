@@ -2,8 +2,9 @@
 in each period of the structure's fastest mode, so a forcing period of more than
 ``max_steps`` of those is beyond it (a sweep from 1e-300 Hz had failed each point as a
 numerical blow-up advising a smaller dt); a fixed-step run takes ``period / dt`` steps
-whatever the modes (an implicit method is stable on a mode far faster than its step),
-and needs two steps a period to see the forcing at all. An adaptive or exact run judges
+whatever the modes (an implicit method is stable on a mode far faster than its step;
+its two steps a period are checked with the run's own settings, in
+:func:`vibroimpact.run_scales.check_forcing_steps`). An adaptive or exact run judges
 positions to ``atol``: a forcing that moves the structure by less than ``atol`` a period
 is not resolved (a 5 Hz oscillator forced at 1e9 Hz had failed its energy balance), and a
 body on no spring is resolved only while the round-off of the run's times stays below
@@ -41,13 +42,6 @@ def _parts(data: Mapping[str, Any], base_dir: Path | None) -> dict[str, Any]:
     )
 
 
-def fastest_mode(data: Mapping[str, Any], base_dir: Path | None = None) -> float:
-    """The highest natural frequency (Hz) of the system between contacts (structure and
-    dampers, ``M x'' + K x = 0``); 0 where nothing is held by a spring."""
-    parts = _parts(data, base_dir)
-    return highest_frequency(parts["mass"], parts["stiffness"])
-
-
 def _accelerations(parts: Mapping[str, Any]) -> tuple[float, float]:
     """The largest acceleration amplitude (m/s^2) the harmonic loads give a coordinate
     (``M^-1`` times the load) and the largest the constant load (gravity) gives."""
@@ -74,25 +68,17 @@ def _check_fixed_step(period: float, dt: float, max_steps: int) -> None:
             f"more than a run's max_steps ({max_steps})",
             f"set the [[excitation]] frequency to at least {1 / (max_steps * dt):.3g} Hz",
         )
-    if period < 2 * dt:
-        # Fewer than two steps a period: the steps sample the forcing below its Nyquist rate.
-        raise _refuse(
-            period,
-            f"its period, {period:.6g} s, is shorter than two steps of dt = {shown(dt)} s",
-            f"set the [[excitation]] frequency to at most {1 / (2 * dt):.3g} Hz, or reduce "
-            f"dt below {period / 20:.3g} s",
-        )
 
 
 def check_forcing_period(
     data: Mapping[str, Any], period: float, max_steps: int, base_dir: Path | None = None
 ) -> None:
     """Refuse a forcing ``period`` (s) no run can step through: for a fixed-step method,
-    more than ``max_steps`` steps of ``dt`` or fewer than two; for an adaptive or exact
-    one, more than ``max_steps`` periods of the system's fastest mode, a forcing moving
-    the structure less than ``atol`` a period, or (a body on no spring) a period whose
-    times' round-off exceeds the time its largest acceleration takes to move it by
-    ``atol``."""
+    more than ``max_steps`` steps of ``dt`` (fewer than two are refused with the run's
+    settings, before this); for an adaptive or exact one, more than ``max_steps`` periods
+    of the system's fastest mode, a forcing moving the structure less than ``atol`` a
+    period, or (a body on no spring) a period whose times' round-off exceeds the time its
+    largest acceleration takes to move it by ``atol``."""
     solver = data.get("solver", {})
     if solver.get("method") in _FIXED_STEP:
         # Checked by the run's own settings: a fixed step is given.
