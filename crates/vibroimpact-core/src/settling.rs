@@ -7,6 +7,22 @@ use crate::error::{positive, Result};
 /// The most forcing periods a settled response may take to repeat.
 pub const MAX_PERIOD: usize = 8;
 
+/// The size of a coordinate's motion through displacement `x` (m) and
+/// velocity `v` (m/s): the amplitude `hypot(x, v / w)` of the harmonic motion
+/// at the forcing's angular frequency w = 1 / `per_radian`, where
+/// `per_radian` = forcing period / 2 pi (s), see [`per_radian`]. The scale of
+/// settling and of shooting alike.
+#[inline]
+pub(crate) fn amplitude(x: f64, v: f64, per_radian: f64) -> f64 {
+    x.hypot(v * per_radian)
+}
+
+/// The forcing period `forcing_period` (s) per radian: 1 / w.
+#[inline]
+pub(crate) fn per_radian(forcing_period: f64) -> f64 {
+    forcing_period / (2.0 * std::f64::consts::PI)
+}
+
 /// [`strobe_period`] for a caller whose `forcing_period` (s) and `tolerance`
 /// are not yet checked (the binding's): each must be finite and > 0.
 pub fn checked_strobe_period(
@@ -51,27 +67,27 @@ pub fn strobe_period(
         return None;
     }
     let half = width / 2;
-    let slow = forcing_period / (2.0 * std::f64::consts::PI);
+    let slow = per_radian(forcing_period);
     let rows: Vec<&[f64]> = strobe.chunks_exact(width).collect();
     // The amplitude of the motion of coordinate i through state a - b.
-    let amplitude = |a: &[f64], b: Option<&[f64]>, i: usize| {
+    let motion = |a: &[f64], b: Option<&[f64]>, i: usize| {
         let (x, v) = match b {
             Some(b) => (a[i] - b[i], a[half + i] - b[half + i]),
             None => (a[i], a[half + i]),
         };
-        x.hypot(v * slow)
+        amplitude(x, v, slow)
     };
     let tail = &rows[rows.len().saturating_sub(2 * max_period + 1)..];
     let scale = tail
         .iter()
-        .flat_map(|r| (0..half).map(move |i| amplitude(r, None, i)))
+        .flat_map(|r| (0..half).map(move |i| motion(r, None, i)))
         .fold(0.0f64, f64::max)
         .max(1e-300);
     let last = rows.last()?;
     (1..=max_period.min(rows.len().saturating_sub(1))).find(|&p| {
         let other = rows[rows.len() - 1 - p];
         let distance = (0..half)
-            .map(|i| amplitude(last, Some(other), i))
+            .map(|i| motion(last, Some(other), i))
             .fold(0.0f64, f64::max);
         distance <= tolerance * scale
     })

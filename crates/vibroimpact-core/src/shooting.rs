@@ -5,6 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::linalg;
+use crate::settling;
 
 /// What a shooting found.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,13 +48,13 @@ pub fn shoot(
     let size = z0.len();
     let dim = size / 2;
     let mut maps = 0usize;
-    let slow = forcing_period / (2.0 * std::f64::consts::PI);
+    let slow = settling::per_radian(forcing_period);
     let scales = |z: &[f64], image: &[f64]| {
         let x = (0..dim)
             .flat_map(|i| {
                 [
-                    z[i].hypot(z[dim + i] * slow),
-                    image[i].hypot(image[dim + i] * slow),
+                    settling::amplitude(z[i], z[dim + i], slow),
+                    settling::amplitude(image[i], image[dim + i], slow),
                 ]
             })
             .fold(1e-12f64, f64::max);
