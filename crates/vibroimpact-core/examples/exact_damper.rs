@@ -6,14 +6,14 @@
 //!     cargo run --release -p vibroimpact-core --example exact_damper
 
 use std::time::Instant;
-use vibroimpact_core::assembly::{
+use vibroimpact_core::kernel::events::{RunOptions, SystemSolution};
+use vibroimpact_core::kernel::reductions::ReduceOptions;
+use vibroimpact_core::methods::registry::AnyStepper;
+use vibroimpact_core::model::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
-use vibroimpact_core::reductions::ReduceOptions;
-use vibroimpact_core::signals::Signal;
-use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::{RunOptions, SystemSolution};
-use vibroimpact_core::system_methods::AnyStepper;
+use vibroimpact_core::model::signals::Signal;
+use vibroimpact_core::model::structure::Structure;
 
 fn run(spec: &SystemSpec, t_end: f64) -> SystemSolution {
     let system = Assembly::new(spec).unwrap();

@@ -8,14 +8,14 @@
 //!     cargo run --release -p vibroimpact-core --example system_throughput
 
 use std::time::Instant;
-use vibroimpact_core::assembly::{
+use vibroimpact_core::kernel::events::{integrate_system, RunOptions, SystemSolution};
+use vibroimpact_core::methods::steppers::ExplicitRk;
+use vibroimpact_core::model::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
-use vibroimpact_core::contact::{Contact, LawKind};
-use vibroimpact_core::signals::Signal;
-use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::{integrate_system, RunOptions, SystemSolution};
-use vibroimpact_core::system_steppers::ExplicitRk;
+use vibroimpact_core::model::contact::{Contact, LawKind};
+use vibroimpact_core::model::signals::Signal;
+use vibroimpact_core::model::structure::Structure;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

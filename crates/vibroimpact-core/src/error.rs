@@ -66,7 +66,7 @@ pub enum Error {
         advice: &'static str,
     },
     /// The records a run keeps (history, stroboscopic states, contacts) would
-    /// pass [`crate::memory::MAX_RECORD_BYTES`], or the machine refused the
+    /// pass [`crate::kernel::memory::MAX_RECORD_BYTES`], or the machine refused the
     /// memory for them.
     #[error(
         "the run's records ({rows} history rows and {strobes} stroboscopic rows of {columns} values, \

@@ -1,61 +1,47 @@
-//! vibroimpact-core: impact dampers and vibro-impact systems.
+//! vibroimpact-core: impact dampers and vibro-impact systems, in pure Rust (no
+//! Python). SI units throughout.
 //!
-//! Pure Rust, no Python: the two-mass impact damper ([`ImpactDamper`]),
-//! compliant contact laws ([`contact`]), fixed-step integrators
-//! ([`integrators`]) driven by one generic kernel ([`run::integrate`]) that
-//! keeps a thinned history and a table of located contacts, and closed-form
-//! references ([`closed_forms`], [`beam`], [`materials`]). SI units throughout.
-//! Every run is bounded in steps and memory and checks its energy balance
-//! (see [`run::simulate`]).
+//! The crate is laid out as it works:
+//! - [`model`]: what is simulated, importing no solver: a structure
+//!   ([`model::structure`], cantilevers in [`model::beam`]), interactions
+//!   (gaps linear in the coordinates, with a law: rigid or compliant,
+//!   [`model::contact`]), excitation signals ([`model::signals`]), all
+//!   assembled into one system ([`model::assembly::Assembly`]); materials
+//!   and closed-form references; the two-mass impact damper
+//!   ([`ImpactDamper`]).
+//! - [`kernel`]: the event-driven simulation of any assembled system
+//!   ([`kernel::events::integrate_system`]): crossings located on the
+//!   method's own solution, rigid impacts resolved together
+//!   (`kernel::impacts`), records, limits and the energy balance, and the
+//!   fixed-size fast path for small systems.
+//! - [`methods`]: the steppers (explicit Runge-Kutta over tableaux, the
+//!   Newmark family, the exact flow of piecewise-linear systems) and the
+//!   registry of methods by name ([`methods::registry`]).
+//! - [`analysis`]: settling, shooting for periodic orbits, studies of many
+//!   runs on every core and lockstep ensembles.
+//! - [`numerics`]: small dense linear algebra, Hermite interpolation, series.
+//! - [`legacy`]: the 0.1 two-mass kernel ([`simulate`]), to be replaced by
+//!   the two-mass preset on the general kernel (issue 24).
+//!
+//! Every run is bounded in steps and memory and checks its energy balance.
 
-pub mod assembly;
-mod balance;
-pub mod beam;
-pub mod closed_forms;
-pub(crate) mod compact;
-pub mod contact;
-mod contact_balance;
-pub mod ensemble;
+pub mod analysis;
 pub mod error;
-pub mod events;
-pub mod exact;
-mod hermite;
-mod impacts;
-pub mod integrators;
-pub mod linalg;
-pub mod materials;
-pub mod matrix_flow;
-pub mod memory;
-pub mod modal;
+pub mod kernel;
+pub mod legacy;
+pub mod methods;
 pub mod model;
-pub mod records;
-pub mod reductions;
-pub mod run;
-mod series;
-pub mod settings;
-pub mod settling;
-pub mod shooting;
-pub mod signals;
-mod sized;
-pub mod step_control;
-pub mod steppers;
-pub mod structure;
-pub mod study;
-pub mod system;
-pub mod system_events;
-pub mod system_methods;
-pub mod system_steppers;
-pub mod tableau;
+pub mod numerics;
 pub mod testing;
 
-pub use contact::{Contact, ContactLaw, LawKind};
 pub use error::{Error, Result};
-pub use memory::MAX_RECORD_BYTES;
-pub use records::{ContactRecord, History, Solution};
-pub use run::simulate;
-pub use settings::{
+pub use kernel::memory::MAX_RECORD_BYTES;
+pub use legacy::records::{ContactRecord, History, Solution};
+pub use legacy::run::simulate;
+pub use legacy::settings::{
     ContactTiming, Method, MethodOptions, Settings, Stepping, DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
 };
-pub use steppers::Tolerances;
-pub use system::{ImpactDamper, State};
+pub use legacy::steppers::Tolerances;
+pub use model::contact::{Contact, ContactLaw, LawKind};
+pub use model::impact_damper::{ImpactDamper, State};

@@ -5,7 +5,7 @@
 
 mod common;
 
-use vibroimpact_core::beam::{
+use vibroimpact_core::model::beam::{
     cantilever_mode, cantilever_mode_shape, cantilever_mode_shape_derivatives, cantilever_root,
     CantileverShape,
 };

@@ -6,7 +6,9 @@
 
 mod common;
 
-use vibroimpact_core::ensemble::{run_ensemble, EnsembleOptions, Member, MemberResult, LANES};
+use vibroimpact_core::analysis::ensemble::{
+    run_ensemble, EnsembleOptions, Member, MemberResult, LANES,
+};
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
 };

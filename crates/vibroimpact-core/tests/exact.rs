@@ -7,16 +7,16 @@
 mod common;
 
 use std::f64::consts::TAU;
-use vibroimpact_core::assembly::{
+use vibroimpact_core::kernel::events::{integrate_system, ContactKind, RunOptions, SystemSolution};
+use vibroimpact_core::kernel::reductions::ReduceOptions;
+use vibroimpact_core::methods::exact::ExactFlow;
+use vibroimpact_core::methods::steppers::ExplicitRk;
+use vibroimpact_core::model::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
-use vibroimpact_core::contact::{Contact, LawKind};
-use vibroimpact_core::exact::ExactFlow;
-use vibroimpact_core::reductions::ReduceOptions;
-use vibroimpact_core::signals::{Signal, SweepLaw};
-use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
-use vibroimpact_core::system_steppers::ExplicitRk;
+use vibroimpact_core::model::contact::{Contact, LawKind};
+use vibroimpact_core::model::signals::{Signal, SweepLaw};
+use vibroimpact_core::model::structure::Structure;
 
 fn spec(structure: Structure) -> SystemSpec {
     SystemSpec {
@@ -524,7 +524,7 @@ fn points_outside_the_structure_are_refused_by_name() {
             "{err}"
         );
         let mut s = spec(Structure::oscillator(1.0, 1.0, 0.0).unwrap());
-        s.points = vec![0.0; vibroimpact_core::assembly::MAX_POINTS + 1];
+        s.points = vec![0.0; vibroimpact_core::model::assembly::MAX_POINTS + 1];
         let err = Assembly::new(&s).unwrap_err().to_string();
         assert!(err.contains("points: at most"), "{err}");
     });

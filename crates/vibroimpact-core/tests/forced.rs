@@ -5,10 +5,10 @@
 
 mod common;
 
-use vibroimpact_core::contact::Hertz;
-use vibroimpact_core::events::integrate_events;
-use vibroimpact_core::model::{Excitation, Model};
-use vibroimpact_core::steppers::{NewmarkFamily, Rk4Stepper, Stepper};
+use vibroimpact_core::legacy::equations::{Excitation, Model};
+use vibroimpact_core::legacy::events::integrate_events;
+use vibroimpact_core::legacy::steppers::{NewmarkFamily, Rk4Stepper, Stepper};
+use vibroimpact_core::model::contact::Hertz;
 use vibroimpact_core::{ContactTiming, ImpactDamper, Method, Settings, State, Stepping};
 
 /// `F0 cos(omega t)` on the main mass, N.

@@ -7,13 +7,13 @@
 
 mod common;
 
-use vibroimpact_core::contact::{Hertz, HysterHertz};
 use vibroimpact_core::error::Error;
-use vibroimpact_core::events::integrate_events;
-use vibroimpact_core::integrators::Rk4;
-use vibroimpact_core::model::{Excitation, Free, Model};
-use vibroimpact_core::run::integrate;
-use vibroimpact_core::steppers::{Dop853Stepper, Rk4Stepper, Tolerances};
+use vibroimpact_core::legacy::equations::{Excitation, Free, Model};
+use vibroimpact_core::legacy::events::integrate_events;
+use vibroimpact_core::legacy::integrators::Rk4;
+use vibroimpact_core::legacy::run::integrate;
+use vibroimpact_core::legacy::steppers::{Dop853Stepper, Rk4Stepper, Tolerances};
+use vibroimpact_core::model::contact::{Hertz, HysterHertz};
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, Solution, State,
     Stepping, DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,

@@ -3,12 +3,14 @@
 
 mod common;
 
-use vibroimpact_core::closed_forms::{goldsmith_contact_duration, goldsmith_max_indentation};
-use vibroimpact_core::contact::Hertz;
-use vibroimpact_core::model::{Free, Mode, Model};
-use vibroimpact_core::steppers::{
+use vibroimpact_core::legacy::equations::{Free, Mode, Model};
+use vibroimpact_core::legacy::steppers::{
     to_vector, Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper, Stepper, Tolerances,
 };
+use vibroimpact_core::model::closed_forms::{
+    goldsmith_contact_duration, goldsmith_max_indentation,
+};
+use vibroimpact_core::model::contact::Hertz;
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
 };

@@ -4,16 +4,16 @@
 
 mod common;
 
-use vibroimpact_core::assembly::{
+use vibroimpact_core::error::Error;
+use vibroimpact_core::kernel::events::{integrate_system_within, RunOptions, SystemSolution};
+use vibroimpact_core::kernel::reductions::ReduceOptions;
+use vibroimpact_core::methods::steppers::ExplicitRk;
+use vibroimpact_core::model::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, SystemSpec,
 };
-use vibroimpact_core::contact::{Contact, LawKind};
-use vibroimpact_core::error::Error;
-use vibroimpact_core::reductions::ReduceOptions;
-use vibroimpact_core::signals::Signal;
-use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::{integrate_system_within, RunOptions, SystemSolution};
-use vibroimpact_core::system_steppers::ExplicitRk;
+use vibroimpact_core::model::contact::{Contact, LawKind};
+use vibroimpact_core::model::signals::Signal;
+use vibroimpact_core::model::structure::Structure;
 use vibroimpact_core::MAX_RECORD_BYTES;
 
 /// A 40-mode cantilever with a damper at its tip, struck: rows of

@@ -5,7 +5,7 @@
 mod common;
 
 use std::f64::consts::{PI, TAU};
-use vibroimpact_core::signals::{Signal, SweepLaw};
+use vibroimpact_core::model::signals::{Signal, SweepLaw};
 use vibroimpact_core::Error;
 
 /// Sign changes of `signal` sampled every `step` over [0, end].
@@ -43,7 +43,7 @@ fn sum_of_harmonics_is_the_sum() {
         let parts = [(1.0, 3.0, 0.2), (0.5, 7.0, -1.0), (0.25, 0.0, 0.0)];
         let list = parts
             .iter()
-            .map(|&(a, f, p)| vibroimpact_core::signals::Harmonic::new(a, f, p).unwrap())
+            .map(|&(a, f, p)| vibroimpact_core::model::signals::Harmonic::new(a, f, p).unwrap())
             .collect();
         let sum = Signal::Harmonics(list);
         for t in [0.0, 0.013, 0.5, 2.7] {

@@ -3,7 +3,7 @@
 
 mod common;
 
-use vibroimpact_core::structure::Structure;
+use vibroimpact_core::model::structure::Structure;
 
 fn rows(flat: &[f64], n: usize) -> Vec<Vec<f64>> {
     flat.chunks(n).map(<[f64]>::to_vec).collect()

@@ -7,14 +7,14 @@
 mod common;
 
 use std::f64::consts::TAU;
-use vibroimpact_core::assembly::{
+use vibroimpact_core::kernel::events::{integrate_system, ContactKind, RunOptions, SystemSolution};
+use vibroimpact_core::methods::steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
+use vibroimpact_core::model::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
-use vibroimpact_core::contact::{Contact, LawKind};
-use vibroimpact_core::signals::Signal;
-use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::{integrate_system, ContactKind, RunOptions, SystemSolution};
-use vibroimpact_core::system_steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
+use vibroimpact_core::model::contact::{Contact, LawKind};
+use vibroimpact_core::model::signals::Signal;
+use vibroimpact_core::model::structure::Structure;
 
 fn options(dt: Option<f64>, t_end: f64) -> RunOptions {
     RunOptions {
@@ -99,7 +99,7 @@ fn steady(m: &[f64], k: &[f64], c: &[f64], f: &[f64], w: f64) -> (Vec<f64>, Vec<
         }
         rhs[i] = f[i];
     }
-    vibroimpact_core::linalg::solve_in_place(&mut a, &mut rhs, 2 * n);
+    vibroimpact_core::numerics::linalg::solve_in_place(&mut a, &mut rhs, 2 * n);
     (rhs[..n].to_vec(), rhs[n..].to_vec())
 }
 

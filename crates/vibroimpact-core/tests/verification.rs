@@ -3,8 +3,10 @@
 
 mod common;
 
-use vibroimpact_core::closed_forms::{goldsmith_contact_duration, goldsmith_max_indentation};
-use vibroimpact_core::model::{Free, Model};
+use vibroimpact_core::legacy::equations::{Free, Model};
+use vibroimpact_core::model::closed_forms::{
+    goldsmith_contact_duration, goldsmith_max_indentation,
+};
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, Solution, State,
 };
@@ -182,7 +184,7 @@ fn energy_is_conserved_without_losses() {
         let sys = table1(1.0, 0.0, 0.0, LawKind::Hertz, None);
         let model = Model::new(
             &sys.0,
-            vibroimpact_core::contact::Hertz { stiffness: 3000.0 },
+            vibroimpact_core::model::contact::Hertz { stiffness: 3000.0 },
             0.0,
             Free,
         );

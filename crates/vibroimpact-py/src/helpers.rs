@@ -1,7 +1,9 @@
 //! Closed forms, materials and beam modes: plain functions of their arguments.
 
 use pyo3::prelude::*;
-use vibroimpact_core::{beam, closed_forms, materials, settling, signals};
+use vibroimpact_core::{
+    analysis::settling, model::beam, model::closed_forms, model::materials, model::signals,
+};
 
 use crate::convert::*;
 use crate::errors::*;

@@ -59,12 +59,18 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_MAX_ROWS", core::DEFAULT_MAX_ROWS)?;
     m.add("MAX_RECORD_BYTES", core::MAX_RECORD_BYTES)?;
-    m.add("MAX_SIGNAL_SAMPLES", core::signals::MAX_SIGNAL_SAMPLES)?;
+    m.add(
+        "MAX_SIGNAL_SAMPLES",
+        core::model::signals::MAX_SIGNAL_SAMPLES,
+    )?;
     m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
-    m.add("RTOL_RANGE", core::settings::RTOL_RANGE)?;
-    m.add("ATOL_MAX", core::settings::ATOL_MAX)?;
-    m.add("MAX_ENERGY_TOLERANCE", core::settings::MAX_ENERGY_TOLERANCE)?;
-    m.add("MAX_POINTS", core::assembly::MAX_POINTS)?;
-    m.add("MAX_PAIRS", core::assembly::MAX_PAIRS)?;
+    m.add("RTOL_RANGE", core::legacy::settings::RTOL_RANGE)?;
+    m.add("ATOL_MAX", core::legacy::settings::ATOL_MAX)?;
+    m.add(
+        "MAX_ENERGY_TOLERANCE",
+        core::legacy::settings::MAX_ENERGY_TOLERANCE,
+    )?;
+    m.add("MAX_POINTS", core::model::assembly::MAX_POINTS)?;
+    m.add("MAX_PAIRS", core::model::assembly::MAX_PAIRS)?;
     Ok(())
 }

@@ -10,15 +10,15 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::assembly::{
+use vibroimpact_core::kernel::events::RunOptions;
+use vibroimpact_core::kernel::reductions::ReduceOptions;
+use vibroimpact_core::methods::registry::AnyStepper;
+use vibroimpact_core::model::assembly::{
     initial_state, resumed_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop,
     SystemSpec,
 };
-use vibroimpact_core::reductions::ReduceOptions;
-use vibroimpact_core::signals::{Harmonic, Signal, SweepLaw};
-use vibroimpact_core::structure::Structure;
-use vibroimpact_core::system_events::RunOptions;
-use vibroimpact_core::system_methods::AnyStepper;
+use vibroimpact_core::model::signals::{Harmonic, Signal, SweepLaw};
+use vibroimpact_core::model::structure::Structure;
 
 use crate::errors::{released, short_numbers, to_py, InvalidInputError};
 
@@ -316,7 +316,7 @@ impl Ready {
         history: (bool, u64),
         record_from: Option<f64>,
         strobe_period: Option<f64>,
-    ) -> PyResult<core::system_events::SystemSolution> {
+    ) -> PyResult<core::kernel::events::SystemSolution> {
         released(py, |interrupt| {
             self.integrate(y0, t_end, history, record_from, strobe_period, interrupt)
         })
@@ -331,7 +331,7 @@ impl Ready {
         record_from: Option<f64>,
         strobe_period: Option<f64>,
         interrupt: &mut dyn FnMut() -> bool,
-    ) -> core::Result<core::system_events::SystemSolution> {
+    ) -> core::Result<core::kernel::events::SystemSolution> {
         let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
         let limits = self.limits;
         let dt = self.stepper.step(limits.dt, t_end, strobe_period);
@@ -474,7 +474,7 @@ impl PreparedSystem {
     /// the flat state `state` (see `vibroimpact.analyses.orbit`): Newton's
     /// method with a central-difference Jacobian, all in the core with the GIL
     /// released. `forcing_period` (s, default `t_end`) sets the scale of the
-    /// motion (see `core::shooting::shoot`). Returns `state`, `monodromy`
+    /// motion (see `core::analysis::shooting::shoot`). Returns `state`, `monodromy`
     /// (flat, row-major), `converged`, `iterations`, `residual`.
     #[pyo3(signature = (state, t_end, *, tolerance, max_iterations, forcing_period = None))]
     fn shoot<'py>(
@@ -509,7 +509,7 @@ impl PreparedSystem {
         }
         let ready: &mut Ready = &mut ready;
         let shot = released(py, |interrupt| {
-            core::shooting::shoot(
+            core::analysis::shooting::shoot(
                 &mut |z| ready.map(z, t_end, interrupt),
                 &state,
                 forcing_period,
@@ -547,15 +547,16 @@ fn check_method(
         (
             "rtol",
             rtol,
-            (vibroimpact_core::settings::RTOL_RANGE.0..=vibroimpact_core::settings::RTOL_RANGE.1)
+            (vibroimpact_core::legacy::settings::RTOL_RANGE.0
+                ..=vibroimpact_core::legacy::settings::RTOL_RANGE.1)
                 .contains(&rtol),
-            vibroimpact_core::settings::RTOL_ALLOWED,
+            vibroimpact_core::legacy::settings::RTOL_ALLOWED,
         ),
         (
             "atol",
             atol,
-            atol > 0.0 && atol <= vibroimpact_core::settings::ATOL_MAX,
-            vibroimpact_core::settings::ATOL_ALLOWED,
+            atol > 0.0 && atol <= vibroimpact_core::legacy::settings::ATOL_MAX,
+            vibroimpact_core::legacy::settings::ATOL_ALLOWED,
         ),
         ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
         ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
@@ -568,8 +569,8 @@ fn check_method(
         (
             "energy_tolerance",
             energy_tolerance,
-            vibroimpact_core::settings::checked_energy_tolerance(energy_tolerance).is_ok(),
-            vibroimpact_core::settings::ENERGY_TOLERANCE_ALLOWED,
+            vibroimpact_core::legacy::settings::checked_energy_tolerance(energy_tolerance).is_ok(),
+            vibroimpact_core::legacy::settings::ENERGY_TOLERANCE_ALLOWED,
         ),
     ] {
         check(field, value, ok, allowed)?;
@@ -647,7 +648,7 @@ pub fn simulate_system<'py>(
 fn solution_dict<'py>(
     py: Python<'py>,
     system: &Assembly,
-    sol: core::system_events::SystemSolution,
+    sol: core::kernel::events::SystemSolution,
 ) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("n", system.n)?;
@@ -659,7 +660,7 @@ fn solution_dict<'py>(
     out.set_item("final_time", sol.final_time)?;
     let columns = PyDict::new(py);
     let c = &sol.contacts;
-    let column = |f: fn(&core::system_events::PairContact) -> f64| {
+    let column = |f: fn(&core::kernel::events::PairContact) -> f64| {
         c.iter().map(f).collect::<Vec<f64>>().into_pyarray(py)
     };
     columns.set_item("pair", c.iter().map(|r| r.pair).collect::<Vec<usize>>())?;
@@ -742,7 +743,7 @@ pub fn linear_parts<'py>(
 /// `analysis = "orbit"` settles, then shoots for an orbit of `orbit_periods`
 /// forcing periods (its multipliers, amplitude and impacts).
 /// `stepping = "fixed"` runs them as a lockstep ensemble of fixed RK4 steps
-/// (one mass, one compliant damper, unforced; see `core::ensemble`).
+/// (one mass, one compliant damper, unforced; see `core::analysis::ensemble`).
 #[pyfunction]
 #[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true, stepping="events", orbit_periods=1))]
 #[allow(clippy::too_many_arguments)]
@@ -772,7 +773,7 @@ pub fn run_study<'py>(
     stepping: &str,
     orbit_periods: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use core::study::{run_study as study, Analysis, Parameter, StudySettings};
+    use core::analysis::study::{run_study as study, Analysis, Parameter, StudySettings};
     check_method(
         t_end,
         dt,
@@ -886,7 +887,7 @@ pub fn run_study<'py>(
         "reason",
         results.iter().map(|r| r.reason.clone()).collect::<Vec<_>>(),
     )?;
-    let flat = |f: &dyn Fn(&core::study::RunMetrics) -> Vec<f64>| {
+    let flat = |f: &dyn Fn(&core::analysis::study::RunMetrics) -> Vec<f64>| {
         results
             .iter()
             .flat_map(f)

@@ -4,12 +4,12 @@
 //! One generic stepper over a Butcher tableau serves RK4 (fixed step),
 //! Dormand-Prince 5(4) and DOP853 (error control, first same as last).
 
-use crate::assembly::{Assembly, Mode, Scratch};
-use crate::compact::Stretch;
 use crate::error::{Error, Result};
-use crate::linalg;
-use crate::sized::by_size;
-use crate::tableau::*;
+use crate::kernel::compact::Stretch;
+use crate::kernel::sized::by_size;
+use crate::methods::tableau::*;
+use crate::model::assembly::{Assembly, Mode, Scratch};
+use crate::numerics::linalg;
 
 /// A method the 0.2 kernel can drive: it advances the state within one set of
 /// contact modes, where the right-hand side is smooth.
@@ -152,7 +152,7 @@ pub struct ExplicitRk {
     rk4: bool,
     /// Whether RK4 takes the compact path where the system has one: its
     /// steps in fixed-size arrays, plain ones in stretches (see
-    /// [`crate::compact`]; the same bits either way).
+    /// [`crate::kernel::compact`]; the same bits either way).
     pub compact: bool,
     /// Stage derivatives, plus one slot for `f` at the new point.
     k: Vec<Vec<f64>>,
@@ -790,10 +790,12 @@ impl SystemStepper for NewmarkFamily {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec, CONTACT};
-    use crate::contact::{Contact, LawKind};
-    use crate::signals::Signal;
-    use crate::structure::Structure;
+    use crate::model::assembly::{
+        initial_state, Damper, Excitation, Load, PairLaw, SystemSpec, CONTACT,
+    };
+    use crate::model::contact::{Contact, LawKind};
+    use crate::model::signals::Signal;
+    use crate::model::structure::Structure;
 
     /// A modal cantilever with two dampers (one compliant, one rigid), two
     /// forces, a base excitation and gravity: every term of the rates.

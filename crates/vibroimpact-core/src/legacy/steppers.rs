@@ -5,12 +5,12 @@
 //! Newmark family solved by Newton's method (implicit Newmark,
 //! generalised-alpha, and the founding paper's lagged Newmark).
 
-use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
-use crate::integrators::{rk4_step, LaggedContact, PaperNewmark};
-use crate::model::{Excitation, Mode, Model};
-use crate::system::State;
-use crate::tableau::*;
+use crate::legacy::equations::{Excitation, Mode, Model};
+use crate::legacy::integrators::{rk4_step, LaggedContact, PaperNewmark};
+use crate::methods::tableau::*;
+use crate::model::contact::ContactLaw;
+use crate::model::impact_damper::State;
 
 /// The integrated variables: `w, w', y, y'` and the non-conservative work so
 /// far (J: apart, what the main damper took less what the external force
@@ -787,9 +787,9 @@ mod tests {
     //! still converges, linearly, in more iterations, which is what these
     //! tests count.
     use super::*;
-    use crate::contact::{Contact, LawKind, LawVisitor};
-    use crate::model::Free;
-    use crate::system::ImpactDamper;
+    use crate::legacy::equations::Free;
+    use crate::model::contact::{Contact, LawKind, LawVisitor};
+    use crate::model::impact_damper::ImpactDamper;
 
     const CLEARANCE: f64 = 0.01;
 

@@ -1,8 +1,8 @@
 //! The equations of motion in the plain-data form the kernels use.
 
-use crate::contact::ContactLaw;
-use crate::hermite;
-use crate::system::{ImpactDamper, State};
+use crate::model::contact::ContactLaw;
+use crate::model::impact_damper::{ImpactDamper, State};
+use crate::numerics::hermite;
 
 /// A force on the main mass that depends on time only (N). The hook for
 /// excitations; `Free` is the unforced system.

@@ -10,19 +10,19 @@
 
 use rayon::prelude::*;
 
-use crate::assembly::{initial_state, resumed_state, Assembly, Load, PairLaw, SystemSpec};
-use crate::contact::Contact;
-use crate::ensemble::{run_ensemble, EnsembleOptions, Member};
+use crate::analysis::ensemble::{run_ensemble, EnsembleOptions, Member};
+use crate::analysis::settling::{self, MAX_PERIOD};
 use crate::error::{Error, Result};
-use crate::exact::ExactFlow;
-use crate::reductions::ReduceOptions;
-use crate::settings::{ContactTiming, Method, Settings, Stepping};
-use crate::settling::{self, MAX_PERIOD};
-use crate::signals::{RecipeKey, Signal};
-use crate::system::{ImpactDamper, State};
-use crate::system_events::{ContactKind, RunOptions, SystemSolution};
-use crate::system_methods::AnyStepper;
-use crate::{linalg, shooting};
+use crate::kernel::events::{ContactKind, RunOptions, SystemSolution};
+use crate::kernel::reductions::ReduceOptions;
+use crate::legacy::settings::{ContactTiming, Method, Settings, Stepping};
+use crate::methods::exact::ExactFlow;
+use crate::methods::registry::AnyStepper;
+use crate::model::assembly::{initial_state, resumed_state, Assembly, Load, PairLaw, SystemSpec};
+use crate::model::contact::Contact;
+use crate::model::impact_damper::{ImpactDamper, State};
+use crate::model::signals::{RecipeKey, Signal};
+use crate::{analysis::shooting, numerics::linalg};
 
 /// Which entry of the scenario a study varies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -369,7 +369,7 @@ pub struct StudySettings {
     /// Whether to integrate the mean squares (the RMS metric).
     pub mean_square: bool,
     /// Fixed steps without cutting them at events, the runs advanced in
-    /// lockstep ([`crate::ensemble`]): RK4 runs of one mass on a spring with
+    /// lockstep ([`crate::analysis::ensemble`]): RK4 runs of one mass on a spring with
     /// one compliant damper, unforced.
     pub lockstep: bool,
 }
@@ -388,7 +388,7 @@ pub enum Analysis {
         tolerance: f64,
     },
     /// `settle` forcing periods, then Newton shooting for an orbit of
-    /// `periods` periods from there (see [`crate::shooting`]): its Floquet
+    /// `periods` periods from there (see [`crate::analysis::shooting`]): its Floquet
     /// multipliers, amplitude and impacts.
     Orbit { settle: u64, periods: u64 },
 }
@@ -491,14 +491,14 @@ pub fn run_study(
 }
 
 /// The forcing period of a steady-state or orbit study, s (see
-/// [`crate::signals::common_period`]).
+/// [`crate::model::signals::common_period`]).
 fn forcing_period(spec: &SystemSpec) -> Result<f64> {
     let parts: Vec<_> = spec
         .excitations
         .iter()
         .map(|e| e.signal.harmonic_frequencies())
         .collect();
-    crate::signals::common_period(&parts)
+    crate::model::signals::common_period(&parts)
 }
 
 /// The study's `rows` runs as a lockstep ensemble of fixed RK4 steps.
@@ -1012,8 +1012,8 @@ fn metrics_of(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{Excitation, Load};
-    use crate::structure::Structure;
+    use crate::model::assembly::{Excitation, Load};
+    use crate::model::structure::Structure;
 
     fn noisy(structure: Structure, signal: Signal) -> SystemSpec {
         SystemSpec {

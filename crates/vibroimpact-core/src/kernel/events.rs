@@ -8,9 +8,9 @@
 //! opening, and a sticking pair's constraint force reaching zero (release).
 //! Every pair past its wall or arriving on it at the instant switches; the
 //! rigid ones are resolved together, impacts, chattering sums and sticking,
-//! by [`crate::impacts`].
+//! by [`crate::kernel::impacts`].
 
-use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT};
+use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch, CONTACT};
 
 /// Contacts held before those a run does not keep are dropped (see
 /// [`ReduceOptions::contacts_from`]): a few, so that dropping them costs as
@@ -22,17 +22,17 @@ const COMPACTED_CONTACTS: usize = 64;
 fn loss_slot(system: &Assembly, i: usize) -> usize {
     2 * system.dim + CONTACT + i
 }
-pub use crate::balance::EnergyBalance;
-use crate::balance::{balance, check_balance, EnergySampler, ENERGY_INTERVAL};
-use crate::compact::Stretch;
-use crate::contact_balance::OnsetBalance;
 use crate::error::{Error, Result};
-use crate::hermite;
-use crate::impacts::{self, Impacts};
-use crate::memory::{self, MAX_RECORD_BYTES};
-use crate::reductions::{self, ReduceOptions, Reductions};
-use crate::step_control::{rejects, StepControl};
-use crate::system_steppers::SystemStepper;
+pub use crate::kernel::balance::EnergyBalance;
+use crate::kernel::balance::{balance, check_balance, EnergySampler, ENERGY_INTERVAL};
+use crate::kernel::compact::Stretch;
+use crate::kernel::contact_balance::OnsetBalance;
+use crate::kernel::impacts::{self, Impacts};
+use crate::kernel::memory::{self, MAX_RECORD_BYTES};
+use crate::kernel::reductions::{self, ReduceOptions, Reductions};
+use crate::methods::step_control::{rejects, StepControl};
+use crate::methods::steppers::SystemStepper;
+use crate::numerics::hermite;
 
 /// How to run and what to keep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -695,8 +695,8 @@ fn locate<S: SystemStepper>(
             if !converged && stepper.end_derivatives(system, &mut buffers.accel, &mut buffers.jerk)
             {
                 let h_i = &system.interactions[c.i].h;
-                let second = sign * crate::linalg::dot(h_i, &buffers.accel);
-                let third = sign * crate::linalg::dot(h_i, &buffers.jerk);
+                let second = sign * crate::numerics::linalg::dot(h_i, &buffers.accel);
+                let third = sign * crate::numerics::linalg::dot(h_i, &buffers.jerk);
                 guess = trial + taylor_root(v, slope, second, third);
             }
         }
@@ -753,7 +753,7 @@ fn interrupt_interval(dim: usize) -> u64 {
     (INTERRUPT_INTERVAL / (scale * scale) / ENERGY_INTERVAL).max(1) * ENERGY_INTERVAL
 }
 
-/// Integrates `system` from `initial` (see [`crate::assembly::initial_state`]).
+/// Integrates `system` from `initial` (see [`crate::model::assembly::initial_state`]).
 pub fn integrate_system<S: SystemStepper>(
     system: &Assembly,
     stepper: &mut S,
@@ -1681,7 +1681,7 @@ fn reduce_step<S: SystemStepper>(
 
 /// The start of compliant interaction `i` (open in `modes`) at `time` and
 /// state `y`, approaching at `approach` (m/s): the rate its law latches (see
-/// [`crate::contact::AnyLaw::latched_approach_rate`]: a damped Hertz law's damping is taken
+/// [`crate::model::contact::AnyLaw::latched_approach_rate`]: a damped Hertz law's damping is taken
 /// from the pressing where the approach is slower) and whether it starts at
 /// rest (an approach the pressing gives within round-off, see
 /// [`impacts::resting`]: no impact, so no rebound ratio). `scales` are the

@@ -3,7 +3,7 @@
 //! rows, energy balance), checked before it starts.
 
 use crate::error::{positive, within, Error, Result};
-use crate::steppers::Tolerances;
+use crate::legacy::steppers::Tolerances;
 
 /// The relative tolerance (`rtol`) a method with error control takes, and
 /// its description: an error control looser than a tenth controls nothing
@@ -418,11 +418,11 @@ impl Settings {
             )));
         }
         // Six f64 columns a row.
-        if self.history && rows.saturating_mul(48) > crate::memory::MAX_RECORD_BYTES {
+        if self.history && rows.saturating_mul(48) > crate::kernel::memory::MAX_RECORD_BYTES {
             return Err(Error::Inconsistent(format!(
                 "the history would keep {rows} rows (t_end / dt / every) of 48 bytes, more than the \
                  {} MiB a run's records may take: raise every, set history = false or shorten t_end",
-                crate::memory::MAX_RECORD_BYTES >> 20
+                crate::kernel::memory::MAX_RECORD_BYTES >> 20
             )));
         }
         Ok(())

@@ -10,10 +10,10 @@
 //! with a Pade approximant (to a few ulps), kept for the lengths that repeat
 //! (a fixed step and its Gauss nodes).
 
-use crate::assembly::LinearParts;
 use crate::error::{Error, Result};
-use crate::linalg;
-use crate::modal::Reduced;
+use crate::methods::modal::Reduced;
+use crate::model::assembly::LinearParts;
+use crate::numerics::linalg;
 
 /// Exponentials kept per configuration.
 const SLOTS: usize = 8;

@@ -2,16 +2,16 @@
 //! thinned time history and builds the table of contacts, with contact
 //! instants located inside the step.
 
-use crate::contact::{Contact, ContactLaw, LawVisitor};
 use crate::error::{Error, Result};
-use crate::events::integrate_events;
-use crate::hermite;
-use crate::integrators::{Integrator, Newmark, Rk4};
-use crate::model::{Excitation, Free, Model, Onset};
-use crate::records::*;
-use crate::settings::*;
-use crate::steppers::{Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper};
-use crate::system::{ImpactDamper, State};
+use crate::legacy::equations::{Excitation, Free, Model, Onset};
+use crate::legacy::events::integrate_events;
+use crate::legacy::integrators::{Integrator, Newmark, Rk4};
+use crate::legacy::records::*;
+use crate::legacy::settings::*;
+use crate::legacy::steppers::{Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper};
+use crate::model::contact::{Contact, ContactLaw, LawVisitor};
+use crate::model::impact_damper::{ImpactDamper, State};
+use crate::numerics::hermite;
 
 /// A contact being followed.
 #[derive(Debug, Clone, Copy)]
@@ -227,7 +227,7 @@ pub fn integrate<L: ContactLaw, X: Excitation, I: Integrator>(
                         max_indentation: oc.max_indentation,
                         approach_speed: oc.approach_speed,
                         rebound_speed: -rate,
-                        restitution: crate::events::restitution(-rate, oc.approach_speed),
+                        restitution: crate::legacy::events::restitution(-rate, oc.approach_speed),
                         energy_dissipated: oc.dissipated + 0.5 * theta * dt * (p0 + p_sep),
                         energy_change: energy - oc.energy,
                     };

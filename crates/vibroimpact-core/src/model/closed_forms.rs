@@ -139,7 +139,7 @@ pub fn adequacy(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::tests::field;
+    use crate::model::contact::tests::field;
 
     #[test]
     fn exact_constant_matches_the_integral() {

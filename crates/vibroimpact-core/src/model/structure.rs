@@ -9,9 +9,9 @@
 //! position along the beam (so a tip force enters each mode with the tip
 //! value of its shape, 2 in magnitude, by construction).
 
-use crate::beam::CantileverShape;
 use crate::error::{non_negative, positive, within, Error, Result};
-use crate::linalg;
+use crate::model::beam::CantileverShape;
+use crate::numerics::linalg;
 
 /// Most degrees of freedom a structure may have: its matrices are dense and
 /// every step multiplies them, so a larger model belongs in modal coordinates.

@@ -9,18 +9,18 @@
 //! time. The step is cut there, the mode switched and the method restarted
 //! (its carried data is invalid after the jump in the contact force).
 
-use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
-use crate::hermite::{self, Quintic};
-use crate::model::{Excitation, Mode, Model};
-use crate::records::{
+use crate::legacy::equations::{Excitation, Mode, Model};
+use crate::legacy::records::{
     check_start, external_work, open_record, speed_squared_integral, ContactRecord, EnergyLedger,
     Records, Solution,
 };
-use crate::settings::Settings;
-use crate::step_control::{rejects, StepControl};
-use crate::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
-use crate::system::State;
+use crate::legacy::settings::Settings;
+use crate::legacy::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
+use crate::methods::step_control::{rejects, StepControl};
+use crate::model::contact::ContactLaw;
+use crate::model::impact_damper::State;
+use crate::numerics::hermite::{self, Quintic};
 
 /// Gap of wall `side` and its rate.
 #[inline(always)]

@@ -11,9 +11,9 @@
 //! and `T = Phi^T N^T M N N^T`, each modal coordinate an oscillator
 //! `eta'' + c eta' + w2 eta = F0 + sum_k Re(P_k e^(i omega_k t))`.
 
-use crate::assembly::LinearParts;
 use crate::error::{Error, Result};
-use crate::linalg;
+use crate::model::assembly::LinearParts;
+use crate::numerics::linalg;
 
 /// One harmonic of the forcing, with each mode's steady (particular)
 /// response `Re(Z e^(i omega t))` as `(Re Z, Im Z)`.

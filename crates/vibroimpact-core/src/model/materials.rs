@@ -1,7 +1,7 @@
 //! Hertz contact stiffness from materials and geometry.
 
-use crate::closed_forms::representable;
 use crate::error::{positive, within, Result};
+use crate::model::closed_forms::representable;
 
 /// Elastic constants of one body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,7 +100,7 @@ mod tests {
 #[cfg(test)]
 mod input_tests {
     use super::*;
-    use crate::contact::tests::field;
+    use crate::model::contact::tests::field;
 
     #[test]
     fn every_argument_is_checked_and_named() {

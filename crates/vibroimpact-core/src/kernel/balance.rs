@@ -2,8 +2,8 @@
 //! that it closes, made every [`ENERGY_INTERVAL`] steps by the event kernel
 //! and by the compact path's stretches alike.
 
-use crate::assembly::{Assembly, Mode, CONTACT, INPUT, VISCOUS};
 use crate::error::{Error, Result};
+use crate::model::assembly::{Assembly, Mode, CONTACT, INPUT, VISCOUS};
 
 /// How often (accepted steps) the energy balance is checked.
 pub(crate) const ENERGY_INTERVAL: u64 = 32;

@@ -11,14 +11,14 @@
 //! Gravity along -x and any base acceleration act on every mass as an
 //! inertial load `-M r a(t)` (`r`: the influence vector, 1 for each damper).
 
-use crate::compact::Compact;
-use crate::contact::{AnyLaw, Contact, ContactLaw};
 use crate::error::{finite, non_negative, positive, within, Error, Result};
-use crate::linalg;
-use crate::series::{sin_cos, sin_cos_by_quadrant};
-use crate::signals::{Harmonic, Signal};
-use crate::sized::by_size;
-use crate::structure::Structure;
+use crate::kernel::compact::Compact;
+use crate::kernel::sized::by_size;
+use crate::model::contact::{AnyLaw, Contact, ContactLaw};
+use crate::model::signals::{Harmonic, Signal};
+use crate::model::structure::Structure;
+use crate::numerics::linalg;
+use crate::numerics::series::{sin_cos, sin_cos_by_quadrant};
 
 /// What happens when a gap closes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -220,7 +220,7 @@ pub struct Assembly {
     /// and [`SystemSpec::moments`]).
     pub point_rows: Vec<f64>,
     /// The system in fixed-size arrays, where it is small and modal (RK4's
-    /// fast path, [`crate::compact`]).
+    /// fast path, [`crate::kernel::compact`]).
     pub(crate) compact: Option<Box<Compact>>,
 }
 
@@ -1343,7 +1343,7 @@ impl Assembly {
 /// increments, so most values are a rotation (four multiplications), with a
 /// direct evaluation every `RESYNC` rotations to keep round-off from growing.
 /// Direct evaluations reduce the angle to a quadrant and take the short
-/// series (see [`crate::series`]): the library's sine and cosine also save
+/// series (see [`crate::numerics::series`]): the library's sine and cosine also save
 /// and restore the rounding mode, which cost 5 % of a run with many events.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Cached {

@@ -2,11 +2,11 @@
 //! fixed step it takes, and the run. What the binding's runs and a study's
 //! runs share, so that a method means the same in both.
 
-use crate::assembly::Assembly;
 use crate::error::{Error, Result};
-use crate::exact::ExactFlow;
-use crate::system_events::{integrate_system, RunOptions, SystemSolution};
-use crate::system_steppers::{ExplicitRk, NewmarkFamily};
+use crate::kernel::events::{integrate_system, RunOptions, SystemSolution};
+use crate::methods::exact::ExactFlow;
+use crate::methods::steppers::{ExplicitRk, NewmarkFamily};
+use crate::model::assembly::Assembly;
 
 /// A 0.2 method, made for one system.
 #[derive(Debug, Clone)]

@@ -3,9 +3,9 @@
 //! differences include the saltation). At the orbit the Jacobian is the
 //! monodromy matrix, whose eigenvalues are the Floquet multipliers.
 
+use crate::analysis::settling;
 use crate::error::{Error, Result};
-use crate::linalg;
-use crate::settling;
+use crate::numerics::linalg;
 
 /// What a shooting found.
 #[derive(Debug, Clone, PartialEq)]

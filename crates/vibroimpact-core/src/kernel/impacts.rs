@@ -27,9 +27,9 @@
 //! dampers settling on one wall launch each other at every landing, the
 //! flights falling by the mass ratio: summed, both rest).
 
-use crate::assembly::{Assembly, InteractionLaw, Mode, Scratch};
-use crate::linalg;
-use crate::system_events::{ContactKind, Open, PairContact};
+use crate::kernel::events::{ContactKind, Open, PairContact};
+use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
+use crate::numerics::linalg;
 
 /// What a pair in the problem is doing at the instant.
 #[derive(Debug, Clone, Copy, PartialEq)]

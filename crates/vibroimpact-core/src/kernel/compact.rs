@@ -2,7 +2,7 @@
 //! common case (a few modes, a damper or two, a stop or two, at most one
 //! force, gravity) with no heap pointer or slice length in its inner loop.
 //!
-//! The general stages ([`crate::system_steppers`]) read the system through
+//! The general stages ([`crate::methods::steppers`]) read the system through
 //! `Vec`s and the state through slices whose length is known only at run
 //! time; here every array has a fixed capacity and every loop over the
 //! coordinates a length fixed at compile time, which roughly halves the
@@ -15,16 +15,18 @@
 // between the arrays measured slower: calls to memcpy, bounds not folded).
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
-use crate::assembly::{h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS};
-use crate::balance::{check_balance, EnergySampler, ENERGY_INTERVAL};
-use crate::contact::{AnyLaw, ContactLaw};
 use crate::error::Error;
-use crate::signals::Signal;
-use crate::sized::by_size;
-use crate::tableau::{RK4_A, RK4_B, RK4_C};
+use crate::kernel::balance::{check_balance, EnergySampler, ENERGY_INTERVAL};
+use crate::kernel::sized::by_size;
+use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
+use crate::model::assembly::{
+    h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
+};
+use crate::model::contact::{AnyLaw, ContactLaw};
+use crate::model::signals::Signal;
 
 /// The largest system held: as many structure coordinates and dampers as
-/// [`crate::sized::by_size`] compiles for, and walls for two dampers and
+/// [`crate::kernel::sized::by_size`] compiles for, and walls for two dampers and
 /// two stops.
 pub(crate) const MAX_MODES: usize = 4;
 pub(crate) const MAX_DAMPERS: usize = 2;
@@ -33,7 +35,7 @@ const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
 /// The longest state: coordinates, velocities and the accumulators.
 const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
 
-/// One wall of a pair (see [`crate::assembly::Interaction`]).
+/// One wall of a pair (see [`crate::model::assembly::Interaction`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Wall {
     h: [f64; MAX_DIM],
@@ -61,7 +63,7 @@ impl Wall {
     }
 
     /// `(h . x, h . v)` at `y` for a compliant wall's force, summed as the
-    /// general path sums them (see [`crate::assembly::h_dot`]).
+    /// general path sums them (see [`crate::model::assembly::h_dot`]).
     #[inline(always)]
     fn products(&self, d: usize, y: &[f64; MAX_LEN]) -> (f64, f64) {
         let h = &self.h[..d];
@@ -684,18 +686,18 @@ pub struct Stretch<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{
-        initial_state, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
-    };
-    use crate::contact::{Contact, LawKind};
     use crate::error::Result;
-    use crate::memory::MAX_RECORD_BYTES;
-    use crate::reductions::ReduceOptions;
-    use crate::structure::Structure;
-    use crate::system_events::{
+    use crate::kernel::events::{
         integrate_system, integrate_system_within, ContactKind, RunOptions, SystemSolution,
     };
-    use crate::system_steppers::{ExplicitRk, SystemStepper};
+    use crate::kernel::memory::MAX_RECORD_BYTES;
+    use crate::kernel::reductions::ReduceOptions;
+    use crate::methods::steppers::{ExplicitRk, SystemStepper};
+    use crate::model::assembly::{
+        initial_state, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+    };
+    use crate::model::contact::{Contact, LawKind};
+    use crate::model::structure::Structure;
 
     /// The 3-mode cantilever of the throughput goal: two compliant dampers
     /// (with contact damping), a tip force, gravity if asked.

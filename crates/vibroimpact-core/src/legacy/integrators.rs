@@ -4,9 +4,9 @@
 //! them through [`Integrator`], the event-driven kernel (`events.rs`)
 //! through its steppers (`steppers.rs`).
 
-use crate::contact::ContactLaw;
-use crate::model::{Excitation, Model};
-use crate::system::State;
+use crate::legacy::equations::{Excitation, Model};
+use crate::model::contact::ContactLaw;
+use crate::model::impact_damper::State;
 
 /// One fixed-step method. `approach_rate` is the indentation rate latched at
 /// the onset of the current contact (used by rate-dependent laws).
@@ -34,7 +34,7 @@ pub trait Integrator {
 /// One classical RK4 step of `y' = f(t, y)` from `(time, y)`: stage points
 /// `y + (h/2) k` and `y + h k`, the end `y + (h/6) (k1 + 2 (k2 + k3) + k4)`.
 /// The one RK4 of the two-mass system, for the fixed-step kernel ([`Rk4`])
-/// and the event-driven one ([`crate::steppers::Rk4Stepper`]) alike;
+/// and the event-driven one ([`crate::legacy::steppers::Rk4Stepper`]) alike;
 /// `ensemble.rs` repeats these operations lane by lane (tested bit for bit).
 /// Systems of any size step with `system_steppers::ExplicitRk` on slices
 /// (the same tableau, summed as the other explicit methods are).
@@ -148,7 +148,7 @@ fn inverse_sym2(a: f64, b: f64, d: f64) -> (f64, f64, f64) {
 /// equations whose matrix is constant between contact changes. The one
 /// implementation of the method: the fixed-step kernel's [`Newmark`] keeps
 /// its two inverses for its one step size, the event-driven kernel's
-/// [`crate::steppers::NewmarkFamily`] (lagged) makes them for each step.
+/// [`crate::legacy::steppers::NewmarkFamily`] (lagged) makes them for each step.
 #[derive(Debug, Clone, Copy)]
 pub struct PaperNewmark {
     pub beta: f64,

@@ -5,7 +5,7 @@
 //! lands on the solution to round-off and the event kernel's location of an
 //! impact is limited by round-off alone.
 //!
-//! It is a [`SystemStepper`] for [`crate::system_events::integrate_system`]:
+//! It is a [`SystemStepper`] for [`crate::kernel::events::integrate_system`]:
 //! the kernel watches the gaps, locates impacts on this flow, applies the
 //! impact map, sums chattering sequences and holds sticking pairs, whose
 //! constrained system has its own modes (computed when first needed). Steps
@@ -14,13 +14,15 @@
 //! one step (grazing). The energy accumulators (viscous loss, input work) are
 //! integrated by 5-point Gauss-Legendre over each step, on the exact flow.
 
-use crate::assembly::{Assembly, InteractionLaw, LinearParts, Mode, Scratch, INPUT, VISCOUS};
-use crate::contact::AnyLaw;
 use crate::error::{Error, Result};
-use crate::matrix_flow::MatrixFlow;
-use crate::modal::Configuration;
-use crate::series::{exp, sin_cos};
-use crate::system_steppers::SystemStepper;
+use crate::methods::matrix_flow::MatrixFlow;
+use crate::methods::modal::Configuration;
+use crate::methods::steppers::SystemStepper;
+use crate::model::assembly::{
+    Assembly, InteractionLaw, LinearParts, Mode, Scratch, INPUT, VISCOUS,
+};
+use crate::model::contact::AnyLaw;
+use crate::numerics::series::{exp, sin_cos};
 
 mod from_rest;
 
@@ -1052,9 +1054,9 @@ impl SystemStepper for ExactFlow {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec};
-    use crate::signals::Signal;
-    use crate::structure::Structure;
+    use crate::model::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec};
+    use crate::model::signals::Signal;
+    use crate::model::structure::Structure;
 
     #[test]
     fn nodes_by_the_addition_theorems_are_the_factors_there() {

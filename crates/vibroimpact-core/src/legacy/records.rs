@@ -2,12 +2,12 @@
 //! and the event-driven kernels: contact records, the history within its
 //! cap, the solution, the start check and the energy ledger.
 
-use crate::contact::ContactLaw;
 use crate::error::{Error, Result};
-use crate::memory::{self, NoRoom, MAX_RECORD_BYTES};
-use crate::model::{Excitation, Model};
-use crate::settings::Settings;
-use crate::system::State;
+use crate::kernel::memory::{self, NoRoom, MAX_RECORD_BYTES};
+use crate::legacy::equations::{Excitation, Model};
+use crate::legacy::settings::Settings;
+use crate::model::contact::ContactLaw;
+use crate::model::impact_damper::State;
 use std::collections::TryReserveError;
 
 /// One contact, from onset to separation. Speeds are relative normal speeds

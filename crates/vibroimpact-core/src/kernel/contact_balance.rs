@@ -7,11 +7,11 @@
 //! where that is smaller) it is an error whatever `energy_tolerance` says, as
 //! in the two-mass kernels. Evaluated at contact ends only, never per step.
 
-use crate::assembly::{Assembly, Mode};
-use crate::balance::balance;
 use crate::error::{Error, Result};
-use crate::settings::CONTACT_CREATION_LIMIT;
-use crate::system_events::PairContact;
+use crate::kernel::balance::balance;
+use crate::kernel::events::PairContact;
+use crate::legacy::settings::CONTACT_CREATION_LIMIT;
+use crate::model::assembly::{Assembly, Mode};
 
 /// The balance at a compliant contact's onset: the stored energy and the
 /// run's residual there, J.

@@ -10,8 +10,8 @@
 //! in a form whose terms are all of order one, so that every mode is right to
 //! round-off, and no mode number overflows.
 
-use crate::closed_forms::representable;
 use crate::error::{positive, within, Error, Result};
+use crate::model::closed_forms::representable;
 
 /// `1 / cosh(x)` and `tanh(x)` for `x >= 0`, from `e^-x` so that neither
 /// overflows however large `x` is.

@@ -3,8 +3,8 @@
 //! lane loop into vector instructions (AVX-512 or AVX2 where the processor
 //! has them, chosen at run time; SSE2 otherwise).
 //!
-//! Each lane is the run the fixed-step kernel ([`crate::run::integrate`]
-//! with [`crate::integrators::Rk4`]) makes of its member, bit for bit: the
+//! Each lane is the run the fixed-step kernel ([`crate::legacy::run::integrate`]
+//! with [`crate::legacy::integrators::Rk4`]) makes of its member, bit for bit: the
 //! same operations in the same order (the contact branch becomes a select,
 //! which changes no result), the same provisional approach-rate latch while
 //! apart and the same located onset rate in contact. What a lane keeps is
@@ -23,11 +23,11 @@
 
 use rayon::prelude::*;
 
-use crate::contact::{Contact, ContactLaw, Hertz, HysterHertz, LawKind, Linear};
 use crate::error::{Error, Result};
-use crate::hermite;
-use crate::model::{Free, Model};
-use crate::system::{ImpactDamper, State};
+use crate::legacy::equations::{Free, Model};
+use crate::model::contact::{Contact, ContactLaw, Hertz, HysterHertz, LawKind, Linear};
+use crate::model::impact_damper::{ImpactDamper, State};
+use crate::numerics::hermite;
 
 /// Runs advanced together: two independent vector chains of eight on
 /// AVX-512 (sixteen hide the latency of the square roots and divisions that
@@ -215,7 +215,7 @@ fn run_group<L: ContactLaw>(
             let s = member(l).initial;
             let model = &models[l];
             let start = model.contact(&s, model.side(&s) * s.relative_velocity());
-            let failed = crate::records::check_start(model, &s)
+            let failed = crate::legacy::records::check_start(model, &s)
                 .err()
                 .map(|e| e.to_string());
             let open = start.indentation > 0.0;
@@ -433,7 +433,7 @@ fn derivative<L: ContactLaw>(lanes: &Lanes<L>, s: &Quad, approach: &[f64; LANES]
     rate
 }
 
-/// Steps `n .. stop` of every lane: [`crate::integrators::Rk4`]'s stages in
+/// Steps `n .. stop` of every lane: [`crate::legacy::integrators::Rk4`]'s stages in
 /// its order, then the rare work of the lanes that need it.
 #[inline(always)]
 fn steps<L: ContactLaw>(

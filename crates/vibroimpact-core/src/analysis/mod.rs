@@ -1,0 +1,4 @@
+pub mod ensemble;
+pub mod settling;
+pub mod shooting;
+pub mod study;

@@ -1,0 +1,7 @@
+pub mod equations;
+pub mod events;
+pub mod integrators;
+pub mod records;
+pub mod run;
+pub mod settings;
+pub mod steppers;

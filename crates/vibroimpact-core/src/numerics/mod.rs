@@ -1,0 +1,3 @@
+pub(crate) mod hermite;
+pub mod linalg;
+pub(crate) mod series;
