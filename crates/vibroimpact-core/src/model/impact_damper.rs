@@ -1,7 +1,13 @@
 //! The impact damper: a main mass on a spring and damper carrying an
 //! enclosure in which a loose impact mass moves with a clearance on each side.
+//! A preset of the general system ([`ImpactDamper::spec`]): an oscillator
+//! with one damper of equal clearances at its coordinate, run by the general
+//! kernel like any other.
 
 use crate::error::{finite, non_negative, positive, Result};
+use crate::model::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
+use crate::model::contact::Contact;
+use crate::model::structure::Structure;
 
 /// Parameters of the two-mass impact damper (SI units).
 ///
@@ -44,6 +50,34 @@ impl ImpactDamper {
     /// Effective mass of the colliding pair, `m M / (m + M)`, kg.
     pub fn effective_mass(&self) -> f64 {
         self.main_mass * self.impact_mass / (self.main_mass + self.impact_mass)
+    }
+
+    /// The same system as a general one, as a 0.2 scenario writes it: a
+    /// `[structure] kind = "oscillator"` of mass M, stiffness K and damping
+    /// C, and one `[[damper]]` of mass m at its coordinate (point 0) with
+    /// both clearances d and `contact`'s law and contact damper c1. Unforced,
+    /// no gravity.
+    pub fn spec(&self, contact: &Contact) -> Result<SystemSpec> {
+        Ok(SystemSpec {
+            structure: Structure::oscillator(self.main_mass, self.stiffness, self.damping)?,
+            dampers: vec![Damper {
+                mass: self.impact_mass,
+                at: 0.0,
+                lower_clearance: self.clearance,
+                upper_clearance: self.clearance,
+                law: PairLaw::Compliant(*contact),
+            }],
+            stops: vec![],
+            gravity: 0.0,
+            excitations: vec![],
+            points: vec![],
+            moments: vec![],
+        })
+    }
+
+    /// [`Self::spec`], assembled for the kernel.
+    pub fn assembly(&self, contact: &Contact) -> Result<Assembly> {
+        Assembly::new(&self.spec(contact)?)
     }
 }
 
@@ -88,6 +122,31 @@ impl State {
         self.impact_velocity - self.main_velocity
     }
 
+    /// The state vector of the preset's assembly ([`ImpactDamper::assembly`]):
+    /// the main mass is the structure's coordinate, the impact mass the
+    /// damper's (both relative to the fixed base, as here). A start with the
+    /// bodies interpenetrating is refused.
+    pub fn vector(&self, system: &Assembly) -> Result<Vec<f64>> {
+        initial_state(
+            system,
+            &[self.main_displacement],
+            &[self.main_velocity],
+            &[self.impact_displacement],
+            &[self.impact_velocity],
+        )
+    }
+
+    /// The state a run of the preset ended in, from its `x` then `v`
+    /// (`[w, y, w', y']`).
+    pub fn of_vector(final_state: &[f64]) -> Self {
+        Self {
+            main_displacement: final_state[0],
+            impact_displacement: final_state[1],
+            main_velocity: final_state[2],
+            impact_velocity: final_state[3],
+        }
+    }
+
     #[inline(always)]
     pub(crate) fn is_finite(&self) -> bool {
         (self.main_displacement
@@ -95,5 +154,116 @@ impl State {
             + self.impact_displacement
             + self.impact_velocity)
             .is_finite()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::events::{RunOptions, SystemSolution};
+    use crate::methods::registry::AnyStepper;
+    use crate::model::closed_forms::linear_contact_duration;
+    use crate::model::contact::LawKind;
+
+    fn options(dt: Option<f64>, t_end: f64) -> RunOptions {
+        RunOptions {
+            dt,
+            t_end,
+            every: 1,
+            keep_history: true,
+            max_steps: 10_000_000,
+            max_rows: 10_000_000,
+            energy_tolerance: 0.05,
+            reduce: Default::default(),
+        }
+    }
+
+    fn run(
+        system: &Assembly,
+        y0: &[f64],
+        method: &str,
+        dt: Option<f64>,
+        t_end: f64,
+    ) -> SystemSolution {
+        let mut stepper = AnyStepper::new(system, method, 1e-12, 1e-15, 0.25, 0.5, 0.9).unwrap();
+        stepper
+            .integrate(system, y0, &options(dt, t_end), &mut || false)
+            .unwrap()
+    }
+
+    #[test]
+    fn the_preset_is_the_oscillator_with_one_damper_of_a_0_2_scenario() {
+        crate::testing::timeout(30, || {
+            let damper = ImpactDamper::new(1.0, 1.0, 0.01, 0.25, 0.01).unwrap();
+            let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
+            // As a 0.2 scenario writes it: [structure] kind = "oscillator" and
+            // one [[damper]] at = 0 with lower = upper clearance.
+            let written = SystemSpec {
+                structure: Structure::oscillator(1.0, 1.0, 0.01).unwrap(),
+                dampers: vec![Damper {
+                    mass: 0.25,
+                    at: 0.0,
+                    lower_clearance: 0.01,
+                    upper_clearance: 0.01,
+                    law: PairLaw::Compliant(contact),
+                }],
+                stops: vec![],
+                gravity: 0.0,
+                excitations: vec![],
+                points: vec![],
+                moments: vec![],
+            };
+            let preset = damper.assembly(&contact).unwrap();
+            let general = Assembly::new(&written).unwrap();
+            assert_eq!(preset, general);
+            let start = State::new(0.0, 0.0, 0.01, 0.1).unwrap();
+            // [initial] structure_displacement = [w], ... damper_velocity = [y'].
+            let y0 = initial_state(&general, &[0.0], &[0.0], &[0.01], &[0.1]).unwrap();
+            assert_eq!(start.vector(&preset).unwrap(), y0);
+            for (method, dt) in [("rk4", Some(1e-5)), ("dop853", None)] {
+                let (a, b) = (
+                    run(&preset, &y0, method, dt, 0.3),
+                    run(&general, &y0, method, dt, 0.3),
+                );
+                assert_eq!(a, b, "{method}");
+                assert!(!a.contacts.is_empty(), "{method}");
+            }
+        });
+    }
+
+    #[test]
+    fn the_preset_s_state_maps_each_mass_to_its_coordinate() {
+        crate::testing::timeout(30, || {
+            // Two free bodies (K = C = 0) meeting on a linear spring without
+            // damper: momentum m y' + M w' is conserved, the contact lasts
+            // pi sqrt(m_eff / k1) and the speeds swap as an elastic collision's.
+            let damper = ImpactDamper::new(1.0, 0.0, 0.0, 0.25, 0.01).unwrap();
+            let contact = Contact::new(LawKind::Linear, 1e4, None, 0.0).unwrap();
+            let system = damper.assembly(&contact).unwrap();
+            let start = State::new(0.0, -0.02, 0.01, 0.1).unwrap();
+            // Apart again after 0.014 s, at the other wall after 0.18 s.
+            let sol = run(
+                &system,
+                &start.vector(&system).unwrap(),
+                "dop853",
+                None,
+                0.1,
+            );
+            let end = State::of_vector(&sol.final_state);
+            let momentum = |s: &State| s.main_velocity + 0.25 * s.impact_velocity;
+            assert!((momentum(&end) - momentum(&start)).abs() < 1e-12);
+            let c = sol.contacts[0];
+            assert_eq!(sol.contacts.len(), 1);
+            assert!((c.onset - 0.0).abs() < 1e-12, "{c:?}");
+            assert!((c.approach_speed - 0.12).abs() < 1e-12, "{c:?}");
+            assert!((c.rebound_speed - 0.12).abs() < 1e-9, "{c:?}");
+            let duration = linear_contact_duration(0.25, 1.0, 1e4, 0.0).unwrap();
+            assert!(
+                (c.duration / duration - 1.0).abs() < 1e-9,
+                "{c:?} {duration}"
+            );
+            // Elastic: the relative velocity reversed, the centre of mass unmoved in speed.
+            assert!((end.relative_velocity() + 0.12).abs() < 1e-9, "{end:?}");
+        });
     }
 }
