@@ -55,10 +55,38 @@ from vibroimpact._core import cantilever_mode_shape as _cantilever_mode_shape
 from vibroimpact._core import check_solver as _check_solver
 from vibroimpact._core import goldsmith_contact_duration as _goldsmith_contact_duration
 from vibroimpact._core import run_study as _run_study
-from vibroimpact._core import simulate as _simulate
+from vibroimpact.analyses import orbit, runner, steady_state, sweep
 from vibroimpact.arguments import typed as _typed
+from vibroimpact.continuation import continue_orbit
+from vibroimpact.maps import basins, bifurcation, poincare
+from vibroimpact.model import (
+    Base,
+    Cantilever,
+    Damper,
+    Force,
+    Gravity,
+    Harmonic,
+    Harmonics,
+    Initial,
+    KanaiTajimi,
+    Matrices,
+    Oscillator,
+    Output,
+    Recorded,
+    Signal,
+    Solver,
+    Stop,
+    Structure,
+    Sweep,
+    System,
+    WhiteNoise,
+)
+from vibroimpact.model.load import load, loads
+from vibroimpact.model.run import TEXTS as _TEXTS
+from vibroimpact.model.run import simulate
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
-from vibroimpact.system import linear_parts, simulate_system
+from vibroimpact.study import study_of
+from vibroimpact.system import SystemContacts, SystemSolution, linear_parts, simulate_system
 
 
 def _equality_only(*classes: type) -> None:
@@ -79,12 +107,6 @@ def _equality_only(*classes: type) -> None:
 _equality_only(ImpactDamper, Contact, InitialState)
 
 # Arguments of the wrong type named (PyO3's TypeError names none).
-_TEXTS: dict[str, type | tuple[type, ...]] = {
-    "method": str,
-    "contact_timing": str,
-    "stepping": (str, type(None)),
-}
-simulate = _typed(system=ImpactDamper, contact=Contact, initial=InitialState, **_TEXTS)(_simulate)
 check_solver = _typed(**_TEXTS)(_check_solver)
 cantilever_mode_shape = _typed(derivative=int)(_cantilever_mode_shape)
 goldsmith_contact_duration = _typed(exact_constant=bool)(_goldsmith_contact_duration)
@@ -130,4 +152,38 @@ __all__ = [
     "parse_scenario",
     "simulate",
     "simulate_system",
+    # The typed model (vibroimpact.model) and what takes it.
+    "System",
+    "Structure",
+    "Oscillator",
+    "Matrices",
+    "Cantilever",
+    "Damper",
+    "Stop",
+    "Force",
+    "Base",
+    "Signal",
+    "Harmonic",
+    "Sweep",
+    "Harmonics",
+    "Recorded",
+    "WhiteNoise",
+    "KanaiTajimi",
+    "Gravity",
+    "Initial",
+    "Solver",
+    "Output",
+    "SystemSolution",
+    "SystemContacts",
+    "load",
+    "loads",
+    "sweep",
+    "orbit",
+    "steady_state",
+    "runner",
+    "poincare",
+    "bifurcation",
+    "basins",
+    "continue_orbit",
+    "study_of",
 ]

@@ -34,6 +34,7 @@ from vibroimpact._core import (
 from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.forcing_limits import check_forcing_period
 from vibroimpact.messages import shown
+from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
 from vibroimpact.system import (
     _NUMBER,
@@ -321,6 +322,12 @@ class Runner:
         return shot
 
 
+def as_runner(run: Runner | System) -> Runner:
+    """The analyses' entry: a :class:`~vibroimpact.System` as its :class:`Runner`
+    (anything else as it is, for :func:`checked_run` to check)."""
+    return runner(run) if isinstance(run, System) else run
+
+
 def checked_run(run: Any, state: Any) -> np.ndarray | None:
     """``run`` checked as a :class:`Runner` and ``state`` as one of its flat states
     (or None)."""
@@ -338,9 +345,10 @@ def _floats(name: str, value: Any) -> np.ndarray:
         raise AnalysisError(f"{name}: must be an array of numbers, got {shown(value)}") from None
 
 
-def runner(data: Mapping[str, Any], base_dir: Path | None = None) -> Runner:
-    """A :class:`Runner` of a scenario's sections (as parsed from TOML)."""
-    arguments.sections("data", data)
+def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Runner:
+    """A :class:`Runner` of a :class:`~vibroimpact.System` or of a scenario's sections
+    (as parsed from TOML)."""
+    data, base_dir = sections_of(data, base_dir)
     base_dir = arguments.directory("base_dir", base_dir)
     prepared, period = _prepare(data, base_dir), forcing_period(data)
     check_forcing_period(data, period, prepared.solver["max_steps"], base_dir)
@@ -415,7 +423,7 @@ class SteadyState:
 
 
 def steady_state(
-    run: Runner,
+    run: Runner | System,
     state: np.ndarray | None = None,
     *,
     settle_periods: int = 200,
@@ -429,7 +437,9 @@ def steady_state(
     motion: each coordinate's state (x, v) counts as the amplitude ``hypot(x, v /
     w)``, w the forcing's angular frequency), then record ``record_periods`` periods,
     rounded up to a whole number of p (impacts counted over part of an orbit differ
-    with where the window ends)."""
+    with where the window ends). ``run``: a :class:`Runner` or a
+    :class:`~vibroimpact.System`."""
+    run = as_runner(run)
     state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     record_periods = whole_count("record_periods", record_periods, 1)
@@ -924,7 +934,7 @@ class _PointFailure(Exception):
 
 
 def sweep(
-    data: Mapping[str, Any],
+    data: Mapping[str, Any] | System,
     parameter: str,
     values: Sequence[float] | np.ndarray,
     *,
@@ -941,8 +951,9 @@ def sweep(
     down from where up ended), each point starting from the last one's state, so
     that jumps and hysteresis show (from ``[initial]`` where that state is not
     admissible: see :func:`from_carried`). A point whose run fails is reported with
-    its error (and the next starts from the last good state)."""
-    arguments.sections("data", data)
+    its error (and the next starts from the last good state). ``data``: a
+    :class:`~vibroimpact.System` or a scenario's sections."""
+    data, base_dir = sections_of(data, base_dir)
     arguments.text("parameter", parameter)
     values = sorted(arguments.numbers("values", values).tolist())
     _choice("", "direction", direction, _DIRECTIONS)
@@ -1070,7 +1081,7 @@ class Orbit:
 
 
 def orbit(
-    run: Runner,
+    run: Runner | System,
     state: np.ndarray | None = None,
     *,
     periods: int = 1,
@@ -1083,7 +1094,9 @@ def orbit(
     differences (across impacts: the saltation is in the differences). At the orbit
     the Jacobian is the monodromy matrix; its eigenvalues are the Floquet multipliers
     and the orbit is stable when all lie inside the unit circle. Newton steps that
-    would start inside a wall are halved."""
+    would start inside a wall are halved. ``run``: a :class:`Runner` or a
+    :class:`~vibroimpact.System`."""
+    run = as_runner(run)
     state = checked_run(run, state)
     periods = whole_count("periods", periods, 1)
     arguments.positive("tolerance", tolerance)

@@ -39,6 +39,7 @@ from vibroimpact.analyses import (
     with_parameter,
 )
 from vibroimpact.messages import shown
+from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
 
 
@@ -102,7 +103,7 @@ STEP_RANGE = (1e-9, 1.0)
 
 
 def continue_orbit(
-    data: Mapping[str, Any],
+    data: Mapping[str, Any] | System,
     parameter: str,
     *,
     stop: float,
@@ -117,8 +118,9 @@ def continue_orbit(
     scenario's value of ``parameter``) towards ``stop``, with arclength steps of
     about ``step`` (in units of the parameter; default 1/50 of the range), at most
     ``max_points`` orbits. Stops at ``stop``, at ``max_points``, or when the
-    corrector fails even with small steps."""
-    arguments.sections("data", data)
+    corrector fails even with small steps. ``data``: a :class:`~vibroimpact.System` or a
+    scenario's sections."""
+    data, base_dir = sections_of(data, base_dir)
     arguments.text("parameter", parameter)
     stop = arguments.number("stop", stop)
     periods = whole_count("periods", periods, 1)

@@ -20,6 +20,7 @@ from vibroimpact.analyses import (
     BIFURCATION_SAMPLES,
     AnalysisError,
     Runner,
+    as_runner,
     check_kept,
     check_total,
     checked_run,
@@ -30,6 +31,7 @@ from vibroimpact.analyses import (
     with_parameter,
 )
 from vibroimpact.messages import shown
+from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
 
 
@@ -48,14 +50,16 @@ class Section:
 
 
 def poincare(
-    run: Runner,
+    run: Runner | System,
     state: np.ndarray | None = None,
     *,
     settle_periods: int = 200,
     periods: int = 500,
 ) -> Section:
     """Settle ``settle_periods`` forcing periods, then sample ``periods`` more: the
-    stroboscopic section and the impact section."""
+    stroboscopic section and the impact section. ``run``: a :class:`Runner` or a
+    :class:`~vibroimpact.System`."""
+    run = as_runner(run)
     state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
     periods = whole_count("periods", periods, 1)
@@ -140,7 +144,7 @@ def _sampled(
 
 
 def bifurcation(
-    data: Mapping[str, Any],
+    data: Mapping[str, Any] | System,
     parameter: str,
     values: Sequence[float] | np.ndarray,
     *,
@@ -159,8 +163,9 @@ def bifurcation(
     ``"displacement"`` (structure coordinate 0's stroboscopic displacement, m),
     ``"impact-velocity"`` (each impact's approach speed, m/s) or ``"impact-phase"``
     (each impact's ``w t`` modulo 2 pi, rad), the impacts of ``pair`` (``"stop 0"``,
-    ``"damper 1"``; every pair's where None)."""
-    arguments.sections("data", data)
+    ``"damper 1"``; every pair's where None). ``data``: a :class:`~vibroimpact.System`
+    or a scenario's sections."""
+    data, base_dir = sections_of(data, base_dir)
     arguments.text("parameter", parameter)
     values = arguments.numbers("values", values)
     base_dir = arguments.directory("base_dir", base_dir)
@@ -252,7 +257,7 @@ def _axis(name: str, value: Any) -> tuple[int, np.ndarray]:
 
 
 def basins(
-    run: Runner,
+    run: Runner | System,
     first: tuple[int, np.ndarray],
     second: tuple[int, np.ndarray],
     *,
@@ -265,7 +270,9 @@ def basins(
     """For each pair of values of two state components (``(index into the flat
     state (x, v), values)``), starting from ``state`` (default ``[initial]``) with
     those two set, find the steady state and group the results into attractors:
-    same period, same impacts per period and amplitudes within 1e-3 relative."""
+    same period, same impacts per period and amplitudes within 1e-3 relative.
+    ``run``: a :class:`Runner` or a :class:`~vibroimpact.System`."""
+    run = as_runner(run)
     # Checked here: each start's steady state would take a bad count for a start
     # inside a wall (every label -3).
     state = checked_run(run, state)

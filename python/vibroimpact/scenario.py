@@ -259,8 +259,20 @@ def parse_scenario(
     arguments.text("text", text)
     arguments.text("source", source)
     base_dir = arguments.directory("base_dir", base_dir)
+    data = read_toml(text, source)
+    if "structure" in data:
+        try:
+            return system_scenario(data, source, base_dir)
+        except InvalidInputError as err:
+            raise ScenarioError(str(err)) from None
+    return two_mass_scenario(data, source)
+
+
+def read_toml(text: str, source: str) -> dict[str, Any]:
+    """The tables of a scenario's TOML text; invalid TOML is a :class:`ScenarioError`
+    naming ``source``."""
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except RecursionError:
         # The parser recurses once per level of nested arrays or inline tables.
         raise ScenarioError(f"{source}: invalid TOML: values nested too deeply") from None
@@ -271,11 +283,10 @@ def parse_scenario(
         # colon advises on a Python setting, no help to the author of a scenario.
         reason = str(err).split(":")[0]
         raise ScenarioError(f"{source}: invalid TOML: a value it cannot read ({reason})") from None
-    if "structure" in data:
-        try:
-            return system_scenario(data, source, base_dir)
-        except InvalidInputError as err:
-            raise ScenarioError(str(err)) from None
+
+
+def two_mass_scenario(data: dict[str, Any], source: str) -> Scenario:
+    """The two-mass :class:`Scenario` of a 0.1 scenario's tables, every key checked."""
     s = _sections(data, source)
 
     def build(section: str, make: Any) -> Any:
@@ -303,6 +314,12 @@ def _validate_solver(scenario: Scenario, source: str) -> None:
 def load_scenario(path: str | Path) -> Scenario | SystemScenario:
     """Read and validate a TOML scenario file (UTF-8, at most ``MAX_SCENARIO_BYTES``)."""
     path = arguments.path("path", path)
+    return parse_scenario(read_scenario_text(path), str(path), path.parent)
+
+
+def read_scenario_text(path: Path) -> str:
+    """The text of a scenario file (a regular file of UTF-8 text, at most
+    ``MAX_SCENARIO_BYTES``); what cannot be read is a :class:`ScenarioError`."""
     try:
         # Checked before opening: opening a FIFO waits for a writer, for ever.
         if not stat.S_ISREG(path.stat().st_mode) and not path.is_dir():
@@ -320,4 +337,4 @@ def load_scenario(path: str | Path) -> Scenario | SystemScenario:
     except (OSError, UnicodeDecodeError) as err:
         reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
         raise ScenarioError(f"cannot read scenario {str(path)!r}: {reason}") from None
-    return parse_scenario(text, str(path), path.parent)
+    return text

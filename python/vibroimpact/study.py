@@ -111,6 +111,7 @@ from vibroimpact.analyses import (
     with_parameter,
 )
 from vibroimpact.forcing_limits import check_forcing_period
+from vibroimpact.model.system import System, sections_of
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in, written_whole
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table, split_observed
 
@@ -596,10 +597,11 @@ def _plain(value: Any) -> Any:
 
 
 def study_of(
-    data: Mapping[str, Any], source: str = "<study>", base_dir: Path | None = None
+    data: Mapping[str, Any] | System, source: str = "<study>", base_dir: Path | None = None
 ) -> Study:
-    """A :class:`Study` of a scenario's sections with a ``[study]`` section."""
-    arguments.sections("data", data)
+    """A :class:`Study` of a :class:`~vibroimpact.System` (its ``analyses["study"]``)
+    or of a scenario's sections with a ``[study]`` section."""
+    data, base_dir = sections_of(data, base_dir)
     arguments.text("source", source)
     base_dir = arguments.directory("base_dir", base_dir)
     if "study" not in data:

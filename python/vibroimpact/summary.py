@@ -97,3 +97,64 @@ def contacts_repr(contacts: Any) -> str:
         + (", ..." if len(pairs) > _SHOWN else "")
         + f"; columns: {', '.join(contacts.columns)})"
     )
+
+
+def _pandas() -> Any:
+    try:
+        import pandas
+    except ImportError:
+        raise ImportError(
+            "to_pandas() needs pandas (pip install pandas); the columns are NumPy arrays "
+            "without it (to_dicts() gives plain rows)"
+        ) from None
+    return pandas
+
+
+def contacts_frame(contacts: Any) -> Any:
+    """A contact table (one row per contact, its ``columns``, SI units) as a
+    ``pandas.DataFrame``; pandas is imported here, and its absence said."""
+    pandas = _pandas()
+    return pandas.DataFrame({name: getattr(contacts, name) for name in contacts.columns})
+
+
+#: The units of a history's arrays (attributes of :func:`history_dataset`'s variables).
+_UNITS = {
+    "structure_displacement": "m",
+    "structure_velocity": "m/s",
+    "damper_displacement": "m",
+    "damper_velocity": "m/s",
+}
+
+
+def history_dataset(sol: Any) -> Any:
+    """A 0.2 run's history as an ``xarray.Dataset``: each array of the history over the
+    dimension ``time`` (s) and ``structure_coordinate`` (modes of a cantilever, from
+    0) or ``damper``, with their units; the run's statistics and energy (J) as
+    attributes."""
+    import xarray as xr
+
+    arrays = {
+        name: (
+            ("time", "structure_coordinate" if name.startswith("structure") else "damper"),
+            getattr(sol, name),
+            {"units": unit},
+        )
+        for name, unit in _UNITS.items()
+    }
+    n, k = sol.structure_displacement.shape[1], sol.damper_displacement.shape[1]
+    statistics = ("steps", "rejected_steps", "rhs_evaluations", "grazing_contacts")
+    return xr.Dataset(
+        arrays,
+        coords={
+            "time": ("time", sol.t, {"units": "s"}),
+            "structure_coordinate": np.arange(n),
+            "damper": np.arange(k),
+        },
+        attrs={
+            "method": sol.method,
+            "final_time": sol.final_time,
+            "contacts": len(sol.contacts),
+            **{name: getattr(sol, name) for name in statistics},
+            **{f"energy_{key}": value for key, value in sol.energy.items()},
+        },
+    )

@@ -63,7 +63,7 @@ from vibroimpact.arguments import directory, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.record_file import check_record, read_record
 from vibroimpact.run_scales import check_forcing_steps, check_natural_period
-from vibroimpact.summary import contacts_repr, solution_repr
+from vibroimpact.summary import contacts_frame, contacts_repr, history_dataset, solution_repr
 
 __all__ = [
     "PreparedRun",
@@ -679,6 +679,10 @@ class SystemContacts:
     def __repr__(self) -> str:
         return contacts_repr(self)
 
+    def to_pandas(self) -> Any:
+        """The table as a ``pandas.DataFrame``, one row per contact (pandas needed)."""
+        return contacts_frame(self)
+
     def to_dicts(self) -> list[dict[str, Any]]:
         """One dict per contact, keyed by the column names."""
         return [
@@ -776,6 +780,12 @@ class SystemSolution:
 
     def __repr__(self) -> str:
         return solution_repr(self)
+
+    def to_xarray(self) -> Any:
+        """The history as an ``xarray.Dataset`` over ``time`` (s), with named
+        coordinates and units, the statistics and energy as attributes (contacts:
+        ``contacts.to_pandas()``)."""
+        return history_dataset(self)
 
 
 def simulate_system(

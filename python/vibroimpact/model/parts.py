@@ -1,0 +1,365 @@
+"""The typed parts of a 0.2 system, named as the sections and keys of its TOML scenario.
+
+Each part is a frozen, keyword-only dataclass whose fields are the keys of its TOML
+table (SI units); a field left at None is a key not written, which takes the format's
+default (see :mod:`vibroimpact.system`, the one place the keys, their defaults and
+their ranges are defined). A part only holds values: a :class:`~vibroimpact.System`
+checks them all at once through that schema, so that a bad value gets the error a
+scenario file gets, naming the section and the key. ``to_dict()`` gives the TOML
+table.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from vibroimpact.system import _GRAVITY, _STRUCTURE
+
+_Numbers = tuple[float, ...]
+_Rows = tuple[tuple[float, ...], ...]
+
+
+def _as_tuple(value: Any, depth: int) -> Any:
+    """Arrays given as lists or NumPy arrays held as tuples (``depth`` 1 for values, 2
+    for rows), so that parts compare and hash by value; anything else is kept as
+    given, for the schema to refuse by name."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence):
+        return value
+    if depth == 1:
+        return tuple(value)
+    return tuple(_as_tuple(row, depth - 1) for row in value)
+
+
+def _plain(value: Any) -> Any:
+    """A tuple as the list TOML reads (rows as lists of lists)."""
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+class Part:
+    """What every part shares: arrays held as tuples, and ``to_dict()``."""
+
+    #: The fields holding arrays: 1 for an array of values, 2 for rows.
+    _arrays: ClassVar[dict[str, int]] = {}
+
+    def __post_init__(self) -> None:
+        for name, depth in self._arrays.items():
+            object.__setattr__(self, name, _as_tuple(getattr(self, name), depth))
+
+    def __repr__(self) -> str:
+        # The keys given only, as the part would be written (None: left to the format).
+        given = ", ".join(
+            f"{f.name}={getattr(self, f.name)!r}"
+            for f in dataclasses.fields(self)  # type: ignore[arg-type]
+            if getattr(self, f.name) is not None
+        )
+        return f"{type(self).__name__}({given})"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The TOML table of this part: its keys that are given (not None), arrays as
+        lists."""
+        return {
+            f.name: _plain(getattr(self, f.name))
+            for f in dataclasses.fields(self)  # type: ignore[arg-type]
+            if getattr(self, f.name) is not None
+        }
+
+
+def _default(table: dict[str, tuple[str, Any]], key: str) -> Any:
+    """The schema's default of ``key`` (one source: :mod:`vibroimpact.system`)."""
+    return table[key][1]
+
+
+# ---------------------------------------------------------------- structures
+
+
+class Structure(Part):
+    """A ``[structure]``: :class:`Oscillator`, :class:`Matrices` or :class:`Cantilever`."""
+
+    kind: ClassVar[str]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, **super().to_dict()}
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Oscillator(Structure):
+    """One mode: ``mass`` (kg), ``stiffness`` (N/m), ``damping`` (N s/m). Its one
+    coordinate is point 0."""
+
+    kind: ClassVar[str] = "oscillator"
+    mass: float
+    stiffness: float
+    damping: float = _default(_STRUCTURE["oscillator"], "damping")
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Matrices(Structure):
+    """``mass`` (kg, symmetric positive definite), ``stiffness`` (N/m) and ``damping``
+    (N s/m; symmetric positive semi-definite; None: zeros) as n x n rows; the points
+    are the coordinate indices."""
+
+    kind: ClassVar[str] = "matrices"
+    _arrays: ClassVar[dict[str, int]] = {"mass": 2, "stiffness": 2, "damping": 2}
+    mass: _Rows
+    stiffness: _Rows
+    damping: _Rows | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Cantilever(Structure):
+    """A clamped-free Euler-Bernoulli beam in ``modes`` modal coordinates: ``length``
+    (m), ``youngs_modulus`` (Pa), ``second_moment`` (m^4), ``mass_per_length`` (kg/m),
+    ``damping_ratio`` of every mode; its points are positions along it (m from the
+    clamp)."""
+
+    kind: ClassVar[str] = "cantilever"
+    length: float
+    youngs_modulus: float
+    second_moment: float
+    mass_per_length: float
+    modes: int
+    damping_ratio: float = _default(_STRUCTURE["cantilever"], "damping_ratio")
+
+
+# -------------------------------------------------------------- interactions
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Damper(Part):
+    """A ``[[damper]]``: a loose ``mass`` (kg) rattling against the point ``at`` (a
+    coordinate index, or m along a cantilever) with ``clearance`` (m) on each side, or
+    ``lower_clearance`` and ``upper_clearance``. ``law``: ``"rigid"`` (Newton's
+    ``restitution`` in [0, 1]) or a compliant law, ``"hertz"``, ``"hyster-hertz"``,
+    ``"hertz-damped"`` or ``"linear"``, with ``stiffness`` (N/m^1.5; N/m for
+    ``"linear"``), ``restitution`` where the law takes one and the contact damper's
+    ``damping`` (N s/m, default 0)."""
+
+    mass: float
+    at: float
+    clearance: float | None = None
+    lower_clearance: float | None = None
+    upper_clearance: float | None = None
+    law: str
+    stiffness: float | None = None
+    restitution: float | None = None
+    damping: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Stop(Part):
+    """A ``[[stop]]``: the point ``at`` hits a stop fixed to the base, ``side =
+    "upper"`` keeping it at or below ``+gap`` (m), ``"lower"`` at or above ``-gap``;
+    with ``against`` (a second point) the stop is carried by that point. ``law`` and
+    its keys as for :class:`Damper`."""
+
+    at: float
+    side: str
+    gap: float
+    against: float | None = None
+    law: str
+    stiffness: float | None = None
+    restitution: float | None = None
+    damping: float | None = None
+
+
+# ------------------------------------------------------------------- signals
+
+
+class Signal(Part):
+    """The signal of an excitation; ``kind`` is its TOML ``signal``."""
+
+    kind: ClassVar[str]
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Harmonic(Signal):
+    """``amplitude * cos(2 pi frequency t + phase)``: ``frequency`` in Hz, ``phase`` in
+    rad (default 0); the amplitude in N for a force, m/s^2 for a base."""
+
+    kind: ClassVar[str] = "harmonic"
+    amplitude: float
+    frequency: float
+    phase: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Sweep(Signal):
+    """A harmonic whose frequency goes from ``start_frequency`` to ``end_frequency``
+    (Hz) over ``duration`` (s, default the run's t_end), ``sweep = "linear"`` or
+    ``"logarithmic"``, then stays at the end frequency."""
+
+    kind: ClassVar[str] = "sweep"
+    amplitude: float
+    start_frequency: float
+    end_frequency: float
+    duration: float | None = None
+    sweep: str | None = None
+    phase: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Harmonics(Signal):
+    """A sum of harmonics: as many ``amplitudes``, ``frequencies`` (Hz) and ``phases``
+    (rad; None: each 0)."""
+
+    kind: ClassVar[str] = "harmonics"
+    _arrays: ClassVar[dict[str, int]] = {"amplitudes": 1, "frequencies": 1, "phases": 1}
+    amplitudes: _Numbers
+    frequencies: _Numbers
+    phases: _Numbers | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Recorded(Signal):
+    """A record: ``file`` (a CSV of time in s and value; relative paths from the
+    system's ``base_dir``), or ``time`` and ``value`` arrays; interpolated linearly,
+    times ``scale``, zero outside the record."""
+
+    kind: ClassVar[str] = "recorded"
+    _arrays: ClassVar[dict[str, int]] = {"time": 1, "value": 1}
+    file: str | None = None
+    time: _Numbers | None = None
+    value: _Numbers | None = None
+    scale: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class WhiteNoise(Signal):
+    """Band-limited white noise: two-sided spectral density ``intensity`` S0 per rad/s
+    up to ``cutoff_frequency`` (Hz), the same for the same ``seed`` on every
+    platform, over ``duration`` (s, default t_end)."""
+
+    kind: ClassVar[str] = "white-noise"
+    intensity: float
+    cutoff_frequency: float
+    seed: int
+    duration: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class KanaiTajimi(Signal):
+    """White noise through the Kanai-Tajimi ground filter of ``ground_frequency`` (Hz)
+    and ``ground_damping``; the other keys as for :class:`WhiteNoise`."""
+
+    kind: ClassVar[str] = "kanai-tajimi"
+    intensity: float
+    ground_frequency: float
+    ground_damping: float
+    cutoff_frequency: float
+    seed: int
+    duration: float | None = None
+
+
+SIGNALS: tuple[type[Signal], ...] = (Harmonic, Sweep, Harmonics, Recorded, WhiteNoise, KanaiTajimi)
+
+# --------------------------------------------------------------- excitations
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Force(Part):
+    """A ``[[excitation]]`` of kind ``"force"``: ``signal`` (N) acting at the point
+    ``at``."""
+
+    at: float
+    signal: Signal
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": "force", "at": self.at, **_signal_keys(self.signal)}
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Base(Part):
+    """A ``[[excitation]]`` of kind ``"base"``: the support's acceleration ``signal``
+    (m/s^2); every coordinate is relative to the base, and stops move with it."""
+
+    signal: Signal
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": "base", **_signal_keys(self.signal)}
+
+
+def _signal_keys(signal: Any) -> dict[str, Any]:
+    """A signal's keys in its excitation's table (a part other than a signal is left for
+    :class:`~vibroimpact.System` to refuse by name)."""
+    if isinstance(signal, Signal):
+        return {"signal": signal.kind, **signal.to_dict()}
+    return {"signal": signal}
+
+
+# ------------------------------------------------- gravity, initial, settings
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Gravity(Part):
+    """``[gravity]``: ``acceleration`` (m/s^2, along -x, on every mass)."""
+
+    acceleration: float = _default(_GRAVITY, "acceleration")
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Initial(Part):
+    """``[initial]``: the state at t = 0 as arrays (m, m/s; zeros where empty): the
+    structure's coordinates, then each damper's own displacement (not relative to its
+    point) and velocity."""
+
+    _arrays: ClassVar[dict[str, int]] = {
+        "structure_displacement": 1,
+        "structure_velocity": 1,
+        "damper_displacement": 1,
+        "damper_velocity": 1,
+    }
+    structure_displacement: _Numbers = ()
+    structure_velocity: _Numbers = ()
+    damper_displacement: _Numbers = ()
+    damper_velocity: _Numbers = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        # Only the arrays given: an [initial] of zeros is written as none.
+        return {key: value for key, value in super().to_dict().items() if value}
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Solver(Part):
+    """``[solver]``: ``method`` (``"rk4"``, ``"dopri5"``, ``"dop853"``,
+    ``"newmark-implicit"``, ``"generalized-alpha"`` or ``"exact"``; default
+    ``"rk4"``), ``t_end`` and ``dt`` (s), ``rtol``, ``atol`` (m, m/s), ``beta``,
+    ``gamma``, ``spectral_radius``, ``max_steps``, ``max_rows``,
+    ``energy_tolerance``; None leaves a key to its default (see
+    :data:`vibroimpact.system.SYSTEM_SOLVER_DEFAULTS`)."""
+
+    method: str | None = None
+    t_end: float | None = None
+    dt: float | None = None
+    rtol: float | None = None
+    atol: float | None = None
+    max_steps: int | None = None
+    energy_tolerance: float | None = None
+    max_rows: int | None = None
+    beta: float | None = None
+    gamma: float | None = None
+    spectral_radius: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Output(Part):
+    """``[output]``: keep ``every`` N-th step of the history (``history = False``
+    keeps none); from ``record_from`` (s) the located peaks and RMS, every
+    ``strobe_period`` (s) the state, the structure at ``points`` and a cantilever's
+    bending moment at ``moments`` (m from the clamp, or coordinate indices)."""
+
+    _arrays: ClassVar[dict[str, int]] = {"points": 1, "moments": 1}
+    every: int | None = None
+    history: bool | None = None
+    record_from: float | None = None
+    strobe_period: float | None = None
+    points: _Numbers | None = None
+    moments: _Numbers | None = None

@@ -1,0 +1,168 @@
+"""``vibroimpact.simulate``: a typed :class:`~vibroimpact.System` on the general kernel,
+or the two-mass impact damper (``ImpactDamper``, ``Contact``, ``InitialState``)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, overload
+
+from vibroimpact._core import Contact, ImpactDamper, InitialState, InvalidInputError, Solution
+from vibroimpact._core import simulate as _two_mass
+from vibroimpact.arguments import typed
+from vibroimpact.messages import shown
+from vibroimpact.model.parts import Output, Solver
+from vibroimpact.model.system import System
+from vibroimpact.system import SystemSolution, prepare_system
+
+#: The text arguments of the two-mass run (PyO3's TypeError names none of them).
+TEXTS: dict[str, type | tuple[type, ...]] = {
+    "method": str,
+    "contact_timing": str,
+    "stepping": (str, type(None)),
+}
+two_mass: Callable[..., Solution] = typed(
+    system=ImpactDamper, contact=Contact, initial=InitialState, **TEXTS
+)(_two_mass)
+
+
+class _Default:
+    """The default of an argument not given (the run's setting, or the method's)."""
+
+    def __repr__(self) -> str:
+        return "default"
+
+
+_UNSET: Any = _Default()
+_SOLVER_KEYS = tuple(Solver.__dataclass_fields__)
+_OUTPUT_KEYS = tuple(Output.__dataclass_fields__)
+
+
+def simulate_model(system: System, **settings: Any) -> SystemSolution:
+    """Integrate ``system`` with its ``solver`` and ``output`` settings, each key
+    replaced by the keyword of that name given (None: not given), as a run of its
+    scenario file does (the same checks and the same bits)."""
+    unknown = [key for key in settings if key not in _SOLVER_KEYS + _OUTPUT_KEYS]
+    if unknown:
+        raise TypeError(
+            f"simulate() of a System got an unexpected keyword argument {unknown[0]!r} "
+            f"(it takes {', '.join(_SOLVER_KEYS + _OUTPUT_KEYS)})"
+        )
+    solver = {} if system.solver is None else system.solver.to_dict()
+    output = {} if system.output is None else system.output.to_dict()
+    for key, value in settings.items():
+        if value is not None:
+            (solver if key in _SOLVER_KEYS else output)[key] = value
+    prepared = prepare_system(
+        **system.model_sections(), solver=solver, output=output, base_dir=system.base_dir
+    )
+    return prepared.run()
+
+
+@overload
+def simulate(
+    system: System,
+    *,
+    t_end: float | None = None,
+    method: str | None = None,
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
+    energy_tolerance: float | None = None,
+    max_rows: int | None = None,
+    beta: float | None = None,
+    gamma: float | None = None,
+    spectral_radius: float | None = None,
+    every: int | None = None,
+    history: bool | None = None,
+    record_from: float | None = None,
+    strobe_period: float | None = None,
+    points: Any = None,
+    moments: Any = None,
+) -> SystemSolution: ...
+@overload
+def simulate(
+    system: ImpactDamper,
+    contact: Contact,
+    initial: InitialState,
+    *,
+    t_end: float,
+    dt: float | None = None,
+    method: str = "newmark",
+    every: int = 1,
+    contact_timing: str = "located",
+    stepping: str | None = None,
+    beta: float = 0.25,
+    gamma: float = 0.5,
+    spectral_radius: float = 0.9,
+    rtol: float = 1e-8,
+    atol: float = 1e-12,
+    max_steps: int = 1_000_000_000,
+    max_rows: int | None = None,
+    energy_tolerance: float | None = None,
+    history: bool = True,
+) -> Solution: ...
+def simulate(
+    system: System | ImpactDamper,
+    contact: Contact = _UNSET,
+    initial: InitialState = _UNSET,
+    *,
+    t_end: float | None = _UNSET,
+    method: str | None = _UNSET,
+    dt: float | None = _UNSET,
+    rtol: float | None = _UNSET,
+    atol: float | None = _UNSET,
+    max_steps: int | None = _UNSET,
+    energy_tolerance: float | None = _UNSET,
+    max_rows: int | None = _UNSET,
+    beta: float | None = _UNSET,
+    gamma: float | None = _UNSET,
+    spectral_radius: float | None = _UNSET,
+    every: int | None = _UNSET,
+    history: bool | None = _UNSET,
+    stepping: str | None = _UNSET,
+    contact_timing: str | None = _UNSET,
+    record_from: float | None = _UNSET,
+    strobe_period: float | None = _UNSET,
+    points: Any = _UNSET,
+    moments: Any = _UNSET,
+) -> SystemSolution | Solution:
+    """Integrate a system from its initial state to ``t_end`` (s); SI units. A keyword
+    not given (or None, for a System) takes the run's setting or its default.
+
+    ``simulate(system, t_end=..., method=..., ...)`` runs a :class:`vibroimpact.System`
+    on the general kernel with its ``solver`` and ``output`` settings (read from its
+    scenario file by :func:`vibroimpact.load`), each replaced by the keyword of that
+    name given: ``method`` (``"rk4"``, ``"dopri5"``, ``"dop853"``,
+    ``"newmark-implicit"``, ``"generalized-alpha"``, ``"exact"``; default ``"rk4"``),
+    ``t_end``, ``dt`` (s), ``rtol``, ``atol`` (m, m/s), ``beta``, ``gamma``,
+    ``spectral_radius``, ``max_steps``, ``max_rows``, ``energy_tolerance``, ``every``,
+    ``history``, ``record_from``, ``strobe_period`` (s), ``points``, ``moments``;
+    returns a :class:`~vibroimpact.SystemSolution` (see
+    :func:`vibroimpact.simulate_system`).
+
+    ``simulate(ImpactDamper, Contact, InitialState, t_end=..., method="newmark", ...)``
+    runs the two-mass impact damper (also ``stepping``, ``contact_timing``; not
+    ``record_from``, ``strobe_period``, ``points``, ``moments``) and returns a
+    :class:`vibroimpact.Solution` (its defaults: ``method="newmark"``, ``dt`` required
+    by the fixed-step methods, the rest as for a System).
+    """
+    given = {key: value for key, value in locals().items() if value is not _UNSET}
+    del given["system"]
+    if isinstance(system, System):
+        for name in ("contact", "initial", "stepping", "contact_timing"):
+            if name in given:
+                raise InvalidInputError(
+                    f"{name}: applies to the two-mass run (simulate(ImpactDamper, Contact, "
+                    f"InitialState, ...)), not to a System, got {shown(given[name])}"
+                )
+        # None leaves a setting to the system's solver or output, or to its default.
+        return simulate_model(system, **{k: v for k, v in given.items() if v is not None})
+    for name in ("record_from", "strobe_period", "points", "moments"):
+        if name in given:
+            raise InvalidInputError(
+                f"{name}: applies to a vibroimpact.System, not to the two-mass run, got "
+                f"{shown(given[name])}"
+            )
+    # Forwarded as given (None included): the two-mass run's checks name what is wrong.
+    return two_mass(system, **given)

@@ -1,0 +1,313 @@
+"""A typed 0.2 system: a structure with its dampers, stops, excitations, gravity and
+initial state, checked by the scenario format's one schema (:mod:`vibroimpact.system`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any, TypeVar
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.arguments import directory, sections
+from vibroimpact.messages import shown
+from vibroimpact.model.parts import (
+    SIGNALS,
+    Base,
+    Cantilever,
+    Damper,
+    Force,
+    Gravity,
+    Initial,
+    Matrices,
+    Oscillator,
+    Output,
+    Part,
+    Signal,
+    Solver,
+    Stop,
+    Structure,
+)
+from vibroimpact.model.toml_text import toml_text
+from vibroimpact.system import _INITIAL, _fail, _table, prepare_system, system_spec
+
+_P = TypeVar("_P", bound=Part)
+
+#: The sections of analyses and studies a System carries as read (see ``analyses``).
+ANALYSIS_SECTIONS = ("sweep", "continuation", "basins", "study")
+_STRUCTURES: dict[str, type[Structure]] = {c.kind: c for c in (Oscillator, Matrices, Cantilever)}
+_SIGNAL_OF: dict[str, type[Signal]] = {c.kind: c for c in SIGNALS}
+
+
+@dataclass(frozen=True, kw_only=True, repr=False)
+class System:
+    """A vibro-impact system (SI units), built from typed parts named as the sections
+    of a TOML scenario: ``structure`` (:class:`Oscillator`, :class:`Matrices` or
+    :class:`Cantilever`), ``dampers`` (``[[damper]]``), ``stops`` (``[[stop]]``),
+    ``excitations`` (``[[excitation]]``: :class:`Force` or :class:`Base`), ``gravity``
+    and ``initial``.
+
+    Its run settings ride along when given (or read from a file by
+    :func:`vibroimpact.load`): ``solver`` and ``output`` are the ``[solver]`` and
+    ``[output]`` a plain :func:`vibroimpact.simulate` of it uses (its keywords override
+    them), ``analyses`` the ``[sweep]``, ``[continuation]``, ``[basins]`` and
+    ``[study]`` tables as written (checked when read from a file, and by the analysis
+    that uses them). ``base_dir`` is the folder a recorded signal's relative ``file`` is
+    read from (the scenario's, for a loaded system; None: the working directory).
+
+    Every value is checked on construction by the scenario's schema, with the error a
+    file gets (``[[damper]] 0: law "rigid" needs restitution in [0, 1], got 1.5``); the
+    solver and output as well when ``solver`` has a ``t_end``. ``to_dict()`` gives the
+    TOML sections, ``to_toml()`` the scenario text.
+    """
+
+    structure: Structure
+    dampers: Sequence[Damper] = ()
+    stops: Sequence[Stop] = ()
+    excitations: Sequence[Force | Base] = ()
+    gravity: Gravity | None = None
+    initial: Initial | None = None
+    solver: Solver | None = None
+    output: Output | None = None
+    analyses: Mapping[str, Any] = field(default_factory=dict, hash=False)
+    base_dir: Path | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        _instance("structure", self.structure, Structure, "Oscillator, Matrices or Cantilever")
+        for name, kind in (("dampers", Damper), ("stops", Stop)):
+            object.__setattr__(self, name, _parts(name, getattr(self, name), kind, kind.__name__))
+        excitations = _parts("excitations", self.excitations, (Force, Base), "Force or Base")
+        for j, excitation in enumerate(excitations):
+            _instance(f"excitations[{j}].signal", excitation.signal, Signal, _SIGNAL_NAMES)
+        object.__setattr__(self, "excitations", excitations)
+        optional: tuple[tuple[str, type[Part]], ...] = (
+            ("gravity", Gravity),
+            ("initial", Initial),
+            ("solver", Solver),
+            ("output", Output),
+        )
+        for name, part in optional:
+            if getattr(self, name) is not None:
+                _instance(name, getattr(self, name), part, part.__name__)
+        if not isinstance(self.analyses, Mapping):
+            raise InvalidInputError(
+                f"System analyses: must be a dict of tables ({', '.join(ANALYSIS_SECTIONS)}), "
+                f"got {shown(self.analyses)}"
+            )
+        for name in self.analyses:
+            if name not in ANALYSIS_SECTIONS:
+                raise InvalidInputError(
+                    f"System analyses: unknown section {shown(name)} (allowed: "
+                    f"{', '.join(ANALYSIS_SECTIONS)})"
+                )
+        object.__setattr__(self, "analyses", dict(self.analyses))
+        object.__setattr__(self, "base_dir", directory("base_dir", self.base_dir))
+        self._check()
+
+    def __repr__(self) -> str:
+        given = ", ".join(
+            f"{f.name}={_shown_field(getattr(self, f.name))}"
+            for f in fields(self)
+            if getattr(self, f.name) not in (None, (), {})
+        )
+        return f"System({given})"
+
+    def _check(self) -> None:
+        """Every value through the scenario's schema (its errors, word for word)."""
+        sections = self.to_dict()
+        model = self.model_sections()
+        if self.solver is not None and self.solver.t_end is not None:
+            prepare_system(
+                **model,
+                solver=sections["solver"],
+                output=sections.get("output"),
+                base_dir=self.base_dir,
+            )
+            return
+        initial = model.pop("initial")
+        try:
+            system_spec(**model, base_dir=self.base_dir)
+        except RecursionError:
+            raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
+        _table("[initial] ", {} if initial is None else initial, _INITIAL)
+
+    def model_sections(self) -> dict[str, Any]:
+        """The model's sections as :func:`vibroimpact.system.prepare_system` takes them
+        (``structure``, ``damper``, ``stop``, ``gravity``, ``excitation``, ``initial``)."""
+        sections = self.to_dict()
+        return {
+            "structure": sections["structure"],
+            "damper": sections.get("damper", []),
+            "stop": sections.get("stop", []),
+            "gravity": sections.get("gravity"),
+            "excitation": sections.get("excitation", []),
+            "initial": sections.get("initial"),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scenario's sections as ``tomllib`` reads them: ``structure``, ``damper``,
+        ``stop``, ``gravity``, ``excitation`` (lists of tables), ``initial``, ``solver``,
+        ``output`` and the analyses' tables, each where given."""
+        sections: dict[str, Any] = {"structure": self.structure.to_dict()}
+        for name, parts in (("damper", self.dampers), ("stop", self.stops)):
+            if parts:
+                sections[name] = [part.to_dict() for part in parts]
+        if self.gravity is not None:
+            sections["gravity"] = self.gravity.to_dict()
+        if self.excitations:
+            sections["excitation"] = [part.to_dict() for part in self.excitations]
+        for name in ("initial", "solver", "output"):
+            part = getattr(self, name)
+            if part is not None:
+                sections[name] = part.to_dict()
+        return sections | {name: self.analyses[name] for name in self.analyses}
+
+    def to_toml(self, *, solver: Solver | None = None, output: Output | None = None) -> str:
+        """The system as a 0.2 scenario (TOML text, SI units) that
+        :func:`vibroimpact.load` reads back into an equal System; ``solver`` and
+        ``output`` in place of the system's own (a scenario run from the command line
+        needs a ``[solver]`` with ``t_end``)."""
+        system = self
+        if solver is not None or output is not None:
+            system = self.replace(
+                solver=self.solver if solver is None else solver,
+                output=self.output if output is None else output,
+            )
+        return toml_text(system.to_dict())
+
+    def replace(self, **changes: Any) -> System:
+        """A copy with ``changes`` (fields by name), checked as a new System."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        for name in changes:
+            if name not in values:
+                raise InvalidInputError(
+                    f"System.replace: unknown field {name!r} (fields: {', '.join(values)})"
+                )
+        return System(**(values | changes))
+
+    @classmethod
+    def from_dict(cls, sections: Mapping[str, Any], base_dir: Path | None = None) -> System:
+        """A System of a scenario's sections (as ``tomllib`` reads a 0.2 scenario, or
+        :meth:`to_dict` gives); checked first as they are, so that a bad table gets the
+        file's error (an unknown key included)."""
+        if not isinstance(sections, Mapping):
+            raise InvalidInputError(
+                f"sections: must be a dict of tables (as tomllib reads a scenario), got "
+                f"{shown(sections)}"
+            )
+        known = {"structure", "damper", "stop", "gravity", "excitation", "initial"}
+        for name in sections:
+            if name not in known | {"solver", "output", *ANALYSIS_SECTIONS}:
+                raise InvalidInputError(
+                    f"unknown section [{name}] (allowed: {', '.join(sorted(known))}, solver, "
+                    f"output, {', '.join(ANALYSIS_SECTIONS)})"
+                )
+        if "structure" not in sections:
+            raise InvalidInputError("missing section [structure]")
+        try:
+            return cls._of_tables(sections, base_dir)
+        except (TypeError, KeyError, AttributeError):
+            # A table the parts cannot take (an unknown key, a missing kind): the
+            # schema's error names it.
+            model = {name: sections.get(name) for name in known}
+            system_spec(
+                model["structure"],
+                model["damper"] or (),
+                model["stop"] or (),
+                model["gravity"],
+                model["excitation"] or (),
+                directory("base_dir", base_dir),
+            )
+            _table("[initial] ", model["initial"] or {}, _INITIAL)
+            for name, kind in (("solver", Solver), ("output", Output)):
+                table = sections.get(name)
+                if isinstance(table, Mapping):
+                    prepared = {f.name for f in fields(kind)}
+                    for key in table:
+                        if key not in prepared:
+                            raise _fail(f"[{name}] ", f"unknown key {key!r}") from None
+            raise
+
+    @classmethod
+    def _of_tables(cls, sections: Mapping[str, Any], base_dir: Path | None) -> System:
+        structure = dict(sections["structure"])
+        kind = _STRUCTURES[str(structure.pop("kind"))]
+        gravity = sections.get("gravity")
+        if gravity is not None and not isinstance(gravity, Mapping):
+            gravity = {"acceleration": gravity}  # a number, as the schema takes it
+        return cls(
+            structure=kind(**structure),
+            dampers=_tables(Damper, sections.get("damper")),
+            stops=_tables(Stop, sections.get("stop")),
+            excitations=[_excitation(dict(e)) for e in _listed(sections.get("excitation"))],
+            gravity=_part(Gravity, gravity),
+            initial=_part(Initial, sections.get("initial")),
+            solver=_part(Solver, sections.get("solver")),
+            output=_part(Output, sections.get("output")),
+            analyses={name: sections[name] for name in ANALYSIS_SECTIONS if name in sections},
+            base_dir=base_dir,
+        )
+
+
+_SIGNAL_NAMES = ", ".join(c.__name__ for c in SIGNALS)
+
+
+def _shown_field(value: Any) -> str:
+    """A field in the repr: a list of parts as a list."""
+    return repr(list(value)) if isinstance(value, tuple) else repr(value)
+
+
+def _instance(name: str, value: Any, kind: type | tuple[type, ...], wanted: str) -> None:
+    if not isinstance(value, kind):
+        raise InvalidInputError(
+            f"System {name}: must be a vibroimpact.{wanted.replace(', ', ', vibroimpact.')}, "
+            f"got {shown(value)}"
+        )
+
+
+def _parts(name: str, value: Any, kind: type | tuple[type, ...], wanted: str) -> tuple[Any, ...]:
+    """A list of parts as a tuple, each checked as one of ``kind``."""
+    if isinstance(value, Part) or isinstance(value, str | bytes | Mapping):
+        raise InvalidInputError(
+            f"System {name}: must be a list of vibroimpact.{wanted} (one in a list too), "
+            f"got {shown(value)}"
+        )
+    if not isinstance(value, Sequence):
+        raise InvalidInputError(f"System {name}: must be a list, got {shown(value)}")
+    for j, part in enumerate(value):
+        _instance(f"{name}[{j}]", part, kind, wanted)
+    return tuple(value)
+
+
+def _listed(value: Any) -> list[Mapping[str, Any]]:
+    """An array of tables (or one table) as a list."""
+    if value is None:
+        return []
+    return [value] if isinstance(value, Mapping) else list(value)
+
+
+def _part(kind: type[_P], table: Any) -> _P | None:
+    return None if table is None else kind(**table)
+
+
+def _tables(kind: type[_P], value: Any) -> list[_P]:
+    return [kind(**table) for table in _listed(value)]
+
+
+def _excitation(table: dict[str, Any]) -> Force | Base:
+    """An ``[[excitation]]`` table (checked) as a Force or a Base with its signal."""
+    load, signal = table.pop("kind"), _SIGNAL_OF[table.pop("signal")]
+    if load == "force":
+        at = table.pop("at")
+        return Force(at=at, signal=signal(**table))
+    return Base(signal=signal(**table))
+
+
+def sections_of(data: Any, base_dir: Path | None = None) -> tuple[Mapping[str, Any], Path | None]:
+    """The analyses' entry: a :class:`System` as its sections (and its ``base_dir``
+    where none is given), or a scenario's sections (a dict of tables) as they are;
+    anything else is refused naming ``data``."""
+    if isinstance(data, System):
+        return data.to_dict(), data.base_dir if base_dir is None else base_dir
+    return sections("data", data), base_dir
