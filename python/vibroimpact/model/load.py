@@ -60,23 +60,24 @@ def loads(text: str, source: str = "<scenario>", base_dir: Path | None = None) -
     arguments.text("source", source)
     base_dir = arguments.directory("base_dir", base_dir)
     data = read_toml(text, source)
+    if "structure" not in data:
+        return _two_mass(two_mass_scenario(data, source), data)
     try:
-        if "structure" not in data:
-            return _two_mass(two_mass_scenario(data, source), data)
         if "solver" in data:
-            # Every section checked as a run of the file checks it.
+            # Every section checked as a run of the file checks it (errors name the file).
             system_scenario(data, source, base_dir)
         else:
             # A system written without [solver] (System.to_toml of a bare System).
             for name in data:
                 if name not in SECTIONS:
                     raise ScenarioError(
-                        f"unknown section [{name}] (allowed with [structure]: "
+                        f"{source}: unknown section [{name}] (allowed with [structure]: "
                         f"{', '.join(SECTIONS)})"
                     )
+    except ValueError as err:
+        raise ScenarioError(str(err)) from None
+    try:
         return System.from_dict(data, base_dir)
-    except ScenarioError:
-        raise
     except ValueError as err:
         raise ScenarioError(f"{source}: {err}") from None
 
