@@ -5,6 +5,7 @@ row, and one ``'damper 0'`` per contact)."""
 from __future__ import annotations
 
 import dataclasses
+import importlib
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
 
@@ -101,7 +102,8 @@ def contacts_repr(contacts: Any) -> str:
 
 def _pandas() -> Any:
     try:
-        import pandas
+        # By name: pandas ships no type hints of its own (pandas-stubs does).
+        pandas = importlib.import_module("pandas")
     except ImportError:
         raise ImportError(
             "to_pandas() needs pandas (pip install pandas); the columns are NumPy arrays "
