@@ -90,3 +90,13 @@ def test_readme_test_command_is_what_ci_runs() -> None:
     command = next(line for line in setup.splitlines() if "pytest" in line)
     ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
     assert command.strip() in ci
+
+
+def test_readme_typed_model_snippet_runs_and_its_comment_is_true(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code = next(b for b in blocks("python") if "vi.System(" in b)
+    exec(compile(code, "README.md", "exec"), {})
+    steps, contacts = capsys.readouterr().out.splitlines()[0].split()
+    claimed = re.search(r"# (\d+) steps, (\d+) contacts", code)
+    assert claimed is not None and (steps, contacts) == claimed.groups()
