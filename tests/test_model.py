@@ -63,6 +63,18 @@ def test_every_part_is_named_as_its_toml_table() -> None:
     assert vi.Gravity().acceleration == schema._GRAVITY["acceleration"][1] == 9.81
 
 
+def aluminium_beam() -> vi.Cantilever:
+    """examples/beam_two_dampers.toml's cantilever."""
+    return vi.Cantilever(
+        length=0.5,
+        youngs_modulus=7e10,
+        second_moment=1e-10,
+        mass_per_length=0.27,
+        modes=3,
+        damping_ratio=0.01,
+    )
+
+
 def issue_example() -> vi.System:
     return vi.System(
         structure=vi.Oscillator(mass=1.0, stiffness=3947.8, damping=2.513),
@@ -186,14 +198,7 @@ def every_kind_of_system() -> list[vi.System]:
             output=vi.Output(every=3, record_from=0.5, strobe_period=0.4, points=[0, 1]),
         ),
         vi.System(
-            structure=vi.Cantilever(
-                length=0.5,
-                youngs_modulus=7e10,
-                second_moment=1e-10,
-                mass_per_length=0.27,
-                modes=3,
-                damping_ratio=0.01,
-            ),
+            structure=aluminium_beam(),
             dampers=[vi.Damper(mass=0.01, at=0.5, clearance=2e-4, law="hertz", stiffness=1e7)],
             excitations=[
                 vi.Base(
@@ -224,6 +229,29 @@ def test_a_built_system_round_trips_bit_for_bit(system: vi.System) -> None:
     # Bit for bit, not merely equal as floats compare (-0.0 == 0.0).
     assert repr(again.to_dict()) == repr(system.to_dict())
     assert tomllib.loads(text) == system.to_dict()
+
+
+def test_a_recorded_file_is_read_from_the_scenarios_folder(tmp_path: Path) -> None:
+    (tmp_path / "ground.csv").write_text("time,value\n0,0\n0.1,1.0\n0.2,-1.0\n0.3,0\n")
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=400.0, damping=1.0),
+        excitations=[vi.Base(signal=vi.Recorded(file="ground.csv", scale=2.0))],
+        solver=vi.Solver(method="dopri5", t_end=0.5),
+        base_dir=tmp_path,
+    )
+    (tmp_path / "shaken.toml").write_text(system.to_toml())
+    loaded = vi.load(tmp_path / "shaken.toml")
+    assert loaded == system and loaded.base_dir == tmp_path
+    inline = system.replace(
+        excitations=[
+            vi.Base(signal=vi.Recorded(time=[0, 0.1, 0.2, 0.3], value=[0, 1.0, -1.0, 0], scale=2.0))
+        ]
+    )
+    from_file, from_arrays = vi.simulate(loaded), vi.simulate(inline)
+    assert abs(from_file.final_state["structure_displacement"][0]) > 1e-5
+    assert np.array_equal(from_file.structure_displacement, from_arrays.structure_displacement)
+    with pytest.raises(vi.InvalidInputError, match="ground.csv"):
+        system.replace(base_dir=None)  # read from the working directory: not there
 
 
 def test_to_toml_takes_a_solver_and_the_file_runs_from_the_command_line(tmp_path: Path) -> None:
@@ -280,14 +308,7 @@ def built(name: str) -> vi.System:
             solver=vi.Solver(method="exact", t_end=1.0)
         ),
         "beam_two_dampers.toml": vi.System(
-            structure=vi.Cantilever(
-                length=0.5,
-                youngs_modulus=7e10,
-                second_moment=1e-10,
-                mass_per_length=0.27,
-                modes=3,
-                damping_ratio=0.01,
-            ),
+            structure=aluminium_beam(),
             dampers=[
                 vi.Damper(
                     mass=0.01,

@@ -21,6 +21,7 @@ with contact events located to round-off. SI units throughout.
 # Imported here, not on the first result array inside a (timed) run.
 import numpy as _numpy  # noqa: F401
 
+from vibroimpact import model as _model
 from vibroimpact._core import (
     ATOL_MAX,
     DEFAULT_ENERGY_TOLERANCE,
@@ -59,28 +60,7 @@ from vibroimpact.analyses import orbit, runner, steady_state, sweep
 from vibroimpact.arguments import typed as _typed
 from vibroimpact.continuation import continue_orbit
 from vibroimpact.maps import basins, bifurcation, poincare
-from vibroimpact.model import (
-    Base,
-    Cantilever,
-    Damper,
-    Force,
-    Gravity,
-    Harmonic,
-    Harmonics,
-    Initial,
-    KanaiTajimi,
-    Matrices,
-    Oscillator,
-    Output,
-    Recorded,
-    Signal,
-    Solver,
-    Stop,
-    Structure,
-    Sweep,
-    System,
-    WhiteNoise,
-)
+from vibroimpact.model import *  # noqa: F403  (the parts and System: model.__all__)
 from vibroimpact.model.load import load, loads
 from vibroimpact.model.run import TEXTS as _TEXTS
 from vibroimpact.model.run import simulate
@@ -152,27 +132,8 @@ __all__ = [
     "parse_scenario",
     "simulate",
     "simulate_system",
-    # The typed model (vibroimpact.model) and what takes it.
-    "System",
-    "Structure",
-    "Oscillator",
-    "Matrices",
-    "Cantilever",
-    "Damper",
-    "Stop",
-    "Force",
-    "Base",
-    "Signal",
-    "Harmonic",
-    "Sweep",
-    "Harmonics",
-    "Recorded",
-    "WhiteNoise",
-    "KanaiTajimi",
-    "Gravity",
-    "Initial",
-    "Solver",
-    "Output",
+    # The typed model (vibroimpact.model.__all__) and what takes it.
+    *_model.__all__,
     "SystemSolution",
     "SystemContacts",
     "load",

@@ -81,7 +81,7 @@ def simulate(
     moments: Any = None,
 ) -> SystemSolution: ...
 @overload
-def simulate(
+def simulate(  # the two-mass run's own signature (_core.pyi)
     system: ImpactDamper,
     contact: Contact,
     initial: InitialState,
