@@ -257,14 +257,7 @@ def test_a_recorded_file_is_read_from_the_scenarios_folder(tmp_path: Path) -> No
 def test_to_toml_takes_a_solver_and_the_file_runs_from_the_command_line(tmp_path: Path) -> None:
     path = tmp_path / "built.toml"
     path.write_text(issue_example().to_toml(solver=vi.Solver(method="exact", t_end=0.5)))
-    done = subprocess.run(
-        [sys.executable, "-m", "vibroimpact", "simulate", str(path), "--json"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout)["final_time"] == 0.5
+    assert cli_json(path)["final_time"] == 0.5
     loaded = vi.load(path)
     assert loaded.solver == vi.Solver(method="exact", t_end=0.5)
     assert loaded.replace(solver=None, base_dir=None) == issue_example()
