@@ -1,0 +1,438 @@
+//! Assembling a [`SystemSpec`] into an [`Assembly`]: the structure's
+//! matrices, the walls of each pair with their pushes, the excitations'
+//! loads, the time scales and the followed points; every input checked.
+
+use super::spec::{Load, PairLaw, Side, SystemSpec, MAX_PAIRS, MAX_POINTS};
+use super::{Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw};
+use crate::error::{non_negative, positive, Error, Result};
+use crate::kernel::compact::Compact;
+use crate::model::signals::Signal;
+use crate::model::structure::Structure;
+use crate::numerics::linalg;
+
+impl Assembly {
+    /// Assemble and check a system. Errors name the input (`damper 1 at`).
+    pub fn new(spec: &SystemSpec) -> Result<Self> {
+        let s = &spec.structure;
+        let (n, k) = (s.dofs(), spec.dampers.len());
+        let dim = n + k;
+        let matrices = StructureMatrices::of(s);
+        let gravity = non_negative("gravity", spec.gravity)?;
+        let walls = Walls::of(spec, &matrices.minv)?;
+        let (forces, base) = excitation_loads(spec, &matrices.minv)?;
+        let scales = TimeScales::of(
+            spec,
+            &matrices.mass_influence,
+            &walls.damper_mass,
+            gravity,
+            &walls.interactions,
+        );
+        let Walls {
+            damper_mass,
+            interactions,
+            pairs,
+        } = walls;
+        duplicate_walls(&interactions, &pairs)?;
+        let mirrors_previous = (0..interactions.len())
+            .map(|i| {
+                i > 0
+                    && interactions[i]
+                        .h
+                        .iter()
+                        .zip(&interactions[i - 1].h)
+                        .all(|(a, b)| *a == -*b)
+            })
+            .collect();
+        let point_rows = followed_rows(spec)?;
+        let mut assembly = Self {
+            compact: None,
+            point_rows,
+            mirrors_previous,
+            sticking_step: 0.1 * scales.shortest,
+            floor_mass_acceleration: scales.floor_mass_acceleration,
+            time_scale: scales.time_scale,
+            n,
+            k,
+            dim,
+            mass: s.mass().to_vec(),
+            stiffness: s.stiffness().to_vec(),
+            damping: s.damping().to_vec(),
+            minv_k: matrices.minv_k,
+            minv_c: matrices.minv_c,
+            damper_mass,
+            diagonals: matrices.diagonals,
+            diagonal: [s.mass(), s.stiffness(), s.damping()]
+                .iter()
+                .all(|a| (0..n * n).all(|p| p % (n + 1) == 0 || a[p] == 0.0)),
+            influence: s.influence().to_vec(),
+            mass_influence: matrices.mass_influence,
+            gravity,
+            forces,
+            base,
+            interactions,
+            longest_period: scales.longest_period,
+            pairs,
+        };
+        assembly.compact = Compact::of(&assembly).map(Box::new);
+        Ok(assembly)
+    }
+
+    /// What [`Compact::of`] reads, for a system with diagonal matrices.
+    pub(crate) fn compact_parts(&self) -> Option<CompactParts<'_>> {
+        self.diagonal.then(|| CompactParts {
+            diagonals: &self.diagonals,
+            forces: self
+                .forces
+                .iter()
+                .map(|f| (&f.signal, &f.push[..], &f.row[..]))
+                .collect(),
+            has_base: !self.base.is_empty(),
+            gravity: self.gravity,
+            mirrors: &self.mirrors_previous,
+        })
+    }
+}
+
+/// Refuses two rigid walls with the same gap (the same points, side and
+/// offset, such as a stop given twice, or as `lower` from the other point):
+/// an impact resolves one of them, which one depending on their order.
+fn duplicate_walls(interactions: &[Interaction], pairs: &[String]) -> Result<()> {
+    let mut rigid: Vec<(u64, usize)> = interactions
+        .iter()
+        .enumerate()
+        .filter(|(_, it)| matches!(it.law, InteractionLaw::Rigid { .. }))
+        .map(|(i, it)| (it.offset.to_bits(), i))
+        .collect();
+    rigid.sort_unstable();
+    for group in rigid.chunk_by(|a, b| a.0 == b.0) {
+        for (k, &(_, i)) in group.iter().enumerate() {
+            for &(_, j) in &group[..k] {
+                let (a, b) = (&interactions[i], &interactions[j]);
+                if a.pair != b.pair && a.h == b.h {
+                    let (first, second) = (a.pair.min(b.pair), a.pair.max(b.pair));
+                    return Err(Error::Inconsistent(format!(
+                        "{} has the same gap as {} (the same points, side and gap): give it \
+                         once (with the restitution wanted)",
+                        pairs[second], pairs[first]
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn interaction_law(name: &str, law: &PairLaw) -> Result<InteractionLaw> {
+    Ok(match *law {
+        PairLaw::Compliant(contact) => InteractionLaw::Compliant {
+            law: contact.any_law(),
+            damping: contact.damping,
+        },
+        PairLaw::Rigid { restitution } => {
+            if !(0.0..=1.0).contains(&restitution) {
+                return Err(Error::Inconsistent(format!(
+                    "{name} restitution must be in [0, 1], got {restitution}"
+                )));
+            }
+            InteractionLaw::Rigid { restitution }
+        }
+    })
+}
+
+fn positive_named(name: &str, key: &'static str, value: f64) -> Result<f64> {
+    positive(key, value).map_err(|e| Error::Inconsistent(format!("{name} {e}")))
+}
+
+fn non_negative_named(name: &str, key: &'static str, value: f64) -> Result<f64> {
+    non_negative(key, value).map_err(|e| Error::Inconsistent(format!("{name} {e}")))
+}
+
+/// The structure's matrices as the rates read them.
+struct StructureMatrices {
+    /// `M^-1`.
+    minv: Vec<f64>,
+    /// `M^-1 K` and `M^-1 C`.
+    minv_k: Vec<f64>,
+    minv_c: Vec<f64>,
+    /// `[M^-1 K, M^-1 C, C, r]` of each coordinate (used when diagonal).
+    diagonals: Vec<[f64; 4]>,
+    /// `M r`.
+    mass_influence: Vec<f64>,
+}
+
+impl StructureMatrices {
+    fn of(s: &Structure) -> Self {
+        let n = s.dofs();
+        let l = linalg::cholesky(s.mass(), n).expect("a structure's mass is positive definite");
+        let minv = linalg::inverse_from_cholesky(&l, n);
+        let product = |a: &[f64]| {
+            let mut out = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..n {
+                    out[i * n + j] = (0..n).map(|p| minv[i * n + p] * a[p * n + j]).sum();
+                }
+            }
+            out
+        };
+        let minv_k = product(s.stiffness());
+        let minv_c = product(s.damping());
+        let diagonals = (0..n)
+            .map(|i| {
+                [
+                    minv_k[i * n + i],
+                    minv_c[i * n + i],
+                    s.damping()[i * n + i],
+                    s.influence()[i],
+                ]
+            })
+            .collect();
+        let mut mass_influence = vec![0.0; n];
+        linalg::multiply(s.mass(), s.influence(), &mut mass_influence);
+        Self {
+            minv,
+            minv_k,
+            minv_c,
+            diagonals,
+            mass_influence,
+        }
+    }
+}
+
+/// The walls of every pair (a damper's two, then each stop's one), with
+/// the pairs' names and the dampers' masses.
+struct Walls {
+    damper_mass: Vec<f64>,
+    interactions: Vec<Interaction>,
+    pairs: Vec<String>,
+}
+
+impl Walls {
+    /// The walls of `spec`'s pairs, each with its push `M^-1 h^T` (`minv`:
+    /// the structure's `M^-1`) and inverse mass, checked.
+    fn of(spec: &SystemSpec, minv: &[f64]) -> Result<Self> {
+        let (n, k) = (spec.structure.dofs(), spec.dampers.len());
+        let dim = n + k;
+        let full_push = |h: &[f64]| {
+            let mut push = vec![0.0; dim];
+            linalg::multiply(minv, &h[..n], &mut push[..n]);
+            for j in 0..k {
+                push[n + j] = h[n + j] / spec.dampers[j].mass;
+            }
+            push
+        };
+        let pairs_asked = spec.dampers.len() + spec.stops.len();
+        if pairs_asked > MAX_PAIRS {
+            return Err(Error::Inconsistent(format!(
+                "[[damper]], [[stop]]: at most {MAX_PAIRS} pairs in all, got {pairs_asked}"
+            )));
+        }
+        let mut walls = Self {
+            damper_mass: Vec::with_capacity(k),
+            interactions: Vec::new(),
+            pairs: Vec::new(),
+        };
+        walls.add_dampers(spec, n, dim)?;
+        walls.add_stops(spec, n, dim)?;
+        for interaction in &mut walls.interactions {
+            interaction.push = full_push(&interaction.h);
+            interaction.inverse_mass = linalg::dot(&interaction.h, &interaction.push);
+            if interaction.inverse_mass.is_nan() || interaction.inverse_mass <= 0.0 {
+                return Err(Error::Inconsistent(format!(
+                    "{} acts at a point that does not move (every mode has a node there): \
+                     move it",
+                    walls.pairs[interaction.pair]
+                )));
+            }
+        }
+        Ok(walls)
+    }
+
+    /// Each damper's two walls (pushes left to fill).
+    fn add_dampers(&mut self, spec: &SystemSpec, n: usize, dim: usize) -> Result<()> {
+        let s = &spec.structure;
+        for (j, d) in spec.dampers.iter().enumerate() {
+            let name = format!("damper {j}");
+            self.damper_mass
+                .push(positive_named(&name, "mass", d.mass)?);
+            let lower = non_negative_named(&name, "lower_clearance", d.lower_clearance)?;
+            let upper = non_negative_named(&name, "upper_clearance", d.upper_clearance)?;
+            let point = s.point(&format!("{name} at"), d.at)?;
+            let law = interaction_law(&name, &d.law)?;
+            let pair = self.pairs.len();
+            self.pairs.push(name);
+            // Relative displacement u = z_j - point . q; upper wall: g = upper - u,
+            // lower wall: g = lower + u.
+            for (sign, offset) in [(-1.0, upper), (1.0, lower)] {
+                let mut h = vec![0.0; dim];
+                for i in 0..n {
+                    h[i] = -sign * point[i];
+                }
+                h[n + j] = sign;
+                self.interactions.push(Interaction {
+                    pair,
+                    push: vec![],
+                    inverse_mass: 0.0,
+                    h,
+                    offset,
+                    law,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Each stop's wall (pushes left to fill).
+    fn add_stops(&mut self, spec: &SystemSpec, n: usize, dim: usize) -> Result<()> {
+        let s = &spec.structure;
+        for (j, stop) in spec.stops.iter().enumerate() {
+            let name = format!("stop {j}");
+            let gap = non_negative_named(&name, "gap", stop.gap)?;
+            let mut point = s.point(&format!("{name} at"), stop.at)?;
+            if let Some(against) = stop.against {
+                // Pounding: the gap closes with the displacement of `at`
+                // relative to `against`'s.
+                let carrier = s.point(&format!("{name} against"), against)?;
+                for (p, c) in point.iter_mut().zip(&carrier) {
+                    *p -= c;
+                }
+                if point.iter().all(|p| *p == 0.0) {
+                    return Err(Error::Inconsistent(format!(
+                        "{name} against: {against} moves as at = {} does, so the gap between \
+                         them never changes: choose another point",
+                        stop.at
+                    )));
+                }
+            }
+            let law = interaction_law(&name, &stop.law)?;
+            let sign = match stop.side {
+                Side::Upper => -1.0,
+                Side::Lower => 1.0,
+            };
+            let mut h = vec![0.0; dim];
+            for i in 0..n {
+                h[i] = sign * point[i];
+            }
+            let pair = self.pairs.len();
+            self.pairs.push(name);
+            self.interactions.push(Interaction {
+                pair,
+                push: vec![],
+                inverse_mass: 0.0,
+                h,
+                offset: gap,
+                law,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The force excitations with their rows and pushes (`minv`: `M^-1`), and
+/// the base signals.
+fn excitation_loads(spec: &SystemSpec, minv: &[f64]) -> Result<(Vec<ForceLoad>, Vec<Signal>)> {
+    let s = &spec.structure;
+    let n = s.dofs();
+    let mut forces = Vec::new();
+    let mut base = Vec::new();
+    for (j, excitation) in spec.excitations.iter().enumerate() {
+        match excitation.load {
+            Load::Force { at } => {
+                let row = s.point(&format!("excitation {j} at"), at)?;
+                let mut push = vec![0.0; n];
+                linalg::multiply(minv, &row, &mut push);
+                forces.push(ForceLoad {
+                    row,
+                    push,
+                    signal: excitation.signal.clone(),
+                });
+            }
+            Load::Base => base.push(excitation.signal.clone()),
+        }
+    }
+    Ok((forces, base))
+}
+
+/// The system's time scales (s) and the energy floor's mass times
+/// acceleration squared (see [`Assembly::energy_floor`]).
+struct TimeScales {
+    /// The shortest natural or forcing period (infinite for none).
+    shortest: f64,
+    longest_period: f64,
+    time_scale: f64,
+    floor_mass_acceleration: f64,
+}
+
+impl TimeScales {
+    fn of(
+        spec: &SystemSpec,
+        mass_influence: &[f64],
+        damper_mass: &[f64],
+        gravity: f64,
+        interactions: &[Interaction],
+    ) -> Self {
+        let s = &spec.structure;
+        let frequencies = s.natural_frequencies();
+        let fastest_natural = frequencies.iter().fold(0.0f64, |m, w| m.max(*w));
+        let mut shortest = if fastest_natural > 0.0 {
+            std::f64::consts::TAU / fastest_natural
+        } else {
+            f64::INFINITY
+        };
+        let total_mass: f64 =
+            linalg::dot(mass_influence, s.influence()) + damper_mass.iter().sum::<f64>();
+        let mut acceleration = gravity;
+        for excitation in &spec.excitations {
+            let (largest, period) = excitation.signal.extent();
+            shortest = shortest.min(period);
+            acceleration += match excitation.load {
+                Load::Base => largest,
+                Load::Force { .. } => largest / total_mass,
+            };
+        }
+        let longest_period = frequencies
+            .iter()
+            .find(|w| **w > 0.0)
+            .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w);
+        // Without a period (a ball under gravity), the time to fall through
+        // the largest gap: a long run's length would make the floor of the
+        // energy check grow without bound.
+        let largest_gap = interactions
+            .iter()
+            .fold(0.0f64, |g, it| g.max(it.offset.abs()));
+        let fall_time = if acceleration > 0.0 && largest_gap > 0.0 {
+            (2.0 * largest_gap / acceleration).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let time_scale = match shortest.min(longest_period) {
+            period if period.is_finite() => period,
+            _ => fall_time,
+        };
+        Self {
+            shortest,
+            longest_period,
+            time_scale,
+            floor_mass_acceleration: total_mass * acceleration * acceleration,
+        }
+    }
+}
+
+/// The rows of the points, then of the moments, the reductions follow
+/// (checked against [`MAX_POINTS`]).
+fn followed_rows(spec: &SystemSpec) -> Result<Vec<f64>> {
+    let s = &spec.structure;
+    let followed = spec.points.len() + spec.moments.len();
+    if followed > MAX_POINTS {
+        return Err(Error::Inconsistent(format!(
+            "points: at most {MAX_POINTS} points and moments may be followed, got {followed}"
+        )));
+    }
+    let mut point_rows = Vec::with_capacity(followed * s.dofs());
+    for (j, &at) in spec.points.iter().enumerate() {
+        point_rows.extend(s.point(&format!("[output] points[{j}]"), at)?);
+    }
+    for (j, &at) in spec.moments.iter().enumerate() {
+        point_rows.extend(s.moment_row(&format!("[output] moments[{j}]"), at)?);
+    }
+    Ok(point_rows)
+}

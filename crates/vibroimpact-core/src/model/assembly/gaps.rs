@@ -1,0 +1,153 @@
+//! The gaps of the interactions and their rates, and what the kernel asks
+//! of one wall: when it lands, whether its mirror holds it, its scale, its
+//! release from sticking.
+
+use super::{Assembly, Mode};
+use crate::kernel::sized::by_size;
+use crate::numerics::linalg;
+
+impl Assembly {
+    /// The gap of interaction `i` and its rate at state `y`.
+    #[inline(always)]
+    pub fn gap(&self, i: usize, y: &[f64]) -> (f64, f64) {
+        let it = &self.interactions[i];
+        let d = self.dim;
+        (
+            it.offset + linalg::dot(&it.h, &y[..d]),
+            linalg::dot(&it.h, &y[d..2 * d]),
+        )
+    }
+
+    /// Every interaction's gap and its rate at state `y` into `out`, as
+    /// [`Self::gap`] gives them (a damper's two walls share their products).
+    pub fn gaps(&self, y: &[f64], out: &mut [(f64, f64)]) {
+        by_size!(self, |n, k| self.gaps_in(n + k, y, out))
+    }
+
+    /// [`Self::gaps`] over `d` coordinates (a constant where inlined).
+    #[inline(always)]
+    pub(crate) fn gaps_in(&self, d: usize, y: &[f64], out: &mut [(f64, f64)]) {
+        let (x, v) = (&y[..d], &y[d..2 * d]);
+        let mut products = (0.0, 0.0);
+        for ((it, mirror), out) in self
+            .interactions
+            .iter()
+            .zip(&self.mirrors_previous)
+            .zip(out.iter_mut())
+        {
+            products = if *mirror {
+                (-products.0, -products.1)
+            } else {
+                dots(&it.h[..d], x, v)
+            };
+            *out = (it.offset + products.0, products.1);
+        }
+    }
+
+    /// When open interaction `i` at state `y`, its coordinates' accelerations
+    /// `acc` (m/s^2), would reach its wall on its gap's parabola (s after
+    /// now); None where the gap's acceleration does not close it.
+    pub fn landing_time(&self, i: usize, y: &[f64], acc: &[f64]) -> Option<f64> {
+        let (gap, rate) = self.gap(i, y);
+        let closing = -linalg::dot(&self.interactions[i].h, &acc[..self.dim]);
+        (closing > 0.0)
+            .then(|| (rate + (rate * rate + 2.0 * closing * gap.max(0.0)).sqrt()) / closing)
+    }
+
+    /// Whether interaction `i` is a wall whose other wall (of the same
+    /// damper) is sticking: its gap is then held too, at the sum of the
+    /// clearances (0 for a zero clearance, to round-off), and it has no
+    /// event of its own. Sticking it as well would make the constraints
+    /// dependent.
+    pub fn held_by_mirror(&self, i: usize, modes: &[Mode]) -> bool {
+        let before = self.mirrors_previous[i] && modes[i - 1] == Mode::Sticking;
+        let after =
+            self.mirrors_previous.get(i + 1) == Some(&true) && modes[i + 1] == Mode::Sticking;
+        before || after
+    }
+
+    /// Whether interaction `i` is a wall of a damper with no clearance at
+    /// all (its two walls' offsets sum to zero): stuck, the damper is locked
+    /// to its point, its constraint force of either sign (the force passes
+    /// from one wall to the other without a release, which round-off would
+    /// otherwise turn into a release and a re-sticking, without end).
+    pub fn locked(&self, i: usize) -> bool {
+        let mirror = if self.mirrors_previous[i] {
+            Some(i - 1)
+        } else if self.mirrors_previous.get(i + 1) == Some(&true) {
+            Some(i + 1)
+        } else {
+            None
+        };
+        mirror.is_some_and(|j| {
+            let (a, b) = (self.interactions[i].offset, self.interactions[j].offset);
+            (a + b).abs() <= 4.0 * f64::EPSILON * (a.abs() + b.abs())
+        })
+    }
+
+    /// The scale of interaction `i`'s gap at state `y`, m: its offset and
+    /// the magnitudes of the terms `h . x` sums, whose round-off the gap
+    /// carries.
+    pub fn gap_scale(&self, i: usize, y: &[f64]) -> f64 {
+        let it = &self.interactions[i];
+        it.offset.abs()
+            + it.h
+                .iter()
+                .zip(&y[..self.dim])
+                .map(|(h, x)| (h * x).abs())
+                .sum::<f64>()
+    }
+
+    /// A sticking pair `i` released: held on its wall only to round-off, it
+    /// is put at rest relative to the wall (no approach left) with its gap
+    /// a few units of that round-off open, along `M^-1 h^T` (the momentum
+    /// and energy that moves are round-off too). Without it a gap a hair
+    /// below zero, slowly opening, reads as a new contact at every step
+    /// until the pair has moved away by more than the round-off.
+    pub fn release(&self, i: usize, y: &mut [f64]) {
+        let it = &self.interactions[i];
+        let d = self.dim;
+        let (gap, rate) = (
+            it.offset + linalg::dot(&it.h, &y[..d]),
+            linalg::dot(&it.h, &y[d..2 * d]),
+        );
+        let opening = (16.0 * f64::EPSILON * self.gap_scale(i, y) - gap) / it.inverse_mass;
+        let lift = -rate.min(0.0) / it.inverse_mass;
+        for (k, p) in it.push.iter().enumerate() {
+            y[k] += p * opening;
+            y[d + k] += p * lift;
+        }
+    }
+}
+
+/// `(h . x, h . v)` in one pass, each summed in order as [`linalg::dot`]
+/// sums it (the same bits): a wall's gap and rate as the events see them.
+#[inline(always)]
+fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
+    let n = h.len();
+    let (x, v) = (&x[..n], &v[..n]);
+    let (mut hx, mut hv) = (-0.0, -0.0);
+    for i in 0..n {
+        hx += h[i] * x[i];
+        hv += h[i] * v[i];
+    }
+    (hx, hv)
+}
+
+/// A wall's `h` times a vector where the product leads to a force: a
+/// compliant wall's indentation and rate, and a sticking wall's `h . a` for
+/// its constraint. The even and the odd terms are summed apart, then
+/// together: two chains of half the length on a step's critical path (a
+/// stage's contact force waits on it). The gaps that the events watch are
+/// summed in order ([`dots`]); the two differ in the last bits at most, and
+/// every path sums each quantity the same way (the same bits).
+#[inline(always)]
+pub(crate) fn h_dot(h: &[f64], x: &[f64]) -> f64 {
+    let n = h.len();
+    let x = &x[..n];
+    let mut sum = [-0.0; 2];
+    for i in 0..n {
+        sum[i % 2] += h[i] * x[i];
+    }
+    sum[0] + sum[1]
+}
