@@ -1,6 +1,4 @@
 pub mod exact;
-pub mod matrix_flow;
-pub mod modal;
 pub mod registry;
 pub mod step_control;
 pub mod steppers;
