@@ -2,9 +2,10 @@
 //! fixed step it takes, and the run. What the binding's runs and a study's
 //! runs share, so that a method means the same in both.
 
-use crate::error::{Error, Result};
+use crate::error::{within, Error, Result};
 use crate::kernel::events::{integrate_system, RunOptions, SystemSolution};
 use crate::methods::exact::ExactFlow;
+use crate::methods::paper_newmark::PaperNewmark;
 use crate::methods::steppers::{ExplicitRk, NewmarkFamily};
 use crate::model::assembly::Assembly;
 
@@ -13,7 +14,18 @@ use crate::model::assembly::Assembly;
 pub enum AnyStepper {
     Rk(ExplicitRk),
     Newmark(NewmarkFamily),
+    /// The founding paper's Newmark, its contact force lagged one step.
+    Paper(PaperNewmark),
     Exact(ExactFlow),
+}
+
+/// Newmark's `beta` in [0, 0.5] and `gamma` in [0.5, 1] (defaults 1/4, 1/2:
+/// average acceleration), or an error naming the one outside.
+fn newmark_options(beta: f64, gamma: f64) -> Result<(f64, f64)> {
+    Ok((
+        within("beta", beta, 0.0, 0.5, false, "in [0, 0.5]")?,
+        within("gamma", gamma, 0.5, 1.0, false, "in [0.5, 1]")?,
+    ))
 }
 
 impl AnyStepper {
@@ -33,15 +45,23 @@ impl AnyStepper {
             "rk4" => Self::Rk(ExplicitRk::rk4(len)),
             "dopri5" => Self::Rk(ExplicitRk::dopri5(len, rtol, atol)),
             "dop853" => Self::Rk(ExplicitRk::dop853(len, rtol, atol)),
-            "newmark-implicit" => Self::Newmark(NewmarkFamily::newmark(system, beta, gamma)),
+            "newmark" => {
+                let (beta, gamma) = newmark_options(beta, gamma)?;
+                Self::Paper(PaperNewmark::new(system, beta, gamma)?)
+            }
+            "newmark-implicit" => {
+                let (beta, gamma) = newmark_options(beta, gamma)?;
+                Self::Newmark(NewmarkFamily::newmark(system, beta, gamma))
+            }
             "generalized-alpha" => {
                 Self::Newmark(NewmarkFamily::generalized_alpha(system, spectral_radius))
             }
             "exact" => Self::Exact(ExactFlow::new(system)?),
             other => {
                 return Err(Error::Inconsistent(format!(
-                    "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark-implicit\", \
-                     \"generalized-alpha\", \"exact\" for a [structure] system, got {other:?}"
+                    "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark\", \
+                     \"newmark-implicit\", \"generalized-alpha\", \"exact\" for a [structure] \
+                     system, got {other:?}"
                 )))
             }
         })
@@ -78,6 +98,7 @@ impl AnyStepper {
         match self {
             Self::Rk(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Newmark(s) => integrate_system(system, s, y0, options, interrupt),
+            Self::Paper(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Exact(s) => integrate_system(system, s, y0, options, interrupt),
         }
     }

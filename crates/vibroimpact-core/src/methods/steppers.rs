@@ -596,10 +596,9 @@ pub struct NewmarkFamily {
     /// Accelerations (algorithmic) at the current point, and the
     /// accumulators' rates there; valid after `reset` and `accept`.
     accel: Vec<f64>,
-    powers: Vec<f64>,
+    powers: Trapezoid,
     valid: bool,
     pending_accel: Vec<f64>,
-    pending_powers: Vec<f64>,
     point: Vec<f64>,
     rates: Vec<f64>,
     a1: Vec<f64>,
@@ -612,6 +611,61 @@ pub struct NewmarkFamily {
 
 /// Newton iterations allowed per step.
 const NEWTON_ITERATIONS: usize = 40;
+
+/// The energy accumulators (the state after its `2 dim` coordinates and
+/// velocities) of the Newmark family's steps by the trapezoidal rule on
+/// their rates, second order like the methods: the rates at the current
+/// point and at the end of the last attempt.
+#[derive(Debug, Clone)]
+pub(crate) struct Trapezoid {
+    start: Vec<f64>,
+    pending: Vec<f64>,
+}
+
+impl Trapezoid {
+    /// For `system`'s accumulators.
+    pub(crate) fn new(system: &Assembly) -> Self {
+        let count = system.state_len() - 2 * system.dim;
+        Self {
+            start: vec![0.0; count],
+            pending: vec![0.0; count],
+        }
+    }
+
+    /// The current point's accumulator rates, from all its `rates`.
+    pub(crate) fn restart(&mut self, system: &Assembly, rates: &[f64]) {
+        self.start.copy_from_slice(&rates[2 * system.dim..]);
+    }
+
+    /// The accumulators at the end `out` of a step `h` from `(time, y)`
+    /// whose coordinates and velocities `out` holds; the rates at the end
+    /// are evaluated into `rates` (the state's length).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn step(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &[f64],
+        h: f64,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        rates: &mut [f64],
+        out: &mut [f64],
+    ) {
+        let d = system.dim;
+        out[2 * d..].copy_from_slice(&y[2 * d..]);
+        system.rates(time + h, out, modes, scratch, rates);
+        for (k, slot) in out[2 * d..].iter_mut().enumerate() {
+            *slot += 0.5 * h * (self.start[k] + rates[2 * d + k]);
+        }
+        self.pending.copy_from_slice(&rates[2 * d..]);
+    }
+
+    /// The last attempt's end is the new current point.
+    pub(crate) fn accept(&mut self) {
+        std::mem::swap(&mut self.start, &mut self.pending);
+    }
+}
 
 impl NewmarkFamily {
     fn build(
@@ -630,10 +684,12 @@ impl NewmarkFamily {
             beta,
             gamma,
             accel: vec![0.0; dim],
-            powers: vec![0.0; len - 2 * dim],
+            powers: Trapezoid {
+                start: vec![0.0; len - 2 * dim],
+                pending: vec![0.0; len - 2 * dim],
+            },
             valid: false,
             pending_accel: vec![0.0; dim],
-            pending_powers: vec![0.0; len - 2 * dim],
             point: vec![0.0; len],
             rates: vec![0.0; len],
             a1: vec![0.0; dim],
@@ -706,7 +762,7 @@ impl SystemStepper for NewmarkFamily {
             system.rates(time, y, modes, scratch, &mut self.rates);
             self.evaluations += 1;
             self.accel.copy_from_slice(&self.rates[d..2 * d]);
-            self.powers.copy_from_slice(&self.rates[2 * d..]);
+            self.powers.restart(system, &self.rates);
             self.valid = true;
         }
         let (bx, gv) = (beta * h * h, gamma * h);
@@ -781,21 +837,17 @@ impl SystemStepper for NewmarkFamily {
             return Err(Error::NewtonFailed { time });
         }
         new_state(&self.a1, out, &self.accel);
-        out[2 * d..].copy_from_slice(&y[2 * d..]);
-        // The accumulators' rates at the end, for the trapezoidal rule.
-        system.rates(time + h, out, modes, scratch, &mut self.rates);
+        let rates = &mut self.rates;
+        self.powers
+            .step(system, time, y, h, modes, scratch, rates, out);
         self.evaluations += 1;
-        for (k, slot) in out[2 * d..].iter_mut().enumerate() {
-            *slot += 0.5 * h * (self.powers[k] + self.rates[2 * d + k]);
-        }
         self.pending_accel.copy_from_slice(&self.a1);
-        self.pending_powers.copy_from_slice(&self.rates[2 * d..]);
         Ok(0.0)
     }
 
     fn accept(&mut self) {
         std::mem::swap(&mut self.accel, &mut self.pending_accel);
-        std::mem::swap(&mut self.powers, &mut self.pending_powers);
+        self.powers.accept();
     }
 
     fn shrink(&self, _error: f64) -> f64 {

@@ -1,0 +1,466 @@
+//! The founding paper's Newmark on the general kernel against closed forms,
+//! the trapezoidal rule it is on linear systems, and 0.1's two-mass Newmark
+//! (the same bits).
+
+use super::*;
+use crate::legacy::equations::{Free, Model};
+use crate::legacy::integrators::{Integrator, Newmark as LegacyNewmark};
+use crate::model::assembly::{initial_state, Excitation, Load, SystemSpec};
+use crate::model::contact::{Contact, LawKind};
+use crate::model::impact_damper::{ImpactDamper, State};
+use crate::model::signals::Signal;
+use crate::model::structure::Structure;
+use std::f64::consts::TAU;
+
+/// A structure alone (no pair), with `excitations`.
+fn bare(structure: Structure, excitations: Vec<Excitation>) -> Assembly {
+    Assembly::new(&SystemSpec {
+        structure,
+        dampers: vec![],
+        stops: vec![],
+        gravity: 0.0,
+        excitations,
+        points: vec![],
+        moments: vec![],
+    })
+    .unwrap()
+}
+
+/// `steps` steps `h` of the paper's Newmark (average acceleration) from
+/// `y0` with every pair open: the end state.
+fn free_steps(system: &Assembly, y0: &[f64], h: f64, steps: usize) -> Vec<f64> {
+    let mut stepper = PaperNewmark::new(system, 0.25, 0.5).unwrap();
+    let mut scratch = Scratch::new(system);
+    let modes = vec![Mode::Open; system.interactions.len()];
+    let (mut y, mut end) = (y0.to_vec(), y0.to_vec());
+    for n in 0..steps {
+        stepper
+            .attempt(system, n as f64 * h, &y, h, &modes, &mut scratch, &mut end)
+            .unwrap();
+        stepper.accept();
+        std::mem::swap(&mut y, &mut end);
+    }
+    y
+}
+
+#[test]
+fn free_oscillation_has_newmark_s_period_elongation() {
+    crate::testing::timeout(30, || {
+        // Average acceleration is the trapezoidal rule: on x'' = -w^2 x it
+        // turns the phase by 2 atan(w h / 2) a step, exactly, at constant
+        // amplitude, so x_n = cos(n theta) from x = 1, v = 0. The period
+        // grows by w h / (2 atan(w h / 2)) - 1 = (w h)^2 / 12 + O(h^4):
+        // the error is second order with constant 1/12.
+        let w = TAU;
+        let system = bare(
+            Structure::oscillator(2.0, 2.0 * w * w, 0.0).unwrap(),
+            vec![],
+        );
+        let y0 = initial_state(&system, &[1.0], &[0.0], &[], &[]).unwrap();
+        let mut elongations = vec![];
+        for per_period in [20, 40, 80, 160] {
+            let h = 1.0 / per_period as f64;
+            let steps = 3 * per_period;
+            let y = free_steps(&system, &y0, h, steps);
+            let theta = 2.0 * (w * h / 2.0).atan();
+            let phase = steps as f64 * theta;
+            assert!((y[0] - phase.cos()).abs() < 1e-12, "{per_period}: {}", y[0]);
+            assert!(
+                (y[1] + w * phase.sin()).abs() < 1e-11,
+                "{per_period}: {}",
+                y[1]
+            );
+            // Three numerical periods take 3 T (1 + elongation).
+            let elongation = w * h / theta - 1.0;
+            let lag = (3.0 * TAU - phase) / phase;
+            assert!((lag - elongation).abs() < 1e-12, "{per_period}");
+            let leading = (w * h).powi(2) / 12.0;
+            assert!(((elongation - leading) / leading).abs() < 0.25 * (w * h).powi(2));
+            // Against the exact motion cos(w t): off by the phase lag only.
+            let exact = (w * steps as f64 * h).cos();
+            assert!((y[0] - exact).abs() <= 1.01 * (3.0 * TAU - phase).abs());
+            elongations.push(elongation);
+        }
+        for pair in elongations.windows(2) {
+            let order = (pair[0] / pair[1]).log2();
+            assert!((order - 2.0).abs() < 0.01, "order {order}");
+        }
+    });
+}
+
+/// The trapezoidal rule on `z' = A z + b(t)` for `z = (x, v)` of a
+/// structure (`M`, `C`, `K`, a force `f(t)` on coordinate 0), written as
+/// its own linear solve a step: the reference for the Newmark stepper.
+fn trapezoidal(
+    (m, c, k): (&[f64], &[f64], &[f64]),
+    force: impl Fn(f64) -> f64,
+    y0: &[f64],
+    h: f64,
+    steps: usize,
+) -> Vec<f64> {
+    let n = y0.len() / 2;
+    let minv = linalg::inverse_from_cholesky(&linalg::cholesky(m, n).unwrap(), n);
+    let product = |a: &[f64]| {
+        let mut out = vec![0.0; n * n];
+        linalg::matmul(&minv, a, &mut out, n);
+        out
+    };
+    let (mk, mc) = (product(k), product(c));
+    let s = 2 * n;
+    let mut a = vec![0.0; s * s];
+    for i in 0..n {
+        a[i * s + n + i] = 1.0;
+        for j in 0..n {
+            a[(n + i) * s + j] = -mk[i * n + j];
+            a[(n + i) * s + n + j] = -mc[i * n + j];
+        }
+    }
+    let b = |t: f64| {
+        let mut out = vec![0.0; s];
+        for i in 0..n {
+            out[n + i] = minv[i * n] * force(t);
+        }
+        out
+    };
+    let mut z = y0.to_vec();
+    for step in 0..steps {
+        let t = step as f64 * h;
+        let (b0, b1) = (b(t), b(t + h));
+        let mut lhs = vec![0.0; s * s];
+        let mut rhs = vec![0.0; s];
+        for i in 0..s {
+            rhs[i] = z[i] + 0.5 * h * (b0[i] + b1[i]);
+            for j in 0..s {
+                let identity = if i == j { 1.0 } else { 0.0 };
+                lhs[i * s + j] = identity - 0.5 * h * a[i * s + j];
+                rhs[i] += 0.5 * h * a[i * s + j] * z[j];
+            }
+        }
+        linalg::solve_in_place(&mut lhs, &mut rhs, s);
+        z = rhs;
+    }
+    z
+}
+
+#[test]
+fn forced_damped_coupled_structures_step_as_the_trapezoidal_rule() {
+    crate::testing::timeout(30, || {
+        // One, two and three coupled coordinates (the 1x1, the adjugate
+        // and the elimination inverse), damped, forced harmonically on the
+        // first: the stepper (its loads from the assembly's linear parts,
+        // its start accelerations from the assembly's rates where the
+        // matrices are not diagonal) against the trapezoidal rule solved
+        // directly on the first-order system.
+        let signal = Signal::harmonic(0.7, 1.3, 0.4).unwrap();
+        let force = |t: f64| 0.7 * (TAU * 1.3 * t + 0.4).cos();
+        let chain = |n: usize| {
+            let row = |i: usize, diagonal: f64, off: f64| {
+                (0..n)
+                    .map(|j| match i.abs_diff(j) {
+                        0 => diagonal,
+                        1 => off,
+                        _ => 0.0,
+                    })
+                    .collect::<Vec<_>>()
+            };
+            let mass: Vec<_> = (0..n).map(|i| row(i, 1.0 + 0.5 * i as f64, 0.1)).collect();
+            let stiffness: Vec<_> = (0..n).map(|i| row(i, 80.0, -30.0)).collect();
+            let damping: Vec<_> = (0..n).map(|i| row(i, 0.4, -0.1)).collect();
+            Structure::matrices(&mass, &stiffness, &damping).unwrap()
+        };
+        for n in 1..=3 {
+            let structure = chain(n);
+            let parts = (
+                structure.mass().to_vec(),
+                structure.damping().to_vec(),
+                structure.stiffness().to_vec(),
+            );
+            let excitation = Excitation {
+                load: Load::Force { at: 0.0 },
+                signal: signal.clone(),
+            };
+            let system = bare(structure, vec![excitation]);
+            let x0: Vec<f64> = (0..n).map(|i| 0.01 * (i as f64 + 1.0)).collect();
+            let v0: Vec<f64> = (0..n).map(|i| 0.2 - 0.15 * i as f64).collect();
+            let y0 = initial_state(&system, &x0, &v0, &[], &[]).unwrap();
+            let (h, steps) = (2e-3, 2000);
+            let ours = free_steps(&system, &y0, h, steps);
+            let z0 = [x0.clone(), v0.clone()].concat();
+            let reference = trapezoidal((&parts.0, &parts.1, &parts.2), force, &z0, h, steps);
+            for (i, (a, b)) in ours.iter().zip(&reference).enumerate() {
+                assert!((a - b).abs() < 1e-11, "{n} coordinates, {i}: {a} vs {b}");
+            }
+        }
+    });
+}
+
+/// The two-mass system of Table 1 (M = 1 kg, K = 1 N/m, C = 0.01 N s/m,
+/// m = 0.25 kg) with clearance `d` (m).
+fn table_1(d: f64) -> ImpactDamper {
+    ImpactDamper::new(1.0, 1.0, 0.01, 0.25, d).unwrap()
+}
+
+/// 0.1's fixed-step Newmark and ours driven side by side over `steps`
+/// steps `dt` from `start`, the contacts switched as 0.1's fixed-step
+/// kernel finds them (the indentation at a step's end; a contact's
+/// approach rate where the step's cubic crosses the wall), ours told
+/// that the step was not cut there. Calls `each` with both ends of every
+/// step; returns the contacts begun.
+fn side_by_side(
+    damper: ImpactDamper,
+    contact: &Contact,
+    start: State,
+    dt: f64,
+    steps: usize,
+    mut each: impl FnMut(&State, &[f64]),
+) -> usize {
+    let system = damper.assembly(contact).unwrap();
+    let model = Model::new(&damper, contact.any_law(), contact.damping, Free);
+    let mut legacy = LegacyNewmark::new(0.25, 0.5);
+    let mut ours = PaperNewmark::new(&system, 0.25, 0.5).unwrap();
+    let mut scratch = Scratch::new(&system);
+    let mut s = start;
+    let mut approach = model.side(&s) * s.relative_velocity();
+    legacy.start(&model, &s, 0.0, dt, approach);
+    let mut y = start.vector(&system).unwrap();
+    let mut end = y.clone();
+    let mut modes = vec![Mode::Open; 2];
+    let mut contacts = 0;
+    for n in 0..steps {
+        let t = n as f64 * dt;
+        let s1 = legacy.step(&model, &s, t, dt, approach);
+        ours.attempt(&system, t, &y, dt, &modes, &mut scratch, &mut end)
+            .unwrap();
+        ours.accept();
+        each(&s1, &end);
+        let c = model.contact(&s1, approach);
+        let before = modes.clone();
+        if c.indentation > 0.0 {
+            // The upper wall (y - w = +d) is the damper's first interaction.
+            let wall = if c.side > 0.0 { 0 } else { 1 };
+            if modes[wall] == Mode::Open {
+                approach = model.onset_in_step(&s, &s1, c.side, dt).rate;
+                contacts += 1;
+            }
+            modes = vec![Mode::Open; 2];
+            modes[wall] = Mode::Compliant {
+                approach_rate: approach,
+            };
+        } else {
+            modes = vec![Mode::Open; 2];
+            approach = model.side(&s1) * s1.relative_velocity();
+        }
+        if modes != before {
+            ours.switched_within_step();
+        }
+        (s, y) = (s1, end.clone());
+    }
+    contacts
+}
+
+#[test]
+fn two_mass_steps_are_0_1_s_to_the_bit() {
+    crate::testing::timeout(60, || {
+        // Rattling between both walls (d = 5 mm, 0.1 m/s apart), from a
+        // start with the main mass moving: every step of both, contact
+        // or not, the same bits, for each law.
+        let bits = |v: [f64; 4]| v.map(f64::to_bits);
+        for (law, restitution) in [
+            (LawKind::Hertz, None),
+            (LawKind::HysterHertz, Some(0.9)),
+            (LawKind::HertzDamped, Some(0.6)),
+            (LawKind::Linear, None),
+        ] {
+            let stiffness = if law == LawKind::Linear {
+                49.05
+            } else {
+                3000.0
+            };
+            let contact = Contact::new(law, stiffness, restitution, 0.01).unwrap();
+            // Table 1's, and masses other than 1 kg (0.1 divided by M
+            // where the assembly multiplies by its inverse).
+            let other = ImpactDamper::new(1.2, 3.7, 0.02, 0.3, 0.005).unwrap();
+            for damper in [table_1(0.005), other] {
+                let start = State::new(1e-3, 0.02, 0.0045, 0.1).unwrap();
+                let mut steps = 0;
+                let contacts = side_by_side(damper, &contact, start, 1e-4, 12_000, |s, y| {
+                    let legacy = [
+                        s.main_displacement,
+                        s.impact_displacement,
+                        s.main_velocity,
+                        s.impact_velocity,
+                    ];
+                    assert_eq!(
+                        bits(legacy),
+                        bits([y[0], y[1], y[2], y[3]]),
+                        "{law:?}, step {steps}: 0.1 {legacy:?}, ours {:?}",
+                        &y[..4]
+                    );
+                    steps += 1;
+                });
+                assert!(contacts >= 3, "{law:?}: {contacts} contacts");
+            }
+        }
+    });
+}
+
+#[test]
+fn restarts_take_0_1_s_accelerations_to_the_bit() {
+    crate::testing::timeout(30, || {
+        // 0.1 divides each term by M where the assembly multiplies by its
+        // inverse, -(k x + c v): the two differ in the last bit for half
+        // of all states (M = 1.2 kg here), apart and in contact with
+        // either wall.
+        let contact = Contact::new(LawKind::HysterHertz, 3000.0, Some(0.8), 0.01).unwrap();
+        let damper = ImpactDamper::new(1.2, 3.7, 0.02, 0.3, 0.005).unwrap();
+        let system = damper.assembly(&contact).unwrap();
+        let model = Model::new(&damper, contact.any_law(), contact.damping, Free);
+        let mut ours = PaperNewmark::new(&system, 0.25, 0.5).unwrap();
+        let mut scratch = Scratch::new(&system);
+        let mut differ = 0;
+        for k in 0..200 {
+            let phase = k as f64;
+            let (w, v) = (2e-3 * phase.sin(), 3e-2 * (1.7 * phase).cos());
+            let u = 0.0058 * (0.3 * phase).sin();
+            let s = State::new(w, v, w + u, v + 0.1 * (0.7 * phase).sin()).unwrap();
+            let approach = 0.1;
+            let mut modes = vec![Mode::Open; 2];
+            if u.abs() > 0.005 {
+                modes[if u > 0.0 { 0 } else { 1 }] = Mode::Compliant {
+                    approach_rate: approach,
+                };
+            }
+            // [w, y, w', y'] and the accumulators (a start inside a wall
+            // is refused by `initial_state`, not by a restart).
+            let mut y = vec![0.0; system.state_len()];
+            y[..4].copy_from_slice(&[w, w + u, v, s.impact_velocity]);
+            ours.reset();
+            ours.start(&system, 0.0, &y, &modes, &mut scratch);
+            let (aw, ay) = model.accelerations(0.0, &s, approach);
+            assert_eq!(
+                (aw.to_bits(), ay.to_bits()),
+                (ours.accel[0].to_bits(), ours.accel[1].to_bits()),
+                "{s:?}: 0.1 ({aw}, {ay}), ours {:?}",
+                ours.accel
+            );
+            differ += usize::from(ours.rates[2].to_bits() != aw.to_bits());
+        }
+        // The assembly's own accelerations would not do.
+        assert!(differ > 20, "{differ}");
+    });
+}
+
+/// One collision from the onset (`y - w = d`, `y' = 0.1` m/s, the main
+/// mass at rest) stepped by 0.1's Newmark and ours side by side at
+/// `dt`: the rebound-to-approach ratio of the relative speed at the
+/// first step apart (both the same bits), and the stored energy's
+/// change then (J).
+fn collision(damper: ImpactDamper, contact: &Contact, dt: f64) -> (f64, f64) {
+    let d = damper.clearance;
+    let system = damper.assembly(contact).unwrap();
+    let start = State::new(0.0, 0.0, d, 0.1).unwrap();
+    let y0 = start.vector(&system).unwrap();
+    let mut after = None;
+    let mut touched = false;
+    let steps = (0.2 / dt) as usize;
+    side_by_side(damper, contact, start, dt, steps, |s, y| {
+        let same = [s.main_displacement, s.impact_displacement]
+            .iter()
+            .zip(y)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{s:?} vs {:?}", &y[..4]);
+        let apart = (y[1] - y[0]).abs() <= d;
+        touched |= !apart;
+        if touched && apart && after.is_none() {
+            after = Some(y.to_vec());
+        }
+    });
+    let y1 = after.expect("the bodies part within 0.2 s");
+    let modes = [Mode::Open; 2];
+    let change = system.energy(&y1, &modes) - system.energy(&y0, &modes);
+    (-(y1[3] - y1[2]) / 0.1, change)
+}
+
+#[test]
+fn the_lagged_contact_force_creates_energy_as_0_1_did() {
+    crate::testing::timeout(60, || {
+        // Two free bodies on a Hertz contact rebound exactly at their
+        // approach speed. Lagging the force one step creates energy at
+        // every step size, an error of first order in dt: the rebound
+        // ratio's excess falls by the step's ratio. The bodies' momentum
+        // is kept (equal and opposite forces), so all of the change is in
+        // the relative motion, 0.5 m_eff v^2 (e^2 - 1).
+        let hertz = Contact::new(LawKind::Hertz, 3000.0, None, 0.0).unwrap();
+        let two_bodies = ImpactDamper::new(1.0, 0.0, 0.0, 0.25, 0.005).unwrap();
+        let relative = 0.5 * two_bodies.effective_mass() * 0.1 * 0.1;
+        let mut excess = vec![];
+        for dt in [1e-4, 2e-5] {
+            let (ratio, change) = collision(two_bodies, &hertz, dt);
+            assert!(change > 0.0, "dt {dt}: {change} J");
+            let kept = relative * (ratio * ratio - 1.0);
+            assert!((change - kept).abs() < 1e-6 * change, "{change} vs {kept}");
+            excess.push(ratio - 1.0);
+        }
+        let order = (excess[0] / excess[1]).ln() / 5f64.ln();
+        assert!((order - 1.0).abs() < 0.05, "order {order}");
+        // Table 1's collision (K, C and c1 = 0.01 N s/m: exactly, a
+        // rebound at 0.99635 of the approach speed): the paper's method
+        // rebounds faster than it came, at 1.0015 at its dt = 1e-4 s and
+        // 1.049 at 1e-3 s, what 0.1 documented (1.0016 and 1.049, its
+        // ratio located within the step).
+        let paper = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
+        let (fine, _) = collision(table_1(0.005), &paper, 1e-4);
+        assert!((fine - 1.0015).abs() < 1e-4, "{fine}");
+        let (coarse, created) = collision(table_1(0.005), &paper, 1e-3);
+        assert!((coarse - 1.049).abs() < 1e-3 && created > 0.0, "{coarse}");
+    });
+}
+
+#[test]
+fn the_registry_makes_it_as_newmark_with_checked_options() {
+    crate::testing::timeout(30, || {
+        use crate::methods::registry::AnyStepper;
+        use crate::model::assembly::{Damper, PairLaw};
+        let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
+        let system = table_1(0.005).assembly(&contact).unwrap();
+        let make = |method: &str, beta: f64, gamma: f64| {
+            AnyStepper::new(&system, method, 1e-8, 1e-12, beta, gamma, 0.9)
+        };
+        let message = |method: &str, beta: f64, gamma: f64| match make(method, beta, gamma) {
+            Ok(_) => panic!("{method} with beta {beta}, gamma {gamma} accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(matches!(
+            make("newmark", 0.25, 0.5),
+            Ok(AnyStepper::Paper(_))
+        ));
+        assert!(matches!(
+            make("newmark", 0.0, 1.0),
+            Ok(AnyStepper::Paper(_))
+        ));
+        for method in ["newmark", "newmark-implicit"] {
+            for (beta, gamma, field) in [
+                (0.51, 0.5, "beta"),
+                (-0.01, 0.5, "beta"),
+                (f64::NAN, 0.5, "beta"),
+                (0.25, 0.49, "gamma"),
+                (0.25, 1.01, "gamma"),
+            ] {
+                let text = message(method, beta, gamma);
+                assert!(text.contains(field), "{method}: {text}");
+            }
+        }
+        assert!(message("newmark-lagged", 0.25, 0.5).contains("\"newmark\", "));
+        // A rigid pair has no force to lag: refused, naming it.
+        let mut spec = table_1(0.005).spec(&contact).unwrap();
+        spec.dampers.push(Damper {
+            law: PairLaw::rigid(0.5).unwrap(),
+            ..spec.dampers[0].clone()
+        });
+        let rigid = Assembly::new(&spec).unwrap();
+        let refused = PaperNewmark::new(&rigid, 0.25, 0.5)
+            .unwrap_err()
+            .to_string();
+        assert!(refused.contains("damper 1 is rigid"), "{refused}");
+    });
+}
