@@ -701,3 +701,29 @@ def test_every_model_name_is_exported() -> None:
     for name in vi.model.__all__ + ["load", "loads", "simulate", "sweep", "orbit", "study_of"]:
         assert name in vi.__all__ and hasattr(vi, name), name
     assert set(SECTIONS) >= {"structure", "solver", *vi.model.system.ANALYSIS_SECTIONS}
+
+
+def test_from_dict_names_what_its_parts_cannot_take() -> None:
+    oscillator = {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0}
+    cases = [
+        ({"structure": oscillator, "solver": {"metod": "rk4"}}, "[solver] unknown key 'metod'"),
+        ({"structure": {**oscillator, "dampng": 1.0}}, "[structure] unknown key 'dampng'"),
+        ({"structure": oscillator, "output": {"evry": 1}}, "[output] unknown key 'evry'"),
+        ({"structure": oscillator, "initial": {"x": [1.0]}}, "[initial] unknown key 'x'"),
+        ({"structure": {"mass": 1.0}}, "[structure] missing key 'kind'"),
+        ({"structure": oscillator, "solver": 5}, "[solver] must be a table, got 5"),
+        ({"structure": oscillator, "extra": {}}, "unknown section [extra]"),
+    ]  # fmt: skip
+    for sections, expected in cases:
+        with pytest.raises(vi.InvalidInputError) as caught:
+            vi.System.from_dict(sections)
+        assert str(caught.value).startswith(expected), caught.value
+
+
+def test_a_system_pickles_and_hashes() -> None:
+    import pickle
+
+    for system in every_kind_of_system():
+        again = pickle.loads(pickle.dumps(system))
+        assert again == system and hash(again) == hash(system)
+    assert len({issue_example(), issue_example()}) == 1

@@ -30,7 +30,16 @@ from vibroimpact.model.parts import (
     Structure,
 )
 from vibroimpact.model.toml_text import toml_text
-from vibroimpact.system import _INITIAL, _fail, _table, prepare_system, system_spec
+from vibroimpact.system import (
+    _INITIAL,
+    _OUTPUT,
+    _SOLVER,
+    _fail,
+    _table,
+    _unknown_key,
+    prepare_system,
+    system_spec,
+)
 
 _P = TypeVar("_P", bound=Part)
 
@@ -220,13 +229,15 @@ class System:
                 directory("base_dir", base_dir),
             )
             _table("[initial] ", model["initial"] or {}, _INITIAL)
-            for name, kind in (("solver", Solver), ("output", Output)):
+            for name, schema in (("solver", _SOLVER), ("output", _OUTPUT)):
                 table = sections.get(name)
-                if isinstance(table, Mapping):
-                    prepared = {f.name for f in fields(kind)}
-                    for key in table:
-                        if key not in prepared:
-                            raise _fail(f"[{name}] ", f"unknown key {key!r}") from None
+                if table is None:
+                    continue
+                if not isinstance(table, Mapping):
+                    raise _fail("", f"[{name}] must be a table, got {shown(table)}") from None
+                for key in table:
+                    if key not in schema:
+                        raise _unknown_key(f"[{name}] ", key, list(schema), "allowed:") from None
             raise
 
     @classmethod

@@ -10,8 +10,8 @@
 //! with a Pade approximant (to a few ulps), kept for the lengths that repeat
 //! (a fixed step and its Gauss nodes).
 
+use super::modal::Reduced;
 use crate::error::{Error, Result};
-use crate::methods::modal::Reduced;
 use crate::model::assembly::LinearParts;
 use crate::numerics::linalg;
 
