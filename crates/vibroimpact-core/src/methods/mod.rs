@@ -1,7 +1,5 @@
 pub mod exact;
 pub mod paper_newmark;
-pub mod matrix_flow;
-pub mod modal;
 pub mod registry;
 pub mod step_control;
 pub mod steppers;
