@@ -12,7 +12,7 @@
 //! `eta'' + c eta' + w2 eta = F0 + sum_k Re(P_k e^(i omega_k t))`.
 
 use crate::error::{Error, Result};
-use crate::model::assembly::LinearParts;
+use crate::model::assembly::{HarmonicLoad, LinearParts};
 use crate::numerics::linalg;
 
 /// One harmonic of the forcing, with each mode's steady (particular)
@@ -84,109 +84,15 @@ impl Configuration {
         let dim = parts.constant.len();
         let reduced = Reduced::new(parts, constraints);
         let (r, null, origin) = (reduced.size, &reduced.null, &reduced.origin);
-        let (mr, kr, cr) = (&reduced.mass, &reduced.stiffness, &reduced.damping);
-        let l = linalg::cholesky(mr, r).ok_or_else(|| {
-            Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
-        })?;
-        let linv = linalg::inverse_lower(&l, r);
-        // A = L^-1 K L^-T; Phi = L^-T V.
-        // As two products (`r^3` each, where the sum over both indices at
-        // once took `r^4`: minutes for a thousand dampers).
-        let similar = |a: &[f64]| {
-            let left = product(&linv, a, r);
-            let mut out = vec![0.0; r * r];
-            for p in 0..r {
-                for q in 0..r {
-                    out[p * r + q] =
-                        linalg::dot(&left[p * r..(p + 1) * r], &linv[q * r..(q + 1) * r]);
-                }
-            }
-            out
+        let Some(NormalModes {
+            values,
+            phi,
+            damping: cm,
+        }) = normal_modes(&reduced, what)?
+        else {
+            return Ok(None);
         };
-        let a = similar(kr);
-        let (mut values, vectors) = linalg::symmetric_eigen(&a, r);
-        // Columns of Phi = L^-T V.
-        let mut phi = vec![0.0; r * r];
-        for i in 0..r {
-            for c in 0..r {
-                phi[i * r + c] = (0..r).map(|k| linv[k * r + i] * vectors[k * r + c]).sum();
-            }
-        }
-        // Phi^T C Phi, as two products (`r^3` each).
-        let modal_damping = |phi: &[f64]| {
-            let damped = product(cr, phi, r);
-            let mut out = vec![0.0; r * r];
-            for i in 0..r {
-                for p in 0..r {
-                    let factor = phi[i * r + p];
-                    for q in 0..r {
-                        out[p * r + q] += factor * damped[i * r + q];
-                    }
-                }
-            }
-            out
-        };
-        // Within a repeated eigenvalue (free masses, symmetric structures)
-        // the modes are any basis of the eigenspace: take the one that
-        // diagonalises the damping there too.
-        let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scale;
-        let mut start = 0;
-        while start < r {
-            let mut end = start + 1;
-            while end < r && same(values[start], values[end]) {
-                end += 1;
-            }
-            if end - start > 1 {
-                let cm = modal_damping(&phi);
-                let g = end - start;
-                let block: Vec<f64> = (0..g * g)
-                    .map(|p| cm[(start + p / g) * r + start + p % g])
-                    .collect();
-                let (_, rotation) = linalg::symmetric_eigen(&block, g);
-                for i in 0..r {
-                    let old: Vec<f64> = (0..g).map(|c| phi[i * r + start + c]).collect();
-                    for c in 0..g {
-                        phi[i * r + start + c] = (0..g).map(|k| old[k] * rotation[k * g + c]).sum();
-                    }
-                }
-            }
-            start = end;
-        }
-        let cm = modal_damping(&phi);
-        let largest = (0..r).fold(0.0f64, |m, i| m.max(cm[i * r + i].abs()));
-        for p in 0..r {
-            for q in p + 1..r {
-                if cm[p * r + q].abs() > 1e-9 * largest {
-                    return Ok(None);
-                }
-            }
-        }
-        for v in values.iter_mut() {
-            // Rigid-body modes: round-off of zero.
-            if v.abs() <= 1e-12 * scale {
-                *v = 0.0;
-            }
-        }
-        // B = N Phi; T = Phi^T Mr N^T.
-        let mut to_coordinates = vec![0.0; dim * r];
-        for i in 0..dim {
-            for c in 0..r {
-                to_coordinates[i * r + c] = (0..r).map(|k| null[k][i] * phi[k * r + c]).sum();
-            }
-        }
-        let mut phi_t_m = vec![0.0; r * r];
-        for c in 0..r {
-            for k in 0..r {
-                phi_t_m[c * r + k] = (0..r).map(|j| phi[j * r + c] * mr[j * r + k]).sum();
-            }
-        }
-        let mut to_modal = vec![0.0; r * dim];
-        for c in 0..r {
-            for i in 0..dim {
-                to_modal[c * dim + i] = (0..r).map(|k| phi_t_m[c * r + k] * null[k][i]).sum();
-            }
-        }
+        let (to_coordinates, to_modal) = transforms(null, &phi, &reduced.mass, dim, r);
         // Modal loads: B^T f.
         let project = |f: &[f64]| -> Vec<f64> {
             (0..r)
@@ -211,49 +117,20 @@ impl Configuration {
                 }
                 continue;
             }
-            let (sin, cos) = load.phase.sin_cos();
-            let mut response = Vec::with_capacity(r);
-            let mut force = Vec::with_capacity(r);
-            for j in 0..r {
-                let (pr, pi) = (
-                    load.amplitude * cos * shape[j],
-                    load.amplitude * sin * shape[j],
-                );
-                force.push((pr, pi));
-                let (dr, di) = (values[j] - load.omega * load.omega, damping[j] * load.omega);
-                let norm = dr * dr + di * di;
-                if norm == 0.0 {
-                    if pr == 0.0 && pi == 0.0 {
-                        response.push((0.0, 0.0));
-                        continue;
-                    }
-                    return Err(Error::Inconsistent(format!(
-                        "{what}: an undamped mode forced at exactly its frequency {} Hz grows \
-                         as t between contacts, which the flow's phasors cannot hold; add \
-                         damping, shift the frequency or use method \"dop853\"",
-                        load.omega / std::f64::consts::TAU
-                    )));
-                }
-                // Z = P / (w2 - omega^2 + i c omega).
-                response.push(((pr * dr + pi * di) / norm, (pi * dr - pr * di) / norm));
-            }
+            let harmonic = steady_response(load, &shape, &values, &damping, what)?;
             // Harmonics of one frequency add.
             match harmonics.iter_mut().find(|h| h.omega == load.omega) {
                 Some(h) => {
-                    for (a, b) in h.response.iter_mut().zip(&response) {
+                    for (a, b) in h.response.iter_mut().zip(&harmonic.response) {
                         a.0 += b.0;
                         a.1 += b.1;
                     }
-                    for (a, b) in h.force.iter_mut().zip(&force) {
+                    for (a, b) in h.force.iter_mut().zip(&harmonic.force) {
                         a.0 += b.0;
                         a.1 += b.1;
                     }
                 }
-                None => harmonics.push(ModalHarmonic {
-                    omega: load.omega,
-                    response,
-                    force,
-                }),
+                None => harmonics.push(harmonic),
             }
         }
         Ok(Some(Self {
@@ -268,6 +145,193 @@ impl Configuration {
             harmonics,
         }))
     }
+}
+
+/// A reduced system's mass-normalised modes.
+struct NormalModes {
+    /// Each mode's `w2` (1/s^2; rigid-body modes' round-off set to zero).
+    values: Vec<f64>,
+    /// `Phi`, row-major `size x size`.
+    phi: Vec<f64>,
+    /// `Phi^T C Phi`.
+    damping: Vec<f64>,
+}
+
+/// The reduced system's mass-normalised modes; None when `Phi^T C Phi` is
+/// not diagonal (the damping is not classical). `what` names the
+/// configuration in errors.
+fn normal_modes(reduced: &Reduced, what: &str) -> Result<Option<NormalModes>> {
+    let r = reduced.size;
+    let (mr, kr, cr) = (&reduced.mass, &reduced.stiffness, &reduced.damping);
+    let l = linalg::cholesky(mr, r).ok_or_else(|| {
+        Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
+    })?;
+    let linv = linalg::inverse_lower(&l, r);
+    // A = L^-1 K L^-T; Phi = L^-T V.
+    // As two products (`r^3` each, where the sum over both indices at
+    // once took `r^4`: minutes for a thousand dampers).
+    let similar = |a: &[f64]| {
+        let left = product(&linv, a, r);
+        let mut out = vec![0.0; r * r];
+        for p in 0..r {
+            for q in 0..r {
+                out[p * r + q] = linalg::dot(&left[p * r..(p + 1) * r], &linv[q * r..(q + 1) * r]);
+            }
+        }
+        out
+    };
+    let a = similar(kr);
+    let (mut values, vectors) = linalg::symmetric_eigen(&a, r);
+    // Columns of Phi = L^-T V.
+    let mut phi = vec![0.0; r * r];
+    for i in 0..r {
+        for c in 0..r {
+            phi[i * r + c] = (0..r).map(|k| linv[k * r + i] * vectors[k * r + c]).sum();
+        }
+    }
+    let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    align_repeated(&values, &mut phi, cr, r, scale);
+    let cm = modal_damping(cr, &phi, r);
+    let largest = (0..r).fold(0.0f64, |m, i| m.max(cm[i * r + i].abs()));
+    for p in 0..r {
+        for q in p + 1..r {
+            if cm[p * r + q].abs() > 1e-9 * largest {
+                return Ok(None);
+            }
+        }
+    }
+    for v in values.iter_mut() {
+        // Rigid-body modes: round-off of zero.
+        if v.abs() <= 1e-12 * scale {
+            *v = 0.0;
+        }
+    }
+    Ok(Some(NormalModes {
+        values,
+        phi,
+        damping: cm,
+    }))
+}
+
+/// `Phi^T C Phi` of the `r x r` damping `cr`, as two products (`r^3` each).
+fn modal_damping(cr: &[f64], phi: &[f64], r: usize) -> Vec<f64> {
+    let damped = product(cr, phi, r);
+    let mut out = vec![0.0; r * r];
+    for i in 0..r {
+        for p in 0..r {
+            let factor = phi[i * r + p];
+            for q in 0..r {
+                out[p * r + q] += factor * damped[i * r + q];
+            }
+        }
+    }
+    out
+}
+
+/// Within a repeated eigenvalue (free masses, symmetric structures) the
+/// modes are any basis of the eigenspace: the columns of `phi` there are
+/// turned to the one that diagonalises the damping `cr` there too (`scale`:
+/// the largest eigenvalue's magnitude).
+fn align_repeated(values: &[f64], phi: &mut [f64], cr: &[f64], r: usize, scale: f64) {
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scale;
+    let mut start = 0;
+    while start < r {
+        let mut end = start + 1;
+        while end < r && same(values[start], values[end]) {
+            end += 1;
+        }
+        if end - start > 1 {
+            let cm = modal_damping(cr, phi, r);
+            let g = end - start;
+            let block: Vec<f64> = (0..g * g)
+                .map(|p| cm[(start + p / g) * r + start + p % g])
+                .collect();
+            let (_, rotation) = linalg::symmetric_eigen(&block, g);
+            for i in 0..r {
+                let old: Vec<f64> = (0..g).map(|c| phi[i * r + start + c]).collect();
+                for c in 0..g {
+                    phi[i * r + start + c] = (0..g).map(|k| old[k] * rotation[k * g + c]).sum();
+                }
+            }
+        }
+        start = end;
+    }
+}
+
+/// `B = N Phi` (`dim x r`: coordinates from modal coordinates) and `T =
+/// Phi^T Mr N^T` (`r x dim`: modal coordinates from coordinates), `null`
+/// holding `N`'s columns and `mr` the reduced mass.
+fn transforms(
+    null: &[Vec<f64>],
+    phi: &[f64],
+    mr: &[f64],
+    dim: usize,
+    r: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let mut to_coordinates = vec![0.0; dim * r];
+    for i in 0..dim {
+        for c in 0..r {
+            to_coordinates[i * r + c] = (0..r).map(|k| null[k][i] * phi[k * r + c]).sum();
+        }
+    }
+    let mut phi_t_m = vec![0.0; r * r];
+    for c in 0..r {
+        for k in 0..r {
+            phi_t_m[c * r + k] = (0..r).map(|j| phi[j * r + c] * mr[j * r + k]).sum();
+        }
+    }
+    let mut to_modal = vec![0.0; r * dim];
+    for c in 0..r {
+        for i in 0..dim {
+            to_modal[c * dim + i] = (0..r).map(|k| phi_t_m[c * r + k] * null[k][i]).sum();
+        }
+    }
+    (to_coordinates, to_modal)
+}
+
+/// The harmonic `load` of modal shape `shape` with each mode's force `(Re
+/// P, Im P)` and steady response `Z = P / (w2 - omega^2 + i c omega)`
+/// (`values`: each mode's `w2`, `damping` its `c`); an error where an
+/// undamped mode is forced at exactly its frequency.
+fn steady_response(
+    load: &HarmonicLoad,
+    shape: &[f64],
+    values: &[f64],
+    damping: &[f64],
+    what: &str,
+) -> Result<ModalHarmonic> {
+    let r = values.len();
+    let (sin, cos) = load.phase.sin_cos();
+    let mut response = Vec::with_capacity(r);
+    let mut force = Vec::with_capacity(r);
+    for j in 0..r {
+        let (pr, pi) = (
+            load.amplitude * cos * shape[j],
+            load.amplitude * sin * shape[j],
+        );
+        force.push((pr, pi));
+        let (dr, di) = (values[j] - load.omega * load.omega, damping[j] * load.omega);
+        let norm = dr * dr + di * di;
+        if norm == 0.0 {
+            if pr == 0.0 && pi == 0.0 {
+                response.push((0.0, 0.0));
+                continue;
+            }
+            return Err(Error::Inconsistent(format!(
+                "{what}: an undamped mode forced at exactly its frequency {} Hz grows \
+                 as t between contacts, which the flow's phasors cannot hold; add \
+                 damping, shift the frequency or use method \"dop853\"",
+                load.omega / std::f64::consts::TAU
+            )));
+        }
+        // Z = P / (w2 - omega^2 + i c omega).
+        response.push(((pr * dr + pi * di) / norm, (pi * dr - pr * di) / norm));
+    }
+    Ok(ModalHarmonic {
+        omega: load.omega,
+        response,
+        force,
+    })
 }
 
 /// A linear system reduced to the null space of its constraints: `x = origin
