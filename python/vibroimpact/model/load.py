@@ -17,12 +17,8 @@ from vibroimpact.scenario import (
     read_toml,
     two_mass_scenario,
 )
+from vibroimpact.system import _METHODS
 from vibroimpact.system_scenario import SECTIONS, system_scenario
-
-#: The methods a 0.1 [solver] names that the general kernel runs the same way (with
-#: stepping "events", located contacts); the paper's "newmark" and "fixed" stepping
-#: are not on it yet.
-_GENERAL_METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha")
 
 
 def load(source: str | os.PathLike[str]) -> System:
@@ -88,7 +84,9 @@ def _two_mass(scenario: Scenario, data: dict[str, object]) -> System:
     solver_table = dict(data.get("solver", {}))  # type: ignore[call-overload]
     stepping = scenario.stepping or ("fixed" if scenario.method in ("newmark", "rk4") else "events")
     solver = None
-    if scenario.method in _GENERAL_METHODS and stepping == "events":
+    # The general kernel's methods run a 0.1 method the same way with stepping "events"
+    # (located contacts); the paper's "newmark" and "fixed" stepping are not on it yet.
+    if scenario.method in _METHODS and stepping == "events":
         solver_table.pop("stepping", None)
         solver_table.pop("contact_timing", None)  # fixed stepping's only
         solver = Solver(**solver_table)
