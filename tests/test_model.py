@@ -665,7 +665,7 @@ def test_the_parameter_analyses_and_studies_take_a_system() -> None:
     assert len(branch.points) == 2 and branch.points[0].stable
     study = vi.load(ROOT / "examples" / "clearance_study.toml")
     assert vi.study_of(study).runs == vi.study_of(study.to_dict()).runs == 108
-    with pytest.raises(vi.InvalidInputError, match="data: must be a scenario's sections"):
+    with pytest.raises(vi.InvalidInputError, match="sections .* or a vibroimpact.System, got"):
         vi.sweep(None, "excitation.0.amplitude", [1.0])  # type: ignore[arg-type]
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.arguments import directory, sections
+from vibroimpact.arguments import directory
 from vibroimpact.messages import shown
 from vibroimpact.model.parts import (
     SIGNALS,
@@ -321,4 +321,9 @@ def sections_of(data: Any, base_dir: Path | None = None) -> tuple[Mapping[str, A
     anything else is refused naming ``data``."""
     if isinstance(data, System):
         return data.to_dict(), data.base_dir if base_dir is None else base_dir
-    return sections("data", data), base_dir
+    if not isinstance(data, Mapping):
+        raise InvalidInputError(
+            "data: must be a scenario's sections (a dict of tables, as tomllib parses a "
+            f"scenario) or a vibroimpact.System, got {shown(data)}"
+        )
+    return data, base_dir
