@@ -386,6 +386,15 @@ def test_load_typed_parts_and_the_command_line_agree_bit_for_bit(name: str) -> N
     assert np.array_equal(from_file.structure_displacement, from_parts.structure_displacement)
 
 
+@pytest.mark.parametrize("path", GENERAL, ids=lambda p: p.name)
+def test_every_general_file_runs_as_the_command_line_runs_it(path: Path) -> None:
+    sol, cli = vi.simulate(vi.load(path)), cli_json(path)
+    assert (sol.steps, sol.final_time) == (cli["steps"], cli["final_time"])
+    assert contacts_as_json(sol) == cli["contacts"]
+    final = {key: [float(v) for v in value] for key, value in sol.final_state.items()}
+    assert final == cli["final_state"]
+
+
 def test_simulate_keywords_replace_the_systems_solver() -> None:
     ball = vi.load(ROOT / "examples" / "bouncing_ball.toml")
     short = vi.simulate(ball, t_end=1.0)
