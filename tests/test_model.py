@@ -699,6 +699,28 @@ def test_results_as_pandas_and_xarray() -> None:
     assert "steps=" in text and f"contacts={len(sol.contacts)}" in text and "\n" not in text
 
 
+def test_the_two_mass_results_as_pandas_and_xarray() -> None:
+    damper = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01)
+    start = vi.InitialState(impact_displacement=0.01, impact_velocity=0.1)
+    contact = vi.Contact("hertz", stiffness=3000.0)
+    sol = vi.simulate(damper, contact, start, method="rk4", dt=1e-4, t_end=0.3)
+    frame = vi.to_pandas(sol.contacts)
+    assert list(frame.columns) == list(vi.ContactTable.columns) and len(frame) == 1
+    assert frame["separation"][0] == sol.contacts.separation[0]
+    data = vi.to_xarray(sol)
+    assert data.sizes == {"time": len(sol.t)}
+    assert np.array_equal(data["contact_force"].to_numpy(), sol.contact_force)
+    assert data["contact_force"].attrs["units"] == "N" and data.attrs["steps"] == sol.steps
+    # The 0.2 results through the same functions, as their methods give them.
+    general = vi.simulate(issue_example(), method="exact", t_end=0.2)
+    assert vi.to_pandas(general.contacts).equals(general.contacts.to_pandas())
+    assert vi.to_xarray(general).identical(general.to_xarray())
+    with pytest.raises(vi.InvalidInputError, match="contacts: must be a contact table"):
+        vi.to_pandas(sol)
+    with pytest.raises(vi.InvalidInputError, match="sol: must be a run's solution"):
+        vi.to_xarray(sol.contacts)
+
+
 def test_to_pandas_says_when_pandas_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
     sol = vi.simulate(issue_example(), method="exact", t_end=0.2)
     monkeypatch.setitem(sys.modules, "pandas", None)

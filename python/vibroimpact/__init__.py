@@ -80,6 +80,7 @@ from vibroimpact.model.run import TEXTS as _TEXTS
 from vibroimpact.model.run import simulate
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
 from vibroimpact.study import study_of
+from vibroimpact.summary import to_pandas, to_xarray
 from vibroimpact.system import SystemContacts, SystemSolution, linear_parts, simulate_system
 
 
@@ -161,4 +162,6 @@ __all__ = [
     "basins",
     "continue_orbit",
     "study_of",
+    "to_pandas",
+    "to_xarray",
 ]

@@ -11,6 +11,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from vibroimpact._core import InvalidInputError
+
 _T = TypeVar("_T", bound=type)
 
 #: Arrays and lists of at most this many entries are shown whole.
@@ -114,7 +116,8 @@ def _pandas() -> Any:
 
 def contacts_frame(contacts: Any) -> Any:
     """A contact table (one row per contact, its ``columns``, SI units) as a
-    ``pandas.DataFrame``; pandas is imported here, and its absence said."""
+    ``pandas.DataFrame``: a 0.2 run's ``SystemContacts`` or the two-mass run's
+    ``ContactTable``; pandas is imported here, and its absence said."""
     pandas = _pandas()
     return pandas.DataFrame({name: getattr(contacts, name) for name in contacts.columns})
 
@@ -126,15 +129,39 @@ _UNITS = {
     "damper_displacement": "m",
     "damper_velocity": "m/s",
 }
+#: The two-mass run's history (``vibroimpact.Solution``), each over time.
+_TWO_MASS_UNITS = {
+    "main_displacement": "m",
+    "main_velocity": "m/s",
+    "impact_displacement": "m",
+    "impact_velocity": "m/s",
+    "contact_force": "N",
+}
 
 
 def history_dataset(sol: Any) -> Any:
-    """A 0.2 run's history as an ``xarray.Dataset``: each array of the history over the
-    dimension ``time`` (s) and ``structure_coordinate`` (modes of a cantilever, from
-    0) or ``damper``, with their units; the run's statistics and energy (J) as
-    attributes."""
+    """A run's history as an ``xarray.Dataset`` over the dimension ``time`` (s): a 0.2
+    run's arrays also over ``structure_coordinate`` (modes of a cantilever, from 0) or
+    ``damper``, the two-mass run's (``vibroimpact.Solution``) main and impact mass's
+    displacements, velocities and the contact force; each with its units, the run's
+    statistics and energy (J) as attributes."""
     import xarray as xr
 
+    statistics = ("steps", "rejected_steps", "rhs_evaluations", "grazing_contacts")
+    attrs = {
+        "method": sol.method,
+        "final_time": sol.final_time,
+        "contacts": len(sol.contacts),
+        **{name: getattr(sol, name) for name in statistics},
+    }
+    time = {"time": ("time", sol.t, {"units": "s"})}
+    if not hasattr(sol, "structure_displacement"):
+        two_mass = {
+            name: ("time", getattr(sol, name), {"units": unit})
+            for name, unit in _TWO_MASS_UNITS.items()
+        }
+        energy = {"energy_growth": sol.energy_growth, "energy_residual": sol.energy_residual}
+        return xr.Dataset(two_mass, coords=time, attrs=attrs | energy)
     arrays = {
         name: (
             ("time", "structure_coordinate" if name.startswith("structure") else "damper"),
@@ -144,19 +171,27 @@ def history_dataset(sol: Any) -> Any:
         for name, unit in _UNITS.items()
     }
     n, k = sol.structure_displacement.shape[1], sol.damper_displacement.shape[1]
-    statistics = ("steps", "rejected_steps", "rhs_evaluations", "grazing_contacts")
-    return xr.Dataset(
-        arrays,
-        coords={
-            "time": ("time", sol.t, {"units": "s"}),
-            "structure_coordinate": np.arange(n),
-            "damper": np.arange(k),
-        },
-        attrs={
-            "method": sol.method,
-            "final_time": sol.final_time,
-            "contacts": len(sol.contacts),
-            **{name: getattr(sol, name) for name in statistics},
-            **{f"energy_{key}": value for key, value in sol.energy.items()},
-        },
-    )
+    coordinates = {"structure_coordinate": np.arange(n), "damper": np.arange(k)}
+    energy = {f"energy_{key}": value for key, value in sol.energy.items()}
+    return xr.Dataset(arrays, coords=time | coordinates, attrs=attrs | energy)
+
+
+def to_pandas(contacts: Any) -> Any:
+    """A contact table as a ``pandas.DataFrame`` (see :func:`contacts_frame`): the
+    two-mass run's ``sol.contacts`` (a ``ContactTable``, compiled, without methods of
+    Python's) as a 0.2 run's ``sol.contacts.to_pandas()``."""
+    if not hasattr(contacts, "columns") or not hasattr(contacts, "to_dicts"):
+        raise InvalidInputError(
+            f"contacts: must be a contact table (sol.contacts), got {type(contacts).__name__}"
+        )
+    return contacts_frame(contacts)
+
+
+def to_xarray(sol: Any) -> Any:
+    """A run's history as an ``xarray.Dataset`` (see :func:`history_dataset`): the
+    two-mass run's ``Solution`` as a 0.2 run's ``sol.to_xarray()``."""
+    if not hasattr(sol, "t") or not hasattr(sol, "contacts"):
+        raise InvalidInputError(
+            f"sol: must be a run's solution (vibroimpact.simulate), got {type(sol).__name__}"
+        )
+    return history_dataset(sol)
