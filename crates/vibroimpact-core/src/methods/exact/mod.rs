@@ -13,13 +13,13 @@
 //! one step (grazing). The energy accumulators (viscous loss, input work) are
 //! integrated by 5-point Gauss-Legendre over each step, on the exact flow.
 //!
-//! Laid out by concern: [`oscillator`] (one mode in closed form),
-//! [`configurations`] (the modes of each set of sticking and touching pairs,
-//! made when first met), [`flow`] (the flow from a start: states and
-//! accelerations), [`energies`] (the accumulators over a step), [`stepper`]
+//! Laid out by concern: `oscillator` (one mode in closed form),
+//! `configurations` (the modes of each set of sticking and touching pairs,
+//! made when first met), `flow` (the flow from a start: states and
+//! accelerations), `energies` (the accumulators over a step), `stepper`
 //! (the flow as a [`SystemStepper`]); [`modal`] and [`matrix_flow`] hold the
 //! modes of classically and non-classically damped configurations,
-//! [`from_rest`] the response from rest near a resonance.
+//! `from_rest` the response from rest near a resonance.
 //!
 //! [`SystemStepper`]: crate::methods::steppers::SystemStepper
 

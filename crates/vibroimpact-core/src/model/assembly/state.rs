@@ -12,7 +12,7 @@ impl Assembly {
     }
 
     /// The quantities the reductions follow: each structure coordinate, then
-    /// each point of [`SystemSpec::points`], then each moment.
+    /// each point of [`super::SystemSpec::points`], then each moment.
     pub fn observed(&self) -> usize {
         self.n + self.point_rows.len() / self.n
     }
