@@ -183,24 +183,28 @@ struct Tally {
     energy_start: f64,
 }
 
+/// The member in lane `l`: the group is padded with copies of its last
+/// member, whose results are dropped.
+fn padded(group: &[Member], l: usize) -> &Member {
+    &group[l.min(group.len() - 1)]
+}
+
 fn run_group<L: ContactLaw>(
     group: &[Member],
     options: &EnsembleOptions,
     interrupt: &(dyn Fn() -> bool + Sync),
     law_of: impl Fn(&Contact) -> L,
 ) -> Result<Vec<MemberResult>> {
-    // Padded with copies of the last member, whose results are dropped.
-    let member = |l: usize| &group[l.min(group.len() - 1)];
     let models: [Model<L, Free>; LANES] = std::array::from_fn(|l| {
-        let m = member(l);
+        let m = padded(group, l);
         Model::new(&m.system, law_of(&m.contact), m.contact.damping, Free)
     });
     let mut lanes = Lanes {
         state: Quad {
-            w: std::array::from_fn(|l| member(l).initial.main_displacement),
-            wv: std::array::from_fn(|l| member(l).initial.main_velocity),
-            y: std::array::from_fn(|l| member(l).initial.impact_displacement),
-            yv: std::array::from_fn(|l| member(l).initial.impact_velocity),
+            w: std::array::from_fn(|l| padded(group, l).initial.main_displacement),
+            wv: std::array::from_fn(|l| padded(group, l).initial.main_velocity),
+            y: std::array::from_fn(|l| padded(group, l).initial.impact_displacement),
+            yv: std::array::from_fn(|l| padded(group, l).initial.impact_velocity),
         },
         damping_per_mass: models.map(|m| m.damping_per_mass),
         stiffness_per_mass: models.map(|m| m.stiffness_per_mass),
@@ -210,44 +214,14 @@ fn run_group<L: ContactLaw>(
         contact_damping: models.map(|m| m.contact_damping),
         law: models.map(|m| m.law),
     };
-    let mut tallies: Vec<Tally> = (0..LANES)
-        .map(|l| {
-            let s = member(l).initial;
-            let model = &models[l];
-            let start = model.contact(&s, model.side(&s) * s.relative_velocity());
-            let failed = crate::legacy::records::check_start(model, &s)
-                .err()
-                .map(|e| e.to_string());
-            let open = start.indentation > 0.0;
-            Tally {
-                side: if open { start.side } else { 0.0 },
-                approach: start.rate,
-                // A contact open at the start is one (as in the kernel's table).
-                contacts: u64::from(open && options.record_from <= 0.0),
-                peak: 0.0,
-                squares: 0.0,
-                failed,
-                energy_start: model.energy(&s),
-            }
-        })
-        .collect();
+    let mut tallies = tallies_of(group, &models, options);
     for (l, tally) in tallies.iter_mut().enumerate() {
         if tally.failed.is_some() {
             park(&mut lanes, tally, l);
         }
     }
     let dt = options.dt;
-    // The first step end recorded (index k, t = k dt).
-    let first_kept = if options.record_from <= 0.0 {
-        0
-    } else {
-        // The first k with k dt >= record_from (the division may round up past it).
-        let mut k = (options.record_from / dt).ceil() as u64;
-        if k > 0 && (k - 1) as f64 * dt >= options.record_from {
-            k -= 1;
-        }
-        k.min(options.steps + 1)
-    };
+    let first_kept = first_kept(options);
     let kept_steps = options.steps.saturating_sub(first_kept);
     if first_kept == 0 {
         for (l, tally) in tallies.iter_mut().enumerate() {
@@ -268,40 +242,116 @@ fn run_group<L: ContactLaw>(
             options,
         );
         n = stop;
-        for (l, tally) in tallies.iter_mut().enumerate() {
-            if tally.failed.is_some() {
-                continue;
-            }
-            let s = lanes.state.lane(l);
-            let t = n as f64 * dt;
-            if !s.is_finite() {
-                tally.failed = Some(format!(
-                    "numerical blow-up by t = {t:.6e} s: the state is no longer finite (reduce dt)"
-                ));
-            } else {
-                let energy = models[l].energy(&s);
-                let allowed = tally.energy_start * (1.0 + options.energy_tolerance);
-                if energy > allowed && energy - tally.energy_start > 1e-300 {
-                    tally.failed = Some(format!(
-                        "energy created by t = {t:.6e} s: the mechanical energy grew from \
-                         {:.6e} J to {energy:.6e} J (more than energy_tolerance = {:e} of it) \
-                         in an unforced damped system; reduce dt",
-                        tally.energy_start, options.energy_tolerance
-                    ));
-                }
-            }
-            if tally.failed.is_some() {
-                park(&mut lanes, tally, l);
-            }
-        }
+        check_lanes(&mut lanes, &mut tallies, &models, n as f64 * dt, options);
         if interrupt() {
             return Err(Error::Interrupted {
                 time: n as f64 * dt,
             });
         }
     }
+    Ok(results_of(
+        group.len(),
+        &lanes,
+        &tallies,
+        (first_kept, kept_steps),
+        options,
+    ))
+}
+
+/// Each lane's tally at the start: its open contact, if any (counted where
+/// recorded from the start), and whether its start is refused.
+fn tallies_of<L: ContactLaw>(
+    group: &[Member],
+    models: &[Model<L, Free>; LANES],
+    options: &EnsembleOptions,
+) -> Vec<Tally> {
+    (0..LANES)
+        .map(|l| {
+            let s = padded(group, l).initial;
+            let model = &models[l];
+            let start = model.contact(&s, model.side(&s) * s.relative_velocity());
+            let failed = crate::legacy::records::check_start(model, &s)
+                .err()
+                .map(|e| e.to_string());
+            let open = start.indentation > 0.0;
+            Tally {
+                side: if open { start.side } else { 0.0 },
+                approach: start.rate,
+                // A contact open at the start is one (as in the kernel's table).
+                contacts: u64::from(open && options.record_from <= 0.0),
+                peak: 0.0,
+                squares: 0.0,
+                failed,
+                energy_start: model.energy(&s),
+            }
+        })
+        .collect()
+}
+
+/// The first step end recorded (index k, t = k dt).
+fn first_kept(options: &EnsembleOptions) -> u64 {
+    let dt = options.dt;
+    if options.record_from <= 0.0 {
+        0
+    } else {
+        // The first k with k dt >= record_from (the division may round up past it).
+        let mut k = (options.record_from / dt).ceil() as u64;
+        if k > 0 && (k - 1) as f64 * dt >= options.record_from {
+            k -= 1;
+        }
+        k.min(options.steps + 1)
+    }
+}
+
+/// The lanes' check at time `t` (s) after a stretch of steps: a state no
+/// longer finite, or energy created beyond the tolerance, fails its lane,
+/// which is parked.
+fn check_lanes<L: ContactLaw>(
+    lanes: &mut Lanes<L>,
+    tallies: &mut [Tally],
+    models: &[Model<L, Free>; LANES],
+    t: f64,
+    options: &EnsembleOptions,
+) {
+    for (l, tally) in tallies.iter_mut().enumerate() {
+        if tally.failed.is_some() {
+            continue;
+        }
+        let s = lanes.state.lane(l);
+        if !s.is_finite() {
+            tally.failed = Some(format!(
+                "numerical blow-up by t = {t:.6e} s: the state is no longer finite (reduce dt)"
+            ));
+        } else {
+            let energy = models[l].energy(&s);
+            let allowed = tally.energy_start * (1.0 + options.energy_tolerance);
+            if energy > allowed && energy - tally.energy_start > 1e-300 {
+                tally.failed = Some(format!(
+                    "energy created by t = {t:.6e} s: the mechanical energy grew from \
+                     {:.6e} J to {energy:.6e} J (more than energy_tolerance = {:e} of it) \
+                     in an unforced damped system; reduce dt",
+                    tally.energy_start, options.energy_tolerance
+                ));
+            }
+        }
+        if tally.failed.is_some() {
+            park(lanes, tally, l);
+        }
+    }
+}
+
+/// The results of the group's `members` lanes (the padding dropped), the
+/// peak and RMS over the steps from `first_kept` on (`kept_steps` of them).
+fn results_of<L: ContactLaw>(
+    members: usize,
+    lanes: &Lanes<L>,
+    tallies: &[Tally],
+    (first_kept, kept_steps): (u64, u64),
+    options: &EnsembleOptions,
+) -> Vec<MemberResult> {
+    let dt = options.dt;
     let recorded = kept_steps as f64 * dt;
-    Ok((0..group.len())
+    (0..members)
         .map(|l| {
             let tally = &tallies[l];
             if let Some(reason) = &tally.failed {
@@ -337,7 +387,7 @@ fn run_group<L: ContactLaw>(
                 final_state: lanes.state.lane(l),
             }
         })
-        .collect())
+        .collect()
 }
 
 /// A failed lane is parked at rest, apart: no more events, no NaN.
