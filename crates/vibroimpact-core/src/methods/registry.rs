@@ -19,6 +19,18 @@ pub enum AnyStepper {
     Exact(ExactFlow),
 }
 
+/// The methods of a `[structure]` system, by name: what [`AnyStepper::new`]
+/// makes, in the order its unknown-name message lists them.
+pub const METHODS: [&str; 7] = [
+    "rk4",
+    "dopri5",
+    "dop853",
+    "newmark",
+    "newmark-implicit",
+    "generalized-alpha",
+    "exact",
+];
+
 /// Newmark's `beta` in [0, 0.5] and `gamma` in [0.5, 1] (defaults 1/4, 1/2:
 /// average acceleration), or an error naming the one outside.
 fn newmark_options(beta: f64, gamma: f64) -> Result<(f64, f64)> {
@@ -58,11 +70,11 @@ impl AnyStepper {
             }
             "exact" => Self::Exact(ExactFlow::new(system)?),
             other => {
+                let names: Vec<String> = METHODS.iter().map(|m| format!("{m:?}")).collect();
                 return Err(Error::Inconsistent(format!(
-                    "method must be one of \"rk4\", \"dopri5\", \"dop853\", \"newmark\", \
-                     \"newmark-implicit\", \"generalized-alpha\", \"exact\" for a [structure] \
-                     system, got {other:?}"
-                )))
+                    "method must be one of {} for a [structure] system, got {other:?}",
+                    names.join(", ")
+                )));
             }
         })
     }
