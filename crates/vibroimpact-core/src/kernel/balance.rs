@@ -130,3 +130,49 @@ pub(crate) fn check_balance(
     }
     Ok(())
 }
+
+/// The run's energy balance as the kernel and its fast path check it:
+/// every [`ENERGY_INTERVAL`] accepted steps and at the end, and the energy
+/// in play sampled between (see [`EnergySampler`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct EnergyWatch {
+    /// The energy stored at the start, J.
+    pub(crate) stored_start: f64,
+    /// The largest energy in play so far, J (see [`check_balance`]).
+    pub(crate) scale: f64,
+    pub(crate) sampler: EnergySampler,
+    /// The energy the rigid impacts took so far, J.
+    pub(crate) impact_loss: f64,
+    pub(crate) tolerance: f64,
+    pub(crate) t_end: f64,
+}
+
+impl EnergyWatch {
+    /// The balance after the `accepted`-th step, at `time` and state `y`
+    /// (`done`: the run's last).
+    #[inline(always)]
+    pub(crate) fn after_step(
+        &mut self,
+        system: &Assembly,
+        (y, modes): (&[f64], &[Mode]),
+        accepted: u64,
+        done: bool,
+        time: f64,
+    ) -> Result<()> {
+        let check = accepted % ENERGY_INTERVAL == 0 || done;
+        if check || self.sampler.due(time) {
+            check_balance(
+                system,
+                y,
+                modes,
+                self.stored_start,
+                &mut self.scale,
+                self.impact_loss,
+                (self.tolerance, check),
+                self.t_end,
+                time,
+            )?;
+        }
+        Ok(())
+    }
+}

@@ -60,6 +60,8 @@ pub(crate) struct Impacts {
     before: Vec<f64>,
     /// Velocities before the instant.
     velocities: Vec<f64>,
+    /// The largest speed before the instant, m/s.
+    speed_scale: f64,
     lcp: Complementarity,
 }
 
@@ -73,6 +75,7 @@ impl Impacts {
             stuck: Vec::with_capacity(count),
             before: Vec::with_capacity(count),
             velocities: vec![0.0; system.dim],
+            speed_scale: 0.0,
             lcp: Complementarity::new(count),
         }
     }
@@ -108,7 +111,53 @@ impl Impacts {
         just_switched: &mut [bool],
     ) -> bool {
         let d = system.dim;
-        let speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // The speeds before the instant (the impulses change them).
+        self.speed_scale = y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scales = (instant, time_scale);
+        let any = self.classify(
+            system,
+            time,
+            y,
+            modes,
+            grazes,
+            scales,
+            scratch,
+            work,
+            just_switched,
+        );
+        if self.members.is_empty() {
+            return any;
+        }
+        self.impulses(system, time, y, modes, resolution, scratch, work);
+        self.record(
+            system,
+            time,
+            y,
+            modes,
+            (open, contacts),
+            impact_loss,
+            grazes,
+            just_switched,
+        ) || any
+    }
+
+    /// The roles of the rigid pairs marked touching at `time`: impact,
+    /// stick, touch (the members of the event's problem); whether any
+    /// switched without one.
+    #[allow(clippy::too_many_arguments)]
+    fn classify(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &mut [f64],
+        modes: &mut [Mode],
+        grazes: &mut u64,
+        (instant, time_scale): (f64, f64),
+        scratch: &mut Scratch,
+        work: &mut [f64],
+        just_switched: &mut [bool],
+    ) -> bool {
+        let speed_scale = self.speed_scale;
         self.members.clear();
         self.roles.clear();
         let mut any = false;
@@ -174,9 +223,25 @@ impl Impacts {
             self.members.push(i);
             self.roles.push(role);
         }
-        if self.members.is_empty() {
-            return any;
-        }
+        any
+    }
+
+    /// The impulses at the event: the members' problem solved, with the
+    /// sticking pairs held and the chattering sequences that finish within
+    /// `resolution` s summed to sticking.
+    #[allow(clippy::too_many_arguments)]
+    fn impulses(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &mut [f64],
+        modes: &mut [Mode],
+        resolution: f64,
+        scratch: &mut Scratch,
+        work: &mut [f64],
+    ) {
+        let d = system.dim;
+        let speed_scale = self.speed_scale;
         for (i, mode) in modes.iter().enumerate() {
             if *mode == Mode::Sticking && !self.members.contains(&i) {
                 self.members.push(i);
@@ -271,6 +336,24 @@ impl Impacts {
                 break;
             }
         }
+    }
+
+    /// Each member's share of the energy the impulses took, its record and
+    /// its new mode; whether any impulse acted or pair lifted off.
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &mut [f64],
+        modes: &mut [Mode],
+        (open, contacts): (&mut [Option<Open>], &mut Vec<PairContact>),
+        impact_loss: &mut f64,
+        grazes: &mut u64,
+        just_switched: &mut [bool],
+    ) -> bool {
+        let speed_scale = self.speed_scale;
+        let mut any = false;
         // Each pair's share of the energy the impulses take, J:
         // -P (u- + u+) / 2, which sums to the kinetic energy lost.
         for (s, &i) in self.members.iter().enumerate() {

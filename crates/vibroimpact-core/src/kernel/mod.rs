@@ -1,8 +1,13 @@
 pub(crate) mod balance;
+pub(crate) mod clock;
 pub(crate) mod compact;
 pub(crate) mod contact_balance;
+pub(crate) mod contacts;
 pub mod events;
 pub(crate) mod impacts;
+pub(crate) mod locate;
 pub mod memory;
+pub(crate) mod records;
 pub mod reductions;
+pub(crate) mod run;
 pub(crate) mod sized;

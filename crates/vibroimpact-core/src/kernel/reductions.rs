@@ -13,6 +13,10 @@
 //! for the exact flow, whose steps are long (an eighth of a period: the
 //! interpolant errs by 1e-6 there), the flow itself at the same nodes.
 
+use crate::error::Result;
+use crate::methods::steppers::SystemStepper;
+use crate::model::assembly::{Assembly, Mode, Scratch};
+
 /// What to reduce: from `record_from` (s) on, and a stroboscopic state every
 /// `strobe_period` (s; infinite for none).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,4 +133,76 @@ pub fn square_integral(a: &[f64; 6]) -> f64 {
             w * v * v
         })
         .sum()
+}
+
+/// Add the kept step `(time, y) -> end` of length `h` to the reductions.
+/// Returns whether the stepper was used (its last attempt is then not the
+/// kept step).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn reduce_step<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    (time, y, end, h): (f64, &[f64], &[f64], f64),
+    modes: &[Mode],
+    scratch: &mut Scratch,
+    (probe, start, work): (&mut [f64], &mut [f64], &mut [f64]),
+    out: &mut Reductions,
+    mean_square: bool,
+) -> Result<bool> {
+    let (n, d) = (system.n, system.dim);
+    let observed = system.observed();
+    // Each observed quantity (a coordinate or a point) of a block of the
+    // structure's displacements, velocities or accelerations.
+    let of = |j: usize, block: &[f64]| system.observe(j, block);
+    // The exact flow's mean square from the flow itself at the quadrature's
+    // nodes (its steps are long, the interpolant's error 1e-6 there).
+    let on_flow = mean_square && stepper.is_exact();
+    let interpolated = mean_square && !on_flow;
+    let mut used = false;
+    if on_flow {
+        for (x, w) in NODES.iter().zip(WEIGHTS) {
+            stepper.attempt(system, time, y, x * h, modes, scratch, probe)?;
+            for j in 0..observed {
+                let value = of(j, &probe[..n]);
+                out.square_integrals[j] += h * w * value * value;
+            }
+        }
+        used = true;
+    }
+    let (v0, v1) = (&y[d..d + n], &end[d..d + n]);
+    // The accelerations at both ends only where the interpolant is needed:
+    // for the mean square, or where a velocity changes sign (a peak inside).
+    let turning = (0..observed).any(|j| of(j, v0) * of(j, v1) < 0.0);
+    if interpolated || turning {
+        system.rates(time, y, modes, scratch, start);
+        system.rates(time + h, end, modes, scratch, work);
+    }
+    for j in 0..observed {
+        let (p0, p1) = (of(j, &y[..n]), of(j, &end[..n]));
+        let (s0, s1) = (of(j, v0), of(j, v1));
+        let mut peak = p0.abs().max(p1.abs());
+        let inside = s0 * s1 < 0.0;
+        if interpolated || inside {
+            let a = quintic(
+                p0,
+                p1,
+                h * s0,
+                h * s1,
+                h * h * of(j, &start[d..d + n]),
+                h * h * of(j, &work[d..d + n]),
+            );
+            if interpolated {
+                out.square_integrals[j] += h * square_integral(&a);
+            }
+            if inside {
+                let theta = derivative_root(&a);
+                stepper.attempt(system, time, y, theta * h, modes, scratch, probe)?;
+                used = true;
+                peak = peak.max(of(j, &probe[..n]).abs());
+            }
+        }
+        out.peaks[j] = out.peaks[j].max(peak);
+    }
+    out.recorded_time += h;
+    Ok(used)
 }

@@ -105,9 +105,179 @@ pub(crate) fn falling_root(slope: impl Fn(f64) -> f64, tolerance: f64) -> f64 {
     best
 }
 
+/// Where the slope of the cubic Hermite interpolant falls from `m0 > 0`
+/// to `m1 <= 0`: its maximum over the step, in closed form (the slope is a
+/// quadratic in theta with one root in [0, 1]). The event kernel's;
+/// [`argmax`] finds the same point by regula falsi, to other bits.
+pub(crate) fn peak(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
+    // slope(theta) = a theta^2 + b theta + m0.
+    let a = 6.0 * (g0 - g1) + 3.0 * (m0 + m1);
+    let b = 6.0 * (g1 - g0) - 4.0 * m0 - 2.0 * m1;
+    if m1 >= 0.0 {
+        return 1.0;
+    }
+    let root = if a == 0.0 {
+        -m0 / b
+    } else {
+        // The two roots without cancellation: q / a and m0 / q.
+        let q = -0.5 * (b + b.signum() * (b * b - 4.0 * a * m0).max(0.0).sqrt());
+        let (r1, r2) = (q / a, if q != 0.0 { m0 / q } else { f64::NAN });
+        // The one in [0, 1] (slope(0) > 0 >= slope(1): exactly one).
+        if (0.0..=1.0).contains(&r1) && !(0.0..=1.0).contains(&r2) {
+            r1
+        } else if (0.0..=1.0).contains(&r2) && !(0.0..=1.0).contains(&r1) {
+            r2
+        } else {
+            // Both (or neither) by round-off: the one whose slope is closer to 0.
+            let slope = |t: f64| eval(g0, g1, m0, m1, t.clamp(0.0, 1.0)).1.abs();
+            if slope(r1) <= slope(r2) || r2.is_nan() {
+                r1
+            } else {
+                r2
+            }
+        }
+    };
+    if root.is_nan() {
+        0.5
+    } else {
+        root.clamp(0.0, 1.0)
+    }
+}
+
+/// The first local maximum of the cubic Hermite interpolant whose slope
+/// starts at `m0 > 0` and ends at `m1 >= 0`: the smaller root of its slope
+/// in [0, 1] when it falls below zero between them, else 0 (no maximum
+/// inside: it rises throughout).
+pub(crate) fn first_maximum(g0: f64, g1: f64, m0: f64, m1: f64) -> f64 {
+    // slope(theta) = a theta^2 + b theta + m0, as in [`peak`].
+    let a = 6.0 * (g0 - g1) + 3.0 * (m0 + m1);
+    let b = 6.0 * (g1 - g0) - 4.0 * m0 - 2.0 * m1;
+    let discriminant = b * b - 4.0 * a * m0;
+    if a <= 0.0 || discriminant <= 0.0 {
+        // A slope that opens downwards and ends >= 0 stays >= 0; one with
+        // no real roots never falls below zero.
+        return 0.0;
+    }
+    // Both roots positive (their product m0 / a > 0): the smaller one.
+    let q = -0.5 * (b - discriminant.sqrt());
+    let root = m0 / q;
+    if root > 0.0 && root < 1.0 {
+        root
+    } else {
+        0.0
+    }
+}
+
+/// A root of the cubic Hermite interpolant (see [`eval`]) between
+/// `lo` and `hi` in theta, where it has opposite signs (else `hi`): Newton's
+/// method on its power form, safeguarded by bisection, to 1e-10 in theta
+/// (the interpolant itself is off by ~ theta^4 of the value's swing). The
+/// first guess of an event's location.
+pub(crate) fn root_within(g0: f64, g1: f64, m0: f64, m1: f64, mut lo: f64, mut hi: f64) -> f64 {
+    // g0 + m0 t + c2 t^2 + c3 t^3.
+    let c2 = 3.0 * (g1 - g0) - 2.0 * m0 - m1;
+    let c3 = 2.0 * (g0 - g1) + m0 + m1;
+    let value = |t: f64| g0 + t * (m0 + t * (c2 + t * c3));
+    let (v_lo, v_hi) = (value(lo), value(hi));
+    if v_lo == 0.0 {
+        return lo;
+    }
+    if v_hi == 0.0 || (v_lo > 0.0) == (v_hi > 0.0) {
+        return hi;
+    }
+    let positive_below = v_lo > 0.0;
+    let mut theta = lo + (hi - lo) * v_lo / (v_lo - v_hi);
+    for _ in 0..64 {
+        let v = value(theta);
+        if v == 0.0 {
+            return theta;
+        }
+        if (v > 0.0) == positive_below {
+            lo = theta;
+        } else {
+            hi = theta;
+        }
+        let slope = m0 + theta * (2.0 * c2 + 3.0 * theta * c3);
+        let newton = theta - v / slope;
+        let next = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if (next - theta).abs() <= 1e-10 || hi - lo <= 1e-10 {
+            return next;
+        }
+        theta = next;
+    }
+    theta
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Hermite data `(g0, g1, m0, m1)` over [0, 1] of `p` with derivative `dp`.
+    fn data(p: impl Fn(f64) -> f64, dp: impl Fn(f64) -> f64) -> (f64, f64, f64, f64) {
+        (p(0.0), p(1.0), dp(0.0), dp(1.0))
+    }
+
+    #[test]
+    fn the_interpolant_s_root_is_a_cubic_s_root() {
+        crate::testing::timeout(30, || {
+            // A cubic is its own Hermite interpolant: its root, to round-off.
+            let p = |t: f64| (t - 0.3) * (t + 2.0) * (t - 4.0);
+            let dp = |t: f64| (t + 2.0) * (t - 4.0) + (t - 0.3) * (t - 4.0) + (t - 0.3) * (t + 2.0);
+            let (g0, g1, m0, m1) = data(p, dp);
+            for (lo, hi) in [(0.0, 1.0), (0.25, 0.9), (0.1, 0.3000001)] {
+                let r = root_within(g0, g1, m0, m1, lo, hi);
+                assert!((r - 0.3).abs() < 1e-14, "[{lo}, {hi}]: {r}");
+            }
+            // Falling through zero (the sign of the old side is positive).
+            let r = root_within(-g0, -g1, -m0, -m1, 0.0, 1.0);
+            assert!((r - 0.3).abs() < 1e-14, "{r}");
+            // No sign change in the bracket: its end.
+            assert_eq!(root_within(g0, g1, m0, m1, 0.5, 1.0), 1.0);
+        });
+    }
+
+    #[test]
+    fn the_first_maximum_of_a_cubic_that_rises_again() {
+        crate::testing::timeout(30, || {
+            // p = 0.3 t - t^2 + t^3: p' = 0.3 - 2 t + 3 t^2 vanishes at
+            // (2 -+ sqrt(0.4)) / 6; the first, 0.2279, is its maximum.
+            let p = |t: f64| 0.3 * t - t * t + t * t * t;
+            let dp = |t: f64| 0.3 - 2.0 * t + 3.0 * t * t;
+            let (g0, g1, m0, m1) = data(p, dp);
+            let exact = (2.0 - 0.4f64.sqrt()) / 6.0;
+            assert!((first_maximum(g0, g1, m0, m1) - exact).abs() < 1e-15);
+            // One that rises throughout has none inside.
+            let (g0, g1, m0, m1) = data(|t| t + t * t * t, |t| 1.0 + 3.0 * t * t);
+            assert_eq!(first_maximum(g0, g1, m0, m1), 0.0);
+        });
+    }
+
+    #[test]
+    fn the_interpolant_s_maximum_in_closed_form() {
+        crate::testing::timeout(30, || {
+            // -(t^3 - t^2 / 2 - 3 t / 2): slope 1.5 at 0, -0.5 at 1, zero at
+            // (1 + sqrt(19)) / 6.
+            let p = |t: f64| -(t * t * t - 0.5 * t * t - 1.5 * t);
+            let dp = |t: f64| -(3.0 * t * t - t - 1.5);
+            let (g0, g1, m0, m1) = data(p, dp);
+            let expected = (1.0 + 19f64.sqrt()) / 6.0;
+            let a = peak(g0, g1, m0, m1);
+            assert!((a - expected).abs() < 1e-15, "{a} {expected}");
+            // A parabola (the slope is linear): its vertex.
+            let q = |t: f64| 1.0 - (t - 0.7) * (t - 0.7);
+            let dq = |t: f64| -2.0 * (t - 0.7);
+            let (g0, g1, m0, m1) = data(q, dq);
+            assert!((peak(g0, g1, m0, m1) - 0.7).abs() < 1e-15);
+            // The regula falsi argmax agrees.
+            assert!((peak(g0, g1, m0, m1) - argmax(g0, g1, m0, m1)).abs() < 1e-12);
+            // Still rising at the end: the end.
+            assert_eq!(peak(0.0, 1.0, 1.0, 0.5), 1.0);
+        });
+    }
 
     #[test]
     fn reproduces_a_cubic_exactly_and_finds_its_root() {

@@ -15,9 +15,9 @@
 // between the arrays measured slower: calls to memcpy, bounds not folded).
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
-use crate::error::Error;
-use crate::kernel::balance::{check_balance, EnergySampler, ENERGY_INTERVAL};
-use crate::kernel::sized::by_size;
+mod stretch;
+pub(crate) use stretch::Stretch;
+
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{
     h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
@@ -383,310 +383,14 @@ impl Compact {
             out[w] = (wall.offset + products.0, products.1);
         }
     }
-
-    /// [`Self::stretch`] for the system's sizes, in the widest vector
-    /// instructions the processor has (the same operations: the same bits).
-    pub(crate) fn run_stretch(
-        &self,
-        system: &Assembly,
-        f: &mut Stretch<'_>,
-        modes: &[Mode],
-        scratch: &mut Scratch,
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                // SAFETY: the processor has the feature the function is built for.
-                return unsafe { stretch_avx512(self, system, f, modes, scratch) };
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: as above.
-                return unsafe { stretch_avx2(self, system, f, modes, scratch) };
-            }
-        }
-        stretch_sized(self, system, f, modes, scratch)
-    }
-
-    /// Plain RK4 steps on the grid, as the event kernel takes them, for as
-    /// long as nothing but the step itself is due (see [`Stretch`]), with
-    /// the system's data in registers across them. Each step is the general
-    /// loop's to the bit; one that turns out not to be plain (a gap that may
-    /// cross, a compliant contact at its deepest, a peak inside the step, a
-    /// state no longer finite) is taken back, for the general loop to take.
-    #[inline(always)]
-    pub(crate) fn stretch<const STICKING: bool>(
-        &self,
-        system: &Assembly,
-        n: usize,
-        k: usize,
-        f: &mut Stretch<'_>,
-        modes: &[Mode],
-        scratch: &mut Scratch,
-    ) {
-        let d = n + k;
-        let row = 2 * d;
-        let count = self.count.min(MAX_WALLS);
-        let len = f.y.len().min(MAX_LEN);
-        let observed = system.observed();
-        let modes = &modes[..count];
-        let mut y = [0.0; MAX_LEN];
-        y[..len].copy_from_slice(&f.y[..len]);
-        let mut start_gaps = [(0.0, 0.0); MAX_WALLS];
-        start_gaps[..count].copy_from_slice(&f.gaps[..count]);
-        let mut end = [0.0; MAX_LEN];
-        let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
-        let mut stages = [[0.0; MAX_LEN]; 4];
-        // Walls the event search passes over: the open wall of a sticking
-        // damper, and sticking walls of a damper without clearance; whether
-        // a sticking pair may release.
-        let mut held = [false; MAX_WALLS];
-        let mut locked = [false; MAX_WALLS];
-        let mut releasable = false;
-        for w in 0..count {
-            held[w] = modes[w] == Mode::Open && system.held_by_mirror(w, modes);
-            locked[w] = system.locked(w);
-            releasable |= modes[w] == Mode::Sticking && !locked[w];
-        }
-        // Whether `stages[0]` holds the rates at the step's start (the last
-        // step's release test evaluated them there).
-        let mut start_valid = false;
-        // In a register through the loop, written back after it.
-        let mut sampler = f.energy_sampler;
-        loop {
-            if f.accepted >= f.max_accepted {
-                f.limited = true;
-                break;
-            }
-            let time = f.time;
-            if f.t_end - time <= 1e-9 * f.dt {
-                break;
-            }
-            let length = ((f.grid + 1) as f64 * f.dt - time).min(f.t_end - time);
-            let next = time + length;
-            let from = f.record_from;
-            if length <= 0.0
-                || (from - time < length && from - time > 1e-9 * length)
-                || (f.next_strobe - time < length && f.next_strobe - time > 1e-9 * f.strobe_period)
-                || next >= f.next_strobe - 1e-9 * f.strobe_period
-                || next >= f.t_end
-                || f.t_end - next <= 1e-9 * f.dt
-                || (f.keep_history && f.until_kept <= 1)
-                || length <= f.chatter_factor * next.abs().max(f.time_scale)
-            {
-                break;
-            }
-            let in_window = time + 1e-9 * length >= f.record_from;
-            if in_window && f.mean_square {
-                break;
-            }
-            let cache = scratch.first_cache().copied();
-            self.step::<STICKING>(
-                system,
-                n,
-                k,
-                time,
-                &y,
-                len,
-                length,
-                modes,
-                scratch,
-                &mut stages,
-                start_valid,
-                &mut end,
-            );
-            self.gaps(d, &end, &mut end_gaps);
-            // What the general loop would do more than count the step: an
-            // event search, a blow-up, a compliant contact's deepest point,
-            // a peak inside the step.
-            let mut plain = end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
-            for w in 0..count {
-                match modes[w] {
-                    // The event search passes over these (see `find_crossing`).
-                    Mode::Sticking => {}
-                    Mode::Open if held[w] => {}
-                    mode => {
-                        plain &= !mode.may_cross(start_gaps[w], end_gaps[w]);
-                        if let Mode::Compliant { .. } = mode {
-                            let (m0, m1) = (start_gaps[w].1 * length, end_gaps[w].1 * length);
-                            plain &= !(m0 < 0.0 && m1 > 0.0);
-                        }
-                    }
-                }
-            }
-            if plain && releasable {
-                // A sticking pair whose constraint force at the step's end
-                // pulls is released: the forces as the event search takes
-                // them.
-                self.rates::<true>(system, n, k, next, &end, modes, scratch, &mut stages[0]);
-                for w in 0..count {
-                    if modes[w] == Mode::Sticking
-                        && !locked[w]
-                        && scratch.force_of(w).unwrap_or(0.0) < 0.0
-                    {
-                        plain = false;
-                    }
-                }
-            }
-            if in_window {
-                for j in 0..observed {
-                    let (s0, s1) = (
-                        system.observe(j, &y[d..d + n]),
-                        system.observe(j, &end[d..d + n]),
-                    );
-                    if s0 * s1 < 0.0 {
-                        plain = false;
-                    }
-                }
-            }
-            if !plain {
-                if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
-                    *cache = saved;
-                }
-                break;
-            }
-            for w in 0..count {
-                if let Mode::Compliant { .. } = modes[w] {
-                    f.deepest[w] = f.deepest[w].max(-end_gaps[w].0);
-                }
-            }
-            if in_window {
-                for (j, peak) in f.peaks.iter_mut().enumerate().take(observed) {
-                    let (p0, p1) = (system.observe(j, &y[..n]), system.observe(j, &end[..n]));
-                    *peak = peak.max(p0.abs().max(p1.abs()));
-                }
-                *f.recorded_time += length;
-            }
-            f.time = next;
-            f.grid += 1;
-            f.accepted += 1;
-            f.until_kept = f.until_kept.saturating_sub(1);
-            f.evaluations += 4;
-            f.steps += 1;
-            // Those rates are the next step's first stage.
-            start_valid = releasable;
-            for e in 0..len {
-                y[e] = end[e];
-            }
-            for w in 0..count {
-                start_gaps[w] = end_gaps[w];
-            }
-            let check = f.accepted % ENERGY_INTERVAL == 0;
-            if check || sampler.due(f.time) {
-                if let Err(failure) = check_balance(
-                    system,
-                    &y[..len],
-                    modes,
-                    f.stored_start,
-                    &mut f.energy_scale,
-                    f.impact_loss,
-                    (f.energy_tolerance, check),
-                    f.t_end,
-                    f.time,
-                ) {
-                    f.unbalanced = Some(failure);
-                    break;
-                }
-            }
-        }
-        f.energy_sampler = sampler;
-        f.y[..len].copy_from_slice(&y[..len]);
-        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
-    }
-}
-
-/// [`Compact::stretch`] for the system's sizes (constants in each arm).
-#[inline(always)]
-fn stretch_sized(
-    compact: &Compact,
-    system: &Assembly,
-    f: &mut Stretch<'_>,
-    modes: &[Mode],
-    scratch: &mut Scratch,
-) {
-    // Without a sticking pair, no constraint solve is compiled in.
-    if modes.contains(&Mode::Sticking) {
-        by_size!(system, |n, k| compact
-            .stretch::<true>(system, n, k, f, modes, scratch))
-    } else {
-        by_size!(system, |n, k| compact
-            .stretch::<false>(system, n, k, f, modes, scratch))
-    }
-}
-
-/// [`stretch_sized`] compiled for a processor feature.
-macro_rules! stretch_with {
-    ($name:ident, $feature:literal) => {
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feature)]
-        unsafe fn $name(
-            compact: &Compact,
-            system: &Assembly,
-            f: &mut Stretch<'_>,
-            modes: &[Mode],
-            scratch: &mut Scratch,
-        ) {
-            stretch_sized(compact, system, f, modes, scratch)
-        }
-    };
-}
-stretch_with!(stretch_avx512, "avx512f");
-stretch_with!(stretch_avx2, "avx2");
-
-/// The event kernel's state that a stretch advances, and where it must stop:
-/// it takes a step only where the general loop would take it whole and do
-/// nothing after it but count it (no landing on the recording window's
-/// start or a strobe instant, no history row, step limit or end of the run
-/// due), or check the energy balance, which the stretch does as the kernel
-/// would, or poll for an interrupt, which the kernel then does (a stretch
-/// ends on that step). The memory and row limits
-/// the loop checks after each step hold through a stretch, which adds no
-/// contact and no row (the kernel starts none before its own first step).
-pub struct Stretch<'a> {
-    pub time: f64,
-    pub grid: u64,
-    pub accepted: u64,
-    pub until_kept: u64,
-    /// The state, advanced in place, and each wall's gap and rate there.
-    pub y: &'a mut [f64],
-    pub gaps: &'a mut [(f64, f64)],
-    /// Each compliant contact's deepest indentation so far (m).
-    pub deepest: &'a mut [f64],
-    /// The reductions' peaks and recorded time (used in the window).
-    pub peaks: &'a mut [f64],
-    pub recorded_time: &'a mut f64,
-    /// Right-hand-side evaluations and steps made.
-    pub evaluations: u64,
-    pub steps: u64,
-    /// The most accepted steps the stretch may reach, and whether it did.
-    pub max_accepted: u64,
-    pub limited: bool,
-    pub dt: f64,
-    pub t_end: f64,
-    pub record_from: f64,
-    pub mean_square: bool,
-    pub next_strobe: f64,
-    pub strobe_period: f64,
-    pub keep_history: bool,
-    /// A step no longer than `chatter_factor * max(|t|, time_scale)` makes
-    /// no progress (the kernel's stall test).
-    pub chatter_factor: f64,
-    pub time_scale: f64,
-    /// The energy balance, checked every [`ENERGY_INTERVAL`] accepted steps
-    /// as the kernel checks it (the scale kept across checks); the error
-    /// where it failed, on which the stretch stops.
-    pub stored_start: f64,
-    pub energy_scale: f64,
-    /// When the energy in play is sampled between the checks.
-    pub energy_sampler: EnergySampler,
-    pub impact_loss: f64,
-    pub energy_tolerance: f64,
-    pub unbalanced: Option<Error>,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::error::Result;
+    use crate::kernel::balance::EnergyWatch;
+    use crate::kernel::clock::{Clock, Schedule};
     use crate::kernel::events::{
         integrate_system, integrate_system_within, ContactKind, RunOptions, SystemSolution,
     };
@@ -911,37 +615,48 @@ mod tests {
             let mut y = initial_state(&system, &[], &[], &[], &[]).unwrap();
             let mut gaps = vec![(0.0, 0.0); count];
             system.gaps(&y, &mut gaps);
-            let (mut deepest, mut peaks, mut recorded) = (vec![f64::NAN; count], vec![0.0; 3], 0.0);
+            let (mut open, mut peaks, mut recorded) = (vec![None; count], vec![0.0; 3], 0.0);
             let dt = 1e-5;
-            let (stored_start, energy_scale) = system.energy_terms(&y, &modes);
-            let mut stretch = Stretch {
+            let (stored_start, scale) = system.energy_terms(&y, &modes);
+            let mut clock = Clock {
                 time: 0.0,
                 grid: 0,
                 accepted: 0,
                 until_kept: 0,
-                y: &mut y,
-                gaps: &mut gaps,
-                deepest: &mut deepest,
-                peaks: &mut peaks,
-                recorded_time: &mut recorded,
-                evaluations: 0,
-                steps: 0,
-                max_accepted: 20,
-                limited: false,
+                next_strobe: f64::INFINITY,
+            };
+            let schedule = Schedule {
+                adaptive: false,
                 dt,
                 t_end: 1.0,
-                record_from: 0.0,
-                mean_square: false,
-                next_strobe: f64::INFINITY,
-                strobe_period: f64::INFINITY,
                 keep_history: false,
-                chatter_factor: 1e3 * f64::EPSILON,
+                every: 1,
+                record_from: 0.0,
+                strobe_period: f64::INFINITY,
+                mean_square: false,
                 time_scale: 1.0,
+            };
+            let mut energy = EnergyWatch {
                 stored_start,
-                energy_scale,
-                energy_sampler: EnergySampler::new(&system, 1.0),
+                scale,
+                sampler: crate::kernel::balance::EnergySampler::new(&system, 1.0),
                 impact_loss: 0.0,
-                energy_tolerance: 1e-6,
+                tolerance: 1e-6,
+                t_end: 1.0,
+            };
+            let mut stretch = Stretch {
+                clock: &mut clock,
+                schedule: &schedule,
+                y: &mut y,
+                gaps: &mut gaps,
+                open: &mut open,
+                peaks: &mut peaks,
+                recorded_time: &mut recorded,
+                energy: &mut energy,
+                max_accepted: 20,
+                limited: false,
+                evaluations: 0,
+                steps: 0,
                 unbalanced: None,
             };
             let mut scratch = Scratch::new(&system);

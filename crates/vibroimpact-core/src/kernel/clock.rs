@@ -1,0 +1,169 @@
+//! The run's clock and its stop rules: why a kernel step ends ([`Stop`]),
+//! where a fixed step lands (the grid, the recorded window's start, a
+//! stroboscopic instant, the end), and when a step is plain: nothing due
+//! after it but counting it, which is what the fast path ("step until a stop
+//! reason", [`crate::kernel::compact`]) takes at once. The kernel's own step
+//! and the fast path read the same rules here.
+
+use crate::kernel::events::RunOptions;
+
+/// Chattering of compliant contacts: this many mode changes in a row, each
+/// closer than the time's round-off can resolve, stop it.
+pub(crate) const CHATTER_EVENTS: u64 = 16;
+/// Events closer than this many units of round-off of the time itself
+/// cannot be told apart.
+const CHATTER_ULPS: f64 = 1e3;
+/// Steps in a row at the round-off of time that stop a run.
+pub(crate) const STALLED_STEPS: u64 = 64;
+
+/// Why a kernel step ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stop {
+    /// A step kept: on the grid, or as long as the error control allows.
+    Step,
+    /// A step kept, landed on the start of the recorded window.
+    RecordWindow,
+    /// A step kept, landed on a stroboscopic instant.
+    Strobe,
+    /// A step kept, ended on the event of interaction `interaction`.
+    Event { interaction: usize },
+    /// No step kept: one rejected by the error control or by its cut, or a
+    /// grid point passed by an event; the kernel steps again.
+    Retry,
+    /// No step: the run is at its end.
+    End,
+}
+
+/// Where a run stands: its time, the fixed-step grid's last point, the
+/// steps kept, the steps to the next history row and the next strobe.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Clock {
+    /// s.
+    pub(crate) time: f64,
+    /// The grid points passed (fixed steps): the next is `(grid + 1) dt`.
+    pub(crate) grid: u64,
+    pub(crate) accepted: u64,
+    /// Steps to the next history row (counts down only while it matters).
+    pub(crate) until_kept: u64,
+    /// s.
+    pub(crate) next_strobe: f64,
+}
+
+/// What a run's options fix about its steps (see [`Clock`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Schedule {
+    pub(crate) adaptive: bool,
+    /// The fixed step, s (NaN for an adaptive method given none).
+    pub(crate) dt: f64,
+    pub(crate) t_end: f64,
+    pub(crate) keep_history: bool,
+    pub(crate) every: u64,
+    pub(crate) record_from: f64,
+    pub(crate) strobe_period: f64,
+    pub(crate) mean_square: bool,
+    /// The run's time scale: `t_end` or the structure's longest period, s.
+    pub(crate) time_scale: f64,
+}
+
+impl Schedule {
+    pub(crate) fn new(options: &RunOptions, adaptive: bool, longest_period: f64) -> Self {
+        Self {
+            adaptive,
+            dt: options.dt.unwrap_or(f64::NAN),
+            t_end: options.t_end,
+            keep_history: options.keep_history,
+            every: options.every,
+            record_from: options.reduce.record_from,
+            strobe_period: options.reduce.strobe_period,
+            mean_square: options.reduce.mean_square,
+            time_scale: options.t_end.min(longest_period),
+        }
+    }
+
+    /// A fixed-step run on `t_end` to the round-off of the grid's times.
+    #[inline(always)]
+    pub(crate) fn at_end(&self, time: f64) -> bool {
+        !self.adaptive && self.t_end - time <= 1e-9 * self.dt
+    }
+
+    /// Whether a run at `time` is done.
+    #[inline(always)]
+    pub(crate) fn done(&self, time: f64) -> bool {
+        time >= self.t_end || self.at_end(time)
+    }
+
+    /// The fixed step to the grid's next point (or to `t_end`), s.
+    #[inline(always)]
+    pub(crate) fn grid_length(&self, clock: &Clock) -> f64 {
+        ((clock.grid + 1) as f64 * self.dt - clock.time).min(self.t_end - clock.time)
+    }
+
+    /// Whether a step of `length` from `time` passes over the recorded
+    /// window's start (it must land there: a step across it would be left
+    /// out of the peak and RMS, or counted whole).
+    #[inline(always)]
+    pub(crate) fn lands_on_window(&self, time: f64, length: f64) -> bool {
+        let from = self.record_from;
+        from - time < length && from - time > 1e-9 * length
+    }
+
+    /// Whether a step of `length` from `time` passes over the next
+    /// stroboscopic instant (it must land there).
+    #[inline(always)]
+    pub(crate) fn lands_on_strobe(&self, clock: &Clock, time: f64, length: f64) -> bool {
+        let to = clock.next_strobe - time;
+        to < length && to > 1e-9 * self.strobe_period
+    }
+
+    /// Whether a stroboscopic state is due at `time`.
+    #[inline(always)]
+    pub(crate) fn strobe_due(&self, clock: &Clock, time: f64) -> bool {
+        time >= clock.next_strobe - 1e-9 * self.strobe_period
+    }
+
+    /// Whether a step of `length` from `time` is in the recorded window (one
+    /// that starts within round-off of the window's start, which it was not
+    /// cut to land on, is).
+    #[inline(always)]
+    pub(crate) fn in_window(&self, time: f64, length: f64) -> bool {
+        time + 1e-9 * length >= self.record_from
+    }
+
+    /// Steps and event intervals within a thousand units of round-off of
+    /// the time itself make no progress, s.
+    #[inline(always)]
+    pub(crate) fn chatter_interval(&self, time: f64) -> f64 {
+        CHATTER_ULPS * f64::EPSILON * time.abs().max(self.time_scale)
+    }
+
+    /// The next fixed step where it is plain, and whether it is in the
+    /// recorded window: a whole grid step after which the kernel would do
+    /// nothing but count it (no landing on the window's start or a strobe
+    /// instant, no strobe, history row or end of the run due after it, not
+    /// a stall, no mean square to sum). None where the kernel's own step
+    /// must follow, for the reason it will give ([`Stop`]).
+    #[inline(always)]
+    pub(crate) fn plain_step(&self, clock: &Clock) -> Option<(f64, bool)> {
+        let time = clock.time;
+        if self.at_end(time) {
+            return None;
+        }
+        let length = self.grid_length(clock);
+        let next = time + length;
+        if length <= 0.0
+            || self.lands_on_window(time, length)
+            || self.lands_on_strobe(clock, time, length)
+            || self.strobe_due(clock, next)
+            || self.done(next)
+            || (self.keep_history && clock.until_kept <= 1)
+            || length <= self.chatter_interval(next)
+        {
+            return None;
+        }
+        let in_window = self.in_window(time, length);
+        if in_window && self.mean_square {
+            return None;
+        }
+        Some((length, in_window))
+    }
+}

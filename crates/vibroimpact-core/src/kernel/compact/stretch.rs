@@ -1,0 +1,287 @@
+//! The fast path: plain RK4 steps on the grid taken at once in the compact
+//! form's fixed-size arrays, up to the kernel's next stop reason (its own
+//! rule, [`Schedule::plain_step`]), each the kernel's step to the bit.
+
+#![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
+
+use super::{Compact, MAX_LEN, MAX_WALLS};
+use crate::error::Error;
+use crate::kernel::balance::EnergyWatch;
+use crate::kernel::clock::{Clock, Schedule};
+use crate::kernel::events::Open;
+use crate::kernel::sized::by_size;
+use crate::model::assembly::{Assembly, Mode, Scratch};
+
+impl Compact {
+    /// [`Self::stretch`] for the system's sizes, in the widest vector
+    /// instructions the processor has (the same operations: the same bits).
+    pub(crate) fn run_stretch(
+        &self,
+        system: &Assembly,
+        f: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the processor has the feature the function is built for.
+                return unsafe { stretch_avx512(self, system, f, modes, scratch) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: as above.
+                return unsafe { stretch_avx2(self, system, f, modes, scratch) };
+            }
+        }
+        stretch_sized(self, system, f, modes, scratch)
+    }
+
+    /// Plain RK4 steps on the grid, as the event kernel takes them, for as
+    /// long as nothing but the step itself is due (the kernel's own rule,
+    /// [`Schedule::plain_step`]), with the system's data in registers across
+    /// them. Each step is the kernel's to the bit; one that turns out not to
+    /// be plain (a gap that may cross, a compliant contact at its deepest, a
+    /// peak inside the step, a state no longer finite) is taken back, for
+    /// the kernel to take.
+    #[inline(always)]
+    pub(crate) fn stretch<const STICKING: bool>(
+        &self,
+        system: &Assembly,
+        n: usize,
+        k: usize,
+        f: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        let d = n + k;
+        let row = 2 * d;
+        let count = self.count.min(MAX_WALLS);
+        let len = f.y.len().min(MAX_LEN);
+        let observed = system.observed();
+        let modes = &modes[..count];
+        let mut y = [0.0; MAX_LEN];
+        y[..len].copy_from_slice(&f.y[..len]);
+        let mut start_gaps = [(0.0, 0.0); MAX_WALLS];
+        start_gaps[..count].copy_from_slice(&f.gaps[..count]);
+        let mut end = [0.0; MAX_LEN];
+        let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
+        let mut stages = [[0.0; MAX_LEN]; 4];
+        let (held, locked, releasable) = passed_over(system, modes);
+        // Whether `stages[0]` holds the rates at the step's start (the last
+        // step's release test evaluated them there).
+        let mut start_valid = false;
+        // In registers through the loop, written back after it.
+        let mut energy = *f.energy;
+        let schedule = *f.schedule;
+        let mut clock = *f.clock;
+        loop {
+            if clock.accepted >= f.max_accepted {
+                f.limited = true;
+                break;
+            }
+            let Some((length, in_window)) = schedule.plain_step(&clock) else {
+                break;
+            };
+            let time = clock.time;
+            let next = time + length;
+            let cache = scratch.first_cache().copied();
+            self.step::<STICKING>(
+                system,
+                n,
+                k,
+                time,
+                &y,
+                len,
+                length,
+                modes,
+                scratch,
+                &mut stages,
+                start_valid,
+                &mut end,
+            );
+            self.gaps(d, &end, &mut end_gaps);
+            // What the kernel would do more than count the step: an event
+            // search, a blow-up, a compliant contact's deepest point, a peak
+            // inside the step.
+            let mut plain = end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
+            plain &= shows_no_event(modes, &held, (&start_gaps, &end_gaps), length);
+            if plain && releasable {
+                // A sticking pair whose constraint force at the step's end
+                // pulls is released: the forces as the event search takes
+                // them.
+                self.rates::<true>(system, n, k, next, &end, modes, scratch, &mut stages[0]);
+                for w in 0..count {
+                    if modes[w] == Mode::Sticking
+                        && !locked[w]
+                        && scratch.force_of(w).unwrap_or(0.0) < 0.0
+                    {
+                        plain = false;
+                    }
+                }
+            }
+            if in_window {
+                for j in 0..observed {
+                    let (s0, s1) = (
+                        system.observe(j, &y[d..d + n]),
+                        system.observe(j, &end[d..d + n]),
+                    );
+                    if s0 * s1 < 0.0 {
+                        plain = false;
+                    }
+                }
+            }
+            if !plain {
+                if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
+                    *cache = saved;
+                }
+                break;
+            }
+            for w in 0..count {
+                if let (Mode::Compliant { .. }, Some(contact)) = (modes[w], &mut f.open[w]) {
+                    contact.max_indentation = contact.max_indentation.max(-end_gaps[w].0);
+                }
+            }
+            if in_window {
+                for (j, peak) in f.peaks.iter_mut().enumerate().take(observed) {
+                    let (p0, p1) = (system.observe(j, &y[..n]), system.observe(j, &end[..n]));
+                    *peak = peak.max(p0.abs().max(p1.abs()));
+                }
+                *f.recorded_time += length;
+            }
+            clock.time = next;
+            clock.grid += 1;
+            clock.accepted += 1;
+            clock.until_kept = clock.until_kept.saturating_sub(1);
+            f.evaluations += 4;
+            f.steps += 1;
+            // Those rates are the next step's first stage.
+            start_valid = releasable;
+            for e in 0..len {
+                y[e] = end[e];
+            }
+            for w in 0..count {
+                start_gaps[w] = end_gaps[w];
+            }
+            let state = (&y[..len], modes);
+            if let Err(failure) = energy.after_step(system, state, clock.accepted, false, next) {
+                f.unbalanced = Some(failure);
+                break;
+            }
+        }
+        *f.energy = energy;
+        *f.clock = clock;
+        f.y[..len].copy_from_slice(&y[..len]);
+        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+    }
+}
+
+/// [`Compact::stretch`] for the system's sizes (constants in each arm).
+#[inline(always)]
+fn stretch_sized(
+    compact: &Compact,
+    system: &Assembly,
+    f: &mut Stretch<'_>,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+) {
+    // Without a sticking pair, no constraint solve is compiled in.
+    if modes.contains(&Mode::Sticking) {
+        by_size!(system, |n, k| compact
+            .stretch::<true>(system, n, k, f, modes, scratch))
+    } else {
+        by_size!(system, |n, k| compact
+            .stretch::<false>(system, n, k, f, modes, scratch))
+    }
+}
+
+/// [`stretch_sized`] compiled for a processor feature.
+macro_rules! stretch_with {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        unsafe fn $name(
+            compact: &Compact,
+            system: &Assembly,
+            f: &mut Stretch<'_>,
+            modes: &[Mode],
+            scratch: &mut Scratch,
+        ) {
+            stretch_sized(compact, system, f, modes, scratch)
+        }
+    };
+}
+stretch_with!(stretch_avx512, "avx512f");
+stretch_with!(stretch_avx2, "avx2");
+
+/// What the fast path advances, lent by the kernel ([`crate::kernel::run`]):
+/// its clock, state, gaps, open contacts (their deepest indentation), peaks
+/// and energy balance, with its stop rules ([`Schedule`]) and the most
+/// accepted steps it may reach (the next interrupt poll or the step limit).
+/// It takes a step only where the kernel would take it whole and do nothing
+/// after it but count it, or check the energy balance, which it does as the
+/// kernel would. The memory and row limits the kernel checks after each
+/// step hold through a stretch, which adds no contact and no row.
+pub struct Stretch<'a> {
+    pub(crate) clock: &'a mut Clock,
+    pub(crate) schedule: &'a Schedule,
+    /// The state, advanced in place, and each wall's gap and rate there.
+    pub(crate) y: &'a mut [f64],
+    pub(crate) gaps: &'a mut [(f64, f64)],
+    pub(crate) open: &'a mut [Option<Open>],
+    /// The reductions' peaks and recorded time (used in the window).
+    pub(crate) peaks: &'a mut [f64],
+    pub(crate) recorded_time: &'a mut f64,
+    pub(crate) energy: &'a mut EnergyWatch,
+    /// The most accepted steps the stretch may reach, and whether it did.
+    pub(crate) max_accepted: u64,
+    pub(crate) limited: bool,
+    /// Right-hand-side evaluations and steps made.
+    pub(crate) evaluations: u64,
+    pub(crate) steps: u64,
+    /// The energy balance's failure, on which the stretch stopped.
+    pub(crate) unbalanced: Option<Error>,
+}
+
+/// The walls the event search passes over in `modes` (the open wall of a
+/// sticking damper), the sticking walls of a damper without clearance
+/// (locked), and whether a sticking pair may release.
+#[inline(always)]
+fn passed_over(system: &Assembly, modes: &[Mode]) -> ([bool; MAX_WALLS], [bool; MAX_WALLS], bool) {
+    let mut held = [false; MAX_WALLS];
+    let mut locked = [false; MAX_WALLS];
+    let mut releasable = false;
+    for w in 0..modes.len().min(MAX_WALLS) {
+        held[w] = modes[w] == Mode::Open && system.held_by_mirror(w, modes);
+        locked[w] = system.locked(w);
+        releasable |= modes[w] == Mode::Sticking && !locked[w];
+    }
+    (held, locked, releasable)
+}
+
+/// Whether the step of `length` whose walls' gaps and rates are `gaps` at
+/// its start and end shows no event the kernel would search for, and no
+/// compliant contact at its deepest.
+#[inline(always)]
+fn shows_no_event(
+    modes: &[Mode],
+    held: &[bool; MAX_WALLS],
+    (start, end): (&[(f64, f64); MAX_WALLS], &[(f64, f64); MAX_WALLS]),
+    length: f64,
+) -> bool {
+    let mut plain = true;
+    for w in 0..modes.len().min(MAX_WALLS) {
+        match modes[w] {
+            // The event search passes over these (see `find_crossing`).
+            Mode::Sticking => {}
+            Mode::Open if held[w] => {}
+            mode => {
+                plain &= !mode.may_cross(start[w], end[w]);
+                if let Mode::Compliant { .. } = mode {
+                    let (m0, m1) = (start[w].1 * length, end[w].1 * length);
+                    plain &= !(m0 < 0.0 && m1 > 0.0);
+                }
+            }
+        }
+    }
+    plain
+}

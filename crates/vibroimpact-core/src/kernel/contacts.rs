@@ -1,0 +1,332 @@
+//! Contacts at events: every interaction on its wall at an event's instant
+//! switches (a compliant contact starts or ends, a sticking pair is
+//! released; the rigid ones are resolved together by
+//! [`crate::kernel::impacts`]), and each contact's record is kept: onset,
+//! approach, deepest indentation, separation, rebound and the energy its
+//! forces took.
+
+use crate::error::{Error, Result};
+use crate::kernel::clock::CHATTER_EVENTS;
+use crate::kernel::contact_balance::OnsetBalance;
+use crate::kernel::events::{ContactKind, Open};
+use crate::kernel::impacts;
+use crate::kernel::locate::{any_compliant, crossed, event_value};
+use crate::kernel::run::{loss_slot, Run};
+use crate::methods::steppers::SystemStepper;
+use crate::model::assembly::{InteractionLaw, Mode};
+use crate::numerics::hermite;
+
+/// Contacts held before those a run does not keep are dropped (see
+/// [`crate::kernel::reductions::ReduceOptions::contacts_from`]): a few, so
+/// that dropping them costs as little as holding them.
+const COMPACTED_CONTACTS: usize = 64;
+
+impl Run<'_> {
+    /// The start of compliant interaction `i` (open) at `time` and the
+    /// state now, approaching at `approach` (m/s): the rate its law latches
+    /// (see [`crate::model::contact::AnyLaw::latched_approach_rate`]: a
+    /// damped Hertz law's damping is taken from the pressing where the
+    /// approach is slower) and whether it starts at rest (an approach the
+    /// pressing gives within round-off, see [`impacts::resting`]: no impact,
+    /// so no rebound ratio). `scales` are the time's round-off and the
+    /// system's time scale, s. Once per onset.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn compliant_onset(
+        &mut self,
+        i: usize,
+        time: f64,
+        approach: f64,
+        (instant, time_scale): (f64, f64),
+    ) -> (f64, bool) {
+        let system = self.system;
+        let it = &system.interactions[i];
+        let InteractionLaw::Compliant { law, .. } = it.law else {
+            return (approach, false);
+        };
+        let y = &self.y;
+        // < 0 presses the pair shut.
+        let pressing = system.gap_acceleration(
+            i,
+            time,
+            y,
+            &self.modes,
+            &mut self.scratch,
+            &mut self.buffers.work,
+        );
+        let mass = 1.0 / it.inverse_mass;
+        // A flight rising less than the round-off of the gap, or of the
+        // indentation the pressing holds (a stop at the origin has a gap
+        // scale of 0), is round-off: the ringing of a body set down on the
+        // contact.
+        let round_off = impacts::flight_round_off(system, i, y)
+            .max(1e-9 * law.static_indentation(mass, -pressing));
+        let (landing, at_rest) =
+            impacts::resting(approach, pressing, round_off, instant, time_scale);
+        let latched = law.latched_approach_rate(approach, mass, -pressing);
+        (latched, landing || at_rest)
+    }
+
+    /// Switch interaction `i` at `time`: start or end a compliant contact,
+    /// or release a sticking pair whose constraint force turned (the open
+    /// rigid pairs are [`impacts::Impacts::resolve`]'s).
+    fn switch(&mut self, i: usize, time: f64, scales: (f64, f64)) {
+        let system = self.system;
+        let it = &system.interactions[i];
+        let (_, rate) = system.gap(i, &self.y);
+        match self.modes[i] {
+            Mode::Open => {
+                let approach = -rate;
+                let (approach_rate, resting) = self.compliant_onset(i, time, approach, scales);
+                self.modes[i] = Mode::Compliant { approach_rate };
+                self.open[i] = Some(Open {
+                    kind: ContactKind::Compliant,
+                    onset: time,
+                    approach_speed: approach,
+                    max_indentation: 0.0,
+                    dissipated: self.y[loss_slot(system, i)],
+                    resting,
+                    balance: OnsetBalance::default(),
+                });
+            }
+            Mode::Compliant { .. } => {
+                self.modes[i] = Mode::Open;
+                if let Some(oc) = self.open[i].take() {
+                    let dissipated = self.y[loss_slot(system, i)] - oc.dissipated;
+                    self.contacts
+                        .push(oc.close(it.pair, time, rate, dissipated));
+                }
+            }
+            Mode::Sticking => {
+                system.release(i, &mut self.y);
+                self.modes[i] = Mode::Open;
+                if let Some(oc) = self.open[i].take() {
+                    self.contacts
+                        .push(oc.close(it.pair, time, 0.0, oc.dissipated));
+                }
+            }
+        }
+    }
+
+    /// The event of interaction `located` that ended the last step: every
+    /// interaction on its wall at this instant switches; the open rigid
+    /// ones are resolved together with the sticking ones.
+    pub(super) fn at_event<S: SystemStepper>(
+        &mut self,
+        stepper: &mut S,
+        located: usize,
+    ) -> Result<()> {
+        let (system, time) = (self.system, self.clock.time);
+        let (resolution, time_scale) = (self.resolution, self.schedule.time_scale);
+        let instant = self.schedule.chatter_interval(time);
+        // An event located within the round-off of the run's start (a pair
+        // on its wall at t = 0: the value's round-off put the root at 1e-66
+        // s), or one of a pair on its wall from the start located within the
+        // run's resolution (not pressed at first, the gap reached its
+        // round-off only after 1e-8 s), is at the start.
+        let from_start = self.on_wall_at_start[located] && time <= resolution;
+        let event_time = if time <= f64::EPSILON * time_scale || from_start {
+            0.0
+        } else {
+            time
+        };
+        let mut any = false;
+        let mut rigid = false;
+        self.just_switched.iter_mut().for_each(|s| *s = false);
+        for i in 0..self.modes.len() {
+            let mode = self.modes[i];
+            let v = event_value(
+                system,
+                i,
+                mode,
+                time,
+                &self.y,
+                &self.modes,
+                &mut self.scratch,
+                &mut self.buffers.work,
+            );
+            if !(i == located || crossed(system, i, mode, v, &self.y))
+                || (mode == Mode::Open && system.held_by_mirror(i, &self.modes))
+            {
+                continue;
+            }
+            if self.impacts.mark(system, i, mode) {
+                rigid = true;
+                continue;
+            }
+            let onset = self.open[i].map(|o| o.balance);
+            self.switch(i, event_time, (instant, time_scale));
+            self.just_switched[i] = true;
+            self.check_contact(i, mode, onset)?;
+            any = true;
+        }
+        if rigid {
+            any |= self.impacts.resolve(
+                system,
+                event_time,
+                &mut self.y,
+                &mut self.modes,
+                &mut self.open,
+                &mut self.contacts,
+                &mut self.energy.impact_loss,
+                &mut self.grazes,
+                (resolution, instant, time_scale),
+                &mut self.scratch,
+                &mut self.buffers.work,
+                &mut self.just_switched,
+            );
+        }
+        if any {
+            self.count_close_events(stepper)?;
+        }
+        // Impacts change the velocities.
+        system.gaps(&self.y, &mut self.gaps.start);
+        self.compliant = any_compliant(&self.modes);
+        let from = self.options.reduce.contacts_from;
+        if self.contacts.len() >= COMPACTED_CONTACTS && time < from {
+            // Before the contacts kept begin: what closed is dropped (a
+            // contact across their start may stay; it is dropped at the end).
+            self.contacts.retain(|c| c.onset >= from);
+        }
+        Ok(())
+    }
+
+    /// A compliant contact's own balance, from its onset to its separation:
+    /// it must not create energy. Interaction `i` was in mode `was`, its
+    /// contact's balance at onset `onset`.
+    fn check_contact(&mut self, i: usize, was: Mode, onset: Option<OnsetBalance>) -> Result<()> {
+        let system = self.system;
+        let energy = &self.energy;
+        match (
+            was,
+            self.modes[i],
+            self.open[i].as_mut(),
+            onset,
+            self.contacts.last(),
+        ) {
+            (Mode::Open, Mode::Compliant { .. }, Some(record), ..) => {
+                record.balance = OnsetBalance::at(
+                    system,
+                    &self.y,
+                    &self.modes,
+                    energy.stored_start,
+                    energy.impact_loss,
+                );
+            }
+            (Mode::Compliant { .. }, Mode::Open, None, Some(onset), Some(record)) => {
+                onset.check_separation(
+                    system,
+                    &self.y,
+                    &self.modes,
+                    (energy.stored_start, energy.impact_loss),
+                    energy.scale,
+                    energy.tolerance,
+                    record,
+                )?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// After an event that switched a pair: the method restarts, and events
+    /// closer than the time's round-off, too many in a row, are chattering.
+    fn count_close_events<S: SystemStepper>(&mut self, stepper: &mut S) -> Result<()> {
+        let time = self.clock.time;
+        stepper.reset();
+        if self.schedule.adaptive {
+            self.control.h = self.control.h.min(1e-3 * self.schedule.t_end);
+        }
+        let interval = self.schedule.chatter_interval(time);
+        if time - self.last_event < interval {
+            self.close_events += 1;
+            if self.close_events >= CHATTER_EVENTS {
+                return Err(Error::Chattering {
+                    time,
+                    events: self.close_events,
+                    interval,
+                });
+            }
+        } else {
+            self.close_events = 0;
+        }
+        self.last_event = time;
+        Ok(())
+    }
+
+    /// Deepest indentation of each compliant contact within the step of
+    /// `taken` s to `end`: where the indentation rate changes sign, the
+    /// method's own state at the interpolant's turning point (the
+    /// interpolant alone errs by its third-order term, 1e-4 of the
+    /// indentation at dop853's steps). Whether the stepper was used (its
+    /// last attempt is then not the step).
+    pub(super) fn deepest_indentation<S: SystemStepper>(
+        &mut self,
+        stepper: &mut S,
+        taken: f64,
+    ) -> Result<bool> {
+        let (system, time) = (self.system, self.clock.time);
+        let mut used = false;
+        for (i, record) in self.open.iter_mut().enumerate() {
+            let (Some(oc), Mode::Compliant { .. }) = (record.as_mut(), self.modes[i]) else {
+                continue;
+            };
+            let ((g0, r0), (g1, r1)) = (self.gaps.start[i], self.gaps.end[i]);
+            let (m0, m1) = (r0 * taken, r1 * taken);
+            let mut deepest = -g1;
+            if m0 < 0.0 && m1 > 0.0 {
+                // Then one Newton step on the gap's rate from there (the
+                // error of the turning point squared).
+                let mut at = hermite::peak(-g0, -g1, -m0, -m1) * taken;
+                let probe = &mut self.buffers.probe;
+                for newton in [true, false] {
+                    stepper.attempt(
+                        system,
+                        time,
+                        &self.y,
+                        at,
+                        &self.modes,
+                        &mut self.scratch,
+                        probe,
+                    )?;
+                    let (gap, rate) = system.gap(i, probe);
+                    deepest = deepest.max(-gap);
+                    if !newton {
+                        break;
+                    }
+                    let curvature = system.gap_acceleration(
+                        i,
+                        time + at,
+                        probe,
+                        &self.modes,
+                        &mut self.scratch,
+                        &mut self.buffers.work,
+                    );
+                    at -= rate / curvature;
+                    if !(at > 0.0 && at < taken) {
+                        break;
+                    }
+                }
+                used = true;
+            }
+            oc.max_indentation = oc.max_indentation.max(deepest);
+        }
+        Ok(used)
+    }
+
+    /// The records of the contacts still open at the end (NaN separation).
+    pub(super) fn close_open(&mut self) {
+        let system = self.system;
+        for (i, record) in self.open.iter().enumerate() {
+            if let Some(oc) = record {
+                let dissipated = match oc.kind {
+                    ContactKind::Compliant => self.y[loss_slot(system, i)] - oc.dissipated,
+                    _ => oc.dissipated,
+                };
+                let pair = system.interactions[i].pair;
+                self.contacts
+                    .push(oc.close(pair, f64::NAN, f64::NAN, dissipated));
+            }
+        }
+    }
+}

@@ -1,0 +1,193 @@
+//! What a run keeps after each step, within its limits: stroboscopic
+//! states, history rows, room for the contacts, and the checks every step
+//! passes (rows, stalls, the energy balance, steps, interrupts); and the
+//! solution at the end.
+
+use crate::error::{Error, Result};
+use crate::kernel::balance::balance;
+use crate::kernel::clock::{Stop, STALLED_STEPS};
+use crate::kernel::events::SystemSolution;
+use crate::kernel::memory::{self, NoRoom};
+use crate::kernel::run::Run;
+use crate::methods::steppers::SystemStepper;
+
+/// The longest a large system goes without asking whether to stop, s.
+const POLL_SECONDS: f64 = 0.2;
+
+impl Run<'_> {
+    /// Bytes held by the records other than the history (strobes, contacts).
+    fn others(&self) -> u64 {
+        memory::held(&self.reductions.strobe)
+            + memory::held(&self.reductions.strobe_time)
+            + memory::held(&self.contacts)
+    }
+
+    /// The error of a run whose records find no room at `time`, with what
+    /// they hold.
+    fn no_room(&self, cause: NoRoom, time: f64) -> Error {
+        let held = self.others() + memory::held(&self.time_rows) + memory::held(&self.states);
+        cause.error(
+            time,
+            (
+                self.time_rows.len() as u64,
+                self.reductions.strobe_time.len() as u64,
+            ),
+            2 * self.system.dim as u64 + 1,
+            self.contacts.len() as u64,
+            held,
+        )
+    }
+
+    /// A history row of the state now, at `time`.
+    pub(super) fn push_history_row(&mut self, time: f64) -> Result<()> {
+        let row = 2 * self.system.dim;
+        let (strobe, strobe_time) = (&self.reductions.strobe, &self.reductions.strobe_time);
+        let contacts = &self.contacts;
+        memory::push_row(
+            &mut self.time_rows,
+            &mut self.states,
+            time,
+            &self.y[..row],
+            || memory::held(strobe) + memory::held(strobe_time) + memory::held(contacts),
+            self.record_limit,
+        )
+        .map_err(|cause| self.no_room(cause, time))
+    }
+
+    /// The records after a kept step (a stroboscopic state, a history row,
+    /// room for the next step's contacts) and the checks every kept step
+    /// passes (rows, stalls, the energy balance, steps, interrupts); `stop`
+    /// is why the step ended.
+    pub(super) fn after_step(
+        &mut self,
+        stop: Stop,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<()> {
+        let (schedule, time) = (self.schedule, self.clock.time);
+        let row = 2 * self.system.dim;
+        if schedule.strobe_due(&self.clock, time) {
+            let (rows, states, contacts) = (&self.time_rows, &self.states, &self.contacts);
+            memory::push_row(
+                &mut self.reductions.strobe_time,
+                &mut self.reductions.strobe,
+                time,
+                &self.y[..row],
+                || memory::held(rows) + memory::held(states) + memory::held(contacts),
+                self.record_limit,
+            )
+            .map_err(|cause| self.no_room(cause, time))?;
+            self.clock.next_strobe =
+                (self.reductions.strobe_time.len() + 1) as f64 * schedule.strobe_period;
+        }
+        let done = schedule.done(time);
+        // Counts down only while it matters (no history: it stays at 0).
+        self.clock.until_kept = self.clock.until_kept.saturating_sub(1);
+        if schedule.keep_history && (self.clock.until_kept == 0 || done) {
+            self.clock.until_kept = schedule.every;
+            self.push_history_row(time)?;
+        }
+        // Room for the contacts the next step may close (a Vec's own
+        // doubling could pass the limit, or abort where memory is refused).
+        let (strobe, strobe_time) = (&self.reductions.strobe, &self.reductions.strobe_time);
+        let (rows, states) = (&self.time_rows, &self.states);
+        let held = || {
+            memory::held(strobe)
+                + memory::held(strobe_time)
+                + memory::held(rows)
+                + memory::held(states)
+        };
+        let more = 2 * self.modes.len() + 2;
+        memory::make_room(&mut self.contacts, more, 8, held, self.record_limit)
+            .map_err(|cause| self.no_room(cause, time))?;
+        let rows = self.time_rows.len() + self.contacts.len() + self.reductions.strobe_time.len();
+        if rows as u64 > self.options.max_rows {
+            return Err(Error::RowLimit {
+                time,
+                max_rows: self.options.max_rows,
+                rows: self.time_rows.len() as u64,
+                contacts: self.contacts.len() as u64,
+                advice: "raise every, set history = false, shorten t_end or raise max_rows",
+            });
+        }
+        self.check_step(matches!(stop, Stop::Event { .. }), done, interrupt)
+    }
+
+    /// The checks after a kept step (`event`: one that ended on an event;
+    /// `done`: the run's last).
+    fn check_step(
+        &mut self,
+        event: bool,
+        done: bool,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<()> {
+        let (time, taken, accepted) = (self.clock.time, self.taken, self.clock.accepted);
+        // Steps within a thousand units of round-off of the time make no
+        // progress: an event that recurs at once (a zero clearance, say)
+        // would otherwise loop. (An adaptive method's own short steps, from
+        // a tiny first step, grow.)
+        if taken <= self.schedule.chatter_interval(time) && (event || !self.schedule.adaptive) {
+            self.stalled += 1;
+            if self.stalled >= STALLED_STEPS {
+                return Err(Error::Chattering {
+                    time,
+                    events: self.stalled,
+                    interval: taken,
+                });
+            }
+        } else {
+            self.stalled = 0;
+        }
+        // The balance is checked every few steps and at the end; the energy
+        // in play is sampled between, by the clock (see EnergySampler).
+        self.energy
+            .after_step(self.system, (&self.y, &self.modes), accepted, done, time)?;
+        let max_steps = self.options.max_steps;
+        if !done && accepted + self.control.rejected >= max_steps {
+            return Err(Error::TooManySteps { time, max_steps });
+        }
+        // Large systems poll by the clock too: a step of hundreds of sticking
+        // pairs (a constraint solve in each stage) takes a tenth of a second.
+        let due = accepted % self.poll_every == 0
+            || (self.timed_polls && self.last_poll.elapsed().as_secs_f64() >= POLL_SECONDS);
+        if due {
+            self.last_poll = std::time::Instant::now();
+            if interrupt() {
+                return Err(Error::Interrupted { time });
+            }
+        }
+        Ok(())
+    }
+
+    /// The solution: the contacts still open closed at NaN, those before
+    /// the kept ones dropped, all in order of onset.
+    pub(super) fn finish<S: SystemStepper>(mut self, stepper: &S) -> SystemSolution {
+        self.close_open();
+        let from = self.options.reduce.contacts_from;
+        if from > f64::NEG_INFINITY {
+            self.contacts.retain(|c| c.onset >= from);
+        }
+        self.contacts.sort_by(|a, b| a.onset.total_cmp(&b.onset));
+        let system = self.system;
+        let energy = balance(
+            system,
+            &self.y,
+            system.energy(&self.y, &self.modes),
+            self.energy.stored_start,
+            self.energy.impact_loss,
+        );
+        let row = 2 * system.dim;
+        SystemSolution {
+            time: self.time_rows,
+            states: self.states,
+            contacts: self.contacts,
+            final_state: self.y[..row].to_vec(),
+            final_time: self.clock.time,
+            energy,
+            steps: self.clock.accepted,
+            rejected_steps: self.control.rejected,
+            rhs_evaluations: stepper.evaluations(),
+            grazing_contacts: self.grazes,
+            reductions: self.reductions,
+        }
+    }
+}
