@@ -91,6 +91,8 @@ pub struct PaperNewmark {
     solved: Vec<f64>,
     rates: Vec<f64>,
     matrix: Vec<f64>,
+    /// One a step, as 0.1 counted the method (the accelerations made again
+    /// at a restart are not counted).
     evaluations: u64,
 }
 
@@ -190,7 +192,6 @@ impl PaperNewmark {
     fn start(&mut self, system: &Assembly, time: f64, y: &[f64], modes: &[Mode], s: &mut Scratch) {
         let d = self.dim;
         system.rates(time, y, modes, s, &mut self.rates);
-        self.evaluations += 1;
         self.powers.restart(system, &self.rates);
         self.powers_valid = true;
         self.valid = true;
@@ -345,7 +346,6 @@ impl SystemStepper for PaperNewmark {
             self.start(system, time, y, modes, scratch);
         } else if !self.powers_valid {
             system.rates(time, y, modes, scratch, &mut self.rates);
-            self.evaluations += 1;
             self.powers.restart(system, &self.rates);
             self.powers_valid = true;
         }

@@ -528,3 +528,31 @@ fn the_kernel_runs_it_at_the_paper_s_first_order_duration_error() {
         }
     });
 }
+
+#[test]
+fn it_counts_one_evaluation_a_step_as_0_1_did() {
+    crate::testing::timeout(30, || {
+        // 0.1's fixed-step kernel reported steps x 1 right-hand-side
+        // evaluations for the paper's Newmark; restarts are not counted.
+        let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
+        let system = table_1(0.005).assembly(&contact).unwrap();
+        let mut stepper = PaperNewmark::new(&system, 0.25, 0.5).unwrap();
+        let mut scratch = Scratch::new(&system);
+        let y = State::new(0.0, 0.0, 0.0, 0.1)
+            .unwrap()
+            .vector(&system)
+            .unwrap();
+        let mut end = y.clone();
+        let modes = [Mode::Open; 2];
+        for step in 0..10 {
+            if step % 3 == 0 {
+                stepper.reset();
+            }
+            stepper
+                .attempt(&system, 0.0, &y, 1e-4, &modes, &mut scratch, &mut end)
+                .unwrap();
+            stepper.accept();
+        }
+        assert_eq!(stepper.evaluations(), 10);
+    });
+}
