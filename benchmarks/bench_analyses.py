@@ -10,7 +10,7 @@
    flow, over the periods scipy runs (scipy is timed on fewer periods and scaled
    per period, saying so; in the full run one whole 1000-period scipy run is also
    timed once).
-2. Periodic orbits with their Floquet multipliers by shooting (``analyses.orbit``):
+2. Periodic orbits with their Floquet multipliers by shooting (``analysis.orbit``):
    the forced damper above from its settled state perturbed by 1 %, and the ball
    on a vibrating table (examples/bouncing_ball_table.toml, multipliers |e|). The
    damper's orbit is also shot with scipy from the same seed (the period mapped by
@@ -49,7 +49,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import vibroimpact as vi
-from vibroimpact import analyses as an
+from vibroimpact import analysis as an
 from vibroimpact.system import SystemSolution
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -342,7 +342,7 @@ def scipy_map(z: np.ndarray, count: int, rtol: float, calls: list[int]) -> np.nd
 def scipy_orbit(
     seed: np.ndarray, count: int, rtol: float, tolerance: float = 1e-10, max_iterations: int = 40
 ) -> tuple[np.ndarray, np.ndarray, bool, int, int, int]:
-    """Shooting as analyses.orbit does it, on scipy's map: Newton on P(z) - z, the
+    """Shooting as analysis.orbit does it, on scipy's map: Newton on P(z) - z, the
     Jacobian by central differences (steps 1e-6 of the displacement and velocity
     scales), converged when max |P(z) - z| / scale <= tolerance; the multipliers are
     the eigenvalues of the Jacobian at the orbit. Returns the state, the multipliers,
@@ -405,7 +405,7 @@ def spectrum_distance(actual: np.ndarray, expected: np.ndarray) -> float:
 
 
 def exact_multiplier_error(run: an.Runner, found: an.Orbit, count: int) -> float:
-    """An estimate of the error of the exact orbit's multipliers, which analyses.orbit
+    """An estimate of the error of the exact orbit's multipliers, which analysis.orbit
     takes from central differences with steps of 1e-6 of the scales: the same with
     steps 1e-5 and 1e-7 differ from them by d5 and d7; the truncation error goes as
     h^2 and the round-off as 1/h, so at 1e-6 about d5 / 100 + d7 / 10."""
@@ -429,7 +429,7 @@ def exact_multiplier_error(run: an.Runner, found: an.Orbit, count: int) -> float
 
 def orbits(quick: bool) -> None:
     repeats = 5 if quick else 21
-    print("2. periodic orbits by shooting (analyses.orbit, periods = the settled period)")
+    print("2. periodic orbits by shooting (analysis.orbit, periods = the settled period)")
     run = an.runner({**DAMPER, "solver": {"method": "exact"}})
     steady = an.steady_state(run, settle_periods=500, record_periods=10)
     seed = steady.state * 1.01
@@ -495,7 +495,7 @@ def scipy_orbits(
         "   the forced damper's orbit by scipy from the same seed (solve_ivp DOP853, wall "
         "events, Newton impact map; the same central differences and Newton iterations; "
         "numpy eigvals); errors against the exact orbit: state (relative, as "
-        "analyses.orbit scales it) and multipliers (largest distance, best paired)"
+        "analysis.orbit scales it) and multipliers (largest distance, best paired)"
     )
     print(
         f"   exact's own error: the state's about {own_state:.0e} (its residual "

@@ -31,7 +31,7 @@ from scipy.linalg import expm
 
 import vibroimpact as vi
 from orbit_checks import spectrum_distance, state_error  # noqa: E402
-from vibroimpact import analyses as an
+from vibroimpact import analysis as an
 from vibroimpact.system import SystemSolution
 
 Array = NDArray[np.float64]
@@ -701,7 +701,7 @@ def test_a_clearance_swept_down_restarts_where_the_damper_would_start_inside_a_w
         assert points[-1].value == values[0]
         assert np.array_equal(points[-1].amplitude, fresh.amplitude)
     else:
-        from vibroimpact.maps import bifurcation
+        from vibroimpact.analysis import bifurcation
 
         points = bifurcation(
             data,

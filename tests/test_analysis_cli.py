@@ -184,7 +184,8 @@ def test_orbit_prints_a_readable_summary(run_cli: RunCli) -> None:
 def test_an_orbit_not_found_says_its_figures_are_of_the_last_iterate(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from vibroimpact import analysis_commands, cli
+    from vibroimpact.cli import analysis_commands
+    from vibroimpact.cli import command as cli
 
     real = analysis_commands.orbit
     # One Newton iteration from a start off the orbit cannot converge.

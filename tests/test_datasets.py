@@ -19,10 +19,20 @@ import scipy.io
 import xarray as xr
 
 import vibroimpact as vi
-from vibroimpact import analyses as an
-from vibroimpact.analyses import AnalysisError, SweepPoint
-from vibroimpact.continuation import Branch, continue_orbit
-from vibroimpact.datasets import (
+from vibroimpact import analysis as an
+from vibroimpact.analysis import (
+    AnalysisError,
+    Basins,
+    BifurcationPoint,
+    Branch,
+    Section,
+    SweepPoint,
+    basins,
+    bifurcation,
+    continue_orbit,
+    poincare,
+)
+from vibroimpact.analysis.datasets import (
     basins_dataset,
     bifurcation_dataset,
     branch_dataset,
@@ -31,7 +41,6 @@ from vibroimpact.datasets import (
     state_names,
     sweep_dataset,
 )
-from vibroimpact.maps import Basins, BifurcationPoint, Section, basins, bifurcation, poincare
 from vibroimpact.system_scenario import SystemScenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -423,7 +432,7 @@ def test_parameter_units(ball: dict[str, Any], frf: dict[str, Any], beam: dict[s
 def test_plot_axes_take_their_units_from_the_datasets() -> None:
     # The plots had a table of their own that labelled every amplitude "N or m/s^2"
     # (user trial); one table now serves both, resolved with the scenario's sections.
-    from vibroimpact.analysis_plots import _unit
+    from vibroimpact.analysis.plots import _unit
 
     harmonic = {"signal": "harmonic", "amplitude": 1.0, "frequency": 1.0}
     force = {"excitation": [{"kind": "force", "at": 0, **harmonic}]}

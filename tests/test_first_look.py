@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
-from vibroimpact import analyses, analysis_plots, beyond, continuation, maps, plots
+from vibroimpact import analysis, beyond, plots
+from vibroimpact.analysis import continuation, maps
+from vibroimpact.analysis import plots as analysis_plots
 from vibroimpact.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,11 +68,11 @@ def test_a_two_body_runs_repr_gives_the_time_reached_and_fields(
 
 def test_every_analysis_result_has_a_short_repr() -> None:
     data = _sections("ball_table_bifurcation.toml")
-    run = analyses.runner(data)
+    run = analysis.runner(data)
     results: list[Any] = [
-        analyses.steady_state(run, settle_periods=20, record_periods=5),
-        analyses.orbit(run, run.initial_state()),
-        *analyses.sweep(data, "excitation.0.amplitude", [12.0], settle_periods=20),
+        analysis.steady_state(run, settle_periods=20, record_periods=5),
+        analysis.orbit(run, run.initial_state()),
+        *analysis.sweep(data, "excitation.0.amplitude", [12.0], settle_periods=20),
         # 500 periods of strobe rows and impacts: thousands of numbers.
         maps.poincare(run, settle_periods=10, periods=500),
         *maps.bifurcation(data, "excitation.0.amplitude", [12.0], sample_periods=400),
@@ -109,7 +111,7 @@ def test_the_poincare_plot_of_a_period_one_orbit_shows_a_point_not_round_off(
 ) -> None:
     # Holmes's period-one orbit of the ball on the table: every strobe and impact the
     # same to 1e-13, which the axes had spread over their whole width.
-    run = analyses.runner(_sections("bouncing_ball_table.toml"))
+    run = analysis.runner(_sections("bouncing_ball_table.toml"))
     section = maps.poincare(run, settle_periods=200, periods=200)
     assert np.ptp(section.strobe[:, 0]) < 1e-10
     analysis_plots.plot_section(Path("section.png"), section, run.period)
@@ -138,7 +140,7 @@ def test_the_frf_plot_marks_unsettled_points_with_their_spread_and_keeps_the_leg
     figures: dict[str, Any],
 ) -> None:
     data = _sections("frf_impact_damper.toml")
-    points = analyses.sweep(
+    points = analysis.sweep(
         data, "excitation.0.frequency", np.linspace(7.0, 13.0, 61), direction="both"
     )
     unsettled = [p for p in points if not p.settled]
@@ -170,9 +172,9 @@ def test_the_spread_of_an_unsettled_response_is_its_periods_smallest_and_largest
     # each period's highest row of a dense history (200 rows a period) of the same run.
     data = _sections("ball_table_bifurcation.toml")
     data["excitation"][0]["amplitude"] = 18.0
-    run = analyses.runner(data)
+    run = analysis.runner(data)
     start = run.map(run.initial_state(), 200)
-    result = analyses.steady_state(run, start, settle_periods=0, record_periods=30)
+    result = analysis.steady_state(run, start, settle_periods=0, record_periods=30)
     assert not result.settled
     history = analysis_plots.orbit_history(run, start, 30)
     t, x = history.t, history.structure_displacement[:, 0]
@@ -234,7 +236,7 @@ def test_bifurcation_sample_and_pair_are_checked() -> None:
         )
     data["sweep"]["sample"] = "velocity"
     with pytest.raises(vi.InvalidInputError, match=r"\[sweep\] sample"):
-        analyses.sweep_settings(data["sweep"])
+        analysis.sweep_settings(data["sweep"])
 
 
 def test_the_bifurcation_command_samples_impacts_with_units(run_cli: Any, tmp_path: Path) -> None:

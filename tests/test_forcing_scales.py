@@ -14,8 +14,7 @@ import numpy as np
 import pytest
 
 from vibroimpact import InvalidInputError, SimulationError
-from vibroimpact.analyses import runner
-from vibroimpact.maps import bifurcation
+from vibroimpact.analysis import bifurcation, runner
 from vibroimpact.system import prepare_system
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"

@@ -19,7 +19,7 @@ import pytest
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER
 from vibroimpact import record_file
-from vibroimpact.analyses import AnalysisError, with_parameter
+from vibroimpact.analysis import AnalysisError, with_parameter
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.scenario import ScenarioError, parse_scenario
 from vibroimpact.study import study_settings
@@ -726,7 +726,7 @@ def test_a_sweep_point_the_exact_flow_cannot_take_fails_alone() -> None:
     # An undamped oscillator forced at exactly its frequency grows as t between
     # impacts, which the exact flow cannot hold: that point failed the whole sweep
     # (exit 2) though a stop bounds the motion; it now fails alone, saying what to use.
-    from vibroimpact.analyses import sweep
+    from vibroimpact.analysis import sweep
 
     data = {
         "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 4 * np.pi**2},

@@ -57,10 +57,10 @@ def test_a_time_beyond_half_the_largest_float_names_the_line(
 
 def test_a_two_dimensional_array_is_quoted_on_one_line() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
     with pytest.raises(vi.InvalidInputError) as caught:
-        analyses.with_parameter({"a": {}}, "a.b", np.zeros((2, 2)))
+        analysis.with_parameter({"a": {}}, "a.b", np.zeros((2, 2)))
     message = str(caught.value)
     assert "\n" not in message and message.startswith("value:"), message
 
@@ -83,16 +83,16 @@ def test_an_analysis_refuses_sections_it_cannot_take_naming_them(
     sections: dict[str, Any], words: str
 ) -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
     excitation = [
         {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 1.0}
     ]
     data = {**sections, "excitation": excitation}
     for call in (
-        lambda: analyses.runner(data),
-        lambda: analyses.linear_amplitude(data),
-        lambda: analyses.sweep(data, "excitation.0.frequency", [1.0]),
+        lambda: analysis.runner(data),
+        lambda: analysis.linear_amplitude(data),
+        lambda: analysis.sweep(data, "excitation.0.frequency", [1.0]),
     ):
         with pytest.raises(vi.InvalidInputError) as caught:
             call()
@@ -101,7 +101,7 @@ def test_an_analysis_refuses_sections_it_cannot_take_naming_them(
 
 def test_linear_response_refuses_a_prepared_run_of_the_wrong_type() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
     data = {
         "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0},
@@ -110,11 +110,11 @@ def test_linear_response_refuses_a_prepared_run_of_the_wrong_type() -> None:
         ],
     }
     with pytest.raises(vi.InvalidInputError, match="^prepared: must be a PreparedRun"):
-        analyses.linear_response(data, prepared="x")  # type: ignore[arg-type]
+        analysis.linear_response(data, prepared="x")  # type: ignore[arg-type]
 
 
 def _dataset_calls() -> list[Any]:
-    from vibroimpact import datasets
+    from vibroimpact.analysis import datasets
 
     bad = [None, "x", [[1.0]], 5.0, {}]
     calls = [
@@ -141,7 +141,8 @@ def test_the_dataset_functions_refuse_a_wrong_type_naming_the_argument(
 ) -> None:
     # Each had failed deep inside as an AttributeError or a TypeError naming nothing.
     import vibroimpact as vi
-    from vibroimpact import analyses, continuation, maps
+    from vibroimpact import analysis
+    from vibroimpact.analysis import continuation, maps
 
     good: dict[str, Any] = {
         "points": [],
@@ -155,7 +156,7 @@ def test_the_dataset_functions_refuse_a_wrong_type_naming_the_argument(
         "y_name": "structure_velocity.0",
         "branch": continuation.Branch("p", 1, [], "max_points", 1, 0),
     }
-    assert issubclass(analyses.AnalysisError, vi.InvalidInputError)
+    assert issubclass(analysis.AnalysisError, vi.InvalidInputError)
     kwargs = {key: good[key] for key in names}
     kwargs[name] = value
     args = [kwargs.pop(key) for key in names[:positional]]
@@ -167,7 +168,7 @@ def test_the_dataset_functions_refuse_a_wrong_type_naming_the_argument(
 
 def test_a_fixed_step_method_is_bounded_by_its_steps_not_by_the_fastest_mode() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
     # A 5e5 Hz mode beside a 5 Hz one, forced at 1e-4 Hz: 5e9 periods of the fast mode
     # in one forcing period, but newmark-implicit takes 1e6 steps of 0.01 s (0.25 s),
@@ -187,17 +188,17 @@ def test_a_fixed_step_method_is_bounded_by_its_steps_not_by_the_fastest_mode() -
             "excitation": excitation,
             "solver": {"method": method, "dt": 1e-2},
         }
-        assert analyses.runner(data).period == pytest.approx(1e4)
+        assert analysis.runner(data).period == pytest.approx(1e4)
         # One forcing period of more than max_steps steps of dt: refused, naming both.
         data["solver"]["max_steps"] = 999_999
         with pytest.raises(vi.InvalidInputError) as caught:
-            analyses.runner(data)
+            analysis.runner(data)
         message = str(caught.value)
         assert message.startswith("forcing frequency 0.0001 Hz") and "dt = 0.01 s" in message
     # An adaptive method still steps through each period of the fast mode: refused.
     data = {"structure": structure, "excitation": excitation, "solver": {"method": "dop853"}}
     with pytest.raises(vi.InvalidInputError, match="fastest mode"):
-        analyses.runner(data)
+        analysis.runner(data)
 
 
 def test_an_orbit_at_exact_resonance_is_found_by_every_analysis_that_shoots(
@@ -205,8 +206,9 @@ def test_an_orbit_at_exact_resonance_is_found_by_every_analysis_that_shoots(
 ) -> None:
     import math
 
-    from vibroimpact import analyses, continuation
+    from vibroimpact import analysis
     from vibroimpact import study as st
+    from vibroimpact.analysis import continuation
 
     # The oscillator at 5.00 Hz: strobed in quadrature, its displacement at
     # the strobe is round-off (3e-10 m) and the shooting, scaled by it, had never
@@ -225,7 +227,7 @@ def test_an_orbit_at_exact_resonance_is_found_by_every_analysis_that_shoots(
     modulus = math.exp(-0.6283 * 0.2 / 2)
     for method in ("exact", "dop853"):
         data["solver"]["method"] = method
-        found = analyses.orbit(analyses.runner(data))
+        found = analysis.orbit(analysis.runner(data))
         assert found.converged and found.stable
         assert found.amplitude[0] == pytest.approx(amplitude, rel=1e-7)
         assert np.abs(found.floquet_multipliers) == pytest.approx([modulus] * 2, rel=1e-7)
@@ -274,9 +276,9 @@ def test_the_core_quotes_a_two_dimensional_array_on_one_line(call: Any, name: st
 @pytest.mark.parametrize(
     ("call", "name"),
     [
-        (lambda bad: __import__("vibroimpact.analyses").analyses.whole_count("n", bad, 1), "n"),
+        (lambda bad: __import__("vibroimpact.analysis").analysis.whole_count("n", bad, 1), "n"),
         (
-            lambda bad: __import__("vibroimpact.maps").maps.bifurcation(
+            lambda bad: __import__("vibroimpact.analysis").analysis.bifurcation(
                 {"structure": {}}, "a.b", [1.0], sample=bad
             ),
             "sample",
@@ -331,7 +333,7 @@ def test_an_absurd_atol_is_refused_with_its_range() -> None:
 def _ball_runner() -> Any:
     import tomllib
 
-    from vibroimpact import analyses as an
+    from vibroimpact import analysis as an
 
     root = Path(__file__).resolve().parents[1]
     return an.runner(tomllib.loads((root / "examples" / "ball_table_basins.toml").read_text()))

@@ -42,9 +42,8 @@ from scipy.optimize import minimize_scalar
 
 import vibroimpact as vi
 from orbit_checks import spectrum_distance, state_error  # noqa: E402
-from vibroimpact import analyses as an
-from vibroimpact.continuation import Branch, continue_orbit
-from vibroimpact.maps import basins, bifurcation, poincare
+from vibroimpact import analysis as an
+from vibroimpact.analysis import Branch, basins, bifurcation, continue_orbit, poincare
 
 Array = NDArray[np.float64]
 RunCli = Callable[..., subprocess.CompletedProcess[str]]
@@ -1106,8 +1105,8 @@ def test_continuation_through_grazing_flags_the_grazing_alone() -> None:
 def test_the_basins_plot_of_starts_all_inside_the_wall(tmp_path: Path) -> None:
     # No attractor at all (every start inside the table): the colour bar had one
     # colour more than its labels, a matplotlib traceback from `basins --plot` (trial).
-    from vibroimpact.analysis_plots import plot_basins
-    from vibroimpact.maps import Basins
+    from vibroimpact.analysis import Basins
+    from vibroimpact.analysis.plots import plot_basins
 
     grid = np.array([-0.03, -0.02, -0.01])
     result = Basins(grid, grid, np.full((3, 3), -3), [])

@@ -181,9 +181,10 @@ NOT_AN_AXIS = [None, 5, "x", (0,), (0, "abc"), ("a", [0.0]), (0, [[0.0, 1.0]]), 
 def _calls() -> list[Any]:
     """(function, valid keyword arguments, argument, bad values) over the public API."""
     import vibroimpact as vi
-    from vibroimpact import analyses, continuation, maps, study
+    from vibroimpact import analysis, study
+    from vibroimpact.analysis import continuation, maps
 
-    run = analyses.runner(SECTIONS)
+    run = analysis.runner(SECTIONS)
     sweep = {"data": SECTIONS, "parameter": "excitation.0.frequency", "values": [10.0]}
     bifurcation = {**sweep, "settle_periods": 1, "sample_periods": 1}
     basins = {"run": run, "first": (0, [0.0]), "second": (1, [0.0]), "settle_periods": 1}
@@ -201,48 +202,48 @@ def _calls() -> list[Any]:
     structure = {"structure": SECTIONS["structure"], "t_end": 0.01, "method": "dopri5"}
     continued = {"data": SECTIONS, "parameter": "excitation.0.frequency", "stop": 11.0}
     table: list[tuple[Any, dict[str, Any], str, list[Any]]] = [
-        (analyses.sweep, sweep, "data", NOT_SECTIONS),
-        (analyses.sweep, sweep, "parameter", NOT_TEXT),
-        (analyses.sweep, sweep, "values", NOT_VALUES),
-        (analyses.sweep, sweep, "direction", [None, 5, "sideways"]),
-        (analyses.sweep, sweep, "settle_periods", NOT_A_COUNT),
-        (analyses.sweep, sweep, "record_periods", NOT_A_COUNT),
-        (analyses.sweep, sweep, "tolerance", NONE_FOR_NUMBER),
-        (analyses.sweep, sweep, "base_dir", NOT_A_FOLDER),
-        (analyses.sweep, sweep, "progress", NOT_A_FUNCTION),
-        (analyses.runner, {"data": SECTIONS}, "data", NOT_SECTIONS),
-        (analyses.runner, {"data": SECTIONS}, "base_dir", NOT_A_FOLDER),
-        (analyses.forcing_period, {"data": SECTIONS}, "data", NOT_SECTIONS),
-        (analyses.linear_amplitude, {"data": SECTIONS}, "data", NOT_SECTIONS),
-        (analyses.linear_response, {"data": SECTIONS}, "base_dir", NOT_A_FOLDER),
-        (analyses.steady_state, {"run": run}, "run", [None, "x", {}, SECTIONS]),
-        (analyses.steady_state, {"run": run}, "state", NOT_A_STATE),
-        (analyses.steady_state, {"run": run}, "settle_periods", NOT_A_COUNT),
-        (analyses.steady_state, {"run": run}, "record_periods", NOT_A_COUNT),
-        (analyses.steady_state, {"run": run}, "max_period", NOT_A_COUNT),
-        (analyses.steady_state, {"run": run}, "tolerance", NONE_FOR_NUMBER),
-        (analyses.orbit, {"run": run}, "run", [None, "x", SECTIONS]),
-        (analyses.orbit, {"run": run}, "state", NOT_A_STATE),
-        (analyses.orbit, {"run": run}, "periods", NOT_A_COUNT),
-        (analyses.orbit, {"run": run}, "tolerance", NONE_FOR_NUMBER),
-        (analyses.orbit, {"run": run}, "max_iterations", NOT_A_COUNT),
+        (analysis.sweep, sweep, "data", NOT_SECTIONS),
+        (analysis.sweep, sweep, "parameter", NOT_TEXT),
+        (analysis.sweep, sweep, "values", NOT_VALUES),
+        (analysis.sweep, sweep, "direction", [None, 5, "sideways"]),
+        (analysis.sweep, sweep, "settle_periods", NOT_A_COUNT),
+        (analysis.sweep, sweep, "record_periods", NOT_A_COUNT),
+        (analysis.sweep, sweep, "tolerance", NONE_FOR_NUMBER),
+        (analysis.sweep, sweep, "base_dir", NOT_A_FOLDER),
+        (analysis.sweep, sweep, "progress", NOT_A_FUNCTION),
+        (analysis.runner, {"data": SECTIONS}, "data", NOT_SECTIONS),
+        (analysis.runner, {"data": SECTIONS}, "base_dir", NOT_A_FOLDER),
+        (analysis.forcing_period, {"data": SECTIONS}, "data", NOT_SECTIONS),
+        (analysis.linear_amplitude, {"data": SECTIONS}, "data", NOT_SECTIONS),
+        (analysis.linear_response, {"data": SECTIONS}, "base_dir", NOT_A_FOLDER),
+        (analysis.steady_state, {"run": run}, "run", [None, "x", {}, SECTIONS]),
+        (analysis.steady_state, {"run": run}, "state", NOT_A_STATE),
+        (analysis.steady_state, {"run": run}, "settle_periods", NOT_A_COUNT),
+        (analysis.steady_state, {"run": run}, "record_periods", NOT_A_COUNT),
+        (analysis.steady_state, {"run": run}, "max_period", NOT_A_COUNT),
+        (analysis.steady_state, {"run": run}, "tolerance", NONE_FOR_NUMBER),
+        (analysis.orbit, {"run": run}, "run", [None, "x", SECTIONS]),
+        (analysis.orbit, {"run": run}, "state", NOT_A_STATE),
+        (analysis.orbit, {"run": run}, "periods", NOT_A_COUNT),
+        (analysis.orbit, {"run": run}, "tolerance", NONE_FOR_NUMBER),
+        (analysis.orbit, {"run": run}, "max_iterations", NOT_A_COUNT),
         (
-            analyses.with_parameter,
+            analysis.with_parameter,
             {"data": SECTIONS, "path": "excitation.0.frequency", "value": 5.0},
             "value",
             NONE_FOR_NUMBER,
         ),
         (
-            analyses.with_parameter,
+            analysis.with_parameter,
             {"data": SECTIONS, "path": "x.y", "value": 5.0},
             "path",
             NOT_TEXT,
         ),
-        (analyses.with_parameter, {"data": SECTIONS, "path": "x.y", "value": 5.0}, "data", [None]),
-        (analyses.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "path", NOT_TEXT),
-        (analyses.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "n", NOT_A_COUNT),
-        (analyses.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "k", NOT_A_COUNT),
-        (analyses.reductions, {"amplitude": [1.0], "linear": [2.0]}, "linear", [None, "x", {}]),
+        (analysis.with_parameter, {"data": SECTIONS, "path": "x.y", "value": 5.0}, "data", [None]),
+        (analysis.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "path", NOT_TEXT),
+        (analysis.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "n", NOT_A_COUNT),
+        (analysis.state_index, {"path": "structure_velocity.0", "n": 1, "k": 1}, "k", NOT_A_COUNT),
+        (analysis.reductions, {"amplitude": [1.0], "linear": [2.0]}, "linear", [None, "x", {}]),
         (maps.poincare, {"run": run, "periods": 1}, "run", [None, SECTIONS]),
         (maps.poincare, {"run": run, "periods": 1}, "state", NOT_A_STATE),
         (maps.poincare, {"run": run, "periods": 1}, "settle_periods", NOT_A_COUNT),
@@ -342,14 +343,14 @@ def test_a_public_function_refuses_a_wrong_type_naming_the_argument(
 
 def test_the_issue_s_calls_name_their_argument() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
     with pytest.raises(vi.InvalidInputError, match=r"^parameter: must be a string, got 5"):
-        analyses.sweep(SECTIONS, 5, [1.0])  # type: ignore[arg-type]
+        analysis.sweep(SECTIONS, 5, [1.0])  # type: ignore[arg-type]
     with pytest.raises(vi.InvalidInputError, match=r"^values: must be a list or 1-D array"):
-        analyses.sweep(SECTIONS, "excitation.0.frequency", [[1.0, 2.0]])
+        analysis.sweep(SECTIONS, "excitation.0.frequency", [[1.0, 2.0]])
     with pytest.raises(vi.InvalidInputError, match=r"^data: must be a scenario's sections"):
-        analyses.runner(None)  # type: ignore[arg-type]
+        analysis.runner(None)  # type: ignore[arg-type]
 
 
 # 3. Ranges: a key's real range, numbers written short.
@@ -358,7 +359,7 @@ def test_the_issue_s_calls_name_their_argument() -> None:
 @pytest.mark.parametrize("step", [1e300, 2.0, 1e-300])
 def test_a_continuation_step_beyond_its_range_is_refused(step: float) -> None:
     import vibroimpact as vi
-    from vibroimpact.continuation import continue_orbit
+    from vibroimpact.analysis import continue_orbit
 
     # From 10 Hz to 11 Hz: a step is at most the whole range, at least 1e-9 of it.
     with pytest.raises(vi.InvalidInputError, match=r"^step: must be in \[1e-09, 1.0\]"):
@@ -413,7 +414,7 @@ def test_a_whole_number_out_of_range_is_refused_with_the_key_s_own_range(
 
 
 def test_analysis_counts_out_of_range_name_their_real_range() -> None:
-    from vibroimpact.analyses import continuation_settings, sweep_settings
+    from vibroimpact.analysis import continuation_settings, sweep_settings
 
     sweep = {"parameter": "excitation.0.frequency", "start": 1.0, "stop": 2.0, "count": 3}
     with pytest.raises(ValueError, match=r"settle_periods: .* in \[0, 10000000\], got -1"):
@@ -501,16 +502,15 @@ def test_every_analysis_refuses_settle_and_record_beyond_the_limit_together(
     analysis: str,
 ) -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses, maps
+    from vibroimpact import analysis as an
+    from vibroimpact.analysis import maps
 
     data = _ball()
-    run = analyses.runner(data)
-    half = analyses.MAX_PERIODS // 2 + 1
+    run = an.runner(data)
+    half = an.MAX_PERIODS // 2 + 1
     calls: dict[str, Callable[[], Any]] = {
         "poincare": lambda: maps.poincare(run, settle_periods=half, periods=half),
-        "steady_state": lambda: analyses.steady_state(
-            run, settle_periods=half, record_periods=half
-        ),
+        "steady_state": lambda: an.steady_state(run, settle_periods=half, record_periods=half),
         "bifurcation": lambda: maps.bifurcation(
             data, "excitation.0.amplitude", [12.0], settle_periods=half, sample_periods=half
         ),
@@ -526,7 +526,7 @@ def test_every_analysis_refuses_settle_and_record_beyond_the_limit_together(
 def test_settings_of_settle_and_record_beyond_the_limit_together_are_refused(
     section: str,
 ) -> None:
-    from vibroimpact.analyses import MAX_PERIODS, basins_settings, sweep_settings
+    from vibroimpact.analysis import MAX_PERIODS, basins_settings, sweep_settings
     from vibroimpact.study import study_settings
 
     half = {"settle_periods": MAX_PERIODS // 2 + 1, "record_periods": MAX_PERIODS // 2 + 1}
@@ -557,11 +557,12 @@ def test_a_long_settling_map_keeps_no_contacts_beyond_its_chunk(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
+    from vibroimpact.analysis import runs
 
     data = _ball()
     data["solver"]["max_rows"] = 60  # two impacts a period: 30 periods' contacts
-    run = analyses.runner(data)
+    run = analysis.runner(data)
     z = run.initial_state()
     # One run of 100 periods keeps 200 contacts: the row limit, worded for an analysis.
     with pytest.raises(vi.SimulationError) as caught:
@@ -570,9 +571,9 @@ def test_a_long_settling_map_keeps_no_contacts_beyond_its_chunk(
     assert "100 forcing periods" in message and "settle or record fewer" in message, message
     assert "raise every" not in message
     # Settling 100 periods 20 at a time never holds more than 40.
-    monkeypatch.setattr(analyses, "SETTLE_CHUNK", 20)
+    monkeypatch.setattr(runs, "SETTLE_CHUNK", 20)  # where Runner.map reads it
     settled = run.map(z, 100)
-    reference = analyses.runner({**data, "solver": {**data["solver"], "max_rows": 10_000}})
+    reference = analysis.runner({**data, "solver": {**data["solver"], "max_rows": 10_000}})
     whole = np.asarray(reference.periods(z, 100)["final_state"], dtype=float)  # one run
     np.testing.assert_allclose(settled, whole, rtol=1e-9, atol=1e-12)
 
@@ -582,20 +583,20 @@ def test_a_long_settling_map_keeps_no_contacts_beyond_its_chunk(
 
 def test_a_forcing_period_beyond_what_a_run_can_step_through_is_refused_naming_it() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
     # The oscillator's mode is 10 Hz: a run of max_steps = 1e9 steps covers 1e8 s.
     for frequency in (1e-300, 1e-30, 5e-9):
-        changed = analyses.with_parameter(SECTIONS, "excitation.0.frequency", frequency)
+        changed = analysis.with_parameter(SECTIONS, "excitation.0.frequency", frequency)
         with pytest.raises(vi.InvalidInputError) as caught:
-            analyses.runner(changed)
+            analysis.runner(changed)
         message = str(caught.value)
         assert message.startswith(f"forcing frequency {frequency!r} Hz: its period"), message
         assert "least 1e-08 Hz" in message and "reduce dt" not in message, message
-    analyses.runner(analyses.with_parameter(SECTIONS, "excitation.0.frequency", 2e-8))
+    analysis.runner(analysis.with_parameter(SECTIONS, "excitation.0.frequency", 2e-8))
     # A body on no spring (a ball on a table) has no mode to bound the period by.
     ball = _ball()
-    analyses.runner(analyses.with_parameter(ball, "excitation.0.frequency", 1e-6))
+    analysis.runner(analysis.with_parameter(ball, "excitation.0.frequency", 1e-6))
 
 
 def test_a_sweep_from_1e_300_hz_is_refused_naming_the_frequency(
@@ -616,9 +617,9 @@ def test_a_sweep_from_1e_300_hz_is_refused_naming_the_frequency(
 
 def test_study_and_runner_helpers_refuse_wrong_types_naming_the_argument() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses, study
+    from vibroimpact import analysis, study
 
-    run = analyses.runner(SECTIONS)
+    run = analysis.runner(SECTIONS)
     assert study.output_kind("x.nc") == ".nc"  # type: ignore[arg-type]  # a str is a path
     calls: list[tuple[str, Callable[[], Any]]] = [
         ("out", lambda: study.output_kind(None)),  # type: ignore[arg-type]
@@ -676,9 +677,9 @@ def test_a_record_with_old_mac_line_ends_is_read_line_by_line(tmp_path: Path) ->
 
 def test_the_binding_s_own_messages_write_numbers_short() -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
-    system = analyses.runner(SECTIONS).system()
+    system = analysis.runner(SECTIONS).system()
     with pytest.raises(vi.InvalidInputError, match=r"strobe_period .* got -1e-300$"):
         system.run([0.0] * 4, 1.0, strobe_period=-1e-300)
     with pytest.raises(vi.InvalidInputError, match=r"tolerance .* got -1e\+300$"):
@@ -690,9 +691,9 @@ def test_the_binding_s_own_messages_write_numbers_short() -> None:
 )
 def test_run_study_names_an_argument_of_the_wrong_type(name: str, bad: Any) -> None:
     import vibroimpact as vi
-    from vibroimpact import analyses
+    from vibroimpact import analysis
 
-    spec = analyses.runner(SECTIONS).prepared.binding_spec()
+    spec = analysis.runner(SECTIONS).prepared.binding_spec()
     kwargs: dict[str, Any] = {
         "spec": spec,
         "initial": [[0.0], [0.0], [0.0], [0.0]],

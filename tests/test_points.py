@@ -21,8 +21,8 @@ import pytest
 import xarray as xr
 
 import vibroimpact as vi
-from vibroimpact.analyses import orbit, runner, sweep
-from vibroimpact.datasets import sweep_dataset
+from vibroimpact.analysis import orbit, runner, sweep
+from vibroimpact.analysis.datasets import sweep_dataset
 
 LENGTH, YOUNG, SECOND, MASS_PER_LENGTH, ZETA = 0.5, 7e10, 1e-10, 0.27, 0.01
 FORCE = 0.5

@@ -35,7 +35,7 @@ import pytest
 from numpy.typing import NDArray
 
 from orbit_checks import spectrum_distance, state_error  # noqa: E402
-from vibroimpact import analyses as an
+from vibroimpact import analysis as an
 
 Array = NDArray[np.float64]
 

@@ -14,7 +14,7 @@ import pytest
 
 import vibroimpact as vi
 from test_hostile_inputs import refused
-from vibroimpact.analyses import MAX_PERIODS, AnalysisError, runner, sweep_settings
+from vibroimpact.analysis import MAX_PERIODS, AnalysisError, runner, sweep_settings
 from vibroimpact.system import prepare_system
 
 ROOT = Path(__file__).resolve().parents[1]

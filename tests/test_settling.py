@@ -16,9 +16,9 @@ import pytest
 from numpy.typing import NDArray
 
 from study_checks import load_study  # noqa: E402
-from vibroimpact import analyses as an
+from vibroimpact import analysis as an
 from vibroimpact import study as st
-from vibroimpact.maps import basins
+from vibroimpact.analysis import basins
 
 Array = NDArray[np.float64]
 

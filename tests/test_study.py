@@ -18,7 +18,7 @@ import xarray as xr
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER, assert_refused  # noqa: E402
 from vibroimpact import study as st
-from vibroimpact.analyses import runner, steady_state
+from vibroimpact.analysis import runner, steady_state
 from vibroimpact.system_scenario import SystemScenario
 
 BASE = FORCED_DAMPER
@@ -53,7 +53,7 @@ def load(path: Path) -> st.Study:
 def without_study(study: st.Study, **changes: Any) -> dict[str, Any]:
     data = {k: v for k, v in study.data.items() if k != "study"}
     for path, value in changes.items():
-        from vibroimpact.analyses import with_parameter
+        from vibroimpact.analysis import with_parameter
 
         data = with_parameter(data, path, value)
     return data
@@ -657,7 +657,7 @@ def test_a_study_the_method_cannot_take_is_refused_before_any_run(tmp_path: Path
 def test_the_heat_map_of_a_study_whose_every_run_failed(tmp_path: Path) -> None:
     # np.nanargmin of an all-NaN map had ended `study --plot` with a traceback after
     # the file was written (trial); the map is drawn empty and says why.
-    from vibroimpact.analysis_plots import plot_study
+    from vibroimpact.analysis.plots import plot_study
 
     axes = {"damper.0.mass": [0.1, 0.2], "damper.0.clearance": [1e-3, 2e-3, 3e-3]}
     dataset = xr.Dataset(

@@ -20,7 +20,7 @@ from study_checks import FORCED_DAMPER  # noqa: E402
 from test_study import BASE, STEADY, Stop, cli, load, scenario
 from test_study_orbit import LINEAR
 from vibroimpact import study as st
-from vibroimpact.analyses import runner, steady_state, with_parameter
+from vibroimpact.analysis import runner, steady_state, with_parameter
 
 # Four runs of a chunk each: the first two fail at once (a clearance below zero fails
 # its run alone), the other two run for 1e6 s, so the interrupt finds two chunks kept.
@@ -171,7 +171,7 @@ def test_the_heat_map_of_settled_draws_1_and_0_and_failed_runs_blank(
     matplotlib.use("Agg")
     from matplotlib.axes import Axes
 
-    from vibroimpact.analysis_plots import plot_study
+    from vibroimpact.analysis.plots import plot_study
 
     drawn: list[np.ndarray] = []
     pcolormesh = Axes.pcolormesh

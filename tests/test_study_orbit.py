@@ -16,7 +16,7 @@ import pytest
 
 from study_checks import FORCED_DAMPER, assert_refused, load_study  # noqa: E402
 from vibroimpact import study as st
-from vibroimpact.analyses import orbit, runner, with_parameter
+from vibroimpact.analysis import orbit, runner, with_parameter
 
 ROOT = Path(__file__).resolve().parents[1]
 M, K, ZETA, F0 = 1.0, 3947.8, 0.02, 5.0

@@ -19,7 +19,7 @@ import pytest
 import vibroimpact as vi
 from study_checks import assert_refused  # noqa: E402
 from vibroimpact import study as st
-from vibroimpact.analyses import with_parameter
+from vibroimpact.analysis import with_parameter
 from vibroimpact.system_scenario import SystemScenario
 
 # A loose mass rattling in an oscillator shaken at its base by white noise.

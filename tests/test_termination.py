@@ -90,7 +90,7 @@ def test_whole_and_boolean_arguments_refuse_other_types_by_name(field: str, valu
 
 @pytest.mark.skipif(not hasattr(signal, "SIGHUP"), reason="no SIGHUP here")
 def test_a_sighup_ignored_as_under_nohup_stays_ignored() -> None:
-    from vibroimpact import cli
+    from vibroimpact.cli import command as cli
 
     before = signal.signal(signal.SIGHUP, signal.SIG_IGN)
     try:

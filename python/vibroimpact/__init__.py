@@ -70,10 +70,17 @@ from vibroimpact._core import cantilever_mode_shape as _cantilever_mode_shape
 from vibroimpact._core import check_solver as _check_solver
 from vibroimpact._core import goldsmith_contact_duration as _goldsmith_contact_duration
 from vibroimpact._core import run_study as _run_study
-from vibroimpact.analyses import orbit, runner, steady_state, sweep
+from vibroimpact.analysis import (
+    basins,
+    bifurcation,
+    continue_orbit,
+    orbit,
+    poincare,
+    runner,
+    steady_state,
+    sweep,
+)
 from vibroimpact.arguments import typed as _typed
-from vibroimpact.continuation import continue_orbit
-from vibroimpact.maps import basins, bifurcation, poincare
 from vibroimpact.model import *  # noqa: F403  (the parts and System: model.__all__)
 from vibroimpact.model.load import load, loads
 from vibroimpact.model.run import TEXTS as _TEXTS

@@ -335,7 +335,7 @@ def check_solver(
     history: bool = True,
 ) -> None: ...
 
-# Internal: the periodic analyses' rule, public as vibroimpact.analyses.forcing_period.
+# Internal: the periodic analyses' rule, public as vibroimpact.analysis.forcing_period.
 def _forcing_period(excitations: list[tuple[str, list[float] | None]]) -> float: ...
 def _strobe_period(
     strobe: npt.NDArray[np.float64], forcing_period: float, tolerance: float, max_period: int

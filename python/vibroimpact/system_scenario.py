@@ -90,7 +90,7 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
     except InvalidInputError as err:
         raise InvalidInputError(f"{source}: {err}") from None
     data = dict(data)
-    from vibroimpact.analyses import SETTINGS
+    from vibroimpact.analysis import SETTINGS
     from vibroimpact.study import checked_study_settings
 
     # [study] is checked, its axes and draws left unmade (a study makes them).

@@ -28,7 +28,9 @@ from vibroimpact._core import (
     Solution,
     __version__,
 )
-from vibroimpact.analysis_commands import COMMANDS, add_commands
+from vibroimpact.cli.analysis_commands import COMMANDS, add_commands
+from vibroimpact.cli.study_commands import add_command as add_study
+from vibroimpact.cli.study_commands import run_study_command
 from vibroimpact.messages import short_numbers
 from vibroimpact.output import (
     UsageError,
@@ -39,8 +41,6 @@ from vibroimpact.output import (
 )
 from vibroimpact.paper import run_paper
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
-from vibroimpact.study_commands import add_command as add_study
-from vibroimpact.study_commands import run_study_command
 from vibroimpact.system_scenario import (
     SystemScenario,
     check_history_file,

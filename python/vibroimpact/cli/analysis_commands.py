@@ -12,14 +12,18 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact import analysis_plots as plots
 from vibroimpact._core import InvalidInputError
-from vibroimpact.analyses import (
+from vibroimpact.analysis import (
     BIFURCATION_SAMPLES,
     AnalysisError,
+    basins,
+    bifurcation,
     check_periods,
     check_total,
+    continue_orbit,
     orbit,
+    plots,
+    poincare,
     runner,
     shown_amplitudes,
     shown_label,
@@ -28,8 +32,6 @@ from vibroimpact.analyses import (
     sweep,
     sweep_values,
 )
-from vibroimpact.continuation import continue_orbit
-from vibroimpact.maps import basins, bifurcation, poincare
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
 from vibroimpact.scenario import load_scenario
 from vibroimpact.system_scenario import SystemScenario

@@ -1,6 +1,6 @@
 """Poincare sections, bifurcation diagrams and basins of attraction of forced 0.2
 systems, built on the stroboscopic states and the located impacts of the core's
-runs (see :mod:`vibroimpact.analyses`). SI units throughout.
+runs (see :mod:`vibroimpact.analysis`). SI units throughout.
 """
 
 from __future__ import annotations
@@ -16,20 +16,12 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, SimulationError
-from vibroimpact.analyses import (
-    BIFURCATION_SAMPLES,
-    AnalysisError,
-    Runner,
-    as_runner,
-    check_kept,
-    check_total,
-    checked_run,
-    from_carried,
-    runner,
-    steady_state,
-    whole_count,
-    with_parameter,
-)
+from vibroimpact.analysis.limits import AnalysisError, check_total, whole_count
+from vibroimpact.analysis.parameters import with_parameter
+from vibroimpact.analysis.runs import Runner, as_runner, check_kept, checked_run, runner
+from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
+from vibroimpact.analysis.steady import steady_state
+from vibroimpact.analysis.sweeps import from_carried
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
@@ -158,7 +150,7 @@ def bifurcation(
 ) -> list[BifurcationPoint]:
     """A bifurcation diagram: for each value of ``parameter`` (a dotted path), in
     the order given (``"up"``), reversed (``"down"``) or both, settle from the last
-    point's state (see :func:`~vibroimpact.analyses.from_carried`), keep
+    point's state (see :func:`~vibroimpact.analysis.from_carried`), keep
     ``sample_periods`` stroboscopic states and sample ``sample`` over those periods:
     ``"displacement"`` (structure coordinate 0's stroboscopic displacement, m),
     ``"impact-velocity"`` (each impact's approach speed, m/s) or ``"impact-phase"``

@@ -29,15 +29,10 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
-from vibroimpact.analyses import (
-    AnalysisError,
-    Runner,
-    forcing_period,
-    orbit,
-    runner,
-    whole_count,
-    with_parameter,
-)
+from vibroimpact.analysis.limits import AnalysisError, whole_count
+from vibroimpact.analysis.orbits import orbit
+from vibroimpact.analysis.parameters import forcing_period, with_parameter
+from vibroimpact.analysis.runs import Runner, runner
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised

@@ -1,7 +1,7 @@
 """The forced-response analyses' results as labelled xarray Datasets.
 
-Each function takes what an analysis of :mod:`vibroimpact.analyses`,
-:mod:`vibroimpact.maps` or :mod:`vibroimpact.continuation` returns and gives an
+Each function takes what an analysis of :mod:`vibroimpact.analysis`,
+:mod:`vibroimpact.analysis.maps` or :mod:`vibroimpact.analysis.continuation` returns and gives an
 :class:`xarray.Dataset` with named dimensions, coordinates and, on every variable,
 a ``long_name`` and, for a physical quantity, its SI ``units`` (UDUNITS spelling,
 as CF asks: ``"m"``, ``"m s-1"``, ``"rad"``, ``"1"`` for a dimensionless one).
@@ -9,8 +9,8 @@ as CF asks: ``"m"``, ``"m s-1"``, ``"rad"``, ``"1"`` for a dimensionless one).
 A sweep written as NetCDF::
 
     import vibroimpact as vi
-    from vibroimpact.analyses import sweep
-    from vibroimpact.datasets import sweep_dataset
+    from vibroimpact.analysis import sweep
+    from vibroimpact.analysis.datasets import sweep_dataset
 
     data = vi.load_scenario("examples/frf_impact_damper.toml").data
     points = sweep(data, "excitation.0.frequency", [9.0, 10.0, 11.0])
@@ -44,9 +44,10 @@ from numpy.typing import NDArray
 
 from vibroimpact import arguments
 from vibroimpact._core import __version__
-from vibroimpact.analyses import AnalysisError, SweepPoint, reductions
-from vibroimpact.continuation import Branch
-from vibroimpact.maps import Basins, BifurcationPoint, Section
+from vibroimpact.analysis.continuation import Branch
+from vibroimpact.analysis.limits import AnalysisError
+from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
+from vibroimpact.analysis.sweeps import SweepPoint, reductions
 from vibroimpact.messages import shown
 from vibroimpact.output import json_text
 
@@ -247,7 +248,7 @@ def _names(**given: Any) -> None:
 def sweep_dataset(
     points: list[SweepPoint], parameter: str, *, units: str | None = None
 ) -> xr.Dataset:
-    """A sweep's points (:func:`vibroimpact.analyses.sweep`) as a Dataset.
+    """A sweep's points (:func:`vibroimpact.analysis.sweep`) as a Dataset.
 
     Dimensions ``point`` (in the sweep's order, up then down) and ``coordinate``
     (the structure's coordinates, with an integer coordinate 0, 1, ...).
@@ -257,7 +258,7 @@ def sweep_dataset(
     Variables: ``amplitude`` and ``rms`` (m, NaN where the point's run failed),
     ``linear_amplitude`` (m, the structure alone), ``reduction`` (``1 - amplitude /
     linear_amplitude``, NaN where either is not finite or the linear one is round-off:
-    see :func:`vibroimpact.analyses.reductions`),
+    see :func:`vibroimpact.analysis.reductions`),
     all ``point`` x ``coordinate``; ``impacts_per_period``, ``settled`` (bool) and
     ``error`` (the failed run's message, ``""`` where none) along ``point``. With
     ``[output] points``, a dimension ``at`` (the points: m along a cantilever, else
@@ -267,7 +268,7 @@ def sweep_dataset(
     the cantilever) and the bending moment's (N m): ``moment_amplitude``,
     ``moment_rms``, ``linear_moment_amplitude``, ``moment_reduction``. Attributes:
     ``parameter``."""
-    _results("points", points, SweepPoint, "vibroimpact.analyses.sweep")
+    _results("points", points, SweepPoint, "vibroimpact.analysis.sweep")
     _names(parameter=parameter, units=units)
     if not points:
         raise AnalysisError("sweep_dataset: no points")
@@ -390,7 +391,7 @@ def bifurcation_dataset(
     k: int | None = None,
     units: str | None = None,
 ) -> xr.Dataset:
-    """A bifurcation diagram (:func:`vibroimpact.maps.bifurcation`) as a Dataset.
+    """A bifurcation diagram (:func:`vibroimpact.analysis.bifurcation`) as a Dataset.
 
     Dimensions ``point``, ``sample`` (the stroboscopic samples, with the coordinate
     ``sample`` = forcing periods after settling: 1, 2, ...) and ``state`` (the flat
@@ -402,7 +403,7 @@ def bifurcation_dataset(
     ``state``, NaN-padded past a point's own samples and where its run failed),
     ``sample_count`` (each point's samples, 0 where its run failed) and ``error``
     (``""`` where none). Attributes: ``parameter``."""
-    _results("points", points, BifurcationPoint, "vibroimpact.maps.bifurcation")
+    _results("points", points, BifurcationPoint, "vibroimpact.analysis.bifurcation")
     _names(parameter=parameter, units=units)
     if not points:
         raise AnalysisError("bifurcation_dataset: no points")
@@ -465,7 +466,7 @@ def bifurcation_dataset(
 
 
 def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
-    """A Poincare section (:func:`vibroimpact.maps.poincare`) of a system of ``n``
+    """A Poincare section (:func:`vibroimpact.analysis.poincare`) of a system of ``n``
     structure coordinates and ``k`` dampers as a Dataset.
 
     Dimensions ``sample`` (coordinate: forcing periods after settling, 1, 2, ...)
@@ -476,7 +477,7 @@ def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
     name, such as ``"damper 0"``). Attributes: ``structure_coordinates`` (n) and
     ``dampers`` (k). With no impact the ``impact`` dimension has length 0 (NetCDF3
     writes it as its unlimited dimension)."""
-    arguments.instance("section", section, Section, "vibroimpact.maps.poincare")
+    arguments.instance("section", section, Section, "vibroimpact.analysis.poincare")
     _count("n", n, 0)
     _count("k", k, 0)
     width = 2 * (n + k)
@@ -533,7 +534,7 @@ _LABELS = (
 
 
 def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
-    """Basins of attraction (:func:`vibroimpact.maps.basins`) as a Dataset.
+    """Basins of attraction (:func:`vibroimpact.analysis.basins`) as a Dataset.
 
     Dimensions ``x`` and ``y``, with coordinates the two initial values varied
     (``result.first`` and ``result.second``), each with the attribute ``name``
@@ -546,7 +547,7 @@ def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
     ``attractors`` (a JSON list of ``{period, impacts_per_period, amplitude}``:
     NetCDF attributes cannot hold a list of records), ``label_meanings`` (the
     labels in words), ``x_name``, ``y_name``."""
-    arguments.instance("result", result, Basins, "vibroimpact.maps.basins")
+    arguments.instance("result", result, Basins, "vibroimpact.analysis.basins")
     _names(x_name=x_name, y_name=y_name)
     first = np.asarray(result.first, dtype=np.float64)
     second = np.asarray(result.second, dtype=np.float64)
@@ -594,7 +595,7 @@ def _state_unit(name: str) -> str | None:
 
 
 def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:
-    """A continued branch (:func:`vibroimpact.continuation.continue_orbit`) as a
+    """A continued branch (:func:`vibroimpact.analysis.continue_orbit`) as a
     Dataset.
 
     Dimensions ``point`` (along the branch), ``state`` (coordinates ``state``, as
@@ -614,7 +615,7 @@ def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:
     flagged bifurcation lies, NaN where not flagged). Attributes: ``parameter``,
     ``periods`` (K), ``stopped`` (why the continuation stopped),
     ``structure_coordinates`` (n), ``dampers`` (k)."""
-    arguments.instance("branch", branch, Branch, "vibroimpact.continuation.continue_orbit")
+    arguments.instance("branch", branch, Branch, "vibroimpact.analysis.continue_orbit")
     _names(units=units)
     points = branch.points
     if not points:

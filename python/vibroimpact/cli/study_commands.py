@@ -143,7 +143,7 @@ def run_study_command(args: argparse.Namespace) -> int:
         resume=f"run again: {_command(args)}",
     )
     if args.plot:
-        from vibroimpact.analysis_plots import plot_study
+        from vibroimpact.analysis.plots import plot_study
 
         plot_study(args.plot, dataset, metric, x, str(y))
     elapsed = time.perf_counter() - start

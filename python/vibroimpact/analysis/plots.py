@@ -12,16 +12,11 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact.analyses import (
-    BIFURCATION_SAMPLES,
-    Runner,
-    SweepPoint,
-    shown_amplitudes,
-    shown_label,
-    shown_values,
-)
-from vibroimpact.continuation import Branch
-from vibroimpact.maps import Basins, BifurcationPoint, Section
+from vibroimpact.analysis.continuation import Branch
+from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
+from vibroimpact.analysis.runs import Runner
+from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
+from vibroimpact.analysis.sweeps import SweepPoint, shown_amplitudes, shown_label, shown_values
 from vibroimpact.output import written_whole
 from vibroimpact.system import SystemSolution, split_observed
 
@@ -76,7 +71,7 @@ def _unit(parameter: str, data: Any = None) -> str:
     amplitude is N for a force, m s-2 for a base acceleration); empty where unknown."""
     # Imported here: the datasets bring xarray, which the command line loads only
     # when it writes one.
-    from vibroimpact.datasets import parameter_units
+    from vibroimpact.analysis.datasets import parameter_units
 
     units = parameter_units(parameter, data)
     return f" ({units})" if units else ""
@@ -258,7 +253,7 @@ def plot_bifurcation(
     sample: str = "displacement",
     pair: str | None = None,
 ) -> None:
-    """The samples of each point (see :func:`~vibroimpact.maps.bifurcation`: the
+    """The samples of each point (see :func:`~vibroimpact.analysis.bifurcation`: the
     stroboscopic displacement of structure coordinate 0, or each impact's approach
     speed or phase) against the parameter, each direction."""
     with _figure(path) as (fig, ax):

@@ -1,0 +1,69 @@
+"""The bounds of the analyses, checked before a run starts: whole counts, the forcing
+periods one run may settle and record, the points of a sweep and the starts of a basins
+grid; :class:`AnalysisError`, what an analysis that cannot be set up raises."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from vibroimpact import arguments
+from vibroimpact._core import InvalidInputError
+from vibroimpact.messages import shown
+
+
+class AnalysisError(InvalidInputError):
+    """An analysis that cannot be set up as asked (a ValueError)."""
+
+
+#: The most values a ``[sweep]`` may step through (``count``), or a ``[continuation]``
+#: find (``max_points``): each is a point of the result kept in memory and hundreds of
+#: forcing periods of computing.
+MAX_POINTS = 100_000
+#: The most starts of ``[basins]`` (``x.count`` times ``y.count``).
+MAX_STARTS = 1_000_000
+#: The most forcing periods one run of an analysis may settle or record: with a few
+#: impacts and tens of steps a period that is already minutes of computing, and every
+#: kept impact is memory; a longer run is a typo (1e12 for 1e2), refused before it starts.
+MAX_PERIODS = 10_000_000
+arguments.WHOLE_RANGES.update(
+    settle_periods=(0, MAX_PERIODS),
+    record_periods=(1, MAX_PERIODS),
+    periods=(1, MAX_PERIODS),
+    orbit_periods=(1, MAX_PERIODS),
+    max_points=(2, MAX_POINTS),
+)
+arguments.WHOLE_RANGES["[sweep] count"] = (1, MAX_POINTS)
+
+
+def whole_count(name: str, value: Any, low: int) -> int:
+    """``value`` as a Python int when it is a whole number >= ``low`` (an int or a
+    NumPy integer, never a boolean); else :class:`AnalysisError` naming ``name``."""
+    if isinstance(value, np.integer):
+        value = int(value)
+    if not isinstance(value, int) or isinstance(value, bool) or value < low:
+        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {shown(value)}")
+    return value
+
+
+def check_total(settle: tuple[str, int], record: tuple[str, int]) -> None:
+    """A run that settles ``settle = (name, periods)`` and then records ``record``
+    spans at most MAX_PERIODS forcing periods in all: refused up front, naming both
+    (``("--settle", 10**7), ("--periods", 10**7)`` had run 21 s into 1.6 GB of
+    contacts before the row limit stopped it)."""
+    if settle[1] + record[1] > MAX_PERIODS:
+        raise AnalysisError(
+            f"{settle[0]} {settle[1]} and {record[0]} {record[1]}: a run settles and records "
+            f"at most {MAX_PERIODS} forcing periods in all, got {settle[1] + record[1]}; "
+            f"settle or record fewer"
+        )
+
+
+def check_periods(where: str, key: str, value: int, low: int) -> None:
+    """``value`` forcing periods must be a whole number in [``low``, MAX_PERIODS]; the
+    error names ``where`` (``"[sweep] "``, ``"--settle"``...) and ``key``."""
+    if not low <= value <= MAX_PERIODS:
+        raise AnalysisError(
+            f"{where}{key}: must be >= {low} and at most {MAX_PERIODS} forcing periods, got {value}"
+        )

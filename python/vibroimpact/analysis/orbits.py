@@ -1,0 +1,92 @@
+"""Periodic orbits found by shooting (Newton's method on the stroboscopic map, in the
+core), with their Floquet multipliers and stability."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from vibroimpact import arguments
+from vibroimpact.analysis.limits import whole_count
+from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run
+from vibroimpact.model.system import System
+from vibroimpact.summary import summarised
+
+
+@summarised
+@dataclass
+class Orbit:
+    """A periodic orbit of ``periods`` forcing periods found by shooting."""
+
+    converged: bool
+    state: np.ndarray
+    floquet_multipliers: np.ndarray
+    stable: bool
+    impacts_per_period: float
+    amplitude: np.ndarray
+    iterations: int
+    residual: float
+    monodromy: np.ndarray = field(repr=False)
+    #: The largest |displacement| (m) on the orbit at each of ``[output] points``, and
+    #: |bending moment| (N m) at each of ``[output] moments``.
+    point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def arrays(self, n: int, k: int) -> dict[str, list[float]]:
+        """The state as the four arrays of ``[initial]``."""
+        d = n + k
+        s = self.state
+        return {
+            "structure_displacement": [float(v) for v in s[:n]],
+            "structure_velocity": [float(v) for v in s[d : d + n]],
+            "damper_displacement": [float(v) for v in s[n:d]],
+            "damper_velocity": [float(v) for v in s[d + n :]],
+        }
+
+
+def orbit(
+    run: Runner | System,
+    state: np.ndarray | None = None,
+    *,
+    periods: int = 1,
+    tolerance: float = 1e-10,
+    max_iterations: int = 40,
+) -> Orbit:
+    """Shoot for an orbit of ``periods`` forcing periods from ``state`` (default the
+    scenario's ``[initial]``): Newton's method on ``P(z) - z = 0``, ``P`` the
+    stroboscopic map over ``periods`` periods, its Jacobian by central finite
+    differences (across impacts: the saltation is in the differences). At the orbit
+    the Jacobian is the monodromy matrix; its eigenvalues are the Floquet multipliers
+    and the orbit is stable when all lie inside the unit circle. Newton steps that
+    would start inside a wall are halved. ``run``: a :class:`Runner` or a
+    :class:`~vibroimpact.System`."""
+    run = as_runner(run)
+    state = checked_run(run, state)
+    periods = whole_count("periods", periods, 1)
+    arguments.positive("tolerance", tolerance)
+    max_iterations = whole_count("max_iterations", max_iterations, 1)
+    z = run.initial_state() if state is None else np.asarray(state, dtype=float)
+    shot = run.shoot(z, periods, tolerance, max_iterations)
+    size = len(z)
+    z = np.asarray(shot["state"], dtype=float)
+    jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
+    converged = bool(shot["converged"])
+    iterations = int(shot["iterations"])
+    residual = float(shot["residual"])
+    multipliers = np.linalg.eigvals(jac)
+    recorded = run.periods(z, periods, record=True)
+    amplitude, point_amplitude, moment_amplitude = run.amplitudes(recorded)
+    return Orbit(
+        converged=converged,
+        state=z,
+        floquet_multipliers=multipliers,
+        stable=bool(converged and np.all(np.abs(multipliers) < 1.0)),
+        impacts_per_period=_impacts(recorded) / periods,
+        amplitude=amplitude,
+        iterations=iterations,
+        residual=residual,
+        monodromy=jac,
+        point_amplitude=point_amplitude,
+        moment_amplitude=moment_amplitude,
+    )

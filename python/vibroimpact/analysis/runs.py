@@ -1,0 +1,268 @@
+"""Runs of one checked 0.2 system from any state over whole forcing periods (the
+:class:`Runner` every analysis takes), and the up-front checks of what a run would keep."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vibroimpact import arguments
+from vibroimpact._core import (
+    MAX_RECORD_BYTES,
+    InvalidInputError,
+    PreparedSystem,
+    SimulationError,
+)
+from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
+from vibroimpact.analysis.parameters import forcing_period
+from vibroimpact.forcing_limits import check_forcing_period
+from vibroimpact.messages import shown
+from vibroimpact.model.system import System, sections_of
+from vibroimpact.system import (
+    PreparedRun,
+    prepare_system,
+    split_observed,
+    structure_coordinates,
+)
+
+
+def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
+    # Refused here, naming the section (a KeyError or a TypeError had named nothing).
+    if "structure" not in data:
+        raise InvalidInputError(
+            "[structure] is required: the analyses take a 0.2 scenario (a [structure] "
+            "section, its dampers, stops and excitations)"
+        )
+    if not isinstance(data.get("solver", {}), Mapping):
+        raise InvalidInputError(f"[solver] must be a table, got {shown(data['solver'])}")
+    solver = dict(data.get("solver", {}))
+    solver.setdefault("t_end", 1.0)
+    output = data.get("output", {})
+    # Of [output], the analyses keep only the points and moments they report.
+    followed = {
+        key: output[key]
+        for key in ("points", "moments")
+        if isinstance(output, Mapping) and key in output
+    }
+    return prepare_system(
+        data["structure"],
+        damper=data.get("damper", ()),
+        stop=data.get("stop", ()),
+        gravity=data.get("gravity"),
+        excitation=data.get("excitation", ()),
+        initial=data.get("initial"),
+        solver=solver,
+        output=followed,
+        base_dir=base_dir,
+    )
+
+
+@dataclass
+class Runner:
+    """Runs of one checked system from any state over whole forcing periods."""
+
+    prepared: PreparedRun
+    period: float
+    n: int = 0
+    k: int = 0
+    runs: int = 0
+    _prepared_system: PreparedSystem | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        self.n = structure_coordinates(self.prepared.spec["structure"])
+        self.k = len(self.prepared.spec.get("damper", ()))
+
+    @property
+    def points(self) -> np.ndarray:
+        """The points ``[output] points`` follows (m along a cantilever, or indices)."""
+        return np.asarray(self.prepared.output["points"], dtype=float)
+
+    @property
+    def moments(self) -> np.ndarray:
+        """Where ``[output] moments`` follows a cantilever's bending moment (m)."""
+        return np.asarray(self.prepared.output["moments"], dtype=float)
+
+    def amplitudes(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The located peaks of a recorded run: of each structure coordinate and of the
+        structure at each point (m), and of the bending moment at each of the moments
+        (N m)."""
+        arguments.instance("recorded", recorded, Mapping, "Runner.periods(..., record=True)")
+        return split_observed(np.asarray(recorded["peaks"], dtype=float), self.n, len(self.points))
+
+    def rms(self, recorded: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The RMS values of a recorded run, as :meth:`amplitudes`."""
+        arguments.instance("recorded", recorded, Mapping, "Runner.periods(..., record=True)")
+        rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
+        return split_observed(rms, self.n, len(self.points))
+
+    def initial_state(self) -> np.ndarray:
+        """The scenario's ``[initial]`` as a flat state ``(x, v)``."""
+        n, k = self.n, self.k
+        init = self.prepared.initial
+        parts = [np.zeros(n), np.zeros(k), np.zeros(n), np.zeros(k)]
+        for slot, key in zip(
+            (0, 2, 1, 3),
+            (
+                "structure_displacement",
+                "structure_velocity",
+                "damper_displacement",
+                "damper_velocity",
+            ),
+            strict=True,
+        ):
+            if len(init[key]):
+                parts[slot] = np.asarray(init[key], dtype=float)
+        return np.concatenate(parts)
+
+    def _run(
+        self, state: np.ndarray | None, t_end: float, *, record: bool, strobe: bool
+    ) -> dict[str, Any]:
+        z = self.initial_state() if state is None else state
+        if len(z) != 2 * (self.n + self.k):
+            raise AnalysisError(
+                f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(z)}"
+            )
+        try:
+            raw = self.system().run(
+                np.asarray(z, dtype=float).tolist(),
+                t_end,
+                record_from=0.0 if record else None,
+                strobe_period=self.period if strobe else None,
+            )
+        except SimulationError as err:
+            if "max_rows" not in str(err):
+                raise
+            # The core's advice (every, history, t_end) is about a run's own keys: an
+            # analysis sets the periods.
+            raise SimulationError(
+                f"{round(t_end / self.period)} forcing periods in one run kept more contacts "
+                f"than [solver] max_rows ({str(err).partition(': ')[0]}): settle or record "
+                "fewer periods, or raise max_rows"
+            ) from None
+        self.runs += 1
+        return raw
+
+    def system(self) -> PreparedSystem:
+        """The core's checked system with its method (made once)."""
+        if self._prepared_system is None:
+            self._prepared_system = PreparedSystem(
+                self.prepared.binding_spec(), **self.prepared.method_arguments()
+            )
+        return self._prepared_system
+
+    def periods(
+        self, state: np.ndarray, count: int, *, record: bool = False, strobe: bool = False
+    ) -> dict[str, Any]:
+        """Run ``count`` forcing periods from ``state``."""
+        state = arguments.state("state", state, 2 * (self.n + self.k))  # type: ignore[assignment]
+        check_periods("", "count", whole_count("count", count, 1), 1)
+        record, strobe = arguments.flag("record", record), arguments.flag("strobe", strobe)
+        return self._periods(state, count, record=record, strobe=strobe)
+
+    def _periods(
+        self, state: np.ndarray | None, count: int, *, record: bool = False, strobe: bool = False
+    ) -> dict[str, Any]:
+        """:meth:`periods` of a state and count already checked (the loops of
+        :meth:`map` and of a response recorded period by period)."""
+        width = 1 + 2 * (self.n + self.k)
+        if strobe and count * width * 8 > MAX_RECORD_BYTES:
+            # A state a period: known before the run, as a fixed-step history is.
+            raise AnalysisError(
+                f"periods: {count} stroboscopic states of {width} values, "
+                f"{count * width * 8 / 2**20:.0f} MiB, more than the "
+                f"{MAX_RECORD_BYTES >> 20} MiB a run's records may take: settle fewer periods"
+            )
+        return self._run(state, count * self.period, record=record, strobe=strobe)
+
+    def map(self, state: np.ndarray, count: int) -> np.ndarray:
+        """The stroboscopic map over ``count`` periods, run :data:`SETTLE_CHUNK` periods
+        at a time: a run keeps its contacts, which settling never reads (ten million
+        periods of a bouncing ball had kept 20 million, 1.6 GB, up to the row limit)."""
+        check_periods("", "count", whole_count("count", count, 1), 1)
+        z = arguments.state("state", state, 2 * (self.n + self.k))
+        for start in range(0, count, SETTLE_CHUNK):
+            z = np.asarray(
+                self._periods(z, min(SETTLE_CHUNK, count - start))["final_state"], dtype=float
+            )
+        assert z is not None  # count >= 1: the loop ran
+        return z
+
+    def shoot(
+        self, state: np.ndarray, count: int, tolerance: float, max_iterations: int
+    ) -> dict[str, Any]:
+        """Newton's shooting over ``count`` periods from ``state``, in the core (see
+        :func:`orbit`)."""
+        check_periods("", "count", whole_count("count", count, 1), 1)
+        if len(state) != 2 * (self.n + self.k):
+            raise AnalysisError(
+                f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(state)}"
+            )
+        shot: dict[str, Any] = self.system().shoot(
+            [float(v) for v in state],
+            count * self.period,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+            forcing_period=self.period,
+        )
+        self.runs += int(shot["maps"])
+        return shot
+
+
+def as_runner(run: Runner | System) -> Runner:
+    """The analyses' entry: a :class:`~vibroimpact.System` as its :class:`Runner`
+    (anything else as it is, for :func:`checked_run` to check)."""
+    return runner(run) if isinstance(run, System) else run
+
+
+def checked_run(run: Any, state: Any) -> np.ndarray | None:
+    """``run`` checked as a :class:`Runner` and ``state`` as one of its flat states
+    (or None)."""
+    arguments.instance("run", run, Runner, "vibroimpact.analysis.runner(sections)")
+    return arguments.state("state", state, 2 * (run.n + run.k))
+
+
+def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Runner:
+    """A :class:`Runner` of a :class:`~vibroimpact.System` or of a scenario's sections
+    (as parsed from TOML)."""
+    data, base_dir = sections_of(data, base_dir)
+    base_dir = arguments.directory("base_dir", base_dir)
+    prepared, period = _prepare(data, base_dir), forcing_period(data)
+    check_forcing_period(data, period, prepared.solver["max_steps"], base_dir)
+    return Runner(prepared, period)
+
+
+def _impacts(raw: Mapping[str, Any]) -> int:
+    kinds = raw["contacts"]["kind"]
+    return sum(1 for kind in kinds if kind in ("impact", "compliant"))
+
+
+#: The forcing periods a long recording's first stretch runs to estimate its contacts
+#: (:func:`check_kept`); only recordings of ten times as many are estimated.
+PROBE_PERIODS = 1000
+
+
+def check_kept(run: Runner, state: np.ndarray, count: int, name: str) -> None:
+    """Refuse up front a recording of ``count`` periods from ``state`` whose contacts,
+    at the rate of its first :data:`PROBE_PERIODS`, would pass ``[solver] max_rows``
+    (``poincare --settle 0 --periods 10000000`` of a bouncing ball had run 15 s into
+    1.2 GB before the row limit stopped it). ``name`` is the count's name."""
+    if count < 10 * PROBE_PERIODS:
+        return
+    seen = len(run.periods(state, PROBE_PERIODS)["contacts"]["onset"])
+    expected = seen * (count / PROBE_PERIODS)
+    limit = run.prepared.solver["max_rows"]
+    if expected > limit:
+        raise AnalysisError(
+            f"{name} {count}: would keep about {expected:.3g} contacts ({seen / PROBE_PERIODS:g}"
+            f" a period over the first {PROBE_PERIODS}), more than [solver] max_rows ({limit});"
+            f" record at most {int(limit / seen * PROBE_PERIODS)} periods, or raise max_rows"
+        )
+
+
+#: The forcing periods one run of a settling map covers (:meth:`Runner.map`): its
+#: contacts, a few per period, stay well within a run's rows.
+SETTLE_CHUNK = 100_000

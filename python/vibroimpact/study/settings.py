@@ -1,0 +1,204 @@
+"""The ``[study]`` section checked, with its defaults: the analysis, the metrics it
+keeps, the periods, the chunks, the samples and the stepping; its axes and draws made
+(:mod:`vibroimpact.study.axes`)."""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_total
+from vibroimpact.study.axes import (
+    _axis_count,
+    _axis_values,
+    _check_path,
+    _check_seeds,
+    _distribution,
+    _draws,
+    _is_seed,
+)
+from vibroimpact.study.limits import MAX_STUDY_RUNS, StudyError
+from vibroimpact.system import _NUMBER, _TEXT, _WHOLE, _choice, _table
+
+# What each analysis keeps; every metric.
+_RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated")
+_STEADY_METRICS = (*_RUN_METRICS, "amplitude", "impacts_per_period", "settled")
+_ANALYSIS_METRICS = {
+    "run": _RUN_METRICS,
+    "steady-state": _STEADY_METRICS,
+    "orbit": ("amplitude", "impacts_per_period", "stable", "largest_multiplier"),
+}
+METRICS = (*_STEADY_METRICS, "stable", "largest_multiplier")
+_ANALYSES = tuple(_ANALYSIS_METRICS)
+_STUDY = {
+    "analysis": (_TEXT, "run"),
+    "settle_periods": (_WHOLE, 200),
+    "record_periods": (_WHOLE, 50),
+    "orbit_periods": (_WHOLE, 1),
+    # None: [output] record_from, else 0 (see study()).
+    "record_from": (_NUMBER, None),
+    "tolerance": (_NUMBER, 1e-6),
+    "chunk_size": (_WHOLE, 1024),
+    "samples": (_WHOLE, 0),
+    "seed": (_WHOLE, 0),
+    "stepping": (_TEXT, "events"),
+}
+_STEPPINGS = ("events", "fixed")
+# What a lockstep ensemble of fixed steps keeps.
+_FIXED_METRICS = ("peak", "rms", "impacts")
+
+
+#: Metrics kept at each of [output] points and moments as well as per coordinate.
+PER_COORDINATE = ("peak", "rms", "amplitude")
+_FOLLOWED = tuple(f"{kind}_{m}" for kind in ("point", "moment") for m in PER_COORDINATE)
+
+
+def base_metrics(names: Sequence[str]) -> list[str]:
+    """The metrics the runs keep for ``names``: ``point_peak``, ``moment_rms``... are
+    the per-coordinate ``peak``, ``rms``... (kept at each of ``[output] points`` and
+    ``moments`` too, in the Dataset's ``point_*``, ``moment_*``); each once, in order."""
+    out = []
+    for name in names:
+        for kind in ("point_", "moment_"):
+            if name.startswith(kind) and name[len(kind) :] in PER_COORDINATE:
+                name = name[len(kind) :]
+        out.append(name)
+    return list(dict.fromkeys(out))
+
+
+def checked_study_settings(table: Any) -> dict[str, Any]:
+    """The ``[study]`` section checked as :func:`study_settings` checks it, without
+    making its axes' values or its random draws: ``axes`` and ``random`` are left as
+    given. What reading a scenario does, so that a command other than ``study`` never
+    allocates them."""
+    return study_settings(table, build=False)
+
+
+def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
+    """The ``[study]`` section checked, with its defaults; each axis as its list of
+    values (``axes``: a dict, path to array). Every count is checked, and the runs
+    bounded by :data:`MAX_STUDY_RUNS`, before any array is made; ``build=False``
+    makes none (see :func:`checked_study_settings`)."""
+    if not isinstance(table, Mapping):
+        raise StudyError(f"[study]: must be a table, got {table!r:.60}")
+    sections = ("metrics", "axes", "random")
+    allowed = [*_STUDY, *sections]
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(str(key), allowed, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise StudyError(f"[study] unknown key {key!r} (allowed: {', '.join(allowed)}){hint}")
+    # A None is a default left to fill (TOML has none): settings checked before.
+    plain = {k: v for k, v in table.items() if k not in sections and v is not None}
+    out = _table("[study] ", plain, _STUDY)
+    _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
+    _choice("[study] ", "stepping", out["stepping"], _STEPPINGS)
+    # By default what the analysis keeps (an orbit's own metrics, none of a run's).
+    default = _ANALYSIS_METRICS["orbit"] if out["analysis"] == "orbit" else _FIXED_METRICS
+    metrics = table.get("metrics", list(default))
+    if isinstance(metrics, str) or not isinstance(metrics, Sequence) or not metrics:
+        raise StudyError(f"[study] metrics: must be a list of names, got {metrics!r:.60}")
+    for name in metrics:
+        _choice("[study] ", "metrics", name, METRICS + _FOLLOWED)
+    asked, metrics = metrics, base_metrics(metrics)
+    if out["stepping"] == "fixed":
+        if out["analysis"] != "run":
+            raise StudyError(
+                '[study] stepping = "fixed": runs each member to [solver] t_end; '
+                'use analysis = "run"'
+            )
+        other = [m for m in metrics if m not in _FIXED_METRICS]
+        if other:
+            raise StudyError(
+                f'[study] metrics: {", ".join(other)} not kept by stepping = "fixed" '
+                f'(allowed: {", ".join(_FIXED_METRICS)}; or stepping = "events")'
+            )
+    kept = _ANALYSIS_METRICS[out["analysis"]]
+    other = [name for name in metrics if name not in kept]
+    if other:
+        keeping = [a for a, names in _ANALYSIS_METRICS.items() if set(other) <= set(names)]
+        hint = f"; use analysis = {' or '.join(repr(a) for a in keeping)}" if keeping else ""
+        raise StudyError(
+            f"[study] metrics: {', '.join(other)} not kept by analysis = "
+            f'"{out["analysis"]}" (it keeps {", ".join(kept)}){hint}'
+        )
+    # As asked (point_peak... among them: see base_metrics).
+    out["metrics"] = list(dict.fromkeys(asked))
+    for key, low in (
+        ("settle_periods", 0),
+        ("record_periods", 1),
+        ("orbit_periods", 1),
+        ("chunk_size", 1),
+    ):
+        if out[key] < low:
+            raise StudyError(f"[study] {key}: must be >= {low}, got {out[key]}")
+        if key != "chunk_size" and out[key] > MAX_PERIODS:
+            # As the analyses' own settings: 1e11 periods ran for half a minute into
+            # gigabytes of contacts before failing (user trial).
+            raise StudyError(
+                f"[study] {key}: must be at most {MAX_PERIODS} forcing periods, got {out[key]}"
+            )
+    try:
+        check_total(
+            ("[study] settle_periods", out["settle_periods"]),
+            ("record_periods", out["record_periods"]),
+        )
+    except AnalysisError as err:
+        raise StudyError(str(err)) from None
+    if out["record_from"] is not None and not out["record_from"] >= 0:
+        raise StudyError(f"[study] record_from: must be >= 0 s, got {out['record_from']}")
+    if not out["tolerance"] > 0:
+        raise StudyError(f"[study] tolerance: must be > 0, got {out['tolerance']}")
+    axes = table.get("axes")
+    if not isinstance(axes, Mapping) or not axes:
+        raise StudyError(
+            "[study.axes]: required, a table of dotted paths to a list of values or "
+            "{start, stop, count}"
+        )
+    counts = {}
+    for path, spec in axes.items():
+        _check_path(f"[study.axes] {str(path)!r}: ", str(path))
+        counts[str(path)] = _axis_count(str(path), spec)
+    random = table.get("random", {})
+    if not isinstance(random, Mapping):
+        raise StudyError("[study.random]: must be a table of dotted paths to distributions")
+    if random and out["samples"] < 1:
+        raise StudyError("[study] samples: must be >= 1 with [study.random]")
+    if out["samples"] and not random:
+        raise StudyError(
+            "[study] samples: needs [study.random] (the parameters drawn for each sample)"
+        )
+    for path, spec in random.items():
+        path = str(path)
+        _check_path(f"[study.random] {path!r}: ", path)
+        if path in counts:
+            raise StudyError(f"[study.random] {path!r}: is also an axis")
+        _distribution(path, spec, out["samples"])
+    runs = math.prod(counts.values()) * max(out["samples"], 1)
+    if runs > MAX_STUDY_RUNS:
+        sizes = " x ".join(f"{path} {count}" for path, count in counts.items())
+        keys = "[study.axes] count"
+        if out["samples"]:
+            sizes += f" x samples {out['samples']}"
+            keys = "[study] samples, [study.axes] count"
+        raise StudyError(
+            f"{keys}: the study would make {runs:.3g} runs ({sizes}), more than "
+            f"{MAX_STUDY_RUNS:,}; lower the counts or samples, or split the study"
+        )
+    if not build:
+        return {**out, "axes": dict(axes), "random": dict(random)}
+    out["axes"] = {str(path): _axis_values(str(path), spec) for path, spec in axes.items()}
+    for path, values in out["axes"].items():
+        if _is_seed(path):
+            _check_seeds(f"[study.axes] {path!r}: ", values)
+    # Every distribution from one generator seeded by `seed`, in the order given:
+    # the same draws on every platform (numpy's PCG64), the same for every grid point.
+    generator = np.random.default_rng(out["seed"])
+    out["random"] = {}
+    for path, spec in random.items():
+        out["random"][str(path)] = _draws(str(path), spec, out["samples"], generator)
+    return out
