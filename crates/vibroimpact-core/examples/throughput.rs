@@ -1,15 +1,56 @@
 //! Steps per second of the core kernels alone (no Python), on the founding
 //! paper's Table 1 system with Hyster-Hertz contact (e = 0.9), 1e7 steps of
 //! 1e-4 s for each fixed-step method; then the time per collision of the
-//! adaptive methods.
+//! adaptive methods. Each event-stepping method on the 0.1 kernel, then on
+//! the general kernel (the preset [`ImpactDamper::assembly`]), which the
+//! two-mass `simulate` of the binding runs.
 //!
 //!     cargo run --release -p vibroimpact-core --example throughput
 
 use std::time::Instant;
+use vibroimpact_core::methods::registry::AnyStepper;
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
     Tolerances,
 };
+
+/// Median of `repeats` seconds of `run`, which returns the steps it took.
+fn median_seconds(repeats: usize, least_steps: u64, mut run: impl FnMut() -> u64) -> f64 {
+    let mut times: Vec<f64> = (0..repeats)
+        .map(|_| {
+            let t0 = Instant::now();
+            assert!(run() >= least_steps);
+            t0.elapsed().as_secs_f64()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[repeats / 2]
+}
+
+/// The run of `settings` on the general kernel, as the binding makes it.
+fn general(system: &ImpactDamper, contact: &Contact, start: &State, settings: &Settings) -> u64 {
+    let assembly = system.assembly(contact).unwrap();
+    let y0 = start.vector(&assembly).unwrap();
+    let (rtol, atol) = match settings.method {
+        Method::Dopri5(t) | Method::Dop853(t) => (t.rtol, t.atol),
+        _ => (1e-8, 1e-12),
+    };
+    let mut stepper = AnyStepper::new(
+        &assembly,
+        settings.method.name(),
+        rtol,
+        atol,
+        0.25,
+        0.5,
+        0.9,
+    )
+    .unwrap();
+    let sol = stepper
+        .integrate(&assembly, &y0, &settings.run_options(), &mut || false)
+        .unwrap();
+    assert!(!sol.contacts.is_empty());
+    sol.steps
+}
 
 fn main() {
     let system = ImpactDamper::new(1.0, 1.0, 0.01, 0.25, 0.01).unwrap();
@@ -52,19 +93,22 @@ fn main() {
             u64::MAX,
         )
         .unwrap();
-        let mut times: Vec<f64> = (0..5)
-            .map(|_| {
-                let t0 = Instant::now();
-                let sol = simulate(&system, &contact, &start, &settings, &mut || false).unwrap();
-                assert!(sol.steps >= steps);
-                t0.elapsed().as_secs_f64()
-            })
-            .collect();
-        times.sort_by(f64::total_cmp);
+        let legacy = median_seconds(5, steps, || {
+            simulate(&system, &contact, &start, &settings, &mut || false)
+                .unwrap()
+                .steps
+        });
         println!(
             "{name:18} {:.3e} steps/s (median of 5)",
-            steps as f64 / times[2]
+            steps as f64 / legacy
         );
+        if stepping == Stepping::Events && !matches!(method, Method::Newmark { .. }) {
+            let run = median_seconds(5, steps, || general(&system, &contact, &start, &settings));
+            println!(
+                "{name:18} {:.3e} steps/s (median of 5), general kernel",
+                steps as f64 / run
+            );
+        }
     }
     collision_times();
 }
@@ -95,19 +139,17 @@ fn collision_times() {
             )
             .unwrap();
             let repeats = 2001;
-            let mut times: Vec<f64> = (0..repeats)
-                .map(|_| {
-                    let t0 = Instant::now();
-                    let sol =
-                        simulate(&system, &contact, &start, &settings, &mut || false).unwrap();
-                    assert_eq!(sol.contacts.len(), 1);
-                    t0.elapsed().as_secs_f64()
-                })
-                .collect();
-            times.sort_by(f64::total_cmp);
+            let legacy = median_seconds(repeats, 1, || {
+                let sol = simulate(&system, &contact, &start, &settings, &mut || false).unwrap();
+                assert_eq!(sol.contacts.len(), 1);
+                sol.steps
+            });
+            let run = median_seconds(repeats, 1, || general(&system, &contact, &start, &settings));
             println!(
-                "{name:8} rtol {rtol:.0e}: {:.2} us per collision (median of {repeats})",
-                times[repeats / 2] * 1e6
+                "{name:8} rtol {rtol:.0e}: {:.2} us per collision (median of {repeats}); \
+                 general kernel {:.2} us",
+                legacy * 1e6,
+                run * 1e6
             );
         }
     }

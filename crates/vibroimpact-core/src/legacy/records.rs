@@ -266,21 +266,7 @@ pub(crate) fn check_start<L: ContactLaw, X: Excitation>(
     model: &Model<L, X>,
     initial: &State,
 ) -> Result<()> {
-    let u = initial.relative_displacement();
-    let indentation = u.abs() - model.clearance;
-    let round_off = 4.0
-        * f64::EPSILON
-        * (initial.main_displacement.abs() + initial.impact_displacement.abs() + model.clearance);
-    if indentation > round_off {
-        return Err(Error::Inconsistent(format!(
-            "the initial state starts the impact mass {indentation:.6e} m inside the wall: \
-             |impact_displacement - main_displacement| = {:e} m is more than the clearance {:e} m; \
-             start with |impact_displacement - main_displacement| <= clearance (at the wall at most)",
-            u.abs(),
-            model.clearance
-        )));
-    }
-    Ok(())
+    initial.check_apart(model.clearance)
 }
 
 /// The work of the main damper `C` over the fixed-step kernel's equal steps

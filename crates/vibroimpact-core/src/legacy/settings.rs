@@ -3,6 +3,7 @@
 //! rows, energy balance), checked before it starts.
 
 use crate::error::{positive, within, Error, Result};
+use crate::kernel::events::RunOptions;
 use crate::legacy::steppers::Tolerances;
 
 /// The relative tolerance (`rtol`) a method with error control takes, and
@@ -432,6 +433,22 @@ impl Settings {
     /// `0.3 / 1e-4` at 3000 despite rounding); infinite when it overflows.
     fn step_count(&self, dt: f64) -> f64 {
         ((self.t_end / dt) * (1.0 - 1e-9)).ceil().max(1.0)
+    }
+
+    /// The general kernel's options for this run of the two-mass preset
+    /// ([`crate::ImpactDamper::assembly`]), as a 0.2 run of the same system
+    /// takes them: no reductions.
+    pub fn run_options(&self) -> RunOptions {
+        RunOptions {
+            dt: self.dt,
+            t_end: self.t_end,
+            every: self.every,
+            keep_history: self.history,
+            max_steps: self.max_steps,
+            max_rows: self.max_rows,
+            energy_tolerance: self.energy_tolerance,
+            reduce: Default::default(),
+        }
     }
 
     /// Number of fixed steps: `t_end / dt` rounded up; 0 without dt.

@@ -4,7 +4,7 @@
 //! with one damper of equal clearances at its coordinate, run by the general
 //! kernel like any other.
 
-use crate::error::{finite, non_negative, positive, Result};
+use crate::error::{finite, non_negative, positive, Error, Result};
 use crate::model::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
 use crate::model::contact::Contact;
 use crate::model::structure::Structure;
@@ -75,6 +75,23 @@ impl ImpactDamper {
         })
     }
 
+    /// The force between the bodies (N, > 0 pushing them apart) in state
+    /// `s` while in contact with the rate latched at its onset
+    /// `approach_rate` (m/s): the law's (none at or below the wall) plus the
+    /// contact damper's `c1` times the indentation rate.
+    pub fn contact_force(&self, contact: &Contact, s: &State, approach_rate: f64) -> Result<f64> {
+        let u = s.relative_displacement();
+        // The wall the impact mass is at or heading for.
+        let side = if u > 0.0 || (u == 0.0 && s.relative_velocity() >= 0.0) {
+            1.0
+        } else {
+            -1.0
+        };
+        let indentation = side * u - self.clearance;
+        let rate = side * s.relative_velocity();
+        Ok(contact.law_force(indentation, rate, approach_rate)? + contact.damping * rate)
+    }
+
     /// [`Self::spec`], assembled for the kernel.
     pub fn assembly(&self, contact: &Contact) -> Result<Assembly> {
         Assembly::new(&self.spec(contact)?)
@@ -120,6 +137,26 @@ impl State {
     #[inline(always)]
     pub fn relative_velocity(&self) -> f64 {
         self.impact_velocity - self.main_velocity
+    }
+
+    /// Refuses a start with the impact mass inside a wall beyond round-off
+    /// (`|y - w| > d`), naming by how much and what is allowed.
+    pub fn check_apart(&self, clearance: f64) -> Result<()> {
+        let u = self.relative_displacement();
+        let indentation = u.abs() - clearance;
+        let round_off = 4.0
+            * f64::EPSILON
+            * (self.main_displacement.abs() + self.impact_displacement.abs() + clearance);
+        if indentation > round_off {
+            return Err(Error::Inconsistent(format!(
+                "the initial state starts the impact mass {indentation:.6e} m inside the wall: \
+                 |impact_displacement - main_displacement| = {:e} m is more than the clearance {:e} m; \
+                 start with |impact_displacement - main_displacement| <= clearance (at the wall at most)",
+                u.abs(),
+                clearance
+            )));
+        }
+        Ok(())
     }
 
     /// The state vector of the preset's assembly ([`ImpactDamper::assembly`]):
