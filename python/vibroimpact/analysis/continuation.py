@@ -29,6 +29,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
+from vibroimpact.analysis.crossings import _CLASSES, _flags, _kind, _largest
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
@@ -54,7 +55,7 @@ class BranchPoint:
     #: parameter at which the crossing multiplier's modulus reaches 1 (bisection along
     #: the arc), or at which the parameter turns (a fold: where the stability changes
     #: there, so located; otherwise the extremum of its cubic along the arc, see
-    #: ``_fold``).
+    #: :func:`vibroimpact.analysis.crossings._fold`).
     crossings: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:
@@ -137,23 +138,13 @@ def continue_orbit(
             f"{shown(ds)}"
         )
 
-    # The stroboscopic section, as a fraction of the forcing period after t = 0: moved
-    # away from the impacts when one comes near it, where the map jumps (an impact
-    # just before the section or just after it), so that the branch stays smooth.
-    section = [0.0]
+    # Harmonic forcing only: its section can move (see _Arc.section).
     shiftable = all(
         isinstance(e, Mapping) and e.get("signal") in ("harmonic", "harmonics")
         for e in data.get("excitation", ()) or ()
     )
-
-    def run_at(p: float, fraction: float | None = None) -> Runner:
-        try:
-            changed = with_parameter(data, parameter, p)
-            return runner(_shifted(changed, section[0] if fraction is None else fraction), base_dir)
-        except InvalidInputError as err:
-            raise AnalysisError(f"{parameter} = {p:g}: {err}") from None
-
-    first_run = run_at(start_value)
+    arc = _Arc(data, parameter, periods, tolerance, base_dir, span, shiftable=shiftable)
+    first_run = arc.run_at(start_value)
     first = orbit(first_run, periods=periods, tolerance=tolerance)
     if not first.converged:
         raise AnalysisError(
@@ -176,24 +167,60 @@ def continue_orbit(
         1e-12,
     )
     scale = np.concatenate([np.full(dim, x_scale), np.full(dim, v_scale), [abs(span)]])
+    arc.size, arc.scale = size, scale
+    points, stopped = arc.trace(
+        first.state, start_value, first_run.period, ds, stop, max_points, progress
+    )
+    return Branch(parameter, periods, points, stopped, first_run.n, first_run.k)
 
-    def residual(u: np.ndarray) -> np.ndarray:
-        z = u[:size] * scale[:size]
-        p = float(u[size] * scale[size])
-        out: np.ndarray = (run_at(p).map(z, periods) - z) / scale[:size]
+
+@dataclass(eq=False)
+class _Arc:
+    """One continuation: the scenario, its parameter and the orbits' periods; the
+    unknowns' scale ``u = (z, p) / scale`` (its length ``size`` that of a state, then
+    the parameter's), which grows with the orbit; and the stroboscopic ``section``."""
+
+    data: Mapping[str, Any]
+    parameter: str
+    periods: int
+    tolerance: float
+    base_dir: Path | None
+    span: float
+    #: The stroboscopic section, as a fraction of the forcing period after t = 0: moved
+    #: away from the impacts when one comes near it, where the map jumps (an impact
+    #: just before the section or just after it), so that the branch stays smooth
+    #: (:meth:`clear_of_impacts`; where ``shiftable``, the forcing being harmonic).
+    section: float = 0.0
+    shiftable: bool = False
+    size: int = 0
+    scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def run_at(self, p: float, fraction: float | None = None) -> Runner:
+        try:
+            changed = with_parameter(self.data, self.parameter, p)
+            return runner(
+                _shifted(changed, self.section if fraction is None else fraction), self.base_dir
+            )
+        except InvalidInputError as err:
+            raise AnalysisError(f"{self.parameter} = {p:g}: {err}") from None
+
+    def residual(self, u: np.ndarray) -> np.ndarray:
+        z = u[: self.size] * self.scale[: self.size]
+        p = float(u[self.size] * self.scale[self.size])
+        out: np.ndarray = (self.run_at(p).map(z, self.periods) - z) / self.scale[: self.size]
         return out
 
-    def jacobian(u: np.ndarray, centre: np.ndarray | None = None) -> np.ndarray:
+    def jacobian(self, u: np.ndarray, centre: np.ndarray | None = None) -> np.ndarray:
         # ``centre``: the residual at ``u``, where the caller has it. Central
         # differences; where the forward and backward ones disagree beyond the map's
         # curvature, the step straddles a grazing (one side touches a wall the orbit
         # misses): that column again with steps a hundred times shorter, the most
         # consistent kept (as the core's shooting does).
-        jac = np.zeros((size, size + 1))
+        jac = np.zeros((self.size, self.size + 1))
         if centre is None:
-            centre = residual(u)
-        for j in range(size + 1):
-            h = 1e-6 * max(abs(u[j]), 1e-3 if j == size else 1.0)
+            centre = self.residual(u)
+        for j in range(self.size + 1):
+            h = 1e-6 * max(abs(u[j]), 1e-3 if j == self.size else 1.0)
             best: tuple[float, np.ndarray] | None = None
             for _ in range(3):
                 sides: list[np.ndarray | None] = []
@@ -201,7 +228,7 @@ def continue_orbit(
                     moved = u.copy()
                     moved[j] += sign * h
                     try:
-                        sides.append(residual(moved))
+                        sides.append(self.residual(moved))
                     except InvalidInputError:
                         # That side starts inside a wall: one-sided from the other.
                         sides.append(None)
@@ -225,31 +252,35 @@ def continue_orbit(
             jac[:, j] = best[1]
         return jac
 
-    def tangent(jac: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+    def tangent(self, jac: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
         t: np.ndarray = np.asarray(np.linalg.svd(jac)[2][-1])
         if previous is None:
-            return t if t[size] * span > 0 else -t
+            return t if t[self.size] * self.span > 0 else -t
         return t if float(np.dot(t, previous)) > 0 else -t
 
-    def multipliers_of(jac: np.ndarray) -> np.ndarray:
+    def multipliers_of(self, jac: np.ndarray) -> np.ndarray:
         """The Floquet multipliers from the scaled Jacobian ``jac`` of the residual: the
         monodromy D P = S (J_z + I) S^-1."""
-        monodromy = (jac[:, :size] + np.eye(size)) * scale[:size, None] / scale[None, :size]
+        monodromy = (
+            (jac[:, : self.size] + np.eye(self.size))
+            * self.scale[: self.size, None]
+            / self.scale[None, : self.size]
+        )
         return np.asarray(np.linalg.eigvals(monodromy))
 
-    def point(u: np.ndarray, jac: np.ndarray) -> BranchPoint:
-        p = float(u[size] * scale[size])
-        z = u[:size] * scale[:size]
-        multipliers = multipliers_of(jac)
-        run = run_at(p)
-        recorded = run.periods(z, periods, record=True)
+    def point(self, u: np.ndarray, jac: np.ndarray) -> BranchPoint:
+        p = float(u[self.size] * self.scale[self.size])
+        z = u[: self.size] * self.scale[: self.size]
+        multipliers = self.multipliers_of(jac)
+        run = self.run_at(p)
+        recorded = run.periods(z, self.periods, record=True)
         kinds = recorded["contacts"]["kind"]
-        impacts = sum(1 for kind in kinds if kind in ("impact", "compliant")) / periods
+        impacts = sum(1 for kind in kinds if kind in ("impact", "compliant")) / self.periods
         # The state at t = 0: the rest of the period from the section.
         at_zero = z
-        if section[0]:
+        if self.section:
             at_zero = np.asarray(
-                run._run(z, (1.0 - section[0]) * run.period, record=False, strobe=False)[
+                run._run(z, (1.0 - self.section) * run.period, record=False, strobe=False)[
                     "final_state"
                 ],
                 dtype=float,
@@ -263,18 +294,18 @@ def continue_orbit(
             amplitude=run.amplitudes(recorded)[0],
         )
 
-    def clear_of_impacts(u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def clear_of_impacts(self, u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``u`` and ``t`` on a section moved away from the impacts, if one is near."""
-        if not shiftable:
+        if not self.shiftable:
             return u, t
-        p = float(u[size] * scale[size])
-        z = u[:size] * scale[:size]
-        run = run_at(p)
-        raw = run.periods(z, periods)
+        p = float(u[self.size] * self.scale[self.size])
+        z = u[: self.size] * self.scale[: self.size]
+        run = self.run_at(p)
+        raw = run.periods(z, self.periods)
         onsets = np.asarray(raw["contacts"]["onset"], dtype=float)
         if onsets.size == 0:
             return u, t
-        span_t = periods * run.period
+        span_t = self.periods * run.period
         phases = np.sort(np.mod(onsets / span_t, 1.0))
         near = min(float(phases[0]), float(1.0 - phases[-1]))
         if near > 0.02:
@@ -285,22 +316,22 @@ def continue_orbit(
         moved = np.asarray(
             run._run(z, move * span_t, record=False, strobe=False)["final_state"], dtype=float
         )
-        section[0] = (section[0] + move * periods) % 1.0
-        u = np.concatenate([moved / scale[:size], [u[size]]])
-        new_t = tangent(jacobian(u), None)
-        return u, (new_t if new_t[size] * t[size] > 0 else -new_t)
+        self.section = (self.section + move * self.periods) % 1.0
+        u = np.concatenate([moved / self.scale[: self.size], [u[self.size]]])
+        new_t = self.tangent(self.jacobian(u), None)
+        return u, (new_t if new_t[self.size] * t[self.size] > 0 else -new_t)
 
-    def correct(predicted: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    def correct(self, predicted: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """The orbit on the plane through ``predicted`` normal to ``t`` (Newton) and its
         residual, or None where the corrector fails."""
         trial = predicted.copy()
         try:
             for _ in range(8):
-                f = residual(trial)
+                f = self.residual(trial)
                 arc = float(np.dot(t, trial - predicted))
-                if max(float(np.max(np.abs(f))), abs(arc)) <= tolerance:
+                if max(float(np.max(np.abs(f))), abs(arc)) <= self.tolerance:
                     return trial, f
-                jt = jacobian(trial, f)
+                jt = self.jacobian(trial, f)
                 system = np.vstack([jt, t[None, :]])
                 trial = trial - np.linalg.solve(system, np.concatenate([f, [arc]]))
         except (InvalidInputError, np.linalg.LinAlgError):
@@ -310,6 +341,7 @@ def continue_orbit(
         return None
 
     def locate(
+        self,
         measure: Callable[[np.ndarray], float],
         u: np.ndarray,
         t: np.ndarray,
@@ -328,173 +360,105 @@ def continue_orbit(
         (below, low), (above, high) = ((p.value, p.floquet_multipliers) for p in ends)
         while hi - lo > 1e-3:
             mid = 0.5 * (lo + hi)
-            found = correct(u + mid * h * t, t)
+            found = self.correct(u + mid * h * t, t)
             if found is None:
                 return None
-            multipliers = multipliers_of(jacobian(*found))
-            value = float(found[0][size] * scale[size])
+            multipliers = self.multipliers_of(self.jacobian(*found))
+            value = float(found[0][self.size] * self.scale[self.size])
             if (measure(multipliers) > 0) == (first > 0):
                 lo, below, low = mid, value, multipliers
             else:
                 hi, above, high = mid, value, multipliers
         return 0.5 * (below + above), (high if last > 0 else low)
 
-    u = np.concatenate([first.state, [start_value]]) / scale
-    jac = jacobian(u)
-    t = tangent(jac, None)
-    points = [point(u, jac)]
-    u, t = clear_of_impacts(u, t)
-    h = ds / abs(span)
-    stopped = "max_points"
-    while len(points) < max_points:
-        if progress is not None:
-            progress(len(points), max_points)
-        solved: tuple[np.ndarray, np.ndarray] | None = None
-        while h >= 1e-6:
-            solved = correct(u + h * t, t)
-            if solved is not None:
+    def trace(
+        self,
+        state: np.ndarray,
+        start_value: float,
+        period: float,
+        ds: float,
+        stop: float,
+        max_points: int,
+        progress: Callable[[int, int], None] | None,
+    ) -> tuple[list[BranchPoint], str]:
+        """The branch from the orbit ``state`` at ``start_value`` towards ``stop`` (the
+        first forcing ``period``, s), steps of about ``ds``: its points and why it
+        stopped."""
+        dim = self.size // 2
+        u = np.concatenate([state, [start_value]]) / self.scale
+        jac = self.jacobian(u)
+        t = self.tangent(jac, None)
+        points = [self.point(u, jac)]
+        u, t = self.clear_of_impacts(u, t)
+        h = ds / abs(self.span)
+        stopped = "max_points"
+        while len(points) < max_points:
+            if progress is not None:
+                progress(len(points), max_points)
+            solved: tuple[np.ndarray, np.ndarray] | None = None
+            while h >= 1e-6:
+                solved = self.correct(u + h * t, t)
+                if solved is not None:
+                    break
+                h *= 0.5
+            if solved is None:
+                stopped = "corrector failed (the branch may end, or turn too sharply)"
                 break
-            h *= 0.5
-        if solved is None:
-            stopped = "corrector failed (the branch may end, or turn too sharply)"
-            break
-        corrected = solved[0]
-        jac = jacobian(*solved)
-        new_t = tangent(jac, t)
-        candidate = point(corrected, jac)
-        # A step that lands on another number of impacts, or turns the tangent
-        # sharply, may have jumped past a fold onto another branch: shorter steps
-        # first, down to a thousandth of the asked one (where a grazing is then
-        # approached, and taken, from its own side).
-        turned = float(np.dot(t, new_t)) < 0.9
-        changed = candidate.impacts_per_period != points[-1].impacts_per_period
-        if (turned or changed) and h > 1e-3 * ds / abs(span):
-            h *= 0.5
-            continue
-        # The arc between the points: their chord (the step h is only its projection
-        # on the tangent, up to a fifth shorter at a fold).
-        chord = float(np.linalg.norm(corrected - u)) * scale[size]
-        flags, crossings = _flags(points[-1], candidate, t, new_t, size, chord)
-        ends = (points[-1], candidate)
-        if candidate.stable != points[-1].stable and "grazing" not in flags:
-            # The stability changes: where the first multiplier crosses the circle,
-            # and which kind it is there (two crossings of one class-based reading
-            # may be one: a complex pair leaving the circle, then meeting on the real
-            # axis outside it, reads as a real one crossing +1).
-            found = locate(lambda m: float(np.max(np.abs(m))) - 1.0, u, t, h, ends)
-            if found is not None:
-                name = _kind(found[1], "fold" in flags)
-                flags = [f for f in flags if f not in _CLASSES and f != name] + [name]
-                crossings = {k: v for k, v in crossings.items() if k in flags}
-                crossings[name] = found[0]
-        else:
-            for name in [f for f in flags if f in _CLASSES]:
-                found = locate(functools.partial(_largest, name=name), u, t, h, ends)
+            corrected = solved[0]
+            jac = self.jacobian(*solved)
+            new_t = self.tangent(jac, t)
+            candidate = self.point(corrected, jac)
+            # A step that lands on another number of impacts, or turns the tangent
+            # sharply, may have jumped past a fold onto another branch: shorter steps
+            # first, down to a thousandth of the asked one (where a grazing is then
+            # approached, and taken, from its own side).
+            turned = float(np.dot(t, new_t)) < 0.9
+            changed = candidate.impacts_per_period != points[-1].impacts_per_period
+            if (turned or changed) and h > 1e-3 * ds / abs(self.span):
+                h *= 0.5
+                continue
+            # The arc between the points: their chord (the step h is only its projection
+            # on the tangent, up to a fifth shorter at a fold).
+            chord = float(np.linalg.norm(corrected - u)) * self.scale[self.size]
+            flags, crossings = _flags(points[-1], candidate, t, new_t, self.size, chord)
+            ends = (points[-1], candidate)
+            if candidate.stable != points[-1].stable and "grazing" not in flags:
+                # The stability changes: where the first multiplier crosses the circle,
+                # and which kind it is there (two crossings of one class-based reading
+                # may be one: a complex pair leaving the circle, then meeting on the real
+                # axis outside it, reads as a real one crossing +1).
+                found = self.locate(lambda m: float(np.max(np.abs(m))) - 1.0, u, t, h, ends)
                 if found is not None:
+                    name = _kind(found[1], "fold" in flags)
+                    flags = [f for f in flags if f not in _CLASSES and f != name] + [name]
+                    crossings = {k: v for k, v in crossings.items() if k in flags}
                     crossings[name] = found[0]
-        candidate.flags, candidate.crossings = flags, crossings
-        points.append(candidate)
-        # An orbit grown well beyond the scale (towards a resonance) rescales the
-        # unknowns: measured in the start's small amplitude, the arclength would be
-        # all state and the parameter would crawl.
-        grown = float(np.max(candidate.amplitude, initial=0.0))
-        if grown > 2 * scale[0]:
-            old = scale.copy()
-            scale[:dim] = grown
-            scale[dim:size] = np.maximum(scale[dim:size], 2 * math.pi / first_run.period * grown)
-            corrected = corrected * old / scale
-            new_t = new_t * old / scale
-            new_t /= np.linalg.norm(new_t)
-        u, t = clear_of_impacts(corrected, new_t)
-        h = min(h * 1.5, 4 * ds / abs(span))
-        if (candidate.value - stop) * span >= 0:
-            stopped = "reached stop"
-            break
-    return Branch(parameter, periods, points, stopped, first_run.n, first_run.k)
-
-
-def _fold(p0: float, p1: float, m0: float, m1: float) -> float:
-    """Where the parameter turns between two points of a branch: the extremum of its
-    cubic Hermite interpolant along the arc (values ``p0``, ``p1``, rates along the arc
-    times its length ``m0``, ``m1`` of opposite signs). Beyond both points, on the side
-    they turn from, as a fold is (a linear interpolation stays between them)."""
-    a = 6.0 * (p0 - p1) + 3.0 * (m0 + m1)
-    b = 6.0 * (p1 - p0) - 4.0 * m0 - 2.0 * m1
-    # The slope a theta^2 + b theta + m0 goes from m0 to m1, of opposite signs: its one
-    # root in [0, 1] by bisection (no choice between two roots to get wrong).
-    lo, hi = 0.0, 1.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if (a * mid * mid + b * mid + m0) * m0 > 0:
-            lo = mid
-        else:
-            hi = mid
-    theta = 0.5 * (lo + hi)
-    h00, h10 = 2 * theta**3 - 3 * theta**2 + 1, theta**3 - 2 * theta**2 + theta
-    h01, h11 = -2 * theta**3 + 3 * theta**2, theta**3 - theta**2
-    return h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
-
-
-# Below this imaginary part a multiplier is real.
-_REAL = 1e-6
-#: The multipliers whose crossing of the unit circle each flag reports.
-_CLASSES: dict[str, Callable[[complex], bool]] = {
-    "flip": lambda m: abs(m.imag) <= _REAL and m.real < 0,
-    "neimark-sacker": lambda m: abs(m.imag) > _REAL,
-    "branch": lambda m: abs(m.imag) <= _REAL and m.real > 0,
-}
-
-
-def _largest(multipliers: np.ndarray, name: str) -> float:
-    """The largest modulus of the multipliers of class ``name``, less 1 (-1 for none)."""
-    chosen = [abs(m) for m in multipliers if _CLASSES[name](m)]
-    return max(chosen) - 1.0 if chosen else -1.0
-
-
-def _kind(outside: np.ndarray, fold: bool) -> str:
-    """The bifurcation of the multiplier that has just left the unit circle (the
-    largest of ``outside``): a flip (real, negative), a Neimark-Sacker (complex) or, real
-    and positive, a fold where the parameter turns and a branch point otherwise."""
-    m = complex(outside[int(np.argmax(np.abs(outside)))])
-    if abs(m.imag) > _REAL:
-        return "neimark-sacker"
-    if m.real < 0:
-        return "flip"
-    return "fold" if fold else "branch"
-
-
-def _flags(
-    before: BranchPoint,
-    after: BranchPoint,
-    t0: np.ndarray,
-    t1: np.ndarray,
-    size: int,
-    arc: float,
-) -> tuple[list[str], dict[str, float]]:
-    """The bifurcations between ``before`` and ``after``, whose unit tangents are
-    ``t0`` and ``t1`` (in the scaled coordinates; the parameter's component at ``size``)
-    and which lie ``arc`` apart along the branch (their scaled chord times the
-    parameter's scale: the rates ``t[size] * arc`` are then in the parameter's unit)."""
-    if before.impacts_per_period != after.impacts_per_period:
-        # A grazing: the two orbits lie on two smooth branches, whose tangents and
-        # multipliers say nothing of each other (the multipliers jump there), so no
-        # fold, flip or other crossing is read between them.
-        return ["grazing"], {}
-    flags: list[str] = []
-    crossings: dict[str, float] = {}
-    if t0[size] * t1[size] < 0:
-        flags.append("fold")
-        # The parameter's rate along the branch is zero there.
-        crossings["fold"] = _fold(before.value, after.value, t0[size] * arc, t1[size] * arc)
-    for name in _CLASSES:
-        if name == "branch" and "fold" in flags:
-            continue
-        a = _largest(before.floquet_multipliers, name)
-        b = _largest(after.floquet_multipliers, name)
-        if (a > 0) != (b > 0):
-            flags.append(name)
-            crossings[name] = before.value + (after.value - before.value) * a / (a - b)
-    return flags, crossings
+            else:
+                for name in [f for f in flags if f in _CLASSES]:
+                    found = self.locate(functools.partial(_largest, name=name), u, t, h, ends)
+                    if found is not None:
+                        crossings[name] = found[0]
+            candidate.flags, candidate.crossings = flags, crossings
+            points.append(candidate)
+            # An orbit grown well beyond the scale (towards a resonance) rescales the
+            # unknowns: measured in the start's small amplitude, the arclength would be
+            # all state and the parameter would crawl.
+            grown = float(np.max(candidate.amplitude, initial=0.0))
+            if grown > 2 * self.scale[0]:
+                old = self.scale.copy()
+                self.scale[:dim] = grown
+                self.scale[dim : self.size] = np.maximum(
+                    self.scale[dim : self.size], 2 * math.pi / period * grown
+                )
+                corrected = corrected * old / self.scale
+                new_t = new_t * old / self.scale
+                new_t /= np.linalg.norm(new_t)
+            u, t = self.clear_of_impacts(corrected, new_t)
+            h = min(h * 1.5, 4 * ds / abs(self.span))
+            if (candidate.value - stop) * self.span >= 0:
+                stopped = "reached stop"
+                break
+        return points, stopped
 
 
 def _shifted(data: dict[str, Any], fraction: float) -> dict[str, Any]:
