@@ -17,6 +17,7 @@ from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
 from vibroimpact.analysis.runs import Runner
 from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
 from vibroimpact.analysis.sweeps import SweepPoint, shown_amplitudes, shown_label, shown_values
+from vibroimpact.analysis.units import parameter_units
 from vibroimpact.output import written_whole
 from vibroimpact.system import SystemSolution, split_observed
 
@@ -69,10 +70,6 @@ def _unit(parameter: str, data: Any = None) -> str:
     """`` (unit)`` of a scenario parameter for an axis label, as the datasets give it
     (resolved with the scenario's sections ``data`` where it depends on them: an
     amplitude is N for a force, m s-2 for a base acceleration); empty where unknown."""
-    # Imported here: the datasets bring xarray, which the command line loads only
-    # when it writes one.
-    from vibroimpact.analysis.datasets import parameter_units
-
     units = parameter_units(parameter, data)
     return f" ({units})" if units else ""
 

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import __version__
+from vibroimpact.analysis.units import parameter_units
 from vibroimpact.study.axes import _is_seed
 from vibroimpact.study.grid import Study, _plain
 from vibroimpact.study.settings import PER_COORDINATE, base_metrics
@@ -117,8 +118,6 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
             data_vars[name] = ([*dims, "pair"], values.reshape(*shape, len(pairs)), attrs)
         else:
             data_vars[name] = (dims, values.reshape(shape), attrs)
-    from vibroimpact.analysis.datasets import parameter_units
-
     coords: dict[str, Any] = {}
     for path, values in study.settings["axes"].items():
         axis_unit = parameter_units(path, study.data)
