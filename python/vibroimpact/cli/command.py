@@ -28,7 +28,8 @@ from vibroimpact._core import (
     Solution,
     __version__,
 )
-from vibroimpact.cli.analysis_commands import COMMANDS, add_commands
+from vibroimpact.cli.analysis_commands import COMMANDS
+from vibroimpact.cli.analysis_parsers import add_commands
 from vibroimpact.cli.study_commands import add_command as add_study
 from vibroimpact.cli.study_commands import run_study_command
 from vibroimpact.messages import short_numbers
