@@ -59,8 +59,11 @@ impl OnsetBalance {
 
     /// The contact `record` just closed at state `y`: an error if the residual
     /// grew across it by more than the creation limit (`CONTACT_CREATION_LIMIT`,
-    /// or `energy_tolerance` where smaller) of the energy in play (the run's
-    /// largest so far, `energy_scale`, or now's).
+    /// or `energy_tolerance` where smaller; `energy_tolerance` alone for a
+    /// method that `creates` energy at contacts by construction, see
+    /// [`crate::methods::steppers::SystemStepper::creates_contact_energy`])
+    /// of the energy in play (the run's largest so far, `energy_scale`, or
+    /// now's). Else the stored energy's change across the contact, J.
     #[allow(clippy::too_many_arguments)]
     #[cold]
     #[inline(never)]
@@ -71,15 +74,19 @@ impl OnsetBalance {
         modes: &[Mode],
         (stored_start, impact): (f64, f64),
         energy_scale: f64,
-        energy_tolerance: f64,
+        (energy_tolerance, creates): (f64, bool),
         record: &PairContact,
-    ) -> Result<()> {
+    ) -> Result<f64> {
         let (stored, residual, in_play) = sample(system, y, modes, stored_start, impact);
         let created = residual - self.residual;
         let scale = energy_scale.max(in_play);
-        let limit = energy_tolerance.min(CONTACT_CREATION_LIMIT);
+        let limit = if creates {
+            energy_tolerance
+        } else {
+            energy_tolerance.min(CONTACT_CREATION_LIMIT)
+        };
+        let change = stored - self.stored;
         if created > limit * scale {
-            let change = stored - self.stored;
             return Err(Error::ContactEnergy {
                 onset: record.onset,
                 separation: record.separation,
@@ -94,6 +101,6 @@ impl OnsetBalance {
                 created: limit < energy_tolerance,
             });
         }
-        Ok(())
+        Ok(change)
     }
 }

@@ -87,6 +87,8 @@ impl Run<'_> {
                     dissipated: self.y[loss_slot(system, i)],
                     resting,
                     balance: OnsetBalance::default(),
+                    energy: f64::NAN,
+                    power: 0.0,
                 });
             }
             Mode::Compliant { .. } => {
@@ -214,15 +216,18 @@ impl Run<'_> {
                 );
             }
             (Mode::Compliant { .. }, Mode::Open, None, Some(onset), Some(record)) => {
-                onset.check_separation(
+                let change = onset.check_separation(
                     system,
                     &self.y,
                     &self.modes,
                     (energy.stored_start, energy.impact_loss),
                     energy.scale,
-                    energy.tolerance,
+                    (energy.tolerance, self.creates_contact_energy),
                     record,
                 )?;
+                if let Some(record) = self.contacts.last_mut() {
+                    record.energy_change = change;
+                }
             }
             _ => {}
         }

@@ -49,6 +49,29 @@ pub struct RunOptions {
     pub reduce: ReduceOptions,
 }
 
+/// How a run steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stepping {
+    /// Steps cut at every event, located on the method's own solution.
+    #[default]
+    Events,
+    /// Steps of `dt` not cut at contacts (0.1's and the founding paper's),
+    /// for fixed-step methods and compliant laws only: see
+    /// [`crate::kernel::fixed`].
+    Fixed { contact_timing: ContactTiming },
+}
+
+/// How a fixed-step run times a contact's onset and separation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactTiming {
+    /// Where the cubic Hermite interpolant of the indentation crosses zero
+    /// within the step.
+    #[default]
+    Located,
+    /// In whole steps, as the founding paper counted them.
+    StepCount,
+}
+
 /// What kind of contact a record is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactKind {
@@ -92,6 +115,14 @@ pub struct PairContact {
     pub restitution: f64,
     /// Energy taken by the contact's dissipative forces or by the impacts, J.
     pub energy_dissipated: f64,
+    /// Net change of the whole system's stored mechanical energy (kinetic,
+    /// elastic, gravity's and the contacts' elastic energy) over the contact,
+    /// at separation minus at onset, J: `-energy_dissipated` for a contact
+    /// with no other damper or force acting (to the method's accuracy); with
+    /// them it also holds their work during the contact. An impact's is its
+    /// kinetic energy lost, negated; NaN for a contact still open at the end
+    /// and for a sticking pair's record.
+    pub energy_change: f64,
 }
 
 /// What a run returns.
@@ -111,6 +142,13 @@ pub struct SystemSolution {
     pub rhs_evaluations: u64,
     pub grazing_contacts: u64,
     pub reductions: Reductions,
+    /// Indices into [`Assembly::pairs`] of the pairs with a compliant wall,
+    /// in order: the columns of `contact_forces`.
+    pub contact_force_pairs: Vec<usize>,
+    /// At each kept row, the force of each pair of `contact_force_pairs`
+    /// (its law's and its contact damper's, N, > 0 pushing it apart; 0
+    /// apart), row after row.
+    pub contact_forces: Vec<f64>,
 }
 
 /// A contact being followed.
@@ -126,6 +164,10 @@ pub(crate) struct Open {
     pub(crate) resting: bool,
     /// The run's balance at a compliant onset (see [`OnsetBalance`]).
     pub(crate) balance: OnsetBalance,
+    /// Fixed stepping: the stored energy at the onset (J) and the power of
+    /// the contact's dissipative forces at the last step's end (W).
+    pub(crate) energy: f64,
+    pub(crate) power: f64,
 }
 
 impl Open {
@@ -171,6 +213,7 @@ impl Open {
             rebound_speed: rebound,
             restitution,
             energy_dissipated: dissipated,
+            energy_change: f64::NAN,
         }
     }
 }
@@ -205,7 +248,41 @@ pub fn integrate_system_within<S: SystemStepper>(
     interrupt: &mut dyn FnMut() -> bool,
     record_limit: u64,
 ) -> Result<SystemSolution> {
-    let mut run = Run::new(system, stepper, initial, options, record_limit)?;
+    let stepping = Stepping::Events;
+    integrate_system_stepped(
+        system,
+        stepper,
+        initial,
+        options,
+        stepping,
+        interrupt,
+        record_limit,
+    )
+}
+
+/// [`integrate_system_within`] stepping as `stepping` says: cut at events,
+/// or in fixed steps (see [`crate::kernel::fixed`]; a rigid pair or an
+/// adaptive or exact method is then refused, naming `stepping`).
+pub fn integrate_system_stepped<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    initial: &[f64],
+    options: &RunOptions,
+    stepping: Stepping,
+    interrupt: &mut dyn FnMut() -> bool,
+    record_limit: u64,
+) -> Result<SystemSolution> {
+    let mut run = Run::new(system, stepper, initial, options, stepping, record_limit)?;
+    if run.timing.is_some() {
+        while run.clock.time < options.t_end {
+            let stop = run.fixed_step(stepper)?;
+            if stop == Stop::End {
+                break;
+            }
+            run.after_step(stop, interrupt)?;
+        }
+        return Ok(run.finish(stepper));
+    }
     while run.clock.time < options.t_end {
         // Plain steps in a row, where the stepper takes them at once (each
         // as the kernel's step would, to the bit); the step after them is

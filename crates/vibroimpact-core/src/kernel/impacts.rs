@@ -406,6 +406,7 @@ impl Impacts {
                                 after / approach
                             },
                             energy_dissipated: (1.0 - kept) * loss,
+                            energy_change: -(1.0 - kept) * loss,
                         });
                     }
                     if let Some((delay, rebound)) = stuck {
@@ -417,6 +418,8 @@ impl Impacts {
                             dissipated: kept * loss,
                             resting: false,
                             balance: Default::default(),
+                            energy: f64::NAN,
+                            power: 0.0,
                         });
                     }
                 }
@@ -433,6 +436,8 @@ impl Impacts {
                         dissipated: loss,
                         resting: false,
                         balance: Default::default(),
+                        energy: f64::NAN,
+                        power: 0.0,
                     });
                 }
                 (Role::Touch, _) => {

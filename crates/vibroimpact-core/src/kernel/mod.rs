@@ -4,6 +4,7 @@ pub(crate) mod compact;
 pub(crate) mod contact_balance;
 pub(crate) mod contacts;
 pub mod events;
+pub mod fixed;
 pub(crate) mod impacts;
 pub(crate) mod locate;
 pub mod memory;

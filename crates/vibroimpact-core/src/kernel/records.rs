@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::kernel::balance::balance;
 use crate::kernel::clock::{Stop, STALLED_STEPS};
 use crate::kernel::events::SystemSolution;
+use crate::kernel::fixed;
 use crate::kernel::memory::{self, NoRoom};
 use crate::kernel::run::Run;
 use crate::methods::steppers::SystemStepper;
@@ -51,7 +52,42 @@ impl Run<'_> {
             || memory::held(strobe) + memory::held(strobe_time) + memory::held(contacts),
             self.record_limit,
         )
-        .map_err(|cause| self.no_room(cause, time))
+        .map_err(|cause| self.no_room(cause, time))?;
+        self.push_contact_forces(time)
+    }
+
+    /// The force of each pair with a compliant wall at the state now, a
+    /// row of the history's contact-force column.
+    fn push_contact_forces(&mut self, time: f64) -> Result<()> {
+        let (system, pairs) = (self.system, self.force_pairs.len());
+        if pairs == 0 {
+            return Ok(());
+        }
+        let (rows, states) = (&self.time_rows, &self.states);
+        let (strobe, contacts) = (&self.reductions.strobe, &self.contacts);
+        let held = || {
+            memory::held(rows)
+                + memory::held(states)
+                + memory::held(strobe)
+                + memory::held(contacts)
+        };
+        memory::make_room(
+            &mut self.contact_forces,
+            pairs,
+            pairs,
+            held,
+            self.record_limit,
+        )
+        .map_err(|cause| self.no_room(cause, time))?;
+        let at = self.contact_forces.len();
+        self.contact_forces.resize(at + pairs, 0.0);
+        for (i, it) in system.interactions.iter().enumerate() {
+            if let Some(column) = self.force_pairs.iter().position(|&p| p == it.pair) {
+                let force = fixed::contact_force(system, i, &self.y, self.modes[i]);
+                self.contact_forces[at + column] += force;
+            }
+        }
+        Ok(())
     }
 
     /// The records after a kept step (a stroboscopic state, a history row,
@@ -188,6 +224,8 @@ impl Run<'_> {
             rhs_evaluations: stepper.evaluations(),
             grazing_contacts: self.grazes,
             reductions: self.reductions,
+            contact_force_pairs: self.force_pairs,
+            contact_forces: self.contact_forces,
         }
     }
 }

@@ -8,7 +8,8 @@ use crate::kernel::balance::{EnergySampler, EnergyWatch, ENERGY_INTERVAL};
 use crate::kernel::clock::{Clock, Schedule, Stop};
 use crate::kernel::compact::Stretch;
 use crate::kernel::contact_balance::OnsetBalance;
-use crate::kernel::events::{ContactKind, Open, PairContact, RunOptions};
+use crate::kernel::events::{ContactKind, ContactTiming, Open, PairContact, RunOptions, Stepping};
+use crate::kernel::fixed::{self, Change};
 use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{
     any_compliant, event_value, find_crossing, locate, may_cross, past, wall_round_off, Buffers,
@@ -99,6 +100,41 @@ pub(super) struct Run<'a> {
     pub(super) poll_every: u64,
     pub(super) timed_polls: bool,
     pub(super) last_poll: std::time::Instant,
+    /// Fixed stepping's timing of contacts (None: stepping by events).
+    pub(super) timing: Option<ContactTiming>,
+    /// Whether the method creates energy at contacts by construction (see
+    /// [`SystemStepper::creates_contact_energy`]).
+    pub(super) creates_contact_energy: bool,
+    /// Fixed stepping: each interaction's contact change in the last step,
+    /// and the onset balance of each contact it ended.
+    pub(super) changes: Vec<Option<Change>>,
+    pub(super) closing: Vec<Option<OnsetBalance>>,
+    /// Every compliant interaction in contact: the modes whose stored
+    /// energy counts each indented pair's elastic energy.
+    pub(super) all_compliant: Vec<Mode>,
+    /// The pairs with a compliant wall, and their forces at each kept row.
+    pub(super) force_pairs: Vec<usize>,
+    pub(super) contact_forces: Vec<f64>,
+}
+
+/// Every compliant interaction in contact (see [`Run::all_compliant`]).
+fn all_compliant(system: &Assembly) -> Vec<Mode> {
+    let mode = |it: &crate::model::assembly::Interaction| match it.law {
+        InteractionLaw::Compliant { .. } => Mode::Compliant { approach_rate: 0.0 },
+        InteractionLaw::Rigid { .. } => Mode::Open,
+    };
+    system.interactions.iter().map(mode).collect()
+}
+
+/// The pairs with a compliant wall, in order (the contact-force columns).
+fn force_pairs(system: &Assembly) -> Vec<usize> {
+    let mut pairs: Vec<usize> = Vec::new();
+    for it in &system.interactions {
+        if matches!(it.law, InteractionLaw::Compliant { .. }) && !pairs.contains(&it.pair) {
+            pairs.push(it.pair);
+        }
+    }
+    pairs
 }
 
 impl<'a> Run<'a> {
@@ -108,10 +144,15 @@ impl<'a> Run<'a> {
         stepper: &mut S,
         initial: &[f64],
         options: &'a RunOptions,
+        stepping: Stepping,
         record_limit: u64,
     ) -> Result<Self> {
         let (len, d, count) = (system.state_len(), system.dim, system.interactions.len());
         let adaptive = stepper.is_adaptive();
+        let timing = Self::timing(stepping);
+        if timing.is_some() {
+            fixed::check(system, stepper)?;
+        }
         let t_end = options.t_end;
         let schedule = Schedule::new(options, adaptive, system.longest_period);
         let dt = schedule.dt;
@@ -214,12 +255,22 @@ impl<'a> Run<'a> {
             impacts: Impacts::new(system),
             compliant: false,
             kinked: system.has_breakpoints(),
-            stretches: !adaptive && stepper.takes_stretches(system),
+            stretches: !adaptive && timing.is_none() && stepper.takes_stretches(system),
+            timing,
+            creates_contact_energy: stepper.creates_contact_energy(),
+            changes: vec![None; count],
+            closing: vec![None; count],
+            all_compliant: all_compliant(system),
+            force_pairs: force_pairs(system),
+            contact_forces: Vec::new(),
             poll_every: interrupt_interval(system.dim),
             timed_polls: system.dim > TIMED_POLLS_BEYOND,
             last_poll: std::time::Instant::now(),
         };
         run.resume_contacts();
+        if timing.is_some() {
+            run.resume_fixed();
+        }
         // Open pairs only (a resumed contact is not on its wall).
         for (i, on_wall) in run.on_wall_at_start.iter_mut().enumerate() {
             *on_wall &= run.modes[i] == Mode::Open;
@@ -261,6 +312,8 @@ impl<'a> Run<'a> {
                     dissipated: self.y[loss_slot(system, i)],
                     resting,
                     balance: OnsetBalance::default(),
+                    energy: f64::NAN,
+                    power: 0.0,
                 });
             }
         }
@@ -397,24 +450,8 @@ impl<'a> Run<'a> {
         if self.compliant && self.deepest_indentation(stepper, taken)? {
             kept_attempt = false;
         }
-        if self.schedule.in_window(time, taken) {
-            let located = reduce_step(
-                system,
-                stepper,
-                (time, &self.y, &self.end, taken),
-                &self.modes,
-                &mut self.reduce_scratch,
-                (
-                    &mut self.buffers.probe,
-                    &mut self.buffers.start,
-                    &mut self.buffers.work,
-                ),
-                &mut self.reductions,
-                self.schedule.mean_square,
-            )?;
-            if located {
-                kept_attempt = false;
-            }
+        if self.reduce(stepper, taken)? {
+            kept_attempt = false;
         }
         self.keep(stepper, taken, switched.is_some(), kept_attempt)?;
         Ok(match switched {
@@ -611,6 +648,30 @@ impl<'a> Run<'a> {
         self.clock.accepted += 1;
         self.taken = taken;
         Ok(())
+    }
+
+    /// The step of `taken` s from the state now to `end` added to the
+    /// reductions where it is in the recorded window; whether the stepper
+    /// was used (its last attempt is then not the step).
+    pub(super) fn reduce<S: SystemStepper>(&mut self, stepper: &mut S, taken: f64) -> Result<bool> {
+        let time = self.clock.time;
+        if !self.schedule.in_window(time, taken) {
+            return Ok(false);
+        }
+        reduce_step(
+            self.system,
+            stepper,
+            (time, &self.y, &self.end, taken),
+            &self.modes,
+            &mut self.reduce_scratch,
+            (
+                &mut self.buffers.probe,
+                &mut self.buffers.start,
+                &mut self.buffers.work,
+            ),
+            &mut self.reductions,
+            self.schedule.mean_square,
+        )
     }
 
     /// Plain fixed steps in a row through the stepper's fast path, each as

@@ -242,11 +242,18 @@ pub struct Stretch<'a> {
     pub(crate) unbalanced: Option<Error>,
 }
 
+/// Per wall, whether the event search passes over it and whether it is
+/// locked; whether a sticking pair may release.
+type PassedOver = ([bool; MAX_WALLS], [bool; MAX_WALLS], bool);
+
+/// Each wall's gap and rate.
+type WallGaps = [(f64, f64); MAX_WALLS];
+
 /// The walls the event search passes over in `modes` (the open wall of a
 /// sticking damper), the sticking walls of a damper without clearance
 /// (locked), and whether a sticking pair may release.
 #[inline(always)]
-fn passed_over(system: &Assembly, modes: &[Mode]) -> ([bool; MAX_WALLS], [bool; MAX_WALLS], bool) {
+fn passed_over(system: &Assembly, modes: &[Mode]) -> PassedOver {
     let mut held = [false; MAX_WALLS];
     let mut locked = [false; MAX_WALLS];
     let mut releasable = false;
@@ -265,7 +272,7 @@ fn passed_over(system: &Assembly, modes: &[Mode]) -> ([bool; MAX_WALLS], [bool; 
 fn shows_no_event(
     modes: &[Mode],
     held: &[bool; MAX_WALLS],
-    (start, end): (&[(f64, f64); MAX_WALLS], &[(f64, f64); MAX_WALLS]),
+    (start, end): (&WallGaps, &WallGaps),
     length: f64,
 ) -> bool {
     let mut plain = true;

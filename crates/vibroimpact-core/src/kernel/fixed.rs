@@ -1,0 +1,397 @@
+//! Fixed stepping ([`Stepping::Fixed`]): steps of `dt` not cut at contacts,
+//! as 0.1's two-mass kernel and the founding paper took them, over any
+//! [`Assembly`] whose pairs are all compliant. A contact's force acts where
+//! its pair is indented; the contact state at a step's start holds through
+//! the step (the modes change from the next step on, see
+//! [`SystemStepper::switched_within_step`]), except that a method whose
+//! force is not lagged (RK4, the implicit Newmark family) feels a contact
+//! entered within the step in the stages past the wall, with 0.1's
+//! provisional approach rate (the indentation rate at the step's start).
+//!
+//! Onsets and separations are where the cubic Hermite interpolant of the
+//! indentation crosses zero within the step (`ContactTiming::Located`), or
+//! counted in whole steps (`ContactTiming::StepCount`: the onset is the
+//! step's start when its sample is already touching, else its end; the
+//! separation the end of the step that ends apart). Records as 0.1 kept
+//! them: the approach rate at the located onset (which the contact then
+//! latches), the deepest indentation (with `Located`, the interpolant's peak
+//! inside a step), the contact's dissipation as the trapezoidal sum of its
+//! power over the steps (the onset's and separation's steps in part), and
+//! the energy change over the contact from the stored energies at the steps'
+//! ends, interpolated to the onset and separation.
+
+use crate::error::{Error, Result};
+use crate::kernel::clock::Stop;
+use crate::kernel::contact_balance::OnsetBalance;
+use crate::kernel::events::{ContactKind, ContactTiming, Open, Stepping};
+use crate::kernel::run::Run;
+use crate::methods::steppers::SystemStepper;
+use crate::model::assembly::{Assembly, InteractionLaw, Mode};
+use crate::model::contact::ContactLaw;
+use crate::numerics::hermite;
+
+/// Whether `stepper` may step `system` fixed: a fixed-step method, every
+/// pair compliant.
+pub(super) fn check<S: SystemStepper>(system: &Assembly, stepper: &S) -> Result<()> {
+    if stepper.is_adaptive() || stepper.is_exact() {
+        return Err(Error::Inconsistent(format!(
+            "stepping = \"fixed\" takes a fixed-step method (rk4, newmark, newmark-implicit, \
+             generalized-alpha), not {:?}; use stepping = \"events\"",
+            stepper.name()
+        )));
+    }
+    if let Some(it) = system
+        .interactions
+        .iter()
+        .find(|it| matches!(it.law, InteractionLaw::Rigid { .. }))
+    {
+        return Err(Error::Inconsistent(format!(
+            "stepping = \"fixed\" takes compliant contact laws only (pair {} is rigid): give it a \
+             compliant law (hertz, hyster-hertz, hertz-damped, linear) or use stepping = \"events\"",
+            it.pair
+        )));
+    }
+    Ok(())
+}
+
+/// The power of compliant interaction `i`'s dissipative forces at state `y`
+/// with the approach rate `approach` latched (W; 0 apart): 0.1's
+/// `contact_dissipation`.
+fn dissipation(system: &Assembly, i: usize, y: &[f64], approach: f64) -> f64 {
+    let InteractionLaw::Compliant { law, damping } = system.interactions[i].law else {
+        return 0.0;
+    };
+    let (gap, rate) = system.gap(i, y);
+    let (indentation, rate) = (-gap, -rate);
+    if indentation > 0.0 {
+        let total = law.force(indentation, rate, approach) + damping * rate;
+        (total - law.elastic_force(indentation)) * rate
+    } else {
+        0.0
+    }
+}
+
+/// The force of compliant interaction `i` at state `y` in `mode` (N, > 0
+/// pushing the pair apart; 0 apart): its law's and its contact damper's.
+/// Apart, a law that reads the approach rate is given the indentation rate.
+pub(super) fn contact_force(system: &Assembly, i: usize, y: &[f64], mode: Mode) -> f64 {
+    let InteractionLaw::Compliant { law, damping } = system.interactions[i].law else {
+        return 0.0;
+    };
+    let (gap, rate) = system.gap(i, y);
+    let (indentation, rate) = (-gap, -rate);
+    let approach = match mode {
+        Mode::Compliant { approach_rate } => approach_rate,
+        _ => rate,
+    };
+    if indentation > 0.0 {
+        law.force(indentation, rate, approach) + damping * rate
+    } else {
+        0.0
+    }
+}
+
+/// A quantity at fraction `theta` of a step, between its values at the
+/// step's ends.
+fn within_step(start: f64, end: f64, theta: f64) -> f64 {
+    start + theta * (end - start)
+}
+
+/// A contact change found in a fixed step.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Change {
+    /// Onset, at fraction `theta` of the step, approaching at `rate` m/s.
+    Onset { theta: f64, rate: f64 },
+    /// Separation at fraction `theta`, receding at `-rate` m/s.
+    Separation { theta: f64, rate: f64 },
+}
+
+impl Run<'_> {
+    /// The timing of contacts of a fixed-step run (None: events).
+    pub(super) fn timing(stepping: Stepping) -> Option<ContactTiming> {
+        match stepping {
+            Stepping::Events => None,
+            Stepping::Fixed { contact_timing } => Some(contact_timing),
+        }
+    }
+
+    /// One fixed step of `dt` from the grid point `grid dt`, its contacts
+    /// recorded; why it ended (an event where a contact began or ended).
+    pub(super) fn fixed_step<S: SystemStepper>(&mut self, stepper: &mut S) -> Result<Stop> {
+        let (system, schedule) = (self.system, self.schedule);
+        let time = self.clock.time;
+        if schedule.at_end(time) {
+            return Ok(Stop::End);
+        }
+        let dt = schedule.dt;
+        // Again where a pair entered contact within the step (its force
+        // then acts past the wall), for a method whose force is not lagged.
+        let mut entered = false;
+        loop {
+            stepper.attempt(
+                system,
+                time,
+                &self.y,
+                dt,
+                &self.modes,
+                &mut self.scratch,
+                &mut self.end,
+            )?;
+            system.gaps(&self.end, &mut self.gaps.end);
+            if entered || stepper.creates_contact_energy() || !self.entered_within() {
+                break;
+            }
+            entered = true;
+        }
+        let row = 2 * system.dim;
+        if self.end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) != 0.0 {
+            return Err(Error::NumericalBlowUp {
+                time: time + dt,
+                reason: "the state is no longer finite",
+            });
+        }
+        let kept_attempt = !self.reduce(stepper, dt)?;
+        let first = self.fixed_changes(dt);
+        if kept_attempt {
+            stepper.accept();
+        } else {
+            stepper.reset();
+        }
+        let next = (self.clock.grid + 1) as f64 * dt;
+        let settle = first.is_some()
+            || (self.clock.accepted + 1) % crate::kernel::balance::ENERGY_INTERVAL == 0
+            || schedule.done(next);
+        stepper.finish(
+            system,
+            time,
+            &self.y,
+            dt,
+            &self.modes,
+            &mut self.scratch,
+            &mut self.end,
+            settle,
+        )?;
+        if first.is_some() {
+            self.record_changes(time, dt)?;
+            stepper.switched_within_step();
+        }
+        self.clock.time = next;
+        self.clock.grid += 1;
+        std::mem::swap(&mut self.y, &mut self.end);
+        std::mem::swap(&mut self.gaps.start, &mut self.gaps.end);
+        self.clock.accepted += 1;
+        self.taken = dt;
+        if first.is_some() {
+            self.balance_changes()?;
+        }
+        Ok(match first {
+            Some(interaction) => Stop::Event { interaction },
+            None => Stop::Step,
+        })
+    }
+
+    /// Whether a compliant pair apart at the step's start ends it indented:
+    /// it then enters contact within the step, and is given its force there
+    /// with 0.1's provisional approach rate (the indentation rate at the
+    /// step's start), for the step to be taken again.
+    fn entered_within(&mut self) -> bool {
+        let mut any = false;
+        for i in 0..self.modes.len() {
+            if self.open[i].is_none() && self.gaps.end[i].0 < 0.0 {
+                self.modes[i] = Mode::Compliant {
+                    approach_rate: -self.gaps.start[i].1,
+                };
+                any = true;
+            }
+        }
+        any
+    }
+
+    /// Each compliant pair's contact change in the step `y -> end` of `dt`
+    /// (into `self.changes`), the deepest indentation and the dissipation
+    /// of the contacts that go on; the first pair that changed.
+    fn fixed_changes(&mut self, dt: f64) -> Option<usize> {
+        let system = self.system;
+        let located = self.timing == Some(ContactTiming::Located);
+        let mut first = None;
+        for i in 0..self.modes.len() {
+            let ((g0, r0), (g1, r1)) = (self.gaps.start[i], self.gaps.end[i]);
+            // The indentation and its rate times the step (0.1's data).
+            let (i0, i1, m0, m1) = (-g0, -g1, -r0 * dt, -r1 * dt);
+            self.changes[i] = None;
+            match self.open[i].as_mut() {
+                None if i1 > 0.0 => {
+                    let theta = if i0 <= 0.0 {
+                        hermite::root(i0, i1, m0, m1)
+                    } else {
+                        0.0
+                    };
+                    let rate = hermite::eval(i0, i1, m0, m1, theta).1 / dt;
+                    self.changes[i] = Some(Change::Onset { theta, rate });
+                }
+                None => continue,
+                Some(oc) => {
+                    if located && m0 > 0.0 && m1 <= 0.0 {
+                        let peak = hermite::argmax(i0, i1, m0, m1);
+                        let deepest = hermite::eval(i0, i1, m0, m1, peak).0;
+                        oc.max_indentation = oc.max_indentation.max(deepest);
+                    }
+                    oc.max_indentation = oc.max_indentation.max(i1);
+                    if i1 > 0.0 {
+                        let p0 = oc.power;
+                        let latched = match self.modes[i] {
+                            Mode::Compliant { approach_rate } => approach_rate,
+                            _ => 0.0,
+                        };
+                        oc.power = dissipation(system, i, &self.end, latched);
+                        oc.dissipated += 0.5 * dt * (p0 + oc.power);
+                        continue;
+                    }
+                    let theta = if i0 > 0.0 {
+                        hermite::root(i0, i1, m0, m1)
+                    } else {
+                        0.0
+                    };
+                    let rate = hermite::eval(i0, i1, m0, m1, theta).1 / dt;
+                    self.changes[i] = Some(Change::Separation { theta, rate });
+                }
+            }
+            first = first.or(Some(i));
+        }
+        first
+    }
+
+    /// The contacts begun and ended in the step from `time` of `dt`: their
+    /// records, and the modes from the next step on.
+    fn record_changes(&mut self, time: f64, dt: f64) -> Result<()> {
+        let system = self.system;
+        let located = self.timing == Some(ContactTiming::Located);
+        let t1 = (self.clock.grid + 1) as f64 * dt;
+        let energies = (
+            system.energy(&self.y, &self.all_compliant),
+            system.energy(&self.end, &self.all_compliant),
+        );
+        for i in 0..self.modes.len() {
+            let Some(change) = self.changes[i] else {
+                continue;
+            };
+            let InteractionLaw::Compliant { damping, .. } = system.interactions[i].law else {
+                continue;
+            };
+            match change {
+                Change::Onset { theta, rate } => {
+                    let i0 = -self.gaps.start[i].0;
+                    let onset = if located {
+                        time + theta * dt
+                    } else if i0 >= 0.0 {
+                        time
+                    } else {
+                        t1
+                    };
+                    let power = dissipation(system, i, &self.end, rate);
+                    let p_onset = damping * rate * rate;
+                    self.modes[i] = Mode::Compliant {
+                        approach_rate: rate,
+                    };
+                    self.open[i] = Some(Open {
+                        kind: ContactKind::Compliant,
+                        onset,
+                        approach_speed: rate,
+                        max_indentation: -self.gaps.end[i].0,
+                        dissipated: 0.5 * (1.0 - theta) * dt * (p_onset + power),
+                        resting: false,
+                        balance: OnsetBalance::default(),
+                        energy: within_step(energies.0, energies.1, theta),
+                        power,
+                    });
+                }
+                Change::Separation { theta, rate } => {
+                    let separation = if located { time + theta * dt } else { t1 };
+                    self.modes[i] = Mode::Open;
+                    let Some(oc) = self.open[i].take() else {
+                        continue;
+                    };
+                    let p_separation = damping * rate * rate;
+                    let dissipated = oc.dissipated + 0.5 * theta * dt * (oc.power + p_separation);
+                    let mut record =
+                        oc.close(system.interactions[i].pair, separation, -rate, dissipated);
+                    record.energy_change = within_step(energies.0, energies.1, theta) - oc.energy;
+                    self.closing[i] = Some(oc.balance);
+                    self.contacts.push(record);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The run's balance at the contacts begun in the last step, and each
+    /// ended one's own balance (it must not create energy), at the step's
+    /// end.
+    fn balance_changes(&mut self) -> Result<()> {
+        let system = self.system;
+        let energy = self.energy;
+        let mut closed = 0;
+        for i in 0..self.modes.len() {
+            match self.changes[i] {
+                Some(Change::Onset { .. }) => {
+                    let at = OnsetBalance::at(
+                        system,
+                        &self.y,
+                        &self.modes,
+                        energy.stored_start,
+                        energy.impact_loss,
+                    );
+                    if let Some(oc) = self.open[i].as_mut() {
+                        oc.balance = at;
+                    }
+                }
+                Some(Change::Separation { .. }) => closed += 1,
+                None => {}
+            }
+        }
+        // The records just pushed, in the order of their pairs.
+        let first = self.contacts.len() - closed;
+        let mut k = first;
+        for i in 0..self.modes.len() {
+            let Some(onset) = self.closing[i].take() else {
+                continue;
+            };
+            let record = self.contacts[k];
+            k += 1;
+            onset.check_separation(
+                system,
+                &self.y,
+                &self.modes,
+                (energy.stored_start, energy.impact_loss),
+                energy.scale,
+                (energy.tolerance, self.creates_contact_energy),
+                &record,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// A resumed compliant contact's sums for fixed stepping: its power now
+    /// and the stored energy at the start.
+    pub(super) fn resume_fixed(&mut self) {
+        let system = self.system;
+        let stored = system.energy(&self.y, &self.all_compliant);
+        for (i, record) in self.open.iter_mut().enumerate() {
+            if let Some(oc) = record {
+                // 0.1's latch: the indentation rate at the start.
+                let approach = -system.gap(i, &self.y).1;
+                self.modes[i] = Mode::Compliant {
+                    approach_rate: approach,
+                };
+                oc.approach_speed = approach;
+                oc.power = dissipation(system, i, &self.y, approach);
+                oc.energy = stored;
+                oc.dissipated = 0.0;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "fixed_tests.rs"]
+mod tests;

@@ -1,0 +1,420 @@
+//! Fixed stepping against 0.1's two-mass kernel, a closed form and the
+//! energy balance of a contact.
+
+use crate::kernel::events::{
+    integrate_system_stepped, ContactTiming, PairContact, RunOptions, Stepping, SystemSolution,
+};
+use crate::kernel::memory::MAX_RECORD_BYTES;
+use crate::kernel::reductions::ReduceOptions;
+use crate::legacy::settings::{self, Method, Settings};
+use crate::methods::steppers::{ExplicitRk, SystemStepper};
+use crate::model::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
+use crate::model::closed_forms::linear_contact_duration;
+use crate::model::contact::{Contact, LawKind};
+use crate::model::impact_damper::{ImpactDamper, State};
+use crate::model::structure::Structure;
+
+/// The two-mass impact damper written as a general system: an oscillator
+/// with one damper of equal clearances.
+fn spec(system: &ImpactDamper, contact: &Contact) -> SystemSpec {
+    SystemSpec {
+        structure: Structure::oscillator(system.main_mass, system.stiffness, system.damping)
+            .unwrap(),
+        dampers: vec![Damper {
+            mass: system.impact_mass,
+            at: 0.0,
+            lower_clearance: system.clearance,
+            upper_clearance: system.clearance,
+            law: PairLaw::Compliant(*contact),
+        }],
+        stops: vec![],
+        gravity: 0.0,
+        excitations: vec![],
+        points: vec![],
+        moments: vec![],
+    }
+}
+
+fn options(dt: f64, t_end: f64) -> RunOptions {
+    RunOptions {
+        dt: Some(dt),
+        t_end,
+        every: 1,
+        keep_history: true,
+        max_steps: u64::MAX,
+        max_rows: u64::MAX,
+        energy_tolerance: 1e-2,
+        reduce: ReduceOptions::default(),
+    }
+}
+
+/// The run of `system` from `start` with fixed steps of `dt`.
+fn fixed<S: SystemStepper>(
+    system: &ImpactDamper,
+    contact: &Contact,
+    start: &State,
+    stepper: &mut S,
+    (dt, t_end, timing, tolerance): (f64, f64, ContactTiming, f64),
+) -> crate::Result<SystemSolution> {
+    let assembly = Assembly::new(&spec(system, contact)).unwrap();
+    let y = initial_state(
+        &assembly,
+        &[start.main_displacement],
+        &[start.main_velocity],
+        &[start.impact_displacement],
+        &[start.impact_velocity],
+    )
+    .unwrap();
+    let stepping = Stepping::Fixed {
+        contact_timing: timing,
+    };
+    integrate_system_stepped(
+        &assembly,
+        stepper,
+        &y,
+        &RunOptions {
+            energy_tolerance: tolerance,
+            ..options(dt, t_end)
+        },
+        stepping,
+        &mut || false,
+        MAX_RECORD_BYTES,
+    )
+}
+
+fn rk4(system: &ImpactDamper) -> ExplicitRk {
+    ExplicitRk::rk4(Assembly::new(&spec(system, &hertz())).unwrap().state_len())
+}
+
+fn hertz() -> Contact {
+    Contact::new(LawKind::Hertz, 1e9, None, 0.0).unwrap()
+}
+
+/// The largest difference between two numbers relative to `scale`.
+fn off(a: f64, b: f64, scale: f64) -> f64 {
+    if a.is_nan() && b.is_nan() {
+        0.0
+    } else {
+        (a - b).abs() / scale
+    }
+}
+
+#[test]
+fn fixed_rk4_is_the_0_1_kernel_to_round_off() {
+    crate::testing::timeout(60, || {
+        let system = ImpactDamper::new(1.0, 3947.8, 0.0, 0.05, 1e-3).unwrap();
+        let start = State::new(0.0, 0.0, 0.0, 0.8).unwrap();
+        let laws = [
+            hertz(),
+            Contact::new(LawKind::HysterHertz, 1e9, Some(0.7), 0.0).unwrap(),
+            Contact::new(LawKind::Linear, 2e6, None, 0.0).unwrap(),
+        ];
+        for contact in laws {
+            for (timing, legacy_timing) in [
+                (ContactTiming::Located, settings::ContactTiming::Located),
+                (ContactTiming::StepCount, settings::ContactTiming::StepCount),
+            ] {
+                let (dt, t_end) = (2e-6, 0.05);
+                let ours = fixed(
+                    &system,
+                    &contact,
+                    &start,
+                    &mut rk4(&system),
+                    (dt, t_end, timing, 1e-2),
+                )
+                .unwrap();
+                let legacy_settings = Settings::new(
+                    Method::Rk4,
+                    Some(dt),
+                    t_end,
+                    1,
+                    legacy_timing,
+                    Some(settings::Stepping::Fixed),
+                    u64::MAX,
+                )
+                .unwrap();
+                let theirs = crate::legacy::run::simulate(
+                    &system,
+                    &contact,
+                    &start,
+                    &legacy_settings,
+                    &mut || false,
+                )
+                .unwrap();
+                let label = format!("{:?} {timing:?}", contact.law);
+                assert!(
+                    theirs.contacts.len() >= 4,
+                    "{label}: {}",
+                    theirs.contacts.len()
+                );
+                assert_eq!(ours.contacts.len(), theirs.contacts.len(), "{label}");
+                assert_eq!(ours.steps, theirs.steps, "{label}");
+                let mut worst = [0.0f64; 8];
+                for (a, b) in ours.contacts.iter().zip(&theirs.contacts) {
+                    let speed = b.approach_speed;
+                    let energy = 0.5 * system.effective_mass() * speed * speed;
+                    let pairs = [
+                        off(a.onset, b.onset, dt),
+                        off(a.separation, b.separation, dt),
+                        off(a.approach_speed, b.approach_speed, speed),
+                        off(a.rebound_speed, b.rebound_speed, speed),
+                        off(a.max_indentation, b.max_indentation, b.max_indentation),
+                        off(a.energy_dissipated, b.energy_dissipated, energy),
+                        off(a.energy_change, b.energy_change, energy),
+                        off(a.restitution, b.restitution, 1.0),
+                    ];
+                    for (w, p) in worst.iter_mut().zip(pairs) {
+                        *w = w.max(p);
+                    }
+                }
+                assert!(worst.iter().all(|w| *w < 1e-9), "{label}: {worst:?}");
+            }
+        }
+    });
+}
+
+#[test]
+fn a_contact_damper_acts_in_every_stage_of_a_compliant_step() {
+    crate::testing::timeout(60, || {
+        // 0.1 applied the contact damper only where the pair is indented;
+        // the general rates apply it through a step in contact mode (the
+        // stages past the separation, or before an onset entered within the
+        // step): the first contact agrees to a few parts in a thousand at
+        // dt = 2e-6 s, not to round-off.
+        let system = ImpactDamper::new(1.0, 3947.8, 0.0, 0.05, 1e-3).unwrap();
+        let start = State::new(0.0, 0.0, 0.0, 0.8).unwrap();
+        let contact = Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap();
+        let (dt, t_end) = (2e-6, 0.01);
+        let timing = ContactTiming::Located;
+        let ours = fixed(
+            &system,
+            &contact,
+            &start,
+            &mut rk4(&system),
+            (dt, t_end, timing, 1e-2),
+        )
+        .unwrap();
+        let legacy_settings = Settings::new(
+            Method::Rk4,
+            Some(dt),
+            t_end,
+            1,
+            settings::ContactTiming::Located,
+            Some(settings::Stepping::Fixed),
+            u64::MAX,
+        )
+        .unwrap();
+        let theirs =
+            crate::legacy::run::simulate(&system, &contact, &start, &legacy_settings, &mut || {
+                false
+            })
+            .unwrap();
+        let (a, b) = (&ours.contacts[0], &theirs.contacts[0]);
+        assert!((a.onset - b.onset).abs() < 1e-9, "{a:?} {b:?}");
+        assert!(
+            (a.duration - b.duration).abs() < 1e-2 * b.duration,
+            "{a:?} {b:?}"
+        );
+        assert!((a.rebound_speed - b.rebound_speed).abs() < 1e-2 * b.rebound_speed);
+    });
+}
+
+#[test]
+fn a_linear_contact_lasts_half_a_damped_period() {
+    crate::testing::timeout(60, || {
+        // Two free bodies (no main spring): the closed form's setting.
+        let system = ImpactDamper::new(1.0, 0.0, 0.0, 0.05, 1e-3).unwrap();
+        let (k1, c1) = (1e6, 5.0);
+        let contact = Contact::new(LawKind::Linear, k1, None, c1).unwrap();
+        let start = State::new(0.0, 0.0, 0.0, 0.5).unwrap();
+        let expected = linear_contact_duration(0.05, 1.0, k1, c1).unwrap();
+        let run = fixed(
+            &system,
+            &contact,
+            &start,
+            &mut rk4(&system),
+            (1e-6, 0.01, ContactTiming::Located, 1e-2),
+        )
+        .unwrap();
+        let first: &PairContact = &run.contacts[0];
+        assert!(
+            (first.duration - expected).abs() < 1e-5 * expected,
+            "{} against {expected}",
+            first.duration
+        );
+        // Counted in whole steps: within a step at each end.
+        let counted = fixed(
+            &system,
+            &contact,
+            &start,
+            &mut rk4(&system),
+            (1e-6, 0.01, ContactTiming::StepCount, 1e-2),
+        )
+        .unwrap();
+        assert!((counted.contacts[0].duration - expected).abs() <= 2e-6);
+        assert_eq!(
+            counted.contacts[0].onset,
+            (counted.contacts[0].onset / 1e-6).round() * 1e-6
+        );
+    });
+}
+
+#[test]
+fn an_undamped_contact_changes_the_energy_by_what_it_dissipates() {
+    crate::testing::timeout(60, || {
+        let system = ImpactDamper::new(1.0, 0.0, 0.0, 0.05, 1e-3).unwrap();
+        let start = State::new(0.0, 0.0, 0.0, 0.5).unwrap();
+        for contact in [
+            Contact::new(LawKind::HysterHertz, 1e9, Some(0.6), 0.0).unwrap(),
+            Contact::new(LawKind::Linear, 1e6, None, 5.0).unwrap(),
+        ] {
+            let run = fixed(
+                &system,
+                &contact,
+                &start,
+                &mut rk4(&system),
+                (1e-6, 0.01, ContactTiming::Located, 1e-2),
+            )
+            .unwrap();
+            let c = &run.contacts[0];
+            assert!(c.energy_dissipated > 1e-4, "{c:?}");
+            assert!(
+                (c.energy_change + c.energy_dissipated).abs() < 1e-5 * c.energy_dissipated,
+                "{c:?}"
+            );
+            // The same in the event-driven kernel.
+            let assembly = Assembly::new(&spec(&system, &contact)).unwrap();
+            let y = initial_state(&assembly, &[0.0], &[0.0], &[0.0], &[0.5]).unwrap();
+            let events = crate::kernel::events::integrate_system(
+                &assembly,
+                &mut rk4(&system),
+                &y,
+                &options(1e-6, 0.01),
+                &mut || false,
+            )
+            .unwrap();
+            let c = &events.contacts[0];
+            assert!(
+                (c.energy_change + c.energy_dissipated).abs() < 1e-6 * c.energy_dissipated,
+                "{c:?}"
+            );
+        }
+    });
+}
+
+#[test]
+fn fixed_stepping_refuses_rigid_pairs_and_adaptive_methods() {
+    crate::testing::timeout(30, || {
+        let system = ImpactDamper::new(1.0, 0.0, 0.0, 0.05, 1e-3).unwrap();
+        let start = State::new(0.0, 0.0, 0.0, 0.5).unwrap();
+        let rigid = Contact::new(LawKind::Linear, 1e6, None, 0.0).unwrap();
+        let mut spec = spec(&system, &rigid);
+        spec.dampers[0].law = PairLaw::rigid(0.5).unwrap();
+        let assembly = Assembly::new(&spec).unwrap();
+        let y = initial_state(&assembly, &[0.0], &[0.0], &[0.0], &[0.5]).unwrap();
+        let stepping = Stepping::Fixed {
+            contact_timing: ContactTiming::Located,
+        };
+        let run = |stepper: &mut ExplicitRk, assembly: &Assembly| {
+            integrate_system_stepped(
+                assembly,
+                stepper,
+                &y,
+                &options(1e-6, 0.01),
+                stepping,
+                &mut || false,
+                MAX_RECORD_BYTES,
+            )
+        };
+        let message = run(&mut rk4(&system), &assembly).unwrap_err().to_string();
+        assert!(
+            message.contains("stepping") && message.contains("rigid"),
+            "{message}"
+        );
+        let compliant = Assembly::new(&self::spec(&system, &rigid)).unwrap();
+        let mut dop853 = ExplicitRk::dop853(compliant.state_len(), 1e-8, 1e-10);
+        let message = run(&mut dop853, &compliant).unwrap_err().to_string();
+        assert!(
+            message.contains("stepping") && message.contains("dop853"),
+            "{message}"
+        );
+        let _ = start;
+    });
+}
+
+#[test]
+fn fixed_paper_newmark_is_the_0_1_kernel() {
+    crate::testing::timeout(60, || {
+        // Every record to the bit, on both contact timings, the contact
+        // damper too: the same operations in the same order.
+        let system = ImpactDamper::new(1.0, 3947.8, 0.0, 0.05, 1e-3).unwrap();
+        let start = State::new(0.0, 0.0, 0.0, 0.8).unwrap();
+        for contact in [
+            hertz(),
+            Contact::new(LawKind::HysterHertz, 1e9, Some(0.7), 0.0).unwrap(),
+            Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap(),
+        ] {
+            for (timing, legacy_timing) in [
+                (ContactTiming::Located, settings::ContactTiming::Located),
+                (ContactTiming::StepCount, settings::ContactTiming::StepCount),
+            ] {
+                let (dt, t_end) = (1e-6, 0.02);
+                let assembly = Assembly::new(&spec(&system, &contact)).unwrap();
+                let mut stepper =
+                    crate::methods::paper_newmark::PaperNewmark::new(&assembly, 0.25, 0.5).unwrap();
+                let ours = fixed(
+                    &system,
+                    &contact,
+                    &start,
+                    &mut stepper,
+                    (dt, t_end, timing, 0.5),
+                )
+                .unwrap();
+                let method = Method::Newmark {
+                    beta: 0.25,
+                    gamma: 0.5,
+                };
+                let mut legacy_settings = Settings::new(
+                    method,
+                    Some(dt),
+                    t_end,
+                    1,
+                    legacy_timing,
+                    Some(settings::Stepping::Fixed),
+                    u64::MAX,
+                )
+                .unwrap();
+                // The lag creates energy at every contact (see
+                // `creates_contact_energy`).
+                legacy_settings.energy_tolerance = 0.5;
+                let theirs = crate::legacy::run::simulate(
+                    &system,
+                    &contact,
+                    &start,
+                    &legacy_settings,
+                    &mut || false,
+                )
+                .unwrap();
+                let label = format!("{:?} {timing:?}", contact.law);
+                assert!(theirs.contacts.len() >= 2, "{label}");
+                assert_eq!(ours.contacts.len(), theirs.contacts.len(), "{label}");
+                for (a, b) in ours.contacts.iter().zip(&theirs.contacts) {
+                    let same = [
+                        (a.onset, b.onset),
+                        (a.separation, b.separation),
+                        (a.approach_speed, b.approach_speed),
+                        (a.rebound_speed, b.rebound_speed),
+                        (a.max_indentation, b.max_indentation),
+                        (a.energy_dissipated, b.energy_dissipated),
+                        (a.energy_change, b.energy_change),
+                    ];
+                    // The same operations in the same order: the same bits.
+                    assert!(
+                        same.iter().all(|(x, y)| x.to_bits() == y.to_bits()),
+                        "{label}: {a:?} {b:?}"
+                    );
+                }
+            }
+        }
+    });
+}
