@@ -556,3 +556,136 @@ fn it_counts_one_evaluation_a_step_as_0_1_did() {
         assert_eq!(stepper.evaluations(), 10);
     });
 }
+
+/// 0.1's fixed-step run of the paper's Newmark (`legacy::run::simulate`) and
+/// the general kernel's, fixed stepping with `timing`, of `damper` with
+/// `contact` from `start` to `t_end` at `dt`.
+fn both_runs(
+    damper: ImpactDamper,
+    contact: &Contact,
+    start: State,
+    (dt, t_end): (f64, f64),
+    timing: crate::legacy::settings::ContactTiming,
+) -> (
+    crate::legacy::records::Solution,
+    crate::kernel::events::SystemSolution,
+) {
+    use crate::kernel::events::{integrate_system_stepped, ContactTiming, RunOptions, Stepping};
+    use crate::legacy::settings::{self, Method, Settings};
+    let newmark = Method::Newmark {
+        beta: 0.25,
+        gamma: 0.5,
+    };
+    let stepping = Some(settings::Stepping::Fixed);
+    let legacy = Settings::new(newmark, Some(dt), t_end, 1, timing, stepping, 10_000_000)
+        .and_then(|s| s.with_limits(false, None, Some(0.05)))
+        .and_then(|s| crate::legacy::run::simulate(&damper, contact, &start, &s, &mut || false))
+        .unwrap();
+    let system = damper.assembly(contact).unwrap();
+    let options = RunOptions {
+        dt: Some(dt),
+        t_end,
+        every: 1,
+        keep_history: false,
+        max_steps: 10_000_000,
+        max_rows: 10_000_000,
+        energy_tolerance: 0.05,
+        reduce: Default::default(),
+    };
+    let contact_timing = match timing {
+        settings::ContactTiming::Located => ContactTiming::Located,
+        settings::ContactTiming::StepCount => ContactTiming::StepCount,
+    };
+    let mut stepper = PaperNewmark::new(&system, 0.25, 0.5).unwrap();
+    let general = integrate_system_stepped(
+        &system,
+        &mut stepper,
+        &start.vector(&system).unwrap(),
+        &options,
+        Stepping::Fixed { contact_timing },
+        &mut || false,
+        crate::MAX_RECORD_BYTES,
+    )
+    .unwrap();
+    (legacy, general)
+}
+
+#[test]
+fn fixed_steps_on_the_general_kernel_are_0_1_s_run() {
+    crate::testing::timeout(60, || {
+        use crate::legacy::settings::ContactTiming;
+        // The paper's collision, and tests/test_one_engine.py's rattle (a
+        // released main mass on a stiff spring, contacts on both walls, the
+        // main damper and the contact damper acting): 0.1's run to the bit,
+        // every record, the final state and the counts (kernel/fixed_tests.rs
+        // checks the records on a stiff system without dampers).
+        let paper = (table_1(0.01), State::new(0.0, 0.0, 0.01, 0.1).unwrap(), 0.3);
+        let rattle = (
+            ImpactDamper::new(1.0, 40.0, 0.01, 0.25, 0.01).unwrap(),
+            State::new(0.05, 0.02, 0.05, 0.0).unwrap(),
+            2.9,
+        );
+        for (law, restitution) in [
+            (LawKind::Hertz, None),
+            (LawKind::HysterHertz, Some(0.9)),
+            (LawKind::HertzDamped, Some(0.7)),
+        ] {
+            let contact = Contact::new(law, 3000.0, restitution, 0.01).unwrap();
+            for (damper, start, t_end) in [paper, rattle] {
+                for timing in [ContactTiming::Located, ContactTiming::StepCount] {
+                    let (old, new) = both_runs(damper, &contact, start, (1e-4, t_end), timing);
+                    let case = format!("{law:?}, t_end {t_end}, {timing:?}");
+                    assert!(!old.contacts.is_empty(), "{case}");
+                    let last = old.contacts.last().unwrap();
+                    assert!(last.separation.is_finite(), "{case}: ends apart");
+                    assert_eq!(old.contacts.len(), new.contacts.len(), "{case}");
+                    assert_eq!(
+                        (old.steps, old.rhs_evaluations),
+                        (new.steps, new.rhs_evaluations),
+                        "{case}"
+                    );
+                    let end = State::of_vector(&new.final_state);
+                    assert_eq!(old.final_state, end, "{case}");
+                    for (a, b) in old.contacts.iter().zip(&new.contacts) {
+                        let same = [
+                            (a.onset, b.onset),
+                            (a.separation, b.separation),
+                            (a.duration, b.duration),
+                            (a.approach_speed, b.approach_speed),
+                            (a.rebound_speed, b.rebound_speed),
+                            (a.max_indentation, b.max_indentation),
+                            (a.energy_dissipated, b.energy_dissipated),
+                            (a.energy_change, b.energy_change),
+                        ];
+                        for (i, (x, y)) in same.iter().enumerate() {
+                            assert_eq!(x.to_bits(), y.to_bits(), "{case}: column {i}: {a:?} {b:?}");
+                        }
+                    }
+                }
+            }
+        }
+    });
+}
+
+#[test]
+#[ignore = "fails until kernel/contacts.rs close_open takes a fixed-step contact's running \
+            sum: it subtracts it from the loss accumulator as for events (1.16e-4 J here for \
+            0.1's 1.62e-5 J)"]
+fn a_contact_open_at_the_end_of_fixed_steps_reports_0_1_s_dissipation() {
+    crate::testing::timeout(60, || {
+        // The rattle of the test above, run on into its next contact.
+        let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
+        let damper = ImpactDamper::new(1.0, 40.0, 0.01, 0.25, 0.01).unwrap();
+        let start = State::new(0.05, 0.02, 0.05, 0.0).unwrap();
+        let timing = crate::legacy::settings::ContactTiming::Located;
+        let (old, new) = both_runs(damper, &contact, start, (1e-4, 3.0), timing);
+        let (a, b) = (old.contacts.last().unwrap(), new.contacts.last().unwrap());
+        assert!(a.separation.is_nan() && b.separation.is_nan());
+        assert_eq!(a.onset.to_bits(), b.onset.to_bits());
+        assert_eq!(
+            a.energy_dissipated.to_bits(),
+            b.energy_dissipated.to_bits(),
+            "{a:?} {b:?}"
+        );
+    });
+}
