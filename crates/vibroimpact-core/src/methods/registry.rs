@@ -3,7 +3,10 @@
 //! runs share, so that a method means the same in both.
 
 use crate::error::{within, Error, Result};
-use crate::kernel::events::{integrate_system, RunOptions, SystemSolution};
+use crate::kernel::events::{
+    integrate_system, integrate_system_stepped, RunOptions, Stepping, SystemSolution,
+};
+use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::methods::exact::ExactFlow;
 use crate::methods::paper_newmark::PaperNewmark;
 use crate::methods::steppers::{ExplicitRk, NewmarkFamily};
@@ -112,6 +115,33 @@ impl AnyStepper {
             Self::Newmark(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Paper(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Exact(s) => integrate_system(system, s, y0, options, interrupt),
+        }
+    }
+
+    /// [`Self::integrate`] stepping as `stepping` says: cut at events, or
+    /// in fixed steps (see [`crate::kernel::fixed`]).
+    pub fn integrate_stepped(
+        &mut self,
+        system: &Assembly,
+        y0: &[f64],
+        options: &RunOptions,
+        stepping: Stepping,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<SystemSolution> {
+        let limit = MAX_RECORD_BYTES;
+        match self {
+            Self::Rk(s) => {
+                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+            }
+            Self::Newmark(s) => {
+                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+            }
+            Self::Paper(s) => {
+                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+            }
+            Self::Exact(s) => {
+                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+            }
         }
     }
 }
