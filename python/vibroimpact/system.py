@@ -159,6 +159,10 @@ SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
     "beta": 0.25,
     "gamma": 0.5,
     "spectral_radius": 0.9,
+    # Steps cut at every event, or fixed steps of dt not cut at contacts (compliant
+    # laws only), their onsets located inside the step or counted in whole steps.
+    "stepping": "events",
+    "contact_timing": "located",
 }
 _SOLVER = {
     "method": (_TEXT, SYSTEM_SOLVER_DEFAULTS["method"]),
@@ -172,6 +176,8 @@ _SOLVER = {
     "beta": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["beta"]),
     "gamma": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["gamma"]),
     "spectral_radius": (_NUMBER, SYSTEM_SOLVER_DEFAULTS["spectral_radius"]),
+    "stepping": (_TEXT, SYSTEM_SOLVER_DEFAULTS["stepping"]),
+    "contact_timing": (_TEXT, SYSTEM_SOLVER_DEFAULTS["contact_timing"]),
 }
 _OUTPUT = {
     "every": (_WHOLE, 1),
@@ -639,8 +645,12 @@ class SystemContacts:
     "impact" (a rigid impact: zero duration) or "sticking" (a rigid pair moving
     together from the accumulation instant of its chattering sequence to its
     release). ``energy_dissipated`` is the work of the contact's dissipative
-    forces, or the kinetic energy an impact takes (J). A contact still open at the
-    end has NaN ``separation``, ``duration``, ``rebound_speed`` and ``restitution``; a
+    forces, or the kinetic energy an impact takes (J). ``energy_change`` is the net
+    change of the system's stored mechanical energy over the contact (J, at separation
+    minus at onset): ``-energy_dissipated`` where no other damper or force acts, to the
+    method's accuracy; an impact's is the kinetic energy it takes, negated. A contact
+    still open at the end has NaN ``separation``, ``duration``, ``rebound_speed``,
+    ``restitution`` and ``energy_change`` (a sticking pair's is NaN too); a
     contact that started at rest (its approach, m/s, at round-off: a body set down on a
     stop, an elastic contact ringing about its static indentation) was never an impact and
     has NaN ``restitution``. A damped Hertz law (``"hyster-hertz"``, ``"hertz-damped"``)
@@ -659,6 +669,7 @@ class SystemContacts:
     rebound_speed: np.ndarray
     restitution: np.ndarray
     energy_dissipated: np.ndarray
+    energy_change: np.ndarray
 
     columns = (
         "pair",
@@ -671,6 +682,7 @@ class SystemContacts:
         "rebound_speed",
         "restitution",
         "energy_dissipated",
+        "energy_change",
     )
 
     def __len__(self) -> int:
@@ -747,6 +759,11 @@ class SystemSolution:
     moments: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: At each kept time, the force of each pair with a compliant law (N, > 0 pushing
+    #: it apart, 0 apart: the law's and its contact damper's), rows x pairs; the
+    #: pairs' names in ``contact_force_pairs``.
+    contact_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    contact_force_pairs: list[str] = field(default_factory=list)
 
     def shape_at(self, at: float) -> np.ndarray:
         """The structure coordinates' weights at a point: the displacement there is
@@ -814,6 +831,8 @@ def simulate_system(
     strobe_period: float | None = None,
     points: Any = (),
     moments: Any = (),
+    stepping: str = SYSTEM_SOLVER_DEFAULTS["stepping"],
+    contact_timing: str = SYSTEM_SOLVER_DEFAULTS["contact_timing"],
 ) -> SystemSolution:
     """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
 
@@ -837,8 +856,12 @@ def simulate_system(
     damper's ``at``: m from a cantilever's clamp, or a coordinate index; ``point_peak``,
     ``point_rms``), and a cantilever's bending moment at each of ``moments`` (m from the
     clamp; ``moment_peak``, ``moment_rms``, N m); every ``strobe_period`` (s) the state is kept
-    (``strobe``; fixed steps are shortened to divide it). The GIL is released while
-    integrating; Ctrl-C interrupts.
+    (``strobe``; fixed steps are shortened to divide it). ``stepping="fixed"`` takes
+    steps of ``dt`` not cut at contacts (fixed-step methods and compliant laws only), each
+    contact's onset and separation located inside its step by interpolation
+    (``contact_timing="located"``) or counted in whole steps (``"step-count"``, as the
+    founding paper counted them). The GIL is released while integrating; Ctrl-C
+    interrupts.
     """
     run = prepare_system(
         structure,
@@ -858,6 +881,8 @@ def simulate_system(
             "beta": beta,
             "gamma": gamma,
             "spectral_radius": spectral_radius,
+            "stepping": stepping,
+            "contact_timing": contact_timing,
             **({} if dt is None else {"dt": dt}),
         },
         output={
@@ -908,6 +933,8 @@ class PreparedRun:
                 "max_steps",
                 "max_rows",
                 "energy_tolerance",
+                "stepping",
+                "contact_timing",
             )
         }
 
@@ -957,6 +984,19 @@ def prepare_system(
     solver = _table("[solver] ", solver, _SOLVER)
     output = _table("[output] ", {} if output is None else output, _OUTPUT)
     _choice("[solver] ", "method", solver["method"], _METHODS)
+    _choice("[solver] ", "stepping", solver["stepping"], ("events", "fixed"))
+    _choice("[solver] ", "contact_timing", solver["contact_timing"], ("located", "step-count"))
+    if solver["stepping"] == "events" and solver["contact_timing"] != "located":
+        raise _fail(
+            "[solver] contact_timing: ",
+            '"step-count" needs stepping = "fixed" (with events the instants are located)',
+        )
+    if solver["stepping"] == "fixed" and solver["method"] not in _FIXED_STEP:
+        raise _fail(
+            "[solver] stepping: ",
+            f'"fixed" takes a fixed-step method ({", ".join(_FIXED_STEP)}), '
+            f"not {solver['method']!r}",
+        )
     for key in ("t_end", "rtol", "atol", "energy_tolerance"):
         if not solver[key] > 0:
             raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
@@ -1123,6 +1163,10 @@ def _solution(
         strobe=raw["strobe"].reshape(-1, width),
         strobe_time=raw["strobe_time"],
         structure=dict(structure),
+        contact_force=raw["contact_forces"].reshape(
+            len(raw["time"]), len(raw["contact_force_pairs"])
+        ),
+        contact_force_pairs=[pairs[p] for p in raw["contact_force_pairs"]],
     )
 
 

@@ -10,7 +10,9 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::kernel::events::RunOptions;
+use vibroimpact_core::kernel::events::{
+    integrate_system_stepped, ContactTiming, RunOptions, Stepping,
+};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::AnyStepper;
 use vibroimpact_core::model::assembly::{
@@ -274,6 +276,8 @@ struct Limits {
     max_steps: u64,
     max_rows: u64,
     energy_tolerance: f64,
+    /// Events, or fixed steps (see `core::kernel::fixed`).
+    stepping: Stepping,
 }
 
 /// A checked system with its method, ready to run from any state.
@@ -350,8 +354,25 @@ impl Ready {
                 contacts_from: f64::NEG_INFINITY,
             },
         };
-        self.stepper
-            .integrate(&self.system, y0, &options, interrupt)
+        let (system, stepping) = (&self.system, limits.stepping);
+        if stepping == Stepping::Events {
+            return self.stepper.integrate(system, y0, &options, interrupt);
+        }
+        let limit = core::MAX_RECORD_BYTES;
+        match &mut self.stepper {
+            AnyStepper::Rk(s) => {
+                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
+            }
+            AnyStepper::Newmark(s) => {
+                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
+            }
+            AnyStepper::Paper(s) => {
+                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
+            }
+            AnyStepper::Exact(s) => {
+                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
+            }
+        }
     }
 
     /// The stroboscopic map over `t_end` from the flat state `z` (x then v).
@@ -383,7 +404,7 @@ impl PreparedSystem {
     /// its method; the settings as for `simulate_system` (`t_end`, s, sets the
     /// default duration of swept signals).
     #[new]
-    #[pyo3(signature = (spec, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, max_rows, energy_tolerance))]
+    #[pyo3(signature = (spec, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, max_rows, energy_tolerance, stepping="events", contact_timing="located"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         spec: &Bound<'_, PyDict>,
@@ -398,7 +419,10 @@ impl PreparedSystem {
         max_steps: u64,
         max_rows: u64,
         #[pyo3(from_py_with = crate::convert::arg::energy_tolerance)] energy_tolerance: f64,
+        stepping: &str,
+        contact_timing: &str,
     ) -> PyResult<Self> {
+        let stepping = stepping_of(stepping, contact_timing)?;
         check_method(
             t_end,
             dt,
@@ -414,19 +438,21 @@ impl PreparedSystem {
             max_steps,
             max_rows,
             energy_tolerance,
+            stepping,
         };
+        let ready = Ready::new(
+            spec,
+            method,
+            t_end,
+            rtol,
+            atol,
+            beta,
+            gamma,
+            spectral_radius,
+            limits,
+        )?;
         Ok(Self {
-            ready: std::sync::Mutex::new(Ready::new(
-                spec,
-                method,
-                t_end,
-                rtol,
-                atol,
-                beta,
-                gamma,
-                spectral_radius,
-                limits,
-            )?),
+            ready: std::sync::Mutex::new(ready),
         })
     }
 
@@ -593,7 +619,7 @@ fn check(field: &str, value: f64, ok: bool, allowed: &str) -> PyResult<f64> {
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
 /// dict of flat arrays that the Python side shapes.
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, every, history, max_steps, max_rows, energy_tolerance, record_from=None, strobe_period=None))]
+#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, every, history, max_steps, max_rows, energy_tolerance, record_from=None, strobe_period=None, stepping="events", contact_timing="located"))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_system<'py>(
     py: Python<'py>,
@@ -614,12 +640,16 @@ pub fn simulate_system<'py>(
     energy_tolerance: f64,
     #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
     #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
+    stepping: &str,
+    contact_timing: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let stepping = stepping_of(stepping, contact_timing)?;
     let limits = Limits {
         dt,
         max_steps,
         max_rows,
         energy_tolerance,
+        stepping,
     };
     let mut ready = Ready::new(
         spec,
@@ -642,6 +672,30 @@ pub fn simulate_system<'py>(
     .map_err(to_py)?;
     let sol = ready.run(py, &y0, t_end, (history, every), record_from, strobe_period)?;
     solution_dict(py, &ready.system, sol)
+}
+
+/// The kernel's stepping from `[solver] stepping` and `contact_timing`.
+fn stepping_of(stepping: &str, contact_timing: &str) -> PyResult<Stepping> {
+    let contact_timing = match contact_timing {
+        "located" => ContactTiming::Located,
+        "step-count" => ContactTiming::StepCount,
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "contact_timing must be \"located\" or \"step-count\", got {other:?}"
+            )))
+        }
+    };
+    match stepping {
+        "events" if contact_timing == ContactTiming::Located => Ok(Stepping::Events),
+        "events" => Err(InvalidInputError::new_err(
+            "contact_timing \"step-count\" needs stepping \"fixed\": with events the contact \
+             instants are located",
+        )),
+        "fixed" => Ok(Stepping::Fixed { contact_timing }),
+        other => Err(InvalidInputError::new_err(format!(
+            "stepping must be \"events\" or \"fixed\", got {other:?}"
+        ))),
+    }
 }
 
 /// A run's results as a dict of flat arrays.
@@ -673,7 +727,10 @@ fn solution_dict<'py>(
     columns.set_item("rebound_speed", column(|r| r.rebound_speed))?;
     columns.set_item("restitution", column(|r| r.restitution))?;
     columns.set_item("energy_dissipated", column(|r| r.energy_dissipated))?;
+    columns.set_item("energy_change", column(|r| r.energy_change))?;
     out.set_item("contacts", columns)?;
+    out.set_item("contact_force_pairs", sol.contact_force_pairs)?;
+    out.set_item("contact_forces", sol.contact_forces.into_pyarray(py))?;
     let e = sol.energy;
     let energy = PyDict::new(py);
     for (key, value) in [

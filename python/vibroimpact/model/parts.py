@@ -333,8 +333,9 @@ class Solver(Part):
     ``"newmark-implicit"``, ``"generalized-alpha"`` or ``"exact"``; default
     ``"rk4"``), ``t_end`` and ``dt`` (s), ``rtol``, ``atol`` (m, m/s), ``beta``,
     ``gamma``, ``spectral_radius``, ``max_steps``, ``max_rows``,
-    ``energy_tolerance``; None leaves a key to its default (see
-    :data:`vibroimpact.system.SYSTEM_SOLVER_DEFAULTS`)."""
+    ``energy_tolerance``, ``stepping`` (``"events"`` or ``"fixed"``) and
+    ``contact_timing`` (``"located"`` or ``"step-count"``); None leaves a key to its
+    default (see :data:`vibroimpact.system.SYSTEM_SOLVER_DEFAULTS`)."""
 
     method: str | None = None
     t_end: float | None = None
@@ -347,6 +348,8 @@ class Solver(Part):
     beta: float | None = None
     gamma: float | None = None
     spectral_radius: float | None = None
+    stepping: str | None = None
+    contact_timing: str | None = None
 
 
 @dataclass(frozen=True, kw_only=True, repr=False)
