@@ -19,7 +19,9 @@
 
 use crate::error::{Error, Result};
 use crate::methods::steppers::{SystemStepper, Trapezoid};
-use crate::model::assembly::{h_dot, Assembly, HarmonicLoad, InteractionLaw, Mode, Scratch};
+use crate::model::assembly::{
+    h_dot, Assembly, HarmonicLoad, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
+};
 use crate::model::contact::{AnyLaw, ContactLaw};
 use crate::numerics::linalg;
 
@@ -239,6 +241,47 @@ impl PaperNewmark {
         }
     }
 
+    /// The accumulators' rates at `(time, xv)` in `modes` (W) into `out`, as
+    /// [`Assembly::rates`] gives them but without its accelerations (which
+    /// cost as much as the rest of a step): the structure's dampers' power
+    /// `v^T C v`, the loads' `f . v` (gravity's is its potential's) and each
+    /// compliant contact's `(F - F_elastic) rate`.
+    fn end_powers(
+        &self,
+        system: &Assembly,
+        time: f64,
+        xv: &[f64],
+        modes: &[Mode],
+        out: &mut [f64],
+    ) {
+        let (n, d) = (self.n, self.dim);
+        let (x, v) = xv.split_at(d);
+        out.iter_mut().for_each(|p| *p = 0.0);
+        out[VISCOUS] = if self.per_mass.is_some() {
+            (0..n).map(|i| self.damping[i * d + i] * v[i] * v[i]).sum()
+        } else {
+            (0..n)
+                .map(|i| v[i] * linalg::dot(&self.damping[i * d..i * d + n], &v[..n]))
+                .sum()
+        };
+        for load in &self.harmonics {
+            let value = load.amplitude * (load.omega * time + load.phase).cos();
+            out[INPUT] += value * linalg::dot(&load.shape, v);
+        }
+        for c in &self.compliant {
+            let Mode::Compliant { approach_rate } = modes[c.index] else {
+                continue;
+            };
+            let (indentation, rate) = Self::indentation(system, c, x, v);
+            let (force, elastic) = if indentation > 0.0 {
+                c.law.force_and_elastic(indentation, rate, approach_rate)
+            } else {
+                (0.0, 0.0)
+            };
+            out[CONTACT + c.index] = (force + c.damping * rate - elastic) * rate;
+        }
+    }
+
     /// Which compliant interactions are in contact in `modes` (into
     /// `self.contacts`); whether any is.
     fn contacts_of(&mut self, modes: &[Mode]) -> bool {
@@ -433,9 +476,13 @@ impl SystemStepper for PaperNewmark {
             out[i] = self.predictor[i] + bb * self.solved[i];
             out[d + i] = self.predictor[d + i] + gg * self.solved[i];
         }
-        let rates = &mut self.rates;
-        self.powers
-            .step(system, time, y, h, modes, scratch, rates, out);
+        // The accumulators by the trapezoidal rule on their rates.
+        out[2 * d..].copy_from_slice(&y[2 * d..]);
+        let mut rates = std::mem::take(&mut self.rates);
+        let end = &mut rates[2 * d..];
+        self.end_powers(system, time + h, &out[..2 * d], modes, end);
+        self.powers.add(h, end, &mut out[2 * d..]);
+        self.rates = rates;
         self.pending_accel.copy_from_slice(&self.solved);
         Ok(0.0)
     }

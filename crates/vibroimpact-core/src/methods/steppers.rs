@@ -655,10 +655,16 @@ impl Trapezoid {
         let d = system.dim;
         out[2 * d..].copy_from_slice(&y[2 * d..]);
         system.rates(time + h, out, modes, scratch, rates);
-        for (k, slot) in out[2 * d..].iter_mut().enumerate() {
-            *slot += 0.5 * h * (self.start[k] + rates[2 * d + k]);
+        self.add(h, &rates[2 * d..], &mut out[2 * d..]);
+    }
+
+    /// The step `h`'s share onto the accumulators `out` (the step's start's
+    /// values), from their rates `end` at the step's end.
+    pub(crate) fn add(&mut self, h: f64, end: &[f64], out: &mut [f64]) {
+        for (k, slot) in out.iter_mut().enumerate() {
+            *slot += 0.5 * h * (self.start[k] + end[k]);
         }
-        self.pending.copy_from_slice(&rates[2 * d..]);
+        self.pending.copy_from_slice(end);
     }
 
     /// The last attempt's end is the new current point.

@@ -689,3 +689,75 @@ fn a_contact_open_at_the_end_of_fixed_steps_reports_0_1_s_dissipation() {
         );
     });
 }
+
+#[test]
+fn its_accumulator_rates_are_the_assembly_s() {
+    crate::testing::timeout(30, || {
+        // The powers the stepper takes at a step's end without the
+        // accelerations equal `Assembly::rates`' last slots: a modal beam
+        // and a coupled chain, forced and on a base, each damper apart, in
+        // contact, and in compliant mode while apart (only its damper acts).
+        use crate::model::assembly::{Damper, PairLaw};
+        let contact = Contact::new(LawKind::HertzDamped, 1e5, Some(0.6), 0.3).unwrap();
+        let coupled = Structure::matrices(
+            &[vec![1.0, 0.1], vec![0.1, 2.0]],
+            &[vec![50.0, -20.0], vec![-20.0, 40.0]],
+            &[vec![0.3, -0.1], vec![-0.1, 0.2]],
+        )
+        .unwrap();
+        let beam = Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap();
+        for (structure, at) in [(coupled, 1.0), (beam, 0.5)] {
+            let system = Assembly::new(&SystemSpec {
+                structure,
+                dampers: vec![Damper {
+                    mass: 0.05,
+                    at,
+                    lower_clearance: 1e-3,
+                    upper_clearance: 2e-3,
+                    law: PairLaw::Compliant(contact),
+                }],
+                stops: vec![],
+                gravity: 9.81,
+                excitations: vec![
+                    Excitation {
+                        load: Load::Force { at },
+                        signal: Signal::harmonic(0.5, 8.0, 0.3).unwrap(),
+                    },
+                    Excitation {
+                        load: Load::Base,
+                        signal: Signal::harmonic(1.5, 5.0, 0.1).unwrap(),
+                    },
+                ],
+                points: vec![],
+                moments: vec![],
+            })
+            .unwrap();
+            let stepper = PaperNewmark::new(&system, 0.25, 0.5).unwrap();
+            let mut scratch = Scratch::new(&system);
+            let (d, len) = (system.dim, system.state_len());
+            let (mut rates, mut ours) = (vec![0.0; len], vec![0.0; len - 2 * d]);
+            for seed in 0..20 {
+                let y: Vec<f64> = (0..len)
+                    .map(|i| 2e-3 * (seed as f64 + 0.37 * i as f64).sin())
+                    .collect();
+                let compliant = Mode::Compliant { approach_rate: 0.2 };
+                for modes in [
+                    [Mode::Open; 2],
+                    [compliant, Mode::Open],
+                    [Mode::Open, compliant],
+                ] {
+                    let time = 0.01 * seed as f64;
+                    system.rates(time, &y, &modes, &mut scratch, &mut rates);
+                    stepper.end_powers(&system, time, &y[..2 * d], &modes, &mut ours);
+                    for (k, (a, b)) in rates[2 * d..].iter().zip(&ours).enumerate() {
+                        let scale = a.abs().max(1e-30);
+                        assert!(
+                            (a - b).abs() <= 1e-12 * scale,
+                            "{seed} {modes:?} {k}: {a} {b}"
+                        );
+                    }
+                }
+            }
+        }
+    });
+}
