@@ -82,6 +82,24 @@ fn fixed<S: SystemStepper>(
     )
 }
 
+/// 0.1's fixed-step run of the same system (`tolerance`: its energy check).
+fn legacy(
+    system: &ImpactDamper,
+    contact: &Contact,
+    start: &State,
+    method: Method,
+    (dt, t_end, timing, tolerance): (f64, f64, ContactTiming, f64),
+) -> crate::Solution {
+    let timing = match timing {
+        ContactTiming::Located => settings::ContactTiming::Located,
+        ContactTiming::StepCount => settings::ContactTiming::StepCount,
+    };
+    let fixed = Some(settings::Stepping::Fixed);
+    let mut settings = Settings::new(method, Some(dt), t_end, 1, timing, fixed, u64::MAX).unwrap();
+    settings.energy_tolerance = tolerance;
+    crate::legacy::run::simulate(system, contact, start, &settings, &mut || false).unwrap()
+}
+
 fn rk4(system: &ImpactDamper) -> ExplicitRk {
     ExplicitRk::rk4(Assembly::new(&spec(system, &hertz())).unwrap().state_len())
 }
@@ -110,10 +128,7 @@ fn fixed_rk4_is_the_0_1_kernel_to_round_off() {
             Contact::new(LawKind::Linear, 2e6, None, 0.0).unwrap(),
         ];
         for contact in laws {
-            for (timing, legacy_timing) in [
-                (ContactTiming::Located, settings::ContactTiming::Located),
-                (ContactTiming::StepCount, settings::ContactTiming::StepCount),
-            ] {
+            for timing in [ContactTiming::Located, ContactTiming::StepCount] {
                 let (dt, t_end) = (2e-6, 0.05);
                 let ours = fixed(
                     &system,
@@ -123,24 +138,14 @@ fn fixed_rk4_is_the_0_1_kernel_to_round_off() {
                     (dt, t_end, timing, 1e-2),
                 )
                 .unwrap();
-                let legacy_settings = Settings::new(
-                    Method::Rk4,
-                    Some(dt),
-                    t_end,
-                    1,
-                    legacy_timing,
-                    Some(settings::Stepping::Fixed),
-                    u64::MAX,
-                )
-                .unwrap();
-                let theirs = crate::legacy::run::simulate(
+                let tolerance = 1e-2;
+                let theirs = legacy(
                     &system,
                     &contact,
                     &start,
-                    &legacy_settings,
-                    &mut || false,
-                )
-                .unwrap();
+                    Method::Rk4,
+                    (dt, t_end, timing, tolerance),
+                );
                 let label = format!("{:?} {timing:?}", contact.law);
                 assert!(
                     theirs.contacts.len() >= 4,
@@ -194,21 +199,13 @@ fn a_contact_damper_acts_in_every_stage_of_a_compliant_step() {
             (dt, t_end, timing, 1e-2),
         )
         .unwrap();
-        let legacy_settings = Settings::new(
+        let theirs = legacy(
+            &system,
+            &contact,
+            &start,
             Method::Rk4,
-            Some(dt),
-            t_end,
-            1,
-            settings::ContactTiming::Located,
-            Some(settings::Stepping::Fixed),
-            u64::MAX,
-        )
-        .unwrap();
-        let theirs =
-            crate::legacy::run::simulate(&system, &contact, &start, &legacy_settings, &mut || {
-                false
-            })
-            .unwrap();
+            (dt, t_end, timing, 1e-2),
+        );
         let (a, b) = (&ours.contacts[0], &theirs.contacts[0]);
         assert!((a.onset - b.onset).abs() < 1e-9, "{a:?} {b:?}");
         assert!(
@@ -354,10 +351,7 @@ fn fixed_paper_newmark_is_the_0_1_kernel() {
             Contact::new(LawKind::HysterHertz, 1e9, Some(0.7), 0.0).unwrap(),
             Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap(),
         ] {
-            for (timing, legacy_timing) in [
-                (ContactTiming::Located, settings::ContactTiming::Located),
-                (ContactTiming::StepCount, settings::ContactTiming::StepCount),
-            ] {
+            for timing in [ContactTiming::Located, ContactTiming::StepCount] {
                 let (dt, t_end) = (1e-6, 0.02);
                 let assembly = Assembly::new(&spec(&system, &contact)).unwrap();
                 let mut stepper =
@@ -374,27 +368,9 @@ fn fixed_paper_newmark_is_the_0_1_kernel() {
                     beta: 0.25,
                     gamma: 0.5,
                 };
-                let mut legacy_settings = Settings::new(
-                    method,
-                    Some(dt),
-                    t_end,
-                    1,
-                    legacy_timing,
-                    Some(settings::Stepping::Fixed),
-                    u64::MAX,
-                )
-                .unwrap();
                 // The lag creates energy at every contact (see
                 // `creates_contact_energy`).
-                legacy_settings.energy_tolerance = 0.5;
-                let theirs = crate::legacy::run::simulate(
-                    &system,
-                    &contact,
-                    &start,
-                    &legacy_settings,
-                    &mut || false,
-                )
-                .unwrap();
+                let theirs = legacy(&system, &contact, &start, method, (dt, t_end, timing, 0.5));
                 let label = format!("{:?} {timing:?}", contact.law);
                 assert!(theirs.contacts.len() >= 2, "{label}");
                 assert_eq!(ours.contacts.len(), theirs.contacts.len(), "{label}");
