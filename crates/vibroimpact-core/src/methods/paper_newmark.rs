@@ -18,6 +18,7 @@
 //! coordinate of a diagonal system.
 
 use crate::error::{Error, Result};
+use crate::kernel::sized::by_size;
 use crate::methods::steppers::{SystemStepper, Trapezoid};
 use crate::model::assembly::{
     h_dot, Assembly, HarmonicLoad, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
@@ -186,7 +187,8 @@ impl PaperNewmark {
     #[inline(always)]
     fn indentation(system: &Assembly, c: &Compliant, x: &[f64], v: &[f64]) -> (f64, f64) {
         let it = &system.interactions[c.index];
-        (-(it.offset + h_dot(&it.h, x)), -h_dot(&it.h, v))
+        let h = &it.h[..x.len()];
+        (-(it.offset + h_dot(h, x)), -h_dot(h, v))
     }
 
     /// The accelerations at `(time, y)` in `modes` after a restart (the
@@ -241,20 +243,124 @@ impl PaperNewmark {
         }
     }
 
+    /// The step `h` from `(time, y)` into `out` after [`Self::start`], for
+    /// `n` structure coordinates of `d` (constants where [`by_size`] makes
+    /// them: the loops unrolled, the same operations).
+    #[inline(always)]
+    fn step_sized(
+        &mut self,
+        system: &Assembly,
+        (n, d): (usize, usize),
+        (time, h): (f64, f64),
+        y: &[f64],
+        modes: &[Mode],
+        out: &mut [f64],
+    ) {
+        let (beta, gamma) = (self.beta, self.gamma);
+        // The predictor: the parts of x1, v1 that do not depend on a1.
+        let (db, dg) = ((0.5 - beta) * h * h, (1.0 - gamma) * h);
+        let (x, v) = (&y[..d], &y[d..2 * d]);
+        let (accel, predictor) = (&self.accel[..d], &mut self.predictor[..2 * d]);
+        for i in 0..d {
+            let a = accel[i];
+            predictor[i] = x[i] + h * v[i] + db * a;
+            predictor[d + i] = v[i] + dg * a;
+        }
+        // The right-hand side: the loads at the step's end, the contact
+        // laws' forces at its start (the lag), the structure's spring and
+        // damper on the predictor, then the contact dampers on it.
+        self.residual[..d].iter_mut().for_each(|r| *r = 0.0);
+        if self.forced {
+            let mut loads = std::mem::take(&mut self.residual);
+            self.add_loads(time + h, &mut loads);
+            self.residual = loads;
+        }
+        for c in &self.compliant {
+            let Mode::Compliant { approach_rate } = modes[c.index] else {
+                continue;
+            };
+            let (indentation, rate) = Self::indentation(system, c, x, v);
+            if indentation > 0.0 {
+                let law = c.law.force(indentation, rate, approach_rate);
+                let row = &system.interactions[c.index].h[..d];
+                for (r, hi) in self.residual[..d].iter_mut().zip(row) {
+                    if *hi != 0.0 {
+                        *r += hi * law;
+                    }
+                }
+            }
+        }
+        let (xp, vp) = self.predictor[..2 * d].split_at(d);
+        for (i, r) in self.residual[..n].iter_mut().enumerate() {
+            let row = i * d..i * d + n;
+            for (c, v) in self.damping[row.clone()].iter().zip(&vp[..n]) {
+                *r -= c * v;
+            }
+            for (k, x) in self.stiffness[row].iter().zip(&xp[..n]) {
+                *r -= k * x;
+            }
+        }
+        for c in &self.compliant {
+            if !matches!(modes[c.index], Mode::Compliant { .. }) {
+                continue;
+            }
+            let (_, rate) = Self::indentation(system, c, xp, vp);
+            let force = c.damping * rate;
+            let row = &system.interactions[c.index].h[..d];
+            for (r, hi) in self.residual[..d].iter_mut().zip(row) {
+                if *hi != 0.0 {
+                    *r += hi * force;
+                }
+            }
+        }
+        let any = self.contacts_of(modes);
+        self.effective(system, h, any);
+        let inverse = if any {
+            &self.touching.inverse
+        } else {
+            &self.apart.inverse
+        };
+        let residual = &self.residual[..d];
+        for (i, a1) in self.solved[..d].iter_mut().enumerate() {
+            // Summed in order from the first product (0.1's `a r + b s`).
+            let row = &inverse[i * d..(i + 1) * d];
+            let mut sum = row[0] * residual[0];
+            for (a, r) in row[1..].iter().zip(&residual[1..]) {
+                sum += a * r;
+            }
+            *a1 = sum;
+        }
+        let (bb, gg) = (beta * h * h, gamma * h);
+        let (predictor, solved) = (&self.predictor[..2 * d], &self.solved[..d]);
+        for i in 0..d {
+            out[i] = predictor[i] + bb * solved[i];
+            out[d + i] = predictor[d + i] + gg * solved[i];
+        }
+        // The accumulators by the trapezoidal rule on their rates.
+        out[2 * d..].copy_from_slice(&y[2 * d..]);
+        let mut rates = std::mem::take(&mut self.rates);
+        let end = &mut rates[2 * d..];
+        self.end_powers(system, (n, d), time + h, &out[..2 * d], modes, end);
+        self.powers.add(h, end, &mut out[2 * d..]);
+        self.rates = rates;
+        self.pending_accel.copy_from_slice(&self.solved);
+    }
+
     /// The accumulators' rates at `(time, xv)` in `modes` (W) into `out`, as
     /// [`Assembly::rates`] gives them but without its accelerations (which
     /// cost as much as the rest of a step): the structure's dampers' power
     /// `v^T C v`, the loads' `f . v` (gravity's is its potential's) and each
     /// compliant contact's `(F - F_elastic) rate`.
+    #[inline(always)]
     fn end_powers(
         &self,
         system: &Assembly,
+        (n, d): (usize, usize),
         time: f64,
         xv: &[f64],
         modes: &[Mode],
         out: &mut [f64],
     ) {
-        let (n, d) = (self.n, self.dim);
         let (x, v) = xv.split_at(d);
         out.iter_mut().for_each(|p| *p = 0.0);
         out[VISCOUS] = if self.per_mass.is_some() {
@@ -272,7 +378,7 @@ impl PaperNewmark {
             let Mode::Compliant { approach_rate } = modes[c.index] else {
                 continue;
             };
-            let (indentation, rate) = Self::indentation(system, c, x, v);
+            let (indentation, rate) = Self::indentation(system, c, &x[..d], &v[..d]);
             let (force, elastic) = if indentation > 0.0 {
                 c.law.force_and_elastic(indentation, rate, approach_rate)
             } else {
@@ -295,12 +401,18 @@ impl PaperNewmark {
 
     /// The inverse effective matrix for a step `h` with `self.contacts`,
     /// made again only where the step or the contacts changed.
+    #[inline(always)]
     fn effective(&mut self, system: &Assembly, h: f64, any: bool) {
-        let d = self.dim;
         let kept = if any { &self.touching } else { &self.apart };
-        if kept.step.to_bits() == h.to_bits() && (!any || kept.contacts == self.contacts) {
-            return;
+        if kept.step.to_bits() != h.to_bits() || (any && kept.contacts != self.contacts) {
+            self.rebuild(system, h, any);
         }
+    }
+
+    /// [`Self::effective`]'s inverse made for `h` and `self.contacts`.
+    #[inline(never)]
+    fn rebuild(&mut self, system: &Assembly, h: f64, any: bool) {
+        let d = self.dim;
         // A = M + (gamma h) C + (beta h^2) K, as 0.1 summed it.
         let (g, b) = (self.gamma * h, self.beta * h * h);
         for p in 0..d * d {
@@ -384,7 +496,6 @@ impl SystemStepper for PaperNewmark {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) -> Result<f64> {
-        let (n, d) = (self.n, self.dim);
         if !self.valid {
             self.start(system, time, y, modes, scratch);
         } else if !self.powers_valid {
@@ -392,98 +503,15 @@ impl SystemStepper for PaperNewmark {
             self.powers.restart(system, &self.rates);
             self.powers_valid = true;
         }
-        let (beta, gamma) = (self.beta, self.gamma);
-        // The predictor: the parts of x1, v1 that do not depend on a1.
-        let (db, dg) = ((0.5 - beta) * h * h, (1.0 - gamma) * h);
-        let (x, v) = (&y[..d], &y[d..2 * d]);
-        for i in 0..d {
-            let a = self.accel[i];
-            self.predictor[i] = x[i] + h * v[i] + db * a;
-            self.predictor[d + i] = v[i] + dg * a;
-        }
-        // The right-hand side: the loads at the step's end, the contact
-        // laws' forces at its start (the lag), the structure's spring and
-        // damper on the predictor, then the contact dampers on it.
-        self.residual.iter_mut().for_each(|r| *r = 0.0);
-        if self.forced {
-            let mut loads = std::mem::take(&mut self.residual);
-            self.add_loads(time + h, &mut loads);
-            self.residual = loads;
-        }
-        for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
-                continue;
-            };
-            let (indentation, rate) = Self::indentation(system, c, x, v);
-            if indentation > 0.0 {
-                let law = c.law.force(indentation, rate, approach_rate);
-                for (r, hi) in self
-                    .residual
-                    .iter_mut()
-                    .zip(&system.interactions[c.index].h)
-                {
-                    if *hi != 0.0 {
-                        *r += hi * law;
-                    }
-                }
-            }
-        }
-        let (xp, vp) = self.predictor.split_at(d);
-        for (i, r) in self.residual[..n].iter_mut().enumerate() {
-            let row = i * d..i * d + n;
-            for (c, v) in self.damping[row.clone()].iter().zip(&vp[..n]) {
-                *r -= c * v;
-            }
-            for (k, x) in self.stiffness[row].iter().zip(&xp[..n]) {
-                *r -= k * x;
-            }
-        }
-        for c in &self.compliant {
-            if !matches!(modes[c.index], Mode::Compliant { .. }) {
-                continue;
-            }
-            let (_, rate) = Self::indentation(system, c, xp, vp);
-            let force = c.damping * rate;
-            for (r, hi) in self
-                .residual
-                .iter_mut()
-                .zip(&system.interactions[c.index].h)
-            {
-                if *hi != 0.0 {
-                    *r += hi * force;
-                }
-            }
-        }
+        by_size!(system, |n, k| self.step_sized(
+            system,
+            (n, n + k),
+            (time, h),
+            y,
+            modes,
+            out
+        ));
         self.evaluations += 1;
-        let any = self.contacts_of(modes);
-        self.effective(system, h, any);
-        let inverse = if any {
-            &self.touching.inverse
-        } else {
-            &self.apart.inverse
-        };
-        for (i, a1) in self.solved.iter_mut().enumerate() {
-            // Summed in order from the first product (0.1's `a r + b s`).
-            let row = &inverse[i * d..(i + 1) * d];
-            let mut sum = row[0] * self.residual[0];
-            for (a, r) in row[1..].iter().zip(&self.residual[1..]) {
-                sum += a * r;
-            }
-            *a1 = sum;
-        }
-        let (bb, gg) = (beta * h * h, gamma * h);
-        for i in 0..d {
-            out[i] = self.predictor[i] + bb * self.solved[i];
-            out[d + i] = self.predictor[d + i] + gg * self.solved[i];
-        }
-        // The accumulators by the trapezoidal rule on their rates.
-        out[2 * d..].copy_from_slice(&y[2 * d..]);
-        let mut rates = std::mem::take(&mut self.rates);
-        let end = &mut rates[2 * d..];
-        self.end_powers(system, time + h, &out[..2 * d], modes, end);
-        self.powers.add(h, end, &mut out[2 * d..]);
-        self.rates = rates;
-        self.pending_accel.copy_from_slice(&self.solved);
         Ok(0.0)
     }
 

@@ -748,7 +748,14 @@ fn its_accumulator_rates_are_the_assembly_s() {
                 ] {
                     let time = 0.01 * seed as f64;
                     system.rates(time, &y, &modes, &mut scratch, &mut rates);
-                    stepper.end_powers(&system, time, &y[..2 * d], &modes, &mut ours);
+                    stepper.end_powers(
+                        &system,
+                        (system.n, d),
+                        time,
+                        &y[..2 * d],
+                        &modes,
+                        &mut ours,
+                    );
                     for (k, (a, b)) in rates[2 * d..].iter().zip(&ours).enumerate() {
                         let scale = a.abs().max(1e-30);
                         assert!(
