@@ -4,3 +4,4 @@ pub mod registry;
 pub mod step_control;
 pub mod steppers;
 pub mod tableau;
+pub mod trapezoid;

@@ -19,7 +19,8 @@
 
 use crate::error::{Error, Result};
 use crate::kernel::sized::by_size;
-use crate::methods::steppers::{SystemStepper, Trapezoid};
+use crate::methods::steppers::SystemStepper;
+use crate::methods::trapezoid::Trapezoid;
 use crate::model::assembly::{
     h_dot, Assembly, HarmonicLoad, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
 };

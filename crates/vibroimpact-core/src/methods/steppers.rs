@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::kernel::compact::Stretch;
 use crate::kernel::sized::by_size;
 use crate::methods::tableau::*;
+use crate::methods::trapezoid::Trapezoid;
 use crate::model::assembly::{Assembly, Mode, Scratch};
 use crate::numerics::linalg;
 
@@ -612,67 +613,6 @@ pub struct NewmarkFamily {
 /// Newton iterations allowed per step.
 const NEWTON_ITERATIONS: usize = 40;
 
-/// The energy accumulators (the state after its `2 dim` coordinates and
-/// velocities) of the Newmark family's steps by the trapezoidal rule on
-/// their rates, second order like the methods: the rates at the current
-/// point and at the end of the last attempt.
-#[derive(Debug, Clone)]
-pub(crate) struct Trapezoid {
-    start: Vec<f64>,
-    pending: Vec<f64>,
-}
-
-impl Trapezoid {
-    /// For `system`'s accumulators.
-    pub(crate) fn new(system: &Assembly) -> Self {
-        let count = system.state_len() - 2 * system.dim;
-        Self {
-            start: vec![0.0; count],
-            pending: vec![0.0; count],
-        }
-    }
-
-    /// The current point's accumulator rates, from all its `rates`.
-    pub(crate) fn restart(&mut self, system: &Assembly, rates: &[f64]) {
-        self.start.copy_from_slice(&rates[2 * system.dim..]);
-    }
-
-    /// The accumulators at the end `out` of a step `h` from `(time, y)`
-    /// whose coordinates and velocities `out` holds; the rates at the end
-    /// are evaluated into `rates` (the state's length).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn step(
-        &mut self,
-        system: &Assembly,
-        time: f64,
-        y: &[f64],
-        h: f64,
-        modes: &[Mode],
-        scratch: &mut Scratch,
-        rates: &mut [f64],
-        out: &mut [f64],
-    ) {
-        let d = system.dim;
-        out[2 * d..].copy_from_slice(&y[2 * d..]);
-        system.rates(time + h, out, modes, scratch, rates);
-        self.add(h, &rates[2 * d..], &mut out[2 * d..]);
-    }
-
-    /// The step `h`'s share onto the accumulators `out` (the step's start's
-    /// values), from their rates `end` at the step's end.
-    pub(crate) fn add(&mut self, h: f64, end: &[f64], out: &mut [f64]) {
-        for (k, slot) in out.iter_mut().enumerate() {
-            *slot += 0.5 * h * (self.start[k] + end[k]);
-        }
-        self.pending.copy_from_slice(end);
-    }
-
-    /// The last attempt's end is the new current point.
-    pub(crate) fn accept(&mut self) {
-        std::mem::swap(&mut self.start, &mut self.pending);
-    }
-}
-
 impl NewmarkFamily {
     fn build(
         name: &'static str,
@@ -690,10 +630,7 @@ impl NewmarkFamily {
             beta,
             gamma,
             accel: vec![0.0; dim],
-            powers: Trapezoid {
-                start: vec![0.0; len - 2 * dim],
-                pending: vec![0.0; len - 2 * dim],
-            },
+            powers: Trapezoid::of(len - 2 * dim),
             valid: false,
             pending_accel: vec![0.0; dim],
             point: vec![0.0; len],
