@@ -1,4 +1,5 @@
 pub mod ensemble;
+pub mod lanes;
 pub mod settling;
 pub mod shooting;
 pub mod study;

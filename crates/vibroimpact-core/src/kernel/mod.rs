@@ -12,3 +12,4 @@ pub(crate) mod records;
 pub mod reductions;
 pub(crate) mod run;
 pub(crate) mod sized;
+pub(crate) mod stepwise;

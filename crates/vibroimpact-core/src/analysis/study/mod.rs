@@ -13,6 +13,7 @@
 //! runs on every core), `lockstep` (the bridge to the lockstep ensemble
 //! for fixed steps) and `metrics` (what each run is reduced to).
 
+mod compact_lanes;
 mod lockstep;
 mod metrics;
 mod parameters;

@@ -15,7 +15,9 @@
 // between the arrays measured slower: calls to memcpy, bounds not folded).
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
+mod lanes;
 mod stretch;
+pub(crate) use lanes::{Group, LaneModes, LaneState, LaneStep, LANES};
 pub(crate) use stretch::Stretch;
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
@@ -635,6 +637,7 @@ mod tests {
                 strobe_period: f64::INFINITY,
                 mean_square: false,
                 time_scale: 1.0,
+                fixed: None,
             };
             let mut energy = EnergyWatch {
                 stored_start,

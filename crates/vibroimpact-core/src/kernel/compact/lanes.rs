@@ -1,0 +1,452 @@
+//! RK4 steps of [`LANES`] compact systems at once: the same operations as
+//! [`Compact::step`] (a fixed step from the rates at its start, no pair
+//! sticking), term for term and in the same order, each over an array of
+//! lanes that the compiler turns into vector instructions. The lanes share
+//! their shape (sizes, walls, law kind, force or not); their values differ.
+//! A contact branch becomes a select, which changes no result.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::{Compact, MAX_DIM, MAX_LEN, MAX_MODES, MAX_WALLS};
+use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
+use crate::model::assembly::{Mode, Scratch, CONTACT, INPUT, VISCOUS};
+use crate::model::contact::{AnyLaw, ContactLaw, Hertz, HysterHertz, Linear};
+use crate::model::signals::Signal;
+
+/// Systems stepped together.
+pub(crate) const LANES: usize = 16;
+
+/// One value per lane.
+type V = [f64; LANES];
+
+/// A state (or its rates) per lane.
+pub(crate) type LaneState = [V; MAX_LEN];
+
+/// A concrete law taken out of [`AnyLaw`].
+pub(crate) trait LaneLaw: ContactLaw + Copy {
+    fn of(law: &AnyLaw) -> Option<Self>;
+}
+impl LaneLaw for Hertz {
+    fn of(law: &AnyLaw) -> Option<Self> {
+        match law {
+            AnyLaw::Hertz(l) => Some(*l),
+            _ => None,
+        }
+    }
+}
+impl LaneLaw for HysterHertz {
+    fn of(law: &AnyLaw) -> Option<Self> {
+        match law {
+            AnyLaw::HysterHertz(l) => Some(*l),
+            _ => None,
+        }
+    }
+}
+impl LaneLaw for Linear {
+    fn of(law: &AnyLaw) -> Option<Self> {
+        match law {
+            AnyLaw::Linear(l) => Some(*l),
+            _ => None,
+        }
+    }
+}
+
+/// A wall of every lane (all compliant).
+#[derive(Debug, Clone, Copy)]
+struct Walls<L> {
+    h: [V; MAX_DIM],
+    push: [V; MAX_DIM],
+    offset: V,
+    law: [L; LANES],
+    damping: V,
+    mirror: bool,
+}
+
+/// The lanes' systems, their values side by side.
+#[derive(Debug, Clone)]
+pub(crate) struct Group<L> {
+    n: usize,
+    k: usize,
+    len: usize,
+    /// `[M^-1 K, M^-1 C, C, r]` of each mode.
+    modal: [[V; 4]; MAX_MODES],
+    /// The force's `M^-1 row^T` and row, and each lane's signal.
+    force: Option<([V; MAX_MODES], [V; MAX_MODES], Vec<Signal>)>,
+    gravity: V,
+    inertial_free: bool,
+    walls: Vec<Walls<L>>,
+}
+
+/// The lanes' step: its end, and the rates at its start.
+pub(crate) struct LaneStep {
+    pub(crate) end: Box<LaneState>,
+    pub(crate) first: Box<LaneState>,
+    point: Box<LaneState>,
+    stages: Box<[LaneState; 3]>,
+}
+
+impl LaneStep {
+    /// A state of every lane, zero.
+    pub(crate) fn state() -> Box<LaneState> {
+        Box::new([[0.0; LANES]; MAX_LEN])
+    }
+}
+
+impl Default for LaneStep {
+    fn default() -> Self {
+        Self {
+            end: Self::state(),
+            first: Self::state(),
+            point: Self::state(),
+            stages: Box::new([[[0.0; LANES]; MAX_LEN]; 3]),
+        }
+    }
+}
+
+/// Each wall's mode per lane: in compliant contact, and its latched approach rate.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LaneModes {
+    active: [[bool; LANES]; MAX_WALLS],
+    approach: [V; MAX_WALLS],
+}
+
+impl LaneModes {
+    /// The modes of lane `l`; false where one is neither open nor compliant
+    /// (the lanes do not take it).
+    pub(crate) fn set(&mut self, l: usize, modes: &[Mode]) -> bool {
+        for (w, mode) in modes.iter().enumerate().take(MAX_WALLS) {
+            match mode {
+                Mode::Open => self.active[w][l] = false,
+                Mode::Compliant { approach_rate } => {
+                    self.active[w][l] = true;
+                    self.approach[w][l] = *approach_rate;
+                }
+                _ => return false,
+            }
+        }
+        true
+    }
+}
+
+impl Default for LaneModes {
+    fn default() -> Self {
+        Self {
+            active: [[false; LANES]; MAX_WALLS],
+            approach: [[0.0; LANES]; MAX_WALLS],
+        }
+    }
+}
+
+/// Whether two systems have one shape: lanes of one group.
+fn same_shape(a: &Compact, b: &Compact) -> bool {
+    let kind = |c: &Compact, w: usize| c.walls[w].law.map(|(law, _)| std::mem::discriminant(&law));
+    a.count == b.count
+        && a.force.is_some() == b.force.is_some()
+        && a.inertial_free == b.inertial_free
+        && (0..a.count.min(MAX_WALLS))
+            .all(|w| a.walls[w].mirror == b.walls[w].mirror && kind(a, w) == kind(b, w))
+}
+
+impl<L: LaneLaw> Group<L> {
+    /// The group of `systems` (`(compact, n, k, state length)`, the first
+    /// repeated into lanes left empty), where they share a shape and every
+    /// wall has law `L`.
+    pub(crate) fn of(systems: &[(&Compact, usize, usize, usize)]) -> Option<Self> {
+        let &(first, n, k, len) = systems.first()?;
+        if systems.len() > LANES
+            || systems
+                .iter()
+                .any(|&(c, n2, k2, len2)| (n2, k2, len2) != (n, k, len) || !same_shape(first, c))
+        {
+            return None;
+        }
+        let lane = |l: usize| systems.get(l).unwrap_or(&systems[0]).0;
+        let d = n + k;
+        let mut modal = [[[0.0; LANES]; 4]; MAX_MODES];
+        let mut gravity = [0.0; LANES];
+        for l in 0..LANES {
+            let c = lane(l);
+            for i in 0..n {
+                for f in 0..4 {
+                    modal[i][f][l] = c.modal[i][f];
+                }
+            }
+            gravity[l] = c.gravity;
+        }
+        let force = first.force.as_ref().map(|_| {
+            let (mut push, mut row) = ([[0.0; LANES]; MAX_MODES], [[0.0; LANES]; MAX_MODES]);
+            let mut signals = Vec::with_capacity(LANES);
+            for l in 0..LANES {
+                let f = lane(l).force.as_ref().expect("one shape");
+                for i in 0..n {
+                    push[i][l] = f.push[i];
+                    row[i][l] = f.row[i];
+                }
+                signals.push(f.signal.clone());
+            }
+            (push, row, signals)
+        });
+        let mut walls = Vec::with_capacity(first.count);
+        for w in 0..first.count.min(MAX_WALLS) {
+            let (law, _) = first.walls[w].law?;
+            let mut wall = Walls {
+                h: [[0.0; LANES]; MAX_DIM],
+                push: [[0.0; LANES]; MAX_DIM],
+                offset: [0.0; LANES],
+                law: [L::of(&law)?; LANES],
+                damping: [0.0; LANES],
+                mirror: first.walls[w].mirror,
+            };
+            for l in 0..LANES {
+                let it = &lane(l).walls[w];
+                let (law, damping) = it.law?;
+                for i in 0..d {
+                    wall.h[i][l] = it.h[i];
+                    wall.push[i][l] = it.push[i];
+                }
+                wall.offset[l] = it.offset;
+                wall.law[l] = L::of(&law)?;
+                wall.damping[l] = damping;
+            }
+            walls.push(wall);
+        }
+        Some(Self {
+            n,
+            k,
+            len,
+            modal,
+            force,
+            gravity,
+            inertial_free: first.inertial_free,
+            walls,
+        })
+    }
+
+    /// [`Compact::rates`] of every lane (no pair sticking), the force's
+    /// value of each lane in `value`.
+    #[inline(always)]
+    fn rates(&self, y: &LaneState, value: &V, modes: &LaneModes, out: &mut LaneState) {
+        let (n, d) = (self.n, self.n + self.k);
+        let mut inertial = [0.0; LANES];
+        for l in 0..LANES {
+            inertial[l] = 0.0 + self.gravity[l];
+        }
+        let mut input = [0.0; LANES];
+        let mut viscous = [0.0; LANES];
+        if let Some((push, row, _)) = &self.force {
+            let mut power = [-0.0; LANES];
+            for i in 0..n {
+                let [k, c, damping, r] = &self.modal[i];
+                for l in 0..LANES {
+                    let (x, v) = (y[i][l], y[d + i][l]);
+                    out[i][l] = v;
+                    let elastic = if self.inertial_free {
+                        -(k[l] * x + c[l] * v)
+                    } else {
+                        -(k[l] * x + c[l] * v) - r[l] * inertial[l]
+                    };
+                    out[d + i][l] = elastic + push[i][l] * value[l];
+                    viscous[l] += damping[l] * v * v;
+                    power[l] += row[i][l] * v;
+                }
+            }
+            for l in 0..LANES {
+                input[l] += value[l] * power[l];
+            }
+        } else {
+            for i in 0..n {
+                let [k, c, damping, r] = &self.modal[i];
+                for l in 0..LANES {
+                    let (x, v) = (y[i][l], y[d + i][l]);
+                    out[i][l] = v;
+                    out[d + i][l] = -(k[l] * x + c[l] * v) - r[l] * inertial[l];
+                    viscous[l] += damping[l] * v * v;
+                }
+            }
+        }
+        for j in n..d {
+            for l in 0..LANES {
+                out[j][l] = y[d + j][l];
+                out[d + j][l] = -inertial[l];
+            }
+        }
+        // The last wall's products where it was in contact (a mirror wall
+        // takes them negated).
+        let mut previous = [false; LANES];
+        let (mut px, mut pv) = ([0.0; LANES], [0.0; LANES]);
+        for (w, wall) in self.walls.iter().enumerate() {
+            let loss = 2 * d + CONTACT + w;
+            let active = &modes.active[w];
+            let mut total = [0.0; LANES];
+            let mut add = [false; LANES];
+            for l in 0..LANES {
+                // `h_dot`'s sums.
+                let (mut sx, mut sv) = ([-0.0; 2], [-0.0; 2]);
+                for i in 0..d {
+                    sx[i % 2] += wall.h[i][l] * y[i][l];
+                    sv[i % 2] += wall.h[i][l] * y[d + i][l];
+                }
+                let (hx, hv) = if previous[l] && wall.mirror {
+                    (-px[l], -pv[l])
+                } else {
+                    (sx[0] + sx[1], sv[0] + sv[1])
+                };
+                let (indentation, rate) = (-(wall.offset[l] + hx), -hv);
+                let (force, elastic) = if indentation > 0.0 {
+                    wall.law[l].force_and_elastic(indentation, rate, modes.approach[w][l])
+                } else {
+                    (0.0, 0.0)
+                };
+                total[l] = force + wall.damping[l] * rate;
+                add[l] = active[l] && total[l] != 0.0;
+                out[loss][l] = if active[l] {
+                    (total[l] - elastic) * rate
+                } else {
+                    0.0
+                };
+                previous[l] = active[l];
+                (px[l], pv[l]) = (hx, hv);
+            }
+            for i in 0..d {
+                for l in 0..LANES {
+                    let pushed = out[d + i][l] + wall.push[i][l] * total[l];
+                    out[d + i][l] = if add[l] { pushed } else { out[d + i][l] };
+                }
+            }
+        }
+        out[2 * d + VISCOUS] = viscous;
+        out[2 * d + INPUT] = input;
+    }
+
+    /// Each lane's force at `time` through its own cache (as its run's
+    /// rates take it, in the same order).
+    #[inline(always)]
+    fn values(&self, scratch: &mut [Scratch], time: f64) -> V {
+        let mut value = [0.0; LANES];
+        if let Some((_, _, signals)) = &self.force {
+            for (l, s) in scratch.iter_mut().enumerate().take(LANES) {
+                value[l] = s.first_force_value(&signals[l], time);
+            }
+        }
+        value
+    }
+
+    /// One RK4 step `h` from `(time, start)` of every lane in `modes`, as
+    /// [`Compact::step`] takes it with no first stage given: the end in
+    /// `out.end`, the first stage in `out.first`; each lane's force through
+    /// its `scratch` (one per lane).
+    pub(crate) fn step(
+        &self,
+        time: f64,
+        start: &LaneState,
+        h: f64,
+        modes: &LaneModes,
+        scratch: &mut [Scratch],
+        out: &mut LaneStep,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the processor has the feature the function is built for.
+                return unsafe { self.step_avx512(time, start, h, modes, scratch, out) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: as above.
+                return unsafe { self.step_avx2(time, start, h, modes, scratch, out) };
+            }
+        }
+        self.step_in(time, start, h, modes, scratch, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn step_avx512(
+        &self,
+        time: f64,
+        start: &LaneState,
+        h: f64,
+        modes: &LaneModes,
+        scratch: &mut [Scratch],
+        out: &mut LaneStep,
+    ) {
+        self.step_in(time, start, h, modes, scratch, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn step_avx2(
+        &self,
+        time: f64,
+        start: &LaneState,
+        h: f64,
+        modes: &LaneModes,
+        scratch: &mut [Scratch],
+        out: &mut LaneStep,
+    ) {
+        self.step_in(time, start, h, modes, scratch, out)
+    }
+
+    #[inline(always)]
+    fn step_in(
+        &self,
+        time: f64,
+        start: &LaneState,
+        h: f64,
+        modes: &LaneModes,
+        scratch: &mut [Scratch],
+        out: &mut LaneStep,
+    ) {
+        let coordinates = 2 * (self.n + self.k);
+        let len = self.len.min(MAX_LEN);
+        let times = [
+            time,
+            time + RK4_C[1] * h,
+            time + RK4_C[2] * h,
+            time + RK4_C[3] * h,
+        ];
+        let hw = [h * RK4_A[1][0], h * RK4_A[2][1], h * RK4_A[3][2]];
+        let w = [h * RK4_B[0], h * RK4_B[1], h * RK4_B[2], h * RK4_B[3]];
+        let LaneStep {
+            end,
+            first,
+            point,
+            stages,
+        } = out;
+        // As the compact step's fresh arrays: slots no rate writes stay 0.
+        **first = [[0.0; LANES]; MAX_LEN];
+        **stages = [[[0.0; LANES]; MAX_LEN]; 3];
+        let value = self.values(scratch, times[0]);
+        self.rates(start, &value, modes, first);
+        let [k1, k2, k3] = &mut **stages;
+        for e in 0..coordinates {
+            for l in 0..LANES {
+                point[e][l] = start[e][l] + hw[0] * first[e][l];
+            }
+        }
+        let value = self.values(scratch, times[1]);
+        self.rates(point, &value, modes, k1);
+        for e in 0..coordinates {
+            for l in 0..LANES {
+                point[e][l] = start[e][l] + hw[1] * k1[e][l];
+            }
+        }
+        let value = self.values(scratch, times[2]);
+        self.rates(point, &value, modes, k2);
+        for e in 0..coordinates {
+            for l in 0..LANES {
+                point[e][l] = start[e][l] + hw[2] * k2[e][l];
+            }
+        }
+        let value = self.values(scratch, times[3]);
+        self.rates(point, &value, modes, k3);
+        for e in 0..len {
+            for l in 0..LANES {
+                end[e][l] = start[e][l]
+                    + w[0] * first[e][l]
+                    + w[1] * k1[e][l]
+                    + w[2] * k2[e][l]
+                    + w[3] * k3[e][l];
+            }
+        }
+    }
+}
