@@ -1,8 +1,20 @@
-//! The methods of a 0.2 run by name: the stepper made once for a system, the
-//! fixed step it takes, and the run. What the binding's runs and a study's
-//! runs share, so that a method means the same in both.
+//! The methods of a run by name, defined once: the table of methods (their
+//! kinds, steppings, options, defaults and ranges, [`table`]), the up-front
+//! limits of a run ([`limits`]), the stepper made once for a system, the
+//! fixed step it takes, and the run. Every front end (the binding's runs, a
+//! study's runs, Python's schemas through the binding) reads it, so that a
+//! method means the same in each.
 
-use crate::error::{within, Error, Result};
+mod limits;
+mod table;
+
+pub use limits::{check_run, RunPlan};
+pub use table::{
+    method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_STEPS, DT, GAMMA,
+    MAX_STEPS, METHOD_OPTIONS, METHOD_SPECS, RTOL, SPECTRAL_RADIUS,
+};
+
+use crate::error::{Error, Result};
 use crate::kernel::events::{
     integrate_system, integrate_system_stepped, RunOptions, Stepping, SystemSolution,
 };
@@ -22,29 +34,23 @@ pub enum AnyStepper {
     Exact(ExactFlow),
 }
 
-/// The methods of a `[structure]` system, by name: what [`AnyStepper::new`]
+/// The methods' names, in the registry's order: what [`AnyStepper::new`]
 /// makes, in the order its unknown-name message lists them.
-pub const METHODS: [&str; 7] = [
-    "rk4",
-    "dopri5",
-    "dop853",
-    "newmark",
-    "newmark-implicit",
-    "generalized-alpha",
-    "exact",
-];
-
-/// Newmark's `beta` in [0, 0.5] and `gamma` in [0.5, 1] (defaults 1/4, 1/2:
-/// average acceleration), or an error naming the one outside.
-fn newmark_options(beta: f64, gamma: f64) -> Result<(f64, f64)> {
-    Ok((
-        within("beta", beta, 0.0, 0.5, false, "in [0, 0.5]")?,
-        within("gamma", gamma, 0.5, 1.0, false, "in [0.5, 1]")?,
-    ))
-}
+pub const METHODS: [&str; 7] = {
+    let mut names = [""; 7];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = METHOD_SPECS[i].name;
+        i += 1;
+    }
+    names
+};
 
 impl AnyStepper {
-    /// The method named `method` for `system`, with its settings.
+    /// The method named `method` for `system`, with its settings; every
+    /// setting checked against the registry's range whatever the method (a
+    /// wrong value is never silently ignored), an unknown name refused with
+    /// the registry's names.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         system: &Assembly,
@@ -55,29 +61,38 @@ impl AnyStepper {
         gamma: f64,
         spectral_radius: f64,
     ) -> Result<Self> {
+        let spec = table::method(method)?;
+        let Options {
+            rtol,
+            atol,
+            beta,
+            gamma,
+            spectral_radius,
+        } = Options {
+            rtol,
+            atol,
+            beta,
+            gamma,
+            spectral_radius,
+        }
+        .checked()?;
         let len = system.state_len();
-        Ok(match method {
+        Ok(match spec.name {
             "rk4" => Self::Rk(ExplicitRk::rk4(len)),
             "dopri5" => Self::Rk(ExplicitRk::dopri5(len, rtol, atol)),
             "dop853" => Self::Rk(ExplicitRk::dop853(len, rtol, atol)),
-            "newmark" => {
-                let (beta, gamma) = newmark_options(beta, gamma)?;
-                Self::Paper(PaperNewmark::new(system, beta, gamma)?)
-            }
-            "newmark-implicit" => {
-                let (beta, gamma) = newmark_options(beta, gamma)?;
-                Self::Newmark(NewmarkFamily::newmark(system, beta, gamma))
-            }
+            "newmark" => Self::Paper(PaperNewmark::new(system, beta, gamma)?),
+            "newmark-implicit" => Self::Newmark(NewmarkFamily::newmark(system, beta, gamma)),
             "generalized-alpha" => {
                 Self::Newmark(NewmarkFamily::generalized_alpha(system, spectral_radius))
             }
             "exact" => Self::Exact(ExactFlow::new(system)?),
+            // A name listed in the table without a stepper here: the test
+            // every_listed_method_is_made catches it before a user does.
             other => {
-                let names: Vec<String> = METHODS.iter().map(|m| format!("{m:?}")).collect();
                 return Err(Error::Inconsistent(format!(
-                    "method must be one of {} for a [structure] system, got {other:?}",
-                    names.join(", ")
-                )));
+                    "method {other:?} is listed but not built"
+                )))
             }
         })
     }

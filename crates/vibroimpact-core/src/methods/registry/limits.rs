@@ -1,0 +1,344 @@
+//! The up-front limits of a run, checked before its first step (SI units):
+//! the steps it may take, the rows and memory its records may keep, and the
+//! time scales its steps must resolve (the fastest natural mode against an
+//! explicit fixed step or a mode-stepped method, a harmonic forcing against
+//! the step). Each refusal is one line naming the field (as a scenario's
+//! `[solver]`, `[output]` or `[[excitation]]` key) and what is allowed.
+
+use super::table::{method, Kind, MethodSpec};
+use crate::error::{Error, Result};
+use crate::kernel::memory::MAX_RECORD_BYTES;
+use crate::model::assembly::SystemSpec;
+use crate::model::structure::Structure;
+
+/// What a run is asked to do, as far as its limits go.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunPlan<'a> {
+    pub method: &'a str,
+    /// Step, s: required by the fixed-step methods, the cap of the exact
+    /// flow's step, an adaptive method's first step.
+    pub dt: Option<f64>,
+    /// End time, s.
+    pub t_end: f64,
+    pub max_steps: u64,
+    /// The history rows plus contacts the run may keep.
+    pub max_rows: u64,
+    /// Every `every`-th step kept in the history.
+    pub every: u64,
+    /// Whether the history is kept.
+    pub history: bool,
+    /// Stroboscopic sampling period, s (None: none).
+    pub strobe_period: Option<f64>,
+}
+
+/// Refuse a run of `system` that `plan` cannot complete within its limits,
+/// before any step: the step count of a fixed step (or of the exact flow's
+/// capped step) beyond `max_steps`, an explicit fixed step over the fastest
+/// mode's period, a mode-stepped method through more than `max_steps` of its
+/// periods, a harmonic forcing sampled below two steps a period (or, for the
+/// exact flow, through more than `max_steps` periods), a history or a strobe
+/// record beyond `max_rows` or the records' memory.
+pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
+    let spec = method(plan.method)?;
+    let fixed = spec.kind.is_fixed_step();
+    if fixed && plan.dt.is_none() {
+        return Err(Error::Inconsistent(format!(
+            "[solver] dt: is required for method {:?} (a step in s > 0)",
+            spec.name
+        )));
+    }
+    // The exact flow steps at most dt where one is given: as many steps.
+    let step = plan.dt.filter(|_| fixed || spec.kind == Kind::Exact);
+    if let Some(dt) = step {
+        let steps = plan.t_end / dt;
+        if steps > plan.max_steps as f64 {
+            return Err(Error::Inconsistent(format!(
+                "[solver] t_end / dt = {} steps exceeds max_steps ({}): raise dt or max_steps, or \
+                 shorten t_end",
+                python_e3(steps),
+                plan.max_steps
+            )));
+        }
+    }
+    check_natural_period(spec, plan, &system.structure)?;
+    check_forcing_steps(spec, plan, system)?;
+    let width = 1 + 2 * (system.structure.dofs() + system.dampers.len());
+    if let Some(dt) = step.filter(|_| plan.history) {
+        check_history(
+            plan,
+            plan.t_end / dt / plan.every.max(1) as f64 + 2.0,
+            width,
+        )?;
+    }
+    if let Some(period) = plan.strobe_period.filter(|p| *p > 0.0) {
+        let strobes = plan.t_end / period;
+        if strobes > plan.max_rows as f64 || strobes * (width * 8) as f64 > MAX_RECORD_BYTES as f64
+        {
+            return Err(Error::Inconsistent(format!(
+                "[output] strobe_period: t_end / strobe_period = {} rows of {width} values, more \
+                 than max_rows = {} or the {} MiB a run's records may take: lengthen \
+                 strobe_period or shorten t_end",
+                python_e3(strobes),
+                plan.max_rows,
+                MAX_RECORD_BYTES >> 20
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A fixed-step history of `rows` rows of `width` values is known before the
+/// run: refused up front rather than stopped at the cap.
+fn check_history(plan: &RunPlan, rows: f64, width: usize) -> Result<()> {
+    if rows > plan.max_rows as f64 {
+        return Err(Error::Inconsistent(format!(
+            "[solver] the history would keep {} rows (t_end / dt / every), more than max_rows = \
+             {}: raise every, set history = false, shorten t_end or raise max_rows",
+            python_e3(rows),
+            plan.max_rows
+        )));
+    }
+    let bytes = rows * (width * 8) as f64;
+    if bytes > MAX_RECORD_BYTES as f64 {
+        return Err(Error::Inconsistent(format!(
+            "[output] history: the history would keep {} rows of {width} values, {:.0} MiB, more \
+             than the {} MiB a run's records may take: raise every, set history = false or \
+             shorten t_end",
+            python_e3(rows),
+            bytes / (1u64 << 20) as f64,
+            MAX_RECORD_BYTES >> 20
+        )));
+    }
+    Ok(())
+}
+
+/// An upper bound (Hz) of the structure's highest natural frequency without
+/// its eigenvalues: w^2 is at most K's largest absolute row sum over the
+/// lower end of M's smallest Gershgorin disc (infinite where that end is not
+/// above 0); 0 where K is zero.
+fn frequency_bound(structure: &Structure) -> f64 {
+    let n = structure.dofs();
+    let (mass, stiffness) = (structure.mass(), structure.stiffness());
+    let row_sum = |m: &[f64], r: usize| m[r * n..(r + 1) * n].iter().map(|v| v.abs()).sum::<f64>();
+    let top = (0..n).map(|r| row_sum(stiffness, r)).fold(0.0, f64::max);
+    if top.is_nan() || top <= 0.0 {
+        return 0.0;
+    }
+    let lowest = (0..n)
+        .map(|r| 2.0 * mass[r * n + r] - row_sum(mass, r))
+        .fold(f64::INFINITY, f64::min);
+    if lowest > 0.0 {
+        (top / lowest).sqrt() / std::f64::consts::TAU
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The structure's highest natural frequency (Hz; 0 for none).
+fn highest_frequency(structure: &Structure) -> f64 {
+    let top = structure
+        .natural_frequencies()
+        .into_iter()
+        .fold(0.0f64, f64::max);
+    if top.is_finite() {
+        top / std::f64::consts::TAU
+    } else {
+        0.0
+    }
+}
+
+/// Whether a run of `spec` and `plan` resolves a fastest mode of `frequency`.
+fn resolves(spec: &MethodSpec, plan: &RunPlan, frequency: f64) -> bool {
+    let explicit = spec.kind == Kind::Explicit;
+    if explicit && frequency * plan.dt.unwrap_or(0.0) > 1.0 {
+        return false;
+    }
+    !(spec.kind.is_mode_stepped() && plan.t_end * frequency > plan.max_steps as f64)
+}
+
+/// Refuse a run that cannot resolve the structure's fastest mode: an
+/// explicit fixed step is unstable on a mode whose period is shorter than
+/// it; an adaptive method or the exact flow steps at least once in each
+/// period of that mode. The eigenvalues only where the bound does not
+/// settle it (they had cost a dropped ball's run a quarter of its time).
+fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure) -> Result<()> {
+    let explicit = spec.kind == Kind::Explicit;
+    if !explicit && !spec.kind.is_mode_stepped() {
+        return Ok(());
+    }
+    if resolves(spec, plan, frequency_bound(structure)) {
+        return Ok(());
+    }
+    let frequency = highest_frequency(structure);
+    if frequency.is_nan() || frequency <= 0.0 {
+        return Ok(());
+    }
+    let period = 1.0 / frequency;
+    if let Some(dt) = plan.dt.filter(|dt| explicit && period < *dt) {
+        return Err(Error::Inconsistent(format!(
+            "[solver] dt: the fastest mode's period, {} s ({} Hz), is below dt = {} s, where {} \
+             is unstable: reduce dt below {} s, use an implicit method (newmark-implicit, \
+             generalized-alpha), or check mass and stiffness",
+            python_g3(period),
+            python_g3(frequency),
+            python_repr(dt),
+            spec.name,
+            python_g3(period / 4.0)
+        )));
+    }
+    let steps = plan.t_end * frequency;
+    if spec.kind.is_mode_stepped() && steps > plan.max_steps as f64 {
+        return Err(Error::Inconsistent(format!(
+            "[solver] t_end = {} s spans {} periods of the fastest mode ({} Hz), and {} steps at \
+             least once in each: more than max_steps ({}); shorten t_end below {} s, raise \
+             max_steps, or check mass and stiffness",
+            python_repr(plan.t_end),
+            python_g3(steps),
+            python_g3(frequency),
+            spec.name,
+            plan.max_steps,
+            python_g3(plan.max_steps as f64 / frequency)
+        )));
+    }
+    Ok(())
+}
+
+/// Refuse a harmonic forcing the run's steps cannot follow: a fixed step
+/// samples it below two steps a period (its result aliased), and the exact
+/// flow steps at least once in each of its periods.
+fn check_forcing_steps(spec: &MethodSpec, plan: &RunPlan, system: &SystemSpec) -> Result<()> {
+    for (index, excitation) in system.excitations.iter().enumerate() {
+        let (_, frequencies) = excitation.signal.harmonic_frequencies();
+        for frequency in frequencies.unwrap_or_default() {
+            let fixed_dt = plan.dt.filter(|_| spec.kind.is_fixed_step());
+            if let Some(dt) = fixed_dt.filter(|dt| frequency * 2.0 * dt > 1.0) {
+                return Err(Error::Inconsistent(format!(
+                    "[[excitation]] {index}: frequency {} Hz is sampled below two steps of dt = \
+                     {} s a period: give at most {} Hz, or reduce dt below {} s",
+                    python_repr(frequency),
+                    python_repr(dt),
+                    python_g3(1.0 / (2.0 * dt)),
+                    python_g3(1.0 / (20.0 * frequency))
+                )));
+            }
+            let periods = frequency * plan.t_end;
+            if spec.kind == Kind::Exact && periods > plan.max_steps as f64 {
+                return Err(Error::Inconsistent(format!(
+                    "[[excitation]] {index}: frequency {} Hz: t_end = {} s spans {} of its \
+                     periods, and the exact flow steps at least once in each: more than \
+                     max_steps ({}); give at most {} Hz or shorten t_end",
+                    python_repr(frequency),
+                    python_repr(plan.t_end),
+                    python_g3(periods),
+                    plan.max_steps,
+                    python_g3(plan.max_steps as f64 / plan.t_end)
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Rust's exponent (`1e8`, `1e-5`) as Python writes it (`1e+08`, `1e-05`),
+/// so that a message reads the same from either language.
+fn python_exponent(text: &str) -> String {
+    match text.split_once('e') {
+        Some((mantissa, exponent)) => {
+            let value: i32 = exponent.parse().unwrap_or(0);
+            let sign = if value < 0 { '-' } else { '+' };
+            format!("{mantissa}e{sign}{:02}", value.abs())
+        }
+        None => text.to_string(),
+    }
+}
+
+/// `x` as Python's `repr` writes a float (shortest round trip).
+pub(crate) fn python_repr(x: f64) -> String {
+    if x.is_nan() {
+        return "nan".into();
+    }
+    if x.is_infinite() {
+        return if x > 0.0 { "inf" } else { "-inf" }.into();
+    }
+    python_exponent(&format!("{x:?}"))
+}
+
+/// `x` as Python's `format(x, ".3e")` writes it.
+pub(crate) fn python_e3(x: f64) -> String {
+    if !x.is_finite() {
+        return python_repr(x);
+    }
+    python_exponent(&format!("{x:.3e}"))
+}
+
+/// `x` as Python's `format(x, ".3g")` writes it: three significant digits,
+/// fixed between 1e-4 and 1e3, trailing zeros dropped.
+pub(crate) fn python_g3(x: f64) -> String {
+    if !x.is_finite() {
+        return python_repr(x);
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let scientific = format!("{x:.2e}");
+    let (mantissa, exponent) = scientific.split_once('e').expect("an exponent");
+    let exponent: i32 = exponent.parse().expect("an integer exponent");
+    let trim = |s: &str| -> String {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    if (-4..3).contains(&exponent) {
+        let decimals = (2 - exponent) as usize;
+        trim(&format!("{x:.decimals$}"))
+    } else {
+        let sign = if exponent < 0 { '-' } else { '+' };
+        format!("{}e{sign}{:02}", trim(mantissa), exponent.abs())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_written_as_python_writes_them() {
+        crate::testing::timeout(10, || {
+            // Python's own outputs: repr(x), format(x, ".3e"), format(x, ".3g").
+            for (x, repr) in [
+                (1e-5, "1e-05"),
+                (1e9, "1000000000.0"),
+                (1e16, "1e+16"),
+                (0.1, "0.1"),
+                (2.0, "2.0"),
+                (1.5e-7, "1.5e-07"),
+                (-3e300, "-3e+300"),
+            ] {
+                assert_eq!(python_repr(x), repr);
+            }
+            for (x, e3) in [
+                (1e8, "1.000e+08"),
+                (3.0e-12, "3.000e-12"),
+                (12345.0, "1.234e+04"),
+            ] {
+                assert_eq!(python_e3(x), e3);
+            }
+            for (x, g3) in [
+                (2e9, "2e+09"),
+                (0.00123456, "0.00123"),
+                (123.456, "123"),
+                (1234.5, "1.23e+03"),
+                (0.5, "0.5"),
+                (1.0, "1"),
+                (9.999e-5, "0.0001"),
+                (1e-5, "1e-05"),
+                (0.0, "0"),
+                (f64::INFINITY, "inf"),
+            ] {
+                assert_eq!(python_g3(x), g3, "{x}");
+            }
+        });
+    }
+}

@@ -1,0 +1,87 @@
+//! The table's defaults, ranges and names.
+
+use super::*;
+
+#[test]
+fn the_default_options_are_the_table_s_and_in_range() {
+    crate::testing::timeout(10, || {
+        let options = Options::default();
+        assert_eq!(options.checked(), Ok(options));
+        let pairs = [
+            (options.rtol, RTOL),
+            (options.atol, ATOL),
+            (options.beta, BETA),
+            (options.gamma, GAMMA),
+            (options.spectral_radius, SPECTRAL_RADIUS),
+        ];
+        for (value, spec) in pairs {
+            assert_eq!(Some(value), spec.default, "{}", spec.name);
+            assert_eq!(spec.check(value), Ok(value));
+        }
+        assert_eq!(MAX_STEPS.default, Some(DEFAULT_MAX_STEPS as f64));
+    });
+}
+
+#[test]
+fn each_option_outside_its_range_is_named_with_what_is_allowed() {
+    crate::testing::timeout(10, || {
+        let outside = [
+            (RTOL, [1e-16, 0.2, f64::NAN]),
+            (ATOL, [0.0, 1.5, f64::INFINITY]),
+            (BETA, [-0.01, 0.51, f64::NAN]),
+            (GAMMA, [0.49, 1.01, f64::NAN]),
+            (SPECTRAL_RADIUS, [-0.1, 1.1, f64::NAN]),
+        ];
+        for (spec, values) in outside {
+            for value in values {
+                let mut options = Options::default();
+                match spec.name {
+                    "rtol" => options.rtol = value,
+                    "atol" => options.atol = value,
+                    "beta" => options.beta = value,
+                    "gamma" => options.gamma = value,
+                    _ => options.spectral_radius = value,
+                }
+                let text = options.checked().unwrap_err().to_string();
+                let expected = format!("{} must be finite and {}, got", spec.name, spec.allowed);
+                assert!(text.starts_with(&expected), "{text}");
+                assert!(!text.contains('\n'));
+            }
+        }
+        // The ends of each range are allowed (the low end of atol excluded).
+        for spec in METHOD_OPTIONS {
+            assert_eq!(spec.check(spec.high), Ok(spec.high), "{}", spec.name);
+            assert_eq!(
+                spec.check(spec.low).is_ok(),
+                !spec.low_open,
+                "{}",
+                spec.name
+            );
+        }
+    });
+}
+
+#[test]
+fn the_kinds_say_which_methods_step_by_dt() {
+    crate::testing::timeout(10, || {
+        let fixed: Vec<&str> = METHOD_SPECS
+            .iter()
+            .filter(|m| m.kind.is_fixed_step())
+            .map(|m| m.name)
+            .collect();
+        assert_eq!(
+            fixed,
+            ["rk4", "newmark", "newmark-implicit", "generalized-alpha"]
+        );
+        for spec in METHOD_SPECS {
+            // Fixed stepping is for the methods that step by dt, and only them.
+            assert_eq!(spec.steppings.contains(&"fixed"), spec.kind.is_fixed_step());
+            assert_eq!(spec.steppings[0], "events");
+            assert_eq!(method(spec.name), Ok(&spec));
+        }
+        let text = method("newmark-lagged").unwrap_err().to_string();
+        for spec in METHOD_SPECS {
+            assert!(text.contains(&format!("\"{}\"", spec.name)), "{text}");
+        }
+    });
+}
