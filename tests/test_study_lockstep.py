@@ -170,11 +170,16 @@ def test_a_run_that_creates_energy_fails_alone(tmp_path: Path) -> None:
             ),
             ["stepping", "rigid"],
         ),
+        # Unequal clearances and gravity are taken by the compact lanes; a base
+        # excitation is not.
         (
-            ("clearance = 0.01", "lower_clearance = 0.01\nupper_clearance = 0.02"),
-            ["stepping", "clearances"],
+            (
+                "[solver]",
+                '[[excitation]]\nkind = "base"\nsignal = "harmonic"\n'
+                "amplitude = 1.0\nfrequency = 1.0\n[solver]",
+            ),
+            ["stepping", "small modal"],
         ),
-        (("[solver]", "[gravity]\n[solver]"), ["stepping", "gravity"]),
     ],
 )
 def test_what_the_lockstep_kernel_cannot_take_exits_2_naming_the_key(
@@ -227,3 +232,92 @@ def test_structure_axes_run_in_lockstep_too(tmp_path: Path) -> None:
         assert point["rms"].item() == pytest.approx(
             np.sqrt(np.trapezoid(w * w, dx=DT) / T_END), rel=1e-12
         )
+
+
+# The acceptance case of issue 24: a forced 2-mode cantilever with two hertz-damped
+# dampers, 1,000 runs in compact lockstep lanes, each equal bit for bit to the single
+# fixed-step run of the same system (t_end shortened to keep the test fast).
+FREQUENCIES = [4.0 + 0.9 * i for i in range(40)]
+CLEARANCES = [1e-4 + 1.6e-5 * j for j in range(25)]
+CANTILEVER = {
+    "kind": "cantilever",
+    "length": 0.5,
+    "youngs_modulus": 7e10,
+    "second_moment": 1e-10,
+    "mass_per_length": 0.27,
+    "modes": 2,
+    "damping_ratio": 0.01,
+}
+
+
+def _damper(at: float, clearance: float) -> dict[str, Any]:
+    return {
+        "mass": 0.01,
+        "at": at,
+        "clearance": clearance,
+        "law": "hertz-damped",
+        "stiffness": 1e7,
+        "restitution": 0.6,
+    }
+
+
+def _force(frequency: float) -> dict[str, Any]:
+    return {
+        "kind": "force",
+        "at": 0.5,
+        "signal": "harmonic",
+        "amplitude": 2.0,
+        "frequency": frequency,
+    }
+
+
+def _toml(value: Any) -> str:
+    return json.dumps(value)
+
+
+def test_a_forced_cantilever_study_in_lanes_is_its_single_fixed_runs(tmp_path: Path) -> None:
+    dt, t_end, record_from = 1e-5, 4e-3, 1e-3
+    lines = ["[structure]", *(f"{k} = {_toml(v)}" for k, v in CANTILEVER.items())]
+    for at, clearance in ((0.5, 2e-4), (0.25, 1e-4)):
+        lines += ["[[damper]]", *(f"{k} = {_toml(v)}" for k, v in _damper(at, clearance).items())]
+    lines += ["[[excitation]]", *(f"{k} = {_toml(v)}" for k, v in _force(8.0).items())]
+    lines += [
+        "[solver]",
+        'method = "rk4"',
+        f"dt = {dt}",
+        f"t_end = {t_end}",
+        "[study]",
+        'analysis = "run"',
+        'stepping = "fixed"',
+        f"record_from = {record_from}",
+        'metrics = ["peak", "rms", "impacts"]',
+        "chunk_size = 1000",
+        "[study.axes]",
+        f'"excitation.0.frequency" = {_toml(FREQUENCIES)}',
+        f'"damper.0.clearance" = {_toml(CLEARANCES)}',
+    ]
+    study = load(tmp_path, "\n".join(lines) + "\n")
+    assert study.runs == 1000
+    out = study.run_chunk(range(study.runs), threads=2)
+    peak = np.asarray(out["peak"]).reshape(1000, 2)
+    rms = np.asarray(out["rms"]).reshape(1000, 2)
+    impacts = np.asarray(out["impacts"])
+    assert int(np.asarray(out["status"]).max()) == 0
+    assert impacts.sum() > 100
+    for row in range(1000):
+        frequency, clearance = FREQUENCIES[row // 25], CLEARANCES[row % 25]
+        sol = vi.simulate_system(
+            CANTILEVER,
+            damper=[_damper(0.5, clearance), _damper(0.25, 1e-4)],
+            excitation=[_force(frequency)],
+            method="rk4",
+            dt=dt,
+            t_end=t_end,
+            stepping="fixed",
+            record_from=record_from,
+        )
+        onsets = np.asarray(sol.contacts.onset)
+        assert impacts[row] == np.count_nonzero(onsets >= record_from), row
+        # Bit for bit: the same float64 values.
+        assert peak[row].tobytes() == np.asarray(sol.peak).tobytes(), row
+        assert rms[row].tobytes() == np.asarray(sol.rms).tobytes(), row
