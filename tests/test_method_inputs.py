@@ -242,12 +242,6 @@ def test_dt_is_optional_for_the_adaptive_methods(table1_toml: str) -> None:
     assert sol.stepping == "events" and sol.method == "dop853"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="two-mass runs on the general kernel: energy_change is NaN where the history "
-    "does not keep the contact's onset and separation (every > 1) until the kernel "
-    "reports it per contact (NaN != NaN in the dicts compared)",
-)
 def test_new_solver_keys_reach_the_run(table1_toml: str) -> None:
     solver = (
         'method = "generalized-alpha"\ndt = 1e-4\nt_end = 0.2\nstepping = "events"\n'

@@ -60,10 +60,6 @@ def general_text(solver: dict[str, Any]) -> str:
     )
 
 
-FIXED_PENDING = pytest.mark.xfail(
-    strict=True,
-    reason="stepping = 'fixed' runs on the 0.1 kernel until the general kernel has it",
-)
 SOLVERS = [
     pytest.param({"method": "rk4", "stepping": "events", "dt": 1e-4}, id="rk4"),
     pytest.param({"method": "dop853", "rtol": 1e-10, "atol": 1e-13}, id="dop853"),
@@ -71,12 +67,20 @@ SOLVERS = [
     pytest.param({"method": "newmark-implicit", "dt": 1e-4}, id="newmark-implicit"),
     pytest.param({"method": "generalized-alpha", "dt": 1e-4}, id="generalized-alpha"),
     pytest.param(
-        {"method": "rk4", "stepping": "fixed", "dt": 1e-4}, id="rk4-fixed", marks=FIXED_PENDING
+        {"method": "rk4", "stepping": "fixed", "dt": 1e-4},
+        id="rk4-fixed",
+        marks=pytest.mark.xfail(
+            strict=True,
+            reason="two-mass fixed RK4 stays on the 0.1 kernel until the general kernel's "
+            "keeps numba's pace (1.41e7 against 7.83e7 steps/s)",
+        ),
     ),
     pytest.param(
         {"method": "newmark", "stepping": "fixed", "dt": 1e-4},
         id="newmark-fixed",
-        marks=FIXED_PENDING,
+        marks=pytest.mark.xfail(
+            strict=True, reason="the 0.2 format's [solver] does not take method 'newmark' yet"
+        ),
     ),
 ]
 

@@ -471,7 +471,11 @@ def test_momentum_conserved_without_spring(
     """K = C = 0: only internal forces, so M w' + m y' is constant to round-off."""
     contact = vi.Contact(law, stiffness=stiffness, damping=0.05, restitution=restitution)
     start = vi.InitialState(main_velocity=-0.03, impact_displacement=0.005, impact_velocity=0.07)
-    sol = vi.simulate(free_system, contact, start, method=method, dt=1e-4, t_end=2.0)
+    # The paper's lagged Newmark creates energy at each contact by design: with Hertz and
+    # c1 the general kernel's balance finds 5.02e-2 of the energy in play by 1.72 s (the
+    # 0.1 kernel's, less), so its tolerance is loosened as `vibroimpact paper` does.
+    limits = {"energy_tolerance": 0.5} if method == "newmark" else {}
+    sol = vi.simulate(free_system, contact, start, method=method, dt=1e-4, t_end=2.0, **limits)
     assert len(sol.contacts) >= 3  # several contacts on both walls
     momentum = MAIN_MASS * sol.main_velocity + IMPACT_MASS * sol.impact_velocity
     p0 = MAIN_MASS * -0.03 + IMPACT_MASS * 0.07

@@ -1,7 +1,7 @@
 //! Steps per second of the core kernels alone (no Python), on the founding
 //! paper's Table 1 system with Hyster-Hertz contact (e = 0.9), 1e7 steps of
 //! 1e-4 s for each fixed-step method; then the time per collision of the
-//! adaptive methods. Each event-stepping method on the 0.1 kernel, then on
+//! adaptive methods. Each method and stepping on the 0.1 kernel, then on
 //! the general kernel (the preset [`ImpactDamper::assembly`]), which the
 //! two-mass `simulate` of the binding runs.
 //!
@@ -45,8 +45,9 @@ fn general(system: &ImpactDamper, contact: &Contact, start: &State, settings: &S
         0.9,
     )
     .unwrap();
+    let (options, stepping) = (settings.run_options(), settings.kernel_stepping());
     let sol = stepper
-        .integrate(&assembly, &y0, &settings.run_options(), &mut || false)
+        .integrate_stepped(&assembly, &y0, &options, stepping, &mut || false)
         .unwrap();
     assert!(!sol.contacts.is_empty());
     sol.steps
@@ -102,7 +103,7 @@ fn main() {
             "{name:18} {:.3e} steps/s (median of 5)",
             steps as f64 / legacy
         );
-        if stepping == Stepping::Events && !matches!(method, Method::Newmark { .. }) {
+        {
             let run = median_seconds(5, steps, || general(&system, &contact, &start, &settings));
             println!(
                 "{name:18} {:.3e} steps/s (median of 5), general kernel",

@@ -422,11 +422,7 @@ pub(crate) fn simulate(
         atol,
     };
     let run = released(py, |interrupt| {
-        if two_mass::on_general_kernel(&settings) {
-            two_mass::general(&sys, &con, &init, &settings, &options, interrupt)
-        } else {
-            two_mass::legacy(&sys, &con, &init, &settings, interrupt)
-        }
+        two_mass::run(&sys, &con, &init, &settings, &options, interrupt)
     })?;
     let [time, w, v, y, u, force] = run.history;
     Ok(Solution {

@@ -3,7 +3,7 @@
 //! rows, energy balance), checked before it starts.
 
 use crate::error::{positive, within, Error, Result};
-use crate::kernel::events::RunOptions;
+use crate::kernel::events::{self, RunOptions};
 use crate::legacy::steppers::Tolerances;
 
 /// The relative tolerance (`rtol`) a method with error control takes, and
@@ -448,6 +448,20 @@ impl Settings {
             max_rows: self.max_rows,
             energy_tolerance: self.energy_tolerance,
             reduce: Default::default(),
+        }
+    }
+
+    /// The general kernel's stepping for this run (fixed steps with their
+    /// contact timing, or events).
+    pub fn kernel_stepping(&self) -> events::Stepping {
+        match self.stepping {
+            Stepping::Events => events::Stepping::Events,
+            Stepping::Fixed => events::Stepping::Fixed {
+                contact_timing: match self.timing {
+                    ContactTiming::Located => events::ContactTiming::Located,
+                    ContactTiming::StepCount => events::ContactTiming::StepCount,
+                },
+            },
         }
     }
 

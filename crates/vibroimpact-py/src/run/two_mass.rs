@@ -1,18 +1,19 @@
-//! A two-mass run as the rows the binding's `Solution` shows, on the general
-//! kernel (the preset [`core::ImpactDamper::spec`]) for every method with
-//! events but the paper's lagged Newmark, and on the 0.1 kernel for those
-//! and the paper's fixed stepping until the general kernel has them.
+//! A two-mass run on the general kernel (the preset
+//! [`core::ImpactDamper::spec`]), every method and stepping but fixed RK4,
+//! as the rows the binding's `Solution` shows. Fixed RK4 stays on the 0.1
+//! kernel until the general one is as fast: 1.41e7 against 7.83e7 steps/s
+//! (the throughput example), where the two-mass RK4 must keep numba's pace
+//! (`benchmarks/bench_numba.py`, 7.1e7).
 
 use vibroimpact_core as core;
 
-use core::kernel::events::{PairContact, SystemSolution};
+use core::kernel::events::SystemSolution;
 use core::methods::registry::AnyStepper;
 use core::model::assembly::{Assembly, Mode};
 
-/// A contact of either kernel as a row of the table (`CONTACT_COLUMNS`),
-/// with its energy change.
+/// A contact of either kernel as a row of the table (`CONTACT_COLUMNS`).
 macro_rules! contact_row {
-    ($c:expr, $energy_change:expr) => {
+    ($c:expr) => {
         [
             $c.onset,
             $c.separation,
@@ -22,12 +23,12 @@ macro_rules! contact_row {
             $c.rebound_speed,
             $c.restitution,
             $c.energy_dissipated,
-            $energy_change,
+            $c.energy_change,
         ]
     };
 }
 
-/// A two-mass run's results, whichever kernel made them.
+/// A two-mass run's results.
 pub(crate) struct TwoMassRun {
     /// Time, w, w', y, y' and the contact force, one row a kept step.
     pub(crate) history: [Vec<f64>; 6],
@@ -43,17 +44,8 @@ pub(crate) struct TwoMassRun {
     pub(crate) energy_residual: f64,
 }
 
-/// Whether a run with `settings` takes the general kernel: the fixed
-/// stepping is the 0.1 kernel's alone, and so is the paper's lagged Newmark
-/// until the general kernel bounds the energy its contacts create by
-/// `energy_tolerance` alone (the 0.1 kernel's `contact_creation_limit`).
-pub(crate) fn on_general_kernel(settings: &core::Settings) -> bool {
-    settings.stepping == core::Stepping::Events
-        && !matches!(settings.method, core::Method::Newmark { .. })
-}
-
 /// The run by the 0.1 kernel.
-pub(crate) fn legacy(
+fn legacy(
     system: &core::ImpactDamper,
     contact: &core::Contact,
     initial: &core::State,
@@ -71,11 +63,7 @@ pub(crate) fn legacy(
             h.impact_velocity,
             h.contact_force,
         ],
-        contacts: sol
-            .contacts
-            .iter()
-            .map(|r| contact_row!(r, r.energy_change))
-            .collect(),
+        contacts: sol.contacts.iter().map(|c| contact_row!(c)).collect(),
         steps: sol.steps,
         rejected_steps: sol.rejected_steps,
         rhs_evaluations: sol.rhs_evaluations,
@@ -88,8 +76,9 @@ pub(crate) fn legacy(
 }
 
 /// The run of the preset by the general kernel, with the options a 0.2 run
-/// of the same system takes (so that both give the same bits).
-pub(crate) fn general(
+/// of the same system takes (so that both give the same bits); fixed RK4
+/// by the 0.1 kernel.
+pub(crate) fn run(
     system: &core::ImpactDamper,
     contact: &core::Contact,
     initial: &core::State,
@@ -97,6 +86,9 @@ pub(crate) fn general(
     options: &core::MethodOptions,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> core::Result<TwoMassRun> {
+    if settings.stepping == core::Stepping::Fixed && settings.method == core::Method::Rk4 {
+        return legacy(system, contact, initial, settings, interrupt);
+    }
     // The two-mass message first: it names the two masses' displacements.
     initial.check_apart(system.clearance)?;
     let assembly = system.assembly(contact)?;
@@ -110,108 +102,75 @@ pub(crate) fn general(
         options.gamma,
         options.spectral_radius,
     )?;
-    let sol = stepper.integrate(&assembly, &y0, &settings.run_options(), interrupt)?;
-    let rows = Rows::of(&sol);
-    let in_play = |y: &[f64]| assembly.energy(y, &[Mode::Compliant { approach_rate: 0.0 }; 2]);
+    let sol = stepper.integrate_stepped(
+        &assembly,
+        &y0,
+        &settings.run_options(),
+        settings.kernel_stepping(),
+        interrupt,
+    )?;
     Ok(TwoMassRun {
-        history: rows.columns(system, contact, &sol.contacts)?,
-        contacts: sol
-            .contacts
-            .iter()
-            .map(|c| contact_row!(c, rows.energy_change(c, &in_play)))
-            .collect(),
+        history: columns(system, contact, &sol)?,
+        contacts: sol.contacts.iter().map(|c| contact_row!(c)).collect(),
         steps: sol.steps,
         rejected_steps: sol.rejected_steps,
         rhs_evaluations: sol.rhs_evaluations,
         grazing_contacts: sol.grazing_contacts,
         final_time: sol.final_time,
         final_state: core::State::of_vector(&sol.final_state),
-        energy_growth: rows.energy_growth(&assembly, &y0, &sol.final_state),
+        energy_growth: energy_growth(&assembly, &y0, &sol),
         energy_residual: relative_residual(&sol),
     })
 }
 
-/// The kept rows of a general run of the preset: `[w, y, w', y']` each.
-struct Rows<'a> {
-    time: &'a [f64],
-    states: &'a [f64],
+/// The two-mass history's columns from the kept rows (`[w, y, w', y']`
+/// each), and the contact force from each row's state while a contact is
+/// open there (from its onset to before its separation, its approach rate
+/// latched), zero elsewhere: as the 0.1 kernel reported it, after the
+/// switch at an onset row and before it at a separation row.
+// Not the kernel's contact_forces: at an onset row it holds the force before
+// the switch (0) in some runs and after it (c1 times the approach) in others.
+fn columns(
+    system: &core::ImpactDamper,
+    contact: &core::Contact,
+    sol: &SystemSolution,
+) -> core::Result<[Vec<f64>; 6]> {
+    let rows = sol.time.len();
+    let column = |k: usize| (0..rows).map(|r| sol.states[4 * r + k]).collect();
+    let mut force = vec![0.0; rows];
+    let mut open = sol.contacts.iter().peekable();
+    for (row, (&t, value)) in sol.time.iter().zip(force.iter_mut()).enumerate() {
+        while open.next_if(|c| c.separation <= t).is_some() {}
+        let Some(c) = open.peek().filter(|c| c.onset <= t) else {
+            continue;
+        };
+        let s = core::State::of_vector(&sol.states[4 * row..4 * row + 4]);
+        *value = system.contact_force(contact, &s, c.approach_speed)?;
+    }
+    Ok([
+        sol.time.clone(),
+        column(0),
+        column(2),
+        column(1),
+        column(3),
+        force,
+    ])
 }
 
-impl<'a> Rows<'a> {
-    fn of(sol: &'a SystemSolution) -> Self {
-        Self {
-            time: &sol.time,
-            states: &sol.states,
-        }
+/// `max(E) / E(0) - 1` over the kept rows and the end (NaN from rest).
+// The general kernel does not follow the growth itself: taken from the rows.
+fn energy_growth(system: &Assembly, start: &[f64], sol: &SystemSolution) -> f64 {
+    let modes = [Mode::Compliant { approach_rate: 0.0 }; 2];
+    let initial = system.energy(start, &modes);
+    if initial <= 0.0 {
+        return f64::NAN;
     }
-
-    fn state(&self, row: usize) -> &'a [f64] {
-        &self.states[4 * row..4 * row + 4]
-    }
-
-    /// The two-mass history's columns; the contact force from each row's
-    /// state while a contact is open there (from its onset to before its
-    /// separation, with its approach rate latched), zero elsewhere.
-    // Interim: the general kernel keeps no contact-force column yet.
-    fn columns(
-        &self,
-        system: &core::ImpactDamper,
-        contact: &core::Contact,
-        contacts: &[PairContact],
-    ) -> core::Result<[Vec<f64>; 6]> {
-        let n = self.time.len();
-        let column = |k: usize| (0..n).map(|r| self.states[4 * r + k]).collect();
-        let mut force = vec![0.0; n];
-        let mut open = contacts.iter().peekable();
-        for (row, (&t, value)) in self.time.iter().zip(force.iter_mut()).enumerate() {
-            while open.next_if(|c| c.separation <= t).is_some() {}
-            let Some(c) = open.peek().filter(|c| c.onset <= t) else {
-                continue;
-            };
-            let s = core::State::of_vector(self.state(row));
-            *value = system.contact_force(contact, &s, c.approach_speed)?;
-        }
-        Ok([
-            self.time.to_vec(),
-            column(0),
-            column(2),
-            column(1),
-            column(3),
-            force,
-        ])
-    }
-
-    /// The row kept at `time` exactly (events are step ends), if any.
-    fn at(&self, time: f64) -> Option<usize> {
-        let row = self.time.partition_point(|t| *t < time);
-        (self.time.get(row) == Some(&time)).then_some(row)
-    }
-
-    /// The mechanical energy at separation minus at onset (J), from the rows
-    /// kept there; NaN for a contact still open or rows not kept.
-    // Interim: the general kernel reports no energy change per contact yet.
-    fn energy_change(&self, c: &PairContact, energy: &dyn Fn(&[f64]) -> f64) -> f64 {
-        match (self.at(c.onset), self.at(c.separation)) {
-            (Some(onset), Some(separation)) => {
-                energy(self.state(separation)) - energy(self.state(onset))
-            }
-            _ => f64::NAN,
-        }
-    }
-
-    /// `max(E) / E(0) - 1` over the kept rows and the end (NaN from rest).
-    // Interim: the general kernel does not follow the growth itself.
-    fn energy_growth(&self, system: &Assembly, start: &[f64], end: &[f64]) -> f64 {
-        let modes = [Mode::Compliant { approach_rate: 0.0 }; 2];
-        let initial = system.energy(start, &modes);
-        if initial <= 0.0 {
-            return f64::NAN;
-        }
-        let largest = (0..self.time.len())
-            .map(|row| system.energy(self.state(row), &modes))
-            .fold(system.energy(end, &modes), f64::max);
-        largest / initial - 1.0
-    }
+    let largest = sol
+        .states
+        .chunks_exact(4)
+        .map(|row| system.energy(row, &modes))
+        .fold(system.energy(&sol.final_state, &modes), f64::max);
+    largest / initial - 1.0
 }
 
 /// The balance's residual at the end relative to the energy in play (the
