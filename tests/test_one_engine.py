@@ -15,6 +15,7 @@ import pytest
 
 import vibroimpact as vi
 from vibroimpact.scenario import parse_scenario
+from vibroimpact.system_scenario import SystemScenario
 
 # A released main mass (50 mm) on a stiff spring carrying the impact mass at rest in
 # the middle of its enclosure: a dozen contacts on both walls in 3 s, with a law whose
@@ -94,7 +95,9 @@ def test_the_two_mass_format_and_the_general_one_give_the_same_run(solver: dict[
     general = {key: value for key, value in settings.items() if key != "stepping"}
     if solver.get("stepping") == "fixed":
         general["stepping"] = "fixed"
-    new = parse_scenario(general_text(general), "general.toml").run()
+    general_scenario = parse_scenario(general_text(general), "general.toml")
+    assert isinstance(general_scenario, SystemScenario)
+    new = general_scenario.run()
     assert len(old.contacts) >= 8
     assert new.contacts.pair == ["damper 0"] * len(old.contacts)
     for column in ("onset", "separation", "approach_speed", "rebound_speed", "duration"):
