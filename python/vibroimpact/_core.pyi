@@ -15,6 +15,8 @@ __all__ = [
     "RTOL_RANGE",
     "ATOL_MAX",
     "MAX_ENERGY_TOLERANCE",
+    "METHODS",
+    "METHOD_OPTIONS",
     "BeamMode",
     "Contact",
     "ContactTable",
@@ -31,6 +33,7 @@ __all__ = [
     "cantilever_mode",
     "cantilever_mode_shape",
     "cantilever_root",
+    "check_run",
     "check_solver",
     "goldsmith_contact_duration",
     "goldsmith_max_indentation",
@@ -53,6 +56,10 @@ ATOL_MAX: float
 MAX_ENERGY_TOLERANCE: float
 MAX_PAIRS: int
 MAX_POINTS: int
+# The core's registry: method -> {"kind", "steppings", "options": {name: {"default",
+# "low", "high", "low_open", "allowed"}}}; METHOD_OPTIONS: every run's options.
+METHODS: dict[str, dict[str, Any]]
+METHOD_OPTIONS: dict[str, dict[str, Any]]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -316,6 +323,18 @@ def simulate(
     energy_tolerance: float | None = None,
     history: bool = True,
 ) -> Solution: ...
+def check_run(
+    spec: dict[str, Any],
+    *,
+    method: str,
+    dt: float | None,
+    t_end: float,
+    max_steps: int,
+    max_rows: int,
+    every: int,
+    history: bool,
+    strobe_period: float | None,
+) -> None: ...
 def check_solver(
     *,
     t_end: float,

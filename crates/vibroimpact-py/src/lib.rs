@@ -9,6 +9,7 @@ mod convert;
 mod errors;
 mod helpers;
 mod inputs;
+mod registry;
 mod run;
 mod system;
 
@@ -56,6 +57,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(goldsmith_max_indentation, m)?)?;
     m.add_function(wrap_pyfunction!(linear_contact_duration, m)?)?;
     m.add_function(wrap_pyfunction!(adequacy, m)?)?;
+    registry::add_registry(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_MAX_ROWS", core::DEFAULT_MAX_ROWS)?;
     m.add("MAX_RECORD_BYTES", core::MAX_RECORD_BYTES)?;

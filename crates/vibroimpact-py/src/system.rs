@@ -26,7 +26,7 @@ use crate::errors::{released, short_numbers, to_py, InvalidInputError};
 
 /// `where key` must be present: the Python side fills defaults, so a missing
 /// key is a bug of the caller's dict, reported as bad input all the same.
-fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+pub(crate) fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     d: &Bound<'py, PyDict>,
     place: &str,
     key: &str,
@@ -62,7 +62,7 @@ fn named(place: &str) -> impl Fn(core::Error) -> PyErr + '_ {
     }
 }
 
-fn structure(d: &Bound<'_, PyDict>) -> PyResult<Structure> {
+pub(crate) fn structure(d: &Bound<'_, PyDict>) -> PyResult<Structure> {
     let place = "structure";
     let kind: String = get(d, place, "kind")?;
     match kind.as_str() {
@@ -193,7 +193,7 @@ fn signal(d: &Bound<'_, PyDict>, place: &str, t_end: f64) -> PyResult<Signal> {
     .map_err(named(place))
 }
 
-fn entries<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Vec<Bound<'py, PyDict>>> {
+pub(crate) fn entries<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Vec<Bound<'py, PyDict>>> {
     match d.get_item(key)? {
         Some(list) => list
             .cast::<PyList>()
@@ -554,7 +554,7 @@ impl PreparedSystem {
     }
 }
 
-/// The method settings a run takes, each finite and in its range.
+/// The settings a run takes, each finite and in its range.
 #[allow(clippy::too_many_arguments)]
 fn check_method(
     t_end: f64,
@@ -567,40 +567,24 @@ fn check_method(
     energy_tolerance: f64,
 ) -> PyResult<()> {
     let dt = dt.unwrap_or(1.0);
-    for (field, value, ok, allowed) in [
-        ("t_end", t_end, t_end > 0.0, "> 0 s"),
-        ("dt", dt, dt > 0.0, "> 0 s or None"),
-        (
-            "rtol",
-            rtol,
-            (vibroimpact_core::legacy::settings::RTOL_RANGE.0
-                ..=vibroimpact_core::legacy::settings::RTOL_RANGE.1)
-                .contains(&rtol),
-            vibroimpact_core::legacy::settings::RTOL_ALLOWED,
-        ),
-        (
-            "atol",
-            atol,
-            atol > 0.0 && atol <= vibroimpact_core::legacy::settings::ATOL_MAX,
-            vibroimpact_core::legacy::settings::ATOL_ALLOWED,
-        ),
-        ("beta", beta, (0.0..=0.5).contains(&beta), "in [0, 0.5]"),
-        ("gamma", gamma, (0.5..=1.0).contains(&gamma), "in [0.5, 1]"),
-        (
-            "spectral_radius",
-            spectral_radius,
-            (0.0..=1.0).contains(&spectral_radius),
-            "in [0, 1]",
-        ),
-        (
-            "energy_tolerance",
-            energy_tolerance,
-            vibroimpact_core::legacy::settings::checked_energy_tolerance(energy_tolerance).is_ok(),
-            vibroimpact_core::legacy::settings::ENERGY_TOLERANCE_ALLOWED,
-        ),
-    ] {
-        check(field, value, ok, allowed)?;
+    check("t_end", t_end, t_end > 0.0, "> 0 s")?;
+    check("dt", dt, dt > 0.0, "> 0 s or None")?;
+    // The method options' ranges are the registry's, checked in the core.
+    core::methods::registry::Options {
+        rtol,
+        atol,
+        beta,
+        gamma,
+        spectral_radius,
     }
+    .checked()
+    .map_err(to_py)?;
+    check(
+        "energy_tolerance",
+        energy_tolerance,
+        vibroimpact_core::legacy::settings::checked_energy_tolerance(energy_tolerance).is_ok(),
+        vibroimpact_core::legacy::settings::ENERGY_TOLERANCE_ALLOWED,
+    )?;
     Ok(())
 }
 

@@ -1,0 +1,118 @@
+//! The core's registry of methods as Python data, and its up-front run
+//! limits: converted here, defined and checked in the core
+//! (`vibroimpact_core::methods::registry`).
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use vibroimpact_core::methods::registry::{
+    self, check_scales, OptionSpec, RunPlan, RunScales, METHOD_OPTIONS, METHOD_SPECS,
+};
+
+use crate::errors::to_py;
+use crate::system::{entries, get, structure};
+
+/// `{name: {default, low, high, low_open, allowed}}` of `options`.
+fn options_dict<'py>(py: Python<'py>, options: &[OptionSpec]) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    for option in options {
+        let entry = PyDict::new(py);
+        // max_steps is a whole number in Python.
+        if option.name == registry::MAX_STEPS.name {
+            entry.set_item("default", registry::DEFAULT_MAX_STEPS)?;
+        } else {
+            entry.set_item("default", option.default)?;
+        }
+        entry.set_item("low", option.low)?;
+        entry.set_item("high", option.high)?;
+        entry.set_item("low_open", option.low_open)?;
+        entry.set_item("allowed", option.allowed)?;
+        out.set_item(option.name, entry)?;
+    }
+    Ok(out)
+}
+
+/// `METHODS`: method -> {kind, steppings, options: {name: {default, low,
+/// high, low_open, allowed}}}, in the registry's order; and `METHOD_OPTIONS`:
+/// the options every run is given and checked, whatever its method.
+pub(crate) fn add_registry(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    let methods = PyDict::new(py);
+    for spec in &METHOD_SPECS {
+        let entry = PyDict::new(py);
+        entry.set_item("kind", spec.kind.name())?;
+        entry.set_item("steppings", spec.steppings.to_vec())?;
+        entry.set_item("options", options_dict(py, spec.options)?)?;
+        methods.set_item(spec.name, entry)?;
+    }
+    m.add("METHODS", methods)?;
+    let mut all = METHOD_OPTIONS.to_vec();
+    all.push(registry::MAX_STEPS);
+    m.add("METHOD_OPTIONS", options_dict(py, &all)?)?;
+    m.add_function(wrap_pyfunction!(check_run, m)?)?;
+    Ok(())
+}
+
+/// The harmonic frequencies (Hz) of a checked spec's `excitation` tables,
+/// each with its index.
+fn forcing(spec: &Bound<'_, PyDict>) -> PyResult<Vec<(usize, f64)>> {
+    let mut found = Vec::new();
+    for (index, table) in entries(spec, "excitation")?.iter().enumerate() {
+        let place = format!("excitation {index}");
+        match get::<String>(table, &place, "signal")?.as_str() {
+            "harmonic" => found.push((index, get(table, &place, "frequency")?)),
+            "harmonics" => found.extend(
+                get::<Vec<f64>>(table, &place, "frequencies")?
+                    .into_iter()
+                    .map(|f| (index, f)),
+            ),
+            _ => {}
+        }
+    }
+    Ok(found)
+}
+
+/// Refuse a run of the checked 0.2 `spec` that its settings cannot complete
+/// within its limits (the core's `registry::check_run`): too many steps, a
+/// step or a method that cannot resolve the fastest mode or a harmonic
+/// forcing, a history or strobe record beyond `max_rows` or the records'
+/// memory. Raises ``InvalidInputError`` naming the key and what is allowed.
+#[pyfunction]
+#[pyo3(signature = (spec, *, method, dt, t_end, max_steps, max_rows, every, history, strobe_period))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_run(
+    spec: &Bound<'_, PyDict>,
+    method: &str,
+    dt: Option<f64>,
+    t_end: f64,
+    max_steps: u64,
+    max_rows: u64,
+    every: u64,
+    history: bool,
+    strobe_period: Option<f64>,
+) -> PyResult<()> {
+    let structure_dict = spec
+        .get_item("structure")?
+        .and_then(|d| d.cast_into::<PyDict>().ok());
+    let Some(structure_dict) = structure_dict else {
+        return Err(crate::errors::InvalidInputError::new_err(
+            "[structure] is required",
+        ));
+    };
+    let built = structure(&structure_dict)?;
+    let scales = RunScales {
+        structure: &built,
+        coordinates: built.dofs() + entries(spec, "damper")?.len(),
+        forcing: forcing(spec)?,
+    };
+    let plan = RunPlan {
+        method,
+        dt,
+        t_end,
+        max_steps,
+        max_rows,
+        every,
+        history,
+        strobe_period,
+    };
+    check_scales(&scales, &plan).map_err(to_py)
+}
