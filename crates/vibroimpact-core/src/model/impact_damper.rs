@@ -197,7 +197,7 @@ impl State {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::events::{RunOptions, SystemSolution};
+    use crate::kernel::events::{ContactTiming, RunOptions, Stepping, SystemSolution};
     use crate::methods::registry::AnyStepper;
     use crate::model::closed_forms::linear_contact_duration;
     use crate::model::contact::LawKind;
@@ -218,13 +218,13 @@ mod tests {
     fn run(
         system: &Assembly,
         y0: &[f64],
-        method: &str,
+        (method, stepping): (&str, Stepping),
         dt: Option<f64>,
         t_end: f64,
     ) -> SystemSolution {
         let mut stepper = AnyStepper::new(system, method, 1e-12, 1e-15, 0.25, 0.5, 0.9).unwrap();
         stepper
-            .integrate(system, y0, &options(dt, t_end), &mut || false)
+            .integrate_stepped(system, y0, &options(dt, t_end), stepping, &mut || false)
             .unwrap()
     }
 
@@ -257,13 +257,19 @@ mod tests {
             // [initial] structure_displacement = [w], ... damper_velocity = [y'].
             let y0 = initial_state(&general, &[0.0], &[0.0], &[0.01], &[0.1]).unwrap();
             assert_eq!(start.vector(&preset).unwrap(), y0);
-            for (method, dt) in [("rk4", Some(1e-5)), ("dop853", None)] {
+            let fixed = |contact_timing| Stepping::Fixed { contact_timing };
+            for (method, dt) in [
+                (("rk4", Stepping::Events), Some(1e-5)),
+                (("dop853", Stepping::Events), None),
+                (("rk4", fixed(ContactTiming::Located)), Some(1e-5)),
+                (("newmark", fixed(ContactTiming::StepCount)), Some(1e-5)),
+            ] {
                 let (a, b) = (
                     run(&preset, &y0, method, dt, 0.3),
                     run(&general, &y0, method, dt, 0.3),
                 );
-                assert_eq!(a, b, "{method}");
-                assert!(!a.contacts.is_empty(), "{method}");
+                assert_eq!(a, b, "{method:?}");
+                assert!(!a.contacts.is_empty(), "{method:?}");
             }
         });
     }
@@ -282,7 +288,7 @@ mod tests {
             let sol = run(
                 &system,
                 &start.vector(&system).unwrap(),
-                "dop853",
+                ("dop853", Stepping::Events),
                 None,
                 0.1,
             );
