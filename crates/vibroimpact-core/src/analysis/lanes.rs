@@ -175,7 +175,9 @@ fn run_group(
             std::mem::swap(&mut stepper.cache, &mut scratch[l]);
             let next = run.step(stepper, &mut || false);
             std::mem::swap(&mut stepper.cache, &mut scratch[l]);
-            stepper.stash = None;
+            if let Some(stash) = stepper.stash.as_mut() {
+                stash.fresh = false;
+            }
             match next {
                 Ok(true) => {}
                 Ok(false) => {
@@ -206,6 +208,8 @@ struct Stash {
     h: f64,
     end: Vec<f64>,
     first: Vec<f64>,
+    /// Not yet taken (the buffers are kept for the next step's).
+    fresh: bool,
 }
 
 /// RK4 on a compact system as [`crate::methods::steppers::ExplicitRk`]
@@ -234,15 +238,18 @@ impl LaneStepper {
 
     /// Lane `l` of the lanes' `step` from `time` of `h`.
     fn stash(&mut self, time: f64, h: f64, step: &LaneStep, l: usize) {
-        let len = self.first.len();
-        let mut stash = Stash {
+        let mut stash = self.stash.take().unwrap_or_else(|| Stash {
             time,
             h,
-            end: Vec::with_capacity(len),
-            first: Vec::with_capacity(len),
-        };
-        stash.end.extend((0..len).map(|e| step.end[e][l]));
-        stash.first.extend((0..len).map(|e| step.first[e][l]));
+            end: vec![0.0; self.first.len()],
+            first: vec![0.0; self.first.len()],
+            fresh: false,
+        });
+        (stash.time, stash.h, stash.fresh) = (time, h, true);
+        for (e, (end, first)) in stash.end.iter_mut().zip(&mut stash.first).enumerate() {
+            *end = step.end[e][l];
+            *first = step.first[e][l];
+        }
         self.stash = Some(stash);
     }
 }
@@ -271,11 +278,15 @@ impl SystemStepper for LaneStepper {
         out: &mut [f64],
     ) -> Result<f64> {
         let len = system.state_len();
-        let made = self.stash.as_ref().is_some_and(|s| {
-            !self.start_valid && s.time.to_bits() == time.to_bits() && s.h.to_bits() == h.to_bits()
+        let start_valid = self.start_valid;
+        let made = self.stash.as_mut().filter(|s| {
+            s.fresh
+                && !start_valid
+                && s.time.to_bits() == time.to_bits()
+                && s.h.to_bits() == h.to_bits()
         });
-        if made {
-            let stash = self.stash.take().expect("checked");
+        if let Some(stash) = made {
+            stash.fresh = false;
             out[..len].copy_from_slice(&stash.end);
             self.first.copy_from_slice(&stash.first);
             if let (Some(to), Some(from)) = (scratch.first_cache(), self.cache.first_cache()) {

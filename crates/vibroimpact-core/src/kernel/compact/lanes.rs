@@ -22,9 +22,27 @@ type V = [f64; LANES];
 /// A state (or its rates) per lane.
 pub(crate) type LaneState = [V; MAX_LEN];
 
-/// A concrete law taken out of [`AnyLaw`].
+/// [`HysterHertz`]'s rate below which it is elastic (its `GRAZING_RATE`;
+/// the lanes' tests hold them to the same bits).
+const GRAZING_RATE: f64 = 1e-12;
+
+/// A concrete law taken out of [`AnyLaw`], its force written without a
+/// branch (its own operations in its order, a select where it branches:
+/// what vectorises over lanes).
 pub(crate) trait LaneLaw: ContactLaw + Copy {
     fn of(law: &AnyLaw) -> Option<Self>;
+    /// Its parameters.
+    fn parts(&self) -> [f64; 2];
+    /// [`ContactLaw::force_and_elastic`] of the law with `parts`, at the
+    /// latched `approach` rate, `factor` its `parts[1] / approach` (the
+    /// division, made once a step: the same bits).
+    fn force_of(
+        parts: [f64; 2],
+        indentation: f64,
+        rate: f64,
+        approach: f64,
+        factor: f64,
+    ) -> (f64, f64);
 }
 impl LaneLaw for Hertz {
     fn of(law: &AnyLaw) -> Option<Self> {
@@ -32,6 +50,14 @@ impl LaneLaw for Hertz {
             AnyLaw::Hertz(l) => Some(*l),
             _ => None,
         }
+    }
+    fn parts(&self) -> [f64; 2] {
+        [self.stiffness, 0.0]
+    }
+    #[inline(always)]
+    fn force_of(parts: [f64; 2], indentation: f64, _: f64, _: f64, _: f64) -> (f64, f64) {
+        let f = parts[0] * indentation * indentation.sqrt();
+        (f, f)
     }
 }
 impl LaneLaw for HysterHertz {
@@ -41,6 +67,26 @@ impl LaneLaw for HysterHertz {
             _ => None,
         }
     }
+    fn parts(&self) -> [f64; 2] {
+        [self.stiffness, self.hysteresis]
+    }
+    #[inline(always)]
+    fn force_of(
+        parts: [f64; 2],
+        indentation: f64,
+        rate: f64,
+        approach: f64,
+        factor: f64,
+    ) -> (f64, f64) {
+        let elastic = parts[0] * indentation * indentation.sqrt();
+        let damped = (elastic * (1.0 + factor * rate)).max(0.0);
+        let force = if approach > GRAZING_RATE {
+            damped
+        } else {
+            elastic
+        };
+        (force, elastic)
+    }
 }
 impl LaneLaw for Linear {
     fn of(law: &AnyLaw) -> Option<Self> {
@@ -48,6 +94,14 @@ impl LaneLaw for Linear {
             AnyLaw::Linear(l) => Some(*l),
             _ => None,
         }
+    }
+    fn parts(&self) -> [f64; 2] {
+        [self.stiffness, 0.0]
+    }
+    #[inline(always)]
+    fn force_of(parts: [f64; 2], indentation: f64, _: f64, _: f64, _: f64) -> (f64, f64) {
+        let f = parts[0] * indentation;
+        (f, f)
     }
 }
 
@@ -57,8 +111,10 @@ struct Walls<L> {
     h: [V; MAX_DIM],
     push: [V; MAX_DIM],
     offset: V,
-    law: [L; LANES],
+    /// Each lane's law's parameters.
+    parts: [V; 2],
     damping: V,
+    law: std::marker::PhantomData<L>,
     mirror: bool,
 }
 
@@ -106,7 +162,8 @@ impl Default for LaneStep {
 /// Each wall's mode per lane: in compliant contact, and its latched approach rate.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LaneModes {
-    active: [[bool; LANES]; MAX_WALLS],
+    /// 1 in contact, 0 open (numbers: what the vector selects read).
+    active: [V; MAX_WALLS],
     approach: [V; MAX_WALLS],
 }
 
@@ -116,9 +173,9 @@ impl LaneModes {
     pub(crate) fn set(&mut self, l: usize, modes: &[Mode]) -> bool {
         for (w, mode) in modes.iter().enumerate().take(MAX_WALLS) {
             match mode {
-                Mode::Open => self.active[w][l] = false,
+                Mode::Open => self.active[w][l] = 0.0,
                 Mode::Compliant { approach_rate } => {
-                    self.active[w][l] = true;
+                    self.active[w][l] = 1.0;
                     self.approach[w][l] = *approach_rate;
                 }
                 _ => return false,
@@ -131,7 +188,7 @@ impl LaneModes {
 impl Default for LaneModes {
     fn default() -> Self {
         Self {
-            active: [[false; LANES]; MAX_WALLS],
+            active: [[0.0; LANES]; MAX_WALLS],
             approach: [[0.0; LANES]; MAX_WALLS],
         }
     }
@@ -189,12 +246,14 @@ impl<L: LaneLaw> Group<L> {
         let mut walls = Vec::with_capacity(first.count);
         for w in 0..first.count.min(MAX_WALLS) {
             let (law, _) = first.walls[w].law?;
+            L::of(&law)?;
             let mut wall = Walls {
                 h: [[0.0; LANES]; MAX_DIM],
                 push: [[0.0; LANES]; MAX_DIM],
                 offset: [0.0; LANES],
-                law: [L::of(&law)?; LANES],
+                parts: [[0.0; LANES]; 2],
                 damping: [0.0; LANES],
+                law: std::marker::PhantomData,
                 mirror: first.walls[w].mirror,
             };
             for l in 0..LANES {
@@ -205,7 +264,9 @@ impl<L: LaneLaw> Group<L> {
                     wall.push[i][l] = it.push[i];
                 }
                 wall.offset[l] = it.offset;
-                wall.law[l] = L::of(&law)?;
+                let parts = L::of(&law)?.parts();
+                wall.parts[0][l] = parts[0];
+                wall.parts[1][l] = parts[1];
                 wall.damping[l] = damping;
             }
             walls.push(wall);
@@ -225,7 +286,14 @@ impl<L: LaneLaw> Group<L> {
     /// [`Compact::rates`] of every lane (no pair sticking), the force's
     /// value of each lane in `value`.
     #[inline(always)]
-    fn rates(&self, y: &LaneState, value: &V, modes: &LaneModes, out: &mut LaneState) {
+    fn rates(
+        &self,
+        y: &LaneState,
+        value: &V,
+        modes: &LaneModes,
+        factor: &[V; MAX_WALLS],
+        out: &mut LaneState,
+    ) {
         let (n, d) = (self.n, self.n + self.k);
         let mut inertial = [0.0; LANES];
         for l in 0..LANES {
@@ -272,45 +340,80 @@ impl<L: LaneLaw> Group<L> {
         }
         // The last wall's products where it was in contact (a mirror wall
         // takes them negated).
-        let mut previous = [false; LANES];
+        let mut previous = [0.0; LANES];
         let (mut px, mut pv) = ([0.0; LANES], [0.0; LANES]);
         for (w, wall) in self.walls.iter().enumerate() {
             let loss = 2 * d + CONTACT + w;
             let active = &modes.active[w];
-            let mut total = [0.0; LANES];
-            let mut add = [false; LANES];
-            for l in 0..LANES {
-                // `h_dot`'s sums.
-                let (mut sx, mut sv) = ([-0.0; 2], [-0.0; 2]);
-                for i in 0..d {
-                    sx[i % 2] += wall.h[i][l] * y[i][l];
-                    sv[i % 2] += wall.h[i][l] * y[d + i][l];
+            if active.iter().all(|a| *a == 0.0) {
+                // No lane touches: no force (the law is not evaluated).
+                out[loss] = [0.0; LANES];
+                previous = [0.0; LANES];
+                continue;
+            }
+            // `h_dot`'s two sums, each lane innermost (what vectorises).
+            let (mut sx, mut sv) = ([[-0.0; LANES]; 2], [[-0.0; LANES]; 2]);
+            for i in 0..d {
+                let (h, x, v) = (&wall.h[i], &y[i], &y[d + i]);
+                let (sx, sv) = (&mut sx[i % 2], &mut sv[i % 2]);
+                for l in 0..LANES {
+                    sx[l] += h[l] * x[l];
+                    sv[l] += h[l] * v[l];
                 }
-                let (hx, hv) = if previous[l] && wall.mirror {
-                    (-px[l], -pv[l])
+            }
+            // In simple loops, each of which vectorises.
+            let (mut indentation, mut rate) = ([0.0; LANES], [0.0; LANES]);
+            for l in 0..LANES {
+                let mirrored = wall.mirror & (previous[l] != 0.0);
+                let hx = if mirrored {
+                    -px[l]
                 } else {
-                    (sx[0] + sx[1], sv[0] + sv[1])
+                    sx[0][l] + sx[1][l]
                 };
-                let (indentation, rate) = (-(wall.offset[l] + hx), -hv);
-                let (force, elastic) = if indentation > 0.0 {
-                    wall.law[l].force_and_elastic(indentation, rate, modes.approach[w][l])
+                let hv = if mirrored {
+                    -pv[l]
                 } else {
-                    (0.0, 0.0)
+                    sv[0][l] + sv[1][l]
                 };
-                total[l] = force + wall.damping[l] * rate;
-                add[l] = active[l] && total[l] != 0.0;
-                out[loss][l] = if active[l] {
-                    (total[l] - elastic) * rate
-                } else {
-                    0.0
-                };
+                indentation[l] = -(wall.offset[l] + hx);
+                rate[l] = -hv;
                 previous[l] = active[l];
                 (px[l], pv[l]) = (hx, hv);
             }
+            let (mut force, mut elastic) = ([0.0; LANES], [0.0; LANES]);
+            for l in 0..LANES {
+                let parts = [wall.parts[0][l], wall.parts[1][l]];
+                let approach = modes.approach[w][l];
+                let (f, e) = L::force_of(parts, indentation[l], rate[l], approach, factor[w][l]);
+                let inside = indentation[l] > 0.0;
+                force[l] = if inside { f } else { 0.0 };
+                elastic[l] = if inside { e } else { 0.0 };
+            }
+            let mut total = [0.0; LANES];
+            let mut add = [0.0; LANES];
+            let loss_rate = &mut out[loss];
+            for l in 0..LANES {
+                total[l] = force[l] + wall.damping[l] * rate[l];
+                add[l] = if (active[l] != 0.0) & (total[l] != 0.0) {
+                    1.0
+                } else {
+                    0.0
+                };
+                loss_rate[l] = if active[l] != 0.0 {
+                    (total[l] - elastic[l]) * rate[l]
+                } else {
+                    0.0
+                };
+            }
             for i in 0..d {
+                let (push, acceleration) = (&wall.push[i], &mut out[d + i]);
                 for l in 0..LANES {
-                    let pushed = out[d + i][l] + wall.push[i][l] * total[l];
-                    out[d + i][l] = if add[l] { pushed } else { out[d + i][l] };
+                    let pushed = acceleration[l] + push[l] * total[l];
+                    acceleration[l] = if add[l] != 0.0 {
+                        pushed
+                    } else {
+                        acceleration[l]
+                    };
                 }
             }
         }
@@ -415,8 +518,15 @@ impl<L: LaneLaw> Group<L> {
         // As the compact step's fresh arrays: slots no rate writes stay 0.
         **first = [[0.0; LANES]; MAX_LEN];
         **stages = [[[0.0; LANES]; MAX_LEN]; 3];
+        // Each compliant law's `parts[1] / approach`, once for the step.
+        let mut factor = [[0.0; LANES]; MAX_WALLS];
+        for (w, wall) in self.walls.iter().enumerate() {
+            for l in 0..LANES {
+                factor[w][l] = wall.parts[1][l] / modes.approach[w][l];
+            }
+        }
         let value = self.values(scratch, times[0]);
-        self.rates(start, &value, modes, first);
+        self.rates(start, &value, modes, &factor, first);
         let [k1, k2, k3] = &mut **stages;
         for e in 0..coordinates {
             for l in 0..LANES {
@@ -424,21 +534,21 @@ impl<L: LaneLaw> Group<L> {
             }
         }
         let value = self.values(scratch, times[1]);
-        self.rates(point, &value, modes, k1);
+        self.rates(point, &value, modes, &factor, k1);
         for e in 0..coordinates {
             for l in 0..LANES {
                 point[e][l] = start[e][l] + hw[1] * k1[e][l];
             }
         }
         let value = self.values(scratch, times[2]);
-        self.rates(point, &value, modes, k2);
+        self.rates(point, &value, modes, &factor, k2);
         for e in 0..coordinates {
             for l in 0..LANES {
                 point[e][l] = start[e][l] + hw[2] * k2[e][l];
             }
         }
         let value = self.values(scratch, times[3]);
-        self.rates(point, &value, modes, k3);
+        self.rates(point, &value, modes, &factor, k3);
         for e in 0..len {
             for l in 0..LANES {
                 end[e][l] = start[e][l]
