@@ -10,7 +10,6 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 
 from vibroimpact import InvalidInputError, SimulationError
@@ -169,26 +168,3 @@ def test_simulate_keeps_an_adaptive_first_step_and_a_followed_forcing() -> None:
         data = _oscillator(frequency, method)
         data["solver"].pop("dt") if method == "exact" else None
         prepare_system(data["structure"], excitation=data["excitation"], solver=data["solver"])
-
-
-def test_the_frequency_bound_is_never_below_the_fastest_mode() -> None:
-    # check_natural_period skips the eigenvalues where this bound already passes: a bound
-    # below the true fastest mode would let an unresolvable run through.
-    from vibroimpact.run_scales import frequency_bound, highest_frequency
-
-    rng = np.random.default_rng(7)
-    finite = 0
-    for dim in (1, 2, 3, 5, 8):
-        for _ in range(50):
-            a = rng.normal(size=(dim, dim)) * rng.uniform(0.05, 1.0)
-            mass = a @ a.T + np.diag(rng.uniform(0.1, 2.0, dim))
-            b = rng.normal(size=(dim, dim)) * rng.uniform(0, 1e3)
-            stiffness = b @ b.T
-            exact = highest_frequency(mass, stiffness)
-            bound = frequency_bound(mass.ravel().tolist(), stiffness.ravel().tolist(), dim)
-            assert bound >= exact * (1 - 1e-12), (dim, bound, exact)
-            finite += bound < np.inf
-    assert finite > 100  # most cases bound by a number, not by infinity
-    # Exact for a single coordinate, zero without a spring.
-    assert frequency_bound([2.0], [8.0], 1) == pytest.approx(2.0 / (2 * np.pi), rel=1e-15)
-    assert frequency_bound([2.0, 0.0, 0.0, 1.0], [0.0] * 4, 2) == 0.0

@@ -33,7 +33,6 @@ __all__ = [
     "cantilever_mode",
     "cantilever_mode_shape",
     "cantilever_root",
-    "check_run",
     "check_solver",
     "goldsmith_contact_duration",
     "goldsmith_max_indentation",
@@ -323,7 +322,10 @@ def simulate(
     energy_tolerance: float | None = None,
     history: bool = True,
 ) -> Solution: ...
-def check_run(
+def _check_options(
+    *, rtol: float, atol: float, beta: float, gamma: float, spectral_radius: float
+) -> None: ...
+def _check_run(
     spec: dict[str, Any],
     *,
     method: str,

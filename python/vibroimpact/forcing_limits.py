@@ -3,8 +3,8 @@ in each period of the structure's fastest mode, so a forcing period of more than
 ``max_steps`` of those is beyond it (a sweep from 1e-300 Hz had failed each point as a
 numerical blow-up advising a smaller dt); a fixed-step run takes ``period / dt`` steps
 whatever the modes (an implicit method is stable on a mode far faster than its step;
-its two steps a period are checked with the run's own settings, in
-:func:`vibroimpact.run_scales.check_forcing_steps`). An adaptive or exact run judges
+its two steps a period are checked with the run's own settings, by the core's
+registry's ``check_run``). An adaptive or exact run judges
 positions to ``atol``: a forcing that moves the structure by less than ``atol`` a period
 is not resolved (a 5 Hz oscillator forced at 1e9 Hz had failed its energy balance), and a
 body on no spring is resolved only while the round-off of the run's times stays below
@@ -22,13 +22,26 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError
+from vibroimpact._core import METHOD_OPTIONS, InvalidInputError
 from vibroimpact.messages import shown
-from vibroimpact.run_scales import highest_frequency
 from vibroimpact.system import _FIXED_STEP, linear_parts
 
 # The relative round-off of a run's times (float64).
 _TIME_ROUND_OFF = float(np.finfo(float).eps)
+
+
+def highest_frequency(mass: np.ndarray, stiffness: np.ndarray) -> float:
+    """The highest natural frequency (Hz) of ``M x'' + K x = 0``; 0 where nothing is
+    held by a spring (or where M is not positive definite: refused elsewhere)."""
+    try:
+        # M = L L^T: the eigenvalues of L^-1 K L^-T are w^2.
+        lower = np.linalg.cholesky(mass)
+        inverse = np.linalg.inv(lower)
+        squares = np.linalg.eigvalsh(inverse @ stiffness @ inverse.T)
+    except np.linalg.LinAlgError:
+        return 0.0
+    top = float(squares[-1])
+    return math.sqrt(top) / (2 * math.pi) if math.isfinite(top) and top > 0 else 0.0
 
 
 def _parts(data: Mapping[str, Any], base_dir: Path | None) -> dict[str, Any]:
@@ -86,7 +99,7 @@ def check_forcing_period(
         return
     parts = _parts(data, base_dir)
     highest = highest_frequency(parts["mass"], parts["stiffness"])
-    atol = float(solver.get("atol", 1e-12))
+    atol = float(solver.get("atol", METHOD_OPTIONS["atol"]["default"]))
     forcing, weight = _accelerations(parts)
     largest = max(forcing, weight)
     # A free body: no mode sets its time scale, so the one the run must resolve is the

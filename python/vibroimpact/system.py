@@ -44,25 +44,25 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import (
-    ATOL_MAX,
     DEFAULT_ENERGY_TOLERANCE,
     DEFAULT_MAX_ROWS,
     MAX_ENERGY_TOLERANCE,
     MAX_PAIRS,
     MAX_POINTS,
-    MAX_RECORD_BYTES,
     MAX_SIGNAL_SAMPLES,
-    RTOL_RANGE,
+    METHOD_OPTIONS,
+    METHODS,
     Contact,
     InvalidInputError,
     cantilever_mode_shape,
 )
+from vibroimpact._core import _check_options as check_options
+from vibroimpact._core import _check_run as check_run
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact._core import simulate_system as _simulate_system
 from vibroimpact.arguments import directory, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.record_file import check_record, read_record
-from vibroimpact.run_scales import check_forcing_steps, check_natural_period
 from vibroimpact.summary import contacts_frame, contacts_repr, history_dataset, solution_repr
 
 __all__ = [
@@ -146,19 +146,20 @@ _INITIAL = {
     "damper_displacement": (_NUMBERS, ()),
     "damper_velocity": (_NUMBERS, ()),
 }
-#: The solver settings of a 0.2 run and their defaults (the one place they live).
+#: The solver settings of a 0.2 run and their defaults: the method options' and
+#: max_steps' are the core's registry's (``_core.METHOD_OPTIONS``).
 SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
     "method": "rk4",
     "dt": None,
-    "rtol": 1e-8,
-    "atol": 1e-12,
-    "max_steps": 1_000_000_000,
+    "rtol": METHOD_OPTIONS["rtol"]["default"],
+    "atol": METHOD_OPTIONS["atol"]["default"],
+    "max_steps": METHOD_OPTIONS["max_steps"]["default"],
     # The same limits as the two-mass runs, from the core.
     "energy_tolerance": DEFAULT_ENERGY_TOLERANCE,
     "max_rows": DEFAULT_MAX_ROWS,
-    "beta": 0.25,
-    "gamma": 0.5,
-    "spectral_radius": 0.9,
+    "beta": METHOD_OPTIONS["beta"]["default"],
+    "gamma": METHOD_OPTIONS["gamma"]["default"],
+    "spectral_radius": METHOD_OPTIONS["spectral_radius"]["default"],
     # Steps cut at every event, or fixed steps of dt not cut at contacts (compliant
     # laws only), their onsets located inside the step or counted in whole steps.
     "stepping": "events",
@@ -188,8 +189,10 @@ _OUTPUT = {
     "moments": (_NUMBERS, ()),
 }
 _INT64 = range(-(2**63), 2**63)
-_METHODS = ("rk4", "dopri5", "dop853", "newmark-implicit", "generalized-alpha", "exact")
-_FIXED_STEP = ("rk4", "newmark-implicit", "generalized-alpha")
+# The core registry's methods ("newmark", the paper's, joins when its wiring lands).
+_METHODS = tuple(name for name, spec in METHODS.items() if spec["kind"] != "paper")
+# Those that step by dt (and take stepping = "fixed").
+_FIXED_STEP = tuple(name for name in _METHODS if "fixed" in METHODS[name]["steppings"])
 _SIDES = ("upper", "lower")
 _LOADS = ("force", "base")
 _SIGNALS = ("harmonic", "sweep", "harmonics", "recorded", "white-noise", "kanai-tajimi")
@@ -476,11 +479,6 @@ def structure_coordinates(structure: Mapping[str, Any]) -> int:
     if kind == "cantilever":
         return int(structure["modes"])
     return len(structure["mass"])
-
-
-def _coordinates(spec: dict[str, Any]) -> int:
-    """The coordinates of a checked system: the structure's and one per damper."""
-    return structure_coordinates(spec["structure"]) + len(spec["damper"])
 
 
 def system_spec(
@@ -997,7 +995,7 @@ def prepare_system(
             f'"fixed" takes a fixed-step method ({", ".join(_FIXED_STEP)}), '
             f"not {solver['method']!r}",
         )
-    for key in ("t_end", "rtol", "atol", "energy_tolerance"):
+    for key in ("t_end", "energy_tolerance"):
         if not solver[key] > 0:
             raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
     if not solver["energy_tolerance"] <= MAX_ENERGY_TOLERANCE:
@@ -1006,15 +1004,7 @@ def prepare_system(
             "[solver] energy_tolerance: ",
             f"must be in (0, {MAX_ENERGY_TOLERANCE:g}], got {solver['energy_tolerance']}",
         )
-    if not solver["atol"] <= ATOL_MAX:
-        # The core's bound (see its ATOL_MAX): a looser error control controls nothing.
-        raise _fail(
-            "[solver] atol: ", f"must be in (0, {ATOL_MAX:g}] (m, m/s), got {solver['atol']}"
-        )
-    low, high = RTOL_RANGE
-    if not low <= solver["rtol"] <= high:
-        # The core's range (see its RTOL_RANGE), checked here to name the table.
-        raise _fail("[solver] rtol: ", f"must be in [{low:g}, {high:g}], got {solver['rtol']}")
+    _check_method_options(solver)
     if solver["dt"] is not None and not solver["dt"] > 0:
         raise _fail("[solver] dt: ", f"must be > 0, got {solver['dt']}")
     fixed = solver["method"] in _FIXED_STEP
@@ -1022,51 +1012,24 @@ def prepare_system(
         raise _fail(
             "[solver] dt: ", f"is required for method {solver['method']!r} (a step in s > 0)"
         )
-    for key, low, high in (("beta", 0.0, 0.5), ("gamma", 0.5, 1.0), ("spectral_radius", 0.0, 1.0)):
-        if not low <= solver[key] <= high:
-            raise _fail(f"[solver] {key}: ", f"must be in [{low}, {high}], got {solver[key]}")
-    # The exact flow steps at most dt where one is given: as many steps at least.
-    stepped = fixed or (solver["method"] == "exact" and solver["dt"] is not None)
-    if stepped and solver["t_end"] / solver["dt"] > solver["max_steps"]:
-        raise _fail(
-            "[solver] ",
-            f"t_end / dt = {solver['t_end'] / solver['dt']:.3e} steps exceeds max_steps "
-            f"({solver['max_steps']}): raise dt or max_steps, or shorten t_end",
+    for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
+        value = (output if section == "output" else solver)[key]
+        if value < 1:
+            raise _fail(f"[{section}] {key}: ", f"must be >= 1, got {value}")
+    if output["strobe_period"] is not None and not output["strobe_period"] > 0:
+        raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
+    # The up-front limits (steps, the fastest mode and forcing against the step, rows,
+    # memory) are the core's (its registry's check_run), with their messages.
+    try:
+        check_run(
+            spec,
+            **{key: solver[key] for key in ("method", "dt", "t_end", "max_steps", "max_rows")},
+            every=output["every"],
+            history=output["history"],
+            strobe_period=output["strobe_period"],
         )
-    check_natural_period(solver, lambda: _mass_and_stiffness(spec), _fail)
-    check_forcing_steps(solver, spec["excitation"], fixed, _fail)
-    if stepped and output["history"]:
-        # The history of a fixed-step run is known before it starts: refuse it
-        # up front rather than stop at the cap.
-        rows = solver["t_end"] / solver["dt"] / max(output["every"], 1) + 2
-        if rows > solver["max_rows"]:
-            raise _fail(
-                "[solver] ",
-                f"the history would keep {rows:.3e} rows (t_end / dt / every), more than "
-                f"max_rows = {solver['max_rows']}: raise every, set history = false, "
-                "shorten t_end or raise max_rows",
-            )
-        # A row is the time and 2 (n + k) values, 8 bytes each.
-        width = 1 + 2 * _coordinates(spec)
-        if rows * width * 8 > MAX_RECORD_BYTES:
-            raise _fail(
-                "[output] history: ",
-                f"the history would keep {rows:.3e} rows of {width} values, "
-                f"{rows * width * 8 / 2**20:.0f} MiB, more than the {MAX_RECORD_BYTES >> 20} MiB "
-                "a run's records may take: raise every, set history = false or shorten t_end",
-            )
-    if output["strobe_period"] is not None and output["strobe_period"] > 0:
-        # Stroboscopic rows are known before any run starts, as fixed-step history is.
-        strobes = solver["t_end"] / output["strobe_period"]
-        width = 1 + 2 * _coordinates(spec)
-        if strobes > solver["max_rows"] or strobes * width * 8 > MAX_RECORD_BYTES:
-            raise _fail(
-                "[output] strobe_period: ",
-                f"t_end / strobe_period = {strobes:.3e} rows of {width} values, "
-                f"more than max_rows = {solver['max_rows']} or the "
-                f"{MAX_RECORD_BYTES >> 20} MiB a run's records may take: lengthen "
-                "strobe_period or shorten t_end",
-            )
+    except InvalidInputError as err:
+        raise _fail("", short_numbers(str(err))) from None
     if output["record_from"] is not None and not output["record_from"] >= 0:
         raise _fail("[output] record_from: ", f"must be >= 0 s, got {output['record_from']}")
     if output["record_from"] is not None and not output["record_from"] < solver["t_end"]:
@@ -1074,8 +1037,6 @@ def prepare_system(
             "[output] record_from: ",
             f"must be before [solver] t_end ({solver['t_end']!r} s), got {output['record_from']!r}",
         )
-    if output["strobe_period"] is not None and not output["strobe_period"] > 0:
-        raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
     followed = len(output["points"]) + len(output["moments"])
     if followed > MAX_POINTS:
         raise _fail(
@@ -1093,10 +1054,6 @@ def prepare_system(
         # Points ask for their peaks: of the whole run where no window is given
         # (user trial: they were silently left out).
         output["record_from"] = 0.0
-    for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
-        value = (output if section == "output" else solver)[key]
-        if value < 1:
-            raise _fail(f"[{section}] {key}: ", f"must be >= 1, got {value}")
     return PreparedRun(spec, init, solver, output)
 
 
@@ -1170,10 +1127,14 @@ def _solution(
     )
 
 
-def _mass_and_stiffness(spec: Mapping[str, Any]) -> tuple[list[float], list[float], int]:
-    """M and K (SI, flat, row-major) of a checked spec between contacts, and their size."""
-    raw = _linear_parts({**spec, "gravity": 0.0, "excitation": []})
-    return raw["mass"], raw["stiffness"], raw["n"] + raw["k"]
+def _check_method_options(solver: Mapping[str, Any]) -> None:
+    """The method options in the core registry's ranges (every one, whatever the
+    method: the core checks them), its message naming ``[solver] key``."""
+    try:
+        check_options(**{key: solver[key] for key in METHOD_OPTIONS if key != "max_steps"})
+    except InvalidInputError as err:
+        key, _, rest = short_numbers(str(err)).partition(" must be ")
+        raise _fail(f"[solver] {key}: ", f"must be {rest}") from None
 
 
 def linear_parts(

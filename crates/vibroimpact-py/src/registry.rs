@@ -48,7 +48,9 @@ pub(crate) fn add_registry(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let mut all = METHOD_OPTIONS.to_vec();
     all.push(registry::MAX_STEPS);
     m.add("METHOD_OPTIONS", options_dict(py, &all)?)?;
-    m.add_function(wrap_pyfunction!(check_run, m)?)?;
+    // Internal (not in __all__): vibroimpact.system's checks call them.
+    m.setattr("_check_run", wrap_pyfunction!(check_run, m)?)?;
+    m.setattr("_check_options", wrap_pyfunction!(check_options, m)?)?;
     Ok(())
 }
 
@@ -82,13 +84,13 @@ fn forcing(spec: &Bound<'_, PyDict>) -> PyResult<Vec<(usize, f64)>> {
 pub(crate) fn check_run(
     spec: &Bound<'_, PyDict>,
     method: &str,
-    dt: Option<f64>,
-    t_end: f64,
-    max_steps: u64,
-    max_rows: u64,
-    every: u64,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+    #[pyo3(from_py_with = crate::convert::max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = crate::convert::max_rows_arg)] max_rows: Option<u64>,
+    #[pyo3(from_py_with = crate::convert::every_arg)] every: u64,
     history: bool,
-    strobe_period: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
 ) -> PyResult<()> {
     let structure_dict = spec
         .get_item("structure")?
@@ -109,10 +111,34 @@ pub(crate) fn check_run(
         dt,
         t_end,
         max_steps,
-        max_rows,
+        max_rows: max_rows.unwrap_or(u64::MAX),
         every,
         history,
         strobe_period,
     };
     check_scales(&scales, &plan).map_err(to_py)
+}
+
+/// Check the method options every run is given, whatever its method, against
+/// the registry's ranges (the core's `Options::checked`); raises
+/// ``InvalidInputError`` naming the first outside and what is allowed.
+#[pyfunction]
+#[pyo3(signature = (*, rtol, atol, beta, gamma, spectral_radius))]
+pub(crate) fn check_options(
+    #[pyo3(from_py_with = crate::convert::arg::rtol)] rtol: f64,
+    #[pyo3(from_py_with = crate::convert::arg::atol)] atol: f64,
+    #[pyo3(from_py_with = crate::convert::arg::beta)] beta: f64,
+    #[pyo3(from_py_with = crate::convert::arg::gamma)] gamma: f64,
+    #[pyo3(from_py_with = crate::convert::arg::spectral_radius)] spectral_radius: f64,
+) -> PyResult<()> {
+    registry::Options {
+        rtol,
+        atol,
+        beta,
+        gamma,
+        spectral_radius,
+    }
+    .checked()
+    .map(|_| ())
+    .map_err(to_py)
 }

@@ -570,15 +570,7 @@ fn check_method(
     check("t_end", t_end, t_end > 0.0, "> 0 s")?;
     check("dt", dt, dt > 0.0, "> 0 s or None")?;
     // The method options' ranges are the registry's, checked in the core.
-    core::methods::registry::Options {
-        rtol,
-        atol,
-        beta,
-        gamma,
-        spectral_radius,
-    }
-    .checked()
-    .map_err(to_py)?;
+    crate::registry::check_options(rtol, atol, beta, gamma, spectral_radius)?;
     check(
         "energy_tolerance",
         energy_tolerance,

@@ -8,7 +8,7 @@
 mod limits;
 mod table;
 
-pub use limits::{check_run, RunPlan};
+pub use limits::{check_run, check_scales, RunPlan, RunScales};
 pub use table::{
     method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_STEPS, DT, GAMMA,
     MAX_STEPS, METHOD_OPTIONS, METHOD_SPECS, RTOL, SPECTRAL_RADIUS,

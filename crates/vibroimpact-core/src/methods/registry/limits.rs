@@ -5,8 +5,8 @@
 //! the step). Each refusal is one line naming the field (as a scenario's
 //! `[solver]`, `[output]` or `[[excitation]]` key) and what is allowed.
 
-use super::table::{method, Kind, MethodSpec};
-use crate::error::{Error, Result};
+use super::table::{method, Kind, MethodSpec, DT};
+use crate::error::{positive, Error, Result};
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::model::assembly::SystemSpec;
 use crate::model::structure::Structure;
@@ -31,6 +31,37 @@ pub struct RunPlan<'a> {
     pub strobe_period: Option<f64>,
 }
 
+/// What the limits read of a system: its structure, its coordinates (the
+/// structure's and one a damper) and the frequencies (Hz) of its harmonic
+/// forcing, each with its excitation's index.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunScales<'a> {
+    pub structure: &'a Structure,
+    pub coordinates: usize,
+    pub forcing: Vec<(usize, f64)>,
+}
+
+impl<'a> RunScales<'a> {
+    /// The scales of `system`.
+    pub fn of(system: &'a SystemSpec) -> Self {
+        let mut forcing = Vec::new();
+        for (index, excitation) in system.excitations.iter().enumerate() {
+            let (_, frequencies) = excitation.signal.harmonic_frequencies();
+            forcing.extend(
+                frequencies
+                    .unwrap_or_default()
+                    .into_iter()
+                    .map(|f| (index, f)),
+            );
+        }
+        Self {
+            structure: &system.structure,
+            coordinates: system.structure.dofs() + system.dampers.len(),
+            forcing,
+        }
+    }
+}
+
 /// Refuse a run of `system` that `plan` cannot complete within its limits,
 /// before any step: the step count of a fixed step (or of the exact flow's
 /// capped step) beyond `max_steps`, an explicit fixed step over the fastest
@@ -39,7 +70,19 @@ pub struct RunPlan<'a> {
 /// exact flow, through more than `max_steps` periods), a history or a strobe
 /// record beyond `max_rows` or the records' memory.
 pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
+    check_scales(&RunScales::of(system), plan)
+}
+
+/// [`check_run`] on what it reads of the system.
+pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
     let spec = method(plan.method)?;
+    if let Some(dt) = plan.dt {
+        DT.check(dt)?;
+    }
+    positive("t_end", plan.t_end)?;
+    if let Some(period) = plan.strobe_period {
+        positive("strobe_period", period)?;
+    }
     let fixed = spec.kind.is_fixed_step();
     if fixed && plan.dt.is_none() {
         return Err(Error::Inconsistent(format!(
@@ -60,9 +103,9 @@ pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
             )));
         }
     }
-    check_natural_period(spec, plan, &system.structure)?;
-    check_forcing_steps(spec, plan, system)?;
-    let width = 1 + 2 * (system.structure.dofs() + system.dampers.len());
+    check_natural_period(spec, plan, system.structure)?;
+    check_forcing_steps(spec, plan, &system.forcing)?;
+    let width = 1 + 2 * system.coordinates;
     if let Some(dt) = step.filter(|_| plan.history) {
         check_history(
             plan,
@@ -70,7 +113,7 @@ pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
             width,
         )?;
     }
-    if let Some(period) = plan.strobe_period.filter(|p| *p > 0.0) {
+    if let Some(period) = plan.strobe_period {
         let strobes = plan.t_end / period;
         if strobes > plan.max_rows as f64 || strobes * (width * 8) as f64 > MAX_RECORD_BYTES as f64
         {
@@ -206,34 +249,31 @@ fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure
 /// Refuse a harmonic forcing the run's steps cannot follow: a fixed step
 /// samples it below two steps a period (its result aliased), and the exact
 /// flow steps at least once in each of its periods.
-fn check_forcing_steps(spec: &MethodSpec, plan: &RunPlan, system: &SystemSpec) -> Result<()> {
-    for (index, excitation) in system.excitations.iter().enumerate() {
-        let (_, frequencies) = excitation.signal.harmonic_frequencies();
-        for frequency in frequencies.unwrap_or_default() {
-            let fixed_dt = plan.dt.filter(|_| spec.kind.is_fixed_step());
-            if let Some(dt) = fixed_dt.filter(|dt| frequency * 2.0 * dt > 1.0) {
-                return Err(Error::Inconsistent(format!(
-                    "[[excitation]] {index}: frequency {} Hz is sampled below two steps of dt = \
-                     {} s a period: give at most {} Hz, or reduce dt below {} s",
-                    python_repr(frequency),
-                    python_repr(dt),
-                    python_g3(1.0 / (2.0 * dt)),
-                    python_g3(1.0 / (20.0 * frequency))
-                )));
-            }
-            let periods = frequency * plan.t_end;
-            if spec.kind == Kind::Exact && periods > plan.max_steps as f64 {
-                return Err(Error::Inconsistent(format!(
-                    "[[excitation]] {index}: frequency {} Hz: t_end = {} s spans {} of its \
-                     periods, and the exact flow steps at least once in each: more than \
-                     max_steps ({}); give at most {} Hz or shorten t_end",
-                    python_repr(frequency),
-                    python_repr(plan.t_end),
-                    python_g3(periods),
-                    plan.max_steps,
-                    python_g3(plan.max_steps as f64 / plan.t_end)
-                )));
-            }
+fn check_forcing_steps(spec: &MethodSpec, plan: &RunPlan, forcing: &[(usize, f64)]) -> Result<()> {
+    for &(index, frequency) in forcing {
+        let fixed_dt = plan.dt.filter(|_| spec.kind.is_fixed_step());
+        if let Some(dt) = fixed_dt.filter(|dt| frequency * 2.0 * dt > 1.0) {
+            return Err(Error::Inconsistent(format!(
+                "[[excitation]] {index}: frequency {} Hz is sampled below two steps of dt = {} s \
+                 a period: give at most {} Hz, or reduce dt below {} s",
+                python_repr(frequency),
+                python_repr(dt),
+                python_g3(1.0 / (2.0 * dt)),
+                python_g3(1.0 / (20.0 * frequency))
+            )));
+        }
+        let periods = frequency * plan.t_end;
+        if spec.kind == Kind::Exact && periods > plan.max_steps as f64 {
+            return Err(Error::Inconsistent(format!(
+                "[[excitation]] {index}: frequency {} Hz: t_end = {} s spans {} of its periods, \
+                 and the exact flow steps at least once in each: more than max_steps ({}); give \
+                 at most {} Hz or shorten t_end",
+                python_repr(frequency),
+                python_repr(plan.t_end),
+                python_g3(periods),
+                plan.max_steps,
+                python_g3(plan.max_steps as f64 / plan.t_end)
+            )));
         }
     }
     Ok(())
@@ -302,6 +342,63 @@ pub(crate) fn python_g3(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `a a^T` of a pseudo-random `n x n` matrix `a` (entries in
+    /// [-scale, scale]), plus `diagonal` on its diagonal.
+    fn gram(next: &mut impl FnMut() -> f64, n: usize, scale: f64, diagonal: f64) -> Vec<Vec<f64>> {
+        let a: Vec<f64> = (0..n * n).map(|_| scale * (2.0 * next() - 1.0)).collect();
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        let dot: f64 = (0..n).map(|p| a[i * n + p] * a[j * n + p]).sum();
+                        dot + if i == j {
+                            diagonal * (0.1 + next())
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_frequency_bound_is_never_below_the_fastest_mode() {
+        // check_natural_period skips the eigenvalues where the bound passes:
+        // a bound below the fastest mode would let an unresolvable run through.
+        crate::testing::timeout(20, || {
+            let mut state = 7u64;
+            let mut next = move || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let mut finite = 0;
+            for n in [1, 2, 3, 5, 8] {
+                for _ in 0..50 {
+                    let scale = 0.05 + next();
+                    let mass = gram(&mut next, n, scale, 2.0);
+                    let spring = 1e3 * next();
+                    let stiffness = gram(&mut next, n, spring, 0.0);
+                    let damping = vec![vec![0.0; n]; n];
+                    let structure = Structure::matrices(&mass, &stiffness, &damping).unwrap();
+                    let (bound, exact) =
+                        (frequency_bound(&structure), highest_frequency(&structure));
+                    assert!(bound >= exact * (1.0 - 1e-12), "{n}: {bound} < {exact}");
+                    finite += usize::from(bound.is_finite());
+                }
+            }
+            assert!(finite > 100, "{finite}");
+            // Exact for one coordinate, zero without a spring.
+            let one = Structure::oscillator(2.0, 8.0, 0.0).unwrap();
+            let expected = 2.0 / std::f64::consts::TAU;
+            assert!((frequency_bound(&one) - expected).abs() <= 1e-15 * expected);
+            let free = Structure::oscillator(2.0, 0.0, 0.0).unwrap();
+            assert_eq!(frequency_bound(&free), 0.0);
+        });
+    }
 
     #[test]
     fn numbers_are_written_as_python_writes_them() {

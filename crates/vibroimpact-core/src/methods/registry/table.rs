@@ -62,7 +62,7 @@ pub struct OptionSpec {
 
 impl OptionSpec {
     /// `value` if finite and in range, else an error naming the option and
-    /// what is allowed.
+    /// what is allowed (`rtol must be in [1e-15, 0.1], got 0.5`).
     pub fn check(&self, value: f64) -> Result<f64> {
         let above = if self.low_open {
             value > self.low
@@ -72,10 +72,11 @@ impl OptionSpec {
         if value.is_finite() && above && value <= self.high {
             Ok(value)
         } else {
-            Err(Error::Inconsistent(format!(
-                "{} must be finite and {}, got {value}",
-                self.name, self.allowed
-            )))
+            Err(Error::InvalidParameter {
+                field: self.name,
+                allowed: self.allowed,
+                value,
+            })
         }
     }
 
@@ -93,7 +94,7 @@ pub const DT: OptionSpec = OptionSpec {
     low: 0.0,
     high: f64::MAX,
     low_open: true,
-    allowed: "> 0 s or None",
+    allowed: "finite and > 0 s or None",
 };
 /// The relative tolerance of an error control: looser than a tenth controls
 /// nothing (the run would stop on its energy balance); tighter than 1e-15 is
