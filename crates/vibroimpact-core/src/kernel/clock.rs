@@ -5,7 +5,7 @@
 //! reason", [`crate::kernel::compact`]) takes at once. The kernel's own step
 //! and the fast path read the same rules here.
 
-use crate::kernel::events::RunOptions;
+use crate::kernel::events::{ContactTiming, RunOptions};
 
 /// Chattering of compliant contacts: this many mode changes in a row, each
 /// closer than the time's round-off can resolve, stop it.
@@ -63,10 +63,17 @@ pub(crate) struct Schedule {
     pub(crate) mean_square: bool,
     /// The run's time scale: `t_end` or the structure's longest period, s.
     pub(crate) time_scale: f64,
+    /// Fixed stepping's timing of contacts (None: stepping by events).
+    pub(crate) fixed: Option<ContactTiming>,
 }
 
 impl Schedule {
-    pub(crate) fn new(options: &RunOptions, adaptive: bool, longest_period: f64) -> Self {
+    pub(crate) fn new(
+        options: &RunOptions,
+        adaptive: bool,
+        longest_period: f64,
+        fixed: Option<ContactTiming>,
+    ) -> Self {
         Self {
             adaptive,
             dt: options.dt.unwrap_or(f64::NAN),
@@ -77,6 +84,7 @@ impl Schedule {
             strobe_period: options.reduce.strobe_period,
             mean_square: options.reduce.mean_square,
             time_scale: options.t_end.min(longest_period),
+            fixed,
         }
     }
 
@@ -165,5 +173,32 @@ impl Schedule {
             return None;
         }
         Some((length, in_window))
+    }
+
+    /// The end of the next fixed step (`dt` from `clock.time`, on the grid)
+    /// where it is plain, and whether it is in the recorded window: after it
+    /// the kernel would do nothing but count it and add the contacts that
+    /// go on (no strobe, history row or end of the run due, not a stall, no
+    /// mean square to sum). None where the kernel's own fixed step must
+    /// follow.
+    #[inline(always)]
+    pub(crate) fn plain_fixed_step(&self, clock: &Clock) -> Option<(f64, bool)> {
+        let time = clock.time;
+        if self.at_end(time) {
+            return None;
+        }
+        let next = (clock.grid + 1) as f64 * self.dt;
+        if self.strobe_due(clock, next)
+            || self.done(next)
+            || (self.keep_history && clock.until_kept <= 1)
+            || self.dt <= self.chatter_interval(next)
+        {
+            return None;
+        }
+        let in_window = self.in_window(time, self.dt);
+        if in_window && self.mean_square {
+            return None;
+        }
+        Some((next, in_window))
     }
 }

@@ -275,6 +275,9 @@ pub fn integrate_system_stepped<S: SystemStepper>(
     let mut run = Run::new(system, stepper, initial, options, stepping, record_limit)?;
     if run.timing.is_some() {
         while run.clock.time < options.t_end {
+            if run.stretches && run.clock.accepted > 0 && run.fast_steps(stepper, interrupt)? {
+                continue;
+            }
             let stop = run.fixed_step(stepper)?;
             if stop == Stop::End {
                 break;

@@ -91,6 +91,33 @@ pub(super) fn contact_force(system: &Assembly, i: usize, y: &[f64], mode: Mode) 
     }
 }
 
+/// A contact's deepest indentation with the step's indentation data `(i0,
+/// i1, m0, m1)` (see [`Run::fixed_step`]): its end, and where located, the
+/// interpolant's peak when the step passes one.
+#[inline(always)]
+pub(crate) fn deepest(oc: &mut Open, (i0, i1, m0, m1): (f64, f64, f64, f64), located: bool) {
+    if located && m0 > 0.0 && m1 <= 0.0 {
+        let peak = hermite::argmax(i0, i1, m0, m1);
+        let deepest = hermite::eval(i0, i1, m0, m1, peak).0;
+        oc.max_indentation = oc.max_indentation.max(deepest);
+    }
+    oc.max_indentation = oc.max_indentation.max(i1);
+}
+
+/// A step of `dt` of compliant interaction `i`'s contact `oc` (in `mode`)
+/// that ends still in contact at `end`: the trapezoidal sum of its
+/// dissipated power.
+#[inline(always)]
+pub(crate) fn press(system: &Assembly, i: usize, oc: &mut Open, end: &[f64], mode: Mode, dt: f64) {
+    let latched = match mode {
+        Mode::Compliant { approach_rate } => approach_rate,
+        _ => 0.0,
+    };
+    let p0 = oc.power;
+    oc.power = dissipation(system, i, end, latched);
+    oc.dissipated += 0.5 * dt * (p0 + oc.power);
+}
+
 /// A quantity at fraction `theta` of a step, between its values at the
 /// step's ends.
 fn within_step(start: f64, end: f64, theta: f64) -> f64 {
@@ -231,20 +258,9 @@ impl Run<'_> {
                 }
                 None => continue,
                 Some(oc) => {
-                    if located && m0 > 0.0 && m1 <= 0.0 {
-                        let peak = hermite::argmax(i0, i1, m0, m1);
-                        let deepest = hermite::eval(i0, i1, m0, m1, peak).0;
-                        oc.max_indentation = oc.max_indentation.max(deepest);
-                    }
-                    oc.max_indentation = oc.max_indentation.max(i1);
+                    deepest(oc, (i0, i1, m0, m1), located);
                     if i1 > 0.0 {
-                        let p0 = oc.power;
-                        let latched = match self.modes[i] {
-                            Mode::Compliant { approach_rate } => approach_rate,
-                            _ => 0.0,
-                        };
-                        oc.power = dissipation(system, i, &self.end, latched);
-                        oc.dissipated += 0.5 * dt * (p0 + oc.power);
+                        press(system, i, oc, &self.end, self.modes[i], dt);
                         continue;
                     }
                     let theta = if i0 > 0.0 {

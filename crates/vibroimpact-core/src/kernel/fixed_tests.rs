@@ -394,3 +394,56 @@ fn fixed_paper_newmark_is_the_0_1_kernel() {
         }
     });
 }
+
+#[test]
+fn fixed_rk4_s_fast_path_is_its_general_path_to_the_bit() {
+    crate::testing::timeout(60, || {
+        // Forced and damped (a contact damper on one law), kept every 7th
+        // step, a recorded window and strobes: every field of the solution.
+        let system = ImpactDamper::new(1.0, 3947.8, 2.5, 0.05, 1e-3).unwrap();
+        let laws = [
+            hertz(),
+            Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap(),
+        ];
+        for (contact, timing) in laws
+            .iter()
+            .flat_map(|c| [(c, ContactTiming::Located), (c, ContactTiming::StepCount)])
+        {
+            let mut spec = spec(&system, contact);
+            spec.excitations = vec![crate::model::assembly::Excitation {
+                load: crate::model::assembly::Load::Force { at: 0.0 },
+                signal: crate::model::signals::Signal::harmonic(20.0, 9.0, 0.3).unwrap(),
+            }];
+            let assembly = Assembly::new(&spec).unwrap();
+            assert!(assembly.compact.is_some());
+            let y = initial_state(&assembly, &[0.0], &[0.0], &[0.0], &[0.3]).unwrap();
+            let mut o = options(1e-5, 0.5);
+            o.every = 7;
+            o.reduce = ReduceOptions {
+                record_from: 0.1,
+                strobe_period: 1.0 / 9.0,
+                mean_square: false,
+                ..ReduceOptions::default()
+            };
+            let stepping = Stepping::Fixed {
+                contact_timing: timing,
+            };
+            let [fast, general] = [true, false].map(|compact| {
+                let mut stepper = ExplicitRk::rk4(assembly.state_len());
+                stepper.compact = compact;
+                let run = integrate_system_stepped(
+                    &assembly,
+                    &mut stepper,
+                    &y,
+                    &o,
+                    stepping,
+                    &mut || false,
+                    MAX_RECORD_BYTES,
+                );
+                format!("{run:?}")
+            });
+            assert!(fast.contains("Compliant"), "{fast:.300}");
+            assert!(fast == general, "{:?} {timing:?}", contact.law);
+        }
+    });
+}

@@ -154,7 +154,7 @@ impl<'a> Run<'a> {
             fixed::check(system, stepper)?;
         }
         let t_end = options.t_end;
-        let schedule = Schedule::new(options, adaptive, system.longest_period);
+        let schedule = Schedule::new(options, adaptive, system.longest_period, timing);
         let dt = schedule.dt;
         if !adaptive && (dt.is_nan() || dt <= 0.0) {
             return Err(Error::Inconsistent(format!(
@@ -255,7 +255,7 @@ impl<'a> Run<'a> {
             impacts: Impacts::new(system),
             compliant: false,
             kinked: system.has_breakpoints(),
-            stretches: !adaptive && timing.is_none() && stepper.takes_stretches(system),
+            stretches: !adaptive && stepper.takes_stretches(system),
             timing,
             creates_contact_energy: stepper.creates_contact_energy(),
             changes: vec![None; count],

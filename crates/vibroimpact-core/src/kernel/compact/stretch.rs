@@ -8,7 +8,8 @@ use super::{Compact, MAX_LEN, MAX_WALLS};
 use crate::error::Error;
 use crate::kernel::balance::EnergyWatch;
 use crate::kernel::clock::{Clock, Schedule};
-use crate::kernel::events::Open;
+use crate::kernel::events::{ContactTiming, Open};
+use crate::kernel::fixed;
 use crate::kernel::sized::by_size;
 use crate::model::assembly::{Assembly, Mode, Scratch};
 
@@ -173,6 +174,114 @@ impl Compact {
         f.y[..len].copy_from_slice(&y[..len]);
         f.gaps[..count].copy_from_slice(&start_gaps[..count]);
     }
+
+    /// Plain fixed steps of `dt` on the grid (`stepping = "fixed"`), as the
+    /// kernel's fixed step takes them ([`crate::kernel::fixed`]), for as
+    /// long as nothing but the step and the contacts that go on are due (the
+    /// kernel's rule, [`Schedule::plain_fixed_step`]): each the kernel's to
+    /// the bit. One that turns out not to be plain (a contact begins or ends
+    /// in it, a peak inside it, a state no longer finite) is taken back, for
+    /// the kernel to take. No pair sticks in fixed stepping (no rigid pair).
+    #[inline(always)]
+    pub(crate) fn fixed_stretch(
+        &self,
+        system: &Assembly,
+        n: usize,
+        k: usize,
+        f: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        let (d, count) = (n + k, self.count.min(MAX_WALLS));
+        let len = f.y.len().min(MAX_LEN);
+        let observed = system.observed();
+        let modes = &modes[..count];
+        let mut y = [0.0; MAX_LEN];
+        y[..len].copy_from_slice(&f.y[..len]);
+        let mut start_gaps = [(0.0, 0.0); MAX_WALLS];
+        start_gaps[..count].copy_from_slice(&f.gaps[..count]);
+        let (mut end, mut end_gaps) = ([0.0; MAX_LEN], [(0.0, 0.0); MAX_WALLS]);
+        let mut stages = [[0.0; MAX_LEN]; 4];
+        let (mut energy, schedule, mut clock) = (*f.energy, *f.schedule, *f.clock);
+        let (dt, located) = (schedule.dt, schedule.fixed == Some(ContactTiming::Located));
+        loop {
+            if clock.accepted >= f.max_accepted {
+                f.limited = true;
+                break;
+            }
+            let Some((next, in_window)) = schedule.plain_fixed_step(&clock) else {
+                break;
+            };
+            let time = clock.time;
+            let cache = scratch.first_cache().copied();
+            self.step::<false>(
+                system,
+                n,
+                k,
+                time,
+                &y,
+                len,
+                dt,
+                modes,
+                scratch,
+                &mut stages,
+                false,
+                &mut end,
+            );
+            self.gaps(d, &end, &mut end_gaps);
+            let mut plain = end[..2 * d].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
+            for w in 0..count {
+                // Indented at the end exactly where in contact: no onset or
+                // separation in the step.
+                plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
+            }
+            if in_window {
+                for j in 0..observed {
+                    let s0 = system.observe(j, &y[d..d + n]);
+                    if s0 * system.observe(j, &end[d..d + n]) < 0.0 {
+                        plain = false;
+                    }
+                }
+            }
+            if !plain {
+                if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
+                    *cache = saved;
+                }
+                break;
+            }
+            for w in 0..count {
+                if let Some(oc) = f.open[w].as_mut() {
+                    let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
+                    fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+                    fixed::press(system, w, oc, &end[..len], modes[w], dt);
+                }
+            }
+            if in_window {
+                for (j, peak) in f.peaks.iter_mut().enumerate().take(observed) {
+                    let (p0, p1) = (system.observe(j, &y[..n]), system.observe(j, &end[..n]));
+                    *peak = peak.max(p0.abs().max(p1.abs()));
+                }
+                *f.recorded_time += dt;
+            }
+            clock.time = next;
+            clock.grid += 1;
+            clock.accepted += 1;
+            clock.until_kept = clock.until_kept.saturating_sub(1);
+            f.evaluations += 4;
+            f.steps += 1;
+            y[..len].copy_from_slice(&end[..len]);
+            start_gaps[..count].copy_from_slice(&end_gaps[..count]);
+            let state = (&y[..len], modes);
+            if let Err(failure) = energy.after_step(system, state, clock.accepted, false, next) {
+                f.unbalanced = Some(failure);
+                break;
+            }
+        }
+        *f.energy = energy;
+        *f.clock = clock;
+        f.y[..len].copy_from_slice(&y[..len]);
+        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+    }
 }
 
 /// [`Compact::stretch`] for the system's sizes (constants in each arm).
@@ -184,6 +293,10 @@ fn stretch_sized(
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
+    if f.schedule.fixed.is_some() {
+        return by_size!(system, |n, k| compact
+            .fixed_stretch(system, n, k, f, modes, scratch));
+    }
     // Without a sticking pair, no constraint solve is compiled in.
     if modes.contains(&Mode::Sticking) {
         by_size!(system, |n, k| compact
