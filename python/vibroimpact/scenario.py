@@ -19,6 +19,7 @@ from typing import Any
 
 from vibroimpact import arguments
 from vibroimpact._core import (
+    METHOD_OPTIONS,
     Contact,
     ImpactDamper,
     InitialState,
@@ -54,6 +55,8 @@ _SHORT.maxstring, _SHORT.maxlong, _SHORT.maxother = 40, 24, 40
 _DEFAULTS: dict[str, Any] = {
     name: parameter.default for name, parameter in inspect.signature(simulate).parameters.items()
 }
+# The method options' defaults are the core registry's (the one place they are written).
+_DEFAULTS.update({name: option["default"] for name, option in METHOD_OPTIONS.items()})
 
 # section -> key -> (type, default; a default of _REQUIRED means the key must be given)
 _REQUIRED = object()
@@ -116,12 +119,12 @@ class Scenario:
     dt: float | None = 1e-4
     t_end: float = 0.3
     stepping: str | None = None
-    beta: float = 0.25
-    gamma: float = 0.5
-    spectral_radius: float = 0.9
-    rtol: float = 1e-8
-    atol: float = 1e-12
-    max_steps: int = 1_000_000_000
+    beta: float = _DEFAULTS["beta"]
+    gamma: float = _DEFAULTS["gamma"]
+    spectral_radius: float = _DEFAULTS["spectral_radius"]
+    rtol: float = _DEFAULTS["rtol"]
+    atol: float = _DEFAULTS["atol"]
+    max_steps: int = _DEFAULTS["max_steps"]
     contact_timing: str = "located"
     every: int = 1
     energy_tolerance: float | None = _DEFAULTS["energy_tolerance"]

@@ -1133,8 +1133,12 @@ def _check_method_options(solver: Mapping[str, Any]) -> None:
     try:
         check_options(**{key: solver[key] for key in METHOD_OPTIONS if key != "max_steps"})
     except InvalidInputError as err:
-        key, _, rest = short_numbers(str(err)).partition(" must be ")
-        raise _fail(f"[solver] {key}: ", f"must be {rest}") from None
+        # The core names the option; the value is written as given.
+        key = str(err).partition(" must be ")[0]
+        if key not in METHOD_OPTIONS:
+            raise _fail("[solver] ", short_numbers(str(err))) from None
+        allowed = METHOD_OPTIONS[key]["allowed"]
+        raise _fail(f"[solver] {key}: ", f"must be {allowed}, got {solver[key]}") from None
 
 
 def linear_parts(
