@@ -77,6 +77,11 @@ interpolant), ``rms`` (trapezoidal rule over the step ends) and ``impacts`` (con
 located onset is at or after ``record_from``). A run whose state stops being finite, or
 whose mechanical energy grows past its start by more than ``energy_tolerance``, fails with
 its reason; these are its only checks, looser than a single run's energy ledger.
+Any other small modal system (at most 4 modes, 2 dampers, 6 walls, compliant laws, one
+force, gravity) runs in compact lanes of sixteen, each run the single fixed-step run
+``vibroimpact.simulate_system(..., method="rk4", stepping="fixed")`` makes of it, bit for
+bit, with the event-driven study's ``peak``, ``rms`` and ``impacts``; a system they cannot
+take is refused naming ``stepping``.
 """
 
 from vibroimpact.study.assembly import assemble

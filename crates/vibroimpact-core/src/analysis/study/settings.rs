@@ -17,8 +17,9 @@ pub struct StudySettings {
     /// Whether to integrate the mean squares (the RMS metric).
     pub mean_square: bool,
     /// Fixed steps without cutting them at events, the runs advanced in
-    /// lockstep ([`crate::analysis::ensemble`]): RK4 runs of one mass on a spring with
-    /// one compliant damper, unforced.
+    /// lockstep: RK4 runs of one mass on a spring with one compliant damper,
+    /// unforced ([`crate::analysis::ensemble`]), or of any small modal system the
+    /// compact path takes ([`crate::analysis::lanes`]).
     pub lockstep: bool,
 }
 

@@ -204,6 +204,26 @@ fn same_shape(a: &Compact, b: &Compact) -> bool {
             .all(|w| a.walls[w].mirror == b.walls[w].mirror && kind(a, w) == kind(b, w))
 }
 
+/// [`Group::step_in`] compiled for a processor feature (the same
+/// operations, so the same bits, in wider vector instructions).
+macro_rules! step_with {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        unsafe fn $name(
+            &self,
+            time: f64,
+            start: &LaneState,
+            h: f64,
+            modes: &LaneModes,
+            scratch: &mut [Scratch],
+            out: &mut LaneStep,
+        ) {
+            self.step_in(time, start, h, modes, scratch, out)
+        }
+    };
+}
+
 impl<L: LaneLaw> Group<L> {
     /// The group of `systems` (`(compact, n, k, state length)`, the first
     /// repeated into lanes left empty), where they share a shape and every
@@ -461,33 +481,8 @@ impl<L: LaneLaw> Group<L> {
         self.step_in(time, start, h, modes, scratch, out)
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn step_avx512(
-        &self,
-        time: f64,
-        start: &LaneState,
-        h: f64,
-        modes: &LaneModes,
-        scratch: &mut [Scratch],
-        out: &mut LaneStep,
-    ) {
-        self.step_in(time, start, h, modes, scratch, out)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn step_avx2(
-        &self,
-        time: f64,
-        start: &LaneState,
-        h: f64,
-        modes: &LaneModes,
-        scratch: &mut [Scratch],
-        out: &mut LaneStep,
-    ) {
-        self.step_in(time, start, h, modes, scratch, out)
-    }
+    step_with!(step_avx512, "avx512f");
+    step_with!(step_avx2, "avx2");
 
     #[inline(always)]
     fn step_in(
