@@ -23,6 +23,10 @@ impl Compact {
         modes: &[Mode],
         scratch: &mut Scratch,
     ) {
+        if f.schedule.fixed.is_some() {
+            // Out of the events' stretches, which it would grow.
+            return fixed_sized(self, system, f, modes, scratch);
+        }
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx512f") {
@@ -293,10 +297,6 @@ fn stretch_sized(
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
-    if f.schedule.fixed.is_some() {
-        return by_size!(system, |n, k| compact
-            .fixed_stretch(system, n, k, f, modes, scratch));
-    }
     // Without a sticking pair, no constraint solve is compiled in.
     if modes.contains(&Mode::Sticking) {
         by_size!(system, |n, k| compact
@@ -305,6 +305,19 @@ fn stretch_sized(
         by_size!(system, |n, k| compact
             .stretch::<false>(system, n, k, f, modes, scratch))
     }
+}
+
+/// [`Compact::fixed_stretch`] for the system's sizes (constants in each arm).
+#[inline(never)]
+fn fixed_sized(
+    compact: &Compact,
+    system: &Assembly,
+    f: &mut Stretch<'_>,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+) {
+    by_size!(system, |n, k| compact
+        .fixed_stretch(system, n, k, f, modes, scratch))
 }
 
 /// [`stretch_sized`] compiled for a processor feature.
