@@ -5,21 +5,22 @@
 use crate::error::{positive, within, Error, Result};
 use crate::kernel::events::{self, RunOptions};
 use crate::legacy::steppers::Tolerances;
+use crate::methods::registry::{self, ATOL, RTOL};
 
 /// The relative tolerance (`rtol`) a method with error control takes, and
 /// its description: an error control looser than a tenth controls nothing
 /// (the run would stop on its energy balance); tighter than 1e-15 is below
 /// round-off. Every check of an rtol (here, the binding's, the Python
 /// scenario's) reads these.
-pub const RTOL_RANGE: (f64, f64) = (1e-15, 0.1);
-pub const RTOL_ALLOWED: &str = "in [1e-15, 0.1]";
+pub const RTOL_RANGE: (f64, f64) = (RTOL.low, RTOL.high);
+pub const RTOL_ALLOWED: &str = RTOL.allowed;
 
 /// The absolute tolerance (`atol`, m and m/s) a method with error control
 /// takes, and its description: an error of a metre (a metre a second)
 /// allowed in every coordinate controls nothing a vibro-impact run could
 /// resolve (1e300 had been accepted). Every check of an atol reads these.
-pub const ATOL_MAX: f64 = 1.0;
-pub const ATOL_ALLOWED: &str = "in (0, 1] (m, m/s)";
+pub const ATOL_MAX: f64 = ATOL.high;
+pub const ATOL_ALLOWED: &str = ATOL.allowed;
 
 /// The largest `energy_tolerance`, and its description. The balance's
 /// residual is measured against the energy in play (all the energy there was
@@ -97,13 +98,15 @@ pub struct MethodOptions {
 }
 
 impl Default for MethodOptions {
+    /// The core registry's defaults.
     fn default() -> Self {
+        let d = registry::Options::default();
         Self {
-            beta: 0.25,
-            gamma: 0.5,
-            spectral_radius: 0.9,
-            rtol: 1e-8,
-            atol: 1e-12,
+            beta: d.beta,
+            gamma: d.gamma,
+            spectral_radius: d.spectral_radius,
+            rtol: d.rtol,
+            atol: d.atol,
         }
     }
 }
@@ -132,27 +135,23 @@ impl Method {
     /// Method by name. Every option is checked whatever the method, so that
     /// a wrong value is never silently ignored.
     pub fn parse(name: &str, options: &MethodOptions) -> Result<Self> {
-        let beta = within("beta", options.beta, 0.0, 0.5, false, "in [0, 0.5]")?;
-        let gamma = within("gamma", options.gamma, 0.5, 1.0, false, "in [0.5, 1]")?;
-        let spectral_radius = within(
-            "spectral_radius",
-            options.spectral_radius,
-            0.0,
-            1.0,
-            false,
-            "in [0, 1]",
-        )?;
-        let tolerances = Tolerances {
-            rtol: within(
-                "rtol",
-                options.rtol,
-                RTOL_RANGE.0,
-                RTOL_RANGE.1,
-                false,
-                RTOL_ALLOWED,
-            )?,
-            atol: within("atol", options.atol, 0.0, ATOL_MAX, true, ATOL_ALLOWED)?,
-        };
+        // The registry's ranges, in its order (rtol, atol, beta, gamma,
+        // spectral_radius).
+        let registry::Options {
+            rtol,
+            atol,
+            beta,
+            gamma,
+            spectral_radius,
+        } = registry::Options {
+            rtol: options.rtol,
+            atol: options.atol,
+            beta: options.beta,
+            gamma: options.gamma,
+            spectral_radius: options.spectral_radius,
+        }
+        .checked()?;
+        let tolerances = Tolerances { rtol, atol };
         match name {
             "newmark" => Ok(Self::Newmark { beta, gamma }),
             "newmark-implicit" => Ok(Self::NewmarkImplicit { beta, gamma }),
