@@ -6,7 +6,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, overload
 
-from vibroimpact._core import Contact, ImpactDamper, InitialState, InvalidInputError, Solution
+from vibroimpact._core import (
+    METHOD_OPTIONS,
+    Contact,
+    ImpactDamper,
+    InitialState,
+    InvalidInputError,
+    Solution,
+)
 from vibroimpact._core import simulate as _two_mass
 from vibroimpact.arguments import typed
 from vibroimpact.messages import shown
@@ -92,12 +99,12 @@ def simulate(  # the two-mass run's own signature (_core.pyi)
     every: int = 1,
     contact_timing: str = "located",
     stepping: str | None = None,
-    beta: float = 0.25,
-    gamma: float = 0.5,
-    spectral_radius: float = 0.9,
-    rtol: float = 1e-8,
-    atol: float = 1e-12,
-    max_steps: int = 1_000_000_000,
+    beta: float = METHOD_OPTIONS["beta"]["default"],
+    gamma: float = METHOD_OPTIONS["gamma"]["default"],
+    spectral_radius: float = METHOD_OPTIONS["spectral_radius"]["default"],
+    rtol: float = METHOD_OPTIONS["rtol"]["default"],
+    atol: float = METHOD_OPTIONS["atol"]["default"],
+    max_steps: int = METHOD_OPTIONS["max_steps"]["default"],
     max_rows: int | None = None,
     energy_tolerance: float | None = None,
     history: bool = True,
