@@ -236,6 +236,8 @@ def simulate_system(
     energy_tolerance: float,
     record_from: float | None = None,
     strobe_period: float | None = None,
+    stepping: str = "events",
+    contact_timing: str = "located",
 ) -> dict[str, Any]: ...
 def linear_parts(spec: dict[str, Any]) -> dict[str, Any]: ...
 def run_study(
@@ -282,6 +284,8 @@ class PreparedSystem:
         max_steps: int,
         max_rows: int,
         energy_tolerance: float,
+        stepping: str = "events",
+        contact_timing: str = "located",
     ) -> PreparedSystem: ...
     def run(
         self,

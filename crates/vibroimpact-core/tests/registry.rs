@@ -1,10 +1,11 @@
 //! The registry's up-front run limits, called from Rust alone: a run past
 //! them is refused before any step, naming the field and what is allowed.
 
+mod common;
+
 use vibroimpact_core::methods::registry::{check_run, RunPlan, DEFAULT_MAX_STEPS};
 use vibroimpact_core::model::assembly::{Excitation, Load, SystemSpec};
 use vibroimpact_core::model::signals::Signal;
-use vibroimpact_core::testing::timeout;
 use vibroimpact_core::{Contact, ImpactDamper, LawKind, MAX_RECORD_BYTES};
 
 /// The founding paper's two masses (M = 1 kg on K = 1 N/m: 0.159 Hz).
@@ -40,7 +41,7 @@ fn refused(system: &SystemSpec, plan: &RunPlan, words: &[&str]) -> String {
 
 #[test]
 fn a_run_within_its_limits_passes() {
-    timeout(10, || {
+    common::timeout(10, || {
         let system = table_1();
         for method in [
             "rk4",
@@ -59,7 +60,7 @@ fn a_run_within_its_limits_passes() {
 
 #[test]
 fn too_many_fixed_steps_are_refused() {
-    timeout(10, || {
+    common::timeout(10, || {
         let system = table_1();
         let mut run = plan("rk4", Some(1e-3), 10.0);
         run.max_steps = 9_999;
@@ -88,7 +89,7 @@ fn too_many_fixed_steps_are_refused() {
 
 #[test]
 fn an_explicit_step_over_the_fastest_period_is_refused() {
-    timeout(10, || {
+    common::timeout(10, || {
         // 1e12 N/m on 1 kg: 1.59e5 Hz, a period of 6.28e-6 s.
         let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
         let stiff = ImpactDamper::new(1.0, 1e12, 0.0, 0.25, 0.005)
@@ -122,7 +123,7 @@ fn an_explicit_step_over_the_fastest_period_is_refused() {
 
 #[test]
 fn a_forcing_the_steps_cannot_follow_is_refused() {
-    timeout(10, || {
+    common::timeout(10, || {
         let mut system = table_1();
         system.excitations.push(Excitation {
             load: Load::Force { at: 0.0 },
@@ -143,7 +144,7 @@ fn a_forcing_the_steps_cannot_follow_is_refused() {
 
 #[test]
 fn a_history_beyond_the_rows_or_the_memory_is_refused() {
-    timeout(10, || {
+    common::timeout(10, || {
         let system = table_1();
         let mut run = plan("rk4", Some(1e-6), 100.0);
         run.max_rows = 1_000;

@@ -363,10 +363,10 @@ mod tests {
             .collect()
     }
 
+    /// check_natural_period skips the eigenvalues where the bound passes: a
+    /// bound below the fastest mode would let an unresolvable run through.
     #[test]
     fn the_frequency_bound_is_never_below_the_fastest_mode() {
-        // check_natural_period skips the eigenvalues where the bound passes:
-        // a bound below the fastest mode would let an unresolvable run through.
         crate::testing::timeout(20, || {
             let mut state = 7u64;
             let mut next = move || {
