@@ -554,7 +554,8 @@ impl PreparedSystem {
     }
 }
 
-/// The settings a run takes, each finite and in its range.
+/// The settings a run takes, each finite and in its range: the core
+/// registry's check.
 #[allow(clippy::too_many_arguments)]
 fn check_method(
     t_end: f64,
@@ -566,18 +567,16 @@ fn check_method(
     spectral_radius: f64,
     energy_tolerance: f64,
 ) -> PyResult<()> {
-    let dt = dt.unwrap_or(1.0);
-    check("t_end", t_end, t_end > 0.0, "> 0 s")?;
-    check("dt", dt, dt > 0.0, "> 0 s or None")?;
-    // The method options' ranges are the registry's, checked in the core.
-    crate::registry::check_options(rtol, atol, beta, gamma, spectral_radius)?;
-    check(
-        "energy_tolerance",
-        energy_tolerance,
-        vibroimpact_core::legacy::settings::checked_energy_tolerance(energy_tolerance).is_ok(),
-        vibroimpact_core::legacy::settings::ENERGY_TOLERANCE_ALLOWED,
-    )?;
-    Ok(())
+    let options = core::methods::registry::Options {
+        rtol,
+        atol,
+        beta,
+        gamma,
+        spectral_radius,
+    };
+    core::methods::registry::check_settings(t_end, dt, options, energy_tolerance)
+        .map(|_| ())
+        .map_err(to_py)
 }
 
 /// `value` of `field`, unless it is not finite or not `ok` (then an error

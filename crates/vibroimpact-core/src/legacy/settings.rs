@@ -28,8 +28,8 @@ pub const ATOL_ALLOWED: &str = ATOL.allowed;
 /// large as all of it, so a larger one would check nothing (a run may then
 /// report energy that never was). Every check of the tolerance (here, the
 /// binding's, the Python scenario's) reads these.
-pub const MAX_ENERGY_TOLERANCE: f64 = 1.0;
-pub const ENERGY_TOLERANCE_ALLOWED: &str = "in (0, 1]";
+pub const MAX_ENERGY_TOLERANCE: f64 = registry::ENERGY_TOLERANCE.high;
+pub const ENERGY_TOLERANCE_ALLOWED: &str = registry::ENERGY_TOLERANCE.allowed;
 
 /// The most energy one contact may create, relative to the energy in play,
 /// whatever `energy_tolerance` says. A contact can only lose energy; what
@@ -220,7 +220,7 @@ impl Stepping {
 /// room for any run a workstation can plot or save, yet a run that would grow
 /// without bound (an adaptive run keeping every step) stops within seconds
 /// with a clear message instead of exhausting the machine's memory.
-pub const DEFAULT_MAX_ROWS: u64 = 20_000_000;
+pub const DEFAULT_MAX_ROWS: u64 = registry::DEFAULT_MAX_ROWS;
 /// Default of `energy_tolerance`: the energy balance may miss by 5 % of the
 /// energy in play. A guard against impossible results, not an accuracy
 /// control (that is dt or rtol): on the founding paper's collision every
@@ -231,7 +231,10 @@ pub const DEFAULT_MAX_ROWS: u64 = 20_000_000;
 /// of the approach speed) and is refused, as are the gross failures (a
 /// contact stepped over whole, "dissipating" a million times the energy
 /// there is).
-pub const DEFAULT_ENERGY_TOLERANCE: f64 = 5e-2;
+pub const DEFAULT_ENERGY_TOLERANCE: f64 = match registry::ENERGY_TOLERANCE.default {
+    Some(tolerance) => tolerance,
+    None => 0.0,
+};
 /// Most fixed steps a run may take: beyond 2^53 the step indices, and so the
 /// step times `n dt`, are no longer exact in f64.
 const MAX_EXACT_STEPS: f64 = 9_007_199_254_740_992.0;

@@ -10,8 +10,9 @@ mod table;
 
 pub use limits::{check_run, check_scales, RunPlan, RunScales};
 pub use table::{
-    method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_STEPS, DT, GAMMA,
-    MAX_STEPS, METHOD_OPTIONS, METHOD_SPECS, RTOL, SPECTRAL_RADIUS,
+    check_settings, method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_ROWS,
+    DEFAULT_MAX_STEPS, DT, ENERGY_TOLERANCE, GAMMA, MAX_STEPS, METHOD_OPTIONS, METHOD_SPECS, RTOL,
+    SPECTRAL_RADIUS, T_END,
 };
 
 use crate::error::{Error, Result};

@@ -154,6 +154,32 @@ pub const MAX_STEPS: OptionSpec = OptionSpec {
     allowed: "a whole number >= 1",
 };
 
+/// A run's end time (s).
+pub const T_END: OptionSpec = OptionSpec {
+    name: "t_end",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0 s",
+};
+/// The relative tolerance of a run's energy-balance checks: the balance may
+/// miss by this fraction of the energy in play (default 5 %, a guard against
+/// impossible results, not an accuracy control). A tolerance of 1 already
+/// accepts a residual as large as all of it, so a larger one checks nothing.
+pub const ENERGY_TOLERANCE: OptionSpec = OptionSpec {
+    name: "energy_tolerance",
+    default: Some(5e-2),
+    low: 0.0,
+    high: 1.0,
+    low_open: true,
+    allowed: "in (0, 1]",
+};
+/// The default of `max_rows`, the history rows plus contacts a run may keep:
+/// 20 million (under 1 GB of two-mass history), room for any run a
+/// workstation can plot, yet a run growing without bound stops within seconds.
+pub const DEFAULT_MAX_ROWS: u64 = 20_000_000;
+
 /// The method options every method is given (and every one checked,
 /// whatever the method, so that a wrong value is never silently ignored), in
 /// the order they are checked.
@@ -261,6 +287,24 @@ impl Default for Options {
             spectral_radius: SPECTRAL_RADIUS.default_value(),
         }
     }
+}
+
+/// A run's settings beside its method options, each checked against the
+/// registry (`t_end`, `dt` where given, `energy_tolerance`), then the method
+/// options ([`Options::checked`]); the first outside is named.
+pub fn check_settings(
+    t_end: f64,
+    dt: Option<f64>,
+    options: Options,
+    energy_tolerance: f64,
+) -> Result<Options> {
+    T_END.check(t_end)?;
+    if let Some(dt) = dt {
+        DT.check(dt)?;
+    }
+    let options = options.checked()?;
+    ENERGY_TOLERANCE.check(energy_tolerance)?;
+    Ok(options)
 }
 
 impl Options {

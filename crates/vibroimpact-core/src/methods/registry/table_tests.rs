@@ -85,3 +85,53 @@ fn the_kinds_say_which_methods_step_by_dt() {
         }
     });
 }
+
+#[test]
+fn a_run_s_settings_are_checked_with_its_options() {
+    crate::testing::timeout(10, || {
+        let good = Options::default();
+        assert_eq!(check_settings(1.0, Some(1e-3), good, 0.05), Ok(good));
+        assert_eq!(check_settings(1.0, None, good, 1.0), Ok(good));
+        let bad_rtol = Options { rtol: 1.0, ..good };
+        for (t_end, dt, options, tolerance, expected) in [
+            (
+                0.0,
+                None,
+                good,
+                0.05,
+                "t_end must be finite and > 0 s, got 0",
+            ),
+            (
+                1.0,
+                Some(-1.0),
+                good,
+                0.05,
+                "dt must be finite and > 0 s or None, got -1",
+            ),
+            (
+                1.0,
+                None,
+                bad_rtol,
+                0.05,
+                "rtol must be in [1e-15, 0.1], got 1",
+            ),
+            (
+                1.0,
+                None,
+                good,
+                1.5,
+                "energy_tolerance must be in (0, 1], got 1.5",
+            ),
+            (
+                f64::NAN,
+                None,
+                good,
+                0.05,
+                "t_end must be finite and > 0 s, got NaN",
+            ),
+        ] {
+            let err = check_settings(t_end, dt, options, tolerance).unwrap_err();
+            assert_eq!(err.to_string(), expected);
+        }
+    });
+}
