@@ -4,6 +4,7 @@
 
 use pyo3::prelude::*;
 use vibroimpact_core as core;
+use vibroimpact_core::methods::registry as core_registry;
 
 mod convert;
 mod errors;
@@ -59,19 +60,23 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(adequacy, m)?)?;
     registry::add_registry(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("DEFAULT_MAX_ROWS", core::DEFAULT_MAX_ROWS)?;
+    // The run limits' defaults and ranges: the core registry's.
+    m.add("DEFAULT_MAX_ROWS", core_registry::DEFAULT_MAX_ROWS)?;
     m.add("MAX_RECORD_BYTES", core::MAX_RECORD_BYTES)?;
     m.add(
         "MAX_SIGNAL_SAMPLES",
         core::model::signals::MAX_SIGNAL_SAMPLES,
     )?;
-    m.add("DEFAULT_ENERGY_TOLERANCE", core::DEFAULT_ENERGY_TOLERANCE)?;
-    m.add("RTOL_RANGE", core::legacy::settings::RTOL_RANGE)?;
-    m.add("ATOL_MAX", core::legacy::settings::ATOL_MAX)?;
     m.add(
-        "MAX_ENERGY_TOLERANCE",
-        core::legacy::settings::MAX_ENERGY_TOLERANCE,
+        "DEFAULT_ENERGY_TOLERANCE",
+        core_registry::ENERGY_TOLERANCE.default_value(),
     )?;
+    m.add(
+        "RTOL_RANGE",
+        (core_registry::RTOL.low, core_registry::RTOL.high),
+    )?;
+    m.add("ATOL_MAX", core_registry::ATOL.high)?;
+    m.add("MAX_ENERGY_TOLERANCE", core_registry::ENERGY_TOLERANCE.high)?;
     m.add("MAX_POINTS", core::model::assembly::MAX_POINTS)?;
     m.add("MAX_PAIRS", core::model::assembly::MAX_PAIRS)?;
     Ok(())
