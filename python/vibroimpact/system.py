@@ -1007,11 +1007,6 @@ def prepare_system(
     _check_method_options(solver)
     if solver["dt"] is not None and not solver["dt"] > 0:
         raise _fail("[solver] dt: ", f"must be > 0, got {solver['dt']}")
-    fixed = solver["method"] in _FIXED_STEP
-    if fixed and solver["dt"] is None:
-        raise _fail(
-            "[solver] dt: ", f"is required for method {solver['method']!r} (a step in s > 0)"
-        )
     for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
         value = (output if section == "output" else solver)[key]
         if value < 1:

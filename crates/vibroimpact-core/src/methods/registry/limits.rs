@@ -86,7 +86,7 @@ pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
     let fixed = spec.kind.is_fixed_step();
     if fixed && plan.dt.is_none() {
         return Err(Error::Inconsistent(format!(
-            "[solver] dt: is required for method {:?} (a step in s > 0)",
+            "[solver] dt: is required for method '{}' (a step in s > 0)",
             spec.name
         )));
     }
