@@ -367,20 +367,7 @@ def test_hertz_damped_contact_keeps_its_restitution() -> None:
     assert contact != vi.Contact("hertz-damped", stiffness=3000.0, damping=0.01, restitution=0.71)
 
 
-@pytest.mark.parametrize(
-    "stepping",
-    [
-        "fixed",
-        pytest.param(
-            "events",
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="general kernel: a contact starting at rest reports an approach "
-                "of 2.2e-308 m/s (the smallest normal), not 0",
-            ),
-        ),
-    ],
-)
+@pytest.mark.parametrize("stepping", ["fixed", "events"])
 def test_a_contact_open_at_rest_has_no_restitution(stepping: str) -> None:
     """Starting at the wall (to round-off) with the bodies at rest, the first contact had no
     approach: its restitution is undefined (NaN), not a division by zero. (A start indented

@@ -301,8 +301,11 @@ impl<'a> Run<'a> {
             let (gap, rate) = system.gap(i, &self.y);
             let compliant = matches!(system.interactions[i].law, InteractionLaw::Compliant { .. });
             if gap < 0.0 && compliant {
-                let approach = rate.abs().max(f64::MIN_POSITIVE);
-                let (approach_rate, resting) = self.compliant_onset(i, 0.0, approach, scales);
+                // The law's rate > 0 (a damped law divides by it); the record
+                // keeps the approach there was: none for bodies at rest.
+                let approach = rate.abs();
+                let (approach_rate, resting) =
+                    self.compliant_onset(i, 0.0, approach.max(f64::MIN_POSITIVE), scales);
                 self.modes[i] = Mode::Compliant { approach_rate };
                 self.open[i] = Some(Open {
                     kind: ContactKind::Compliant,
