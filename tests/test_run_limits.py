@@ -178,9 +178,6 @@ def test_a_fixed_step_history_beyond_max_rows_is_refused_before_running() -> Non
     check_solver(**settings, history=False)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="general kernel: keeps one history row past max_rows (4001 of 4000)"
-)
 @pytest.mark.parametrize(("method", "stepping"), ADAPTIVE)
 def test_a_run_stops_at_its_row_cap_not_after(method: str, stepping: str | None) -> None:
     """An adaptive run's rows are not known before: it stops when they reach the cap."""
@@ -203,11 +200,6 @@ def test_a_run_stops_at_its_row_cap_not_after(method: str, stepping: str | None)
     assert len(roomy.t) > rows
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="general kernel: without a history its row-limit message does not say the "
-    "contacts alone fill max_rows",
-)
 def test_the_contact_table_is_capped_too() -> None:
     with pytest.raises(vi.SimulationError) as err:
         vi.simulate(

@@ -137,15 +137,32 @@ impl Run<'_> {
             .map_err(|cause| self.no_room(cause, time))?;
         let rows = self.time_rows.len() + self.contacts.len() + self.reductions.strobe_time.len();
         if rows as u64 > self.options.max_rows {
-            return Err(Error::RowLimit {
-                time,
-                max_rows: self.options.max_rows,
-                rows: self.time_rows.len() as u64,
-                contacts: self.contacts.len() as u64,
-                advice: "raise every, set history = false, shorten t_end or raise max_rows",
-            });
+            return Err(self.row_limit(rows as u64, time));
         }
         self.check_step(matches!(stop, Stop::Event { .. }), done, interrupt)
+    }
+
+    /// The run's `rows` (history, strobes and contacts) passed `max_rows` at
+    /// `time`: the error counts what fit (the rows and contacts this step
+    /// added past the cap are not kept) and says what to change.
+    #[cold]
+    fn row_limit(&self, rows: u64, time: f64) -> Error {
+        let (max_rows, over) = (self.options.max_rows, rows - self.options.max_rows);
+        let history = self.time_rows.len() as u64;
+        let kept_rows = history.saturating_sub(over);
+        let contacts = (self.contacts.len() as u64).saturating_sub(over - (history - kept_rows));
+        let contacts_alone = !self.schedule.keep_history && self.reductions.strobe_time.is_empty();
+        Error::RowLimit {
+            time,
+            max_rows,
+            rows: kept_rows,
+            contacts,
+            advice: if contacts_alone {
+                "the contacts alone fill it: shorten t_end or raise max_rows"
+            } else {
+                "raise every, set history = false, shorten t_end or raise max_rows"
+            },
+        }
     }
 
     /// The checks after a kept step (`event`: one that ended on an event;
