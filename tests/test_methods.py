@@ -754,11 +754,6 @@ def graze_run(relative_overshoot: float, **settings: Any) -> vi.Solution:
         return vi.simulate(GRAZE_SYSTEM, ELASTIC_CONTACT, start, t_end=3.0, **settings)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="general kernel: a step ending 5e-15 m inside the wall (below its graze "
-    "tolerance 1e-12 d) starts a contact; the 0.1 kernel counted a graze",
-)
 @pytest.mark.parametrize("settings", GRAZE_METHODS, ids=GRAZE_IDS)
 def test_touching_the_wall_is_a_graze(settings: dict[str, Any]) -> None:
     # Peak indentation 5e-15 m: half the kernel's graze tolerance (1e-12 * d).

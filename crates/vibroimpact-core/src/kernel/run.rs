@@ -503,7 +503,7 @@ impl<'a> Run<'a> {
                 &self.full,
                 full_error,
                 &self.modes,
-                c,
+                (c, self.graze),
                 &mut self.scratch,
                 &mut self.buffers,
             )?;
@@ -522,10 +522,13 @@ impl<'a> Run<'a> {
                     self.end.copy_from_slice(&self.buffers.best);
                     system.gaps(&self.end, &mut self.gaps.end);
                 }
-                Location::Unconfirmed => {
+                Location::Unconfirmed | Location::Graze => {
+                    if matches!(location, Location::Graze) {
+                        self.grazes += 1;
+                    }
                     kept_attempt = false;
                     if switched.is_none() {
-                        // That dip stays above its wall: another pair may
+                        // That dip stays above its wall (or grazes it): another pair may
                         // still cross within the step.
                         self.unconfirmed[c.i] = true;
                         self.any_unconfirmed = true;
