@@ -105,8 +105,9 @@ def test_an_unknown_method_lists_the_registry_s_names() -> None:
 def test_a_range_is_the_core_s_with_its_text(name: str, value: float) -> None:
     option = _core.METHOD_OPTIONS[name]
     assert not option["low"] <= value <= option["high"]
+    settings: dict[str, Any] = {name: value}
     with pytest.raises(vi.InvalidInputError) as err:
-        vi.simulate_system(OSCILLATOR, method="rk4", t_end=1.0, dt=1e-3, **{name: value})
+        vi.simulate_system(OSCILLATOR, method="rk4", t_end=1.0, dt=1e-3, **settings)
     assert str(err.value) == f"[solver] {name}: must be {option['allowed']}, got {value}"
 
 
