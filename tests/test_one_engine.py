@@ -76,12 +76,10 @@ SOLVERS = [
             "keeps numba's pace (1.41e7 against 7.83e7 steps/s)",
         ),
     ),
+    pytest.param({"method": "newmark", "stepping": "fixed", "dt": 1e-4}, id="newmark-fixed"),
     pytest.param(
-        {"method": "newmark", "stepping": "fixed", "dt": 1e-4},
-        id="newmark-fixed",
-        marks=pytest.mark.xfail(
-            strict=True, reason="the 0.2 format's [solver] does not take method 'newmark' yet"
-        ),
+        {"method": "newmark", "stepping": "fixed", "contact_timing": "step-count", "dt": 1e-4},
+        id="newmark-fixed-step-count",
     ),
 ]
 

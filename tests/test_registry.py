@@ -70,7 +70,9 @@ def test_every_method_s_defaults_in_python_are_the_core_s(method: str) -> None:
 
 def test_the_fixed_step_methods_are_the_registry_s() -> None:
     stepping_fixed = {m for m, s in _core.METHODS.items() if "fixed" in s["steppings"]}
-    by_kind = {m for m, s in _core.METHODS.items() if s["kind"] in ("explicit", "implicit")}
+    by_kind = {
+        m for m, s in _core.METHODS.items() if s["kind"] in ("explicit", "implicit", "paper")
+    }
     assert set(_FIXED_STEP) == stepping_fixed & set(_METHODS) == by_kind
     assert set(_METHODS) <= set(_core.METHODS)
 

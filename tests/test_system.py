@@ -515,7 +515,7 @@ BAD = [
         "damper 0 starts",
     ),
     ("clearance = 0.002", "clearence = 0.002", "did you mean 'clearance'"),
-    ('method = "dopri5"', 'method = "newmark"', 'method must be one of "rk4"'),
+    ('method = "dopri5"', 'method = "newmark-beta"', 'method must be one of "'),
 ]
 
 
