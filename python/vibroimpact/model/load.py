@@ -37,11 +37,10 @@ def load(source: str | os.PathLike[str]) -> System:
     the same ``clearance`` each side, the ``[contact]`` law, ``stiffness``,
     ``restitution`` and contact ``damping``) and the ``[initial]`` state (main mass as
     the structure's coordinate, impact mass as the damper's). Its ``[output]`` is kept,
-    and its ``[solver]`` where the general kernel runs that method the same way
-    (``stepping = "events"``: the adaptive and implicit methods, and rk4 asked for
-    events); the paper's ``"newmark"`` and ``"fixed"`` stepping (rk4's default in 0.1)
-    are not on the general kernel yet, so such a file's System has no ``solver``: give
-    ``method`` and ``t_end`` to :func:`vibroimpact.simulate`.
+    and its ``[solver]`` with its stepping written out (0.1's default is ``"fixed"`` for
+    ``"newmark"`` and ``"rk4"``, 0.2's ``"events"``), so that the general kernel runs the
+    file's method as the file asks (fixed-step rk4 to round-off of the two-mass kernel,
+    which keeps that one method; every other method bit for bit).
     """
     if isinstance(source, str) and "\n" in source:
         return loads(source)
@@ -83,13 +82,14 @@ def _two_mass(scenario: Scenario, data: dict[str, object]) -> System:
     main, contact, start = scenario.system, scenario.contact, scenario.initial
     solver_table = dict(data.get("solver", {}))  # type: ignore[call-overload]
     stepping = scenario.stepping or ("fixed" if scenario.method in ("newmark", "rk4") else "events")
-    solver = None
-    # The general kernel's methods run a 0.1 method the same way with stepping "events"
-    # (located contacts); the paper's "newmark" and "fixed" stepping are not on it yet.
-    if scenario.method in _METHODS and stepping == "events":
+    # 0.1's stepping defaults to "fixed" for newmark and rk4, 0.2's to "events": written
+    # out, so that the general kernel runs the file's method as the 0.1 file asks.
+    if stepping == "events":  # 0.2's default
         solver_table.pop("stepping", None)
         solver_table.pop("contact_timing", None)  # fixed stepping's only
-        solver = Solver(**solver_table)
+    else:
+        solver_table["stepping"] = stepping
+    solver = Solver(**solver_table) if scenario.method in _METHODS else None
     output = data.get("output")
     return System(
         structure=Oscillator(mass=main.main_mass, stiffness=main.stiffness, damping=main.damping),

@@ -140,24 +140,26 @@ def simulate(
     ``simulate(system, t_end=..., method=..., ...)`` runs a :class:`vibroimpact.System`
     on the general kernel with its ``solver`` and ``output`` settings (read from its
     scenario file by :func:`vibroimpact.load`), each replaced by the keyword of that
-    name given: ``method`` (``"rk4"``, ``"dopri5"``, ``"dop853"``,
+    name given: ``method`` (``"rk4"``, ``"dopri5"``, ``"dop853"``, ``"newmark"``,
     ``"newmark-implicit"``, ``"generalized-alpha"``, ``"exact"``; default ``"rk4"``),
-    ``t_end``, ``dt`` (s), ``rtol``, ``atol`` (m, m/s), ``beta``, ``gamma``,
+    ``stepping`` (``"events"``, default, or ``"fixed"``), ``contact_timing``
+    (``"located"`` or ``"step-count"``, fixed stepping's), ``t_end``, ``dt`` (s),
+    ``rtol``, ``atol`` (m, m/s), ``beta``, ``gamma``,
     ``spectral_radius``, ``max_steps``, ``max_rows``, ``energy_tolerance``, ``every``,
     ``history``, ``record_from``, ``strobe_period`` (s), ``points``, ``moments``;
     returns a :class:`~vibroimpact.SystemSolution` (see
     :func:`vibroimpact.simulate_system`).
 
     ``simulate(ImpactDamper, Contact, InitialState, t_end=..., method="newmark", ...)``
-    runs the two-mass impact damper (also ``stepping``, ``contact_timing``; not
-    ``record_from``, ``strobe_period``, ``points``, ``moments``) and returns a
-    :class:`vibroimpact.Solution` (its defaults: ``method="newmark"``, ``dt`` required
-    by the fixed-step methods, the rest as for a System).
+    runs the two-mass impact damper (not ``record_from``, ``strobe_period``, ``points``,
+    ``moments``) and returns a :class:`vibroimpact.Solution` (its defaults:
+    ``method="newmark"``, ``dt`` required by the fixed-step methods, the rest as for a
+    System).
     """
     given = {key: value for key, value in locals().items() if value is not _UNSET}
     del given["system"]
     if isinstance(system, System):
-        for name in ("contact", "initial", "stepping", "contact_timing"):
+        for name in ("contact", "initial"):
             if name in given:
                 raise InvalidInputError(
                     f"{name}: applies to the two-mass run (simulate(ImpactDamper, Contact, "
