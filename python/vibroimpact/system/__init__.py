@@ -1,0 +1,70 @@
+"""vibroimpact 0.2 systems: the scenario format's one schema (:mod:`.schema`: every
+section, key, default and range, and the checked spec the core takes), the results of
+a run (:mod:`.solution`) and the runs themselves (:mod:`.run`). SI units throughout;
+the sections are described in :mod:`vibroimpact.system.schema`.
+"""
+
+from vibroimpact.system.run import PreparedRun, prepare_system, simulate_system
+from vibroimpact.system.schema import (
+    _DAMPER,
+    _FIXED_STEP,
+    _GRAVITY,
+    _INITIAL,
+    _METHODS,
+    _NUMBER,
+    _OUTPUT,
+    _REQ,
+    _SIGNAL_KEYS,
+    _SIGNALS,
+    _SOLVER,
+    _STOP,
+    _STRUCTURE,
+    _TEXT,
+    _WHOLE,
+    SYSTEM_SOLVER_DEFAULTS,
+    _choice,
+    _fail,
+    _table,
+    _unknown_key,
+    linear_parts,
+    moment_weights,
+    point_weights,
+    split_observed,
+    structure_coordinates,
+    system_spec,
+)
+from vibroimpact.system.solution import SystemContacts, SystemSolution
+
+__all__ = [
+    "PreparedRun",
+    "SystemContacts",
+    "SystemSolution",
+    "prepare_system",
+    "simulate_system",
+    "SYSTEM_SOLVER_DEFAULTS",
+    "linear_parts",
+    "moment_weights",
+    "point_weights",
+    "split_observed",
+    "structure_coordinates",
+    "system_spec",
+    "_DAMPER",
+    "_FIXED_STEP",
+    "_GRAVITY",
+    "_INITIAL",
+    "_METHODS",
+    "_NUMBER",
+    "_OUTPUT",
+    "_REQ",
+    "_SIGNAL_KEYS",
+    "_SIGNALS",
+    "_SOLVER",
+    "_STOP",
+    "_STRUCTURE",
+    "_TEXT",
+    "_WHOLE",
+    "_choice",
+    "_fail",
+    "_table",
+    "_unknown_key",
+]
