@@ -8,8 +8,8 @@ use vibroimpact_core::methods::registry::{
     self, check_scales, OptionSpec, RunPlan, RunScales, METHOD_OPTIONS, METHOD_SPECS,
 };
 
+use crate::convert::system::{entries, get, structure};
 use crate::errors::to_py;
-use crate::system::{entries, get, structure};
 
 /// `{name: {default, low, high, low_open, allowed}}` of `options`.
 fn options_dict<'py>(py: Python<'py>, options: &[OptionSpec]) -> PyResult<Bound<'py, PyDict>> {

@@ -1,6 +1,8 @@
 //! Argument conversions shared by the functions: whole numbers and floats
 //! from Python ints of any size, as InvalidInputError naming the field.
 
+pub(crate) mod system;
+
 use pyo3::prelude::*;
 use pyo3::types::PyBool;
 
