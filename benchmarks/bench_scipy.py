@@ -16,7 +16,7 @@ step).
 
 from __future__ import annotations
 
-from vibroimpact import beyond
+from vibroimpact.paper import beyond
 
 
 def main() -> None:

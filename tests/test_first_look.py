@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
-from vibroimpact import analysis, beyond, plots
+from vibroimpact import analysis
 from vibroimpact.analysis import continuation, maps
 from vibroimpact.analysis import plots as analysis_plots
+from vibroimpact.paper import beyond, plots
 from vibroimpact.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]

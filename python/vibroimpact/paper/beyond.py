@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from vibroimpact._core import Contact, ImpactDamper, InitialState, Solution, simulate
-from vibroimpact.paper_data import PAPER_METHOD_LIMITS
+from vibroimpact.paper.data import PAPER_METHOD_LIMITS
 from vibroimpact.scenario import paper_collision
 
 # Table 1 of the paper, at the onset of a 0.1 m/s collision (SI units).

@@ -5,9 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from vibroimpact.beyond import cheapest, scipy_missing
 from vibroimpact.output import written_whole
-from vibroimpact.paper_data import (
+from vibroimpact.paper.beyond import cheapest, scipy_missing
+from vibroimpact.paper.data import (
     PAPER_HYSTER,
     PAPER_TABLE2,
     PAPER_TABLE3,
@@ -20,7 +20,7 @@ from vibroimpact.paper_data import (
 )
 
 if TYPE_CHECKING:
-    from vibroimpact.paper import Findings, Row
+    from vibroimpact.paper.job import Findings, Row
 
 Block = list[tuple[str, float | None, list[float]]]
 

@@ -18,7 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from vibroimpact import beyond
+import vibroimpact.paper.beyond as beyond
 from vibroimpact._core import (
     Contact,
     ImpactDamper,
@@ -32,7 +32,8 @@ from vibroimpact._core import (
     linear_contact_duration,
     simulate,
 )
-from vibroimpact.beyond import (
+from vibroimpact.output import UsageError, written_whole
+from vibroimpact.paper.beyond import (
     APPROACH_SPEED,
     CLEARANCE,
     CONTACT_DAMPING,
@@ -42,15 +43,14 @@ from vibroimpact.beyond import (
     first_duration,
     median_time,
 )
-from vibroimpact.output import UsageError, written_whole
-from vibroimpact.paper_data import (
+from vibroimpact.paper.data import (
     PAPER_LINEAR_STIFFNESS,
     RUN_TIME,
     STEP_SIZES,
     WEIGHTS,
     collision,
 )
-from vibroimpact.report import write_report
+from vibroimpact.paper.report import write_report
 
 # Rows of table 3: method, dt (None for adaptive runs), adequacy per WF1.
 Block = list[tuple[str, float | None, list[float]]]
@@ -290,7 +290,7 @@ def findings(
 def run_paper(out: Path) -> int:
     """Compute everything, write the files into ``out`` and print the tables."""
     # Here, not at the top: matplotlib loads for this job only, not for every command.
-    from vibroimpact.plots import fig1, fig3, fig4, work_precision
+    from vibroimpact.paper.plots import fig1, fig3, fig4, work_precision
 
     started = time.perf_counter()
     try:

@@ -13,14 +13,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from vibroimpact._core import Contact, Solution, goldsmith_max_indentation  # noqa: E402
-from vibroimpact.beyond import (  # noqa: E402
+from vibroimpact.output import written_whole  # noqa: E402
+from vibroimpact.paper.beyond import (  # noqa: E402
     APPROACH_SPEED,
     CONTACT_DAMPING,
     HERTZ_STIFFNESS,
     StudyRun,  # noqa: E402
 )
-from vibroimpact.output import written_whole  # noqa: E402
-from vibroimpact.paper_data import PAPER_LINEAR_STIFFNESS, collision  # noqa: E402
+from vibroimpact.paper.data import PAPER_LINEAR_STIFFNESS, collision  # noqa: E402
 
 
 def _save(fig: Any, path: Path) -> None:
