@@ -586,3 +586,47 @@ fn a_run_without_history_ends_where_the_run_with_one_does() {
         assert!(a.time.len() > 1000 && b.time.is_empty());
     });
 }
+
+#[test]
+fn the_run_reports_its_energy_growth_and_largest_balance_residual() {
+    common::timeout(20, || {
+        let (m, k, x0) = (2.0, 800.0, 0.01);
+        let stored = 0.5 * k * x0 * x0;
+        let y0 = [vec![x0], vec![0.0], vec![], vec![]];
+        // Damped and free: the energy only falls, so its largest is the start's.
+        let damped = run(
+            &spec(Structure::oscillator(m, k, 3.0).unwrap()),
+            &y0,
+            "rk4",
+            1e-3,
+            2.0,
+        );
+        assert_eq!(damped.energy_growth, 0.0);
+        // Undamped: average-acceleration Newmark keeps a linear system's energy
+        // to round-off, RK4 loses (w dt)^6 / 72 a step (1.8e-9 over 2000 steps
+        // at w dt = 0.02); the largest residual is at least the end's.
+        let free = spec(Structure::oscillator(m, k, 0.0).unwrap());
+        for (method, bound) in [("newmark-implicit", 1e-12), ("rk4", 3e-9)] {
+            let sol = run(&free, &y0, method, 1e-3, 2.0);
+            assert!(
+                sol.energy_growth >= 0.0 && sol.energy_growth < 1e-12,
+                "{method}: {}",
+                sol.energy_growth
+            );
+            let end = sol.energy.residual.abs() / stored;
+            assert!(
+                sol.energy_residual >= 0.999 * end && sol.energy_residual < bound,
+                "{method}: {} vs {end}",
+                sol.energy_residual
+            );
+        }
+        // Forced: its energy may grow, so no growth is reported.
+        let mut forced = spec(Structure::oscillator(m, k, 3.0).unwrap());
+        forced.excitations.push(Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(5.0, 2.7, 0.0).unwrap(),
+        });
+        let sol = run(&forced, &y0, "rk4", 1e-3, 1.0);
+        assert!(sol.energy_growth.is_nan() && sol.energy_residual < 1e-9);
+    });
+}

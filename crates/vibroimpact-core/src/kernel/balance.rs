@@ -102,10 +102,12 @@ pub(crate) fn check_balance(
     (tolerance, check): (f64, bool),
     t_end: f64,
     time: f64,
+    extremes: &mut Extremes,
 ) -> Result<()> {
     // One evaluation of the stored energy gives both its value and its scale.
     let (stored, magnitude) = system.energy_terms(y, modes);
     let b = balance(system, y, stored, stored_start, impact);
+    extremes.stored = extremes.stored.max(stored);
     // The largest seen so far: a system without losses can pass through
     // states where every term is near zero.
     *scale = scale.max(magnitude + b.input_work.abs() + b.dissipated.abs());
@@ -113,6 +115,7 @@ pub(crate) fn check_balance(
         return Ok(());
     }
     *scale = scale.max(system.energy_floor(t_end)).max(f64::MIN_POSITIVE);
+    extremes.residual = extremes.residual.max(b.residual.abs() / *scale);
     if !b.residual.is_finite() {
         return Err(Error::NumericalBlowUp {
             time,
@@ -131,6 +134,36 @@ pub(crate) fn check_balance(
     Ok(())
 }
 
+/// What the balance checks saw: the largest stored energy (J, at the checks
+/// and samples) and the largest residual relative to the energy in play (at
+/// the checks; NaN before the first).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Extremes {
+    pub(crate) stored: f64,
+    pub(crate) residual: f64,
+}
+
+impl Default for Extremes {
+    fn default() -> Self {
+        Self {
+            stored: f64::NEG_INFINITY,
+            residual: f64::NAN,
+        }
+    }
+}
+
+impl Extremes {
+    /// `max(E) / E(0) - 1` over the start, the checks and the end `stored_end`
+    /// of an unforced system (NaN when forced or starting with no energy).
+    pub(crate) fn growth(&self, system: &Assembly, stored_start: f64, stored_end: f64) -> f64 {
+        if system.is_free() && stored_start > 0.0 {
+            self.stored.max(stored_start).max(stored_end) / stored_start - 1.0
+        } else {
+            f64::NAN
+        }
+    }
+}
+
 /// The run's energy balance as the kernel and its fast path check it:
 /// every [`ENERGY_INTERVAL`] accepted steps and at the end, and the energy
 /// in play sampled between (see [`EnergySampler`]).
@@ -145,6 +178,7 @@ pub(crate) struct EnergyWatch {
     pub(crate) impact_loss: f64,
     pub(crate) tolerance: f64,
     pub(crate) t_end: f64,
+    pub(crate) extremes: Extremes,
 }
 
 impl EnergyWatch {
@@ -171,6 +205,7 @@ impl EnergyWatch {
                 (self.tolerance, check),
                 self.t_end,
                 time,
+                &mut self.extremes,
             )?;
         }
         Ok(())

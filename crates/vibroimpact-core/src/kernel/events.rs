@@ -137,6 +137,14 @@ pub struct SystemSolution {
     pub final_state: Vec<f64>,
     pub final_time: f64,
     pub energy: EnergyBalance,
+    /// Largest relative growth of an unforced system's stored energy,
+    /// `max(E) / E(0) - 1` over the start, the balance checks (every 32
+    /// steps, and sampled between) and the end; NaN when forced or starting
+    /// with no energy. Physically it is 0: more is numerical error.
+    pub energy_growth: f64,
+    /// Largest residual of the energy balance the checks found, relative to
+    /// the energy in play; NaN when none was checked.
+    pub energy_residual: f64,
     pub steps: u64,
     pub rejected_steps: u64,
     pub rhs_evaluations: u64,

@@ -235,6 +235,12 @@ impl Run<'_> {
             contacts: self.contacts,
             final_state: self.y[..row].to_vec(),
             final_time: self.clock.time,
+            energy_growth: self.energy.extremes.growth(
+                system,
+                energy.stored_start,
+                energy.stored_end,
+            ),
+            energy_residual: self.energy.extremes.residual,
             energy,
             steps: self.clock.accepted,
             rejected_steps: self.control.rejected,

@@ -233,6 +233,7 @@ impl<'a> Run<'a> {
                 impact_loss: 0.0,
                 tolerance: options.energy_tolerance,
                 t_end,
+                extremes: Default::default(),
             },
             contacts: Vec::new(),
             time_rows: Vec::new(),

@@ -646,6 +646,7 @@ mod tests {
                 impact_loss: 0.0,
                 tolerance: 1e-6,
                 t_end: 1.0,
+                extremes: Default::default(),
             };
             let mut stretch = Stretch {
                 clock: &mut clock,
