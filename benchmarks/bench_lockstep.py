@@ -21,7 +21,7 @@ import numpy as np
 
 import vibroimpact as vi
 from vibroimpact import study as st
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
 
 QUICK = "--quick" in sys.argv
 T_END = float(sys.argv[sys.argv.index("--t-end") + 1]) if "--t-end" in sys.argv else 0.2

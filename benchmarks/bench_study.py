@@ -26,7 +26,7 @@ import numpy as np
 
 import vibroimpact as vi
 from vibroimpact import study as st
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
 
 QUICK = "--quick" in sys.argv
 CORES = os.cpu_count() or 1

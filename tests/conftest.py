@@ -166,7 +166,7 @@ def bounded_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     # The defaults of simulate and of a scenario: a test that sets neither.
     defaults = (
         inspect.signature(unbounded).parameters["max_steps"].default,
-        vi.scenario.Scenario.max_steps,
+        vi.scenario.two_mass.Scenario.max_steps,
     )
 
     def simulate(*args: Any, **kwargs: Any) -> vi.Solution:
@@ -175,4 +175,4 @@ def bounded_runs(monkeypatch: pytest.MonkeyPatch) -> None:
         return unbounded(*args, **kwargs)
 
     monkeypatch.setattr(vi, "simulate", simulate)
-    monkeypatch.setattr(vi.scenario, "simulate", simulate)
+    monkeypatch.setattr(vi.scenario.two_mass, "simulate", simulate)

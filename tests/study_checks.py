@@ -8,7 +8,7 @@ from pathlib import Path
 
 import vibroimpact as vi
 from vibroimpact import study as st
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
 
 # A 10 Hz structure with 2 % damping, a 0.05 kg loose mass with 5 mm clearance each side
 # and rigid impacts (e = 0.6), forced by 5 N at 10 Hz; the exact method.

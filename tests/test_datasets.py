@@ -41,7 +41,7 @@ from vibroimpact.analysis.datasets import (
     state_names,
     sweep_dataset,
 )
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

@@ -17,7 +17,7 @@ from vibroimpact import analysis
 from vibroimpact.analysis import continuation, maps
 from vibroimpact.analysis import plots as analysis_plots
 from vibroimpact.paper import beyond, plots
-from vibroimpact.scenario import load_scenario
+from vibroimpact.scenario.two_mass import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

@@ -18,12 +18,12 @@ import pytest
 
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER
-from vibroimpact import record_file
 from vibroimpact.analysis import AnalysisError, with_parameter
 from vibroimpact.output import UsageError, written_whole
-from vibroimpact.scenario import ScenarioError, parse_scenario
+from vibroimpact.scenario.system import SystemScenario
+from vibroimpact.scenario.two_mass import ScenarioError, parse_scenario
 from vibroimpact.study import study_settings
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.system import record_file
 
 ROOT = Path(__file__).resolve().parents[1]
 Cli = Callable[..., subprocess.CompletedProcess[str]]

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from test_hostile_inputs import RECORDED
-from vibroimpact.scenario import ScenarioError, parse_scenario
+from vibroimpact.scenario.two_mass import ScenarioError, parse_scenario
 
 
 def _record_error(tmp_path: Path, csv: str) -> str:

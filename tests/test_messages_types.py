@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from test_hostile_inputs import RECORDED, refused
-from vibroimpact.record_file import MAX_RECORDED_FILE_BYTES
-from vibroimpact.scenario import ScenarioError, parse_scenario
+from vibroimpact.scenario.two_mass import ScenarioError, parse_scenario
+from vibroimpact.system.record_file import MAX_RECORDED_FILE_BYTES
 
 Cli = Callable[..., subprocess.CompletedProcess[str]]
 
@@ -111,7 +111,7 @@ def test_a_record_at_the_size_limit_is_parsed_within_bounded_memory(tmp_path: Pa
     (tmp_path / "s.toml").write_text(RECORDED.format(file="rec.csv"))
     child = (
         "import sys\n"
-        "from vibroimpact.scenario import load_scenario\n"
+        "from vibroimpact.scenario.two_mass import load_scenario\n"
         "e = load_scenario('s.toml').prepared.spec['excitation'][0]\n"
         "t, v = e['time'], e['value']\n"
         "assert len(t) == len(v) == int(sys.argv[1]), len(t)\n"
@@ -136,7 +136,7 @@ def test_a_record_at_the_size_limit_is_parsed_within_bounded_memory(tmp_path: Pa
 def test_a_record_file_beyond_the_limit_is_refused_before_it_is_read(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from vibroimpact import record_file
+    from vibroimpact.system import record_file
 
     monkeypatch.setattr(record_file, "MAX_RECORDED_FILE_BYTES", 20)
     message = record_error(tmp_path, "".join(f"{k},0\n" for k in range(10)))

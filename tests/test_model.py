@@ -21,7 +21,7 @@ import pytest
 
 import vibroimpact as vi
 from vibroimpact import system as schema
-from vibroimpact.system_scenario import SECTIONS
+from vibroimpact.scenario.system import SECTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
-from vibroimpact.scenario import parse_scenario
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
+from vibroimpact.scenario.two_mass import parse_scenario
 
 # A released main mass (50 mm) on a stiff spring carrying the impact mass at rest in
 # the middle of its enclosure: a dozen contacts on both walls in 3 s, with a law whose

@@ -13,7 +13,7 @@ import pytest
 
 import vibroimpact as vi
 from vibroimpact import _core
-from vibroimpact.scenario import Scenario
+from vibroimpact.scenario.two_mass import Scenario
 from vibroimpact.system import _FIXED_STEP, _METHODS, SYSTEM_SOLVER_DEFAULTS
 
 OPTIONS = ("rtol", "atol", "beta", "gamma", "spectral_radius", "max_steps")

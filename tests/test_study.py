@@ -19,7 +19,7 @@ import vibroimpact as vi
 from study_checks import FORCED_DAMPER, assert_refused  # noqa: E402
 from vibroimpact import study as st
 from vibroimpact.analysis import runner, steady_state
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
 
 BASE = FORCED_DAMPER
 

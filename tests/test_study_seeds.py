@@ -20,7 +20,7 @@ import vibroimpact as vi
 from study_checks import assert_refused  # noqa: E402
 from vibroimpact import study as st
 from vibroimpact.analysis import with_parameter
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
 
 # A loose mass rattling in an oscillator shaken at its base by white noise.
 NOISY = """

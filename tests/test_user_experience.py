@@ -25,13 +25,13 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
-from vibroimpact import scenario
 from vibroimpact.cli import command as cli
 from vibroimpact.cli import main
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.paper import beyond, plots
 from vibroimpact.paper import data as paper_data
 from vibroimpact.paper import job as paper
+from vibroimpact.scenario import two_mass as scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "python" / "vibroimpact"

@@ -17,9 +17,9 @@ from vibroimpact._core import (
     PreparedSystem,
     SimulationError,
 )
+from vibroimpact.analysis.forcing_limits import check_forcing_period
 from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
-from vibroimpact.forcing_limits import check_forcing_period
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.system import (

@@ -35,8 +35,8 @@ from vibroimpact.analysis import (
     sweep_values,
 )
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
-from vibroimpact.scenario import load_scenario
-from vibroimpact.system_scenario import SystemScenario
+from vibroimpact.scenario.system import SystemScenario
+from vibroimpact.scenario.two_mass import load_scenario
 
 
 def _system(path: Path) -> SystemScenario:

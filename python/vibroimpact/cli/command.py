@@ -41,8 +41,7 @@ from vibroimpact.output import (
     written_whole,
 )
 from vibroimpact.paper import run_paper
-from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, paper_collision
-from vibroimpact.system_scenario import (
+from vibroimpact.scenario.system import (
     SystemScenario,
     check_history_file,
     expected_rows,
@@ -51,6 +50,7 @@ from vibroimpact.system_scenario import (
     system_summary,
     write_system_history,
 )
+from vibroimpact.scenario.two_mass import Scenario, ScenarioError, load_scenario, paper_collision
 
 HISTORY_COLUMNS = (
     ("t", "time, s"),

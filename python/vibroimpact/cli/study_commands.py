@@ -15,7 +15,8 @@ import numpy as np
 
 from vibroimpact._core import InvalidInputError
 from vibroimpact.output import UsageError, check_output, check_plot, json_text
-from vibroimpact.scenario import load_scenario
+from vibroimpact.scenario.system import SystemScenario
+from vibroimpact.scenario.two_mass import load_scenario
 from vibroimpact.study import (
     MAX_WORKERS,
     PER_COORDINATE,
@@ -26,7 +27,6 @@ from vibroimpact.study import (
     study_of,
     terminal_progress,
 )
-from vibroimpact.system_scenario import SystemScenario
 
 
 def add_command(sub: Any) -> None:

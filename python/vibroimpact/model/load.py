@@ -10,7 +10,8 @@ from pathlib import Path
 from vibroimpact import arguments
 from vibroimpact.model.parts import Damper, Initial, Oscillator, Output, Solver
 from vibroimpact.model.system import System
-from vibroimpact.scenario import (
+from vibroimpact.scenario.system import SECTIONS, system_scenario
+from vibroimpact.scenario.two_mass import (
     Scenario,
     ScenarioError,
     read_scenario_text,
@@ -18,7 +19,6 @@ from vibroimpact.scenario import (
     two_mass_scenario,
 )
 from vibroimpact.system import _METHODS
-from vibroimpact.system_scenario import SECTIONS, system_scenario
 
 
 def load(source: str | os.PathLike[str]) -> System:

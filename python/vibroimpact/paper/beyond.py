@@ -19,7 +19,7 @@ from typing import Any
 
 from vibroimpact._core import Contact, ImpactDamper, InitialState, Solution, simulate
 from vibroimpact.paper.data import PAPER_METHOD_LIMITS
-from vibroimpact.scenario import paper_collision
+from vibroimpact.scenario.two_mass import paper_collision
 
 # Table 1 of the paper, at the onset of a 0.1 m/s collision (SI units).
 MAIN_MASS, STIFFNESS, DAMPING = 1.0, 1.0, 0.01

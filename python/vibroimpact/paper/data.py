@@ -12,7 +12,7 @@ from dataclasses import replace
 from typing import Any
 
 from vibroimpact._core import RestitutionWarning, adequacy
-from vibroimpact.scenario import Scenario, paper_collision
+from vibroimpact.scenario.two_mass import Scenario, paper_collision
 
 # Table 1 of the paper (MAIN_MASS, ..., APPROACH_SPEED) comes from `beyond`.
 PAPER_LINEAR_STIFFNESS = 49.05  # N/m, the paper's k1

@@ -14,10 +14,10 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError, __version__, run_study
+from vibroimpact.analysis.forcing_limits import check_forcing_period
 from vibroimpact.analysis.limits import whole_count
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
 from vibroimpact.analysis.runs import _prepare
-from vibroimpact.forcing_limits import check_forcing_period
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.study.limits import StudyError, check_threads
 from vibroimpact.study.settings import base_metrics, study_settings

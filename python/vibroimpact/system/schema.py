@@ -56,7 +56,7 @@ from vibroimpact._core import (
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact.arguments import directory, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
-from vibroimpact.record_file import check_record, read_record
+from vibroimpact.system.record_file import check_record, read_record
 
 _NUMBER, _TEXT, _WHOLE, _NUMBERS, _MATRIX = "number", "string", "whole number", "array", "matrix"
 _REQ = object()

@@ -28,7 +28,7 @@ from vibroimpact._core import (
     check_solver,
     simulate,
 )
-from vibroimpact.system_scenario import SystemScenario, system_scenario
+from vibroimpact.scenario.system import SystemScenario, system_scenario
 
 
 class ScenarioError(InvalidInputError):
@@ -255,7 +255,7 @@ def parse_scenario(
     """Build a scenario from TOML text; ``source`` names it in errors.
 
     A file with a ``[structure]`` section describes a 0.2 system
-    (:class:`~vibroimpact.system_scenario.SystemScenario`; recorded signals' files
+    (:class:`~vibroimpact.scenario.system.SystemScenario`; recorded signals' files
     are read relative to ``base_dir``); one with ``[system]`` and ``[contact]``,
     the two-mass impact damper (:class:`Scenario`).
     """
