@@ -61,21 +61,37 @@ def general_text(solver: dict[str, Any]) -> str:
     )
 
 
+# The two-mass call runs on the 0.1 kernel until the general kernel keeps the earlier
+# issues' bars for it (issue 3: DOP853 within 1e-10 of the exact collision in 22 us
+# on the general kernel against a 20 us goal, 86 times scipy's speed at 1e-8 against
+# 100; bench_steps: the paper's Newmark 2.1e7 against 9.4e7 steps/s).
+_ON_THE_0_1_KERNEL = pytest.mark.xfail(
+    strict=True,
+    reason="the two-mass call runs on the 0.1 kernel until the general kernel keeps issue "
+    "3's bars (DOP853 22 us a collision against 20 us; 86x scipy against 100x)",
+)
+
+
+def _events(solver: dict[str, Any], name: str) -> Any:
+    return pytest.param(solver, id=name, marks=_ON_THE_0_1_KERNEL)
+
+
 SOLVERS = [
-    pytest.param({"method": "rk4", "stepping": "events", "dt": 1e-4}, id="rk4"),
-    pytest.param({"method": "dop853", "rtol": 1e-10, "atol": 1e-13}, id="dop853"),
-    pytest.param({"method": "dopri5", "rtol": 1e-9, "atol": 1e-13}, id="dopri5"),
-    pytest.param({"method": "newmark-implicit", "dt": 1e-4}, id="newmark-implicit"),
-    pytest.param({"method": "generalized-alpha", "dt": 1e-4}, id="generalized-alpha"),
+    _events({"method": "rk4", "stepping": "events", "dt": 1e-4}, "rk4"),
+    _events({"method": "dop853", "rtol": 1e-10, "atol": 1e-13}, "dop853"),
+    _events({"method": "dopri5", "rtol": 1e-9, "atol": 1e-13}, "dopri5"),
+    _events({"method": "newmark-implicit", "dt": 1e-4}, "newmark-implicit"),
+    _events({"method": "generalized-alpha", "dt": 1e-4}, "generalized-alpha"),
     pytest.param(
         {"method": "rk4", "stepping": "fixed", "dt": 1e-4},
         id="rk4-fixed",
         marks=pytest.mark.xfail(
             strict=True,
             reason="two-mass fixed RK4 stays on the 0.1 kernel until the general kernel's "
-            "keeps numba's pace (1.41e7 against 7.83e7 steps/s)",
+            "keeps numba's pace (2.4e7 against 7.9e7 steps/s)",
         ),
     ),
+    # The general kernel's fixed-step Newmark is 0.1's to the bit.
     pytest.param({"method": "newmark", "stepping": "fixed", "dt": 1e-4}, id="newmark-fixed"),
     pytest.param(
         {"method": "newmark", "stepping": "fixed", "contact_timing": "step-count", "dt": 1e-4},

@@ -414,15 +414,8 @@ pub(crate) fn simulate(
     )?;
     let parsed = settings.method;
     let (sys, con, init) = (system.0, contact.0, initial.0);
-    let options = core::MethodOptions {
-        beta,
-        gamma,
-        spectral_radius,
-        rtol,
-        atol,
-    };
     let run = released(py, |interrupt| {
-        two_mass::run(&sys, &con, &init, &settings, &options, interrupt)
+        two_mass::run(&sys, &con, &init, &settings, interrupt)
     })?;
     let [time, w, v, y, u, force] = run.history;
     Ok(Solution {
