@@ -11,8 +11,6 @@ use vibroimpact_core as core;
 use crate::convert::*;
 use crate::errors::*;
 use crate::inputs::{Contact, ImpactDamper, InitialState};
-
-mod two_mass;
 /// A column of results that becomes a NumPy array on first access (without
 /// a copy): a call pays only for the arrays it reads.
 pub(crate) struct Column {
@@ -54,18 +52,31 @@ pub(crate) const CONTACT_COLUMNS: [&str; 9] = [
     "energy_change",
 ];
 
+pub(crate) fn record_values(r: &core::ContactRecord) -> [f64; 9] {
+    [
+        r.onset,
+        r.separation,
+        r.duration,
+        r.max_indentation,
+        r.approach_speed,
+        r.rebound_speed,
+        r.restitution,
+        r.energy_dissipated,
+        r.energy_change,
+    ]
+}
+
 /// The contacts of a run, one entry per contact, as NumPy arrays in SI units.
 /// A contact still open at the end of the run has NaN ``separation``,
 /// ``duration``, ``rebound_speed``, ``restitution`` and ``energy_change``.
 #[pyclass(frozen, module = "vibroimpact._core")]
 pub(crate) struct ContactTable {
-    /// One row a contact, the values of [`CONTACT_COLUMNS`].
-    records: Vec<[f64; 9]>,
+    records: Vec<core::ContactRecord>,
     columns: [OnceLock<Py<PyArray1<f64>>>; 9],
 }
 
 impl ContactTable {
-    fn new(records: Vec<[f64; 9]>) -> Self {
+    fn new(records: Vec<core::ContactRecord>) -> Self {
         Self {
             records,
             columns: Default::default(),
@@ -75,7 +86,11 @@ impl ContactTable {
     fn column(&self, py: Python<'_>, index: usize) -> Py<PyArray1<f64>> {
         self.columns[index]
             .get_or_init(|| {
-                let values: Vec<f64> = self.records.iter().map(|r| r[index]).collect();
+                let values: Vec<f64> = self
+                    .records
+                    .iter()
+                    .map(|r| record_values(r)[index])
+                    .collect();
                 values.into_pyarray(py).unbind()
             })
             .clone_ref(py)
@@ -149,7 +164,7 @@ impl ContactTable {
         let list = PyList::empty(py);
         for r in &self.records {
             let d = PyDict::new(py);
-            for (name, value) in CONTACT_COLUMNS.iter().zip(r) {
+            for (name, value) in CONTACT_COLUMNS.iter().zip(record_values(r)) {
                 d.set_item(name, value)?;
             }
             list.append(d)?;
@@ -414,29 +429,32 @@ pub(crate) fn simulate(
     )?;
     let parsed = settings.method;
     let (sys, con, init) = (system.0, contact.0, initial.0);
-    let run = released(py, |interrupt| {
-        two_mass::run(&sys, &con, &init, &settings, interrupt)
+    // The 0.1 kernel, every method: the general kernel runs this system 2 to 5
+    // times slower, past issue 3's and bench_steps' bars (issue 24's note); a
+    // vibroimpact.System of it runs there.
+    let sol = released(py, |interrupt| {
+        core::simulate(&sys, &con, &init, &settings, interrupt)
     })?;
-    let [time, w, v, y, u, force] = run.history;
+    let h = sol.history;
     Ok(Solution {
-        rows: time.len(),
+        rows: h.time.len(),
         history: [
-            Column::new(time),
-            Column::new(w),
-            Column::new(v),
-            Column::new(y),
-            Column::new(u),
-            Column::new(force),
+            Column::new(h.time),
+            Column::new(h.main_displacement),
+            Column::new(h.main_velocity),
+            Column::new(h.impact_displacement),
+            Column::new(h.impact_velocity),
+            Column::new(h.contact_force),
         ],
-        contacts: Py::new(py, ContactTable::new(run.contacts))?,
-        steps: run.steps,
-        rejected_steps: run.rejected_steps,
-        rhs_evaluations: run.rhs_evaluations,
-        grazing_contacts: run.grazing_contacts,
-        final_time: run.final_time,
-        energy_growth: run.energy_growth,
-        energy_residual: run.energy_residual,
-        final_state: InitialState(run.final_state),
+        contacts: Py::new(py, ContactTable::new(sol.contacts))?,
+        steps: sol.steps,
+        rejected_steps: sol.rejected_steps,
+        rhs_evaluations: sol.rhs_evaluations,
+        grazing_contacts: sol.grazing_contacts,
+        final_time: sol.final_time,
+        energy_growth: sol.energy_growth,
+        energy_residual: sol.energy_residual,
+        final_state: InitialState(sol.final_state),
         method: parsed.name(),
         stepping: match settings.stepping {
             core::Stepping::Fixed => "fixed",

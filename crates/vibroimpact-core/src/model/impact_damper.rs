@@ -75,23 +75,6 @@ impl ImpactDamper {
         })
     }
 
-    /// The force between the bodies (N, > 0 pushing them apart) in state
-    /// `s` while in contact with the rate latched at its onset
-    /// `approach_rate` (m/s): the law's (none at or below the wall) plus the
-    /// contact damper's `c1` times the indentation rate.
-    pub fn contact_force(&self, contact: &Contact, s: &State, approach_rate: f64) -> Result<f64> {
-        let u = s.relative_displacement();
-        // The wall the impact mass is at or heading for.
-        let side = if u > 0.0 || (u == 0.0 && s.relative_velocity() >= 0.0) {
-            1.0
-        } else {
-            -1.0
-        };
-        let indentation = side * u - self.clearance;
-        let rate = side * s.relative_velocity();
-        Ok(contact.law_force(indentation, rate, approach_rate)? + contact.damping * rate)
-    }
-
     /// [`Self::spec`], assembled for the kernel.
     pub fn assembly(&self, contact: &Contact) -> Result<Assembly> {
         Assembly::new(&self.spec(contact)?)
