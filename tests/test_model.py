@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 import tomllib
@@ -600,6 +601,17 @@ def test_a_two_mass_file_loads_to_the_system_it_describes() -> None:
     adaptive = vi.load(ROOT / "examples" / "adaptive_hertz_damped.toml")
     assert adaptive.solver == vi.Solver(method="dop853", rtol=1e-10, atol=1e-13, t_end=20.0)
     assert adaptive.output == vi.Output(every=10)
+
+
+def test_a_two_mass_file_s_default_method_is_written_out() -> None:
+    """0.1's default method is the paper's newmark in fixed steps, 0.2's rk4 with events:
+    a 0.1 file that leaves method out loads as newmark, fixed."""
+    text = (ROOT / "examples" / "paper_collision.toml").read_text()
+    without = re.sub(r'\nmethod = "newmark".*\n', "\n", text)
+    assert without != text
+    solver = vi.loads(without).solver
+    assert solver is not None
+    assert (solver.method, solver.stepping) == ("newmark", "fixed")
 
 
 @pytest.mark.parametrize(

@@ -18,7 +18,6 @@ from vibroimpact.scenario.two_mass import (
     read_toml,
     two_mass_scenario,
 )
-from vibroimpact.system import _METHODS
 
 
 def load(source: str | os.PathLike[str]) -> System:
@@ -83,14 +82,16 @@ def _two_mass(scenario: Scenario, data: dict[str, object]) -> System:
     main, contact, start = scenario.system, scenario.contact, scenario.initial
     solver_table = dict(data.get("solver", {}))  # type: ignore[call-overload]
     stepping = scenario.stepping or ("fixed" if scenario.method in ("newmark", "rk4") else "events")
-    # 0.1's stepping defaults to "fixed" for newmark and rk4, 0.2's to "events": written
-    # out, so that the general kernel runs the file's method as the 0.1 file asks.
+    # 0.1's defaults are "newmark" and, for newmark and rk4, "fixed" stepping; 0.2's are
+    # "rk4" and "events": written out, so that the general kernel runs the file's method
+    # as the 0.1 file asks.
+    solver_table["method"] = scenario.method
     if stepping == "events":  # 0.2's default
         solver_table.pop("stepping", None)
         solver_table.pop("contact_timing", None)  # fixed stepping's only
     else:
         solver_table["stepping"] = stepping
-    solver = Solver(**solver_table) if scenario.method in _METHODS else None
+    solver = Solver(**solver_table)
     output = data.get("output")
     return System(
         structure=Oscillator(mass=main.main_mass, stiffness=main.stiffness, damping=main.damping),
