@@ -193,21 +193,58 @@ impl EnergyWatch {
         done: bool,
         time: f64,
     ) -> Result<()> {
-        let check = accepted % ENERGY_INTERVAL == 0 || done;
-        if check || self.sampler.due(time) {
-            check_balance(
-                system,
-                y,
-                modes,
-                self.stored_start,
-                &mut self.scale,
-                self.impact_loss,
-                (self.tolerance, check),
-                self.t_end,
-                time,
-                &mut self.extremes,
-            )?;
+        match self.due(accepted, done, time) {
+            Some(check) => self.balance(system, (y, modes), check, time),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// [`Self::after_step`] on a fixed-size state of `len` values, copied
+    /// where the balance is due: the fast paths keep their state in
+    /// registers, which a reference taken on every step would not allow.
+    #[inline(always)]
+    pub(crate) fn after_step_of<const N: usize>(
+        &mut self,
+        system: &Assembly,
+        (y, len, modes): (&[f64; N], usize, &[Mode]),
+        accepted: u64,
+        time: f64,
+    ) -> Result<()> {
+        match self.due(accepted, false, time) {
+            Some(check) => {
+                let copy = *y;
+                self.balance(system, (&copy[..len.min(N)], modes), check, time)
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Whether the balance is due after the `accepted`-th step at `time`:
+    /// `Some(true)` to check it, `Some(false)` to sample the energy in play.
+    #[inline(always)]
+    fn due(&mut self, accepted: u64, done: bool, time: f64) -> Option<bool> {
+        let check = accepted % ENERGY_INTERVAL == 0 || done;
+        (check || self.sampler.due(time)).then_some(check)
+    }
+
+    fn balance(
+        &mut self,
+        system: &Assembly,
+        (y, modes): (&[f64], &[Mode]),
+        check: bool,
+        time: f64,
+    ) -> Result<()> {
+        check_balance(
+            system,
+            y,
+            modes,
+            self.stored_start,
+            &mut self.scale,
+            self.impact_loss,
+            (self.tolerance, check),
+            self.t_end,
+            time,
+            &mut self.extremes,
+        )
     }
 }

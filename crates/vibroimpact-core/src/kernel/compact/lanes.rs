@@ -9,7 +9,7 @@
 
 use super::{Compact, MAX_DIM, MAX_LEN, MAX_MODES, MAX_WALLS};
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
-use crate::model::assembly::{Mode, Scratch, CONTACT, INPUT, VISCOUS};
+use crate::model::assembly::{elastic, Mode, Scratch, CONTACT, INPUT, VISCOUS};
 use crate::model::contact::{AnyLaw, ContactLaw, Hertz, HysterHertz, Linear};
 use crate::model::signals::Signal;
 
@@ -129,7 +129,6 @@ pub(crate) struct Group<L> {
     /// The force's `M^-1 row^T` and row, and each lane's signal.
     force: Option<([V; MAX_MODES], [V; MAX_MODES], Vec<Signal>)>,
     gravity: V,
-    inertial_free: bool,
     walls: Vec<Walls<L>>,
 }
 
@@ -199,7 +198,6 @@ fn same_shape(a: &Compact, b: &Compact) -> bool {
     let kind = |c: &Compact, w: usize| c.walls[w].law.map(|(law, _)| std::mem::discriminant(&law));
     a.count == b.count
         && a.force.is_some() == b.force.is_some()
-        && a.inertial_free == b.inertial_free
         && (0..a.count.min(MAX_WALLS))
             .all(|w| a.walls[w].mirror == b.walls[w].mirror && kind(a, w) == kind(b, w))
 }
@@ -298,7 +296,6 @@ impl<L: LaneLaw> Group<L> {
             modal,
             force,
             gravity,
-            inertial_free: first.inertial_free,
             walls,
         })
     }
@@ -328,12 +325,8 @@ impl<L: LaneLaw> Group<L> {
                 for l in 0..LANES {
                     let (x, v) = (y[i][l], y[d + i][l]);
                     out[i][l] = v;
-                    let elastic = if self.inertial_free {
-                        -(k[l] * x + c[l] * v)
-                    } else {
-                        -(k[l] * x + c[l] * v) - r[l] * inertial[l]
-                    };
-                    out[d + i][l] = elastic + push[i][l] * value[l];
+                    let own = elastic(k[l], c[l], r[l], inertial[l], x, v);
+                    out[d + i][l] = own + push[i][l] * value[l];
                     viscous[l] += damping[l] * v * v;
                     power[l] += row[i][l] * v;
                 }
@@ -347,7 +340,7 @@ impl<L: LaneLaw> Group<L> {
                 for l in 0..LANES {
                     let (x, v) = (y[i][l], y[d + i][l]);
                     out[i][l] = v;
-                    out[d + i][l] = -(k[l] * x + c[l] * v) - r[l] * inertial[l];
+                    out[d + i][l] = elastic(k[l], c[l], r[l], inertial[l], x, v);
                     viscous[l] += damping[l] * v * v;
                 }
             }

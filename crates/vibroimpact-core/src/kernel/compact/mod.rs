@@ -22,7 +22,7 @@ pub(crate) use stretch::Stretch;
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{
-    h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
+    elastic, h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
 };
 use crate::model::contact::{AnyLaw, ContactLaw};
 use crate::model::signals::Signal;
@@ -88,9 +88,6 @@ pub(crate) struct Compact {
     modal: [[f64; 4]; MAX_MODES],
     force: Option<Force>,
     gravity: f64,
-    /// Whether `r * inertial` is +0 for every mode (no gravity, every `r`
-    /// >= +0), and so may be left out: `a - (+0) = a` to the bit.
-    inertial_free: bool,
     walls: [Wall; MAX_WALLS],
     count: usize,
 }
@@ -150,8 +147,6 @@ impl Compact {
             modal,
             force,
             gravity: parts.gravity,
-            inertial_free: parts.gravity == 0.0
-                && modal[..n].iter().all(|m| m[3].is_sign_positive()),
             walls,
             count: system.interactions.len(),
         })
@@ -185,12 +180,7 @@ impl Compact {
                 let [k, c, damping, r] = self.modal[i];
                 let (x, v) = (y[i], y[d + i]);
                 out[i] = v;
-                let elastic = if self.inertial_free {
-                    -(k * x + c * v)
-                } else {
-                    -(k * x + c * v) - r * inertial
-                };
-                out[d + i] = elastic + force.push[i] * value;
+                out[d + i] = elastic(k, c, r, inertial, x, v) + force.push[i] * value;
                 viscous += damping * v * v;
                 power += force.row[i] * v;
             }
@@ -200,7 +190,7 @@ impl Compact {
                 let [k, c, damping, r] = self.modal[i];
                 let (x, v) = (y[i], y[d + i]);
                 out[i] = v;
-                out[d + i] = -(k * x + c * v) - r * inertial;
+                out[d + i] = elastic(k, c, r, inertial, x, v);
                 viscous += damping * v * v;
             }
         }
@@ -212,10 +202,11 @@ impl Compact {
         let modes = &modes[..count];
         let mut products: Option<(f64, f64)> = None;
         let mut sticking = 0;
+        // Each wall's loss rate, held apart: indexed by the wall (a number
+        // known at run time), the stages themselves would be kept in memory.
+        let mut losses = [0.0; MAX_WALLS];
         for w in 0..count {
             let wall = &self.walls[w];
-            let loss = 2 * d + CONTACT + w;
-            out[loss] = 0.0;
             let previous = products.take();
             if let (Mode::Compliant { approach_rate }, Some((law, damping))) =
                 (&modes[w], &wall.law)
@@ -237,7 +228,7 @@ impl Compact {
                         out[d + i] += wall.push[i] * total;
                     }
                 }
-                out[loss] = (total - elastic) * rate;
+                losses[w] = (total - elastic) * rate;
             } else if STICKING && modes[w] == Mode::Sticking {
                 scratch.sticking[sticking] = w;
                 sticking += 1;
@@ -263,10 +254,13 @@ impl Compact {
         scratch.count = sticking;
         out[2 * d + VISCOUS] = viscous;
         out[2 * d + INPUT] = input;
+        for w in 0..MAX_WALLS {
+            out[2 * d + CONTACT + w] = losses[w];
+        }
     }
 
-    /// One RK4 step `h` from `(time, start)` into `out`, the state's
-    /// `len` values, for `n` modes and `k` dampers (`STICKING`: whether a
+    /// One RK4 step `h` from `(time, start)` into `out` (every wall's room),
+    /// for `n` modes and `k` dampers (`STICKING`: whether a
     /// pair may stick): the general stages' arithmetic. `stages[0]` holds `f(start)` where
     /// `start_valid`, and receives it where not.
     #[allow(clippy::too_many_arguments)]
@@ -278,7 +272,6 @@ impl Compact {
         k: usize,
         time: f64,
         start: &[f64; MAX_LEN],
-        len: usize,
         h: f64,
         modes: &[Mode],
         scratch: &mut Scratch,
@@ -287,7 +280,6 @@ impl Compact {
         out: &mut [f64; MAX_LEN],
     ) {
         let coordinates = 2 * (n + k);
-        let len = len.min(MAX_LEN);
         // The general stages' times and weights (written out: `map` over
         // arrays is not inlined here).
         let times = [
@@ -316,7 +308,9 @@ impl Compact {
             point[e] = start[e] + hw[2] * k2[e];
         }
         self.rates::<STICKING>(system, n, k, times[3], &point, modes, scratch, k3);
-        for e in 0..len {
+        // Over every wall's room (a length fixed at compile time; the rooms
+        // past the system's walls hold zeros).
+        for e in 0..coordinates + CONTACT + MAX_WALLS {
             out[e] = start[e] + w[0] * k0[e] + w[1] * k1[e] + w[2] * k2[e] + w[3] * k3[e];
         }
     }
@@ -356,7 +350,6 @@ impl Compact {
             k,
             time,
             &start,
-            len,
             h,
             modes,
             scratch,

@@ -4,7 +4,7 @@
 
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
-use super::{Compact, MAX_LEN, MAX_WALLS};
+use super::{Compact, MAX_LEN, MAX_MODES, MAX_WALLS};
 use crate::error::Error;
 use crate::kernel::balance::EnergyWatch;
 use crate::kernel::clock::{Clock, Schedule};
@@ -96,7 +96,6 @@ impl Compact {
                 k,
                 time,
                 &y,
-                len,
                 length,
                 modes,
                 scratch,
@@ -124,16 +123,8 @@ impl Compact {
                     }
                 }
             }
-            if in_window {
-                for j in 0..observed {
-                    let (s0, s1) = (
-                        system.observe(j, &y[d..d + n]),
-                        system.observe(j, &end[d..d + n]),
-                    );
-                    if s0 * s1 < 0.0 {
-                        plain = false;
-                    }
-                }
+            if in_window && peak_inside(system, observed, (&y, &end), d, n) {
+                plain = false;
             }
             if !plain {
                 if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
@@ -147,10 +138,8 @@ impl Compact {
                 }
             }
             if in_window {
-                for (j, peak) in f.peaks.iter_mut().enumerate().take(observed) {
-                    let (p0, p1) = (system.observe(j, &y[..n]), system.observe(j, &end[..n]));
-                    *peak = peak.max(p0.abs().max(p1.abs()));
-                }
+                let kept = observed.min(f.peaks.len());
+                widen_peaks(system, &mut f.peaks[..kept], (&y, &end), n);
                 *f.recorded_time += length;
             }
             clock.time = next;
@@ -161,14 +150,10 @@ impl Compact {
             f.steps += 1;
             // Those rates are the next step's first stage.
             start_valid = releasable;
-            for e in 0..len {
-                y[e] = end[e];
-            }
-            for w in 0..count {
-                start_gaps[w] = end_gaps[w];
-            }
-            let state = (&y[..len], modes);
-            if let Err(failure) = energy.after_step(system, state, clock.accepted, false, next) {
+            y = end;
+            start_gaps = end_gaps;
+            let state = (&y, len, modes);
+            if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
                 f.unbalanced = Some(failure);
                 break;
             }
@@ -224,7 +209,6 @@ impl Compact {
                 k,
                 time,
                 &y,
-                len,
                 dt,
                 modes,
                 scratch,
@@ -239,13 +223,8 @@ impl Compact {
                 // separation in the step.
                 plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
             }
-            if in_window {
-                for j in 0..observed {
-                    let s0 = system.observe(j, &y[d..d + n]);
-                    if s0 * system.observe(j, &end[d..d + n]) < 0.0 {
-                        plain = false;
-                    }
-                }
+            if in_window && peak_inside(system, observed, (&y, &end), d, n) {
+                plain = false;
             }
             if !plain {
                 if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
@@ -257,14 +236,14 @@ impl Compact {
                 if let Some(oc) = f.open[w].as_mut() {
                     let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
                     fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
-                    fixed::press(system, w, oc, &end[..len], modes[w], dt);
+                    // A copy: the state's address stays untaken (in registers).
+                    let at = end;
+                    fixed::press(system, w, oc, &at[..len], modes[w], dt);
                 }
             }
             if in_window {
-                for (j, peak) in f.peaks.iter_mut().enumerate().take(observed) {
-                    let (p0, p1) = (system.observe(j, &y[..n]), system.observe(j, &end[..n]));
-                    *peak = peak.max(p0.abs().max(p1.abs()));
-                }
+                let kept = observed.min(f.peaks.len());
+                widen_peaks(system, &mut f.peaks[..kept], (&y, &end), n);
                 *f.recorded_time += dt;
             }
             clock.time = next;
@@ -273,10 +252,10 @@ impl Compact {
             clock.until_kept = clock.until_kept.saturating_sub(1);
             f.evaluations += 4;
             f.steps += 1;
-            y[..len].copy_from_slice(&end[..len]);
-            start_gaps[..count].copy_from_slice(&end_gaps[..count]);
-            let state = (&y[..len], modes);
-            if let Err(failure) = energy.after_step(system, state, clock.accepted, false, next) {
+            y = end;
+            start_gaps = end_gaps;
+            let state = (&y, len, modes);
+            if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
                 f.unbalanced = Some(failure);
                 break;
             }
@@ -338,6 +317,47 @@ macro_rules! stretch_with {
 }
 stretch_with!(stretch_avx512, "avx512f");
 stretch_with!(stretch_avx2, "avx2");
+
+/// `n` values of `y` from `from`, copied: a runtime index into the state
+/// itself would keep it in memory rather than in registers.
+#[inline(always)]
+fn block(y: &[f64; MAX_LEN], from: usize, n: usize) -> [f64; MAX_MODES] {
+    let mut out = [0.0; MAX_MODES];
+    for i in 0..n.min(MAX_MODES) {
+        out[i] = y[from + i];
+    }
+    out
+}
+
+/// Whether an observed velocity changes sign in the step from `y` to `end`
+/// (`d` coordinates, `n` of the structure): a peak inside it, for the kernel
+/// to find.
+#[inline(always)]
+fn peak_inside(
+    system: &Assembly,
+    observed: usize,
+    (y, end): (&[f64; MAX_LEN], &[f64; MAX_LEN]),
+    d: usize,
+    n: usize,
+) -> bool {
+    let (v0, v1) = (block(y, d, n), block(end, d, n));
+    (0..observed).any(|j| system.observe(j, &v0[..n]) * system.observe(j, &v1[..n]) < 0.0)
+}
+
+/// The observed displacements' peaks widened to the step's ends.
+#[inline(always)]
+fn widen_peaks(
+    system: &Assembly,
+    peaks: &mut [f64],
+    (y, end): (&[f64; MAX_LEN], &[f64; MAX_LEN]),
+    n: usize,
+) {
+    let (x0, x1) = (block(y, 0, n), block(end, 0, n));
+    for (j, peak) in peaks.iter_mut().enumerate() {
+        let (p0, p1) = (system.observe(j, &x0[..n]), system.observe(j, &x1[..n]));
+        *peak = peak.max(p0.abs().max(p1.abs()));
+    }
+}
 
 /// What the fast path advances, lent by the kernel ([`crate::kernel::run`]):
 /// its clock, state, gaps, open contacts (their deepest indentation), peaks

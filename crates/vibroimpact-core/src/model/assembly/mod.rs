@@ -23,6 +23,7 @@ mod state;
 
 pub(crate) use gaps::h_dot;
 pub use linear::{HarmonicLoad, LinearParts};
+pub(crate) use rates::elastic;
 pub use scratch::Scratch;
 pub use spec::{Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec, MAX_PAIRS, MAX_POINTS};
 pub use state::{initial_state, resumed_state};
