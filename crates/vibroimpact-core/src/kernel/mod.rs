@@ -8,6 +8,7 @@ pub mod fixed;
 pub(crate) mod impacts;
 pub(crate) mod locate;
 pub mod memory;
+pub(crate) mod plain_fixed;
 pub(crate) mod records;
 pub mod reductions;
 pub(crate) mod run;

@@ -18,6 +18,8 @@
 //! coordinate of a diagonal system.
 
 use crate::error::{Error, Result};
+use crate::kernel::compact::Stretch;
+use crate::kernel::plain_fixed::plain_fixed_steps;
 use crate::kernel::sized::by_size;
 use crate::methods::steppers::SystemStepper;
 use crate::methods::trapezoid::Trapezoid;
@@ -485,6 +487,24 @@ impl SystemStepper for PaperNewmark {
 
     fn creates_contact_energy(&self) -> bool {
         true
+    }
+
+    fn takes_stretches(&self, _system: &Assembly, fixed: bool) -> bool {
+        fixed
+    }
+
+    fn stretch(
+        &mut self,
+        system: &Assembly,
+        stretch: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        plain_fixed_steps(self, system, stretch, modes, scratch);
+    }
+
+    fn uncount(&mut self, evaluations: u64) {
+        self.evaluations -= evaluations;
     }
 
     fn attempt(

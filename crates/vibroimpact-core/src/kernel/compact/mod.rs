@@ -18,7 +18,7 @@
 mod lanes;
 mod stretch;
 pub(crate) use lanes::{Group, LaneModes, LaneState, LaneStep, LANES};
-pub(crate) use stretch::Stretch;
+pub(crate) use stretch::{peak_inside, widen_peaks, Stretch};
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{
@@ -646,6 +646,8 @@ mod tests {
                 schedule: &schedule,
                 y: &mut y,
                 gaps: &mut gaps,
+                end: &mut [],
+                end_gaps: &mut [],
                 open: &mut open,
                 peaks: &mut peaks,
                 recorded_time: &mut recorded,

@@ -123,7 +123,7 @@ impl Compact {
                     }
                 }
             }
-            if in_window && peak_inside(system, observed, (&y, &end), d, n) {
+            if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
                 plain = false;
             }
             if !plain {
@@ -139,7 +139,7 @@ impl Compact {
             }
             if in_window {
                 let kept = observed.min(f.peaks.len());
-                widen_peaks(system, &mut f.peaks[..kept], (&y, &end), n);
+                widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
                 *f.recorded_time += length;
             }
             clock.time = next;
@@ -223,7 +223,7 @@ impl Compact {
                 // separation in the step.
                 plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
             }
-            if in_window && peak_inside(system, observed, (&y, &end), d, n) {
+            if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
                 plain = false;
             }
             if !plain {
@@ -243,7 +243,7 @@ impl Compact {
             }
             if in_window {
                 let kept = observed.min(f.peaks.len());
-                widen_peaks(system, &mut f.peaks[..kept], (&y, &end), n);
+                widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
                 *f.recorded_time += dt;
             }
             clock.time = next;
@@ -319,9 +319,10 @@ stretch_with!(stretch_avx512, "avx512f");
 stretch_with!(stretch_avx2, "avx2");
 
 /// `n` values of `y` from `from`, copied: a runtime index into the state
-/// itself would keep it in memory rather than in registers.
+/// itself would keep the compact path's state in memory rather than in
+/// registers.
 #[inline(always)]
-fn block(y: &[f64; MAX_LEN], from: usize, n: usize) -> [f64; MAX_MODES] {
+fn block(y: &[f64], from: usize, n: usize) -> [f64; MAX_MODES] {
     let mut out = [0.0; MAX_MODES];
     for i in 0..n.min(MAX_MODES) {
         out[i] = y[from + i];
@@ -330,33 +331,43 @@ fn block(y: &[f64; MAX_LEN], from: usize, n: usize) -> [f64; MAX_MODES] {
 }
 
 /// Whether an observed velocity changes sign in the step from `y` to `end`
-/// (`d` coordinates, `n` of the structure): a peak inside it, for the kernel
-/// to find.
+/// (`d` coordinates, `n` of the structure, at most [`MAX_MODES`]): a peak
+/// inside it, for the kernel to find.
 #[inline(always)]
-fn peak_inside(
+pub(crate) fn peak_inside(
     system: &Assembly,
     observed: usize,
-    (y, end): (&[f64; MAX_LEN], &[f64; MAX_LEN]),
+    (y, end): (&[f64], &[f64]),
     d: usize,
     n: usize,
 ) -> bool {
+    if n > MAX_MODES {
+        let of = |j, block: &[f64]| system.observe(j, &block[d..d + n]);
+        return (0..observed).any(|j| of(j, y) * of(j, end) < 0.0);
+    }
     let (v0, v1) = (block(y, d, n), block(end, d, n));
     (0..observed).any(|j| system.observe(j, &v0[..n]) * system.observe(j, &v1[..n]) < 0.0)
 }
 
 /// The observed displacements' peaks widened to the step's ends.
 #[inline(always)]
-fn widen_peaks(
+pub(crate) fn widen_peaks(
     system: &Assembly,
     peaks: &mut [f64],
-    (y, end): (&[f64; MAX_LEN], &[f64; MAX_LEN]),
+    (y, end): (&[f64], &[f64]),
     n: usize,
 ) {
-    let (x0, x1) = (block(y, 0, n), block(end, 0, n));
-    for (j, peak) in peaks.iter_mut().enumerate() {
-        let (p0, p1) = (system.observe(j, &x0[..n]), system.observe(j, &x1[..n]));
-        *peak = peak.max(p0.abs().max(p1.abs()));
+    let widen = |peaks: &mut [f64], x0: &[f64], x1: &[f64]| {
+        for (j, peak) in peaks.iter_mut().enumerate() {
+            let (p0, p1) = (system.observe(j, x0), system.observe(j, x1));
+            *peak = peak.max(p0.abs().max(p1.abs()));
+        }
+    };
+    if n > MAX_MODES {
+        return widen(peaks, &y[..n], &end[..n]);
     }
+    let (x0, x1) = (block(y, 0, n), block(end, 0, n));
+    widen(peaks, &x0[..n], &x1[..n]);
 }
 
 /// What the fast path advances, lent by the kernel ([`crate::kernel::run`]):
@@ -373,6 +384,10 @@ pub struct Stretch<'a> {
     /// The state, advanced in place, and each wall's gap and rate there.
     pub(crate) y: &'a mut [f64],
     pub(crate) gaps: &'a mut [(f64, f64)],
+    /// Room for a step's end and its gaps (the methods without a compact
+    /// form of their own: [`crate::kernel::plain_fixed`]).
+    pub(crate) end: &'a mut [f64],
+    pub(crate) end_gaps: &'a mut [(f64, f64)],
     pub(crate) open: &'a mut [Option<Open>],
     /// The reductions' peaks and recorded time (used in the window).
     pub(crate) peaks: &'a mut [f64],

@@ -67,11 +67,15 @@ pub trait SystemStepper {
     fn creates_contact_energy(&self) -> bool {
         false
     }
-    /// Whether the method takes stretches of plain fixed steps of `system`
-    /// (see [`Self::stretch`]). No by default.
-    fn takes_stretches(&self, _system: &Assembly) -> bool {
+    /// Whether the method takes stretches of plain steps of `system` (see
+    /// [`Self::stretch`]) when stepping fixed (`fixed`) or by events. No by
+    /// default.
+    fn takes_stretches(&self, _system: &Assembly, _fixed: bool) -> bool {
         false
     }
+    /// Forget the last `evaluations` counted: an attempt taken back, which
+    /// the kernel makes again ([`crate::kernel::plain_fixed`]).
+    fn uncount(&mut self, _evaluations: u64) {}
     /// Plain fixed steps taken at once (see [`Stretch`], a type of the
     /// kernel's, not for callers), where the method can: each the step the
     /// kernel would take, to the bit. None by default.

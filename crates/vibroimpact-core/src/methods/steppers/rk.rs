@@ -319,7 +319,7 @@ impl SystemStepper for ExplicitRk {
         self.end_slot = None;
     }
 
-    fn takes_stretches(&self, system: &Assembly) -> bool {
+    fn takes_stretches(&self, system: &Assembly, _fixed: bool) -> bool {
         self.rk4 && self.compact && system.compact.is_some()
     }
 

@@ -136,6 +136,12 @@ impl Scratch {
         self.force_values.first_mut()
     }
 
+    /// Whether the first force's is the only signal cache (see
+    /// [`Self::first_cache`]).
+    pub(crate) fn first_cache_only(&self) -> bool {
+        self.force_values.len() <= 1 && self.base_values.is_empty()
+    }
+
     /// The first force's signal at `time`, through its cache (the value the
     /// general right-hand side takes, to the bit).
     #[inline(always)]
