@@ -5,8 +5,8 @@
 //! the step). Each refusal is one line naming the field (as a scenario's
 //! `[solver]`, `[output]` or `[[excitation]]` key) and what is allowed.
 
-use super::table::{method, Kind, MethodSpec, DT};
-use crate::error::{positive, Error, Result};
+use super::table::{method, Kind, MethodSpec, DT, T_END};
+use crate::error::{Error, Result};
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::model::assembly::SystemSpec;
 use crate::model::structure::Structure;
@@ -79,9 +79,12 @@ pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
     if let Some(dt) = plan.dt {
         DT.check(dt)?;
     }
-    positive("t_end", plan.t_end)?;
-    if let Some(period) = plan.strobe_period {
-        positive("strobe_period", period)?;
+    T_END.check(plan.t_end)?;
+    if let Some(period) = plan.strobe_period.filter(|p| !(p.is_finite() && *p > 0.0)) {
+        return Err(Error::Inconsistent(format!(
+            "[output] strobe_period: must be finite and > 0 s, got {}",
+            python_repr(period)
+        )));
     }
     let fixed = spec.kind.is_fixed_step();
     if fixed && plan.dt.is_none() {

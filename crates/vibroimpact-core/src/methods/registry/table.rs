@@ -308,9 +308,27 @@ pub fn check_settings(
 }
 
 impl Options {
+    /// The options given, each left out (None) taking the registry's default.
+    pub fn or_defaults(
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        beta: Option<f64>,
+        gamma: Option<f64>,
+        spectral_radius: Option<f64>,
+    ) -> Self {
+        let d = Self::default();
+        Self {
+            rtol: rtol.unwrap_or(d.rtol),
+            atol: atol.unwrap_or(d.atol),
+            beta: beta.unwrap_or(d.beta),
+            gamma: gamma.unwrap_or(d.gamma),
+            spectral_radius: spectral_radius.unwrap_or(d.spectral_radius),
+        }
+    }
+
     /// Every option checked against its range, in [`METHOD_OPTIONS`]'s order
     /// (whatever the method), or the first outside named.
-    pub fn checked(self) -> Result<Self> {
+    pub fn checked(&self) -> Result<Self> {
         Ok(Self {
             rtol: RTOL.check(self.rtol)?,
             atol: ATOL.check(self.atol)?,
