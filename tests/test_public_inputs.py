@@ -244,6 +244,12 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
         {"strobe": np.ones((3, 2)), "forcing_period": 0.2, "tolerance": 1e-6, "max_period": 8},
     ),
     "_check_settings": (_core._check_settings, PREPARED),
+    "_check_forcing_period": (
+        lambda **kwargs: _core._check_forcing_period(
+            SPEC, method="dop853", max_steps=10**6, **kwargs
+        ),
+        {"forcing_period": 0.1, "dt": 1e-3, "atol": 1e-12},
+    ),
     "_check_run": (
         lambda **kwargs: _core._check_run(
             {"structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 10.0, "damping": 0.0}},

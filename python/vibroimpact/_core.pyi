@@ -353,6 +353,15 @@ def _check_run(
     history: bool,
     strobe_period: float | None,
 ) -> None: ...
+def _check_forcing_period(
+    spec: dict[str, Any],
+    *,
+    forcing_period: float,
+    method: str,
+    dt: float | None,
+    atol: float | None,
+    max_steps: int | None,
+) -> None: ...
 def check_solver(
     *,
     t_end: float,

@@ -8,7 +8,7 @@ use vibroimpact_core::methods::registry::{
     self, check_scales, OptionSpec, RunPlan, RunScales, METHOD_OPTIONS, METHOD_SPECS,
 };
 
-use crate::convert::system::{entries, get, structure};
+use crate::convert::system::{entries, get, structure, system_spec};
 use crate::errors::to_py;
 
 /// `{name: {default, low, high, low_open, allowed}}` of `options`.
@@ -62,6 +62,10 @@ pub(crate) fn add_registry(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // Internal (not in __all__): vibroimpact.system's checks call them.
     m.setattr("_check_run", wrap_pyfunction!(check_run, m)?)?;
     m.setattr("_check_settings", wrap_pyfunction!(check_settings, m)?)?;
+    m.setattr(
+        "_check_forcing_period",
+        wrap_pyfunction!(check_forcing_period, m)?,
+    )?;
     Ok(())
 }
 
@@ -155,4 +159,30 @@ pub(crate) fn check_settings(
     registry::check_settings(t_end, dt, options, energy_tolerance)
         .map(|_| ())
         .map_err(to_py)
+}
+
+/// Refuse an analysis's `forcing_period` (s) of the checked 0.2 `spec` that
+/// no run of its settings can step through (the core's
+/// `registry::check_forcing_period`); raises ``InvalidInputError`` naming the
+/// frequency and the range a run can take.
+#[pyfunction]
+#[pyo3(signature = (spec, *, forcing_period, method, dt, atol, max_steps))]
+pub(crate) fn check_forcing_period(
+    spec: &Bound<'_, PyDict>,
+    #[pyo3(from_py_with = crate::convert::arg::forcing_period)] forcing_period: f64,
+    method: &str,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional_max_steps)] max_steps: Option<u64>,
+) -> PyResult<()> {
+    // Harmonic loads only (the check reads no other): no signal needs the
+    // run's length.
+    let system = system_spec(spec, 1.0)?;
+    let plan = registry::ForcingPlan {
+        method,
+        dt,
+        atol: atol.unwrap_or(registry::ATOL.default_value()),
+        max_steps: max_steps.unwrap_or(registry::DEFAULT_MAX_STEPS),
+    };
+    registry::check_forcing_period(&system, &plan, forcing_period).map_err(to_py)
 }

@@ -14,7 +14,6 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError, __version__, run_study
-from vibroimpact.analysis.forcing_limits import check_forcing_period
 from vibroimpact.analysis.limits import whole_count
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
 from vibroimpact.analysis.runs import _prepare
@@ -187,7 +186,7 @@ def check_axis_frequencies(
         changed = with_parameter(data, str(path), lowest)
         try:
             period = forcing_period(changed)
-            check_forcing_period(changed, period, _prepare(changed, base_dir).solver["max_steps"])
+            _prepare(changed, base_dir).check_forcing_period(period)
         except InvalidInputError as err:
             if not str(err).startswith("forcing frequency"):
                 continue  # the study's own check of the axis says what else is wrong

@@ -15,6 +15,7 @@ from vibroimpact._core import (
     METHOD_OPTIONS,
     InvalidInputError,
 )
+from vibroimpact._core import _check_forcing_period as check_forcing_period
 from vibroimpact._core import _check_run as check_run
 from vibroimpact._core import _check_settings as check_settings
 from vibroimpact._core import simulate_system as _simulate_system
@@ -170,6 +171,23 @@ class PreparedRun:
                 "contact_timing",
             )
         }
+
+    def check_forcing_period(self, period: float) -> None:
+        """Refuse an analysis's forcing ``period`` (s) no run of these settings can step
+        through (the core registry's ``check_forcing_period``: more than ``max_steps``
+        steps of a fixed ``dt``; for an adaptive or exact method more than ``max_steps``
+        periods of the fastest mode, a forcing moving the structure less than ``atol`` a
+        period, or a free body's times' round-off beyond what ``atol`` resolves), naming
+        the frequency and the range a run can take."""
+        solver = self.solver
+        try:
+            check_forcing_period(
+                self.binding_spec(),
+                forcing_period=period,
+                **{key: solver[key] for key in ("method", "dt", "atol", "max_steps")},
+            )
+        except InvalidInputError as err:
+            raise InvalidInputError(short_numbers(str(err))) from None
 
     def run(self) -> SystemSolution:
         """Integrate it."""

@@ -1,16 +1,19 @@
 //! The methods of a run by name, defined once: the table of methods (their
 //! kinds, steppings, options, defaults and ranges, [`table`]), each model
 //! kind's default method and stepping ([`defaults`]), the up-front
-//! limits of a run ([`limits`]), the stepper made once for a system, the
+//! limits of a run ([`limits`]) and of an analysis's forcing period
+//! ([`forcing`]), the stepper made once for a system, the
 //! fixed step it takes, and the run. Every front end (the binding's runs, a
 //! study's runs, Python's schemas through the binding) reads it, so that a
 //! method means the same in each.
 
 mod defaults;
+mod forcing;
 mod limits;
 mod table;
 
 pub use defaults::{ModelKind, RunDefaults, RUN_DEFAULTS, SYSTEM, TWO_MASS};
+pub use forcing::{check_forcing_period, ForcingPlan};
 pub use limits::{check_run, check_scales, RunPlan, RunScales};
 pub use table::{
     check_settings, method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_ROWS,
