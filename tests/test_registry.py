@@ -234,8 +234,10 @@ def test_no_default_is_written_outside_the_core_registry() -> None:
         for number, line in enumerate(path.read_text().splitlines(), 1):
             # An annotated parameter or field with a literal default ...
             annotated = re.search(rf"\b({names})\s*:[^=\n]*=\s*([\"'\d][^,)\n]*)", line)
-            # ... or a dict entry of a literal.
-            entry = re.search(rf"[\"']({names})[\"']\s*:\s*([\"'\d][^,}}\n]*)", line)
+            # ... or a dict entry of a literal (or a schema's (type, literal) entry).
+            entry = re.search(
+                rf"[\"']({names})[\"']\s*:\s*(?:\(\s*_\w+\s*,\s*)?([\"'\d][^,}})\n]*)", line
+            )
             for match in (annotated, entry):
                 if match:
                     found.append(f"{path.name}:{number}: {line.strip()}")

@@ -105,7 +105,8 @@ class Study:
             tolerance=s["tolerance"],
             threads=threads,
             mean_square="rms" in base_metrics(s["metrics"]),
-            stepping=s.get("stepping", "events"),
+            # None: the core registry's default stepping.
+            stepping=s.get("stepping"),
             orbit_periods=s.get("orbit_periods", 1),
         )
         return raw
