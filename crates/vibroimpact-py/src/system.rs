@@ -16,12 +16,12 @@ use vibroimpact_core::kernel::events::{
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::{
     check_settings, AnyStepper, Options, DEFAULT_MAX_ROWS, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE,
-    SYSTEM,
+    FORCING_PERIOD, RECORD_FROM, STROBE_PERIOD, SYSTEM, TOLERANCE, T_END,
 };
 use vibroimpact_core::model::assembly::{initial_state, resumed_state, Assembly};
 
 use crate::convert::system::system_spec;
-use crate::errors::{released, short_numbers, to_py, InvalidInputError};
+use crate::errors::{released, to_py, InvalidInputError};
 
 /// The numbers a run takes beside its system and method.
 #[derive(Debug, Clone, Copy)]
@@ -244,13 +244,15 @@ impl PreparedSystem {
                 state.len()
             )));
         }
-        check("t_end", t_end, t_end > 0.0, "> 0 s")?;
-        if let Some(value) = record_from {
-            check("record_from", value, value >= 0.0, ">= 0 s or None")?;
-        }
-        if let Some(value) = strobe_period {
-            check("strobe_period", value, value > 0.0, "> 0 s or None")?;
-        }
+        T_END.check(t_end).map_err(to_py)?;
+        record_from
+            .map(|v| RECORD_FROM.check(v))
+            .transpose()
+            .map_err(to_py)?;
+        strobe_period
+            .map(|v| STROBE_PERIOD.check(v))
+            .transpose()
+            .map_err(to_py)?;
         let y0 = resumed_state(
             system,
             [&state[..n], &state[d..d + n], &state[n..d], &state[d + n..]],
@@ -278,15 +280,11 @@ impl PreparedSystem {
             f64,
         >,
     ) -> PyResult<Bound<'py, PyDict>> {
-        check("t_end", t_end, t_end > 0.0, "> 0 s")?;
-        check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
-        let forcing_period = forcing_period.unwrap_or(t_end);
-        check(
-            "forcing_period",
-            forcing_period,
-            forcing_period.is_finite() && forcing_period > 0.0,
-            "> 0 s",
-        )?;
+        T_END.check(t_end).map_err(to_py)?;
+        TOLERANCE.check(tolerance).map_err(to_py)?;
+        let forcing_period = FORCING_PERIOD
+            .check(forcing_period.unwrap_or(t_end))
+            .map_err(to_py)?;
         let mut ready = self.ready.lock().map_err(|_| {
             InvalidInputError::new_err("a run of this system failed; make it again")
         })?;
@@ -329,18 +327,6 @@ fn check_method(
     check_settings(t_end, dt, *options, energy_tolerance)
         .map(|_| ())
         .map_err(to_py)
-}
-
-/// `value` of `field`, unless it is not finite or not `ok` (then an error
-/// saying what is `allowed`).
-fn check(field: &str, value: f64, ok: bool, allowed: &str) -> PyResult<f64> {
-    if value.is_finite() && ok {
-        Ok(value)
-    } else {
-        Err(InvalidInputError::new_err(short_numbers(&format!(
-            "{field} must be finite and {allowed}, got {value}"
-        ))))
-    }
 }
 
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
@@ -562,8 +548,8 @@ pub fn run_study<'py>(
         Some(stepping) => stepping,
         None => SYSTEM.stepping(&method).map_err(to_py)?,
     };
-    check("record_from", record_from, record_from >= 0.0, ">= 0 s")?;
-    check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
+    RECORD_FROM.check(record_from).map_err(to_py)?;
+    TOLERANCE.check(tolerance).map_err(to_py)?;
     let system_spec = system_spec(spec, t_end)?;
     // The base system and start must be valid on their own.
     let base = Assembly::new(&system_spec).map_err(to_py)?;

@@ -17,8 +17,8 @@ pub use forcing::{check_forcing_period, ForcingPlan};
 pub use limits::{check_run, check_scales, RunPlan, RunScales};
 pub use table::{
     check_settings, method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_ROWS,
-    DEFAULT_MAX_STEPS, DT, ENERGY_TOLERANCE, GAMMA, MAX_STEPS, METHOD_OPTIONS, METHOD_SPECS, RTOL,
-    SPECTRAL_RADIUS, T_END,
+    DEFAULT_MAX_STEPS, DT, ENERGY_TOLERANCE, FORCING_PERIOD, GAMMA, MAX_STEPS, METHOD_OPTIONS,
+    METHOD_SPECS, RECORD_FROM, RTOL, SPECTRAL_RADIUS, STROBE_PERIOD, TOLERANCE, T_END,
 };
 
 use crate::error::{Error, Result};

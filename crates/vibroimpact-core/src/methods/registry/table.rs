@@ -175,6 +175,43 @@ pub const ENERGY_TOLERANCE: OptionSpec = OptionSpec {
     low_open: true,
     allowed: "in (0, 1]",
 };
+/// When a run's peaks and RMS start being recorded (s from the start).
+pub const RECORD_FROM: OptionSpec = OptionSpec {
+    name: "record_from",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: false,
+    allowed: "finite and >= 0 s",
+};
+/// The period of a run's stroboscopic record (s).
+pub const STROBE_PERIOD: OptionSpec = OptionSpec {
+    name: "strobe_period",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0 s",
+};
+/// The forcing period an analysis samples or shoots over (s).
+pub const FORCING_PERIOD: OptionSpec = OptionSpec {
+    name: "forcing_period",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0 s",
+};
+/// An analysis's relative tolerance (a steady state's repeat, an orbit's
+/// residual).
+pub const TOLERANCE: OptionSpec = OptionSpec {
+    name: "tolerance",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0",
+};
 /// The default of `max_rows`, the history rows plus contacts a run may keep:
 /// 20 million (under 1 GB of two-mass history), room for any run a
 /// workstation can plot, yet a run growing without bound stops within seconds.
