@@ -300,11 +300,12 @@ def _calls() -> list[Any]:
         (vi.simulate, simulate, "system", [None, "x", {}]),
         (vi.simulate, simulate, "contact", [None, "hertz"]),
         (vi.simulate, simulate, "initial", [None, {}]),
-        (vi.simulate, simulate, "method", [None, 5, ["rk4"]]),
-        (vi.simulate, simulate, "contact_timing", [None, 5]),
+        # None: the core registry's default (RUN_DEFAULTS["two-mass"]), as for stepping.
+        (vi.simulate, simulate, "method", [5, ["rk4"]]),
+        (vi.simulate, simulate, "contact_timing", [5]),
         (vi.simulate, simulate, "stepping", [5]),
         (vi.simulate, simulate, "t_end", [None, "1", [1.0]]),
-        (vi.check_solver, {"t_end": 1.0, "method": "dopri5"}, "method", [None, 5]),
+        (vi.check_solver, {"t_end": 1.0, "method": "dopri5"}, "method", [5]),
         (vi.simulate_system, structure, "structure", [None, "x", 5]),
         (vi.simulate_system, structure, "excitation", ["x", 5, [5]]),
         (vi.simulate_system, structure, "method", [None, 5]),
@@ -687,7 +688,7 @@ def test_the_binding_s_own_messages_write_numbers_short() -> None:
 
 
 @pytest.mark.parametrize(
-    ("name", "bad"), [("spec", None), ("max_steps", None), ("analysis", 5), ("values", "abc")]
+    ("name", "bad"), [("spec", None), ("threads", "two"), ("analysis", 5), ("values", "abc")]
 )
 def test_run_study_names_an_argument_of_the_wrong_type(name: str, bad: Any) -> None:
     import vibroimpact as vi

@@ -243,9 +243,12 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
         _core._strobe_period,
         {"strobe": np.ones((3, 2)), "forcing_period": 0.2, "tolerance": 1e-6, "max_period": 8},
     ),
-    "_check_options": (
-        _core._check_options,
-        {"rtol": 1e-8, "atol": 1e-12, "beta": 0.25, "gamma": 0.5, "spectral_radius": 0.9},
+    "_check_settings": (_core._check_settings, PREPARED),
+    "_check_forcing_period": (
+        lambda **kwargs: _core._check_forcing_period(
+            SPEC, method="dop853", max_steps=10**6, **kwargs
+        ),
+        {"forcing_period": 0.1, "dt": 1e-3, "atol": 1e-12},
     ),
     "_check_run": (
         lambda **kwargs: _core._check_run(

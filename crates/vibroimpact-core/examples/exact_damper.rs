@@ -8,7 +8,7 @@
 use std::time::Instant;
 use vibroimpact_core::kernel::events::{RunOptions, SystemSolution};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
-use vibroimpact_core::methods::registry::AnyStepper;
+use vibroimpact_core::methods::registry::{AnyStepper, Options};
 use vibroimpact_core::model::assembly::{
     initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
@@ -18,7 +18,7 @@ use vibroimpact_core::model::structure::Structure;
 fn run(spec: &SystemSpec, t_end: f64) -> SystemSolution {
     let system = Assembly::new(spec).unwrap();
     let y = initial_state(&system, &[], &[], &[], &[]).unwrap();
-    let mut stepper = AnyStepper::new(&system, "exact", 1e-8, 1e-11, 0.25, 0.5, 0.8).unwrap();
+    let mut stepper = AnyStepper::new(&system, "exact", &Options::default()).unwrap();
     let options = RunOptions {
         dt: stepper.step(None, t_end, f64::INFINITY),
         t_end,

@@ -8,7 +8,7 @@
 //!     cargo run --release -p vibroimpact-core --example throughput
 
 use std::time::Instant;
-use vibroimpact_core::methods::registry::AnyStepper;
+use vibroimpact_core::methods::registry::{AnyStepper, Options};
 use vibroimpact_core::{
     simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
     Tolerances,
@@ -31,20 +31,15 @@ fn median_seconds(repeats: usize, least_steps: u64, mut run: impl FnMut() -> u64
 fn general(system: &ImpactDamper, contact: &Contact, start: &State, settings: &Settings) -> u64 {
     let assembly = system.assembly(contact).unwrap();
     let y0 = start.vector(&assembly).unwrap();
-    let (rtol, atol) = match settings.method {
-        Method::Dopri5(t) | Method::Dop853(t) => (t.rtol, t.atol),
-        _ => (1e-8, 1e-12),
+    let options = match settings.method {
+        Method::Dopri5(t) | Method::Dop853(t) => Options {
+            rtol: t.rtol,
+            atol: t.atol,
+            ..Options::default()
+        },
+        _ => Options::default(),
     };
-    let mut stepper = AnyStepper::new(
-        &assembly,
-        settings.method.name(),
-        rtol,
-        atol,
-        0.25,
-        0.5,
-        0.9,
-    )
-    .unwrap();
+    let mut stepper = AnyStepper::new(&assembly, settings.method.name(), &options).unwrap();
     let (options, stepping) = (settings.run_options(), settings.kernel_stepping());
     let sol = stepper
         .integrate_stepped(&assembly, &y0, &options, stepping, &mut || false)

@@ -8,7 +8,7 @@ use vibroimpact_core::methods::registry::{
     self, check_scales, OptionSpec, RunPlan, RunScales, METHOD_OPTIONS, METHOD_SPECS,
 };
 
-use crate::convert::system::{entries, get, structure};
+use crate::convert::system::{entries, get, structure, system_spec};
 use crate::errors::to_py;
 
 /// `{name: {default, low, high, low_open, allowed}}` of `options`.
@@ -32,8 +32,10 @@ fn options_dict<'py>(py: Python<'py>, options: &[OptionSpec]) -> PyResult<Bound<
 }
 
 /// `METHODS`: method -> {kind, steppings, options: {name: {default, low,
-/// high, low_open, allowed}}}, in the registry's order; and `METHOD_OPTIONS`:
-/// the options every run is given and checked, whatever its method.
+/// high, low_open, allowed}}}, in the registry's order; `METHOD_OPTIONS`:
+/// the options every run is given and checked, whatever its method; and
+/// `RUN_DEFAULTS`: model kind ("two-mass", "system") -> {method,
+/// fixed_by_default, contact_timing}.
 pub(crate) fn add_registry(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     let methods = PyDict::new(py);
@@ -48,9 +50,22 @@ pub(crate) fn add_registry(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let mut all = METHOD_OPTIONS.to_vec();
     all.push(registry::MAX_STEPS);
     m.add("METHOD_OPTIONS", options_dict(py, &all)?)?;
+    let defaults = PyDict::new(py);
+    for kind in &registry::RUN_DEFAULTS {
+        let entry = PyDict::new(py);
+        entry.set_item("method", kind.method)?;
+        entry.set_item("fixed_by_default", kind.fixed_by_default.to_vec())?;
+        entry.set_item("contact_timing", kind.contact_timing)?;
+        defaults.set_item(kind.name, entry)?;
+    }
+    m.add("RUN_DEFAULTS", defaults)?;
     // Internal (not in __all__): vibroimpact.system's checks call them.
     m.setattr("_check_run", wrap_pyfunction!(check_run, m)?)?;
-    m.setattr("_check_options", wrap_pyfunction!(check_options, m)?)?;
+    m.setattr("_check_settings", wrap_pyfunction!(check_settings, m)?)?;
+    m.setattr(
+        "_check_forcing_period",
+        wrap_pyfunction!(check_forcing_period, m)?,
+    )?;
     Ok(())
 }
 
@@ -119,26 +134,55 @@ pub(crate) fn check_run(
     check_scales(&scales, &plan).map_err(to_py)
 }
 
-/// Check the method options every run is given, whatever its method, against
-/// the registry's ranges (the core's `Options::checked`); raises
-/// ``InvalidInputError`` naming the first outside and what is allowed.
+/// Check a run's settings against the registry's ranges (the core's
+/// `check_settings`: `t_end`, `dt` where given, the method options every run
+/// is given whatever its method, `energy_tolerance`), each left out (None)
+/// the registry's default; raises ``InvalidInputError`` naming the first
+/// outside and what is allowed.
 #[pyfunction]
-#[pyo3(signature = (*, rtol, atol, beta, gamma, spectral_radius))]
-pub(crate) fn check_options(
-    #[pyo3(from_py_with = crate::convert::arg::rtol)] rtol: f64,
-    #[pyo3(from_py_with = crate::convert::arg::atol)] atol: f64,
-    #[pyo3(from_py_with = crate::convert::arg::beta)] beta: f64,
-    #[pyo3(from_py_with = crate::convert::arg::gamma)] gamma: f64,
-    #[pyo3(from_py_with = crate::convert::arg::spectral_radius)] spectral_radius: f64,
+#[pyo3(signature = (*, t_end, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, energy_tolerance=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_settings(
+    #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::beta)] beta: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::gamma)] gamma: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::spectral_radius)] spectral_radius: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::energy_tolerance)] energy_tolerance: Option<
+        f64,
+    >,
 ) -> PyResult<()> {
-    registry::Options {
-        rtol,
-        atol,
-        beta,
-        gamma,
-        spectral_radius,
-    }
-    .checked()
-    .map(|_| ())
-    .map_err(to_py)
+    let options = registry::Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
+    let energy_tolerance = energy_tolerance.unwrap_or(registry::ENERGY_TOLERANCE.default_value());
+    registry::check_settings(t_end, dt, options, energy_tolerance)
+        .map(|_| ())
+        .map_err(to_py)
+}
+
+/// Refuse an analysis's `forcing_period` (s) of the checked 0.2 `spec` that
+/// no run of its settings can step through (the core's
+/// `registry::check_forcing_period`); raises ``InvalidInputError`` naming the
+/// frequency and the range a run can take.
+#[pyfunction]
+#[pyo3(signature = (spec, *, forcing_period, method, dt, atol, max_steps))]
+pub(crate) fn check_forcing_period(
+    spec: &Bound<'_, PyDict>,
+    #[pyo3(from_py_with = crate::convert::arg::forcing_period)] forcing_period: f64,
+    method: &str,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional_max_steps)] max_steps: Option<u64>,
+) -> PyResult<()> {
+    // Harmonic loads only (the check reads no other): no signal needs the
+    // run's length.
+    let system = system_spec(spec, 1.0)?;
+    let plan = registry::ForcingPlan {
+        method,
+        dt,
+        atol: atol.unwrap_or(registry::ATOL.default_value()),
+        max_steps: max_steps.unwrap_or(registry::DEFAULT_MAX_STEPS),
+    };
+    registry::check_forcing_period(&system, &plan, forcing_period).map_err(to_py)
 }

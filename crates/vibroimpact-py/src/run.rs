@@ -7,6 +7,7 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
+use vibroimpact_core::methods::registry as core_registry;
 
 use crate::convert::*;
 use crate::errors::*;
@@ -278,37 +279,37 @@ impl Solution {
     }
 }
 
+/// The two-mass run's settings from its arguments, each left out (None)
+/// taking the core registry's default for the two-mass damper (method,
+/// stepping, contact timing, method options, `max_steps`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn settings(
     dt: Option<f64>,
     t_end: f64,
-    method: &str,
+    method: Option<&str>,
     every: u64,
-    contact_timing: &str,
+    contact_timing: Option<&str>,
     stepping: Option<&str>,
-    beta: f64,
-    gamma: f64,
-    spectral_radius: f64,
-    rtol: f64,
-    atol: f64,
-    max_steps: u64,
+    beta: Option<f64>,
+    gamma: Option<f64>,
+    spectral_radius: Option<f64>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    max_steps: Option<u64>,
     max_rows: Option<u64>,
     energy_tolerance: Option<f64>,
     history: bool,
 ) -> PyResult<core::Settings> {
-    let options = core::MethodOptions {
-        beta,
-        gamma,
-        spectral_radius,
-        rtol,
-        atol,
-    };
-    let parsed = core::Method::parse(method, &options).map_err(to_py)?;
-    let timing = core::ContactTiming::parse(contact_timing).map_err(to_py)?;
+    let defaults = core_registry::TWO_MASS;
+    let options = core_registry::Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
+    let parsed = core::Method::parse(method.unwrap_or(defaults.method), &options).map_err(to_py)?;
+    let timing = core::ContactTiming::parse(contact_timing.unwrap_or(defaults.contact_timing))
+        .map_err(to_py)?;
     let stepping = stepping
         .map(core::Stepping::parse)
         .transpose()
         .map_err(to_py)?;
+    let max_steps = max_steps.unwrap_or(core_registry::DEFAULT_MAX_STEPS);
     core::Settings::new(parsed, dt, t_end, every, timing, stepping, max_steps)
         .and_then(|s| s.with_limits(history, max_rows, energy_tolerance))
         .map_err(to_py)
@@ -317,21 +318,21 @@ pub(crate) fn settings(
 /// Check solver settings as ``simulate`` would, without running; raises
 /// ``InvalidInputError`` naming the offending field.
 #[pyfunction]
-#[pyo3(signature = (*, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000, max_rows = None, energy_tolerance = None, history = true))]
+#[pyo3(signature = (*, t_end, dt = None, method = None, every = 1, contact_timing = None, stepping = None, beta = None, gamma = None, spectral_radius = None, rtol = None, atol = None, max_steps = None, max_rows = None, energy_tolerance = None, history = true))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn check_solver(
     #[pyo3(from_py_with = arg::t_end)] t_end: f64,
     #[pyo3(from_py_with = optional::dt)] dt: Option<f64>,
-    method: &str,
+    method: Option<&str>,
     #[pyo3(from_py_with = every_arg)] every: u64,
-    contact_timing: &str,
+    contact_timing: Option<&str>,
     stepping: Option<&str>,
-    #[pyo3(from_py_with = arg::beta)] beta: f64,
-    #[pyo3(from_py_with = arg::gamma)] gamma: f64,
-    #[pyo3(from_py_with = arg::spectral_radius)] spectral_radius: f64,
-    #[pyo3(from_py_with = arg::rtol)] rtol: f64,
-    #[pyo3(from_py_with = arg::atol)] atol: f64,
-    #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = optional::beta)] beta: Option<f64>,
+    #[pyo3(from_py_with = optional::gamma)] gamma: Option<f64>,
+    #[pyo3(from_py_with = optional::spectral_radius)] spectral_radius: Option<f64>,
+    #[pyo3(from_py_with = optional::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = optional_max_steps)] max_steps: Option<u64>,
     #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
     #[pyo3(from_py_with = optional::energy_tolerance)] energy_tolerance: Option<f64>,
     #[pyo3(from_py_with = history_arg)] history: bool,
@@ -387,7 +388,7 @@ pub(crate) fn check_solver(
 /// documented error).
 /// The GIL is released while integrating; Ctrl-C interrupts.
 #[pyfunction]
-#[pyo3(signature = (system, contact, initial, *, t_end, dt = None, method = "newmark", every = 1, contact_timing = "located", stepping = None, beta = 0.25, gamma = 0.5, spectral_radius = 0.9, rtol = 1e-8, atol = 1e-12, max_steps = 1_000_000_000, max_rows = None, energy_tolerance = None, history = true))]
+#[pyo3(signature = (system, contact, initial, *, t_end, dt = None, method = None, every = 1, contact_timing = None, stepping = None, beta = None, gamma = None, spectral_radius = None, rtol = None, atol = None, max_steps = None, max_rows = None, energy_tolerance = None, history = true))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn simulate(
     py: Python<'_>,
@@ -396,16 +397,16 @@ pub(crate) fn simulate(
     initial: &InitialState,
     #[pyo3(from_py_with = arg::t_end)] t_end: f64,
     #[pyo3(from_py_with = optional::dt)] dt: Option<f64>,
-    method: &str,
+    method: Option<&str>,
     #[pyo3(from_py_with = every_arg)] every: u64,
-    contact_timing: &str,
+    contact_timing: Option<&str>,
     stepping: Option<&str>,
-    #[pyo3(from_py_with = arg::beta)] beta: f64,
-    #[pyo3(from_py_with = arg::gamma)] gamma: f64,
-    #[pyo3(from_py_with = arg::spectral_radius)] spectral_radius: f64,
-    #[pyo3(from_py_with = arg::rtol)] rtol: f64,
-    #[pyo3(from_py_with = arg::atol)] atol: f64,
-    #[pyo3(from_py_with = max_steps_arg)] max_steps: u64,
+    #[pyo3(from_py_with = optional::beta)] beta: Option<f64>,
+    #[pyo3(from_py_with = optional::gamma)] gamma: Option<f64>,
+    #[pyo3(from_py_with = optional::spectral_radius)] spectral_radius: Option<f64>,
+    #[pyo3(from_py_with = optional::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = optional_max_steps)] max_steps: Option<u64>,
     #[pyo3(from_py_with = max_rows_arg)] max_rows: Option<u64>,
     #[pyo3(from_py_with = optional::energy_tolerance)] energy_tolerance: Option<f64>,
     #[pyo3(from_py_with = history_arg)] history: bool,

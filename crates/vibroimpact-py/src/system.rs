@@ -14,11 +14,14 @@ use vibroimpact_core::kernel::events::{
     integrate_system_stepped, ContactTiming, RunOptions, Stepping,
 };
 use vibroimpact_core::kernel::reductions::ReduceOptions;
-use vibroimpact_core::methods::registry::AnyStepper;
+use vibroimpact_core::methods::registry::{
+    check_settings, AnyStepper, Options, DEFAULT_MAX_ROWS, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE,
+    FORCING_PERIOD, RECORD_FROM, STROBE_PERIOD, SYSTEM, TOLERANCE, T_END,
+};
 use vibroimpact_core::model::assembly::{initial_state, resumed_state, Assembly};
 
 use crate::convert::system::system_spec;
-use crate::errors::{released, short_numbers, to_py, InvalidInputError};
+use crate::errors::{released, to_py, InvalidInputError};
 
 /// The numbers a run takes beside its system and method.
 #[derive(Debug, Clone, Copy)]
@@ -31,6 +34,36 @@ struct Limits {
     stepping: Stepping,
 }
 
+impl Limits {
+    /// The limits as given, each left out (None) taking the core registry's
+    /// default for a system, checked with the method's `options` against the
+    /// registry's ranges.
+    fn new(
+        method: &str,
+        t_end: f64,
+        dt: Option<f64>,
+        options: &Options,
+        (max_steps, max_rows, energy_tolerance): (Option<u64>, Option<u64>, Option<f64>),
+        (stepping, contact_timing): (Option<&str>, Option<&str>),
+    ) -> PyResult<Self> {
+        let energy_tolerance = energy_tolerance.unwrap_or(ENERGY_TOLERANCE.default_value());
+        check_method(t_end, dt, options, energy_tolerance)?;
+        Ok(Self {
+            dt,
+            max_steps: max_steps.unwrap_or(DEFAULT_MAX_STEPS),
+            max_rows: max_rows.unwrap_or(DEFAULT_MAX_ROWS),
+            energy_tolerance,
+            stepping: stepping_of(
+                match stepping {
+                    Some(stepping) => stepping,
+                    None => SYSTEM.stepping(method).map_err(to_py)?,
+                },
+                contact_timing.unwrap_or(SYSTEM.contact_timing),
+            )?,
+        })
+    }
+}
+
 /// A checked system with its method, ready to run from any state.
 struct Ready {
     system: Assembly,
@@ -39,22 +72,16 @@ struct Ready {
 }
 
 impl Ready {
-    #[allow(clippy::too_many_arguments)]
     fn new(
         spec: &Bound<'_, PyDict>,
         method: &str,
         t_end: f64,
-        rtol: f64,
-        atol: f64,
-        beta: f64,
-        gamma: f64,
-        spectral_radius: f64,
+        options: &Options,
         limits: Limits,
     ) -> PyResult<Self> {
         let system_spec = system_spec(spec, t_end)?;
         let system = Assembly::new(&system_spec).map_err(to_py)?;
-        let stepper = AnyStepper::new(&system, method, rtol, atol, beta, gamma, spectral_radius)
-            .map_err(to_py)?;
+        let stepper = AnyStepper::new(&system, method, options).map_err(to_py)?;
         Ok(Self {
             system,
             stepper,
@@ -155,53 +182,39 @@ impl PreparedSystem {
     /// its method; the settings as for `simulate_system` (`t_end`, s, sets the
     /// default duration of swept signals).
     #[new]
-    #[pyo3(signature = (spec, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, max_rows, energy_tolerance, stepping="events", contact_timing="located"))]
+    #[pyo3(signature = (spec, *, t_end, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, max_rows=None, energy_tolerance=None, stepping=None, contact_timing=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         spec: &Bound<'_, PyDict>,
-        method: &str,
         #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+        method: Option<&str>,
         #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
-        #[pyo3(from_py_with = crate::convert::arg::rtol)] rtol: f64,
-        #[pyo3(from_py_with = crate::convert::arg::atol)] atol: f64,
-        #[pyo3(from_py_with = crate::convert::arg::beta)] beta: f64,
-        #[pyo3(from_py_with = crate::convert::arg::gamma)] gamma: f64,
-        #[pyo3(from_py_with = crate::convert::arg::spectral_radius)] spectral_radius: f64,
-        max_steps: u64,
-        max_rows: u64,
-        #[pyo3(from_py_with = crate::convert::arg::energy_tolerance)] energy_tolerance: f64,
-        stepping: &str,
-        contact_timing: &str,
+        #[pyo3(from_py_with = crate::convert::optional::rtol)] rtol: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::optional::atol)] atol: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::optional::beta)] beta: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::optional::gamma)] gamma: Option<f64>,
+        #[pyo3(from_py_with = crate::convert::optional::spectral_radius)] spectral_radius: Option<
+            f64,
+        >,
+        #[pyo3(from_py_with = crate::convert::optional_max_steps)] max_steps: Option<u64>,
+        #[pyo3(from_py_with = crate::convert::max_rows_arg)] max_rows: Option<u64>,
+        #[pyo3(from_py_with = crate::convert::optional::energy_tolerance)] energy_tolerance: Option<
+            f64,
+        >,
+        stepping: Option<&str>,
+        contact_timing: Option<&str>,
     ) -> PyResult<Self> {
-        let stepping = stepping_of(stepping, contact_timing)?;
-        check_method(
-            t_end,
-            dt,
-            rtol,
-            atol,
-            beta,
-            gamma,
-            spectral_radius,
-            energy_tolerance,
-        )?;
-        let limits = Limits {
-            dt,
-            max_steps,
-            max_rows,
-            energy_tolerance,
-            stepping,
-        };
-        let ready = Ready::new(
-            spec,
+        let options = Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
+        let method = method.unwrap_or(SYSTEM.method);
+        let limits = Limits::new(
             method,
             t_end,
-            rtol,
-            atol,
-            beta,
-            gamma,
-            spectral_radius,
-            limits,
+            dt,
+            &options,
+            (max_steps, max_rows, energy_tolerance),
+            (stepping, contact_timing),
         )?;
+        let ready = Ready::new(spec, method, t_end, &options, limits)?;
         Ok(Self {
             ready: std::sync::Mutex::new(ready),
         })
@@ -231,13 +244,15 @@ impl PreparedSystem {
                 state.len()
             )));
         }
-        check("t_end", t_end, t_end > 0.0, "> 0 s")?;
-        if let Some(value) = record_from {
-            check("record_from", value, value >= 0.0, ">= 0 s or None")?;
-        }
-        if let Some(value) = strobe_period {
-            check("strobe_period", value, value > 0.0, "> 0 s or None")?;
-        }
+        T_END.check(t_end).map_err(to_py)?;
+        record_from
+            .map(|v| RECORD_FROM.check(v))
+            .transpose()
+            .map_err(to_py)?;
+        strobe_period
+            .map(|v| STROBE_PERIOD.check(v))
+            .transpose()
+            .map_err(to_py)?;
         let y0 = resumed_state(
             system,
             [&state[..n], &state[d..d + n], &state[n..d], &state[d + n..]],
@@ -265,15 +280,11 @@ impl PreparedSystem {
             f64,
         >,
     ) -> PyResult<Bound<'py, PyDict>> {
-        check("t_end", t_end, t_end > 0.0, "> 0 s")?;
-        check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
-        let forcing_period = forcing_period.unwrap_or(t_end);
-        check(
-            "forcing_period",
-            forcing_period,
-            forcing_period.is_finite() && forcing_period > 0.0,
-            "> 0 s",
-        )?;
+        T_END.check(t_end).map_err(to_py)?;
+        TOLERANCE.check(tolerance).map_err(to_py)?;
+        let forcing_period = FORCING_PERIOD
+            .check(forcing_period.unwrap_or(t_end))
+            .map_err(to_py)?;
         let mut ready = self.ready.lock().map_err(|_| {
             InvalidInputError::new_err("a run of this system failed; make it again")
         })?;
@@ -307,87 +318,57 @@ impl PreparedSystem {
 
 /// The settings a run takes, each finite and in its range: the core
 /// registry's check.
-#[allow(clippy::too_many_arguments)]
 fn check_method(
     t_end: f64,
     dt: Option<f64>,
-    rtol: f64,
-    atol: f64,
-    beta: f64,
-    gamma: f64,
-    spectral_radius: f64,
+    options: &Options,
     energy_tolerance: f64,
 ) -> PyResult<()> {
-    let options = core::methods::registry::Options {
-        rtol,
-        atol,
-        beta,
-        gamma,
-        spectral_radius,
-    };
-    core::methods::registry::check_settings(t_end, dt, options, energy_tolerance)
+    check_settings(t_end, dt, *options, energy_tolerance)
         .map(|_| ())
         .map_err(to_py)
-}
-
-/// `value` of `field`, unless it is not finite or not `ok` (then an error
-/// saying what is `allowed`).
-fn check(field: &str, value: f64, ok: bool, allowed: &str) -> PyResult<f64> {
-    if value.is_finite() && ok {
-        Ok(value)
-    } else {
-        Err(InvalidInputError::new_err(short_numbers(&format!(
-            "{field} must be finite and {allowed}, got {value}"
-        ))))
-    }
 }
 
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
 /// dict of flat arrays that the Python side shapes.
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, method, t_end, dt, rtol, atol, beta, gamma, spectral_radius, every, history, max_steps, max_rows, energy_tolerance, record_from=None, strobe_period=None, stepping="events", contact_timing="located"))]
+#[pyo3(signature = (spec, initial, *, t_end, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, every=1, history=true, max_steps=None, max_rows=None, energy_tolerance=None, record_from=None, strobe_period=None, stepping=None, contact_timing=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_system<'py>(
     py: Python<'py>,
     spec: &Bound<'py, PyDict>,
     initial: [Vec<f64>; 4],
-    method: &str,
-    t_end: f64,
-    dt: Option<f64>,
-    rtol: f64,
-    atol: f64,
-    beta: f64,
-    gamma: f64,
-    spectral_radius: f64,
-    every: u64,
-    history: bool,
-    max_steps: u64,
-    max_rows: u64,
-    energy_tolerance: f64,
+    #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+    method: Option<&str>,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::beta)] beta: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::gamma)] gamma: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::spectral_radius)] spectral_radius: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::every_arg)] every: u64,
+    #[pyo3(from_py_with = crate::convert::history_arg)] history: bool,
+    #[pyo3(from_py_with = crate::convert::optional_max_steps)] max_steps: Option<u64>,
+    #[pyo3(from_py_with = crate::convert::max_rows_arg)] max_rows: Option<u64>,
+    #[pyo3(from_py_with = crate::convert::optional::energy_tolerance)] energy_tolerance: Option<
+        f64,
+    >,
     #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
     #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
-    stepping: &str,
-    contact_timing: &str,
+    stepping: Option<&str>,
+    contact_timing: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let stepping = stepping_of(stepping, contact_timing)?;
-    let limits = Limits {
-        dt,
-        max_steps,
-        max_rows,
-        energy_tolerance,
-        stepping,
-    };
-    let mut ready = Ready::new(
-        spec,
+    let options = Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
+    let method = method.unwrap_or(SYSTEM.method);
+    let limits = Limits::new(
         method,
         t_end,
-        rtol,
-        atol,
-        beta,
-        gamma,
-        spectral_radius,
-        limits,
+        dt,
+        &options,
+        (max_steps, max_rows, energy_tolerance),
+        (stepping, contact_timing),
     )?;
+    let mut ready = Ready::new(spec, method, t_end, &options, limits)?;
     let y0 = initial_state(
         &ready.system,
         &initial[0],
@@ -528,7 +509,7 @@ pub fn linear_parts<'py>(
 /// `stepping = "fixed"` runs them as a lockstep ensemble of fixed RK4 steps
 /// (one mass, one compliant damper, unforced; see `core::analysis::ensemble`).
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, paths, values, method, dt, rtol, atol, beta, gamma, spectral_radius, max_steps, energy_tolerance, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, mean_square=true, stepping="events", orbit_periods=1))]
+#[pyo3(signature = (spec, initial, *, paths, values, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, energy_tolerance=None, mean_square=true, stepping=None, orbit_periods=1))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_study<'py>(
     py: Python<'py>,
@@ -536,15 +517,6 @@ pub fn run_study<'py>(
     initial: [Vec<f64>; 4],
     paths: Vec<String>,
     values: numpy::PyReadonlyArray1<'py, f64>,
-    method: String,
-    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
-    #[pyo3(from_py_with = crate::convert::arg::rtol)] rtol: f64,
-    #[pyo3(from_py_with = crate::convert::arg::atol)] atol: f64,
-    #[pyo3(from_py_with = crate::convert::arg::beta)] beta: f64,
-    #[pyo3(from_py_with = crate::convert::arg::gamma)] gamma: f64,
-    #[pyo3(from_py_with = crate::convert::arg::spectral_radius)] spectral_radius: f64,
-    max_steps: u64,
-    #[pyo3(from_py_with = crate::convert::arg::energy_tolerance)] energy_tolerance: f64,
     analysis: &str,
     #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
     #[pyo3(from_py_with = crate::convert::arg::record_from)] record_from: f64,
@@ -552,23 +524,32 @@ pub fn run_study<'py>(
     record_periods: u64,
     #[pyo3(from_py_with = crate::convert::arg::tolerance)] tolerance: f64,
     threads: usize,
+    method: Option<String>,
+    #[pyo3(from_py_with = crate::convert::optional::dt)] dt: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::rtol)] rtol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::atol)] atol: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::beta)] beta: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::gamma)] gamma: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::spectral_radius)] spectral_radius: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional_max_steps)] max_steps: Option<u64>,
+    #[pyo3(from_py_with = crate::convert::optional::energy_tolerance)] energy_tolerance: Option<
+        f64,
+    >,
     mean_square: bool,
-    stepping: &str,
+    stepping: Option<&str>,
     orbit_periods: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use core::analysis::study::{run_study as study, Analysis, Parameter, StudySettings};
-    check_method(
-        t_end,
-        dt,
-        rtol,
-        atol,
-        beta,
-        gamma,
-        spectral_radius,
-        energy_tolerance,
-    )?;
-    check("record_from", record_from, record_from >= 0.0, ">= 0 s")?;
-    check("tolerance", tolerance, tolerance > 0.0, "> 0")?;
+    let options = Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
+    let method = method.unwrap_or_else(|| SYSTEM.method.to_string());
+    let energy_tolerance = energy_tolerance.unwrap_or(ENERGY_TOLERANCE.default_value());
+    check_method(t_end, dt, &options, energy_tolerance)?;
+    let stepping = match stepping {
+        Some(stepping) => stepping,
+        None => SYSTEM.stepping(&method).map_err(to_py)?,
+    };
+    RECORD_FROM.check(record_from).map_err(to_py)?;
+    TOLERANCE.check(tolerance).map_err(to_py)?;
     let system_spec = system_spec(spec, t_end)?;
     // The base system and start must be valid on their own.
     let base = Assembly::new(&system_spec).map_err(to_py)?;
@@ -606,12 +587,8 @@ pub fn run_study<'py>(
     let settings = StudySettings {
         method,
         dt,
-        rtol,
-        atol,
-        beta,
-        gamma,
-        spectral_radius,
-        max_steps,
+        options,
+        max_steps: max_steps.unwrap_or(DEFAULT_MAX_STEPS),
         energy_tolerance,
         analysis,
         mean_square,

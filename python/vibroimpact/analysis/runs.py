@@ -17,7 +17,6 @@ from vibroimpact._core import (
     PreparedSystem,
     SimulationError,
 )
-from vibroimpact.analysis.forcing_limits import check_forcing_period
 from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
 from vibroimpact.messages import shown
@@ -231,7 +230,7 @@ def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Ru
     data, base_dir = sections_of(data, base_dir)
     base_dir = arguments.directory("base_dir", base_dir)
     prepared, period = _prepare(data, base_dir), forcing_period(data)
-    check_forcing_period(data, period, prepared.solver["max_steps"], base_dir)
+    prepared.check_forcing_period(period)
     return Runner(prepared, period)
 
 

@@ -18,6 +18,7 @@ from vibroimpact.scenario.two_mass import (
     read_toml,
     two_mass_scenario,
 )
+from vibroimpact.system import default_stepping
 
 
 def load(source: str | os.PathLike[str]) -> System:
@@ -81,12 +82,12 @@ def _two_mass(scenario: Scenario, data: dict[str, object]) -> System:
     """The System a checked 0.1 scenario describes (see :func:`load`)."""
     main, contact, start = scenario.system, scenario.contact, scenario.initial
     solver_table = dict(data.get("solver", {}))  # type: ignore[call-overload]
-    stepping = scenario.stepping or ("fixed" if scenario.method in ("newmark", "rk4") else "events")
-    # 0.1's defaults are "newmark" and, for newmark and rk4, "fixed" stepping; 0.2's are
-    # "rk4" and "events": written out, so that the general kernel runs the file's method
-    # as the 0.1 file asks.
+    stepping = scenario.stepping or default_stepping("two-mass", scenario.method)
+    # The two kinds' defaults differ (the core registry's RUN_DEFAULTS: the paper's
+    # "newmark", with "newmark" and "rk4" in fixed steps, against "rk4" by events):
+    # written out, so that the general kernel runs the file's method as the 0.1 file asks.
     solver_table["method"] = scenario.method
-    if stepping == "events":  # 0.2's default
+    if stepping == default_stepping("system", scenario.method):
         solver_table.pop("stepping", None)
         solver_table.pop("contact_timing", None)  # fixed stepping's only
     else:

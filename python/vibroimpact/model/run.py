@@ -8,7 +8,6 @@ from collections.abc import Callable
 from typing import Any, overload
 
 from vibroimpact._core import (
-    METHOD_OPTIONS,
     Contact,
     ImpactDamper,
     InitialState,
@@ -26,8 +25,8 @@ from vibroimpact.system import SystemSolution, prepare_system
 # Keywords of a System's run only (refused by name for the two-mass run).
 _SYSTEM_ONLY = frozenset(("record_from", "strobe_period", "points", "moments"))
 TEXTS: dict[str, type | tuple[type, ...]] = {
-    "method": str,
-    "contact_timing": str,
+    "method": (str, type(None)),
+    "contact_timing": (str, type(None)),
     "stepping": (str, type(None)),
 }
 two_mass: Callable[..., Solution] = typed(
@@ -100,8 +99,9 @@ def _simulate(
     on the general kernel with its ``solver`` and ``output`` settings (read from its
     scenario file by :func:`vibroimpact.load`), each replaced by the keyword of that
     name given: ``method`` (``"rk4"``, ``"dopri5"``, ``"dop853"``, ``"newmark"``,
-    ``"newmark-implicit"``, ``"generalized-alpha"``, ``"exact"``; default ``"rk4"``),
-    ``stepping`` (``"events"``, default, or ``"fixed"``), ``contact_timing``
+    ``"newmark-implicit"``, ``"generalized-alpha"``, ``"exact"``; default ``"rk4"``, the
+    core registry's ``vibroimpact.RUN_DEFAULTS["system"]``), ``stepping`` (``"events"``,
+    default, or ``"fixed"``), ``contact_timing``
     (``"located"`` or ``"step-count"``, fixed stepping's), ``t_end``, ``dt`` (s),
     ``rtol``, ``atol`` (m, m/s), ``beta``, ``gamma``,
     ``spectral_radius``, ``max_steps``, ``max_rows``, ``energy_tolerance``, ``every``,
@@ -111,9 +111,10 @@ def _simulate(
 
     ``simulate(ImpactDamper, Contact, InitialState, t_end=..., method="newmark", ...)``
     runs the two-mass impact damper (not ``record_from``, ``strobe_period``, ``points``,
-    ``moments``) and returns a :class:`vibroimpact.Solution` (its defaults:
-    ``method="newmark"``, ``dt`` required by the fixed-step methods, the rest as for a
-    System).
+    ``moments``) and returns a :class:`vibroimpact.Solution` (its defaults, the core
+    registry's for the two-mass damper, ``vibroimpact.RUN_DEFAULTS["two-mass"]``:
+    ``method="newmark"`` in fixed steps, ``dt`` required by the fixed-step methods, the
+    rest as for a System).
     """
     given = {key: value for key, value in locals().items() if value is not _UNSET}
     del given["system"]
@@ -166,16 +167,16 @@ def simulate(  # the two-mass run's own signature (_core.pyi)
     *,
     t_end: float,
     dt: float | None = None,
-    method: str = "newmark",
+    method: str | None = None,
     every: int = 1,
-    contact_timing: str = "located",
+    contact_timing: str | None = None,
     stepping: str | None = None,
-    beta: float = METHOD_OPTIONS["beta"]["default"],
-    gamma: float = METHOD_OPTIONS["gamma"]["default"],
-    spectral_radius: float = METHOD_OPTIONS["spectral_radius"]["default"],
-    rtol: float = METHOD_OPTIONS["rtol"]["default"],
-    atol: float = METHOD_OPTIONS["atol"]["default"],
-    max_steps: int = METHOD_OPTIONS["max_steps"]["default"],
+    beta: float | None = None,
+    gamma: float | None = None,
+    spectral_radius: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
     max_rows: int | None = None,
     energy_tolerance: float | None = None,
     history: bool = True,

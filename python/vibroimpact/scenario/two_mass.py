@@ -20,6 +20,7 @@ from typing import Any
 from vibroimpact import arguments
 from vibroimpact._core import (
     METHOD_OPTIONS,
+    RUN_DEFAULTS,
     Contact,
     ImpactDamper,
     InitialState,
@@ -55,8 +56,11 @@ _SHORT.maxstring, _SHORT.maxlong, _SHORT.maxother = 40, 24, 40
 _DEFAULTS: dict[str, Any] = {
     name: parameter.default for name, parameter in inspect.signature(simulate).parameters.items()
 }
-# The method options' defaults are the core registry's (the one place they are written).
+# The method options' defaults, and the two-mass damper's method and contact timing,
+# are the core registry's (the one place they are written; the stepping, left None, is
+# the method's own there too).
 _DEFAULTS.update({name: option["default"] for name, option in METHOD_OPTIONS.items()})
+_DEFAULTS.update({key: RUN_DEFAULTS["two-mass"][key] for key in ("method", "contact_timing")})
 
 # section -> key -> (type, default; a default of _REQUIRED means the key must be given)
 _REQUIRED = object()
@@ -115,7 +119,7 @@ class Scenario:
     system: ImpactDamper
     contact: Contact
     initial: InitialState
-    method: str = "newmark"
+    method: str = _DEFAULTS["method"]
     dt: float | None = 1e-4
     t_end: float = 0.3
     stepping: str | None = None
@@ -125,7 +129,7 @@ class Scenario:
     rtol: float = _DEFAULTS["rtol"]
     atol: float = _DEFAULTS["atol"]
     max_steps: int = _DEFAULTS["max_steps"]
-    contact_timing: str = "located"
+    contact_timing: str = _DEFAULTS["contact_timing"]
     every: int = 1
     energy_tolerance: float | None = _DEFAULTS["energy_tolerance"]
     history: bool = _DEFAULTS["history"]
@@ -157,7 +161,7 @@ class Scenario:
 
 
 def paper_collision(
-    restitution: float | None = None, method: str = "newmark", dt: float = 1e-4
+    restitution: float | None = None, method: str = _DEFAULTS["method"], dt: float = 1e-4
 ) -> Scenario:
     """The founding paper's Table 1 system at the onset of a 0.1 m/s collision.
 

@@ -14,7 +14,6 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError, __version__, run_study
-from vibroimpact.analysis.forcing_limits import check_forcing_period
 from vibroimpact.analysis.limits import whole_count
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
 from vibroimpact.analysis.runs import _prepare
@@ -106,7 +105,8 @@ class Study:
             tolerance=s["tolerance"],
             threads=threads,
             mean_square="rms" in base_metrics(s["metrics"]),
-            stepping=s.get("stepping", "events"),
+            # None: the core registry's default stepping.
+            stepping=s.get("stepping"),
             orbit_periods=s.get("orbit_periods", 1),
         )
         return raw
@@ -187,7 +187,7 @@ def check_axis_frequencies(
         changed = with_parameter(data, str(path), lowest)
         try:
             period = forcing_period(changed)
-            check_forcing_period(changed, period, _prepare(changed, base_dir).solver["max_steps"])
+            _prepare(changed, base_dir).check_forcing_period(period)
         except InvalidInputError as err:
             if not str(err).startswith("forcing frequency"):
                 continue  # the study's own check of the axis says what else is wrong

@@ -22,7 +22,14 @@ from vibroimpact.study.axes import (
     _is_seed,
 )
 from vibroimpact.study.limits import MAX_STUDY_RUNS, StudyError
-from vibroimpact.system import _NUMBER, _TEXT, _WHOLE, _choice, _table
+from vibroimpact.system import (
+    _NUMBER,
+    _TEXT,
+    _WHOLE,
+    SYSTEM_SOLVER_DEFAULTS,
+    _choice,
+    _table,
+)
 
 # What each analysis keeps; every metric.
 _RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated")
@@ -45,7 +52,9 @@ _STUDY = {
     "chunk_size": (_WHOLE, 1024),
     "samples": (_WHOLE, 0),
     "seed": (_WHOLE, 0),
-    "stepping": (_TEXT, "events"),
+    # A study's runs step as any system's do unless [study] stepping = "fixed" (the core
+    # registry's default, RUN_DEFAULTS["system"]).
+    "stepping": (_TEXT, SYSTEM_SOLVER_DEFAULTS["stepping"]),
 }
 _STEPPINGS = ("events", "fixed")
 # What a lockstep ensemble of fixed steps keeps.

@@ -11,13 +11,13 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import (
-    MAX_ENERGY_TOLERANCE,
     MAX_POINTS,
     METHOD_OPTIONS,
     InvalidInputError,
 )
-from vibroimpact._core import _check_options as check_options
+from vibroimpact._core import _check_forcing_period as check_forcing_period
 from vibroimpact._core import _check_run as check_run
+from vibroimpact._core import _check_settings as check_settings
 from vibroimpact._core import simulate_system as _simulate_system
 from vibroimpact.arguments import directory
 from vibroimpact.messages import short_numbers, shown
@@ -172,6 +172,23 @@ class PreparedRun:
             )
         }
 
+    def check_forcing_period(self, period: float) -> None:
+        """Refuse an analysis's forcing ``period`` (s) no run of these settings can step
+        through (the core registry's ``check_forcing_period``: more than ``max_steps``
+        steps of a fixed ``dt``; for an adaptive or exact method more than ``max_steps``
+        periods of the fastest mode, a forcing moving the structure less than ``atol`` a
+        period, or a free body's times' round-off beyond what ``atol`` resolves), naming
+        the frequency and the range a run can take."""
+        solver = self.solver
+        try:
+            check_forcing_period(
+                self.binding_spec(),
+                forcing_period=period,
+                **{key: solver[key] for key in ("method", "dt", "atol", "max_steps")},
+            )
+        except InvalidInputError as err:
+            raise InvalidInputError(short_numbers(str(err))) from None
+
     def run(self) -> SystemSolution:
         """Integrate it."""
         init, solver, output = self.initial, self.solver, self.output
@@ -231,26 +248,11 @@ def prepare_system(
             f'"fixed" takes a fixed-step method ({", ".join(_FIXED_STEP)}), '
             f"not {solver['method']!r}",
         )
-    for key in ("t_end", "energy_tolerance"):
-        if not solver[key] > 0:
-            raise _fail(f"[solver] {key}: ", f"must be > 0, got {solver[key]}")
-    if not solver["energy_tolerance"] <= MAX_ENERGY_TOLERANCE:
-        # The core's bound: beyond it the residual may exceed all the energy in play.
-        raise _fail(
-            "[solver] energy_tolerance: ",
-            f"must be in (0, {MAX_ENERGY_TOLERANCE:g}], got {solver['energy_tolerance']}",
-        )
-    _check_method_options(solver)
-    if solver["dt"] is not None and not solver["dt"] > 0:
-        raise _fail("[solver] dt: ", f"must be > 0, got {solver['dt']}")
-    for section, key in (("output", "every"), ("solver", "max_steps"), ("solver", "max_rows")):
-        value = (output if section == "output" else solver)[key]
-        if value < 1:
-            raise _fail(f"[{section}] {key}: ", f"must be >= 1, got {value}")
-    if output["strobe_period"] is not None and not output["strobe_period"] > 0:
-        raise _fail("[output] strobe_period: ", f"must be > 0 s, got {output['strobe_period']}")
-    # The up-front limits (steps, the fastest mode and forcing against the step, rows,
-    # memory) are the core's (its registry's check_run), with their messages.
+    _check_settings(solver)
+    # every, max_steps and max_rows are whole numbers >= 1 (the schema's WHOLE_RANGES).
+    # The up-front limits (strobe_period > 0, steps, the fastest mode and forcing against
+    # the step, rows, memory) are the core's (its registry's check_run), with their
+    # messages.
     try:
         check_run(
             spec,
@@ -358,15 +360,26 @@ def _solution(
     )
 
 
-def _check_method_options(solver: Mapping[str, Any]) -> None:
-    """The method options in the core registry's ranges (every one, whatever the
-    method: the core checks them), its message naming ``[solver] key``."""
+def _check_settings(solver: Mapping[str, Any]) -> None:
+    """``t_end``, ``dt``, the method options (every one, whatever the method: the core
+    checks them) and ``energy_tolerance`` in the core registry's ranges (its
+    ``check_settings``, the one place they are checked), the message naming
+    ``[solver] key`` and the value as given."""
     try:
-        check_options(**{key: solver[key] for key in METHOD_OPTIONS if key != "max_steps"})
+        check_settings(**{key: solver[key] for key in _CHECKED})
     except InvalidInputError as err:
-        # The core names the option; the value is written as given.
-        key = str(err).partition(" must be ")[0]
-        if key not in METHOD_OPTIONS:
+        # The core writes "key must be <allowed>, got <value>".
+        key, _, rest = str(err).partition(" must be ")
+        if key not in _CHECKED:
             raise _fail("[solver] ", short_numbers(str(err))) from None
-        allowed = METHOD_OPTIONS[key]["allowed"]
+        allowed = rest.rpartition(", got ")[0]
         raise _fail(f"[solver] {key}: ", f"must be {allowed}, got {solver[key]}") from None
+
+
+# The settings the core registry's check_settings takes.
+_CHECKED = (
+    "t_end",
+    "dt",
+    *(key for key in METHOD_OPTIONS if key != "max_steps"),
+    "energy_tolerance",
+)

@@ -49,6 +49,7 @@ from vibroimpact._core import (
     MAX_SIGNAL_SAMPLES,
     METHOD_OPTIONS,
     METHODS,
+    RUN_DEFAULTS,
     Contact,
     InvalidInputError,
     cantilever_mode_shape,
@@ -130,10 +131,20 @@ _INITIAL = {
     "damper_displacement": (_NUMBERS, ()),
     "damper_velocity": (_NUMBERS, ()),
 }
-#: The solver settings of a 0.2 run and their defaults: the method options' and
-#: max_steps' are the core's registry's (``_core.METHOD_OPTIONS``).
+
+
+def default_stepping(kind: str, method: str) -> str:
+    """The stepping (``"fixed"`` or ``"events"``) a run of ``method`` on a model of
+    ``kind`` (``"two-mass"`` or ``"system"``) takes where none is given: the core
+    registry's (``_core.RUN_DEFAULTS``)."""
+    return "fixed" if method in RUN_DEFAULTS[kind]["fixed_by_default"] else "events"
+
+
+#: The solver settings of a 0.2 run and their defaults: the method, its stepping and
+#: contact timing, the method options' and max_steps' are the core's registry's
+#: (``_core.RUN_DEFAULTS["system"]``, ``_core.METHOD_OPTIONS``).
 SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
-    "method": "rk4",
+    "method": RUN_DEFAULTS["system"]["method"],
     "dt": None,
     "rtol": METHOD_OPTIONS["rtol"]["default"],
     "atol": METHOD_OPTIONS["atol"]["default"],
@@ -146,8 +157,8 @@ SYSTEM_SOLVER_DEFAULTS: dict[str, Any] = {
     "spectral_radius": METHOD_OPTIONS["spectral_radius"]["default"],
     # Steps cut at every event, or fixed steps of dt not cut at contacts (compliant
     # laws only), their onsets located inside the step or counted in whole steps.
-    "stepping": "events",
-    "contact_timing": "located",
+    "stepping": default_stepping("system", RUN_DEFAULTS["system"]["method"]),
+    "contact_timing": RUN_DEFAULTS["system"]["contact_timing"],
 }
 _SOLVER = {
     "method": (_TEXT, SYSTEM_SOLVER_DEFAULTS["method"]),

@@ -2,7 +2,7 @@
 //! stepping, the step and end time, what to keep, and the run's limits (steps,
 //! rows, energy balance), checked before it starts.
 
-use crate::error::{positive, within, Error, Result};
+use crate::error::{Error, Result};
 use crate::kernel::events::{self, RunOptions};
 use crate::legacy::steppers::Tolerances;
 use crate::methods::registry::{self, ATOL, RTOL};
@@ -44,16 +44,9 @@ pub const ENERGY_TOLERANCE_ALLOWED: &str = registry::ENERGY_TOLERANCE.allowed;
 /// alone.
 pub const CONTACT_CREATION_LIMIT: f64 = 1e-2;
 
-/// An `energy_tolerance` in (0, [`MAX_ENERGY_TOLERANCE`]].
+/// An `energy_tolerance` in (0, [`MAX_ENERGY_TOLERANCE`]]: the registry's check.
 pub fn checked_energy_tolerance(tolerance: f64) -> Result<f64> {
-    within(
-        "energy_tolerance",
-        tolerance,
-        0.0,
-        MAX_ENERGY_TOLERANCE,
-        true,
-        ENERGY_TOLERANCE_ALLOWED,
-    )
+    registry::ENERGY_TOLERANCE.check(tolerance)
 }
 
 /// How contact instants are reported.
@@ -82,34 +75,9 @@ impl ContactTiming {
     }
 }
 
-/// Options of the methods, by name; each method reads the ones it uses.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MethodOptions {
-    /// Newmark's beta, in [0, 0.5] (default 1/4).
-    pub beta: f64,
-    /// Newmark's gamma, in [0.5, 1] (default 1/2).
-    pub gamma: f64,
-    /// Generalised-alpha's spectral radius at infinite frequency, in [0, 1].
-    pub spectral_radius: f64,
-    /// Relative tolerance of the adaptive methods.
-    pub rtol: f64,
-    /// Absolute tolerance of the adaptive methods (m and m/s).
-    pub atol: f64,
-}
-
-impl Default for MethodOptions {
-    /// The core registry's defaults.
-    fn default() -> Self {
-        let d = registry::Options::default();
-        Self {
-            beta: d.beta,
-            gamma: d.gamma,
-            spectral_radius: d.spectral_radius,
-            rtol: d.rtol,
-            atol: d.atol,
-        }
-    }
-}
+/// Options of the methods, by name; each method reads the ones it uses:
+/// the registry's, with its defaults.
+pub type MethodOptions = registry::Options;
 
 /// The integration method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -143,14 +111,7 @@ impl Method {
             beta,
             gamma,
             spectral_radius,
-        } = registry::Options {
-            rtol: options.rtol,
-            atol: options.atol,
-            beta: options.beta,
-            gamma: options.gamma,
-            spectral_radius: options.spectral_radius,
-        }
-        .checked()?;
+        } = options.checked()?;
         let tolerances = Tolerances { rtol, atol };
         match name {
             "newmark" => Ok(Self::Newmark { beta, gamma }),
@@ -265,7 +226,8 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// `stepping` None takes the method's default: "fixed" for the paper's
+    /// `stepping` None takes the method's default, the registry's for the
+    /// two-mass damper ([`registry::TWO_MASS`]): "fixed" for the paper's
     /// "newmark" and "rk4", "events" for the others (which have no other).
     /// The history is kept, within [`DEFAULT_MAX_ROWS`], and the energy
     /// checked to [`DEFAULT_ENERGY_TOLERANCE`]; see [`Settings::with_limits`].
@@ -279,8 +241,9 @@ impl Settings {
         stepping: Option<Stepping>,
         max_steps: u64,
     ) -> Result<Self> {
-        let dt = dt.map(|dt| positive("dt", dt)).transpose()?;
-        let t_end = positive("t_end", t_end)?;
+        // The registry's ranges and messages, as every other path's.
+        let dt = dt.map(|dt| registry::DT.check(dt)).transpose()?;
+        let t_end = registry::T_END.check(t_end)?;
         if every == 0 {
             return Err(Error::InvalidParameter {
                 field: "every",
@@ -301,12 +264,10 @@ impl Settings {
                 method.name()
             )));
         }
-        let default = if method.has_fixed_stepping() {
-            Stepping::Fixed
-        } else {
-            Stepping::Events
+        let stepping = match stepping {
+            Some(stepping) => stepping,
+            None => Stepping::parse(registry::TWO_MASS.stepping(method.name())?)?,
         };
-        let stepping = stepping.unwrap_or(default);
         if stepping == Stepping::Fixed && !method.has_fixed_stepping() {
             return Err(Error::Inconsistent(format!(
                 "stepping \"fixed\" is the founding paper's, for methods \"newmark\" and \"rk4\" only, not {:?}",

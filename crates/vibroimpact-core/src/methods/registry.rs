@@ -1,18 +1,24 @@
 //! The methods of a run by name, defined once: the table of methods (their
-//! kinds, steppings, options, defaults and ranges, [`table`]), the up-front
-//! limits of a run ([`limits`]), the stepper made once for a system, the
+//! kinds, steppings, options, defaults and ranges, [`table`]), each model
+//! kind's default method and stepping ([`defaults`]), the up-front
+//! limits of a run ([`limits`]) and of an analysis's forcing period
+//! ([`forcing`]), the stepper made once for a system, the
 //! fixed step it takes, and the run. Every front end (the binding's runs, a
 //! study's runs, Python's schemas through the binding) reads it, so that a
 //! method means the same in each.
 
+mod defaults;
+mod forcing;
 mod limits;
 mod table;
 
+pub use defaults::{ModelKind, RunDefaults, RUN_DEFAULTS, SYSTEM, TWO_MASS};
+pub use forcing::{check_forcing_period, ForcingPlan};
 pub use limits::{check_run, check_scales, RunPlan, RunScales};
 pub use table::{
     check_settings, method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_ROWS,
-    DEFAULT_MAX_STEPS, DT, ENERGY_TOLERANCE, GAMMA, MAX_STEPS, METHOD_OPTIONS, METHOD_SPECS, RTOL,
-    SPECTRAL_RADIUS, T_END,
+    DEFAULT_MAX_STEPS, DT, ENERGY_TOLERANCE, FORCING_PERIOD, GAMMA, MAX_STEPS, METHOD_OPTIONS,
+    METHOD_SPECS, RECORD_FROM, RTOL, SPECTRAL_RADIUS, STROBE_PERIOD, TOLERANCE, T_END,
 };
 
 use crate::error::{Error, Result};
@@ -48,20 +54,12 @@ pub const METHODS: [&str; 7] = {
 };
 
 impl AnyStepper {
-    /// The method named `method` for `system`, with its settings; every
-    /// setting checked against the registry's range whatever the method (a
+    /// The method named `method` for `system`, with its `options` (the
+    /// registry's defaults where not given: `Options::default()`); every
+    /// option checked against the registry's range whatever the method (a
     /// wrong value is never silently ignored), an unknown name refused with
     /// the registry's names.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        system: &Assembly,
-        method: &str,
-        rtol: f64,
-        atol: f64,
-        beta: f64,
-        gamma: f64,
-        spectral_radius: f64,
-    ) -> Result<Self> {
+    pub fn new(system: &Assembly, method: &str, options: &Options) -> Result<Self> {
         let spec = table::method(method)?;
         let Options {
             rtol,
@@ -69,14 +67,7 @@ impl AnyStepper {
             beta,
             gamma,
             spectral_radius,
-        } = Options {
-            rtol,
-            atol,
-            beta,
-            gamma,
-            spectral_radius,
-        }
-        .checked()?;
+        } = options.checked()?;
         let len = system.state_len();
         Ok(match spec.name {
             "rk4" => Self::Rk(ExplicitRk::rk4(len)),

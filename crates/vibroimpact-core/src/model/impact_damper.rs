@@ -181,7 +181,7 @@ impl State {
 mod tests {
     use super::*;
     use crate::kernel::events::{ContactTiming, RunOptions, Stepping, SystemSolution};
-    use crate::methods::registry::AnyStepper;
+    use crate::methods::registry::{AnyStepper, Options};
     use crate::model::closed_forms::linear_contact_duration;
     use crate::model::contact::LawKind;
 
@@ -205,7 +205,16 @@ mod tests {
         dt: Option<f64>,
         t_end: f64,
     ) -> SystemSolution {
-        let mut stepper = AnyStepper::new(system, method, 1e-12, 1e-15, 0.25, 0.5, 0.9).unwrap();
+        let mut stepper = AnyStepper::new(
+            system,
+            method,
+            &Options {
+                rtol: 1e-12,
+                atol: 1e-15,
+                ..Options::default()
+            },
+        )
+        .unwrap();
         stepper
             .integrate_stepped(system, y0, &options(dt, t_end), stepping, &mut || false)
             .unwrap()

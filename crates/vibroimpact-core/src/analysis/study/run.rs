@@ -272,13 +272,5 @@ pub(super) fn run_options(
 
 /// The study's method for `system`.
 pub(super) fn stepper_of(system: &Assembly, settings: &StudySettings) -> Result<AnyStepper> {
-    AnyStepper::new(
-        system,
-        &settings.method,
-        settings.rtol,
-        settings.atol,
-        settings.beta,
-        settings.gamma,
-        settings.spectral_radius,
-    )
+    AnyStepper::new(system, &settings.method, &settings.options)
 }

@@ -1,15 +1,14 @@
 //! Study settings: the method and limits of each run, and the analysis it makes.
 
+use crate::methods::registry::Options;
+
 /// How each run of a study is made and what it keeps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StudySettings {
     pub method: String,
     pub dt: Option<f64>,
-    pub rtol: f64,
-    pub atol: f64,
-    pub beta: f64,
-    pub gamma: f64,
-    pub spectral_radius: f64,
+    /// The method's options (checked when its stepper is made).
+    pub options: Options,
     pub max_steps: u64,
     pub energy_tolerance: f64,
     /// `"run"` (to `t_end`) or `"steady-state"` (whole forcing periods).

@@ -419,12 +419,20 @@ fn the_lagged_contact_force_creates_energy_as_0_1_did() {
 #[test]
 fn the_registry_makes_it_as_newmark_with_checked_options() {
     crate::testing::timeout(30, || {
-        use crate::methods::registry::{AnyStepper, METHODS};
+        use crate::methods::registry::{AnyStepper, Options, METHODS};
         use crate::model::assembly::{Damper, PairLaw};
         let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
         let system = table_1(0.005).assembly(&contact).unwrap();
         let make = |method: &str, beta: f64, gamma: f64| {
-            AnyStepper::new(&system, method, 1e-8, 1e-12, beta, gamma, 0.9)
+            AnyStepper::new(
+                &system,
+                method,
+                &Options {
+                    beta,
+                    gamma,
+                    ..Options::default()
+                },
+            )
         };
         let message = |method: &str, beta: f64, gamma: f64| match make(method, beta, gamma) {
             Ok(_) => panic!("{method} with beta {beta}, gamma {gamma} accepted"),
@@ -488,7 +496,7 @@ fn the_kernel_runs_it_at_the_paper_s_first_order_duration_error() {
         // for the lag's error, about 0.05 % at dt = 1e-4 s and 0.01 % at
         // 2e-5 s: first order.
         use crate::kernel::events::RunOptions;
-        use crate::methods::registry::AnyStepper;
+        use crate::methods::registry::{AnyStepper, Options};
         for (law, restitution, exact) in [
             (LawKind::Hertz, None, 0.1089819),
             (LawKind::HysterHertz, Some(0.9), 0.1100637),
@@ -511,8 +519,7 @@ fn the_kernel_runs_it_at_the_paper_s_first_order_duration_error() {
                     energy_tolerance: 0.05,
                     reduce: Default::default(),
                 };
-                let mut stepper =
-                    AnyStepper::new(&system, "newmark", 1e-8, 1e-12, 0.25, 0.5, 0.9).unwrap();
+                let mut stepper = AnyStepper::new(&system, "newmark", &Options::default()).unwrap();
                 let sol = stepper
                     .integrate(&system, &y0, &options, &mut || false)
                     .unwrap();

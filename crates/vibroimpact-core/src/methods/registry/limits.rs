@@ -5,8 +5,8 @@
 //! the step). Each refusal is one line naming the field (as a scenario's
 //! `[solver]`, `[output]` or `[[excitation]]` key) and what is allowed.
 
-use super::table::{method, Kind, MethodSpec, DT};
-use crate::error::{positive, Error, Result};
+use super::table::{method, Kind, MethodSpec, DT, T_END};
+use crate::error::{Error, Result};
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::model::assembly::SystemSpec;
 use crate::model::structure::Structure;
@@ -79,9 +79,12 @@ pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
     if let Some(dt) = plan.dt {
         DT.check(dt)?;
     }
-    positive("t_end", plan.t_end)?;
-    if let Some(period) = plan.strobe_period {
-        positive("strobe_period", period)?;
+    T_END.check(plan.t_end)?;
+    if let Some(period) = plan.strobe_period.filter(|p| !(p.is_finite() && *p > 0.0)) {
+        return Err(Error::Inconsistent(format!(
+            "[output] strobe_period: must be finite and > 0 s, got {}",
+            python_repr(period)
+        )));
     }
     let fixed = spec.kind.is_fixed_step();
     if fixed && plan.dt.is_none() {
@@ -178,7 +181,7 @@ fn frequency_bound(structure: &Structure) -> f64 {
 }
 
 /// The structure's highest natural frequency (Hz; 0 for none).
-fn highest_frequency(structure: &Structure) -> f64 {
+pub(super) fn highest_frequency(structure: &Structure) -> f64 {
     let top = structure
         .natural_frequencies()
         .into_iter()
@@ -314,13 +317,20 @@ pub(crate) fn python_e3(x: f64) -> String {
 /// `x` as Python's `format(x, ".3g")` writes it: three significant digits,
 /// fixed between 1e-4 and 1e3, trailing zeros dropped.
 pub(crate) fn python_g3(x: f64) -> String {
+    python_g(x, 3)
+}
+
+/// `x` as Python's `format(x, ".{digits}g")` writes it: `digits` significant
+/// digits, fixed between 1e-4 and 10^digits, trailing zeros dropped.
+pub(crate) fn python_g(x: f64, digits: usize) -> String {
     if !x.is_finite() {
         return python_repr(x);
     }
     if x == 0.0 {
         return "0".into();
     }
-    let scientific = format!("{x:.2e}");
+    let decimals = digits.max(1) - 1;
+    let scientific = format!("{x:.decimals$e}");
     let (mantissa, exponent) = scientific.split_once('e').expect("an exponent");
     let exponent: i32 = exponent.parse().expect("an integer exponent");
     let trim = |s: &str| -> String {
@@ -330,8 +340,8 @@ pub(crate) fn python_g3(x: f64) -> String {
             s.to_string()
         }
     };
-    if (-4..3).contains(&exponent) {
-        let decimals = (2 - exponent) as usize;
+    if (-4..digits as i32).contains(&exponent) {
+        let decimals = (decimals as i32 - exponent) as usize;
         trim(&format!("{x:.decimals$}"))
     } else {
         let sign = if exponent < 0 { '-' } else { '+' };
@@ -435,6 +445,17 @@ mod tests {
                 (f64::INFINITY, "inf"),
             ] {
                 assert_eq!(python_g3(x), g3, "{x}");
+            }
+            // format(x, ".6g").
+            for (x, g6) in [
+                (1e8, "1e+08"),
+                (0.1, "0.1"),
+                (123456.7, "123457"),
+                (1234567.0, "1.23457e+06"),
+                (3.33333333e-9, "3.33333e-09"),
+                (0.000123456789, "0.000123457"),
+            ] {
+                assert_eq!(python_g(x, 6), g6, "{x}");
             }
         });
     }

@@ -175,6 +175,43 @@ pub const ENERGY_TOLERANCE: OptionSpec = OptionSpec {
     low_open: true,
     allowed: "in (0, 1]",
 };
+/// When a run's peaks and RMS start being recorded (s from the start).
+pub const RECORD_FROM: OptionSpec = OptionSpec {
+    name: "record_from",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: false,
+    allowed: "finite and >= 0 s",
+};
+/// The period of a run's stroboscopic record (s).
+pub const STROBE_PERIOD: OptionSpec = OptionSpec {
+    name: "strobe_period",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0 s",
+};
+/// The forcing period an analysis samples or shoots over (s).
+pub const FORCING_PERIOD: OptionSpec = OptionSpec {
+    name: "forcing_period",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0 s",
+};
+/// An analysis's relative tolerance (a steady state's repeat, an orbit's
+/// residual).
+pub const TOLERANCE: OptionSpec = OptionSpec {
+    name: "tolerance",
+    default: None,
+    low: 0.0,
+    high: f64::MAX,
+    low_open: true,
+    allowed: "finite and > 0",
+};
 /// The default of `max_rows`, the history rows plus contacts a run may keep:
 /// 20 million (under 1 GB of two-mass history), room for any run a
 /// workstation can plot, yet a run growing without bound stops within seconds.
@@ -308,9 +345,27 @@ pub fn check_settings(
 }
 
 impl Options {
+    /// The options given, each left out (None) taking the registry's default.
+    pub fn or_defaults(
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        beta: Option<f64>,
+        gamma: Option<f64>,
+        spectral_radius: Option<f64>,
+    ) -> Self {
+        let d = Self::default();
+        Self {
+            rtol: rtol.unwrap_or(d.rtol),
+            atol: atol.unwrap_or(d.atol),
+            beta: beta.unwrap_or(d.beta),
+            gamma: gamma.unwrap_or(d.gamma),
+            spectral_radius: spectral_radius.unwrap_or(d.spectral_radius),
+        }
+    }
+
     /// Every option checked against its range, in [`METHOD_OPTIONS`]'s order
     /// (whatever the method), or the first outside named.
-    pub fn checked(self) -> Result<Self> {
+    pub fn checked(&self) -> Result<Self> {
         Ok(Self {
             rtol: RTOL.check(self.rtol)?,
             atol: ATOL.check(self.atol)?,

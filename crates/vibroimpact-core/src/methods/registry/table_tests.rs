@@ -135,3 +135,22 @@ fn a_run_s_settings_are_checked_with_its_options() {
         }
     });
 }
+
+#[test]
+fn an_analysis_s_times_and_tolerance_are_checked_with_their_texts() {
+    crate::testing::timeout(10, || {
+        // record_from may be 0 (the start); the periods and the tolerance may not.
+        assert_eq!(RECORD_FROM.check(0.0), Ok(0.0));
+        for spec in [STROBE_PERIOD, FORCING_PERIOD, TOLERANCE, T_END] {
+            assert!(spec.check(0.0).is_err(), "{}", spec.name);
+            assert_eq!(spec.check(1e-300), Ok(1e-300));
+        }
+        for spec in [RECORD_FROM, STROBE_PERIOD, FORCING_PERIOD, TOLERANCE] {
+            for value in [-1.0, f64::NAN, f64::INFINITY] {
+                let text = spec.check(value).unwrap_err().to_string();
+                let expected = format!("{} must be finite and ", spec.name);
+                assert!(text.starts_with(&expected), "{text}");
+            }
+        }
+    });
+}
