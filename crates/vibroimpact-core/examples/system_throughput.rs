@@ -3,7 +3,10 @@
 //! rigid as in `examples/beam_two_dampers.toml`; and of its peer without
 //! contact, the clearances 1 m, every event test still made), the time per run of a ball dropped 1 m
 //! (e = 0.8, to 6 s), and of a harmonically forced damper with rigid impacts
-//! over 1000 forcing periods. Medians of repeated runs.
+//! over 1000 forcing periods. Medians of repeated runs. First issue 24's
+//! acceptance case: both hertz-damped dampers rattling over 50 s against the
+//! peer without contact, timed alternately, and the ratio of their rates.
+//! `system_throughput contacts` (or `peer`) runs that case once (for perf).
 //!
 //!     cargo run --release -p vibroimpact-core --example system_throughput
 
@@ -94,6 +97,41 @@ fn main() {
         law: PairLaw::rigid(0.5).unwrap(),
         ..file.dampers[1].clone()
     };
+    // One run of a case, for perf: "contacts" (both hertz-damped) or "peer",
+    // over the acceptance case's 50 s.
+    if let Some(case) = std::env::args().nth(1) {
+        let spec = if case == "peer" { &peer } else { &beam };
+        let (t, sol) = time_runs(1, spec, &ExplicitRk::rk4, &options(Some(1e-5), 50.0));
+        println!(
+            "{case}: {} steps, {} contacts, {t:.3} s",
+            sol.steps,
+            sol.contacts.len()
+        );
+        return;
+    }
+    // Issue 24's acceptance case: steady rattling of both hertz-damped
+    // dampers over 50 s (thousands of contacts) at least 0.8x the steps per
+    // second of the peer without contact; the two timed alternately, the
+    // ratio of their medians.
+    let (mut rattling, mut free) = (Vec::new(), Vec::new());
+    let (mut with, mut without) = (None, None);
+    for _ in 0..5 {
+        let (t, sol) = time_runs(1, &beam, &ExplicitRk::rk4, &options(Some(1e-5), 50.0));
+        rattling.push(sol.steps as f64 / t);
+        with = Some(sol);
+        let (t, sol) = time_runs(1, &peer, &ExplicitRk::rk4, &options(Some(1e-5), 50.0));
+        free.push(sol.steps as f64 / t);
+        without = Some(sol);
+    }
+    let (with, without) = (with.unwrap(), without.unwrap());
+    let (rattling, free) = (median(rattling), median(free));
+    println!(
+        "acceptance: cantilever, 3 modes, 2 hertz-damped dampers rattling, rk4 with events, 50 s: {rattling:.3e} steps/s ({} steps, {} contacts); peer without contact {free:.3e} steps/s ({} steps): {:.3}x the peer (goal 0.8x)",
+        with.steps,
+        with.contacts.len(),
+        without.steps,
+        rattling / free
+    );
     for (name, spec) in [
         ("", &beam),
         (", the example file's laws (one damper rigid)", &file),

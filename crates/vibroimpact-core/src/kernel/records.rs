@@ -9,7 +9,7 @@ use crate::kernel::clock::{Stop, STALLED_STEPS};
 use crate::kernel::events::SystemSolution;
 use crate::kernel::fixed;
 use crate::kernel::memory::{self, NoRoom};
-use crate::kernel::run::Run;
+use crate::kernel::run::{poll_due, Run};
 use crate::methods::steppers::SystemStepper;
 
 /// The longest a large system goes without asking whether to stop, s.
@@ -200,7 +200,7 @@ impl Run<'_> {
         }
         // Large systems poll by the clock too: a step of hundreds of sticking
         // pairs (a constraint solve in each stage) takes a tenth of a second.
-        let due = accepted % self.poll_every == 0
+        let due = poll_due(accepted, self.poll_every)
             || (self.timed_polls && self.last_poll.elapsed().as_secs_f64() >= POLL_SECONDS);
         if due {
             self.last_poll = std::time::Instant::now();

@@ -36,6 +36,19 @@ fn interrupt_interval(dim: usize) -> u64 {
     (INTERRUPT_INTERVAL / (scale * scale) / ENERGY_INTERVAL).max(1) * ENERGY_INTERVAL
 }
 
+/// Whether the caller is asked whether to stop after `accepted` steps, every
+/// `poll_every` (a mask where that is a power of two, as for every system of
+/// up to [`TIMED_POLLS_BEYOND`] coordinates: a division each kernel step
+/// cost more than the rest of the checks).
+#[inline(always)]
+pub(super) fn poll_due(accepted: u64, poll_every: u64) -> bool {
+    if poll_every.is_power_of_two() {
+        accepted & (poll_every - 1) == 0
+    } else {
+        accepted % poll_every == 0
+    }
+}
+
 /// The contact-loss accumulator of interaction `i` in a state vector.
 #[inline(always)]
 pub(super) fn loss_slot(system: &Assembly, i: usize) -> usize {
@@ -660,11 +673,20 @@ impl<'a> Run<'a> {
     /// The step of `taken` s from the state now to `end` added to the
     /// reductions where it is in the recorded window; whether the stepper
     /// was used (its last attempt is then not the step).
+    #[inline(always)]
     pub(super) fn reduce<S: SystemStepper>(&mut self, stepper: &mut S, taken: f64) -> Result<bool> {
-        let time = self.clock.time;
-        if !self.schedule.in_window(time, taken) {
+        if !self.schedule.in_window(self.clock.time, taken) {
             return Ok(false);
         }
+        self.reduce_in_window(stepper, taken)
+    }
+
+    /// [`Self::reduce`] for a step in the recorded window: the window's test
+    /// is inlined in the step, the reductions (a loop over the observed
+    /// quantities, a peak's location) stay a call of their own.
+    #[inline(never)]
+    fn reduce_in_window<S: SystemStepper>(&mut self, stepper: &mut S, taken: f64) -> Result<bool> {
+        let time = self.clock.time;
         reduce_step(
             self.system,
             stepper,
@@ -728,7 +750,7 @@ impl<'a> Run<'a> {
         self.stalled = 0;
         // What the kernel does after a plain step that it may have been,
         // beyond the energy check the fast path made: an interrupt poll.
-        if self.clock.accepted % poll_every == 0 && interrupt() {
+        if poll_due(self.clock.accepted, poll_every) && interrupt() {
             return Err(Error::Interrupted {
                 time: self.clock.time,
             });

@@ -17,6 +17,7 @@
 
 mod lanes;
 mod stretch;
+use lanes::LaneLaw;
 pub(crate) use lanes::{Group, LaneModes, LaneState, LaneStep, LANES};
 pub(crate) use stretch::{peak_inside, widen_peaks, Stretch};
 
@@ -24,7 +25,7 @@ use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{
     elastic, h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
 };
-use crate::model::contact::{AnyLaw, ContactLaw};
+use crate::model::contact::{AnyLaw, ContactLaw, HysterHertz};
 use crate::model::signals::Signal;
 
 /// The largest system held: as many structure coordinates and dampers as
@@ -36,6 +37,10 @@ const MAX_DIM: usize = MAX_MODES + MAX_DAMPERS;
 const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
 /// The longest state: coordinates, velocities and the accumulators.
 const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
+
+/// Per wall, the damping factor of its law in the modes stepped (see
+/// [`Compact::rate_factors`]).
+pub(crate) type Factors = [f64; MAX_WALLS];
 
 /// One wall of a pair (see [`crate::model::assembly::Interaction`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -164,7 +169,7 @@ impl Compact {
         k: usize,
         time: f64,
         y: &[f64; MAX_LEN],
-        modes: &[Mode],
+        (modes, factors): (&[Mode], &Factors),
         scratch: &mut Scratch,
         out: &mut [f64; MAX_LEN],
     ) {
@@ -173,6 +178,10 @@ impl Compact {
         let inertial = 0.0 + self.gravity;
         let mut input = 0.0;
         let mut viscous = 0.0;
+        // The accelerations, summed here term by term in the general path's
+        // order and stored once: a contact force's term then waits on no
+        // store and load of `out` (a stage's critical path in contact).
+        let mut accel = [0.0; MAX_DIM];
         if let Some(force) = &self.force {
             let value = scratch.first_force_value(&force.signal, time);
             let mut power = -0.0;
@@ -180,7 +189,7 @@ impl Compact {
                 let [k, c, damping, r] = self.modal[i];
                 let (x, v) = (y[i], y[d + i]);
                 out[i] = v;
-                out[d + i] = elastic(k, c, r, inertial, x, v) + force.push[i] * value;
+                accel[i] = elastic(k, c, r, inertial, x, v) + force.push[i] * value;
                 viscous += damping * v * v;
                 power += force.row[i] * v;
             }
@@ -190,13 +199,13 @@ impl Compact {
                 let [k, c, damping, r] = self.modal[i];
                 let (x, v) = (y[i], y[d + i]);
                 out[i] = v;
-                out[d + i] = elastic(k, c, r, inertial, x, v);
+                accel[i] = elastic(k, c, r, inertial, x, v);
                 viscous += damping * v * v;
             }
         }
         for j in n..d {
             out[j] = y[d + j];
-            out[d + j] = -inertial;
+            accel[j] = -inertial;
         }
         let count = self.count.min(MAX_WALLS);
         let modes = &modes[..count];
@@ -218,14 +227,23 @@ impl Compact {
                 products = Some((hx, hv));
                 let (indentation, rate) = (-(wall.offset + hx), -hv);
                 let (force, elastic) = if indentation > 0.0 {
-                    law.force_and_elastic(indentation, rate, *approach_rate)
+                    match law {
+                        AnyLaw::HysterHertz(l) => HysterHertz::force_of(
+                            l.parts(),
+                            indentation,
+                            rate,
+                            *approach_rate,
+                            factors[w],
+                        ),
+                        _ => law.force_and_elastic(indentation, rate, *approach_rate),
+                    }
                 } else {
                     (0.0, 0.0)
                 };
                 let total = force + *damping * rate;
                 if total != 0.0 {
                     for i in 0..d {
-                        out[d + i] += wall.push[i] * total;
+                        accel[i] += wall.push[i] * total;
                     }
                 }
                 losses[w] = (total - elastic) * rate;
@@ -233,6 +251,9 @@ impl Compact {
                 scratch.sticking[sticking] = w;
                 sticking += 1;
             }
+        }
+        for i in 0..d {
+            out[d + i] = accel[i];
         }
         if STICKING && sticking == 1 {
             // One constraint, as `Assembly::add_constraint_forces` solves it.
@@ -273,7 +294,7 @@ impl Compact {
         time: f64,
         start: &[f64; MAX_LEN],
         h: f64,
-        modes: &[Mode],
+        modes: (&[Mode], &Factors),
         scratch: &mut Scratch,
         stages: &mut [[f64; MAX_LEN]; 4],
         start_valid: bool,
@@ -341,6 +362,7 @@ impl Compact {
             stages[0][..len].copy_from_slice(&first[..len]);
         }
         let mut end = [0.0; MAX_LEN];
+        let factors = self.rate_factors(modes);
         // One body for every mode (with no pair sticking, the constraint
         // branch is skipped at run time): the stretches, where speed counts,
         // compile the two apart.
@@ -351,7 +373,7 @@ impl Compact {
             time,
             &start,
             h,
-            modes,
+            (modes, &factors),
             scratch,
             &mut stages,
             start_valid,
@@ -361,6 +383,23 @@ impl Compact {
             first[..len].copy_from_slice(&stages[0][..len]);
         }
         out[..len].copy_from_slice(&end[..len]);
+    }
+
+    /// Each wall's damping factor on the indentation rate where its law
+    /// damps ([`HysterHertz`]: `alpha / delta'_minus`, the latched approach
+    /// rate's quotient): the division made once for the steps in `modes`
+    /// (the law's own, the same bits), not in every stage.
+    #[inline(always)]
+    pub(crate) fn rate_factors(&self, modes: &[Mode]) -> Factors {
+        let mut factors = [0.0; MAX_WALLS];
+        for w in 0..self.count.min(MAX_WALLS).min(modes.len()) {
+            if let (Mode::Compliant { approach_rate }, Some((AnyLaw::HysterHertz(law), _))) =
+                (modes[w], &self.walls[w].law)
+            {
+                factors[w] = law.hysteresis / approach_rate;
+            }
+        }
+        factors
     }
 
     /// Every wall's gap and rate at `y`, as [`Assembly::gaps`] gives them.

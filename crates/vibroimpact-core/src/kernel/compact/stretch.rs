@@ -72,6 +72,7 @@ impl Compact {
         let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
         let mut stages = [[0.0; MAX_LEN]; 4];
         let (held, locked, releasable) = passed_over(system, modes);
+        let factors = self.rate_factors(modes);
         // Whether `stages[0]` holds the rates at the step's start (the last
         // step's release test evaluated them there).
         let mut start_valid = false;
@@ -97,7 +98,7 @@ impl Compact {
                 time,
                 &y,
                 length,
-                modes,
+                (modes, &factors),
                 scratch,
                 &mut stages,
                 start_valid,
@@ -113,7 +114,8 @@ impl Compact {
                 // A sticking pair whose constraint force at the step's end
                 // pulls is released: the forces as the event search takes
                 // them.
-                self.rates::<true>(system, n, k, next, &end, modes, scratch, &mut stages[0]);
+                let at = (modes, &factors);
+                self.rates::<true>(system, n, k, next, &end, at, scratch, &mut stages[0]);
                 for w in 0..count {
                     if modes[w] == Mode::Sticking
                         && !locked[w]
@@ -193,6 +195,7 @@ impl Compact {
         let mut stages = [[0.0; MAX_LEN]; 4];
         let (mut energy, schedule, mut clock) = (*f.energy, *f.schedule, *f.clock);
         let (dt, located) = (schedule.dt, schedule.fixed == Some(ContactTiming::Located));
+        let factors = self.rate_factors(modes);
         loop {
             if clock.accepted >= f.max_accepted {
                 f.limited = true;
@@ -210,7 +213,7 @@ impl Compact {
                 time,
                 &y,
                 dt,
-                modes,
+                (modes, &factors),
                 scratch,
                 &mut stages,
                 false,
