@@ -193,21 +193,42 @@ impl EnergyWatch {
         done: bool,
         time: f64,
     ) -> Result<()> {
-        let check = accepted % ENERGY_INTERVAL == 0 || done;
-        if check || self.sampler.due(time) {
-            check_balance(
-                system,
-                y,
-                modes,
-                self.stored_start,
-                &mut self.scale,
-                self.impact_loss,
-                (self.tolerance, check),
-                self.t_end,
-                time,
-                &mut self.extremes,
-            )?;
+        match self.due(accepted, done, time) {
+            Some(check) => self.balance(system, (y, modes), check, time),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// Whether the `accepted`-th step, ending at `time`, needs the balance
+    /// (`Some(check)`; with `check` false only the energy in play is
+    /// sampled): the lockstep lanes ask this of every lane and gather a
+    /// lane's state only where it does.
+    #[inline(always)]
+    pub(crate) fn due(&mut self, accepted: u64, done: bool, time: f64) -> Option<bool> {
+        let check = accepted % ENERGY_INTERVAL == 0 || done;
+        (check || self.sampler.due(time)).then_some(check)
+    }
+
+    /// The balance at `time` and state `y` (see [`Self::due`]).
+    #[inline(always)]
+    pub(crate) fn balance(
+        &mut self,
+        system: &Assembly,
+        (y, modes): (&[f64], &[Mode]),
+        check: bool,
+        time: f64,
+    ) -> Result<()> {
+        check_balance(
+            system,
+            y,
+            modes,
+            self.stored_start,
+            &mut self.scale,
+            self.impact_loss,
+            (self.tolerance, check),
+            self.t_end,
+            time,
+            &mut self.extremes,
+        )
     }
 }
