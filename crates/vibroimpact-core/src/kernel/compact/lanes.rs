@@ -190,6 +190,28 @@ fn stage_point(point: &mut V, start: &V, a: f64, k: &V) {
     }
 }
 
+/// `sum + h x` of every lane (see [`stage_point`]).
+#[inline(always)]
+fn accumulate(sum: &mut V, h: &V, x: &V) {
+    for l in 0..LANES {
+        sum[l] += h[l] * x[l];
+    }
+}
+
+/// `acceleration + push total` in the lanes where `add` is not 0 (see
+/// [`stage_point`]).
+#[inline(always)]
+fn push_where(acceleration: &mut V, push: &V, total: &V, add: &V) {
+    for l in 0..LANES {
+        let pushed = acceleration[l] + push[l] * total[l];
+        acceleration[l] = if add[l] != 0.0 {
+            pushed
+        } else {
+            acceleration[l]
+        };
+    }
+}
+
 /// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane (see
 /// [`stage_point`]).
 #[inline(always)]
@@ -488,12 +510,8 @@ impl<L: LaneLaw> Group<L> {
             // `h_dot`'s two sums, each lane innermost (what vectorises).
             let (mut sx, mut sv) = ([[-0.0; LANES]; 2], [[-0.0; LANES]; 2]);
             for i in 0..d {
-                let (h, x, v) = (&wall.h[i], &y[i], &y[d + i]);
-                let (sx, sv) = (&mut sx[i % 2], &mut sv[i % 2]);
-                for l in 0..LANES {
-                    sx[l] += h[l] * x[l];
-                    sv[l] += h[l] * v[l];
-                }
+                accumulate(&mut sx[i % 2], &wall.h[i], &y[i]);
+                accumulate(&mut sv[i % 2], &wall.h[i], &y[d + i]);
             }
             // In simple loops, each of which vectorises.
             let (mut indentation, mut rate) = ([0.0; LANES], [0.0; LANES]);
@@ -540,15 +558,7 @@ impl<L: LaneLaw> Group<L> {
                 };
             }
             for i in 0..d {
-                let (push, acceleration) = (&wall.push[i], &mut out[d + i]);
-                for l in 0..LANES {
-                    let pushed = acceleration[l] + push[l] * total[l];
-                    acceleration[l] = if add[l] != 0.0 {
-                        pushed
-                    } else {
-                        acceleration[l]
-                    };
-                }
+                push_where(&mut out[d + i], &wall.push[i], &total, &add);
             }
         }
         out[2 * d + VISCOUS] = viscous;
