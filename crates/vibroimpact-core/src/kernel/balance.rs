@@ -219,15 +219,19 @@ impl EnergyWatch {
         }
     }
 
-    /// Whether the balance is due after the `accepted`-th step at `time`:
-    /// `Some(true)` to check it, `Some(false)` to sample the energy in play.
+    /// Whether the `accepted`-th step, ending at `time`, needs the balance
+    /// (`Some(check)`; with `check` false only the energy in play is
+    /// sampled): the lockstep lanes ask this of every lane and gather a
+    /// lane's state only where it does.
     #[inline(always)]
-    fn due(&mut self, accepted: u64, done: bool, time: f64) -> Option<bool> {
+    pub(crate) fn due(&mut self, accepted: u64, done: bool, time: f64) -> Option<bool> {
         let check = accepted % ENERGY_INTERVAL == 0 || done;
         (check || self.sampler.due(time)).then_some(check)
     }
 
-    fn balance(
+    /// The balance at `time` and state `y` (see [`Self::due`]).
+    #[inline(always)]
+    pub(crate) fn balance(
         &mut self,
         system: &Assembly,
         (y, modes): (&[f64], &[Mode]),

@@ -183,6 +183,17 @@ impl Schedule {
     /// follow.
     #[inline(always)]
     pub(crate) fn plain_fixed_step(&self, clock: &Clock) -> Option<(f64, bool)> {
+        let (next, in_window) = self.plain_fixed_summed_step(clock)?;
+        if in_window && self.mean_square {
+            return None;
+        }
+        Some((next, in_window))
+    }
+
+    /// [`Self::plain_fixed_step`] where the mean squares are summed in the
+    /// step (the lockstep lanes sum them).
+    #[inline(always)]
+    pub(crate) fn plain_fixed_summed_step(&self, clock: &Clock) -> Option<(f64, bool)> {
         let time = clock.time;
         if self.at_end(time) {
             return None;
@@ -195,10 +206,6 @@ impl Schedule {
         {
             return None;
         }
-        let in_window = self.in_window(time, self.dt);
-        if in_window && self.mean_square {
-            return None;
-        }
-        Some((next, in_window))
+        Some((next, self.in_window(time, self.dt)))
     }
 }

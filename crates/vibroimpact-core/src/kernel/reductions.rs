@@ -63,6 +63,7 @@ pub struct Reductions {
 /// Monomial coefficients (in `theta` in [0, 1]) of the quintic Hermite
 /// interpolant with values `p`, slopes `m` (per unit theta) and second
 /// derivatives `c` (per unit theta squared) at both ends.
+#[inline(always)]
 pub fn quintic(p0: f64, p1: f64, m0: f64, m1: f64, c0: f64, c1: f64) -> [f64; 6] {
     let d = p1 - p0;
     [
@@ -76,7 +77,7 @@ pub fn quintic(p0: f64, p1: f64, m0: f64, m1: f64, c0: f64, c1: f64) -> [f64; 6]
 }
 
 /// The polynomial `a` and its derivative at `t`.
-#[inline]
+#[inline(always)]
 pub fn evaluate(a: &[f64; 6], t: f64) -> (f64, f64) {
     let mut value = a[5];
     let mut slope = 0.0;
@@ -124,6 +125,7 @@ pub(crate) const WEIGHTS: [f64; 6] = [
 ];
 
 /// The integral over [0, 1] of the square of the quintic `a`.
+#[inline(always)]
 pub fn square_integral(a: &[f64; 6]) -> f64 {
     NODES
         .iter()

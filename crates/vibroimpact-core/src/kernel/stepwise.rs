@@ -9,11 +9,11 @@ use crate::kernel::events::{ContactTiming, RunOptions, Stepping, SystemSolution}
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::kernel::run::Run;
 use crate::methods::steppers::SystemStepper;
-use crate::model::assembly::{Assembly, Mode, Scratch};
+use crate::model::assembly::Assembly;
 
 /// A fixed-step run in progress.
 pub(crate) struct FixedRun<'a> {
-    run: Run<'a>,
+    pub(super) run: Run<'a>,
 }
 
 impl<'a> FixedRun<'a> {
@@ -37,22 +37,6 @@ impl<'a> FixedRun<'a> {
             MAX_RECORD_BYTES,
         )?;
         Ok(Self { run })
-    }
-
-    /// The time (s), the state and the contact modes at the next step's start.
-    pub(crate) fn time(&self) -> f64 {
-        self.run.clock.time
-    }
-    pub(crate) fn state(&self) -> &[f64] {
-        &self.run.y
-    }
-    pub(crate) fn modes(&self) -> &[Mode] {
-        &self.run.modes
-    }
-
-    /// The work space the next step's attempt is given.
-    pub(crate) fn scratch(&mut self) -> &mut Scratch {
-        &mut self.run.scratch
     }
 
     /// The next step and what follows it; false where the run has ended.

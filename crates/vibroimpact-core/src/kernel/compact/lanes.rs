@@ -9,7 +9,7 @@
 
 use super::{Compact, MAX_DIM, MAX_LEN, MAX_MODES, MAX_WALLS};
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
-use crate::model::assembly::{elastic, Mode, Scratch, CONTACT, INPUT, VISCOUS};
+use crate::model::assembly::{elastic, Assembly, Mode, CONTACT, INPUT, VISCOUS};
 use crate::model::contact::{AnyLaw, ContactLaw, Hertz, HysterHertz, Linear};
 use crate::model::signals::Signal;
 
@@ -17,10 +17,24 @@ use crate::model::signals::Signal;
 pub(crate) const LANES: usize = 16;
 
 /// One value per lane.
-type V = [f64; LANES];
+pub(super) type V = [f64; LANES];
 
 /// A state (or its rates) per lane.
 pub(crate) type LaneState = [V; MAX_LEN];
+
+/// The most quantities the lanes observe (structure coordinates, points).
+pub(crate) const MAX_OBSERVED: usize = 8;
+
+/// RK4's stage times of a step `h` from `time` (the compact step's).
+#[inline(always)]
+pub(crate) fn stage_times(time: f64, h: f64) -> [f64; 4] {
+    [
+        time,
+        time + RK4_C[1] * h,
+        time + RK4_C[2] * h,
+        time + RK4_C[3] * h,
+    ]
+}
 
 /// [`HysterHertz`]'s rate below which it is elastic (its `GRAZING_RATE`;
 /// the lanes' tests hold them to the same bits).
@@ -107,37 +121,132 @@ impl LaneLaw for Linear {
 
 /// A wall of every lane (all compliant).
 #[derive(Debug, Clone, Copy)]
-struct Walls<L> {
-    h: [V; MAX_DIM],
+pub(super) struct Walls<L> {
+    pub(super) h: [V; MAX_DIM],
     push: [V; MAX_DIM],
-    offset: V,
+    pub(super) offset: V,
     /// Each lane's law's parameters.
     parts: [V; 2],
     damping: V,
     law: std::marker::PhantomData<L>,
-    mirror: bool,
+    pub(super) mirror: bool,
 }
+
+impl<L: LaneLaw> Walls<L> {
+    /// Lane `l`'s `(h . x, h . v)` at `y` (of `d` coordinates), as the
+    /// vector sums them; the previous wall's negated where `mirrored` gives
+    /// them.
+    #[inline(always)]
+    fn touch(&self, l: usize, y: &LaneState, d: usize, mirrored: Option<(f64, f64)>) -> (f64, f64) {
+        if let Some((hx, hv)) = mirrored {
+            return (-hx, -hv);
+        }
+        let (mut sx, mut sv) = ([-0.0; 2], [-0.0; 2]);
+        for i in 0..d {
+            sx[i % 2] += self.h[i][l] * y[i][l];
+            sv[i % 2] += self.h[i][l] * y[d + i][l];
+        }
+        (sx[0] + sx[1], sv[0] + sv[1])
+    }
+
+    /// Lane `l`'s contact force on the wall with products `(hx, hv)`, in
+    /// contact with the latched `approach` rate (`factor` its law's), added
+    /// to its accelerations in `out` and its loss rate into slot `loss`:
+    /// the vector's operations on that lane.
+    #[inline(always)]
+    fn push_lane(
+        &self,
+        l: usize,
+        (hx, hv): (f64, f64),
+        (approach, factor): (f64, f64),
+        d: usize,
+        out: &mut LaneState,
+        loss: usize,
+    ) {
+        let (indentation, rate) = (-(self.offset[l] + hx), -hv);
+        let parts = [self.parts[0][l], self.parts[1][l]];
+        let (force, elastic) = if indentation > 0.0 {
+            L::force_of(parts, indentation, rate, approach, factor)
+        } else {
+            (0.0, 0.0)
+        };
+        let total = force + self.damping[l] * rate;
+        if total != 0.0 {
+            for i in 0..d {
+                out[d + i][l] += self.push[i][l] * total;
+            }
+        }
+        out[loss][l] = (total - elastic) * rate;
+    }
+}
+
+/// `start + a k` of every lane. The lanes' buffers are fields of one
+/// struct: as a function's distinct references they are known not to
+/// overlap, and the loop vectorises (inline, it ran lane by lane).
+#[inline(always)]
+fn stage_point(point: &mut V, start: &V, a: f64, k: &V) {
+    for l in 0..LANES {
+        point[l] = start[l] + a * k[l];
+    }
+}
+
+/// `sum + h x` of every lane (see [`stage_point`]).
+#[inline(always)]
+fn accumulate(sum: &mut V, h: &V, x: &V) {
+    for l in 0..LANES {
+        sum[l] += h[l] * x[l];
+    }
+}
+
+/// `acceleration + push total` in the lanes where `add` is not 0 (see
+/// [`stage_point`]).
+#[inline(always)]
+fn push_where(acceleration: &mut V, push: &V, total: &V, add: &V) {
+    for l in 0..LANES {
+        let pushed = acceleration[l] + push[l] * total[l];
+        acceleration[l] = if add[l] != 0.0 {
+            pushed
+        } else {
+            acceleration[l]
+        };
+    }
+}
+
+/// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane (see
+/// [`stage_point`]).
+#[inline(always)]
+fn combine(end: &mut V, start: &V, w: &[f64; 4], [k0, k1, k2, k3]: [&V; 4]) {
+    for l in 0..LANES {
+        end[l] = start[l] + w[0] * k0[l] + w[1] * k1[l] + w[2] * k2[l] + w[3] * k3[l];
+    }
+}
+
+/// Walls touched by at most this many lanes are evaluated lane by lane.
+const LANE_BY_LANE: usize = 4;
 
 /// The lanes' systems, their values side by side.
 #[derive(Debug, Clone)]
 pub(crate) struct Group<L> {
-    n: usize,
-    k: usize,
-    len: usize,
+    pub(super) n: usize,
+    pub(super) k: usize,
+    pub(super) len: usize,
     /// `[M^-1 K, M^-1 C, C, r]` of each mode.
     modal: [[V; 4]; MAX_MODES],
     /// The force's `M^-1 row^T` and row, and each lane's signal.
     force: Option<([V; MAX_MODES], [V; MAX_MODES], Vec<Signal>)>,
     gravity: V,
-    walls: Vec<Walls<L>>,
+    pub(super) walls: Vec<Walls<L>>,
+    /// Each followed point's row over the modes (see
+    /// [`Assembly::observe`]): the quantities observed past the modes.
+    pub(super) points: Vec<[V; MAX_MODES]>,
 }
 
 /// The lanes' step: its end, and the rates at its start.
 pub(crate) struct LaneStep {
     pub(crate) end: Box<LaneState>,
     pub(crate) first: Box<LaneState>,
-    point: Box<LaneState>,
-    stages: Box<[LaneState; 3]>,
+    pub(super) point: Box<LaneState>,
+    pub(super) stages: Box<[LaneState; 3]>,
 }
 
 impl LaneStep {
@@ -162,7 +271,7 @@ impl Default for LaneStep {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LaneModes {
     /// 1 in contact, 0 open (numbers: what the vector selects read).
-    active: [V; MAX_WALLS],
+    pub(super) active: [V; MAX_WALLS],
     approach: [V; MAX_WALLS],
 }
 
@@ -210,25 +319,31 @@ macro_rules! step_with {
         #[target_feature(enable = $feature)]
         unsafe fn $name(
             &self,
-            time: f64,
             start: &LaneState,
             h: f64,
             modes: &LaneModes,
-            scratch: &mut [Scratch],
+            values: &[V; 4],
             out: &mut LaneStep,
         ) {
-            self.step_in(time, start, h, modes, scratch, out)
+            self.step_in((self.n, self.k), start, h, modes, values, out)
         }
     };
 }
 
 impl<L: LaneLaw> Group<L> {
-    /// The group of `systems` (`(compact, n, k, state length)`, the first
-    /// repeated into lanes left empty), where they share a shape and every
-    /// wall has law `L`.
-    pub(crate) fn of(systems: &[(&Compact, usize, usize, usize)]) -> Option<Self> {
+    /// The group of `systems` (the first repeated into lanes left empty),
+    /// where each has a compact form, they share a shape and every wall has
+    /// law `L`.
+    pub(crate) fn of(assemblies: &[&Assembly]) -> Option<Self> {
+        let systems: Vec<_> = assemblies
+            .iter()
+            .map(|s| Some((s.compact.as_deref()?, s.n, s.k, s.state_len())))
+            .collect::<Option<_>>()?;
         let &(first, n, k, len) = systems.first()?;
+        let observed = assemblies[0].observed();
         if systems.len() > LANES
+            || observed > MAX_OBSERVED
+            || assemblies.iter().any(|s| s.observed() != observed)
             || systems
                 .iter()
                 .any(|&(c, n2, k2, len2)| (n2, k2, len2) != (n, k, len) || !same_shape(first, c))
@@ -236,6 +351,15 @@ impl<L: LaneLaw> Group<L> {
             return None;
         }
         let lane = |l: usize| systems.get(l).unwrap_or(&systems[0]).0;
+        let mut points = vec![[[0.0; LANES]; MAX_MODES]; observed - n];
+        for (p, row) in points.iter_mut().enumerate() {
+            for l in 0..LANES {
+                let rows = &assemblies.get(l).unwrap_or(&assemblies[0]).point_rows;
+                for i in 0..n {
+                    row[i][l] = rows[p * n + i];
+                }
+            }
+        }
         let d = n + k;
         let mut modal = [[[0.0; LANES]; 4]; MAX_MODES];
         let mut gravity = [0.0; LANES];
@@ -297,21 +421,23 @@ impl<L: LaneLaw> Group<L> {
             force,
             gravity,
             walls,
+            points,
         })
     }
 
     /// [`Compact::rates`] of every lane (no pair sticking), the force's
     /// value of each lane in `value`.
     #[inline(always)]
-    fn rates(
+    pub(super) fn rates(
         &self,
+        (n, k): (usize, usize),
         y: &LaneState,
         value: &V,
         modes: &LaneModes,
         factor: &[V; MAX_WALLS],
         out: &mut LaneState,
     ) {
-        let (n, d) = (self.n, self.n + self.k);
+        let d = n + k;
         let mut inertial = [0.0; LANES];
         for l in 0..LANES {
             inertial[l] = 0.0 + self.gravity[l];
@@ -358,21 +484,27 @@ impl<L: LaneLaw> Group<L> {
         for (w, wall) in self.walls.iter().enumerate() {
             let loss = 2 * d + CONTACT + w;
             let active = &modes.active[w];
-            if active.iter().all(|a| *a == 0.0) {
-                // No lane touches: no force (the law is not evaluated).
+            let touching = active.iter().filter(|a| **a != 0.0).count();
+            if touching <= LANE_BY_LANE {
+                // No lane touches, or few: those few lane by lane (the
+                // vector would evaluate the law in every lane).
                 out[loss] = [0.0; LANES];
-                previous = [0.0; LANES];
+                for l in 0..LANES {
+                    if active[l] != 0.0 {
+                        let mirrored = wall.mirror & (previous[l] != 0.0);
+                        (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
+                        let latched = (modes.approach[w][l], factor[w][l]);
+                        wall.push_lane(l, (px[l], pv[l]), latched, d, out, loss);
+                    }
+                }
+                previous = *active;
                 continue;
             }
             // `h_dot`'s two sums, each lane innermost (what vectorises).
             let (mut sx, mut sv) = ([[-0.0; LANES]; 2], [[-0.0; LANES]; 2]);
             for i in 0..d {
-                let (h, x, v) = (&wall.h[i], &y[i], &y[d + i]);
-                let (sx, sv) = (&mut sx[i % 2], &mut sv[i % 2]);
-                for l in 0..LANES {
-                    sx[l] += h[l] * x[l];
-                    sv[l] += h[l] * v[l];
-                }
+                accumulate(&mut sx[i % 2], &wall.h[i], &y[i]);
+                accumulate(&mut sv[i % 2], &wall.h[i], &y[d + i]);
             }
             // In simple loops, each of which vectorises.
             let (mut indentation, mut rate) = ([0.0; LANES], [0.0; LANES]);
@@ -419,82 +551,76 @@ impl<L: LaneLaw> Group<L> {
                 };
             }
             for i in 0..d {
-                let (push, acceleration) = (&wall.push[i], &mut out[d + i]);
-                for l in 0..LANES {
-                    let pushed = acceleration[l] + push[l] * total[l];
-                    acceleration[l] = if add[l] != 0.0 {
-                        pushed
-                    } else {
-                        acceleration[l]
-                    };
-                }
+                push_where(&mut out[d + i], &wall.push[i], &total, &add);
             }
         }
         out[2 * d + VISCOUS] = viscous;
         out[2 * d + INPUT] = input;
     }
 
-    /// Each lane's force at `time` through its own cache (as its run's
-    /// rates take it, in the same order).
-    #[inline(always)]
-    fn values(&self, scratch: &mut [Scratch], time: f64) -> V {
-        let mut value = [0.0; LANES];
-        if let Some((_, _, signals)) = &self.force {
-            for (l, s) in scratch.iter_mut().enumerate().take(LANES) {
-                value[l] = s.first_force_value(&signals[l], time);
-            }
-        }
-        value
+    /// Lane `l`'s force signal, if the lanes are forced.
+    pub(crate) fn signal(&self, l: usize) -> Option<&Signal> {
+        self.force.as_ref().map(|(_, _, signals)| &signals[l])
     }
 
-    /// One RK4 step `h` from `(time, start)` of every lane in `modes`, as
+    /// Each compliant law's `parts[1] / approach` in `modes`, made once a
+    /// step (as the compact step makes it).
+    #[inline(always)]
+    pub(super) fn factors(&self, modes: &LaneModes) -> [V; MAX_WALLS] {
+        let mut factor = [[0.0; LANES]; MAX_WALLS];
+        for (w, wall) in self.walls.iter().enumerate() {
+            if modes.active[w].iter().all(|a| *a == 0.0) {
+                continue;
+            }
+            for l in 0..LANES {
+                factor[w][l] = wall.parts[1][l] / modes.approach[w][l];
+            }
+        }
+        factor
+    }
+
+    /// One RK4 step `h` from `start` of every lane in `modes`, as
     /// [`Compact::step`] takes it with no first stage given: the end in
-    /// `out.end`, the first stage in `out.first`; each lane's force through
-    /// its `scratch` (one per lane).
+    /// `out.end`, the first stage in `out.first`; each lane's force at the
+    /// four stages' times in `values` (each lane's through its own cache, in
+    /// the order of the stages).
     pub(crate) fn step(
         &self,
-        time: f64,
         start: &LaneState,
         h: f64,
         modes: &LaneModes,
-        scratch: &mut [Scratch],
+        values: &[V; 4],
         out: &mut LaneStep,
     ) {
         #[cfg(target_arch = "x86_64")]
         {
             if std::arch::is_x86_feature_detected!("avx512f") {
                 // SAFETY: the processor has the feature the function is built for.
-                return unsafe { self.step_avx512(time, start, h, modes, scratch, out) };
+                return unsafe { self.step_avx512(start, h, modes, values, out) };
             }
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: as above.
-                return unsafe { self.step_avx2(time, start, h, modes, scratch, out) };
+                return unsafe { self.step_avx2(start, h, modes, values, out) };
             }
         }
-        self.step_in(time, start, h, modes, scratch, out)
+        self.step_in((self.n, self.k), start, h, modes, values, out)
     }
 
     step_with!(step_avx512, "avx512f");
     step_with!(step_avx2, "avx2");
 
     #[inline(always)]
-    fn step_in(
+    pub(super) fn step_in(
         &self,
-        time: f64,
+        (n, k): (usize, usize),
         start: &LaneState,
         h: f64,
         modes: &LaneModes,
-        scratch: &mut [Scratch],
+        values: &[V; 4],
         out: &mut LaneStep,
     ) {
-        let coordinates = 2 * (self.n + self.k);
+        let coordinates = 2 * (n + k);
         let len = self.len.min(MAX_LEN);
-        let times = [
-            time,
-            time + RK4_C[1] * h,
-            time + RK4_C[2] * h,
-            time + RK4_C[3] * h,
-        ];
         let hw = [h * RK4_A[1][0], h * RK4_A[2][1], h * RK4_A[3][2]];
         let w = [h * RK4_B[0], h * RK4_B[1], h * RK4_B[2], h * RK4_B[3]];
         let LaneStep {
@@ -503,48 +629,30 @@ impl<L: LaneLaw> Group<L> {
             point,
             stages,
         } = out;
-        // As the compact step's fresh arrays: slots no rate writes stay 0.
-        **first = [[0.0; LANES]; MAX_LEN];
-        **stages = [[[0.0; LANES]; MAX_LEN]; 3];
-        // Each compliant law's `parts[1] / approach`, once for the step.
-        let mut factor = [[0.0; LANES]; MAX_WALLS];
-        for (w, wall) in self.walls.iter().enumerate() {
-            for l in 0..LANES {
-                factor[w][l] = wall.parts[1][l] / modes.approach[w][l];
-            }
-        }
-        let value = self.values(scratch, times[0]);
-        self.rates(start, &value, modes, &factor, first);
+        // Every slot of the state's length is written by each rate (the
+        // compact step's fresh zeros are not needed).
+        let factor = self.factors(modes);
+        self.rates((n, k), start, &values[0], modes, &factor, first);
         let [k1, k2, k3] = &mut **stages;
         for e in 0..coordinates {
-            for l in 0..LANES {
-                point[e][l] = start[e][l] + hw[0] * first[e][l];
-            }
+            stage_point(&mut point[e], &start[e], hw[0], &first[e]);
         }
-        let value = self.values(scratch, times[1]);
-        self.rates(point, &value, modes, &factor, k1);
+        self.rates((n, k), point, &values[1], modes, &factor, k1);
         for e in 0..coordinates {
-            for l in 0..LANES {
-                point[e][l] = start[e][l] + hw[1] * k1[e][l];
-            }
+            stage_point(&mut point[e], &start[e], hw[1], &k1[e]);
         }
-        let value = self.values(scratch, times[2]);
-        self.rates(point, &value, modes, &factor, k2);
+        self.rates((n, k), point, &values[2], modes, &factor, k2);
         for e in 0..coordinates {
-            for l in 0..LANES {
-                point[e][l] = start[e][l] + hw[2] * k2[e][l];
-            }
+            stage_point(&mut point[e], &start[e], hw[2], &k2[e]);
         }
-        let value = self.values(scratch, times[3]);
-        self.rates(point, &value, modes, &factor, k3);
+        self.rates((n, k), point, &values[3], modes, &factor, k3);
         for e in 0..len {
-            for l in 0..LANES {
-                end[e][l] = start[e][l]
-                    + w[0] * first[e][l]
-                    + w[1] * k1[e][l]
-                    + w[2] * k2[e][l]
-                    + w[3] * k3[e][l];
-            }
+            combine(
+                &mut end[e],
+                &start[e],
+                &w,
+                [&first[e], &k1[e], &k2[e], &k3[e]],
+            );
         }
     }
 }

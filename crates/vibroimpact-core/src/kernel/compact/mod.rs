@@ -15,10 +15,14 @@
 // between the arrays measured slower: calls to memcpy, bounds not folded).
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
+mod lane_stepper;
+mod lane_steps;
 mod lanes;
+mod lockstep;
 mod stretch;
 use lanes::LaneLaw;
-pub(crate) use lanes::{Group, LaneModes, LaneState, LaneStep, LANES};
+pub(crate) use lanes::LANES;
+pub(crate) use lockstep::run_group;
 pub(crate) use stretch::{peak_inside, widen_peaks, Stretch};
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};

@@ -1,0 +1,322 @@
+//! What a plain fixed step does beside the RK4 step itself, for every lane
+//! at once: the walls' gaps at its end, whether it is plain (the rule of
+//! [`Compact::fixed_stretch`](super::Compact): finite, no contact begun or
+//! ended, no observed velocity changing sign in the recorded window) and
+//! its reductions (peaks, mean squares, recorded time) as
+//! [`crate::kernel::reductions::reduce_step`] adds them, term for term and
+//! in the same order, each over an array of lanes.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::lanes::{Group, LaneLaw, LaneModes, LaneState, LaneStep, LANES, MAX_OBSERVED, V};
+use super::MAX_WALLS;
+use crate::kernel::reductions::{quintic, square_integral};
+
+/// Each wall's gap and rate, per lane.
+pub(crate) type LaneGaps = [[V; 2]; MAX_WALLS];
+
+/// What the lanes keep of each run between the kernel's steps: the state,
+/// its walls' gaps, and the reductions.
+pub(crate) struct LaneRuns {
+    pub(crate) y: Box<LaneState>,
+    pub(crate) gaps: LaneGaps,
+    pub(crate) peaks: [V; MAX_OBSERVED],
+    pub(crate) squares: [V; MAX_OBSERVED],
+    pub(crate) recorded: V,
+    /// The rates at a step's ends (the mean squares' accelerations).
+    rates: Box<[LaneState; 2]>,
+}
+
+impl Default for LaneRuns {
+    fn default() -> Self {
+        Self {
+            y: LaneStep::state(),
+            gaps: [[[0.0; LANES]; 2]; MAX_WALLS],
+            peaks: [[0.0; LANES]; MAX_OBSERVED],
+            squares: [[0.0; LANES]; MAX_OBSERVED],
+            recorded: [0.0; LANES],
+            rates: Box::new([[[0.0; LANES]; super::MAX_LEN]; 2]),
+        }
+    }
+}
+
+/// What a plain step of the lanes reads besides their runs.
+pub(crate) struct PlainStep<'s> {
+    pub(crate) h: f64,
+    pub(crate) modes: &'s LaneModes,
+    /// Each wall's contact per lane (1 in contact).
+    pub(crate) open: &'s [V; MAX_WALLS],
+    /// The lanes with a run in progress.
+    pub(crate) live: [bool; LANES],
+    pub(crate) in_window: bool,
+    /// Each lane's force at the four stages' times, and (for the mean
+    /// squares) at the step's ends through the reductions' cache.
+    pub(crate) values: &'s [V; 4],
+    pub(crate) reduce_values: Option<&'s [V; 2]>,
+}
+
+/// [`Group::plain_step_in`] compiled for a processor feature (the same
+/// operations, so the same bits, in wider vector instructions).
+macro_rules! plain_step_with {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        unsafe fn $name(
+            &self,
+            p: &PlainStep<'_>,
+            runs: &mut LaneRuns,
+            out: &mut LaneStep,
+            end_gaps: &mut LaneGaps,
+        ) -> [bool; LANES] {
+            // The common sizes as constants (loops unrolled, no bounds
+            // checks); the same arithmetic in every arm.
+            match (self.n, self.k) {
+                (1, 1) => self.plain_step_in((1, 1), p, runs, out, end_gaps),
+                (2, 1) => self.plain_step_in((2, 1), p, runs, out, end_gaps),
+                (2, 2) => self.plain_step_in((2, 2), p, runs, out, end_gaps),
+                (3, 2) => self.plain_step_in((3, 2), p, runs, out, end_gaps),
+                sizes => self.plain_step_in(sizes, p, runs, out, end_gaps),
+            }
+        }
+    };
+}
+
+/// `if keep { new } else { old }` of every lane (a select, which vectorises).
+#[inline(always)]
+fn select(keep: &[bool; LANES], new: &V, old: &mut V) {
+    for l in 0..LANES {
+        old[l] = if keep[l] { new[l] } else { old[l] };
+    }
+}
+
+impl<L: LaneLaw> Group<L> {
+    /// The fixed RK4 step of `p.h` of every lane from its state in `runs`
+    /// (its end and first stage into `out`, the walls' gaps at its end into
+    /// `end_gaps`): which lanes' step is plain ([`Self::plain`]), those
+    /// lanes' reductions added (in the recorded window). Their state is
+    /// left at the step's start (see [`Self::advance`]).
+    pub(crate) fn plain_step(
+        &self,
+        p: &PlainStep<'_>,
+        runs: &mut LaneRuns,
+        out: &mut LaneStep,
+        end_gaps: &mut LaneGaps,
+    ) -> [bool; LANES] {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the processor has the feature the function is built for.
+                return unsafe { self.plain_step_avx512(p, runs, out, end_gaps) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: as above.
+                return unsafe { self.plain_step_avx2(p, runs, out, end_gaps) };
+            }
+        }
+        self.plain_step_in((self.n, self.k), p, runs, out, end_gaps)
+    }
+
+    plain_step_with!(plain_step_avx512, "avx512f");
+    plain_step_with!(plain_step_avx2, "avx2");
+
+    #[inline(always)]
+    fn plain_step_in(
+        &self,
+        sizes: (usize, usize),
+        p: &PlainStep<'_>,
+        runs: &mut LaneRuns,
+        out: &mut LaneStep,
+        end_gaps: &mut LaneGaps,
+    ) -> [bool; LANES] {
+        self.step_in(sizes, &runs.y, p.h, p.modes, p.values, out);
+        self.gaps(sizes, &out.end, end_gaps);
+        let mut plain = self.plain(sizes, (&runs.y, &out.end), end_gaps, p.open, p.in_window);
+        for l in 0..LANES {
+            plain[l] &= p.live[l];
+        }
+        if p.in_window {
+            self.reduce(
+                sizes,
+                (&out.end, p.h),
+                p.modes,
+                p.reduce_values,
+                &plain,
+                runs,
+            );
+        }
+        plain
+    }
+
+    /// Observed quantity `j` of every lane's `block` (structure coordinates'
+    /// values from `at`), as [`crate::model::assembly::Assembly::observe`].
+    #[inline(always)]
+    fn observe(&self, n: usize, j: usize, block: &LaneState, at: usize) -> V {
+        if j < n {
+            return block[at + j];
+        }
+        let row = &self.points[j - n];
+        // `linalg::dot`'s sum, in order.
+        let mut sum = [-0.0; LANES];
+        for i in 0..n {
+            for l in 0..LANES {
+                sum[l] += row[i][l] * block[at + i][l];
+            }
+        }
+        sum
+    }
+
+    /// Every wall's gap and rate at `y`, as [`super::Compact::gaps`] gives them.
+    #[inline(always)]
+    pub(crate) fn gaps(&self, (n, k): (usize, usize), y: &LaneState, out: &mut LaneGaps) {
+        let d = n + k;
+        let (mut px, mut pv) = ([0.0; LANES], [0.0; LANES]);
+        for (w, wall) in self.walls.iter().enumerate() {
+            if wall.mirror {
+                for l in 0..LANES {
+                    (px[l], pv[l]) = (-px[l], -pv[l]);
+                }
+            } else {
+                (px, pv) = ([-0.0; LANES], [-0.0; LANES]);
+                for i in 0..d {
+                    for l in 0..LANES {
+                        px[l] += wall.h[i][l] * y[i][l];
+                        pv[l] += wall.h[i][l] * y[d + i][l];
+                    }
+                }
+            }
+            for l in 0..LANES {
+                out[w][0][l] = wall.offset[l] + px[l];
+                out[w][1][l] = pv[l];
+            }
+        }
+    }
+
+    /// Which lanes' fixed step `start -> end` (walls' gaps `end_gaps` at its
+    /// end) is plain: a finite end, indented at the end exactly where in
+    /// contact (`open`, 1 in contact: no onset or separation in the step),
+    /// and `in_window`, no observed velocity changing sign (no peak inside).
+    #[inline(always)]
+    pub(crate) fn plain(
+        &self,
+        (n, k): (usize, usize),
+        (start, end): (&LaneState, &LaneState),
+        end_gaps: &LaneGaps,
+        open: &[V; MAX_WALLS],
+        in_window: bool,
+    ) -> [bool; LANES] {
+        let d = n + k;
+        // v * 0 is 0 for a finite v, NaN otherwise (the kernel's test).
+        let mut sum = [0.0; LANES];
+        for e in 0..2 * d {
+            for l in 0..LANES {
+                sum[l] += end[e][l] * 0.0;
+            }
+        }
+        let mut plain = [false; LANES];
+        for l in 0..LANES {
+            plain[l] = sum[l] == 0.0;
+        }
+        for w in 0..self.walls.len() {
+            for l in 0..LANES {
+                plain[l] &= (end_gaps[w][0][l] < 0.0) == (open[w][l] != 0.0);
+            }
+        }
+        if in_window {
+            for j in 0..n + self.points.len() {
+                let (s0, s1) = (self.observe(n, j, start, d), self.observe(n, j, end, d));
+                for l in 0..LANES {
+                    // Not `>= 0`: a NaN product is no sign change.
+                    let turning = s0[l] * s1[l] < 0.0;
+                    plain[l] &= !turning;
+                }
+            }
+        }
+        plain
+    }
+
+    /// The plain fixed step of `h` from the lanes' state in `runs` to
+    /// `end` of the lanes in `plain` added to their reductions, as
+    /// `reduce_step` adds a step with no peak inside: each observed
+    /// quantity's peak, with `values` (each lane's force at the step's ends,
+    /// through the cache the run's reductions use) its mean square over the
+    /// step's quintic interpolant, and the recorded time.
+    #[inline(always)]
+    pub(crate) fn reduce(
+        &self,
+        (n, k): (usize, usize),
+        (end, h): (&LaneState, f64),
+        modes: &LaneModes,
+        values: Option<&[V; 2]>,
+        plain: &[bool; LANES],
+        runs: &mut LaneRuns,
+    ) {
+        let d = n + k;
+        let LaneRuns {
+            y: start,
+            peaks,
+            squares,
+            recorded,
+            rates,
+            ..
+        } = runs;
+        let start: &LaneState = start;
+        if let Some(values) = values {
+            let factor = self.factors(modes);
+            let [at_start, at_end] = &mut **rates;
+            self.rates((n, k), start, &values[0], modes, &factor, at_start);
+            self.rates((n, k), end, &values[1], modes, &factor, at_end);
+        }
+        for j in 0..n + self.points.len() {
+            let (p0, p1) = (self.observe(n, j, start, 0), self.observe(n, j, end, 0));
+            let mut peak = [0.0; LANES];
+            for l in 0..LANES {
+                peak[l] = peaks[j][l].max(p0[l].abs().max(p1[l].abs()));
+            }
+            select(plain, &peak, &mut peaks[j]);
+            if values.is_none() {
+                continue;
+            }
+            let (s0, s1) = (self.observe(n, j, start, d), self.observe(n, j, end, d));
+            let c0 = self.observe(n, j, &rates[0], d);
+            let c1 = self.observe(n, j, &rates[1], d);
+            let mut square = [0.0; LANES];
+            for l in 0..LANES {
+                let a = quintic(
+                    p0[l],
+                    p1[l],
+                    h * s0[l],
+                    h * s1[l],
+                    h * h * c0[l],
+                    h * h * c1[l],
+                );
+                square[l] = squares[j][l] + h * square_integral(&a);
+            }
+            select(plain, &square, &mut squares[j]);
+        }
+        let mut sum = [0.0; LANES];
+        for l in 0..LANES {
+            sum[l] = recorded[l] + h;
+        }
+        select(plain, &sum, recorded);
+    }
+
+    /// The lanes in `plain` moved to the step's end `end` (walls' gaps
+    /// `end_gaps`).
+    #[inline(always)]
+    pub(crate) fn advance(
+        &self,
+        plain: &[bool; LANES],
+        end: &LaneState,
+        end_gaps: &LaneGaps,
+        runs: &mut LaneRuns,
+    ) {
+        for e in 0..self.len.min(super::MAX_LEN) {
+            select(plain, &end[e], &mut runs.y[e]);
+        }
+        for w in 0..self.walls.len() {
+            for g in 0..2 {
+                select(plain, &end_gaps[w][g], &mut runs.gaps[w][g]);
+            }
+        }
+    }
+}

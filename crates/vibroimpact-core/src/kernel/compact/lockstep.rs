@@ -1,0 +1,397 @@
+//! A group of at most [`LANES`] fixed-step RK4 runs of compact systems in
+//! lockstep (see [`crate::analysis::lanes`]). Each lane is the kernel's own
+//! run ([`FixedRun`]); its plain steps (the rule of
+//! [`Compact::fixed_stretch`](super::Compact), the single run's fast path:
+//! no onset or separation in the step, nothing due after it but counting
+//! it, the contacts that go on and the reductions) are taken for all lanes
+//! at once in fixed-size arrays ([`Group`]), the state, gaps and
+//! reductions of each run held there ([`LaneRuns`]) meanwhile; a lane whose
+//! step is not plain is handed back to its run, which takes that step
+//! itself (from the lanes' attempt, [`LaneStepper`]) and whatever follows
+//! it. The same operations in the same order as the single run: the same
+//! bits.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::lane_stepper::LaneStepper;
+use super::lane_steps::{LaneGaps, LaneRuns, PlainStep};
+use super::lanes::{stage_times, Group, LaneLaw, LaneModes, LaneStep, LANES, V};
+use super::{MAX_LEN, MAX_WALLS};
+use crate::error::{Error, Result};
+use crate::kernel::events::{ContactTiming, RunOptions, SystemSolution};
+use crate::kernel::fixed;
+use crate::kernel::stepwise::FixedRun;
+use crate::model::assembly::Assembly;
+use crate::model::contact::{Hertz, HysterHertz, Linear};
+
+/// Group steps between the caller's interrupt polls.
+const POLL_INTERVAL: u64 = 1024;
+
+/// Each run of `members` (systems with a compact form, and their starts),
+/// in fixed RK4 steps of `options.dt` with located contacts, advanced in
+/// lockstep: each run's solution or error, in order. Only an interrupt
+/// fails the whole.
+pub(crate) fn run_group(
+    members: &[(&Assembly, &Vec<f64>)],
+    options: &RunOptions,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<Result<SystemSolution>>> {
+    let systems: Vec<&Assembly> = members.iter().map(|(s, _)| *s).collect();
+    if let Some(g) = Group::<HysterHertz>::of(&systems) {
+        return Lockstep::new(members, options, true).run(Some(&g), interrupt);
+    }
+    if let Some(g) = Group::<Hertz>::of(&systems) {
+        return Lockstep::new(members, options, true).run(Some(&g), interrupt);
+    }
+    // Lanes that differ in shape are stepped by their runs alone.
+    let group = Group::<Linear>::of(&systems);
+    Lockstep::new(members, options, group.is_some()).run(group.as_ref(), interrupt)
+}
+
+/// The group's runs and what the lanes hold of them.
+struct Lockstep<'a> {
+    /// Whether the lanes step the runs (else each run steps alone).
+    vector: bool,
+    mean_square: bool,
+    systems: Vec<&'a Assembly>,
+    runs: Vec<Option<FixedRun<'a>>>,
+    steppers: Vec<LaneStepper>,
+    results: Vec<Option<Result<SystemSolution>>>,
+    lanes: LaneRuns,
+    modes: LaneModes,
+    /// Each wall's contact per lane (1 in contact).
+    open: [V; MAX_WALLS],
+    /// Whether the lanes take lane `l`'s steps (its modes are theirs).
+    fed: [bool; LANES],
+    /// Plain steps each lane took since its run was last brought up to date.
+    pending: [u64; LANES],
+    /// Each run's most accepted steps before its step limit.
+    max_accepted: [u64; LANES],
+    step: LaneStep,
+    end_gaps: LaneGaps,
+    dt: f64,
+}
+
+impl<'a> Lockstep<'a> {
+    fn new(members: &[(&'a Assembly, &Vec<f64>)], options: &'a RunOptions, vector: bool) -> Self {
+        let count = members.len();
+        let mut me = Self {
+            vector,
+            mean_square: options.reduce.mean_square,
+            systems: members.iter().map(|(s, _)| *s).collect(),
+            runs: Vec::with_capacity(count),
+            steppers: members.iter().map(|(s, _)| LaneStepper::new(s)).collect(),
+            results: vec![None; count],
+            lanes: LaneRuns::default(),
+            modes: LaneModes::default(),
+            open: [[0.0; LANES]; MAX_WALLS],
+            fed: [false; LANES],
+            pending: [0; LANES],
+            max_accepted: [0; LANES],
+            step: LaneStep::default(),
+            end_gaps: [[[0.0; LANES]; 2]; MAX_WALLS],
+            dt: options.dt.unwrap_or(f64::NAN),
+        };
+        for (l, (system, initial)) in members.iter().enumerate() {
+            let run = FixedRun::new(
+                system,
+                &mut me.steppers[l],
+                initial,
+                options,
+                ContactTiming::Located,
+            );
+            match run {
+                Ok(run) => {
+                    me.max_accepted[l] = options
+                        .max_steps
+                        .saturating_sub(run.run.control.rejected + 1);
+                    me.runs.push(Some(run));
+                    me.load(l);
+                }
+                Err(e) => {
+                    me.results[l] = Some(Err(e));
+                    me.runs.push(None);
+                }
+            }
+        }
+        me
+    }
+
+    fn run<L: LaneLaw>(
+        mut self,
+        group: Option<&Group<L>>,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<Result<SystemSolution>>> {
+        // Every run is on the grid's `grid`-th point: a fixed step, plain
+        // or the kernel's, is one grid step and one accepted step.
+        let mut grid = 0u64;
+        while self.runs.iter().any(Option::is_some) {
+            let time = grid as f64 * self.dt;
+            match group.and_then(|g| Some((g, self.plain_window(grid)?))) {
+                Some((group, in_window)) => self.plain_steps(group, grid, in_window),
+                None => {
+                    if let Some(group) = group {
+                        self.attempt(group, time);
+                    }
+                    for l in 0..self.runs.len() {
+                        self.kernel_step(l);
+                    }
+                }
+            }
+            grid += 1;
+            if grid % POLL_INTERVAL == 0 && interrupt() {
+                return Err(Error::Interrupted { time });
+            }
+        }
+        Ok(self
+            .results
+            .into_iter()
+            .map(|r| r.expect("every run ended"))
+            .collect())
+    }
+
+    /// Whether every run's next step from grid point `grid` may be plain
+    /// (the kernel's rule, after its first step, within the step limit),
+    /// and if so whether it is in the recorded window.
+    fn plain_window(&self, grid: u64) -> Option<bool> {
+        if grid == 0 {
+            return None;
+        }
+        let mut in_window = false;
+        for (l, run) in self.runs.iter().enumerate() {
+            let Some(run) = run else { continue };
+            if !self.fed[l] || grid >= self.max_accepted[l] {
+                return None;
+            }
+            let run = &run.run;
+            let mut clock = run.clock;
+            let pending = self.pending[l];
+            clock.until_kept = clock.until_kept.saturating_sub(pending);
+            (clock.grid, clock.accepted) = (grid, grid);
+            clock.time = grid as f64 * self.dt;
+            in_window = run.schedule.plain_fixed_summed_step(&clock)?.1;
+        }
+        Some(in_window)
+    }
+
+    /// Each run's force at the stages of the step from `time` (through its
+    /// own cache, in the stages' order), and the lanes' attempt of that
+    /// step, which a run taking the step itself is given.
+    fn attempt<L: LaneLaw>(&mut self, group: &Group<L>, time: f64) {
+        let times = stage_times(time, self.dt);
+        let mut values = [[0.0; LANES]; 4];
+        for (l, run) in self.runs.iter_mut().enumerate() {
+            let (Some(run), Some(signal)) = (run, group.signal(l)) else {
+                continue;
+            };
+            for (value, t) in values.iter_mut().zip(times) {
+                value[l] = run.run.scratch.first_force_value(signal, t);
+            }
+        }
+        group.step(&self.lanes.y, self.dt, &self.modes, &values, &mut self.step);
+        for (l, stepper) in self.steppers.iter_mut().enumerate() {
+            if self.fed[l] && self.runs[l].is_some() {
+                stepper.stash(time, self.dt, &self.step, l);
+            }
+        }
+    }
+
+    /// A step from grid point `grid` of every lane: plain for the lanes
+    /// whose step is, the kernel's for the others.
+    fn plain_steps<L: LaneLaw>(&mut self, group: &Group<L>, grid: u64, in_window: bool) {
+        let (dt, time) = (self.dt, grid as f64 * self.dt);
+        let next = (grid + 1) as f64 * dt;
+        let times = stage_times(time, dt);
+        let mut values = [[0.0; LANES]; 4];
+        let mut live = [false; LANES];
+        for (l, run) in self.runs.iter_mut().enumerate() {
+            let Some(run) = run else { continue };
+            live[l] = true;
+            if let Some(signal) = group.signal(l) {
+                for (value, t) in values.iter_mut().zip(times) {
+                    value[l] = run.run.scratch.first_force_value(signal, t);
+                }
+            }
+        }
+        // The reductions' cache of a lane whose step is not plain is put
+        // back: its run's own step takes the values again.
+        let mut saved = [None; LANES];
+        let mut reduce_values = [[0.0; LANES]; 2];
+        let summed = in_window && self.mean_square;
+        for (l, run) in self.runs.iter_mut().enumerate() {
+            let (Some(run), Some(signal), true) = (run, group.signal(l), summed) else {
+                continue;
+            };
+            let scratch = &mut run.run.reduce_scratch;
+            saved[l] = scratch.first_cache().copied();
+            reduce_values[0][l] = scratch.first_force_value(signal, time);
+            reduce_values[1][l] = scratch.first_force_value(signal, time + dt);
+        }
+        let step = PlainStep {
+            h: dt,
+            modes: &self.modes,
+            open: &self.open,
+            live,
+            in_window,
+            values: &values,
+            reduce_values: summed.then_some(&reduce_values),
+        };
+        let plain = group.plain_step(&step, &mut self.lanes, &mut self.step, &mut self.end_gaps);
+        for (l, run) in self.runs.iter_mut().enumerate() {
+            if let (Some(run), Some(cache), false) = (run, saved[l], plain[l]) {
+                if let Some(to) = run.run.reduce_scratch.first_cache() {
+                    *to = cache;
+                }
+            }
+        }
+        self.go_on(&plain);
+        group.advance(&plain, &self.step.end, &self.end_gaps, &mut self.lanes);
+        for l in 0..self.runs.len() {
+            if plain[l] {
+                self.pending[l] += 1;
+                self.balance(l, grid + 1, next);
+            } else if live[l] {
+                self.steppers[l].stash(time, dt, &self.step, l);
+                self.kernel_step(l);
+            }
+        }
+    }
+
+    /// The contacts that go on through the plain steps of the lanes in
+    /// `plain`: their deepest indentation and dissipation, as the kernel's
+    /// fixed step sums them.
+    fn go_on(&mut self, plain: &[bool; LANES]) {
+        let dt = self.dt;
+        let located = true;
+        let mut end = [0.0; MAX_LEN];
+        for (l, run) in self.runs.iter_mut().enumerate() {
+            let Some(run) = run else { continue };
+            let run = &mut run.run;
+            if !plain[l] || run.open.iter().all(Option::is_none) {
+                continue;
+            }
+            let system = self.systems[l];
+            let len = system.state_len().min(MAX_LEN);
+            for e in 0..len {
+                end[e] = self.step.end[e][l];
+            }
+            for (w, oc) in run.open.iter_mut().enumerate() {
+                let Some(oc) = oc.as_mut() else { continue };
+                let (g0, r0) = (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]);
+                let (g1, r1) = (self.end_gaps[w][0][l], self.end_gaps[w][1][l]);
+                fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+                fixed::press(system, w, oc, &end[..len], run.modes[w], dt);
+            }
+        }
+    }
+
+    /// The energy balance after lane `l`'s plain `accepted`-th step, ending
+    /// at `time`, where it is due (the kernel's cadence); a failure ends
+    /// the run.
+    fn balance(&mut self, l: usize, accepted: u64, time: f64) {
+        let Some(run) = self.runs[l].as_mut() else {
+            return;
+        };
+        let run = &mut run.run;
+        let Some(check) = run.energy.due(accepted, false, time) else {
+            return;
+        };
+        let len = run.y.len().min(MAX_LEN);
+        for e in 0..len {
+            run.y[e] = self.lanes.y[e][l];
+        }
+        let system = self.systems[l];
+        if let Err(e) = run
+            .energy
+            .balance(system, (&run.y, &run.modes), check, time)
+        {
+            self.runs[l] = None;
+            self.results[l] = Some(Err(e));
+        }
+    }
+
+    /// Run `l`'s next step taken by the run itself (and what follows it),
+    /// brought up to date with the lanes before and read back after.
+    fn kernel_step(&mut self, l: usize) {
+        if self.runs[l].is_none() {
+            return;
+        }
+        self.store(l);
+        let (Some(run), stepper) = (self.runs[l].as_mut(), &mut self.steppers[l]) else {
+            return;
+        };
+        let next = run.step(stepper, &mut || false);
+        stepper.taken();
+        match next {
+            Ok(true) => self.load(l),
+            Ok(false) => {
+                let run = self.runs[l].take().expect("a run in progress");
+                self.results[l] = Some(Ok(run.finish(&self.steppers[l])));
+            }
+            Err(e) => {
+                self.runs[l] = None;
+                self.results[l] = Some(Err(e));
+            }
+        }
+    }
+
+    /// Run `l` brought up to date: the lanes' state, gaps and reductions,
+    /// and its clock, step count and evaluations past its plain steps.
+    fn store(&mut self, l: usize) {
+        let (true, Some(run)) = (self.vector, self.runs[l].as_mut()) else {
+            return;
+        };
+        let run = &mut run.run;
+        let len = run.y.len().min(MAX_LEN);
+        for e in 0..len {
+            run.y[e] = self.lanes.y[e][l];
+        }
+        for (w, gap) in run.gaps.start.iter_mut().enumerate().take(MAX_WALLS) {
+            *gap = (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]);
+        }
+        let reductions = &mut run.reductions;
+        for (j, peak) in reductions.peaks.iter_mut().enumerate() {
+            *peak = self.lanes.peaks[j][l];
+        }
+        for (j, square) in reductions.square_integrals.iter_mut().enumerate() {
+            *square = self.lanes.squares[j][l];
+        }
+        reductions.recorded_time = self.lanes.recorded[l];
+        let pending = std::mem::take(&mut self.pending[l]);
+        if pending > 0 {
+            let clock = &mut run.clock;
+            clock.grid += pending;
+            clock.accepted += pending;
+            clock.until_kept = clock.until_kept.saturating_sub(pending);
+            clock.time = clock.grid as f64 * self.dt;
+            run.stalled = 0;
+            self.steppers[l].plain_steps(pending);
+        }
+    }
+
+    /// The lanes' copy of run `l` (after its own step).
+    fn load(&mut self, l: usize) {
+        let (true, Some(run)) = (self.vector, self.runs[l].as_ref()) else {
+            return;
+        };
+        let run = &run.run;
+        for (e, v) in run.y.iter().enumerate().take(MAX_LEN) {
+            self.lanes.y[e][l] = *v;
+        }
+        for (w, (gap, rate)) in run.gaps.start.iter().enumerate().take(MAX_WALLS) {
+            (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]) = (*gap, *rate);
+        }
+        let reductions = &run.reductions;
+        for (j, peak) in reductions.peaks.iter().enumerate() {
+            self.lanes.peaks[j][l] = *peak;
+        }
+        for (j, square) in reductions.square_integrals.iter().enumerate() {
+            self.lanes.squares[j][l] = *square;
+        }
+        self.lanes.recorded[l] = reductions.recorded_time;
+        self.fed[l] = self.modes.set(l, &run.modes);
+        for (w, oc) in run.open.iter().enumerate().take(MAX_WALLS) {
+            self.open[w][l] = if oc.is_some() { 1.0 } else { 0.0 };
+        }
+    }
+}
