@@ -184,41 +184,49 @@ impl<L: LaneLaw> Walls<L> {
 /// struct: as a function's distinct references they are known not to
 /// overlap, and the loop vectorises (inline, it ran lane by lane).
 #[inline(always)]
-fn stage_point(point: &mut V, start: &V, a: f64, k: &V) {
+fn stage_point(start: &V, a: f64, k: &V) -> V {
+    let mut point = [0.0; LANES];
     for l in 0..LANES {
         point[l] = start[l] + a * k[l];
     }
+    point
 }
 
 /// `sum + h x` of every lane (see [`stage_point`]).
 #[inline(always)]
-fn accumulate(sum: &mut V, h: &V, x: &V) {
+fn accumulate(sum: &V, h: &V, x: &V) -> V {
+    let mut out = [0.0; LANES];
     for l in 0..LANES {
-        sum[l] += h[l] * x[l];
+        out[l] = sum[l] + h[l] * x[l];
     }
+    out
 }
 
 /// `acceleration + push total` in the lanes where `add` is not 0 (see
 /// [`stage_point`]).
 #[inline(always)]
-fn push_where(acceleration: &mut V, push: &V, total: &V, add: &V) {
+fn push_where(acceleration: &V, push: &V, total: &V, add: &V) -> V {
+    let mut out = [0.0; LANES];
     for l in 0..LANES {
         let pushed = acceleration[l] + push[l] * total[l];
-        acceleration[l] = if add[l] != 0.0 {
+        out[l] = if add[l] != 0.0 {
             pushed
         } else {
             acceleration[l]
         };
     }
+    out
 }
 
 /// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane (see
 /// [`stage_point`]).
 #[inline(always)]
-fn combine(end: &mut V, start: &V, w: &[f64; 4], [k0, k1, k2, k3]: [&V; 4]) {
+fn combine(start: &V, w: &[f64; 4], [k0, k1, k2, k3]: [&V; 4]) -> V {
+    let mut end = [0.0; LANES];
     for l in 0..LANES {
         end[l] = start[l] + w[0] * k0[l] + w[1] * k1[l] + w[2] * k2[l] + w[3] * k3[l];
     }
+    end
 }
 
 /// Walls touched by at most this many lanes are evaluated lane by lane.
@@ -503,8 +511,9 @@ impl<L: LaneLaw> Group<L> {
             // `h_dot`'s two sums, each lane innermost (what vectorises).
             let (mut sx, mut sv) = ([[-0.0; LANES]; 2], [[-0.0; LANES]; 2]);
             for i in 0..d {
-                accumulate(&mut sx[i % 2], &wall.h[i], &y[i]);
-                accumulate(&mut sv[i % 2], &wall.h[i], &y[d + i]);
+                let (x, v) = (&mut sx[i % 2], &mut sv[i % 2]);
+                *x = accumulate(x, &wall.h[i], &y[i]);
+                *v = accumulate(v, &wall.h[i], &y[d + i]);
             }
             // In simple loops, each of which vectorises.
             let (mut indentation, mut rate) = ([0.0; LANES], [0.0; LANES]);
@@ -551,7 +560,7 @@ impl<L: LaneLaw> Group<L> {
                 };
             }
             for i in 0..d {
-                push_where(&mut out[d + i], &wall.push[i], &total, &add);
+                out[d + i] = push_where(&out[d + i], &wall.push[i], &total, &add);
             }
         }
         out[2 * d + VISCOUS] = viscous;
@@ -635,24 +644,19 @@ impl<L: LaneLaw> Group<L> {
         self.rates((n, k), start, &values[0], modes, &factor, first);
         let [k1, k2, k3] = &mut **stages;
         for e in 0..coordinates {
-            stage_point(&mut point[e], &start[e], hw[0], &first[e]);
+            point[e] = stage_point(&start[e], hw[0], &first[e]);
         }
         self.rates((n, k), point, &values[1], modes, &factor, k1);
         for e in 0..coordinates {
-            stage_point(&mut point[e], &start[e], hw[1], &k1[e]);
+            point[e] = stage_point(&start[e], hw[1], &k1[e]);
         }
         self.rates((n, k), point, &values[2], modes, &factor, k2);
         for e in 0..coordinates {
-            stage_point(&mut point[e], &start[e], hw[2], &k2[e]);
+            point[e] = stage_point(&start[e], hw[2], &k2[e]);
         }
         self.rates((n, k), point, &values[3], modes, &factor, k3);
         for e in 0..len {
-            combine(
-                &mut end[e],
-                &start[e],
-                &w,
-                [&first[e], &k1[e], &k2[e], &k3[e]],
-            );
+            end[e] = combine(&start[e], &w, [&first[e], &k1[e], &k2[e], &k3[e]]);
         }
     }
 }
