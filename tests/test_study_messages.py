@@ -93,6 +93,19 @@ def test_a_stopped_study_notes_its_chunks_and_a_resumed_one_says_so(tmp_path: Pa
         f"1 of 3 chunks (5 of 12 runs) done, kept in {parts}; to resume, run the same study "
         "into the same output again"
     ]
+    # Interrupted at the very moment it says it resumes (Ctrl-C just after that line):
+    # it still says what is kept (the notice was made before the guarded run, so such
+    # an interrupt went out bare, as the CLI test above once saw under load).
+
+    def interrupted(line: str) -> None:
+        raise Stop
+
+    with pytest.raises(Stop) as stopped:
+        st.run(study, out, notice=interrupted)
+    assert stopped.value.__notes__ == [
+        f"1 of 3 chunks (5 of 12 runs) done, kept in {parts}; to resume, run the same study "
+        "into the same output again"
+    ]
     notices: list[str] = []
     st.run(study, out, notice=notices.append)
     assert notices == [

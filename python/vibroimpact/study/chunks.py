@@ -107,11 +107,6 @@ def run(
                 # Written whole, so damaged since (a disk, a hand): run it again.
                 pass
     pending = [number for number in range(len(path_of)) if number not in parts]
-    if parts and notice is not None:
-        notice(
-            f"resuming from {parts_dir}: {_kept(study, chunks, path_of)} by an earlier run, "
-            f"{len(pending)} chunks to run"
-        )
     start = time.perf_counter()
     state = {"computed": 0, "done": study.runs - sum(len(chunks[i]) for i in pending)}
 
@@ -126,6 +121,12 @@ def run(
             progress(state["done"], study.runs, rate)
 
     try:
+        # Inside the try: an interrupt just after the notice still says what is kept.
+        if parts and notice is not None:
+            notice(
+                f"resuming from {parts_dir}: {_kept(study, chunks, path_of)} by an earlier "
+                f"run, {len(pending)} chunks to run"
+            )
         if dask is None:
             for number in pending:
                 runs = chunks[number]
