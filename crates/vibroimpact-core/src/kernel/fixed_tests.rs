@@ -405,15 +405,20 @@ fn fixed_rk4_s_fast_path_is_its_general_path_to_the_bit() {
             hertz(),
             Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap(),
         ];
-        for (contact, timing) in laws
-            .iter()
-            .flat_map(|c| [(c, ContactTiming::Located), (c, ContactTiming::StepCount)])
-        {
+        // Unforced too: the free flights' stretch without a force.
+        let cases = laws.iter().flat_map(|c| {
+            [
+                (c, ContactTiming::Located, true),
+                (c, ContactTiming::StepCount, true),
+            ]
+        });
+        for (contact, timing, forced) in cases.chain([(&laws[0], ContactTiming::Located, false)]) {
             let mut spec = spec(&system, contact);
             spec.excitations = vec![crate::model::assembly::Excitation {
                 load: crate::model::assembly::Load::Force { at: 0.0 },
                 signal: crate::model::signals::Signal::harmonic(20.0, 9.0, 0.3).unwrap(),
             }];
+            spec.excitations.truncate(usize::from(forced));
             let assembly = Assembly::new(&spec).unwrap();
             assert!(assembly.compact.is_some());
             let y = initial_state(&assembly, &[0.0], &[0.0], &[0.0], &[0.3]).unwrap();

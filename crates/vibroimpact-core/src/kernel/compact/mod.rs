@@ -163,10 +163,12 @@ impl Compact {
 
     /// [`Assembly::rates_with`] for `n` modes and `k` dampers (constants
     /// where inlined); sticking pairs' constraint forces by `system`'s own
-    /// solve.
+    /// solve. `FREE`: every wall open and no gravity (see [`Self::free`]),
+    /// the walls' and the inertial load's terms then left out at compile
+    /// time (the zeros they add: the same bits).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn rates<const STICKING: bool>(
+    fn rates<const STICKING: bool, const FREE: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -178,8 +180,9 @@ impl Compact {
         out: &mut [f64; MAX_LEN],
     ) {
         let d = n + k;
-        // The general path's sum of no base signal and gravity.
-        let inertial = 0.0 + self.gravity;
+        // The general path's sum of no base signal and gravity (+0 without
+        // gravity: a constant the elastic term's test folds).
+        let inertial = if FREE { 0.0 } else { 0.0 + self.gravity };
         let mut input = 0.0;
         let mut viscous = 0.0;
         // The accelerations, summed here term by term in the general path's
@@ -218,7 +221,8 @@ impl Compact {
         // Each wall's loss rate, held apart: indexed by the wall (a number
         // known at run time), the stages themselves would be kept in memory.
         let mut losses = [0.0; MAX_WALLS];
-        for w in 0..count {
+        // Free: every wall open, no force and no loss (as the loop finds).
+        for w in 0..if FREE { 0 } else { count } {
             let wall = &self.walls[w];
             let previous = products.take();
             if let (Mode::Compliant { approach_rate }, Some((law, damping))) =
@@ -290,7 +294,7 @@ impl Compact {
     /// `start_valid`, and receives it where not.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn step<const STICKING: bool>(
+    fn step<const STICKING: bool, const FREE: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -317,26 +321,34 @@ impl Compact {
         let w = [h * RK4_B[0], h * RK4_B[1], h * RK4_B[2], h * RK4_B[3]];
         let [k0, k1, k2, k3] = stages;
         if !start_valid {
-            self.rates::<STICKING>(system, n, k, times[0], start, modes, scratch, k0);
+            self.rates::<STICKING, FREE>(system, n, k, times[0], start, modes, scratch, k0);
         }
         // The stages written out (a loop over them keeps less in registers).
         let mut point = [0.0; MAX_LEN];
         for e in 0..coordinates {
             point[e] = start[e] + hw[0] * k0[e];
         }
-        self.rates::<STICKING>(system, n, k, times[1], &point, modes, scratch, k1);
+        self.rates::<STICKING, FREE>(system, n, k, times[1], &point, modes, scratch, k1);
         for e in 0..coordinates {
             point[e] = start[e] + hw[1] * k1[e];
         }
-        self.rates::<STICKING>(system, n, k, times[2], &point, modes, scratch, k2);
+        self.rates::<STICKING, FREE>(system, n, k, times[2], &point, modes, scratch, k2);
         for e in 0..coordinates {
             point[e] = start[e] + hw[2] * k2[e];
         }
-        self.rates::<STICKING>(system, n, k, times[3], &point, modes, scratch, k3);
+        self.rates::<STICKING, FREE>(system, n, k, times[3], &point, modes, scratch, k3);
         // Over every wall's room (a length fixed at compile time; the rooms
         // past the system's walls hold zeros).
-        for e in 0..coordinates + CONTACT + MAX_WALLS {
+        let walls = coordinates + CONTACT;
+        for e in 0..if FREE { walls } else { walls + MAX_WALLS } {
             out[e] = start[e] + w[0] * k0[e] + w[1] * k1[e] + w[2] * k2[e] + w[3] * k3[e];
+        }
+        if FREE {
+            // No loss in any stage: `w k` is +0 (`h > 0`), and the sum the
+            // start's plus zeros.
+            for e in walls..walls + MAX_WALLS {
+                out[e] = start[e] + 0.0;
+            }
         }
     }
 
@@ -370,7 +382,7 @@ impl Compact {
         // One body for every mode (with no pair sticking, the constraint
         // branch is skipped at run time): the stretches, where speed counts,
         // compile the two apart.
-        self.step::<true>(
+        self.step::<true, false>(
             system,
             n,
             k,
@@ -389,6 +401,12 @@ impl Compact {
         out[..len].copy_from_slice(&end[..len]);
     }
 
+    /// Whether the stages in `modes` are free flight: every wall open and
+    /// no gravity (`FREE` in [`Self::rates`]).
+    pub(crate) fn free(&self, modes: &[Mode]) -> bool {
+        self.gravity == 0.0 && modes.iter().all(|m| *m == Mode::Open)
+    }
+
     /// Each wall's damping factor on the indentation rate where its law
     /// damps ([`HysterHertz`]: `alpha / delta'_minus`, the latched approach
     /// rate's quotient): the division made once for the steps in `modes`
@@ -404,6 +422,24 @@ impl Compact {
             }
         }
         factors
+    }
+
+    /// Whether a wall's gap at `y` is below zero: the gaps' displacements
+    /// alone, as [`Self::gaps`] sums them.
+    #[inline(always)]
+    fn indented(&self, d: usize, y: &[f64; MAX_LEN]) -> bool {
+        let mut hx = 0.0;
+        let mut indented = false;
+        for w in 0..self.count.min(MAX_WALLS) {
+            let wall = &self.walls[w];
+            hx = if wall.mirror {
+                -hx
+            } else {
+                wall.gap_products(d, y).0
+            };
+            indented |= wall.offset + hx < 0.0;
+        }
+        indented
     }
 
     /// Every wall's gap and rate at `y`, as [`Assembly::gaps`] gives them.

@@ -49,7 +49,7 @@ impl Compact {
     /// peak inside the step, a state no longer finite) is taken back, for
     /// the kernel to take.
     #[inline(always)]
-    pub(crate) fn stretch<const STICKING: bool>(
+    pub(crate) fn stretch<const STICKING: bool, const FREE: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -91,7 +91,7 @@ impl Compact {
             let time = clock.time;
             let next = time + length;
             let cache = scratch.first_cache().copied();
-            self.step::<STICKING>(
+            self.step::<STICKING, FREE>(
                 system,
                 n,
                 k,
@@ -115,7 +115,7 @@ impl Compact {
                 // pulls is released: the forces as the event search takes
                 // them.
                 let at = (modes, &factors);
-                self.rates::<true>(system, n, k, next, &end, at, scratch, &mut stages[0]);
+                self.rates::<true, false>(system, n, k, next, &end, at, scratch, &mut stages[0]);
                 for w in 0..count {
                     if modes[w] == Mode::Sticking
                         && !locked[w]
@@ -173,8 +173,9 @@ impl Compact {
     /// the bit. One that turns out not to be plain (a contact begins or ends
     /// in it, a peak inside it, a state no longer finite) is taken back, for
     /// the kernel to take. No pair sticks in fixed stepping (no rigid pair).
+    /// `FREE`: free flight ([`Compact::free`]).
     #[inline(always)]
-    pub(crate) fn fixed_stretch(
+    pub(crate) fn fixed_stretch<const FREE: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -206,7 +207,7 @@ impl Compact {
             };
             let time = clock.time;
             let cache = scratch.first_cache().copied();
-            self.step::<false>(
+            self.step::<false, FREE>(
                 system,
                 n,
                 k,
@@ -219,12 +220,18 @@ impl Compact {
                 false,
                 &mut end,
             );
-            self.gaps(d, &end, &mut end_gaps);
             let mut plain = end[..2 * d].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
-            for w in 0..count {
-                // Indented at the end exactly where in contact: no onset or
-                // separation in the step.
-                plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
+            if FREE {
+                // No contact: none may begin (the gaps themselves are
+                // needed only where the stretch ends).
+                plain &= !self.indented(d, &end);
+            } else {
+                self.gaps(d, &end, &mut end_gaps);
+                for w in 0..count {
+                    // Indented at the end exactly where in contact: no onset
+                    // or separation in the step.
+                    plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
+                }
             }
             if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
                 plain = false;
@@ -235,7 +242,7 @@ impl Compact {
                 }
                 break;
             }
-            for w in 0..count {
+            for w in 0..if FREE { 0 } else { count } {
                 if let Some(oc) = f.open[w].as_mut() {
                     let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
                     fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
@@ -263,6 +270,9 @@ impl Compact {
                 break;
             }
         }
+        if FREE && f.steps > 0 {
+            self.gaps(d, &y, &mut start_gaps);
+        }
         *f.energy = energy;
         *f.clock = clock;
         f.y[..len].copy_from_slice(&y[..len]);
@@ -279,13 +289,17 @@ fn stretch_sized(
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
-    // Without a sticking pair, no constraint solve is compiled in.
+    // Without a sticking pair, no constraint solve is compiled in; in free
+    // flight, no wall's force and no gravity.
     if modes.contains(&Mode::Sticking) {
         by_size!(system, |n, k| compact
-            .stretch::<true>(system, n, k, f, modes, scratch))
+            .stretch::<true, false>(system, n, k, f, modes, scratch))
+    } else if compact.free(modes) {
+        by_size!(system, |n, k| compact
+            .stretch::<false, true>(system, n, k, f, modes, scratch))
     } else {
         by_size!(system, |n, k| compact
-            .stretch::<false>(system, n, k, f, modes, scratch))
+            .stretch::<false, false>(system, n, k, f, modes, scratch))
     }
 }
 
@@ -298,8 +312,13 @@ fn fixed_sized(
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
-    by_size!(system, |n, k| compact
-        .fixed_stretch(system, n, k, f, modes, scratch))
+    if compact.free(modes) && f.open.iter().all(Option::is_none) {
+        by_size!(system, |n, k| compact
+            .fixed_stretch::<true>(system, n, k, f, modes, scratch))
+    } else {
+        by_size!(system, |n, k| compact
+            .fixed_stretch::<false>(system, n, k, f, modes, scratch))
+    }
 }
 
 /// [`stretch_sized`] compiled for a processor feature.
