@@ -91,10 +91,9 @@ pub struct PaperNewmark {
     valid: bool,
     powers_valid: bool,
     /// Work space: the predictor `(x*, v*)`, the right-hand side and the
-    /// new accelerations, the rates, and a matrix for the inverse.
+    /// rates, and a matrix for the inverse.
     predictor: Vec<f64>,
     residual: Vec<f64>,
-    solved: Vec<f64>,
     rates: Vec<f64>,
     matrix: Vec<f64>,
     /// One a step, as 0.1 counted the method (the accelerations made again
@@ -166,7 +165,6 @@ impl PaperNewmark {
             powers_valid: false,
             predictor: vec![0.0; 2 * dim],
             residual: vec![0.0; dim],
-            solved: vec![0.0; dim],
             rates: vec![0.0; len],
             matrix: vec![0.0; dim * dim],
             evaluations: 0,
@@ -324,7 +322,8 @@ impl PaperNewmark {
             &self.apart.inverse
         };
         let residual = &self.residual[..d];
-        for (i, a1) in self.solved[..d].iter_mut().enumerate() {
+        let solved = &mut self.pending_accel[..d];
+        for (i, a1) in solved.iter_mut().enumerate() {
             // Summed in order from the first product (0.1's `a r + b s`).
             let row = &inverse[i * d..(i + 1) * d];
             let mut sum = row[0] * residual[0];
@@ -334,19 +333,18 @@ impl PaperNewmark {
             *a1 = sum;
         }
         let (bb, gg) = (beta * h * h, gamma * h);
-        let (predictor, solved) = (&self.predictor[..2 * d], &self.solved[..d]);
+        let predictor = &self.predictor[..2 * d];
         for i in 0..d {
             out[i] = predictor[i] + bb * solved[i];
             out[d + i] = predictor[d + i] + gg * solved[i];
         }
         // The accumulators by the trapezoidal rule on their rates.
-        out[2 * d..].copy_from_slice(&y[2 * d..]);
-        let mut rates = std::mem::take(&mut self.rates);
-        let end = &mut rates[2 * d..];
-        self.end_powers(system, (n, d), time + h, &out[..2 * d], modes, end);
-        self.powers.add(h, end, &mut out[2 * d..]);
-        self.rates = rates;
-        self.pending_accel.copy_from_slice(&self.solved);
+        let mut powers = std::mem::take(&mut self.powers);
+        let (xv, accumulators) = out.split_at_mut(2 * d);
+        powers.integrate(h, &y[2 * d..], accumulators, |end| {
+            self.end_powers(system, (n, d), time + h, xv, modes, end)
+        });
+        self.powers = powers;
     }
 
     /// The accumulators' rates at `(time, xv)` in `modes` (W) into `out`, as

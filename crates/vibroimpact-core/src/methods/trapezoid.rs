@@ -8,7 +8,7 @@ use crate::model::assembly::{Assembly, Mode, Scratch};
 /// velocities) of the Newmark family's steps by the trapezoidal rule on
 /// their rates, second order like the methods: the rates at the current
 /// point and at the end of the last attempt.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Trapezoid {
     start: Vec<f64>,
     pending: Vec<f64>,
@@ -61,6 +61,29 @@ impl Trapezoid {
             *slot += 0.5 * h * (self.start[k] + end[k]);
         }
         self.pending.copy_from_slice(end);
+    }
+
+    /// The accumulators `out` at the end of a step `h` from their values
+    /// `start` (the step's start's), with their rates at the end written by
+    /// `end_rates` (into the pending slot, with no copy): [`Self::add`]'s
+    /// arithmetic.
+    #[inline(always)]
+    pub(crate) fn integrate(
+        &mut self,
+        h: f64,
+        start: &[f64],
+        out: &mut [f64],
+        end_rates: impl FnOnce(&mut [f64]),
+    ) {
+        end_rates(&mut self.pending);
+        let count = out
+            .len()
+            .min(start.len())
+            .min(self.start.len())
+            .min(self.pending.len());
+        for k in 0..count {
+            out[k] = start[k] + 0.5 * h * (self.start[k] + self.pending[k]);
+        }
     }
 
     /// The last attempt's end is the new current point.
