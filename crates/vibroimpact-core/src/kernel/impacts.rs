@@ -67,14 +67,20 @@ pub(crate) struct Impacts {
 
 impl Impacts {
     pub(crate) fn new(system: &Assembly) -> Self {
-        let count = system.interactions.len();
+        // A system without rigid pairs never resolves any: no buffers (a
+        // run's set-up allocates each, and a short run's cost is set-up).
+        let (count, dim) = if system.has_rigid() {
+            (system.interactions.len(), system.dim)
+        } else {
+            (0, 0)
+        };
         Self {
             touching: vec![false; count],
             members: Vec::with_capacity(count),
             roles: Vec::with_capacity(count),
             stuck: Vec::with_capacity(count),
             before: Vec::with_capacity(count),
-            velocities: vec![0.0; system.dim],
+            velocities: vec![0.0; dim],
             speed_scale: 0.0,
             lcp: Complementarity::new(count),
         }
@@ -85,7 +91,9 @@ impl Impacts {
     pub(crate) fn mark(&mut self, system: &Assembly, i: usize, mode: Mode) -> bool {
         let open_rigid = mode == Mode::Open
             && matches!(system.interactions[i].law, InteractionLaw::Rigid { .. });
-        self.touching[i] |= open_rigid;
+        if open_rigid {
+            self.touching[i] = true;
+        }
         open_rigid
     }
 

@@ -15,6 +15,11 @@ use crate::error::Error;
 /// run starts and stops any other run with [`crate::Error::MemoryLimit`].
 pub const MAX_RECORD_BYTES: u64 = 1 << 31;
 
+/// Rows a record's first growth makes room for, where the run does not
+/// know how many it keeps (fewer for a fixed-step run keeping fewer: a
+/// short run's set-up allocates what it keeps).
+pub(crate) const FIRST_ROWS: usize = 64;
+
 /// Bytes held by `v`'s allocation.
 #[inline(always)]
 pub(crate) fn held<T>(v: &Vec<T>) -> u64 {
@@ -108,20 +113,20 @@ fn grow<T>(
 }
 
 /// Appends a row, `time` to `times` and `values` to `rows`, growing both
-/// together (as many rows again as they hold, at least 64, at most half
-/// the room left) within `limit` bytes of all the run's records, of which
-/// `others` are held elsewhere (asked only when they must grow).
+/// together (as many rows again as they hold, at least `least`, at most
+/// half the room left) within `limit` bytes of all the run's records, of
+/// which `others` are held elsewhere (asked only when they must grow).
 #[inline(always)]
 pub(crate) fn push_row(
     times: &mut Vec<f64>,
     rows: &mut Vec<f64>,
-    time: f64,
-    values: &[f64],
+    (time, values): (f64, &[f64]),
+    least: usize,
     others: impl FnOnce() -> u64,
     limit: u64,
 ) -> Result<(), NoRoom> {
     if times.len() == times.capacity() || rows.capacity() - rows.len() < values.len() {
-        grow_rows(times, rows, values.len(), others(), limit)?;
+        grow_rows(times, rows, (values.len(), least), others(), limit)?;
     }
     times.push(time);
     rows.extend_from_slice(values);
@@ -133,7 +138,7 @@ pub(crate) fn push_row(
 fn grow_rows(
     times: &mut Vec<f64>,
     rows: &mut Vec<f64>,
-    width: usize,
+    (width, least): (usize, usize),
     others: u64,
     limit: u64,
 ) -> Result<(), NoRoom> {
@@ -143,7 +148,7 @@ fn grow_rows(
         return Err(NoRoom::Limit(limit));
     }
     // At most half the room left, so that the other records can still grow.
-    let more = (times.len().max(64) as u64).min((fits / 2).max(1)) as usize;
+    let more = (times.len().max(least) as u64).min((fits / 2).max(1)) as usize;
     times.try_reserve_exact(more).map_err(|_| NoRoom::Refused)?;
     rows.try_reserve_exact(more * width)
         .map_err(|_| NoRoom::Refused)
@@ -194,8 +199,8 @@ mod tests {
                 push_row(
                     &mut times,
                     &mut rows,
-                    i as f64,
-                    &[1.0, 2.0, 3.0],
+                    (i as f64, &[1.0, 2.0, 3.0]),
+                    64,
                     || 0,
                     limit,
                 )
@@ -205,7 +210,14 @@ mod tests {
             assert_eq!(times.capacity(), 100);
             assert_eq!(rows.capacity(), 300);
             assert_eq!(
-                push_row(&mut times, &mut rows, 100.0, &[1.0, 2.0, 3.0], || 0, limit),
+                push_row(
+                    &mut times,
+                    &mut rows,
+                    (100.0, &[1.0, 2.0, 3.0]),
+                    64,
+                    || 0,
+                    limit
+                ),
                 Err(NoRoom::Limit(limit))
             );
             assert_eq!((times.len(), rows.len()), (100, 300), "nothing half kept");
@@ -224,7 +236,15 @@ mod tests {
             let mut contacts: Vec<f64> = Vec::new();
             for i in 0..200 {
                 let others = held(&contacts);
-                push_row(&mut times, &mut rows, i as f64, &[0.0; 3], || others, limit).unwrap();
+                push_row(
+                    &mut times,
+                    &mut rows,
+                    (i as f64, &[0.0; 3]),
+                    64,
+                    || others,
+                    limit,
+                )
+                .unwrap();
             }
             let others = held(&times) + held(&rows);
             make_room(&mut contacts, 37, 8, || others, limit).unwrap();

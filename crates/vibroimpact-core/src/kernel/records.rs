@@ -8,7 +8,7 @@ use crate::kernel::balance::balance;
 use crate::kernel::clock::{Stop, STALLED_STEPS};
 use crate::kernel::events::SystemSolution;
 use crate::kernel::fixed;
-use crate::kernel::memory::{self, NoRoom};
+use crate::kernel::memory::{self, NoRoom, FIRST_ROWS};
 use crate::kernel::run::{poll_due, Run};
 use crate::methods::steppers::SystemStepper;
 
@@ -47,8 +47,8 @@ impl Run<'_> {
         memory::push_row(
             &mut self.time_rows,
             &mut self.states,
-            time,
-            &self.y[..row],
+            (time, &self.y[..row]),
+            self.first_rows,
             || memory::held(strobe) + memory::held(strobe_time) + memory::held(contacts),
             self.record_limit,
         )
@@ -106,8 +106,8 @@ impl Run<'_> {
             memory::push_row(
                 &mut self.reductions.strobe_time,
                 &mut self.reductions.strobe,
-                time,
-                &self.y[..row],
+                (time, &self.y[..row]),
+                FIRST_ROWS,
                 || memory::held(rows) + memory::held(states) + memory::held(contacts),
                 self.record_limit,
             )

@@ -15,6 +15,7 @@ use crate::kernel::locate::{
     any_compliant, event_value, find_crossing, locate, may_cross, past, wall_round_off, Buffers,
     Crossing, Gaps, Location,
 };
+use crate::kernel::memory::FIRST_ROWS;
 use crate::kernel::reductions::{reduce_step, Reductions};
 use crate::methods::step_control::{rejects, StepControl};
 use crate::methods::steppers::SystemStepper;
@@ -128,6 +129,20 @@ pub(super) struct Run<'a> {
     /// The pairs with a compliant wall, and their forces at each kept row.
     pub(super) force_pairs: Vec<usize>,
     pub(super) contact_forces: Vec<f64>,
+    /// History rows the first growth makes room for (see [`first_rows`]).
+    pub(super) first_rows: usize,
+}
+
+/// History rows the first growth of a run's history makes room for:
+/// [`FIRST_ROWS`], or fewer where a fixed-step run keeps fewer (its steps
+/// to `t_end`, each `every`-th kept, with the first and last rows).
+fn first_rows(schedule: &Schedule) -> usize {
+    let steps = (schedule.t_end / schedule.dt).ceil();
+    // NaN (no dt) or as many steps as the rows: the first growth's.
+    if schedule.adaptive || steps.is_nan() || steps >= FIRST_ROWS as f64 {
+        return FIRST_ROWS;
+    }
+    (steps as usize / schedule.every.max(1) as usize + 2).min(FIRST_ROWS)
 }
 
 /// Every compliant interaction in contact (see [`Run::all_compliant`]).
@@ -277,6 +292,7 @@ impl<'a> Run<'a> {
             all_compliant: all_compliant(system),
             force_pairs: force_pairs(system),
             contact_forces: Vec::new(),
+            first_rows: first_rows(&schedule),
             poll_every: interrupt_interval(system.dim),
             timed_polls: system.dim > TIMED_POLLS_BEYOND,
             last_poll: std::time::Instant::now(),

@@ -107,7 +107,7 @@ impl SystemStepper for LaneStepper {
             self.start_valid = true;
             return Ok(0.0);
         }
-        let compact = system.compact.as_deref().ok_or_else(|| {
+        let compact = system.compact.as_ref().ok_or_else(|| {
             Error::Inconsistent("lockstep lanes take small modal systems only".into())
         })?;
         compact.rk4(

@@ -345,7 +345,7 @@ impl<L: LaneLaw> Group<L> {
     pub(crate) fn of(assemblies: &[&Assembly]) -> Option<Self> {
         let systems: Vec<_> = assemblies
             .iter()
-            .map(|s| Some((s.compact.as_deref()?, s.n, s.k, s.state_len())))
+            .map(|s| Some((s.compact.as_ref()?, s.n, s.k, s.state_len())))
             .collect::<Option<_>>()?;
         let &(first, n, k, len) = systems.first()?;
         let observed = assemblies[0].observed();

@@ -682,7 +682,7 @@ mod tests {
     fn a_stretch_takes_plain_steps_as_the_general_attempts_do() {
         crate::testing::timeout(60, || {
             let system = Assembly::new(&beam(0.0)).unwrap();
-            let compact = system.compact.as_deref().unwrap();
+            let compact = system.compact.as_ref().unwrap();
             let len = system.state_len();
             let count = system.interactions.len();
             let modes = vec![Mode::Open; count];

@@ -180,15 +180,22 @@ impl SystemStepper for NewmarkFamily {
             for i in 0..d {
                 let accel = self.rates[d + i];
                 self.step[i] = -((1.0 - am) * self.a1[i] + am * self.accel[i] - accel);
+                for j in 0..d {
+                    let identity = if i == j { 1.0 - am } else { 0.0 };
+                    let (by_x, by_v) = (self.dadx[i * d + j], self.dadv[i * d + j]);
+                    self.jacobian[i * d + j] = identity - (1.0 - af) * (bx * by_x + gv * by_v);
+                }
+                if linear {
+                    // One update solves it: no convergence test to scale.
+                    continue;
+                }
                 // The scale of the equation's terms, whose round-off bounds
                 // how far Newton can go: the new and old accelerations and
                 // the stiffness and damping terms (the accelerations can be
                 // exactly zero, a pair at rest on a resting wall).
                 let mut terms = 0.0;
                 for j in 0..d {
-                    let identity = if i == j { 1.0 - am } else { 0.0 };
                     let (by_x, by_v) = (self.dadx[i * d + j], self.dadv[i * d + j]);
-                    self.jacobian[i * d + j] = identity - (1.0 - af) * (bx * by_x + gv * by_v);
                     terms += (by_x * self.point[j]).abs() + (by_v * self.point[d + j]).abs();
                 }
                 size = size

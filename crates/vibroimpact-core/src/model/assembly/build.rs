@@ -73,7 +73,7 @@ impl Assembly {
             longest_period: scales.longest_period,
             pairs,
         };
-        assembly.compact = Compact::of(&assembly).map(Box::new);
+        assembly.compact = Compact::of(&assembly);
         Ok(assembly)
     }
 

@@ -117,7 +117,7 @@ pub struct Assembly {
     pub point_rows: Vec<f64>,
     /// The system in fixed-size arrays, where it is small and modal (RK4's
     /// fast path, [`crate::kernel::compact`]).
-    pub(crate) compact: Option<Box<Compact>>,
+    pub(crate) compact: Option<Compact>,
 }
 
 /// What [`Compact::of`] reads of a modal system.

@@ -118,7 +118,13 @@ pub struct Scratch {
 
 impl Scratch {
     pub fn new(assembly: &Assembly) -> Self {
-        let m = assembly.interactions.len().max(1);
+        // Only rigid pairs stick: without one the constraint system is
+        // never solved (and a run's set-up allocates nothing for it).
+        let m = if assembly.has_rigid() {
+            assembly.interactions.len().max(1)
+        } else {
+            0
+        };
         let empty = Cached::EMPTY;
         Self {
             force_values: vec![empty; assembly.forces.len()],

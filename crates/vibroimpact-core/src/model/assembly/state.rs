@@ -11,6 +11,13 @@ impl Assembly {
         2 * self.dim + CONTACT + self.interactions.len()
     }
 
+    /// Whether any pair is rigid (only those stick or take impacts).
+    pub fn has_rigid(&self) -> bool {
+        self.interactions
+            .iter()
+            .any(|it| matches!(it.law, InteractionLaw::Rigid { .. }))
+    }
+
     /// The quantities the reductions follow: each structure coordinate, then
     /// each point of [`super::SystemSpec::points`], then each moment.
     pub fn observed(&self) -> usize {
