@@ -24,7 +24,7 @@ pub(crate) struct LaneRuns {
     pub(crate) squares: [V; MAX_OBSERVED],
     pub(crate) recorded: V,
     /// The rates at a step's ends (the mean squares' accelerations).
-    rates: Box<[LaneState; 2]>,
+    pub(crate) rates: Box<[LaneState; 2]>,
 }
 
 impl Default for LaneRuns {
@@ -53,6 +53,9 @@ pub(crate) struct PlainStep<'s> {
     /// squares) at the step's ends through the reductions' cache.
     pub(crate) values: &'s [V; 4],
     pub(crate) reduce_values: Option<&'s [V; 2]>,
+    /// Whether the rates at the start with `reduce_values[0]` are those
+    /// at the last step's end (the runs' reductions' rates, to the bit).
+    pub(crate) start_rates_kept: bool,
 }
 
 /// [`Group::plain_step_in`] compiled for a processor feature (the same
@@ -128,9 +131,22 @@ impl<L: LaneLaw> Group<L> {
         out: &mut LaneStep,
         end_gaps: &mut LaneGaps,
     ) -> [bool; LANES] {
-        self.step_in(sizes, &runs.y, p.h, p.modes, p.values, out);
+        let (n, k) = sizes;
+        let [at_start, at_end] = &mut *runs.rates;
+        let with_first = match p.reduce_values {
+            Some(_) if p.start_rates_kept => {
+                // Only the structure's accelerations are read (`reduce`).
+                let d = n + k;
+                at_start[d..d + n].copy_from_slice(&at_end[d..d + n]);
+                None
+            }
+            Some(values) => Some((&values[0], at_start)),
+            None => None,
+        };
+        self.step_in(sizes, &runs.y, p.h, p.modes, p.values, with_first, out);
         self.gaps(sizes, &out.end, end_gaps);
         let mut plain = self.plain(sizes, (&runs.y, &out.end), end_gaps, p.open, p.in_window);
+        self.power(sizes, &out.end, p, &mut out.power);
         for l in 0..LANES {
             plain[l] &= p.live[l];
         }
@@ -187,6 +203,50 @@ impl<L: LaneLaw> Group<L> {
             for l in 0..LANES {
                 out[w][0][l] = wall.offset[l] + px[l];
                 out[w][1][l] = pv[l];
+            }
+        }
+    }
+
+    /// Each wall's dissipated power at `end` where a lane is in contact
+    /// with it (`p.open`), as [`crate::kernel::fixed::press`] takes it from
+    /// the interaction's gap ([`crate::model::assembly::Assembly::gap`]'s
+    /// sums), its law at the latched approach rate and its damper.
+    #[inline(always)]
+    fn power(
+        &self,
+        (n, k): (usize, usize),
+        end: &LaneState,
+        p: &PlainStep<'_>,
+        out: &mut [V; MAX_WALLS],
+    ) {
+        let d = n + k;
+        for (w, wall) in self.walls.iter().enumerate() {
+            if p.open[w].iter().all(|o| *o == 0.0) {
+                continue;
+            }
+            // `linalg::dot`'s sums, in order.
+            let (mut hx, mut hv) = ([-0.0; LANES], [-0.0; LANES]);
+            for i in 0..d {
+                for l in 0..LANES {
+                    hx[l] += wall.h[i][l] * end[i][l];
+                    hv[l] += wall.h[i][l] * end[d + i][l];
+                }
+            }
+            let (active, approach) = (&p.modes.active[w], &p.modes.approach[w]);
+            // Lane by lane: few lanes are in contact at once (the law's
+            // root and division only in those).
+            for l in 0..LANES {
+                if p.open[w][l] == 0.0 {
+                    continue;
+                }
+                let (indentation, rate) = (-(wall.offset[l] + hx[l]), -hv[l]);
+                let parts = [wall.parts[0][l], wall.parts[1][l]];
+                let latched = if active[l] != 0.0 { approach[l] } else { 0.0 };
+                let factor = parts[1] / latched;
+                let (force, elastic) = L::force_of(parts, indentation, rate, latched, factor);
+                let total = force + wall.damping[l] * rate;
+                let power = (total - elastic) * rate;
+                out[w][l] = if indentation > 0.0 { power } else { 0.0 };
             }
         }
     }
@@ -260,11 +320,10 @@ impl<L: LaneLaw> Group<L> {
             ..
         } = runs;
         let start: &LaneState = start;
+        // The rates at the start were made with the step's first stage.
         if let Some(values) = values {
             let factor = self.factors(modes);
-            let [at_start, at_end] = &mut **rates;
-            self.rates((n, k), start, &values[0], modes, &factor, at_start);
-            self.rates((n, k), end, &values[1], modes, &factor, at_end);
+            self.rates((n, k), end, &values[1], modes, &factor, &mut rates[1]);
         }
         for j in 0..n + self.points.len() {
             let (p0, p1) = (self.observe(n, j, start, 0), self.observe(n, j, end, 0));

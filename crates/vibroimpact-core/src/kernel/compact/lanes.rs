@@ -126,8 +126,8 @@ pub(super) struct Walls<L> {
     push: [V; MAX_DIM],
     pub(super) offset: V,
     /// Each lane's law's parameters.
-    parts: [V; 2],
-    damping: V,
+    pub(super) parts: [V; 2],
+    pub(super) damping: V,
     law: std::marker::PhantomData<L>,
     pub(super) mirror: bool,
 }
@@ -151,16 +151,16 @@ impl<L: LaneLaw> Walls<L> {
 
     /// Lane `l`'s contact force on the wall with products `(hx, hv)`, in
     /// contact with the latched `approach` rate (`factor` its law's), added
-    /// to its accelerations in `out` and its loss rate into slot `loss`:
-    /// the vector's operations on that lane.
+    /// to its accelerations in each of `outs` and its loss rate into slot
+    /// `loss`: the vector's operations on that lane.
     #[inline(always)]
-    fn push_lane(
+    fn push_lane<const M: usize>(
         &self,
         l: usize,
         (hx, hv): (f64, f64),
         (approach, factor): (f64, f64),
         d: usize,
-        out: &mut LaneState,
+        outs: &mut [&mut LaneState; M],
         loss: usize,
     ) {
         let (indentation, rate) = (-(self.offset[l] + hx), -hv);
@@ -171,12 +171,14 @@ impl<L: LaneLaw> Walls<L> {
             (0.0, 0.0)
         };
         let total = force + self.damping[l] * rate;
-        if total != 0.0 {
-            for i in 0..d {
-                out[d + i][l] += self.push[i][l] * total;
+        for out in outs.iter_mut() {
+            if total != 0.0 {
+                for i in 0..d {
+                    out[d + i][l] += self.push[i][l] * total;
+                }
             }
+            out[loss][l] = (total - elastic) * rate;
         }
-        out[loss][l] = (total - elastic) * rate;
     }
 }
 
@@ -253,6 +255,9 @@ pub(crate) struct Group<L> {
 pub(crate) struct LaneStep {
     pub(crate) end: Box<LaneState>,
     pub(crate) first: Box<LaneState>,
+    /// Each wall's dissipated power at the end of a plain step, where a
+    /// lane is in contact with it ([`crate::kernel::fixed::press`]'s).
+    pub(crate) power: [V; MAX_WALLS],
     pub(super) point: Box<LaneState>,
     pub(super) stages: Box<[LaneState; 3]>,
 }
@@ -269,6 +274,7 @@ impl Default for LaneStep {
         Self {
             end: Self::state(),
             first: Self::state(),
+            power: [[0.0; LANES]; MAX_WALLS],
             point: Self::state(),
             stages: Box::new([[[0.0; LANES]; MAX_LEN]; 3]),
         }
@@ -280,7 +286,7 @@ impl Default for LaneStep {
 pub(crate) struct LaneModes {
     /// 1 in contact, 0 open (numbers: what the vector selects read).
     pub(super) active: [V; MAX_WALLS],
-    approach: [V; MAX_WALLS],
+    pub(super) approach: [V; MAX_WALLS],
 }
 
 impl LaneModes {
@@ -333,7 +339,7 @@ macro_rules! step_with {
             values: &[V; 4],
             out: &mut LaneStep,
         ) {
-            self.step_in((self.n, self.k), start, h, modes, values, out)
+            self.step_in((self.n, self.k), start, h, modes, values, None, out)
         }
     };
 }
@@ -438,19 +444,35 @@ impl<L: LaneLaw> Group<L> {
     #[inline(always)]
     pub(super) fn rates(
         &self,
-        (n, k): (usize, usize),
+        sizes: (usize, usize),
         y: &LaneState,
         value: &V,
         modes: &LaneModes,
         factor: &[V; MAX_WALLS],
         out: &mut LaneState,
     ) {
+        self.rates_of(sizes, y, [value], modes, factor, [out]);
+    }
+
+    /// [`Self::rates`] at one state `y` for each of the force's `values`
+    /// into the matching one of `outs`: what does not depend on the force
+    /// (the modes' own terms, the contacts) made once, the same bits.
+    #[inline(always)]
+    pub(super) fn rates_of<const M: usize>(
+        &self,
+        (n, k): (usize, usize),
+        y: &LaneState,
+        values: [&V; M],
+        modes: &LaneModes,
+        factor: &[V; MAX_WALLS],
+        mut outs: [&mut LaneState; M],
+    ) {
         let d = n + k;
         let mut inertial = [0.0; LANES];
         for l in 0..LANES {
             inertial[l] = 0.0 + self.gravity[l];
         }
-        let mut input = [0.0; LANES];
+        let mut input = [[0.0; LANES]; M];
         let mut viscous = [0.0; LANES];
         if let Some((push, row, _)) = &self.force {
             let mut power = [-0.0; LANES];
@@ -458,31 +480,40 @@ impl<L: LaneLaw> Group<L> {
                 let [k, c, damping, r] = &self.modal[i];
                 for l in 0..LANES {
                     let (x, v) = (y[i][l], y[d + i][l]);
-                    out[i][l] = v;
                     let own = elastic(k[l], c[l], r[l], inertial[l], x, v);
-                    out[d + i][l] = own + push[i][l] * value[l];
+                    for (out, value) in outs.iter_mut().zip(values) {
+                        out[i][l] = v;
+                        out[d + i][l] = own + push[i][l] * value[l];
+                    }
                     viscous[l] += damping[l] * v * v;
                     power[l] += row[i][l] * v;
                 }
             }
-            for l in 0..LANES {
-                input[l] += value[l] * power[l];
+            for (input, value) in input.iter_mut().zip(values) {
+                for l in 0..LANES {
+                    input[l] += value[l] * power[l];
+                }
             }
         } else {
             for i in 0..n {
                 let [k, c, damping, r] = &self.modal[i];
                 for l in 0..LANES {
                     let (x, v) = (y[i][l], y[d + i][l]);
-                    out[i][l] = v;
-                    out[d + i][l] = elastic(k[l], c[l], r[l], inertial[l], x, v);
+                    let own = elastic(k[l], c[l], r[l], inertial[l], x, v);
+                    for out in outs.iter_mut() {
+                        out[i][l] = v;
+                        out[d + i][l] = own;
+                    }
                     viscous[l] += damping[l] * v * v;
                 }
             }
         }
-        for j in n..d {
-            for l in 0..LANES {
-                out[j][l] = y[d + j][l];
-                out[d + j][l] = -inertial[l];
+        for out in outs.iter_mut() {
+            for j in n..d {
+                for l in 0..LANES {
+                    out[j][l] = y[d + j][l];
+                    out[d + j][l] = -inertial[l];
+                }
             }
         }
         // The last wall's products where it was in contact (a mirror wall
@@ -496,13 +527,15 @@ impl<L: LaneLaw> Group<L> {
             if touching <= LANE_BY_LANE {
                 // No lane touches, or few: those few lane by lane (the
                 // vector would evaluate the law in every lane).
-                out[loss] = [0.0; LANES];
+                for out in outs.iter_mut() {
+                    out[loss] = [0.0; LANES];
+                }
                 for l in 0..LANES {
                     if active[l] != 0.0 {
                         let mirrored = wall.mirror & (previous[l] != 0.0);
                         (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
                         let latched = (modes.approach[w][l], factor[w][l]);
-                        wall.push_lane(l, (px[l], pv[l]), latched, d, out, loss);
+                        wall.push_lane(l, (px[l], pv[l]), latched, d, &mut outs, loss);
                     }
                 }
                 previous = *active;
@@ -545,7 +578,7 @@ impl<L: LaneLaw> Group<L> {
             }
             let mut total = [0.0; LANES];
             let mut add = [0.0; LANES];
-            let loss_rate = &mut out[loss];
+            let mut loss_rate = [0.0; LANES];
             for l in 0..LANES {
                 total[l] = force[l] + wall.damping[l] * rate[l];
                 add[l] = if (active[l] != 0.0) & (total[l] != 0.0) {
@@ -559,12 +592,17 @@ impl<L: LaneLaw> Group<L> {
                     0.0
                 };
             }
-            for i in 0..d {
-                out[d + i] = push_where(&out[d + i], &wall.push[i], &total, &add);
+            for out in outs.iter_mut() {
+                out[loss] = loss_rate;
+                for i in 0..d {
+                    out[d + i] = push_where(&out[d + i], &wall.push[i], &total, &add);
+                }
             }
         }
-        out[2 * d + VISCOUS] = viscous;
-        out[2 * d + INPUT] = input;
+        for (out, input) in outs.iter_mut().zip(input) {
+            out[2 * d + VISCOUS] = viscous;
+            out[2 * d + INPUT] = input;
+        }
     }
 
     /// Lane `l`'s force signal, if the lanes are forced.
@@ -612,12 +650,15 @@ impl<L: LaneLaw> Group<L> {
                 return unsafe { self.step_avx2(start, h, modes, values, out) };
             }
         }
-        self.step_in((self.n, self.k), start, h, modes, values, out)
+        self.step_in((self.n, self.k), start, h, modes, values, None, out)
     }
 
     step_with!(step_avx512, "avx512f");
     step_with!(step_avx2, "avx2");
 
+    /// `with_first`: another force value at the start and where the rates
+    /// with it go (the reductions'), made with the first stage.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn step_in(
         &self,
@@ -626,6 +667,7 @@ impl<L: LaneLaw> Group<L> {
         h: f64,
         modes: &LaneModes,
         values: &[V; 4],
+        with_first: Option<(&V, &mut LaneState)>,
         out: &mut LaneStep,
     ) {
         let coordinates = 2 * (n + k);
@@ -637,11 +679,18 @@ impl<L: LaneLaw> Group<L> {
             first,
             point,
             stages,
+            ..
         } = out;
         // Every slot of the state's length is written by each rate (the
         // compact step's fresh zeros are not needed).
         let factor = self.factors(modes);
-        self.rates((n, k), start, &values[0], modes, &factor, first);
+        match with_first {
+            Some((value, rates)) => {
+                let values = [&values[0], value];
+                self.rates_of((n, k), start, values, modes, &factor, [first, rates]);
+            }
+            None => self.rates((n, k), start, &values[0], modes, &factor, first),
+        }
         let [k1, k2, k3] = &mut **stages;
         for e in 0..coordinates {
             point[e] = stage_point(&start[e], hw[0], &first[e]);

@@ -63,6 +63,10 @@ struct Lockstep<'a> {
     open: [V; MAX_WALLS],
     /// Whether the lanes take lane `l`'s steps (its modes are theirs).
     fed: [bool; LANES],
+    /// Whether the lanes' reductions' rates at the end of lane `l`'s last
+    /// step are those at its state now, made with its force `end_values`.
+    end_rates: [bool; LANES],
+    end_values: V,
     /// Plain steps each lane took since its run was last brought up to date.
     pending: [u64; LANES],
     /// Each run's most accepted steps before its step limit.
@@ -86,6 +90,8 @@ impl<'a> Lockstep<'a> {
             modes: LaneModes::default(),
             open: [[0.0; LANES]; MAX_WALLS],
             fed: [false; LANES],
+            end_rates: [false; LANES],
+            end_values: [0.0; LANES],
             pending: [0; LANES],
             max_accepted: [0; LANES],
             step: LaneStep::default(),
@@ -227,7 +233,15 @@ impl<'a> Lockstep<'a> {
             reduce_values[0][l] = scratch.first_force_value(signal, time);
             reduce_values[1][l] = scratch.first_force_value(signal, time + dt);
         }
+        // The reductions' rates at the start are those at the last step's
+        // end where every lane's state and force are that end's.
+        let mut kept = summed;
+        for l in 0..LANES {
+            let same = reduce_values[0][l].to_bits() == self.end_values[l].to_bits();
+            kept &= !live[l] | (self.end_rates[l] & same);
+        }
         let step = PlainStep {
+            start_rates_kept: kept,
             h: dt,
             modes: &self.modes,
             open: &self.open,
@@ -244,6 +258,10 @@ impl<'a> Lockstep<'a> {
                 }
             }
         }
+        for l in 0..LANES {
+            self.end_rates[l] = summed & plain[l];
+        }
+        self.end_values = reduce_values[1];
         self.go_on(&plain);
         group.advance(&plain, &self.step.end, &self.end_gaps, &mut self.lanes);
         for l in 0..self.runs.len() {
@@ -263,24 +281,22 @@ impl<'a> Lockstep<'a> {
     fn go_on(&mut self, plain: &[bool; LANES]) {
         let dt = self.dt;
         let located = true;
-        let mut end = [0.0; MAX_LEN];
-        for (l, run) in self.runs.iter_mut().enumerate() {
-            let Some(run) = run else { continue };
-            let run = &mut run.run;
-            if !plain[l] || run.open.iter().all(Option::is_none) {
+        for w in 0..MAX_WALLS {
+            if self.open[w].iter().all(|o| *o == 0.0) {
                 continue;
             }
-            let system = self.systems[l];
-            let len = system.state_len().min(MAX_LEN);
-            for e in 0..len {
-                end[e] = self.step.end[e][l];
-            }
-            for (w, oc) in run.open.iter_mut().enumerate() {
-                let Some(oc) = oc.as_mut() else { continue };
+            for (l, run) in self.runs.iter_mut().enumerate() {
+                let Some(run) = run else { continue };
+                let Some(Some(oc)) = run.run.open.get_mut(w).filter(|_| plain[l]) else {
+                    continue;
+                };
                 let (g0, r0) = (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]);
                 let (g1, r1) = (self.end_gaps[w][0][l], self.end_gaps[w][1][l]);
                 fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
-                fixed::press(system, w, oc, &end[..len], run.modes[w], dt);
+                // `fixed::press`, with the power the lanes made.
+                let p0 = oc.power;
+                oc.power = self.step.power[w][l];
+                oc.dissipated += 0.5 * dt * (p0 + oc.power);
             }
         }
     }
@@ -390,6 +406,7 @@ impl<'a> Lockstep<'a> {
         }
         self.lanes.recorded[l] = reductions.recorded_time;
         self.fed[l] = self.modes.set(l, &run.modes);
+        self.end_rates[l] = false;
         for (w, oc) in run.open.iter().enumerate().take(MAX_WALLS) {
             self.open[w][l] = if oc.is_some() { 1.0 } else { 0.0 };
         }
