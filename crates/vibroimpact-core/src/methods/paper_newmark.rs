@@ -227,7 +227,7 @@ impl PaperNewmark {
             self.residual = loads;
         }
         for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
+            let Mode::Compliant { approach_rate, .. } = modes[c.index] else {
                 continue;
             };
             let (indentation, rate) = Self::indentation(system, c, x, v);
@@ -279,7 +279,7 @@ impl PaperNewmark {
             self.residual = loads;
         }
         for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
+            let Mode::Compliant { approach_rate, .. } = modes[c.index] else {
                 continue;
             };
             let (indentation, rate) = Self::indentation(system, c, x, v);
@@ -378,7 +378,7 @@ impl PaperNewmark {
             out[INPUT] += value * linalg::dot(&load.shape, v);
         }
         for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
+            let Mode::Compliant { approach_rate, .. } = modes[c.index] else {
                 continue;
             };
             let (indentation, rate) = Self::indentation(system, c, &x[..d], &v[..d]);
