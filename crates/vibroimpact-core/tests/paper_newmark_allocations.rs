@@ -61,7 +61,10 @@ fn a_step_allocates_nothing() {
             .vector(&system)
             .unwrap();
         let mut end = y.clone();
-        let touching = Mode::Compliant { approach_rate: 0.1 };
+        let touching = Mode::Compliant {
+            approach_rate: 0.1,
+            indented_only: false,
+        };
         let sets = [
             [Mode::Open, Mode::Open],
             [touching, Mode::Open],

@@ -78,7 +78,10 @@ impl Run<'_> {
             Mode::Open => {
                 let approach = -rate;
                 let (approach_rate, resting) = self.compliant_onset(i, time, approach, scales);
-                self.modes[i] = Mode::Compliant { approach_rate };
+                self.modes[i] = Mode::Compliant {
+                    approach_rate,
+                    indented_only: false,
+                };
                 self.open[i] = Some(Open {
                     kind: ContactKind::Compliant,
                     onset: time,

@@ -1,9 +1,11 @@
 //! Fixed stepping ([`Stepping::Fixed`]): steps of `dt` not cut at contacts,
 //! as 0.1's two-mass kernel and the founding paper took them, over any
-//! [`Assembly`] whose pairs are all compliant. A contact's force acts where
-//! its pair is indented; the contact state at a step's start holds through
-//! the step (the modes change from the next step on, see
-//! [`SystemStepper::switched_within_step`]), except that a method whose
+//! [`Assembly`] whose pairs are all compliant. A contact's force (its law's
+//! and its contact damper's) acts where its pair is indented, nothing apart:
+//! 0.1's force, a function of the state (its modes are marked
+//! `indented_only`, see [`Mode::Compliant`]). The contact state at a step's
+//! start holds through the step (the modes change from the next step on,
+//! see [`SystemStepper::switched_within_step`]), except that a method whose
 //! force is not lagged (RK4, the implicit Newmark family) feels a contact
 //! entered within the step in the stages past the wall, with 0.1's
 //! provisional approach rate (the indentation rate at the step's start).
@@ -81,7 +83,7 @@ pub(super) fn contact_force(system: &Assembly, i: usize, y: &[f64], mode: Mode) 
     let (gap, rate) = system.gap(i, y);
     let (indentation, rate) = (-gap, -rate);
     let approach = match mode {
-        Mode::Compliant { approach_rate } => approach_rate,
+        Mode::Compliant { approach_rate, .. } => approach_rate,
         _ => rate,
     };
     if indentation > 0.0 {
@@ -110,7 +112,7 @@ pub(crate) fn deepest(oc: &mut Open, (i0, i1, m0, m1): (f64, f64, f64, f64), loc
 #[inline(always)]
 pub(crate) fn press(system: &Assembly, i: usize, oc: &mut Open, end: &[f64], mode: Mode, dt: f64) {
     let latched = match mode {
-        Mode::Compliant { approach_rate } => approach_rate,
+        Mode::Compliant { approach_rate, .. } => approach_rate,
         _ => 0.0,
     };
     let p0 = oc.power;
@@ -170,6 +172,9 @@ impl Run<'_> {
             }
             entered = true;
         }
+        if entered {
+            self.left_within();
+        }
         let row = 2 * system.dim;
         if self.end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) != 0.0 {
             return Err(Error::NumericalBlowUp {
@@ -220,18 +225,34 @@ impl Run<'_> {
     /// Whether a compliant pair apart at the step's start ends it indented:
     /// it then enters contact within the step, and is given its force there
     /// with 0.1's provisional approach rate (the indentation rate at the
-    /// step's start), for the step to be taken again.
+    /// step's start), for the step to be taken again. An open pair feels no
+    /// force; in contact mode, only where indented: the step taken again
+    /// is 0.1's, whose force is the state's with that latch (except where
+    /// a pair's stages indent in a step whose ends are apart: 0.1 pushed
+    /// it there, this kernel does not look).
     fn entered_within(&mut self) -> bool {
         let mut any = false;
         for i in 0..self.modes.len() {
             if self.open[i].is_none() && self.gaps.end[i].0 < 0.0 {
                 self.modes[i] = Mode::Compliant {
                     approach_rate: -self.gaps.start[i].1,
+                    indented_only: true,
                 };
                 any = true;
             }
         }
         any
+    }
+
+    /// A pair given its force for a step taken again that ends it apart
+    /// (the force pushed it back): still open, no force from the next step
+    /// on (it had kept the provisional latch).
+    fn left_within(&mut self) {
+        for i in 0..self.modes.len() {
+            if self.open[i].is_none() && self.gaps.end[i].0 >= 0.0 {
+                self.modes[i] = Mode::Open;
+            }
+        }
     }
 
     /// Each compliant pair's contact change in the step `y -> end` of `dt`
@@ -308,6 +329,7 @@ impl Run<'_> {
                     let p_onset = damping * rate * rate;
                     self.modes[i] = Mode::Compliant {
                         approach_rate: rate,
+                        indented_only: true,
                     };
                     self.open[i] = Some(Open {
                         kind: ContactKind::Compliant,
@@ -398,6 +420,7 @@ impl Run<'_> {
                 let approach = -system.gap(i, &self.y).1;
                 self.modes[i] = Mode::Compliant {
                     approach_rate: approach,
+                    indented_only: true,
                 };
                 oc.approach_speed = approach;
                 oc.power = dissipation(system, i, &self.y, approach);

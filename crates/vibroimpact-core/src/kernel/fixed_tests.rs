@@ -7,7 +7,7 @@ use crate::kernel::events::{
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::kernel::reductions::ReduceOptions;
 use crate::legacy::settings::{self, Method, Settings};
-use crate::methods::steppers::{ExplicitRk, SystemStepper};
+use crate::methods::steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 use crate::model::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
 use crate::model::closed_forms::linear_contact_duration;
 use crate::model::contact::{Contact, LawKind};
@@ -117,6 +117,40 @@ fn off(a: f64, b: f64, scale: f64) -> f64 {
     }
 }
 
+/// The largest differences between the records of two runs of `system`
+/// with steps of `dt` (as many contacts in each): onset and separation in
+/// steps, the speeds relative to the approach, the deepest indentation
+/// relative to itself, the energies relative to the approach's kinetic
+/// energy, the restitution.
+fn worst(
+    system: &ImpactDamper,
+    dt: f64,
+    ours: &SystemSolution,
+    theirs: &crate::Solution,
+    label: &str,
+) -> [f64; 8] {
+    assert_eq!(ours.contacts.len(), theirs.contacts.len(), "{label}");
+    let mut worst = [0.0f64; 8];
+    for (a, b) in ours.contacts.iter().zip(&theirs.contacts) {
+        let speed = b.approach_speed;
+        let energy = 0.5 * system.effective_mass() * speed * speed;
+        let pairs = [
+            off(a.onset, b.onset, dt),
+            off(a.separation, b.separation, dt),
+            off(a.approach_speed, b.approach_speed, speed),
+            off(a.rebound_speed, b.rebound_speed, speed),
+            off(a.max_indentation, b.max_indentation, b.max_indentation),
+            off(a.energy_dissipated, b.energy_dissipated, energy),
+            off(a.energy_change, b.energy_change, energy),
+            off(a.restitution, b.restitution, 1.0),
+        ];
+        for (w, p) in worst.iter_mut().zip(pairs) {
+            *w = w.max(p);
+        }
+    }
+    worst
+}
+
 #[test]
 fn fixed_rk4_is_the_0_1_kernel_to_round_off() {
     crate::testing::timeout(60, || {
@@ -152,26 +186,8 @@ fn fixed_rk4_is_the_0_1_kernel_to_round_off() {
                     "{label}: {}",
                     theirs.contacts.len()
                 );
-                assert_eq!(ours.contacts.len(), theirs.contacts.len(), "{label}");
                 assert_eq!(ours.steps, theirs.steps, "{label}");
-                let mut worst = [0.0f64; 8];
-                for (a, b) in ours.contacts.iter().zip(&theirs.contacts) {
-                    let speed = b.approach_speed;
-                    let energy = 0.5 * system.effective_mass() * speed * speed;
-                    let pairs = [
-                        off(a.onset, b.onset, dt),
-                        off(a.separation, b.separation, dt),
-                        off(a.approach_speed, b.approach_speed, speed),
-                        off(a.rebound_speed, b.rebound_speed, speed),
-                        off(a.max_indentation, b.max_indentation, b.max_indentation),
-                        off(a.energy_dissipated, b.energy_dissipated, energy),
-                        off(a.energy_change, b.energy_change, energy),
-                        off(a.restitution, b.restitution, 1.0),
-                    ];
-                    for (w, p) in worst.iter_mut().zip(pairs) {
-                        *w = w.max(p);
-                    }
-                }
+                let worst = worst(&system, dt, &ours, &theirs, &label);
                 assert!(worst.iter().all(|w| *w < 1e-9), "{label}: {worst:?}");
             }
         }
@@ -179,40 +195,53 @@ fn fixed_rk4_is_the_0_1_kernel_to_round_off() {
 }
 
 #[test]
-fn a_contact_damper_acts_in_every_stage_of_a_compliant_step() {
-    crate::testing::timeout(60, || {
-        // 0.1 applied the contact damper only where the pair is indented;
-        // the general rates apply it through a step in contact mode (the
-        // stages past the separation, or before an onset entered within the
-        // step): the first contact agrees to a few parts in a thousand at
-        // dt = 2e-6 s, not to round-off.
+fn a_contact_damper_acts_only_where_the_pair_is_indented() {
+    crate::testing::timeout(120, || {
+        // 0.1's fixed-step force is a function of the state: the law's and
+        // the contact damper's force act where the pair is indented, nothing
+        // apart (in the stages past a separation or before an onset within
+        // a step). With the damper on through a step in contact mode (the
+        // rule before), the speeds agreed only to 2.5e-3 (linear, c1 = 20),
+        // 2.6e-4 (Table 1, hertz) and 3.5e-3 (hyster-hertz), the onsets
+        // and separations to 4.4, 18.6 and 47.7 steps.
         let system = ImpactDamper::new(1.0, 3947.8, 0.0, 0.05, 1e-3).unwrap();
         let start = State::new(0.0, 0.0, 0.0, 0.8).unwrap();
         let contact = Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap();
-        let (dt, t_end) = (2e-6, 0.01);
-        let timing = ContactTiming::Located;
-        let ours = fixed(
-            &system,
-            &contact,
-            &start,
-            &mut rk4(&system),
-            (dt, t_end, timing, 1e-2),
-        )
-        .unwrap();
-        let theirs = legacy(
-            &system,
-            &contact,
-            &start,
-            Method::Rk4,
-            (dt, t_end, timing, 1e-2),
-        );
-        let (a, b) = (&ours.contacts[0], &theirs.contacts[0]);
-        assert!((a.onset - b.onset).abs() < 1e-9, "{a:?} {b:?}");
-        assert!(
-            (a.duration - b.duration).abs() < 1e-2 * b.duration,
-            "{a:?} {b:?}"
-        );
-        assert!((a.rebound_speed - b.rebound_speed).abs() < 1e-2 * b.rebound_speed);
+        // The founding paper's Table 1 system, its contact damper c1 on
+        // both laws, with many contacts.
+        let table1 = ImpactDamper::new(1.0, 1.0, 0.01, 0.25, 0.01).unwrap();
+        let table1_start = State::new(0.0, 0.0, 0.01, 0.1).unwrap();
+        let cases = [
+            (system, start, contact, (2e-6, 0.01)),
+            (
+                table1,
+                table1_start,
+                Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap(),
+                (1e-4, 20.0),
+            ),
+            (
+                table1,
+                table1_start,
+                Contact::new(LawKind::HysterHertz, 3000.0, Some(0.9), 0.01).unwrap(),
+                (1e-4, 20.0),
+            ),
+        ];
+        for (system, start, contact, (dt, t_end)) in cases {
+            for timing in [ContactTiming::Located, ContactTiming::StepCount] {
+                let run = (dt, t_end, timing, 1e-2);
+                let ours = fixed(&system, &contact, &start, &mut rk4(&system), run).unwrap();
+                let theirs = legacy(&system, &contact, &start, Method::Rk4, run);
+                let label = format!("{:?} {timing:?}", contact.law);
+                assert!(theirs.contacts.len() >= 3, "{label}");
+                let worst = worst(&system, dt, &ours, &theirs, &label);
+                // Round-off apart (the sums' order differs), grown over
+                // Table 1's 2e5 steps: measured to 1.2e-7 of a step at the
+                // onsets and separations, 1.1e-11 in the rest.
+                let (times, rest) = worst.split_at(2);
+                assert!(times.iter().all(|w| *w < 1e-6), "{label}: {worst:?}");
+                assert!(rest.iter().all(|w| *w < 1e-10), "{label}: {worst:?}");
+            }
+        }
     });
 }
 
@@ -265,20 +294,30 @@ fn an_undamped_contact_changes_the_energy_by_what_it_dissipates() {
             Contact::new(LawKind::HysterHertz, 1e9, Some(0.6), 0.0).unwrap(),
             Contact::new(LawKind::Linear, 1e6, None, 5.0).unwrap(),
         ] {
-            let run = fixed(
-                &system,
-                &contact,
-                &start,
-                &mut rk4(&system),
-                (1e-6, 0.01, ContactTiming::Located, 1e-2),
-            )
-            .unwrap();
+            let dt = 1e-6;
+            let settings = (dt, 0.01, ContactTiming::Located, 1e-2);
+            let run = fixed(&system, &contact, &start, &mut rk4(&system), settings).unwrap();
             let c = &run.contacts[0];
             assert!(c.energy_dissipated > 1e-4, "{c:?}");
-            assert!(
-                (c.energy_change + c.energy_dissipated).abs() < 1e-5 * c.energy_dissipated,
-                "{c:?}"
-            );
+            // The stored energy is interpolated linearly to the onset and
+            // the separation inside their steps, where the contact damper's
+            // power jumps between 0 and c1 v^2: off by up to dt c1 v^2 / 4
+            // at each: 1.1e-7 J of 4.1e-4 here, 3.2e-7 in 0.1's kernel,
+            // whose rule this is.
+            let c1 = contact.damping;
+            let (va, vr) = (c.approach_speed, c.rebound_speed);
+            let kinks = 0.25 * dt * c1 * (va * va + vr * vr);
+            let theirs = legacy(&system, &contact, &start, Method::Rk4, settings);
+            let b = &theirs.contacts[0];
+            for (change, dissipated) in [
+                (c.energy_change, c.energy_dissipated),
+                (b.energy_change, b.energy_dissipated),
+            ] {
+                assert!(
+                    (change + dissipated).abs() < 1e-5 * dissipated + kinks,
+                    "{c:?} {b:?}"
+                );
+            }
             // The same in the event-driven kernel.
             let assembly = Assembly::new(&spec(&system, &contact)).unwrap();
             let y = initial_state(&assembly, &[0.0], &[0.0], &[0.0], &[0.5]).unwrap();
@@ -295,6 +334,70 @@ fn an_undamped_contact_changes_the_energy_by_what_it_dissipates() {
                 (c.energy_change + c.energy_dissipated).abs() < 1e-6 * c.energy_dissipated,
                 "{c:?}"
             );
+        }
+    });
+}
+
+#[test]
+fn a_damped_contact_dissipates_the_kinetic_energy_lost() {
+    crate::testing::timeout(60, || {
+        // Two free bodies of Table 1 (no spring, no damper: every joule
+        // lost is the contact's), hertz with c1 = 0.2 N s/m, fixed steps of
+        // 1e-5 s (tests/test_verification.py's hertz+c1 case). The
+        // contact's dissipation by the trapezoidal sum of its power against
+        // the kinetic energy lost over the run: 0.1's RK4 holds them to
+        // 2.4e-5. With the damper on through the steps in contact mode,
+        // 1.2e-4 (rk4), 6.5e-5 (newmark-implicit), 1.5e-4
+        // (generalized-alpha); now 2.4e-5, 1.2e-5 and 3.5e-6.
+        let system = ImpactDamper::new(1.0, 0.0, 0.0, 0.25, 0.01).unwrap();
+        let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.2).unwrap();
+        let start = State::new(0.0, 0.0, 0.01, 0.1).unwrap();
+        let settings = (1e-5, 0.3, ContactTiming::Located, 1e-2);
+        let kinetic = |main: f64, impact: f64| 0.5 * (main * main + 0.25 * impact * impact);
+        let initial = kinetic(0.0, 0.1);
+        let check = |label: &str, lost: f64, dissipated: f64| {
+            assert!(lost > 0.0, "{label}");
+            let off = (dissipated - lost).abs() / lost;
+            assert!(off < 5e-5, "{label}: {dissipated} against {lost}: {off:e}");
+        };
+        let theirs = legacy(&system, &contact, &start, Method::Rk4, settings);
+        let end = theirs.final_state;
+        let lost = initial - kinetic(end.main_velocity, end.impact_velocity);
+        check("0.1", lost, theirs.contacts[0].energy_dissipated);
+        let assembly = Assembly::new(&spec(&system, &contact)).unwrap();
+        let runs = [
+            (
+                "rk4",
+                fixed(&system, &contact, &start, &mut rk4(&system), settings),
+            ),
+            (
+                "newmark-implicit",
+                fixed(
+                    &system,
+                    &contact,
+                    &start,
+                    &mut NewmarkFamily::newmark(&assembly, 0.25, 0.5),
+                    settings,
+                ),
+            ),
+            (
+                "generalized-alpha",
+                fixed(
+                    &system,
+                    &contact,
+                    &start,
+                    &mut NewmarkFamily::generalized_alpha(&assembly, 1.0),
+                    settings,
+                ),
+            ),
+        ];
+        for (label, run) in runs {
+            let ours = run.unwrap();
+            assert_eq!(ours.contacts.len(), 1, "{label}");
+            // [w, y, w', y'] and the accumulators.
+            let v = &ours.final_state;
+            let lost = initial - kinetic(v[2], v[3]);
+            check(label, lost, ours.contacts[0].energy_dissipated);
         }
     });
 }

@@ -148,7 +148,10 @@ fn first_rows(schedule: &Schedule) -> usize {
 /// Every compliant interaction in contact (see [`Run::all_compliant`]).
 fn all_compliant(system: &Assembly) -> Vec<Mode> {
     let mode = |it: &crate::model::assembly::Interaction| match it.law {
-        InteractionLaw::Compliant { .. } => Mode::Compliant { approach_rate: 0.0 },
+        InteractionLaw::Compliant { .. } => Mode::Compliant {
+            approach_rate: 0.0,
+            indented_only: false,
+        },
         InteractionLaw::Rigid { .. } => Mode::Open,
     };
     system.interactions.iter().map(mode).collect()
@@ -336,7 +339,10 @@ impl<'a> Run<'a> {
                 let approach = rate.abs();
                 let (approach_rate, resting) =
                     self.compliant_onset(i, 0.0, approach.max(f64::MIN_POSITIVE), scales);
-                self.modes[i] = Mode::Compliant { approach_rate };
+                self.modes[i] = Mode::Compliant {
+                    approach_rate,
+                    indented_only: self.timing.is_some(),
+                };
                 self.open[i] = Some(Open {
                     kind: ContactKind::Compliant,
                     onset: 0.0,

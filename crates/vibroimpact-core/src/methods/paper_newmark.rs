@@ -225,7 +225,7 @@ impl PaperNewmark {
             self.residual = loads;
         }
         for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
+            let Mode::Compliant { approach_rate, .. } = modes[c.index] else {
                 continue;
             };
             let (indentation, rate) = Self::indentation(system, c, x, v);
@@ -277,7 +277,7 @@ impl PaperNewmark {
             self.residual = loads;
         }
         for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
+            let Mode::Compliant { approach_rate, .. } = modes[c.index] else {
                 continue;
             };
             let (indentation, rate) = Self::indentation(system, c, x, v);
@@ -376,7 +376,7 @@ impl PaperNewmark {
             out[INPUT] += value * linalg::dot(&load.shape, v);
         }
         for c in &self.compliant {
-            let Mode::Compliant { approach_rate } = modes[c.index] else {
+            let Mode::Compliant { approach_rate, .. } = modes[c.index] else {
                 continue;
             };
             let (indentation, rate) = Self::indentation(system, c, &x[..d], &v[..d]);

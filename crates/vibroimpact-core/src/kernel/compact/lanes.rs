@@ -165,12 +165,14 @@ impl<L: LaneLaw> Walls<L> {
     ) {
         let (indentation, rate) = (-(self.offset[l] + hx), -hv);
         let parts = [self.parts[0][l], self.parts[1][l]];
-        let (force, elastic) = if indentation > 0.0 {
-            L::force_of(parts, indentation, rate, approach, factor)
+        // Fixed stepping's modes (see `LaneModes::set`): no damper apart.
+        let (force, elastic, damping) = if indentation > 0.0 {
+            let (force, elastic) = L::force_of(parts, indentation, rate, approach, factor);
+            (force, elastic, self.damping[l])
         } else {
-            (0.0, 0.0)
+            (0.0, 0.0, 0.0)
         };
-        let total = force + self.damping[l] * rate;
+        let total = force + damping * rate;
         for out in outs.iter_mut() {
             if total != 0.0 {
                 for i in 0..d {
@@ -290,13 +292,17 @@ pub(crate) struct LaneModes {
 }
 
 impl LaneModes {
-    /// The modes of lane `l`; false where one is neither open nor compliant
-    /// (the lanes do not take it).
+    /// The modes of lane `l`; false where one is neither open nor
+    /// fixed stepping's compliant contact, whose forces act only where the
+    /// pair is indented (the lanes do not take it).
     pub(crate) fn set(&mut self, l: usize, modes: &[Mode]) -> bool {
         for (w, mode) in modes.iter().enumerate().take(MAX_WALLS) {
             match mode {
                 Mode::Open => self.active[w][l] = 0.0,
-                Mode::Compliant { approach_rate } => {
+                Mode::Compliant {
+                    approach_rate,
+                    indented_only: true,
+                } => {
                     self.active[w][l] = 1.0;
                     self.approach[w][l] = *approach_rate;
                 }
@@ -568,6 +574,7 @@ impl<L: LaneLaw> Group<L> {
                 (px[l], pv[l]) = (hx, hv);
             }
             let (mut force, mut elastic) = ([0.0; LANES], [0.0; LANES]);
+            let mut damping = [0.0; LANES];
             for l in 0..LANES {
                 let parts = [wall.parts[0][l], wall.parts[1][l]];
                 let approach = modes.approach[w][l];
@@ -575,12 +582,13 @@ impl<L: LaneLaw> Group<L> {
                 let inside = indentation[l] > 0.0;
                 force[l] = if inside { f } else { 0.0 };
                 elastic[l] = if inside { e } else { 0.0 };
+                damping[l] = if inside { wall.damping[l] } else { 0.0 };
             }
             let mut total = [0.0; LANES];
             let mut add = [0.0; LANES];
             let mut loss_rate = [0.0; LANES];
             for l in 0..LANES {
-                total[l] = force[l] + wall.damping[l] * rate[l];
+                total[l] = force[l] + damping[l] * rate[l];
                 add[l] = if (active[l] != 0.0) & (total[l] != 0.0) {
                     1.0
                 } else {

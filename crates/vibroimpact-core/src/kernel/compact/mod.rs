@@ -27,7 +27,7 @@ pub(crate) use stretch::{peak_inside, widen_peaks, Stretch};
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{
-    elastic, h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
+    apart_damping, elastic, h_dot, Assembly, InteractionLaw, Mode, Scratch, CONTACT, INPUT, VISCOUS,
 };
 use crate::model::contact::{AnyLaw, ContactLaw, HysterHertz};
 use crate::model::signals::Signal;
@@ -225,8 +225,13 @@ impl Compact {
         for w in 0..if FREE { 0 } else { count } {
             let wall = &self.walls[w];
             let previous = products.take();
-            if let (Mode::Compliant { approach_rate }, Some((law, damping))) =
-                (&modes[w], &wall.law)
+            if let (
+                Mode::Compliant {
+                    approach_rate,
+                    indented_only,
+                },
+                Some((law, damping)),
+            ) = (&modes[w], &wall.law)
             {
                 let (hx, hv) = match previous {
                     Some((hx, hv)) if wall.mirror => (-hx, -hv),
@@ -234,8 +239,8 @@ impl Compact {
                 };
                 products = Some((hx, hv));
                 let (indentation, rate) = (-(wall.offset + hx), -hv);
-                let (force, elastic) = if indentation > 0.0 {
-                    match law {
+                let (force, elastic, damping) = if indentation > 0.0 {
+                    let (force, elastic) = match law {
                         AnyLaw::HysterHertz(l) => HysterHertz::force_of(
                             l.parts(),
                             indentation,
@@ -244,11 +249,12 @@ impl Compact {
                             factors[w],
                         ),
                         _ => law.force_and_elastic(indentation, rate, *approach_rate),
-                    }
+                    };
+                    (force, elastic, *damping)
                 } else {
-                    (0.0, 0.0)
+                    (0.0, 0.0, apart_damping(*damping, *indented_only))
                 };
-                let total = force + *damping * rate;
+                let total = force + damping * rate;
                 if total != 0.0 {
                     for i in 0..d {
                         accel[i] += wall.push[i] * total;
@@ -415,7 +421,7 @@ impl Compact {
     pub(crate) fn rate_factors(&self, modes: &[Mode]) -> Factors {
         let mut factors = [0.0; MAX_WALLS];
         for w in 0..self.count.min(MAX_WALLS).min(modes.len()) {
-            if let (Mode::Compliant { approach_rate }, Some((AnyLaw::HysterHertz(law), _))) =
+            if let (Mode::Compliant { approach_rate, .. }, Some((AnyLaw::HysterHertz(law), _))) =
                 (modes[w], &self.walls[w].law)
             {
                 factors[w] = law.hysteresis / approach_rate;

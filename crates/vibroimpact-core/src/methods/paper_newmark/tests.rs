@@ -245,6 +245,7 @@ fn side_by_side(
             modes = vec![Mode::Open; 2];
             modes[wall] = Mode::Compliant {
                 approach_rate: approach,
+                indented_only: true,
             };
         } else {
             modes = vec![Mode::Open; 2];
@@ -328,6 +329,7 @@ fn restarts_take_0_1_s_accelerations_to_the_bit() {
             if u.abs() > 0.005 {
                 modes[if u > 0.0 { 0 } else { 1 }] = Mode::Compliant {
                     approach_rate: approach,
+                    indented_only: false,
                 };
             }
             // [w, y, w', y'] and the accumulators (a start inside a wall
@@ -748,7 +750,10 @@ fn its_accumulator_rates_are_the_assembly_s() {
                 let y: Vec<f64> = (0..len)
                     .map(|i| 2e-3 * (seed as f64 + 0.37 * i as f64).sin())
                     .collect();
-                let compliant = Mode::Compliant { approach_rate: 0.2 };
+                let compliant = Mode::Compliant {
+                    approach_rate: 0.2,
+                    indented_only: false,
+                };
                 for modes in [
                     [Mode::Open; 2],
                     [compliant, Mode::Open],

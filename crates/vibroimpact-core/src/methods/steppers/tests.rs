@@ -66,10 +66,15 @@ fn mode_sets(system: &Assembly) -> Vec<Vec<Mode>> {
     let count = system.interactions.len();
     let mut sets = vec![vec![Mode::Open; count]];
     let mut compliant = vec![Mode::Open; count];
-    compliant[1] = Mode::Compliant {
-        approach_rate: 0.01,
-    };
-    sets.push(compliant.clone());
+    // Both rules of a compliant contact: the damper through the mode
+    // (events) and only where indented (fixed stepping).
+    for indented_only in [false, true] {
+        compliant[1] = Mode::Compliant {
+            approach_rate: 0.01,
+            indented_only,
+        };
+        sets.push(compliant.clone());
+    }
     compliant[2] = Mode::Sticking;
     sets.push(compliant);
     sets

@@ -2,7 +2,7 @@
 //! Newton's method (compliant slopes, constraints projected out).
 
 use super::gaps::h_dot;
-use super::{Assembly, InteractionLaw, Mode, Scratch};
+use super::{apart_damping, Assembly, InteractionLaw, Mode, Scratch};
 use crate::model::contact::ContactLaw;
 use crate::numerics::linalg;
 
@@ -67,13 +67,21 @@ impl Assembly {
         let mut sticking = 0;
         for (i, (it, mode)) in self.interactions.iter().zip(modes).enumerate() {
             match (*mode, it.law) {
-                (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
+                (
+                    Mode::Compliant {
+                        approach_rate,
+                        indented_only,
+                    },
+                    InteractionLaw::Compliant { law, damping },
+                ) => {
                     let indentation = -(it.offset + h_dot(&it.h, x));
                     let rate = -h_dot(&it.h, v);
-                    let (_, by_indentation, by_rate) = if indentation > 0.0 {
-                        law.force_derivatives(indentation, rate, approach_rate)
+                    let (_, by_indentation, by_rate, damping) = if indentation > 0.0 {
+                        let (force, by_indentation, by_rate) =
+                            law.force_derivatives(indentation, rate, approach_rate);
+                        (force, by_indentation, by_rate, damping)
                     } else {
-                        (0.0, 0.0, 0.0)
+                        (0.0, 0.0, 0.0, apart_damping(damping, indented_only))
                     };
                     // lambda(delta, delta'), delta = -(b + h.x): d/dx = -lambda_delta h.
                     for (r, p) in it.push.iter().enumerate() {

@@ -23,7 +23,7 @@ mod state;
 
 pub(crate) use gaps::h_dot;
 pub use linear::{HarmonicLoad, LinearParts};
-pub(crate) use rates::elastic;
+pub(crate) use rates::{apart_damping, elastic};
 pub use scratch::Scratch;
 pub use spec::{Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec, MAX_PAIRS, MAX_POINTS};
 pub use state::{initial_state, resumed_state};
@@ -164,6 +164,12 @@ pub enum Mode {
     /// A compliant contact, with the indentation rate latched at its onset.
     Compliant {
         approach_rate: f64,
+        /// Whether its forces (the law's and the contact damper's) act only
+        /// where the pair is indented: fixed stepping's rule (0.1's, whose
+        /// force was a function of the state), where the mode is held
+        /// through a step that may leave or enter the contact. Else (events)
+        /// the mode is the contact, and the damper acts through it.
+        indented_only: bool,
     },
     /// A rigid pair moving together after a chattering sequence: the gap
     /// and its rate stay zero, held by a constraint force.

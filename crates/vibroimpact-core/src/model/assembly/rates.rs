@@ -173,7 +173,13 @@ impl Assembly {
             // Only the interaction just before may lend its products.
             let previous = products.take();
             match (mode, &it.law) {
-                (Mode::Compliant { approach_rate }, InteractionLaw::Compliant { law, damping }) => {
+                (
+                    Mode::Compliant {
+                        approach_rate,
+                        indented_only,
+                    },
+                    InteractionLaw::Compliant { law, damping },
+                ) => {
                     let (approach_rate, damping) = (*approach_rate, *damping);
                     let (hx, hv) = match previous {
                         Some((hx, hv)) if *mirror => (-hx, -hv),
@@ -181,10 +187,12 @@ impl Assembly {
                     };
                     products = Some((hx, hv));
                     let (indentation, rate) = (-(it.offset + hx), -hv);
-                    let (force, elastic) = if indentation > 0.0 {
-                        law.force_and_elastic(indentation, rate, approach_rate)
+                    let (force, elastic, damping) = if indentation > 0.0 {
+                        let (force, elastic) =
+                            law.force_and_elastic(indentation, rate, approach_rate);
+                        (force, elastic, damping)
                     } else {
-                        (0.0, 0.0)
+                        (0.0, 0.0, apart_damping(damping, *indented_only))
                     };
                     let total = force + damping * rate;
                     // Apart with no contact damper there is no force to add.
@@ -296,6 +304,19 @@ impl Assembly {
             input += value * linalg::dot(&f.row[..n], &v[..n]);
         }
         input
+    }
+}
+
+/// A compliant pair's contact damping (N s/m) where it is apart: none
+/// where its forces act only where it is indented (fixed stepping, see
+/// [`Mode::Compliant`]), its own where the mode is the contact (events).
+/// Every path (general, compact, lanes, Jacobian) gates it here.
+#[inline(always)]
+pub(crate) fn apart_damping(damping: f64, indented_only: bool) -> f64 {
+    if indented_only {
+        0.0
+    } else {
+        damping
     }
 }
 
