@@ -115,9 +115,16 @@ pub(crate) fn press(system: &Assembly, i: usize, oc: &mut Open, end: &[f64], mod
         Mode::Compliant { approach_rate, .. } => approach_rate,
         _ => 0.0,
     };
+    pressed(oc, dissipation(system, i, end, latched), dt);
+}
+
+/// A step of `dt` of contact `oc` that ends still in contact with the
+/// dissipated `power` (W) at its end: the trapezoidal sum (see [`press`]).
+#[inline(always)]
+pub(crate) fn pressed(oc: &mut Open, power: f64, dt: f64) {
     let p0 = oc.power;
-    oc.power = dissipation(system, i, end, latched);
-    oc.dissipated += 0.5 * dt * (p0 + oc.power);
+    oc.power = power;
+    oc.dissipated += 0.5 * dt * (p0 + power);
 }
 
 /// A quantity at fraction `theta` of a step, between its values at the

@@ -240,13 +240,17 @@ impl<L: LaneLaw> Group<L> {
                     continue;
                 }
                 let (indentation, rate) = (-(wall.offset[l] + hx[l]), -hv[l]);
-                let parts = [wall.parts[0][l], wall.parts[1][l]];
-                let latched = if active[l] != 0.0 { approach[l] } else { 0.0 };
-                let factor = parts[1] / latched;
-                let (force, elastic) = L::force_of(parts, indentation, rate, latched, factor);
-                let total = force + wall.damping[l] * rate;
-                let power = (total - elastic) * rate;
-                out[w][l] = if indentation > 0.0 { power } else { 0.0 };
+                // Apart (or not a number): no power, the law not evaluated.
+                out[w][l] = if indentation > 0.0 {
+                    let parts = [wall.parts[0][l], wall.parts[1][l]];
+                    let latched = if active[l] != 0.0 { approach[l] } else { 0.0 };
+                    let factor = parts[1] / latched;
+                    let (force, elastic) = L::force_of(parts, indentation, rate, latched, factor);
+                    let total = force + wall.damping[l] * rate;
+                    (total - elastic) * rate
+                } else {
+                    0.0
+                };
             }
         }
     }

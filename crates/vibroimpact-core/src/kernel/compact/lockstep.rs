@@ -294,9 +294,7 @@ impl<'a> Lockstep<'a> {
                 let (g1, r1) = (self.end_gaps[w][0][l], self.end_gaps[w][1][l]);
                 fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
                 // `fixed::press`, with the power the lanes made.
-                let p0 = oc.power;
-                oc.power = self.step.power[w][l];
-                oc.dissipated += 0.5 * dt * (p0 + oc.power);
+                fixed::pressed(oc, self.step.power[w][l], dt);
             }
         }
     }
