@@ -72,6 +72,22 @@ def test_every_method_s_defaults_in_python_are_the_core_s(method: str) -> None:
             assert parameters[name].default is None, name
 
 
+def test_a_scenario_s_defaults_are_its_file_s() -> None:
+    # A Scenario built in code and one read from a file that leaves the same keys out
+    # run the same: each field's default is the file schema's (dt had been 1e-4 in code
+    # and the method's own in a file; t_end 0.3 in code and required in a file).
+    from vibroimpact.scenario import two_mass
+
+    fields = {f.name: f for f in dataclasses.fields(Scenario)}
+    for section in ("solver", "output"):
+        for name, (_, default) in two_mass._SCHEMA[section].items():
+            field = fields[name]
+            if default is two_mass._REQUIRED:
+                assert field.default is dataclasses.MISSING, name
+            else:
+                assert field.default == default, name
+
+
 def test_the_fixed_step_methods_are_the_registry_s() -> None:
     stepping_fixed = {m for m, s in _core.METHODS.items() if "fixed" in s["steppings"]}
     by_kind = {

@@ -13,7 +13,7 @@ import math
 import reprlib
 import stat
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -120,8 +120,10 @@ class Scenario:
     contact: Contact
     initial: InitialState
     method: str = _DEFAULTS["method"]
-    dt: float | None = 1e-4
-    t_end: float = 0.3
+    dt: float | None = _DEFAULTS["dt"]
+    # Required, as in the file's [solver] section; keyword-only so it may follow the
+    # defaulted fields.
+    t_end: float = field(kw_only=True)
     stepping: str | None = None
     beta: float = _DEFAULTS["beta"]
     gamma: float = _DEFAULTS["gamma"]
