@@ -234,7 +234,29 @@ fn combine(start: &V, w: &[f64; 4], [k0, k1, k2, k3]: [&V; 4]) -> V {
 }
 
 /// Walls touched by at most this many lanes are evaluated lane by lane.
-const LANE_BY_LANE: usize = 4;
+const LANE_BY_LANE: u32 = 4;
+
+/// The lanes where `v` is not 0, a bit each (lane `l` bit `l`).
+#[inline(always)]
+pub(super) fn lanes_where(v: &V) -> u32 {
+    let mut mask = 0u32;
+    for l in 0..LANES {
+        mask |= u32::from(v[l] != 0.0) << l;
+    }
+    mask
+}
+
+/// The lanes of `mask`, in order.
+#[inline(always)]
+pub(super) fn each_lane(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            l
+        })
+    })
+}
 
 /// The lanes' systems, their values side by side.
 #[derive(Debug, Clone)]
@@ -246,6 +268,9 @@ pub(crate) struct Group<L> {
     modal: [[V; 4]; MAX_MODES],
     /// The force's `M^-1 row^T` and row, and each lane's signal.
     force: Option<([V; MAX_MODES], [V; MAX_MODES], Vec<Signal>)>,
+    /// Each lane's harmonic's amplitude, angular frequency and phase,
+    /// where every lane's signal is one.
+    harmonics: Option<[V; 3]>,
     gravity: V,
     pub(super) walls: Vec<Walls<L>>,
     /// Each followed point's row over the modes (see
@@ -405,6 +430,19 @@ impl<L: LaneLaw> Group<L> {
             }
             (push, row, signals)
         });
+        let harmonics = force.as_ref().and_then(|(_, _, signals)| {
+            let mut harmonics = [[0.0; LANES]; 3];
+            for (l, signal) in signals.iter().enumerate() {
+                let Signal::Harmonic(h) = signal else {
+                    return None;
+                };
+                harmonics[0][l] = h.amplitude;
+                // As the signal's cache makes it.
+                harmonics[1][l] = std::f64::consts::TAU * h.frequency;
+                harmonics[2][l] = h.phase;
+            }
+            Some(harmonics)
+        });
         let mut walls = Vec::with_capacity(first.count);
         for w in 0..first.count.min(MAX_WALLS) {
             let (law, _) = first.walls[w].law?;
@@ -439,6 +477,7 @@ impl<L: LaneLaw> Group<L> {
             len,
             modal,
             force,
+            harmonics,
             gravity,
             walls,
             points,
@@ -525,28 +564,29 @@ impl<L: LaneLaw> Group<L> {
         // The last wall's products where it was in contact (a mirror wall
         // takes them negated).
         let mut previous = [0.0; LANES];
+        let mut previous_lanes = 0u32;
         let (mut px, mut pv) = ([0.0; LANES], [0.0; LANES]);
         for (w, wall) in self.walls.iter().enumerate() {
             let loss = 2 * d + CONTACT + w;
             let active = &modes.active[w];
-            let touching = active.iter().filter(|a| **a != 0.0).count();
-            if touching <= LANE_BY_LANE {
+            let touching = lanes_where(active);
+            if touching.count_ones() <= LANE_BY_LANE {
                 // No lane touches, or few: those few lane by lane (the
                 // vector would evaluate the law in every lane).
                 for out in outs.iter_mut() {
                     out[loss] = [0.0; LANES];
                 }
-                for l in 0..LANES {
-                    if active[l] != 0.0 {
-                        let mirrored = wall.mirror & (previous[l] != 0.0);
-                        (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
-                        let latched = (modes.approach[w][l], factor[w][l]);
-                        wall.push_lane(l, (px[l], pv[l]), latched, d, &mut outs, loss);
-                    }
+                for l in each_lane(touching) {
+                    let mirrored = wall.mirror & (previous_lanes >> l & 1 != 0);
+                    (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
+                    let latched = (modes.approach[w][l], factor[w][l]);
+                    wall.push_lane(l, (px[l], pv[l]), latched, d, &mut outs, loss);
                 }
                 previous = *active;
+                previous_lanes = touching;
                 continue;
             }
+            previous_lanes = touching;
             // `h_dot`'s two sums, each lane innermost (what vectorises).
             let (mut sx, mut sv) = ([[-0.0; LANES]; 2], [[-0.0; LANES]; 2]);
             for i in 0..d {
@@ -613,9 +653,11 @@ impl<L: LaneLaw> Group<L> {
         }
     }
 
-    /// Lane `l`'s force signal, if the lanes are forced.
-    pub(crate) fn signal(&self, l: usize) -> Option<&Signal> {
-        self.force.as_ref().map(|(_, _, signals)| &signals[l])
+    /// Each lane's force signal, if the lanes are forced, and their
+    /// amplitudes, angular frequencies and phases where all are harmonic.
+    pub(crate) fn signals(&self) -> Option<(&[Signal], Option<&[V; 3]>)> {
+        let (_, _, signals) = self.force.as_ref()?;
+        Some((signals, self.harmonics.as_ref()))
     }
 
     /// Each compliant law's `parts[1] / approach` in `modes`, made once a
@@ -624,7 +666,7 @@ impl<L: LaneLaw> Group<L> {
     pub(super) fn factors(&self, modes: &LaneModes) -> [V; MAX_WALLS] {
         let mut factor = [[0.0; LANES]; MAX_WALLS];
         for (w, wall) in self.walls.iter().enumerate() {
-            if modes.active[w].iter().all(|a| *a == 0.0) {
+            if lanes_where(&modes.active[w]) == 0 {
                 continue;
             }
             for l in 0..LANES {
