@@ -184,19 +184,21 @@ impl<L: LaneLaw> Walls<L> {
     }
 }
 
-/// `start + a k` of every lane. The lanes' buffers are fields of one
-/// struct: as a function's distinct references they are known not to
-/// overlap, and the loop vectorises (inline, it ran lane by lane).
+/// `start + a k` of every lane in the first `count` entries, taken as one
+/// run of values: the loop vectorises along contiguous values (taken entry
+/// by entry, the compiler vectorised across the entries, in gathers and
+/// scatters). The lanes' buffers are fields of one struct: as a function's
+/// distinct references they are known not to overlap.
 #[inline(always)]
-fn stage_point(start: &V, a: f64, k: &V) -> V {
-    let mut point = [0.0; LANES];
-    for l in 0..LANES {
-        point[l] = start[l] + a * k[l];
+fn stage_points(point: &mut LaneState, (start, a, k): (&LaneState, f64, &LaneState), count: usize) {
+    let point = point[..count].as_flattened_mut();
+    let (start, k) = (start[..count].as_flattened(), k[..count].as_flattened());
+    for ((p, s), k) in point.iter_mut().zip(start).zip(k) {
+        *p = s + a * k;
     }
-    point
 }
 
-/// `sum + h x` of every lane (see [`stage_point`]).
+/// `sum + h x` of every lane (see [`stage_points`]).
 #[inline(always)]
 fn accumulate(sum: &V, h: &V, x: &V) -> V {
     let mut out = [0.0; LANES];
@@ -207,7 +209,7 @@ fn accumulate(sum: &V, h: &V, x: &V) -> V {
 }
 
 /// `acceleration + push total` in the lanes where `add` is not 0 (see
-/// [`stage_point`]).
+/// [`stage_points`]).
 #[inline(always)]
 fn push_where(acceleration: &V, push: &V, total: &V, add: &V) -> V {
     let mut out = [0.0; LANES];
@@ -222,15 +224,22 @@ fn push_where(acceleration: &V, push: &V, total: &V, add: &V) -> V {
     out
 }
 
-/// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane (see
-/// [`stage_point`]).
+/// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane in the
+/// first `count` entries (see [`stage_points`]).
 #[inline(always)]
-fn combine(start: &V, w: &[f64; 4], [k0, k1, k2, k3]: [&V; 4]) -> V {
-    let mut end = [0.0; LANES];
-    for l in 0..LANES {
-        end[l] = start[l] + w[0] * k0[l] + w[1] * k1[l] + w[2] * k2[l] + w[3] * k3[l];
+fn combine(
+    end: &mut LaneState,
+    start: &LaneState,
+    w: &[f64; 4],
+    [k0, k1, k2, k3]: [&LaneState; 4],
+    count: usize,
+) {
+    let end = end[..count].as_flattened_mut();
+    let start = start[..count].as_flattened();
+    let [k0, k1, k2, k3] = [k0, k1, k2, k3].map(|k| k[..count].as_flattened());
+    for i in 0..end.len().min(start.len()) {
+        end[i] = start[i] + w[0] * k0[i] + w[1] * k1[i] + w[2] * k2[i] + w[3] * k3[i];
     }
-    end
 }
 
 /// Walls touched by at most this many lanes are evaluated lane by lane.
@@ -742,20 +751,12 @@ impl<L: LaneLaw> Group<L> {
             None => self.rates((n, k), start, &values[0], modes, &factor, first),
         }
         let [k1, k2, k3] = &mut **stages;
-        for e in 0..coordinates {
-            point[e] = stage_point(&start[e], hw[0], &first[e]);
-        }
+        stage_points(point, (start, hw[0], first), coordinates);
         self.rates((n, k), point, &values[1], modes, &factor, k1);
-        for e in 0..coordinates {
-            point[e] = stage_point(&start[e], hw[1], &k1[e]);
-        }
+        stage_points(point, (start, hw[1], k1), coordinates);
         self.rates((n, k), point, &values[2], modes, &factor, k2);
-        for e in 0..coordinates {
-            point[e] = stage_point(&start[e], hw[2], &k2[e]);
-        }
+        stage_points(point, (start, hw[2], k2), coordinates);
         self.rates((n, k), point, &values[3], modes, &factor, k3);
-        for e in 0..len {
-            end[e] = combine(&start[e], &w, [&first[e], &k1[e], &k2[e], &k3[e]]);
-        }
+        combine(end, start, &w, [first, k1, k2, k3], len);
     }
 }
