@@ -8,7 +8,9 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use super::lanes::{Group, LaneLaw, LaneModes, LaneState, LaneStep, LANES, MAX_OBSERVED, V};
+use super::lanes::{
+    each_lane, lanes_where, Group, LaneLaw, LaneModes, LaneState, LaneStep, LANES, MAX_OBSERVED, V,
+};
 use super::MAX_WALLS;
 use crate::kernel::reductions::{quintic, square_integral};
 
@@ -221,7 +223,8 @@ impl<L: LaneLaw> Group<L> {
     ) {
         let d = n + k;
         for (w, wall) in self.walls.iter().enumerate() {
-            if p.open[w].iter().all(|o| *o == 0.0) {
+            let open = lanes_where(&p.open[w]);
+            if open == 0 {
                 continue;
             }
             // `linalg::dot`'s sums, in order.
@@ -235,10 +238,7 @@ impl<L: LaneLaw> Group<L> {
             let (active, approach) = (&p.modes.active[w], &p.modes.approach[w]);
             // Lane by lane: few lanes are in contact at once (the law's
             // root and division only in those).
-            for l in 0..LANES {
-                if p.open[w][l] == 0.0 {
-                    continue;
-                }
+            for l in each_lane(open) {
                 let (indentation, rate) = (-(wall.offset[l] + hx[l]), -hv[l]);
                 // Apart (or not a number): no power, the law not evaluated.
                 out[w][l] = if indentation > 0.0 {

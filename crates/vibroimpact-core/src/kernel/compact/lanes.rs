@@ -184,19 +184,21 @@ impl<L: LaneLaw> Walls<L> {
     }
 }
 
-/// `start + a k` of every lane. The lanes' buffers are fields of one
-/// struct: as a function's distinct references they are known not to
-/// overlap, and the loop vectorises (inline, it ran lane by lane).
+/// `start + a k` of every lane in the first `count` entries, taken as one
+/// run of values: the loop vectorises along contiguous values (taken entry
+/// by entry, the compiler vectorised across the entries, in gathers and
+/// scatters). The lanes' buffers are fields of one struct: as a function's
+/// distinct references they are known not to overlap.
 #[inline(always)]
-fn stage_point(start: &V, a: f64, k: &V) -> V {
-    let mut point = [0.0; LANES];
-    for l in 0..LANES {
-        point[l] = start[l] + a * k[l];
+fn stage_points(point: &mut LaneState, (start, a, k): (&LaneState, f64, &LaneState), count: usize) {
+    let point = point[..count].as_flattened_mut();
+    let (start, k) = (start[..count].as_flattened(), k[..count].as_flattened());
+    for ((p, s), k) in point.iter_mut().zip(start).zip(k) {
+        *p = s + a * k;
     }
-    point
 }
 
-/// `sum + h x` of every lane (see [`stage_point`]).
+/// `sum + h x` of every lane (see [`stage_points`]).
 #[inline(always)]
 fn accumulate(sum: &V, h: &V, x: &V) -> V {
     let mut out = [0.0; LANES];
@@ -207,7 +209,7 @@ fn accumulate(sum: &V, h: &V, x: &V) -> V {
 }
 
 /// `acceleration + push total` in the lanes where `add` is not 0 (see
-/// [`stage_point`]).
+/// [`stage_points`]).
 #[inline(always)]
 fn push_where(acceleration: &V, push: &V, total: &V, add: &V) -> V {
     let mut out = [0.0; LANES];
@@ -222,19 +224,48 @@ fn push_where(acceleration: &V, push: &V, total: &V, add: &V) -> V {
     out
 }
 
-/// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane (see
-/// [`stage_point`]).
+/// RK4's end `start + w0 k0 + w1 k1 + w2 k2 + w3 k3` of every lane in the
+/// first `count` entries (see [`stage_points`]).
 #[inline(always)]
-fn combine(start: &V, w: &[f64; 4], [k0, k1, k2, k3]: [&V; 4]) -> V {
-    let mut end = [0.0; LANES];
-    for l in 0..LANES {
-        end[l] = start[l] + w[0] * k0[l] + w[1] * k1[l] + w[2] * k2[l] + w[3] * k3[l];
+fn combine(
+    end: &mut LaneState,
+    start: &LaneState,
+    w: &[f64; 4],
+    [k0, k1, k2, k3]: [&LaneState; 4],
+    count: usize,
+) {
+    let end = end[..count].as_flattened_mut();
+    let start = start[..count].as_flattened();
+    let [k0, k1, k2, k3] = [k0, k1, k2, k3].map(|k| k[..count].as_flattened());
+    for i in 0..end.len().min(start.len()) {
+        end[i] = start[i] + w[0] * k0[i] + w[1] * k1[i] + w[2] * k2[i] + w[3] * k3[i];
     }
-    end
 }
 
 /// Walls touched by at most this many lanes are evaluated lane by lane.
-const LANE_BY_LANE: usize = 4;
+const LANE_BY_LANE: u32 = 4;
+
+/// The lanes where `v` is not 0, a bit each (lane `l` bit `l`).
+#[inline(always)]
+pub(super) fn lanes_where(v: &V) -> u32 {
+    let mut mask = 0u32;
+    for l in 0..LANES {
+        mask |= u32::from(v[l] != 0.0) << l;
+    }
+    mask
+}
+
+/// The lanes of `mask`, in order.
+#[inline(always)]
+pub(super) fn each_lane(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            l
+        })
+    })
+}
 
 /// The lanes' systems, their values side by side.
 #[derive(Debug, Clone)]
@@ -246,6 +277,9 @@ pub(crate) struct Group<L> {
     modal: [[V; 4]; MAX_MODES],
     /// The force's `M^-1 row^T` and row, and each lane's signal.
     force: Option<([V; MAX_MODES], [V; MAX_MODES], Vec<Signal>)>,
+    /// Each lane's harmonic's amplitude, angular frequency and phase,
+    /// where every lane's signal is one.
+    harmonics: Option<[V; 3]>,
     gravity: V,
     pub(super) walls: Vec<Walls<L>>,
     /// Each followed point's row over the modes (see
@@ -405,6 +439,19 @@ impl<L: LaneLaw> Group<L> {
             }
             (push, row, signals)
         });
+        let harmonics = force.as_ref().and_then(|(_, _, signals)| {
+            let mut harmonics = [[0.0; LANES]; 3];
+            for (l, signal) in signals.iter().enumerate() {
+                let Signal::Harmonic(h) = signal else {
+                    return None;
+                };
+                harmonics[0][l] = h.amplitude;
+                // As the signal's cache makes it.
+                harmonics[1][l] = std::f64::consts::TAU * h.frequency;
+                harmonics[2][l] = h.phase;
+            }
+            Some(harmonics)
+        });
         let mut walls = Vec::with_capacity(first.count);
         for w in 0..first.count.min(MAX_WALLS) {
             let (law, _) = first.walls[w].law?;
@@ -439,6 +486,7 @@ impl<L: LaneLaw> Group<L> {
             len,
             modal,
             force,
+            harmonics,
             gravity,
             walls,
             points,
@@ -525,28 +573,29 @@ impl<L: LaneLaw> Group<L> {
         // The last wall's products where it was in contact (a mirror wall
         // takes them negated).
         let mut previous = [0.0; LANES];
+        let mut previous_lanes = 0u32;
         let (mut px, mut pv) = ([0.0; LANES], [0.0; LANES]);
         for (w, wall) in self.walls.iter().enumerate() {
             let loss = 2 * d + CONTACT + w;
             let active = &modes.active[w];
-            let touching = active.iter().filter(|a| **a != 0.0).count();
-            if touching <= LANE_BY_LANE {
+            let touching = lanes_where(active);
+            if touching.count_ones() <= LANE_BY_LANE {
                 // No lane touches, or few: those few lane by lane (the
                 // vector would evaluate the law in every lane).
                 for out in outs.iter_mut() {
                     out[loss] = [0.0; LANES];
                 }
-                for l in 0..LANES {
-                    if active[l] != 0.0 {
-                        let mirrored = wall.mirror & (previous[l] != 0.0);
-                        (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
-                        let latched = (modes.approach[w][l], factor[w][l]);
-                        wall.push_lane(l, (px[l], pv[l]), latched, d, &mut outs, loss);
-                    }
+                for l in each_lane(touching) {
+                    let mirrored = wall.mirror & (previous_lanes >> l & 1 != 0);
+                    (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
+                    let latched = (modes.approach[w][l], factor[w][l]);
+                    wall.push_lane(l, (px[l], pv[l]), latched, d, &mut outs, loss);
                 }
                 previous = *active;
+                previous_lanes = touching;
                 continue;
             }
+            previous_lanes = touching;
             // `h_dot`'s two sums, each lane innermost (what vectorises).
             let (mut sx, mut sv) = ([[-0.0; LANES]; 2], [[-0.0; LANES]; 2]);
             for i in 0..d {
@@ -613,9 +662,11 @@ impl<L: LaneLaw> Group<L> {
         }
     }
 
-    /// Lane `l`'s force signal, if the lanes are forced.
-    pub(crate) fn signal(&self, l: usize) -> Option<&Signal> {
-        self.force.as_ref().map(|(_, _, signals)| &signals[l])
+    /// Each lane's force signal, if the lanes are forced, and their
+    /// amplitudes, angular frequencies and phases where all are harmonic.
+    pub(crate) fn signals(&self) -> Option<(&[Signal], Option<&[V; 3]>)> {
+        let (_, _, signals) = self.force.as_ref()?;
+        Some((signals, self.harmonics.as_ref()))
     }
 
     /// Each compliant law's `parts[1] / approach` in `modes`, made once a
@@ -624,7 +675,7 @@ impl<L: LaneLaw> Group<L> {
     pub(super) fn factors(&self, modes: &LaneModes) -> [V; MAX_WALLS] {
         let mut factor = [[0.0; LANES]; MAX_WALLS];
         for (w, wall) in self.walls.iter().enumerate() {
-            if modes.active[w].iter().all(|a| *a == 0.0) {
+            if lanes_where(&modes.active[w]) == 0 {
                 continue;
             }
             for l in 0..LANES {
@@ -700,20 +751,12 @@ impl<L: LaneLaw> Group<L> {
             None => self.rates((n, k), start, &values[0], modes, &factor, first),
         }
         let [k1, k2, k3] = &mut **stages;
-        for e in 0..coordinates {
-            point[e] = stage_point(&start[e], hw[0], &first[e]);
-        }
+        stage_points(point, (start, hw[0], first), coordinates);
         self.rates((n, k), point, &values[1], modes, &factor, k1);
-        for e in 0..coordinates {
-            point[e] = stage_point(&start[e], hw[1], &k1[e]);
-        }
+        stage_points(point, (start, hw[1], k1), coordinates);
         self.rates((n, k), point, &values[2], modes, &factor, k2);
-        for e in 0..coordinates {
-            point[e] = stage_point(&start[e], hw[2], &k2[e]);
-        }
+        stage_points(point, (start, hw[2], k2), coordinates);
         self.rates((n, k), point, &values[3], modes, &factor, k3);
-        for e in 0..len {
-            end[e] = combine(&start[e], &w, [&first[e], &k1[e], &k2[e], &k3[e]]);
-        }
+        combine(end, start, &w, [first, k1, k2, k3], len);
     }
 }

@@ -13,9 +13,11 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use super::lane_signals::LaneCaches;
 use super::lane_stepper::LaneStepper;
 use super::lane_steps::{LaneGaps, LaneRuns, PlainStep};
-use super::lanes::{stage_times, Group, LaneLaw, LaneModes, LaneStep, LANES, V};
+use super::lanes::{each_lane, lanes_where, stage_times, Group, LaneLaw, LaneModes, LaneStep};
+use super::lanes::{LANES, V};
 use super::{MAX_LEN, MAX_WALLS};
 use crate::error::{Error, Result};
 use crate::kernel::events::{ContactTiming, RunOptions, SystemSolution};
@@ -71,6 +73,10 @@ struct Lockstep<'a> {
     pending: [u64; LANES],
     /// Each run's most accepted steps before its step limit.
     max_accepted: [u64; LANES],
+    /// Each run's force caches, the stages' and the reductions' (theirs
+    /// while the lanes step them, see [`Self::store`]).
+    stage_caches: LaneCaches,
+    reduce_caches: LaneCaches,
     step: LaneStep,
     end_gaps: LaneGaps,
     dt: f64,
@@ -94,6 +100,8 @@ impl<'a> Lockstep<'a> {
             end_values: [0.0; LANES],
             pending: [0; LANES],
             max_accepted: [0; LANES],
+            stage_caches: LaneCaches::default(),
+            reduce_caches: LaneCaches::default(),
             step: LaneStep::default(),
             end_gaps: [[[0.0; LANES]; 2]; MAX_WALLS],
             dt: options.dt.unwrap_or(f64::NAN),
@@ -184,16 +192,7 @@ impl<'a> Lockstep<'a> {
     /// own cache, in the stages' order), and the lanes' attempt of that
     /// step, which a run taking the step itself is given.
     fn attempt<L: LaneLaw>(&mut self, group: &Group<L>, time: f64) {
-        let times = stage_times(time, self.dt);
-        let mut values = [[0.0; LANES]; 4];
-        for (l, run) in self.runs.iter_mut().enumerate() {
-            let (Some(run), Some(signal)) = (run, group.signal(l)) else {
-                continue;
-            };
-            for (value, t) in values.iter_mut().zip(times) {
-                value[l] = run.run.scratch.first_force_value(signal, t);
-            }
-        }
+        let values = self.stage_values(group, time, &self.live());
         group.step(&self.lanes.y, self.dt, &self.modes, &values, &mut self.step);
         for (l, stepper) in self.steppers.iter_mut().enumerate() {
             if self.fed[l] && self.runs[l].is_some() {
@@ -202,36 +201,49 @@ impl<'a> Lockstep<'a> {
         }
     }
 
+    /// The lanes with a run in progress.
+    fn live(&self) -> [bool; LANES] {
+        let mut live = [false; LANES];
+        for (l, run) in self.runs.iter().enumerate() {
+            live[l] = run.is_some();
+        }
+        live
+    }
+
+    /// Each run's force at the stages of the step from `time` through its
+    /// stages' cache, in the stages' order (0 where the lanes are not forced).
+    fn stage_values<L: LaneLaw>(
+        &mut self,
+        group: &Group<L>,
+        time: f64,
+        live: &[bool; LANES],
+    ) -> [V; 4] {
+        let mut values = [[0.0; LANES]; 4];
+        if let Some((signals, harmonics)) = group.signals() {
+            for (value, t) in values.iter_mut().zip(stage_times(time, self.dt)) {
+                *value = self.stage_caches.values(signals, harmonics, live, t);
+            }
+        }
+        values
+    }
+
     /// A step from grid point `grid` of every lane: plain for the lanes
     /// whose step is, the kernel's for the others.
     fn plain_steps<L: LaneLaw>(&mut self, group: &Group<L>, grid: u64, in_window: bool) {
         let (dt, time) = (self.dt, grid as f64 * self.dt);
         let next = (grid + 1) as f64 * dt;
-        let times = stage_times(time, dt);
-        let mut values = [[0.0; LANES]; 4];
-        let mut live = [false; LANES];
-        for (l, run) in self.runs.iter_mut().enumerate() {
-            let Some(run) = run else { continue };
-            live[l] = true;
-            if let Some(signal) = group.signal(l) {
-                for (value, t) in values.iter_mut().zip(times) {
-                    value[l] = run.run.scratch.first_force_value(signal, t);
-                }
-            }
-        }
+        let live = self.live();
+        let values = self.stage_values(group, time, &live);
         // The reductions' cache of a lane whose step is not plain is put
         // back: its run's own step takes the values again.
-        let mut saved = [None; LANES];
+        let mut saved = None;
         let mut reduce_values = [[0.0; LANES]; 2];
         let summed = in_window && self.mean_square;
-        for (l, run) in self.runs.iter_mut().enumerate() {
-            let (Some(run), Some(signal), true) = (run, group.signal(l), summed) else {
-                continue;
-            };
-            let scratch = &mut run.run.reduce_scratch;
-            saved[l] = scratch.first_cache().copied();
-            reduce_values[0][l] = scratch.first_force_value(signal, time);
-            reduce_values[1][l] = scratch.first_force_value(signal, time + dt);
+        if let (Some((signals, harmonics)), true) = (group.signals(), summed) {
+            saved = Some(self.reduce_caches.clone());
+            let caches = &mut self.reduce_caches;
+            reduce_values[0] = caches.values(signals, harmonics, &live, time);
+            reduce_values[1] = caches.values(signals, harmonics, &live, time + dt);
         }
         // The reductions' rates at the start are those at the last step's
         // end where every lane's state and force are that end's.
@@ -251,10 +263,10 @@ impl<'a> Lockstep<'a> {
             reduce_values: summed.then_some(&reduce_values),
         };
         let plain = group.plain_step(&step, &mut self.lanes, &mut self.step, &mut self.end_gaps);
-        for (l, run) in self.runs.iter_mut().enumerate() {
-            if let (Some(run), Some(cache), false) = (run, saved[l], plain[l]) {
-                if let Some(to) = run.run.reduce_scratch.first_cache() {
-                    *to = cache;
+        if let Some(saved) = saved {
+            for l in 0..LANES {
+                if live[l] & !plain[l] {
+                    self.reduce_caches.set(l, &saved.get(l));
                 }
             }
         }
@@ -281,13 +293,16 @@ impl<'a> Lockstep<'a> {
     fn go_on(&mut self, plain: &[bool; LANES]) {
         let dt = self.dt;
         let located = true;
+        let mut plain_lanes = 0u32;
+        for l in 0..LANES {
+            plain_lanes |= u32::from(plain[l]) << l;
+        }
         for w in 0..MAX_WALLS {
-            if self.open[w].iter().all(|o| *o == 0.0) {
-                continue;
-            }
-            for (l, run) in self.runs.iter_mut().enumerate() {
-                let Some(run) = run else { continue };
-                let Some(Some(oc)) = run.run.open.get_mut(w).filter(|_| plain[l]) else {
+            for l in each_lane(lanes_where(&self.open[w]) & plain_lanes) {
+                let Some(run) = self.runs.get_mut(l).and_then(Option::as_mut) else {
+                    continue;
+                };
+                let Some(Some(oc)) = run.run.open.get_mut(w) else {
                     continue;
                 };
                 let (g0, r0) = (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]);
@@ -371,6 +386,12 @@ impl<'a> Lockstep<'a> {
             *square = self.lanes.squares[j][l];
         }
         reductions.recorded_time = self.lanes.recorded[l];
+        if let Some(cache) = run.scratch.first_cache() {
+            *cache = self.stage_caches.get(l);
+        }
+        if let Some(cache) = run.reduce_scratch.first_cache() {
+            *cache = self.reduce_caches.get(l);
+        }
         let pending = std::mem::take(&mut self.pending[l]);
         if pending > 0 {
             let clock = &mut run.clock;
@@ -385,10 +406,16 @@ impl<'a> Lockstep<'a> {
 
     /// The lanes' copy of run `l` (after its own step).
     fn load(&mut self, l: usize) {
-        let (true, Some(run)) = (self.vector, self.runs[l].as_ref()) else {
+        let (true, Some(run)) = (self.vector, self.runs[l].as_mut()) else {
             return;
         };
-        let run = &run.run;
+        let run = &mut run.run;
+        if let Some(cache) = run.scratch.first_cache() {
+            self.stage_caches.set(l, cache);
+        }
+        if let Some(cache) = run.reduce_scratch.first_cache() {
+            self.reduce_caches.set(l, cache);
+        }
         for (e, v) in run.y.iter().enumerate().take(MAX_LEN) {
             self.lanes.y[e][l] = *v;
         }

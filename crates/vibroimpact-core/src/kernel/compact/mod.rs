@@ -15,6 +15,7 @@
 // between the arrays measured slower: calls to memcpy, bounds not folded).
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
+mod lane_signals;
 mod lane_stepper;
 mod lane_steps;
 mod lanes;

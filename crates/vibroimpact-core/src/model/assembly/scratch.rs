@@ -28,10 +28,34 @@ pub(crate) struct Cached {
 }
 
 /// Rotations between direct evaluations of a harmonic.
-const RESYNC: u32 = 64;
+pub(crate) const RESYNC: u32 = 64;
+
+/// The phasor `(c, s)` turned by the rotation `(delta_cos, delta_sin)`
+/// (the cache's four multiplications, which the lockstep lanes make in
+/// vector instructions: the same bits).
+#[inline(always)]
+pub(crate) fn rotated(c: f64, s: f64, delta_cos: f64, delta_sin: f64) -> (f64, f64) {
+    (c * delta_cos - s * delta_sin, s * delta_cos + c * delta_sin)
+}
+
+/// Whether a time increment `delta` to `time` is the cached one, `cached`:
+/// the same to the round-off of the times themselves (t + h/2 and t + h
+/// differ by h/2 only to a few ulps of t), so rotating by the cached one
+/// errs no more than the cosine's own argument does.
+#[inline(always)]
+pub(crate) fn same_increment(delta: f64, cached: f64, time: f64) -> bool {
+    (delta - cached).abs() <= 8.0 * f64::EPSILON * time.abs()
+}
+
+/// A [`Cached`]'s fields, for the lockstep lanes' copy of it.
+pub(crate) struct CachedParts {
+    /// `[time, value, cos, sin, delta, delta_cos, delta_sin]`.
+    pub(crate) values: [f64; 7],
+    pub(crate) rotations: u32,
+}
 
 impl Cached {
-    const EMPTY: Self = Self {
+    pub(crate) const EMPTY: Self = Self {
         time: f64::NAN,
         value: 0.0,
         cos: 1.0,
@@ -45,10 +69,39 @@ impl Cached {
     /// The phasor turned by the cached increment.
     #[inline(always)]
     fn rotate(&mut self) {
-        let (c, s) = (self.cos, self.sin);
-        self.cos = c * self.delta_cos - s * self.delta_sin;
-        self.sin = s * self.delta_cos + c * self.delta_sin;
+        (self.cos, self.sin) = rotated(self.cos, self.sin, self.delta_cos, self.delta_sin);
         self.rotations += 1;
+    }
+
+    /// Its fields (see [`CachedParts`]).
+    pub(crate) fn parts(&self) -> CachedParts {
+        CachedParts {
+            values: [
+                self.time,
+                self.value,
+                self.cos,
+                self.sin,
+                self.delta,
+                self.delta_cos,
+                self.delta_sin,
+            ],
+            rotations: self.rotations,
+        }
+    }
+
+    /// The cache of `parts`.
+    pub(crate) fn of_parts(parts: &CachedParts) -> Self {
+        let [time, value, cos, sin, delta, delta_cos, delta_sin] = parts.values;
+        Self {
+            time,
+            value,
+            cos,
+            sin,
+            delta,
+            delta_cos,
+            delta_sin,
+            rotations: parts.rotations,
+        }
     }
 
     /// The phasor at `time`, `delta` after the last, where the steps' path
@@ -77,18 +130,14 @@ impl Cached {
     }
 
     #[inline(always)]
-    pub(super) fn value(&mut self, signal: &Signal, time: f64) -> f64 {
+    pub(crate) fn value(&mut self, signal: &Signal, time: f64) -> f64 {
         if time.to_bits() == self.time.to_bits() {
             return self.value;
         }
         match signal {
             Signal::Harmonic(h) => {
                 let delta = time - self.time;
-                // The same increment to the round-off of the times themselves
-                // (t + h/2 and t + h differ by h/2 only to a few ulps of t):
-                // rotating by the cached one errs no more than the cosine's
-                // own argument does.
-                let same = (delta - self.delta).abs() <= 8.0 * f64::EPSILON * time.abs();
+                let same = same_increment(delta, self.delta, time);
                 if same && self.rotations > 0 && self.rotations < RESYNC {
                     self.rotate();
                 } else {
