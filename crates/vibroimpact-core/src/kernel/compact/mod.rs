@@ -39,9 +39,9 @@ use crate::model::signals::Signal;
 pub(crate) const MAX_MODES: usize = 4;
 pub(crate) const MAX_DAMPERS: usize = 2;
 const MAX_DIM: usize = MAX_MODES + MAX_DAMPERS;
-const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
+pub(crate) const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
 /// The longest state: coordinates, velocities and the accumulators.
-const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
+pub(crate) const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
 
 /// Per wall, the damping factor of its law in the modes stepped (see
 /// [`Compact::rate_factors`]).
@@ -169,7 +169,7 @@ impl Compact {
     /// time (the zeros they add: the same bits).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn rates<const STICKING: bool, const FREE: bool>(
+    pub(crate) fn rates<const STICKING: bool, const FREE: bool>(
         &self,
         system: &Assembly,
         n: usize,

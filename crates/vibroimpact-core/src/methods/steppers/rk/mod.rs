@@ -8,6 +8,16 @@ use crate::kernel::sized::by_size;
 use crate::methods::tableau::*;
 use crate::model::assembly::{Assembly, Mode, Scratch};
 
+mod compact;
+use compact::Stages;
+
+/// The adaptive tableaus the compact path takes (see [`compact`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Fixed {
+    Dopri5,
+    Dop853,
+}
+
 /// How a tableau estimates its local error.
 #[derive(Debug, Clone)]
 pub(super) enum Estimate {
@@ -36,12 +46,18 @@ pub struct ExplicitRk {
     stages: usize,
     /// Classical RK4 (a fixed step taken by a loop of its own).
     rk4: bool,
-    /// Whether RK4 takes the compact path where the system has one: its
-    /// steps in fixed-size arrays, plain ones in stretches (see
-    /// [`crate::kernel::compact`]; the same bits either way).
+    /// Whether RK4, Dormand-Prince 5(4) and DOP853 take the compact path
+    /// where the system has one: their steps in fixed-size arrays, RK4's
+    /// plain ones in stretches (see [`crate::kernel::compact`]; the same bits
+    /// either way).
     pub compact: bool,
     /// Stage derivatives, plus one slot for `f` at the new point.
     k: Vec<Vec<f64>>,
+    /// The adaptive tableau of the compact path, and its stages (a state
+    /// that fits its arrays only).
+    fixed: Option<(Fixed, Box<Stages>)>,
+    /// The last attempt's stages are in `fixed`.
+    fixed_used: bool,
     point: Vec<f64>,
     /// `f` at the current point is in `k[0]` (after `reset` or `accept`).
     start_valid: bool,
@@ -78,6 +94,52 @@ fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[f64], k: &[Vec<f64>]) 
     }
 }
 
+/// The embedded estimate's scaled error of a step `h`: the RMS over the
+/// `coordinates` of `h sum_j e_j k_j` over each one's `scale`.
+#[inline(always)]
+fn embedded_error<K: AsRef<[f64]>>(
+    e: &[f64],
+    k: &[K],
+    h: f64,
+    coordinates: usize,
+    scale: impl Fn(usize) -> f64,
+) -> f64 {
+    let mut sum = 0.0;
+    for n in 0..coordinates {
+        let err: f64 = e.iter().zip(k).map(|(w, k)| w * k.as_ref()[n]).sum();
+        let ratio = h * err / scale(n);
+        sum += ratio * ratio;
+    }
+    (sum / coordinates as f64).sqrt()
+}
+
+/// DOP853's scaled error of a step `h` from its fifth- and third-order
+/// estimates (Hairer's `err5^2 / sqrt(err5^2 + 0.01 err3^2)`).
+#[inline(always)]
+fn dop853_error<K: AsRef<[f64]>>(
+    e5: &[f64],
+    e3: &[f64],
+    k: &[K],
+    h: f64,
+    coordinates: usize,
+    scale: impl Fn(usize) -> f64,
+) -> f64 {
+    let (mut err5, mut err3) = (0.0, 0.0);
+    for n in 0..coordinates {
+        let a: f64 = e5.iter().zip(k).map(|(w, k)| w * k.as_ref()[n]).sum();
+        let b: f64 = e3.iter().zip(k).map(|(w, k)| w * k.as_ref()[n]).sum();
+        let sc = scale(n);
+        err5 += (a / sc) * (a / sc);
+        err3 += (b / sc) * (b / sc);
+    }
+    let denominator = err5 + 0.01 * err3;
+    if denominator > 0.0 {
+        h.abs() * err5 / (denominator * coordinates as f64).sqrt()
+    } else {
+        0.0
+    }
+}
+
 pub(super) fn flatten<const S: usize>(a: &[[f64; S]; S]) -> Vec<f64> {
     a.iter().flatten().copied().collect()
 }
@@ -106,6 +168,8 @@ impl ExplicitRk {
             rk4: name == "rk4",
             compact: true,
             k: vec![vec![0.0; len]; stages + 1],
+            fixed: None,
+            fixed_used: false,
             point: vec![0.0; len],
             start_valid: false,
             end_slot: None,
@@ -138,6 +202,7 @@ impl ExplicitRk {
             len,
         );
         (s.rtol, s.atol) = (rtol, atol);
+        s.fixed = compact::stages(len).map(|k| (Fixed::Dopri5, k));
         s
     }
 
@@ -156,6 +221,7 @@ impl ExplicitRk {
             len,
         );
         (s.rtol, s.atol) = (rtol, atol);
+        s.fixed = compact::stages(len).map(|k| (Fixed::Dop853, k));
         s
     }
 }
@@ -353,12 +419,21 @@ impl SystemStepper for ExplicitRk {
         if !self.is_adaptive() {
             return None;
         }
+        let len = self.point.len();
+        let fixed = match &mut self.fixed {
+            Some((_, stages)) if self.compact && system.compact.is_some() => Some(stages),
+            _ => None,
+        };
+        let first = match fixed {
+            Some(stages) => &mut stages[0][..len],
+            None => &mut self.k[0][..],
+        };
         if !self.start_valid {
-            system.rates(time, y, modes, scratch, &mut self.k[0]);
+            system.rates(time, y, modes, scratch, first);
             self.evaluations += 1;
             self.start_valid = true;
         }
-        Some(&self.k[0])
+        Some(first)
     }
 
     /// The error control weighs the coordinates and velocities, not the
@@ -379,6 +454,11 @@ impl SystemStepper for ExplicitRk {
             self.end_slot = None;
             return Ok(0.0);
         }
+        if let (Some(compact), true, true) = (&system.compact, self.compact, self.fixed.is_some()) {
+            self.fixed_used = true;
+            return Ok(self.compact_attempt(compact, system, time, y, h, modes, scratch, out));
+        }
+        self.fixed_used = false;
         by_size!(system, |n, k| self
             .tableau_stages(system, n, k, time, y, h, modes, scratch));
         let coordinates = 2 * system.dim;
@@ -392,32 +472,13 @@ impl SystemStepper for ExplicitRk {
             Estimate::Embedded(e) => {
                 // The last stage is evaluated at the new point (c = 1, a = b).
                 self.end_slot = Some(s - 1);
-                let mut sum = 0.0;
-                for n in 0..coordinates {
-                    let err: f64 = e.iter().zip(&self.k).map(|(w, k)| w * k[n]).sum();
-                    let ratio = h * err / scale(n);
-                    sum += ratio * ratio;
-                }
-                (sum / coordinates as f64).sqrt()
+                embedded_error(e, &self.k, h, coordinates, scale)
             }
             Estimate::Dop853 { e5, e3 } => {
                 system.rates(time + h, out, modes, scratch, &mut self.k[s]);
                 self.evaluations += 1;
                 self.end_slot = Some(s);
-                let (mut err5, mut err3) = (0.0, 0.0);
-                for n in 0..coordinates {
-                    let a: f64 = e5.iter().zip(&self.k).map(|(w, k)| w * k[n]).sum();
-                    let b: f64 = e3.iter().zip(&self.k).map(|(w, k)| w * k[n]).sum();
-                    let sc = scale(n);
-                    err5 += (a / sc) * (a / sc);
-                    err3 += (b / sc) * (b / sc);
-                }
-                let denominator = err5 + 0.01 * err3;
-                if denominator > 0.0 {
-                    h.abs() * err5 / (denominator * coordinates as f64).sqrt()
-                } else {
-                    0.0
-                }
+                dop853_error(e5, e3, &self.k, h, coordinates, scale)
             }
         })
     }
@@ -425,7 +486,10 @@ impl SystemStepper for ExplicitRk {
     fn accept(&mut self) {
         match self.end_slot {
             Some(slot) => {
-                self.k.swap(0, slot);
+                match &mut self.fixed {
+                    Some((_, stages)) if self.fixed_used => stages[0] = stages[slot],
+                    _ => self.k.swap(0, slot),
+                }
                 self.start_valid = true;
             }
             None => self.start_valid = false,
