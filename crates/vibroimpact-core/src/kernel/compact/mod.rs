@@ -37,10 +37,10 @@ use crate::model::signals::Signal;
 /// two stops.
 pub(crate) const MAX_MODES: usize = 4;
 pub(crate) const MAX_DAMPERS: usize = 2;
-const MAX_DIM: usize = MAX_MODES + MAX_DAMPERS;
-const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
+pub(crate) const MAX_DIM: usize = MAX_MODES + MAX_DAMPERS;
+pub(crate) const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
 /// The longest state: coordinates, velocities and the accumulators.
-const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
+pub(crate) const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
 
 /// Per wall, the damping factor of its law in the modes stepped (see
 /// [`Compact::rate_factors`]).
