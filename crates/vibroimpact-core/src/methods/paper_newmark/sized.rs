@@ -255,13 +255,6 @@ impl PaperNewmark {
         let first_cache = scratch.first_cache().copied();
         self.prepare(system, clock.time, f.y, modes, scratch);
         let (dt, located) = (schedule.dt, timing == ContactTiming::Located);
-        let any = self.contacts_of(modes);
-        self.effective(system, dt, any);
-        let kept = if any { &self.touching } else { &self.apart };
-        let mut inverse = [[0.0; MAX_DIM]; MAX_DIM];
-        for i in 0..d {
-            inverse[i][..d].copy_from_slice(&kept.inverse[i * d..(i + 1) * d]);
-        }
         let (len, count, observed) = (f.y.len().min(MAX_LEN), sized.wall_count, system.observed());
         let count = count.min(MAX_WALLS);
         let rate_count = sized.rate_count.min(MAX_RATES);
@@ -270,25 +263,15 @@ impl PaperNewmark {
         y[..len].copy_from_slice(&f.y[..len]);
         let mut start_gaps = [(0.0, 0.0); MAX_WALLS];
         start_gaps[..count].copy_from_slice(&f.gaps[..count]);
-        let mut carried = Carried {
-            accel: [0.0; MAX_DIM],
-            rates: [0.0; MAX_RATES],
-            lag: [0.0; MAX_WALLS],
-            lagged: [false; MAX_WALLS],
-        };
-        carried.accel[..d].copy_from_slice(&self.accel[..d]);
-        carried.rates[..rate_count].copy_from_slice(&self.powers.start_rates()[..rate_count]);
-        for w in 0..if FREE { 0 } else { count } {
-            if let Mode::Compliant { approach_rate, .. } = modes[w] {
-                let wall = &sized.walls[w];
-                let (indentation, rate) = wall.indentation(d, &y[..d], &y[d..2 * d]);
-                if indentation > 0.0 {
-                    carried.lag[w] = wall.law.force(indentation, rate, approach_rate);
-                    carried.lagged[w] = true;
-                }
-            }
-        }
+        let (inverse, mut carried) = self.sized_start::<FREE>(system, sized, (d, dt), &y, modes);
         let (mut energy, mut end_gaps) = (*f.energy, [(0.0, 0.0); MAX_WALLS]);
+        // Free, the walls' accumulators change in the first step alone, as
+        // the step sums them (their rates are +0 at its end, and each later
+        // step adds +0 to a sum that is not -0): left out of the steps.
+        let mut first_walls = [0.0; MAX_RATES];
+        for k in if FREE { CONTACT } else { MAX_RATES }..MAX_RATES {
+            first_walls[k] = y[2 * d + k] + 0.5 * dt * (carried.rates[k] + 0.0);
+        }
         loop {
             if clock.accepted >= f.max_accepted {
                 f.limited = true;
@@ -355,15 +338,22 @@ impl PaperNewmark {
             }
             // Accepted (the method's `finish` has nothing to add).
             carried = step.carried;
-            for k in 0..MAX_RATES.min(MAX_LEN - 2 * d) {
-                end[2 * d + k] = step.accumulators[k];
+            for i in 0..2 * d {
+                y[i] = end[i];
+            }
+            for k in 0..if FREE { CONTACT } else { MAX_RATES } {
+                y[2 * d + k] = step.accumulators[k];
+            }
+            if FREE && f.steps == 0 {
+                for k in CONTACT..MAX_RATES {
+                    y[2 * d + k] = first_walls[k];
+                }
             }
             clock.time = next;
             clock.grid += 1;
             clock.accepted += 1;
             clock.until_kept = clock.until_kept.saturating_sub(1);
             f.steps += 1;
-            y = end;
             start_gaps = end_gaps;
             let state = (&y, len, modes);
             if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
@@ -381,6 +371,46 @@ impl PaperNewmark {
         *f.clock = clock;
         f.y[..len].copy_from_slice(&y[..len]);
         f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+    }
+
+    /// The inverse effective matrix for steps `dt` in `modes` and what the
+    /// first step from `y` takes ([`Self::sized_steps`]).
+    #[inline(always)]
+    fn sized_start<const FREE: bool>(
+        &mut self,
+        system: &Assembly,
+        sized: &Sized,
+        (d, dt): (usize, f64),
+        y: &[f64; MAX_LEN],
+        modes: &[Mode],
+    ) -> ([[f64; MAX_DIM]; MAX_DIM], Carried) {
+        let any = self.contacts_of(modes);
+        self.effective(system, dt, any);
+        let kept = if any { &self.touching } else { &self.apart };
+        let mut inverse = [[0.0; MAX_DIM]; MAX_DIM];
+        for i in 0..d {
+            inverse[i][..d].copy_from_slice(&kept.inverse[i * d..(i + 1) * d]);
+        }
+        let rate_count = sized.rate_count.min(MAX_RATES);
+        let mut carried = Carried {
+            accel: [0.0; MAX_DIM],
+            rates: [0.0; MAX_RATES],
+            lag: [0.0; MAX_WALLS],
+            lagged: [false; MAX_WALLS],
+        };
+        carried.accel[..d].copy_from_slice(&self.accel[..d]);
+        carried.rates[..rate_count].copy_from_slice(&self.powers.start_rates()[..rate_count]);
+        for w in 0..if FREE { 0 } else { modes.len().min(MAX_WALLS) } {
+            if let Mode::Compliant { approach_rate, .. } = modes[w] {
+                let wall = &sized.walls[w];
+                let (indentation, rate) = wall.indentation(d, &y[..d], &y[d..2 * d]);
+                if indentation > 0.0 {
+                    carried.lag[w] = wall.law.force(indentation, rate, approach_rate);
+                    carried.lagged[w] = true;
+                }
+            }
+        }
+        (inverse, carried)
     }
 
     /// [`Self::step_sized`] and [`Self::end_powers`] in the arrays: the step
@@ -488,8 +518,9 @@ impl PaperNewmark {
             rates[CONTACT + w] = (force + wall.damping * rate - elastic) * rate;
             step.contact[w] = (indentation, rate);
         }
-        // The accumulators by the trapezoidal rule (`Trapezoid::integrate`).
-        for k in 0..MAX_RATES {
+        // The accumulators by the trapezoidal rule (`Trapezoid::integrate`;
+        // free, the walls' are the stretch's, see `first_walls`).
+        for k in 0..if FREE { CONTACT } else { MAX_RATES } {
             step.accumulators[k] = y[2 * d + k] + 0.5 * h * (carried.rates[k] + rates[k]);
         }
         carried.accel = accel;
