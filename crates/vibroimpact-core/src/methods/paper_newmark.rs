@@ -187,7 +187,8 @@ impl PaperNewmark {
 
     /// What an attempt from `(time, y)` in `modes` needs before its step:
     /// the accelerations after a restart, the accumulators' rates in new
-    /// modes.
+    /// modes. (Inlined: the tests in each attempt, as they were written there.)
+    #[inline(always)]
     fn prepare(
         &mut self,
         system: &Assembly,
