@@ -19,6 +19,17 @@ use crate::kernel::fixed;
 use crate::methods::steppers::SystemStepper;
 use crate::model::assembly::{Assembly, Mode, Scratch};
 
+/// The contacts' timing of a fixed-step run whose plain steps may be taken
+/// in a stretch; None where the kernel takes every step. A step that is not
+/// plain is taken back, and with it the first force's signal cache (its
+/// harmonic advances by rotation from the last time asked: the values
+/// depend on the order of the times); with more signals than that one, the
+/// kernel takes every step.
+#[inline(always)]
+pub(crate) fn stretch_timing(f: &Stretch<'_>, scratch: &Scratch) -> Option<ContactTiming> {
+    f.schedule.fixed.filter(|_| scratch.first_cache_only())
+}
+
 /// Plain fixed steps of `stepper` on `system` from the kernel's state lent
 /// in `f` (see [`Stretch`]), each the kernel's fixed step to the bit.
 pub(crate) fn plain_fixed_steps<S: SystemStepper + ?Sized>(
@@ -28,16 +39,9 @@ pub(crate) fn plain_fixed_steps<S: SystemStepper + ?Sized>(
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
-    let Some(timing) = f.schedule.fixed else {
+    let Some(timing) = stretch_timing(f, scratch) else {
         return;
     };
-    // A step that is not plain is taken back, and with it the first
-    // force's signal cache (its harmonic advances by rotation from the last
-    // time asked: the values depend on the order of the times); with more
-    // signals than that one, the kernel takes every step.
-    if !scratch.first_cache_only() {
-        return;
-    }
     let (n, d) = (system.n, system.dim);
     let (row, observed) = (2 * d, system.observed());
     let (dt, located) = (f.schedule.dt, timing == ContactTiming::Located);

@@ -28,6 +28,7 @@ use crate::model::assembly::{
 };
 use crate::model::contact::{AnyLaw, ContactLaw};
 use crate::numerics::linalg;
+use sized::Sized;
 
 /// A compliant interaction: its index, law and contact damper (N s/m).
 #[derive(Debug, Clone, Copy)]
@@ -99,6 +100,9 @@ pub struct PaperNewmark {
     /// One a step, as 0.1 counted the method (the accelerations made again
     /// at a restart are not counted).
     evaluations: u64,
+    /// The data in fixed-size arrays where the compact path takes the
+    /// system: its plain fixed steps are taken there ([`sized`]).
+    sized: Option<Box<Sized>>,
 }
 
 impl PaperNewmark {
@@ -142,7 +146,7 @@ impl PaperNewmark {
         let forced = !parts.harmonics.is_empty() || parts.constant.iter().any(|f| *f != 0.0);
         let count = compliant.len();
         let len = system.state_len();
-        Ok(Self {
+        let mut method = Self {
             beta,
             gamma,
             n,
@@ -168,7 +172,38 @@ impl PaperNewmark {
             rates: vec![0.0; len],
             matrix: vec![0.0; dim * dim],
             evaluations: 0,
-        })
+            sized: None,
+        };
+        method.sized = Sized::of(&method, system).map(Box::new);
+        Ok(method)
+    }
+
+    /// Without the fixed-size path (its steps then through the attempt).
+    #[cfg(test)]
+    pub(crate) fn general(mut self) -> Self {
+        self.sized = None;
+        self
+    }
+
+    /// What an attempt from `(time, y)` in `modes` needs before its step:
+    /// the accelerations after a restart, the accumulators' rates in new
+    /// modes. (Inlined: the tests in each attempt, as they were written there.)
+    #[inline(always)]
+    fn prepare(
+        &mut self,
+        system: &Assembly,
+        time: f64,
+        y: &[f64],
+        modes: &[Mode],
+        s: &mut Scratch,
+    ) {
+        if !self.valid {
+            self.start(system, time, y, modes, s);
+        } else if !self.powers_valid {
+            system.rates(time, y, modes, s, &mut self.rates);
+            self.powers.restart(system, &self.rates);
+            self.powers_valid = true;
+        }
     }
 
     /// The loads at `time` (N) added to `out`.
@@ -498,7 +533,19 @@ impl SystemStepper for PaperNewmark {
         modes: &[Mode],
         scratch: &mut Scratch,
     ) {
-        plain_fixed_steps(self, system, stretch, modes, scratch);
+        let Some(sized) = self.sized.take() else {
+            return plain_fixed_steps(self, system, stretch, modes, scratch);
+        };
+        // Free flight (every wall open, none in contact) without the walls'
+        // terms.
+        let free =
+            modes.iter().all(|m| *m == Mode::Open) && stretch.open.iter().all(Option::is_none);
+        if free {
+            self.sized_stretch::<true>(system, &sized, stretch, modes, scratch);
+        } else {
+            self.sized_stretch::<false>(system, &sized, stretch, modes, scratch);
+        }
+        self.sized = Some(sized);
     }
 
     fn uncount(&mut self, evaluations: u64) {
@@ -515,13 +562,7 @@ impl SystemStepper for PaperNewmark {
         scratch: &mut Scratch,
         out: &mut [f64],
     ) -> Result<f64> {
-        if !self.valid {
-            self.start(system, time, y, modes, scratch);
-        } else if !self.powers_valid {
-            system.rates(time, y, modes, scratch, &mut self.rates);
-            self.powers.restart(system, &self.rates);
-            self.powers_valid = true;
-        }
+        self.prepare(system, time, y, modes, scratch);
         by_size!(system, |n, k| self.step_sized(
             system,
             (n, n + k),
@@ -548,5 +589,8 @@ impl SystemStepper for PaperNewmark {
     }
 }
 
+mod sized;
+#[cfg(test)]
+mod sized_tests;
 #[cfg(test)]
 mod tests;

@@ -86,6 +86,12 @@ impl Trapezoid {
         }
     }
 
+    /// The current point's accumulator rates (a fixed-size path carries
+    /// them through its steps and writes them back).
+    pub(crate) fn start_rates(&mut self) -> &mut [f64] {
+        &mut self.start
+    }
+
     /// The last attempt's end is the new current point.
     pub(crate) fn accept(&mut self) {
         std::mem::swap(&mut self.start, &mut self.pending);

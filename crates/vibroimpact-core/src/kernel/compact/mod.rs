@@ -38,7 +38,7 @@ use crate::model::signals::Signal;
 /// two stops.
 pub(crate) const MAX_MODES: usize = 4;
 pub(crate) const MAX_DAMPERS: usize = 2;
-const MAX_DIM: usize = MAX_MODES + MAX_DAMPERS;
+pub(crate) const MAX_DIM: usize = MAX_MODES + MAX_DAMPERS;
 pub(crate) const MAX_WALLS: usize = 2 * MAX_DAMPERS + 2;
 /// The longest state: coordinates, velocities and the accumulators.
 pub(crate) const MAX_LEN: usize = 2 * MAX_DIM + CONTACT + MAX_WALLS;
