@@ -84,6 +84,9 @@ impl Compact {
         let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
         let mut stages = [[0.0; MAX_LEN]; 4];
         let (held, locked, releasable) = passed_over(system, modes);
+        // Only a sticking pair releases (and with none, `stages[0]` never
+        // carries over: known at compile time).
+        let releasable = STICKING && releasable;
         let factors = self.rate_factors(modes);
         // Whether `stages[0]` holds the rates at the step's start (the last
         // step's release test evaluated them there).
