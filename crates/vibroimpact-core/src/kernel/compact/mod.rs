@@ -286,10 +286,7 @@ impl Compact {
         } else if STICKING && sticking > 1 {
             system.add_constraint_forces(sticking, &mut out[d..2 * d], scratch);
         }
-        if STICKING {
-            // (Without, [`Self::step`] sets it once for its four stages.)
-            scratch.count = sticking;
-        }
+        scratch.count = sticking;
         out[2 * d + VISCOUS] = viscous;
         out[2 * d + INPUT] = input;
         for w in 0..MAX_WALLS {
@@ -329,10 +326,6 @@ impl Compact {
         let hw = [h * RK4_A[1][0], h * RK4_A[2][1], h * RK4_A[3][2]];
         let w = [h * RK4_B[0], h * RK4_B[1], h * RK4_B[2], h * RK4_B[3]];
         let [k0, k1, k2, k3] = stages;
-        if !STICKING {
-            // What each stage's `rates` would set: no pair sticking.
-            scratch.count = 0;
-        }
         if !start_valid {
             self.rates::<STICKING, FREE>(system, n, k, times[0], start, modes, scratch, k0);
         }
