@@ -190,6 +190,55 @@ impl Schedule {
         Some((next, in_window))
     }
 
+    /// How many plain fixed steps ([`Self::plain_fixed_step`]) follow in a
+    /// row from `clock`, at most `most`: the rule asked of each step's clock
+    /// as the steps before it leave it (on the grid, the row's countdown
+    /// down by one a step). Its terms only grow with the grid (the time, the
+    /// steps taken towards a row), so no step after one that is not plain
+    /// is: the first found by doubling and bisection, a few rules asked
+    /// instead of one a step.
+    pub(crate) fn plain_fixed_run(&self, clock: &Clock, most: u64) -> u64 {
+        let plain = |i: u64| {
+            if i == 0 {
+                return self.plain_fixed_step(clock).is_some();
+            }
+            let grid = clock.grid + i;
+            let at = Clock {
+                time: grid as f64 * self.dt,
+                grid,
+                accepted: clock.accepted + i,
+                until_kept: clock.until_kept.saturating_sub(i),
+                next_strobe: clock.next_strobe,
+            };
+            self.plain_fixed_step(&at).is_some()
+        };
+        if most == 0 || !plain(0) {
+            return 0;
+        }
+        // plain(lo); hi is `most` or not plain.
+        let (mut lo, mut stride) = (0, 1);
+        let mut hi = loop {
+            let probe = lo + stride;
+            if probe >= most {
+                break most;
+            }
+            if !plain(probe) {
+                break probe;
+            }
+            lo = probe;
+            stride *= 2;
+        };
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if plain(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    }
+
     /// [`Self::plain_fixed_step`] where the mean squares are summed in the
     /// step (the lockstep lanes sum them).
     #[inline(always)]

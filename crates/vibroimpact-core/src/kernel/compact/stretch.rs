@@ -11,6 +11,7 @@ use crate::kernel::clock::{Clock, Schedule};
 use crate::kernel::events::{ContactTiming, Open};
 use crate::kernel::fixed;
 use crate::kernel::sized::by_size;
+use crate::model::assembly::CONTACT;
 use crate::model::assembly::{Assembly, Mode, Scratch};
 
 impl Compact {
@@ -23,9 +24,20 @@ impl Compact {
         modes: &[Mode],
         scratch: &mut Scratch,
     ) {
+        #[cfg(target_arch = "x86_64")]
         if f.schedule.fixed.is_some() {
             // Out of the events' stretches, which it would grow.
-            return fixed_sized(self, system, f, modes, scratch);
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the processor has the feature the function is built for.
+                return unsafe { fixed_avx512(self, system, f, modes, scratch) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: as above.
+                return unsafe { fixed_avx2(self, system, f, modes, scratch) };
+            }
+        }
+        if f.schedule.fixed.is_some() {
+            return fixed_baseline(self, system, f, modes, scratch);
         }
         #[cfg(target_arch = "x86_64")]
         {
@@ -72,6 +84,11 @@ impl Compact {
         let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
         let mut stages = [[0.0; MAX_LEN]; 4];
         let (held, locked, releasable) = passed_over(system, modes);
+        // None in free flight (only a sticking pair releases): `stages[0]`
+        // then never carries over, known at compile time. (The contact
+        // stretches keep the flag at run time: made a constant there too, a
+        // rattling cantilever's run measured 15 % slower.)
+        let releasable = !FREE && releasable;
         let factors = self.rate_factors(modes);
         // Whether `stages[0]` holds the rates at the step's start (the last
         // step's release test evaluated them there).
@@ -197,15 +214,20 @@ impl Compact {
         let (mut energy, schedule, mut clock) = (*f.energy, *f.schedule, *f.clock);
         let (dt, located) = (schedule.dt, schedule.fixed == Some(ContactTiming::Located));
         let factors = self.rate_factors(modes);
-        loop {
-            if clock.accepted >= f.max_accepted {
-                f.limited = true;
-                break;
-            }
-            let Some((next, in_window)) = schedule.plain_fixed_step(&clock) else {
-                break;
-            };
+        // The stop rules asked once for the steps they allow in a row (the
+        // most the stretch may take: it is then limited, if all were plain).
+        let most = f.max_accepted.saturating_sub(clock.accepted);
+        let allowed = schedule.plain_fixed_run(&clock, most);
+        f.limited = allowed == most;
+        // The steps taken (counted into `f` after the loop).
+        let mut taken = 0;
+        // The state's rooms a step writes: the rest is never read.
+        let room = (2 * d + CONTACT + MAX_WALLS).min(MAX_LEN);
+        while taken < allowed {
+            debug_assert!(schedule.plain_fixed_step(&clock).is_some());
             let time = clock.time;
+            let next = (clock.grid + 1) as f64 * dt;
+            let in_window = schedule.in_window(time, dt);
             let cache = scratch.first_cache().copied();
             self.step::<false, FREE>(
                 system,
@@ -240,6 +262,7 @@ impl Compact {
                 if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
                     *cache = saved;
                 }
+                f.limited = false;
                 break;
             }
             for w in 0..if FREE { 0 } else { count } {
@@ -260,17 +283,23 @@ impl Compact {
             clock.grid += 1;
             clock.accepted += 1;
             clock.until_kept = clock.until_kept.saturating_sub(1);
-            f.evaluations += 4;
-            f.steps += 1;
-            y = end;
-            start_gaps = end_gaps;
+            taken += 1;
+            for e in 0..room {
+                y[e] = end[e];
+            }
+            if !FREE {
+                start_gaps = end_gaps;
+            }
             let state = (&y, len, modes);
             if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
                 f.unbalanced = Some(failure);
+                f.limited = false;
                 break;
             }
         }
-        if FREE && f.steps > 0 {
+        f.steps += taken;
+        f.evaluations += 4 * taken;
+        if FREE && taken > 0 {
             self.gaps(d, &y, &mut start_gaps);
         }
         *f.energy = energy;
@@ -304,7 +333,7 @@ fn stretch_sized(
 }
 
 /// [`Compact::fixed_stretch`] for the system's sizes (constants in each arm).
-#[inline(never)]
+#[inline(always)]
 fn fixed_sized(
     compact: &Compact,
     system: &Assembly,
@@ -321,9 +350,22 @@ fn fixed_sized(
     }
 }
 
-/// [`stretch_sized`] compiled for a processor feature.
+/// [`fixed_sized`] for the baseline processor, out of line (its arms'
+/// arrays kept out of the caller's frame).
+#[inline(never)]
+fn fixed_baseline(
+    compact: &Compact,
+    system: &Assembly,
+    f: &mut Stretch<'_>,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+) {
+    fixed_sized(compact, system, f, modes, scratch)
+}
+
+/// [`stretch_sized`] (or [`fixed_sized`]) compiled for a processor feature.
 macro_rules! stretch_with {
-    ($name:ident, $feature:literal) => {
+    ($name:ident, $sized:ident, $feature:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feature)]
         unsafe fn $name(
@@ -333,12 +375,14 @@ macro_rules! stretch_with {
             modes: &[Mode],
             scratch: &mut Scratch,
         ) {
-            stretch_sized(compact, system, f, modes, scratch)
+            $sized(compact, system, f, modes, scratch)
         }
     };
 }
-stretch_with!(stretch_avx512, "avx512f");
-stretch_with!(stretch_avx2, "avx2");
+stretch_with!(stretch_avx512, stretch_sized, "avx512f");
+stretch_with!(stretch_avx2, stretch_sized, "avx2");
+stretch_with!(fixed_avx512, fixed_sized, "avx512f");
+stretch_with!(fixed_avx2, fixed_sized, "avx2");
 
 /// `n` values of `y` from `from`, copied: a runtime index into the state
 /// itself would keep the compact path's state in memory rather than in
