@@ -38,10 +38,6 @@ pub struct NewmarkFamily {
     dadx: Vec<f64>,
     dadv: Vec<f64>,
     jacobian: Vec<f64>,
-    /// Every pair open, the Jacobian of the step's equations depends on the
-    /// step alone: the last one made there and its elimination, kept for
-    /// the steps whose Jacobian is the same (the same bits).
-    open: Option<(Vec<f64>, linalg::Factored)>,
     evaluations: u64,
 }
 
@@ -75,7 +71,6 @@ impl NewmarkFamily {
             dadx: vec![0.0; dim * dim],
             dadv: vec![0.0; dim * dim],
             jacobian: vec![0.0; dim * dim],
-            open: None,
             evaluations: 0,
         }
     }
@@ -209,23 +204,7 @@ impl SystemStepper for NewmarkFamily {
                     .max(self.accel[i].abs())
                     .max(terms);
             }
-            if linear {
-                // The elimination of the last open step's Jacobian where this
-                // one is the same (a free flight at one step size).
-                let same = |kept: &[f64]| {
-                    let bits = |(a, b): (&f64, &f64)| a.to_bits() == b.to_bits();
-                    kept.iter().zip(&self.jacobian).all(bits)
-                };
-                let kept = matches!(&self.open, Some((j, _)) if same(j));
-                if !kept {
-                    let factored = linalg::Factored::new(&self.jacobian, d);
-                    self.open = factored.map(|f| (self.jacobian.clone(), f));
-                }
-            }
-            match &self.open {
-                Some((_, f)) if linear => f.solve(&mut self.step),
-                _ => linalg::solve_in_place(&mut self.jacobian, &mut self.step, d),
-            }
+            linalg::solve_in_place(&mut self.jacobian, &mut self.step, d);
             let mut largest = 0.0f64;
             for i in 0..d {
                 self.a1[i] += self.step[i];

@@ -16,7 +16,7 @@ mod tests;
 
 pub use eigen::eigenvalues;
 pub use expm::expm;
-pub use solve::{solve_in_place, solve_matrix_in_place, Factored};
+pub use solve::{solve_in_place, solve_matrix_in_place};
 pub use symmetric::{symmetric_eigen, symmetric_eigenvalues};
 
 /// The largest absolute entry.

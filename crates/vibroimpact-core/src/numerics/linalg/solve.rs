@@ -10,47 +10,13 @@ use super::max_abs;
 /// solution of a consistent system. Partial pivoting alone could move an
 /// independent row into a dependent one's place and drop it.
 pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
+    const MOST: usize = 64;
     if n > MOST {
         return solve_partial(a, b, n);
     }
-    let mut columns = [0usize; MOST];
-    let rank = eliminate(a, n, &mut columns[..n], b);
-    back_substitute(a, b, n, rank, &columns[..n]);
-}
-
-/// The most unknowns [`solve_in_place`] pivots completely (stack arrays).
-const MOST: usize = 64;
-
-/// What the elimination does to a right-hand side: row swaps and
-/// subtractions, in order.
-trait RowOps {
-    fn swap_rows(&mut self, k: usize, row: usize);
-    fn subtract(&mut self, r: usize, k: usize, factor: f64);
-}
-
-impl RowOps for [f64] {
-    #[inline(always)]
-    fn swap_rows(&mut self, k: usize, row: usize) {
-        self.swap(k, row);
-    }
-    #[inline(always)]
-    fn subtract(&mut self, r: usize, k: usize, factor: f64) {
-        self[r] -= factor * self[k];
-    }
-}
-
-/// [`solve_in_place`]'s elimination with complete pivoting of `A` (`n <=
-/// MOST`), its operations on the right-hand side made by `rhs`; `columns`
-/// receives the reduced system's column order. The rank.
-#[inline(always)]
-fn eliminate<R: RowOps + ?Sized>(
-    a: &mut [f64],
-    n: usize,
-    columns: &mut [usize],
-    rhs: &mut R,
-) -> usize {
     let tiny = 1e-13 * max_abs(&a[..n * n]);
     // Column k of the reduced system is column `columns[k]` of A's.
+    let mut columns = [0usize; MOST];
     for (k, c) in columns[..n].iter_mut().enumerate() {
         *c = k;
     }
@@ -73,7 +39,7 @@ fn eliminate<R: RowOps + ?Sized>(
             for c in 0..n {
                 a.swap(k * n + c, row * n + c);
             }
-            rhs.swap_rows(k, row);
+            b.swap(k, row);
         }
         if col != k {
             for r in 0..n {
@@ -88,17 +54,10 @@ fn eliminate<R: RowOps + ?Sized>(
                 for c in k..n {
                     a[r * n + c] -= factor * a[k * n + c];
                 }
-                rhs.subtract(r, k, factor);
+                b[r] -= factor * b[k];
             }
         }
     }
-    rank
-}
-
-/// The reduced system's back substitution, the unknowns then put back in
-/// `A`'s column order (unknown k of the reduced system is `columns[k]`).
-#[inline(always)]
-fn back_substitute(a: &[f64], b: &mut [f64], n: usize, rank: usize, columns: &[usize]) {
     for k in (0..n).rev() {
         if k >= rank {
             b[k] = 0.0;
@@ -107,87 +66,13 @@ fn back_substitute(a: &[f64], b: &mut [f64], n: usize, rank: usize, columns: &[u
         let sum: f64 = (k + 1..rank).map(|c| a[k * n + c] * b[c]).sum();
         b[k] = (b[k] - sum) / a[k * n + k];
     }
+    // Back to A's column order: unknown k of the reduced system is A's
+    // `columns[k]`.
     let mut x = [0.0f64; MOST];
     for k in 0..n {
         x[columns[k]] = b[k];
     }
     b[..n].copy_from_slice(&x[..n]);
-}
-
-/// [`solve_in_place`]'s elimination of one `A` (at most 64 unknowns), kept
-/// to solve for many right-hand sides: each solution has the bits
-/// [`solve_in_place`] gives it, without the elimination's cost.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Factored {
-    n: usize,
-    /// The reduced (upper triangular) system.
-    a: Vec<f64>,
-    columns: Vec<usize>,
-    rank: usize,
-    /// The row swapped into row k at step k.
-    rows: Vec<usize>,
-    /// At `k * n + r`, the multiple of row k subtracted from row r at step
-    /// k (0: none).
-    factors: Vec<f64>,
-}
-
-/// Records the elimination's operations on a right-hand side.
-struct Recorder<'a> {
-    n: usize,
-    rows: &'a mut [usize],
-    factors: &'a mut [f64],
-}
-
-impl RowOps for Recorder<'_> {
-    fn swap_rows(&mut self, k: usize, row: usize) {
-        self.rows[k] = row;
-    }
-    fn subtract(&mut self, r: usize, k: usize, factor: f64) {
-        self.factors[k * self.n + r] = factor;
-    }
-}
-
-impl Factored {
-    /// The elimination of `a` (row-major `n x n`, `n <= 64`); None for
-    /// more unknowns.
-    pub fn new(a: &[f64], n: usize) -> Option<Self> {
-        if n > MOST {
-            return None;
-        }
-        let mut f = Self {
-            n,
-            a: a[..n * n].to_vec(),
-            columns: vec![0; n],
-            rank: 0,
-            rows: (0..n).collect(),
-            factors: vec![0.0; n * n],
-        };
-        let mut recorder = Recorder {
-            n,
-            rows: &mut f.rows,
-            factors: &mut f.factors,
-        };
-        f.rank = eliminate(&mut f.a, n, &mut f.columns, &mut recorder);
-        Some(f)
-    }
-
-    /// Solves `A x = b` in place (`b` becomes `x`), as [`solve_in_place`]
-    /// would, to the bit.
-    pub fn solve(&self, b: &mut [f64]) {
-        let n = self.n;
-        for k in 0..self.rank {
-            if self.rows[k] != k {
-                b.swap(k, self.rows[k]);
-            }
-            for r in k + 1..n {
-                let factor = self.factors[k * n + r];
-                if factor != 0.0 {
-                    b[r] -= factor * b[k];
-                }
-            }
-        }
-        back_substitute(&self.a, b, n, self.rank, &self.columns);
-    }
 }
 
 /// [`solve_in_place`] by partial pivoting, for systems too large for its
