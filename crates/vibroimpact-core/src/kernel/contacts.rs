@@ -385,8 +385,8 @@ fn contact_time_scale(system: &Assembly, i: usize, speed: f64) -> f64 {
 impl Run<'_> {
     /// An adaptive method's first step where the run sets none: Hairer's
     /// ([`initial_step`]) from the rates at the start, at most a tenth of
-    /// the run, and below the onset cap of a contact the run starts in or
-    /// on the wall of (0.1's rule).
+    /// the run and at least 1e-12 of it, and below the onset cap of a
+    /// contact the run starts in or on the wall of (0.1's rules).
     pub(super) fn first_step<S: SystemStepper>(&mut self, stepper: &mut S) {
         let (system, t_end) = (self.system, self.schedule.t_end);
         let (Some(tolerances), None) = (stepper.tolerances(), self.options.dt) else {
@@ -408,7 +408,10 @@ impl Run<'_> {
             0.1 * t_end,
             buffers,
             |time, y1, f1| system.rates(time, y1, modes, scratch, f1),
-        );
+        )
+        // At least 1e-12 of the run, as 0.1 (and a NaN one, of rates beyond
+        // floating point, so: the first step finds the blow-up, not a crawl).
+        .max(1e-12 * t_end);
         for (i, mode) in self.modes.iter().enumerate() {
             let speed = match mode {
                 Mode::Compliant { approach_rate, .. } => *approach_rate,
