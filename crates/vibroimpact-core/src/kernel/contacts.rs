@@ -12,8 +12,10 @@ use crate::kernel::events::{ContactKind, Open};
 use crate::kernel::impacts;
 use crate::kernel::locate::{any_compliant, crossed, event_value};
 use crate::kernel::run::{loss_slot, Run};
+use crate::methods::step_control::initial_step;
 use crate::methods::steppers::SystemStepper;
-use crate::model::assembly::{InteractionLaw, Mode};
+use crate::model::assembly::{Assembly, InteractionLaw, Mode};
+use crate::model::contact::{AnyLaw, Hertz, HysterHertz, Linear};
 use crate::numerics::hermite;
 
 /// Contacts held before those a run does not keep are dropped (see
@@ -182,7 +184,7 @@ impl Run<'_> {
             );
         }
         if any {
-            self.count_close_events(stepper)?;
+            self.count_close_events(stepper, rigid)?;
         }
         // Impacts change the velocities.
         system.gaps(&self.y, &mut self.gaps.start);
@@ -239,11 +241,25 @@ impl Run<'_> {
 
     /// After an event that switched a pair: the method restarts, and events
     /// closer than the time's round-off, too many in a row, are chattering.
-    fn count_close_events<S: SystemStepper>(&mut self, stepper: &mut S) -> Result<()> {
+    /// An adaptive method's step restarts below the onset cap of each
+    /// contact just begun (0.1's rule); after a rigid impact (the velocities
+    /// jumped) at most 1e-3 of the run.
+    fn count_close_events<S: SystemStepper>(&mut self, stepper: &mut S, rigid: bool) -> Result<()> {
         let time = self.clock.time;
         stepper.reset();
         if self.schedule.adaptive {
-            self.control.h = self.control.h.min(1e-3 * self.schedule.t_end);
+            if rigid {
+                self.control.h = self.control.h.min(1e-3 * self.schedule.t_end);
+            }
+            for i in 0..self.modes.len() {
+                if let (true, Mode::Compliant { approach_rate, .. }) =
+                    (self.just_switched[i], self.modes[i])
+                {
+                    let cap =
+                        ONSET_STEP_FRACTION * contact_time_scale(self.system, i, approach_rate);
+                    self.control.h = self.control.h.min(cap);
+                }
+            }
         }
         let interval = self.schedule.chatter_interval(time);
         if time - self.last_event < interval {
@@ -336,5 +352,74 @@ impl Run<'_> {
                     .push(oc.close(pair, f64::NAN, f64::NAN, dissipated));
             }
         }
+    }
+}
+
+/// The first adaptive step after a compliant contact's onset, as a fraction
+/// of its time scale ([`contact_time_scale`]; 0.1's rule).
+const ONSET_STEP_FRACTION: f64 = 1e-3;
+
+/// The time compliant interaction `i`, approaching at `speed` (m/s), takes
+/// to store the pair's relative kinetic energy elastically, `delta* /
+/// speed` (s): a fraction of the contact's duration, where `F ~ delta^1.5`
+/// makes the solution rough. Infinite for a rigid pair or no approach.
+fn contact_time_scale(system: &Assembly, i: usize, speed: f64) -> f64 {
+    let it = &system.interactions[i];
+    let (InteractionLaw::Compliant { law, .. }, true) =
+        (it.law, speed.abs() > 0.0 && speed.is_finite())
+    else {
+        return f64::INFINITY;
+    };
+    let speed = speed.abs();
+    let energy = 0.5 * speed * speed / it.inverse_mass;
+    // The law's potential inverted: `0.4 k delta^2.5` (Hertz), `0.5 k delta^2`.
+    let indentation = match law {
+        AnyLaw::Hertz(Hertz { stiffness }) | AnyLaw::HysterHertz(HysterHertz { stiffness, .. }) => {
+            (energy / (0.4 * stiffness)).powf(0.4)
+        }
+        AnyLaw::Linear(Linear { stiffness }) => (2.0 * energy / stiffness).sqrt(),
+    };
+    indentation / speed
+}
+
+impl Run<'_> {
+    /// An adaptive method's first step where the run sets none: Hairer's
+    /// ([`initial_step`]) from the rates at the start, at most a tenth of
+    /// the run and at least 1e-12 of it, and below the onset cap of a
+    /// contact the run starts in or on the wall of (0.1's rules).
+    pub(super) fn first_step<S: SystemStepper>(&mut self, stepper: &mut S) {
+        let (system, t_end) = (self.system, self.schedule.t_end);
+        let (Some(tolerances), None) = (stepper.tolerances(), self.options.dt) else {
+            return;
+        };
+        let y = &self.y;
+        let Some(f0) = stepper.start_rates(system, 0.0, y, &self.modes, &mut self.scratch) else {
+            return;
+        };
+        self.buffers.start.copy_from_slice(f0);
+        let (modes, scratch) = (&self.modes, &mut self.scratch);
+        let buffers = (&mut self.buffers.probe[..], &mut self.buffers.work[..]);
+        let mut h = initial_step(
+            y,
+            &self.buffers.start,
+            2 * system.dim,
+            tolerances,
+            |e| stepper.shrink(e),
+            0.1 * t_end,
+            buffers,
+            |time, y1, f1| system.rates(time, y1, modes, scratch, f1),
+        )
+        // At least 1e-12 of the run, as 0.1 (and a NaN one, of rates beyond
+        // floating point, so: the first step finds the blow-up, not a crawl).
+        .max(1e-12 * t_end);
+        for (i, mode) in self.modes.iter().enumerate() {
+            let speed = match mode {
+                Mode::Compliant { approach_rate, .. } => *approach_rate,
+                Mode::Open if self.on_wall_at_start[i] => system.gap(i, y).1,
+                _ => continue,
+            };
+            h = h.min(ONSET_STEP_FRACTION * contact_time_scale(system, i, speed));
+        }
+        self.control.h = h;
     }
 }

@@ -318,6 +318,7 @@ impl<'a> Run<'a> {
         if options.keep_history {
             run.push_history_row(0.0)?;
         }
+        run.first_step(stepper);
         Ok(run)
     }
 

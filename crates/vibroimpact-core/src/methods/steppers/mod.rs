@@ -45,6 +45,10 @@ pub trait SystemStepper {
     ) -> Option<&[f64]> {
         None
     }
+    /// An adaptive method's `(rtol, atol)`; None for a fixed-step one.
+    fn tolerances(&self) -> Option<(f64, f64)> {
+        None
+    }
     /// Forget data carried from the last step (the right-hand side jumped).
     fn reset(&mut self);
     /// Fixed stepping (steps not cut at contacts): the step just kept and

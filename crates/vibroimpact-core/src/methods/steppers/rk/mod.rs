@@ -380,6 +380,10 @@ impl SystemStepper for ExplicitRk {
         !matches!(self.estimate, Estimate::None)
     }
 
+    fn tolerances(&self) -> Option<(f64, f64)> {
+        self.is_adaptive().then_some((self.rtol, self.atol))
+    }
+
     fn reset(&mut self) {
         self.start_valid = false;
         self.end_slot = None;
