@@ -539,7 +539,7 @@ pub fn run_study<'py>(
     stepping: Option<&str>,
     orbit_periods: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use core::analysis::study::{run_study as study, Analysis, Parameter, StudySettings};
+    use core::analysis::study::{run_study as study, Parameter, StudySettings};
     let options = Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
     let method = method.unwrap_or_else(|| SYSTEM.method.to_string());
     let energy_tolerance = energy_tolerance.unwrap_or(ENERGY_TOLERANCE.default_value());
@@ -567,23 +567,15 @@ pub fn run_study<'py>(
             values.len()
         )));
     }
-    let analysis = match analysis {
-        "run" => Analysis::Run { t_end, record_from },
-        "steady-state" => Analysis::SteadyState {
-            settle: settle_periods,
-            record: record_periods.max(1),
-            tolerance,
-        },
-        "orbit" => Analysis::Orbit {
-            settle: settle_periods,
-            periods: orbit_periods.max(1),
-        },
-        other => {
-            return Err(InvalidInputError::new_err(format!(
-                "analysis must be \"run\", \"steady-state\" or \"orbit\", got {other:?}"
-            )))
-        }
-    };
+    let analysis = study_analysis(
+        analysis,
+        t_end,
+        record_from,
+        settle_periods,
+        record_periods,
+        tolerance,
+        orbit_periods,
+    )?;
     let settings = StudySettings {
         method,
         dt,
@@ -592,15 +584,7 @@ pub fn run_study<'py>(
         energy_tolerance,
         analysis,
         mean_square,
-        lockstep: match stepping {
-            "events" => false,
-            "fixed" => true,
-            other => {
-                return Err(InvalidInputError::new_err(format!(
-                    "stepping must be \"events\" or \"fixed\", got {other:?}"
-                )))
-            }
-        },
+        lockstep: lockstep_of(stepping)?,
     };
     let results = released(py, |interrupt| {
         // The runs go on the study's threads, where Python's signals cannot be
@@ -632,6 +616,57 @@ pub fn run_study<'py>(
             })
         })
     })?;
+    study_dict(py, &base, &results)
+}
+
+/// The analysis a study's runs make, by its name.
+#[allow(clippy::too_many_arguments)]
+fn study_analysis(
+    analysis: &str,
+    t_end: f64,
+    record_from: f64,
+    settle_periods: u64,
+    record_periods: u64,
+    tolerance: f64,
+    orbit_periods: u64,
+) -> PyResult<core::analysis::study::Analysis> {
+    use core::analysis::study::Analysis;
+    Ok(match analysis {
+        "run" => Analysis::Run { t_end, record_from },
+        "steady-state" => Analysis::SteadyState {
+            settle: settle_periods,
+            record: record_periods.max(1),
+            tolerance,
+        },
+        "orbit" => Analysis::Orbit {
+            settle: settle_periods,
+            periods: orbit_periods.max(1),
+        },
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "analysis must be \"run\", \"steady-state\" or \"orbit\", got {other:?}"
+            )))
+        }
+    })
+}
+
+/// Whether a study's `stepping` asks for lockstep fixed steps.
+fn lockstep_of(stepping: &str) -> PyResult<bool> {
+    match stepping {
+        "events" => Ok(false),
+        "fixed" => Ok(true),
+        other => Err(InvalidInputError::new_err(format!(
+            "stepping must be \"events\" or \"fixed\", got {other:?}"
+        ))),
+    }
+}
+
+/// A study's metrics as flat arrays, one row a run.
+fn study_dict<'py>(
+    py: Python<'py>,
+    base: &Assembly,
+    results: &[core::analysis::study::RunMetrics],
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("n", base.n)?;
     out.set_item("pairs", base.pairs.clone())?;

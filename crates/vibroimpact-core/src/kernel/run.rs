@@ -157,6 +157,31 @@ fn all_compliant(system: &Assembly) -> Vec<Mode> {
     system.interactions.iter().map(mode).collect()
 }
 
+/// The distance (m) within which a gap counts as grazed: 1e-12 of the
+/// largest wall offset, at least 1e-21 m.
+fn graze_tolerance(system: &Assembly) -> f64 {
+    1e-12
+        * system
+            .interactions
+            .iter()
+            .map(|it| it.offset.abs())
+            .fold(1e-9, f64::max)
+}
+
+/// The time (s) below which an adaptive or exact run sums a chattering
+/// sequence: a millionth of the structure's longest period; without one (a
+/// body on no spring), of the system's time scale (its forcing period or
+/// fall time), not of the run: a cut-off growing with t_end had counted one
+/// orbit's impacts differently in runs of different lengths.
+fn chatter_resolution(system: &Assembly, t_end: f64) -> f64 {
+    let longest = if system.longest_period.is_finite() {
+        system.longest_period
+    } else {
+        system.time_scale()
+    };
+    1e-6 * t_end.min(longest)
+}
+
 /// The pairs with a compliant wall, in order (the contact-force columns).
 fn force_pairs(system: &Assembly) -> Vec<usize> {
     let mut pairs: Vec<usize> = Vec::new();
@@ -193,25 +218,9 @@ impl<'a> Run<'a> {
                 stepper.name()
             )));
         }
-        let graze = 1e-12
-            * system
-                .interactions
-                .iter()
-                .map(|it| it.offset.abs())
-                .fold(1e-9, f64::max);
-        // The time below which a chattering sequence is summed: the step, or
-        // a millionth of the structure's longest period; without one (a body
-        // on no spring), of the system's time scale (its forcing period or
-        // fall time), not of the run: a cut-off growing with t_end had
-        // counted one orbit's impacts differently in runs of different
-        // lengths.
+        let graze = graze_tolerance(system);
         let resolution = if adaptive || stepper.is_exact() {
-            let longest = if system.longest_period.is_finite() {
-                system.longest_period
-            } else {
-                system.time_scale()
-            };
-            1e-6 * t_end.min(longest)
+            chatter_resolution(system, t_end)
         } else {
             dt
         };
@@ -300,26 +309,34 @@ impl<'a> Run<'a> {
             timed_polls: system.dim > TIMED_POLLS_BEYOND,
             last_poll: std::time::Instant::now(),
         };
-        run.resume_contacts();
-        if timing.is_some() {
-            run.resume_fixed();
+        run.start(stepper)?;
+        Ok(run)
+    }
+
+    /// The state at t = 0: contacts resumed, gaps and stored energy taken,
+    /// the first history row kept and the first step chosen.
+    fn start<S: SystemStepper>(&mut self, stepper: &mut S) -> Result<()> {
+        let system = self.system;
+        self.resume_contacts();
+        if self.timing.is_some() {
+            self.resume_fixed();
         }
         // Open pairs only (a resumed contact is not on its wall).
-        for (i, on_wall) in run.on_wall_at_start.iter_mut().enumerate() {
-            *on_wall &= run.modes[i] == Mode::Open;
+        for (i, on_wall) in self.on_wall_at_start.iter_mut().enumerate() {
+            *on_wall &= self.modes[i] == Mode::Open;
         }
-        system.gaps(&run.y, &mut run.gaps.start);
-        let (stored_start, energy_scale) = system.energy_terms(&run.y, &run.modes);
-        (run.energy.stored_start, run.energy.scale) = (stored_start, energy_scale);
-        for record in run.open.iter_mut().flatten() {
-            record.balance = OnsetBalance::at(system, &run.y, &run.modes, stored_start, 0.0);
+        system.gaps(&self.y, &mut self.gaps.start);
+        let (stored_start, energy_scale) = system.energy_terms(&self.y, &self.modes);
+        (self.energy.stored_start, self.energy.scale) = (stored_start, energy_scale);
+        for record in self.open.iter_mut().flatten() {
+            record.balance = OnsetBalance::at(system, &self.y, &self.modes, stored_start, 0.0);
         }
-        run.compliant = any_compliant(&run.modes);
-        if options.keep_history {
-            run.push_history_row(0.0)?;
+        self.compliant = any_compliant(&self.modes);
+        if self.options.keep_history {
+            self.push_history_row(0.0)?;
         }
-        run.first_step(stepper);
-        Ok(run)
+        self.first_step(stepper);
+        Ok(())
     }
 
     /// A compliant pair that starts in contact (a run continued from
