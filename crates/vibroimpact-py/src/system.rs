@@ -10,9 +10,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::kernel::events::{
-    integrate_system_stepped, ContactTiming, RunOptions, Stepping,
-};
+use vibroimpact_core::kernel::events::{integrate_system_stepped, RunOptions, Stepping};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::{
     check_settings, AnyStepper, Options, DEFAULT_MAX_ROWS, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE,
@@ -383,26 +381,7 @@ pub fn simulate_system<'py>(
 
 /// The kernel's stepping from `[solver] stepping` and `contact_timing`.
 fn stepping_of(stepping: &str, contact_timing: &str) -> PyResult<Stepping> {
-    let contact_timing = match contact_timing {
-        "located" => ContactTiming::Located,
-        "step-count" => ContactTiming::StepCount,
-        other => {
-            return Err(InvalidInputError::new_err(format!(
-                "contact_timing must be \"located\" or \"step-count\", got {other:?}"
-            )))
-        }
-    };
-    match stepping {
-        "events" if contact_timing == ContactTiming::Located => Ok(Stepping::Events),
-        "events" => Err(InvalidInputError::new_err(
-            "contact_timing \"step-count\" needs stepping \"fixed\": with events the contact \
-             instants are located",
-        )),
-        "fixed" => Ok(Stepping::Fixed { contact_timing }),
-        other => Err(InvalidInputError::new_err(format!(
-            "stepping must be \"events\" or \"fixed\", got {other:?}"
-        ))),
-    }
+    Stepping::parse(stepping, contact_timing).map_err(to_py)
 }
 
 /// A run's results as a dict of flat arrays.
@@ -652,13 +631,8 @@ fn study_analysis(
 
 /// Whether a study's `stepping` asks for lockstep fixed steps.
 fn lockstep_of(stepping: &str) -> PyResult<bool> {
-    match stepping {
-        "events" => Ok(false),
-        "fixed" => Ok(true),
-        other => Err(InvalidInputError::new_err(format!(
-            "stepping must be \"events\" or \"fixed\", got {other:?}"
-        ))),
-    }
+    let stepping = Stepping::parse(stepping, "located").map_err(to_py)?;
+    Ok(matches!(stepping, Stepping::Fixed { .. }))
 }
 
 /// A study's metrics as flat arrays, one row a run.

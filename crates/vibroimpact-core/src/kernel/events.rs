@@ -18,7 +18,7 @@
 //! ([`crate::kernel::contacts`]); records and checks after each step
 //! ([`crate::kernel::records`]).
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 pub use crate::kernel::balance::EnergyBalance;
 use crate::kernel::clock::Stop;
 use crate::kernel::contact_balance::OnsetBalance;
@@ -70,6 +70,46 @@ pub enum ContactTiming {
     Located,
     /// In whole steps, as the founding paper counted them.
     StepCount,
+}
+
+impl Stepping {
+    pub const NAMES: &'static str = "\"events\", \"fixed\"";
+
+    /// The stepping named by `[solver] stepping` and `contact_timing`.
+    pub fn parse(stepping: &str, contact_timing: &str) -> Result<Self> {
+        let contact_timing = ContactTiming::parse(contact_timing)?;
+        match stepping {
+            "events" if contact_timing == ContactTiming::Located => Ok(Self::Events),
+            "events" => Err(Error::Inconsistent(
+                "contact_timing \"step-count\" needs stepping \"fixed\": with events the \
+                 contact instants are located"
+                    .into(),
+            )),
+            "fixed" => Ok(Self::Fixed { contact_timing }),
+            other => Err(Error::UnknownChoice {
+                field: "stepping",
+                allowed: Self::NAMES,
+                value: other.to_string(),
+            }),
+        }
+    }
+}
+
+impl ContactTiming {
+    pub const NAMES: &'static str = "\"located\", \"step-count\"";
+
+    /// The timing named by `[solver] contact_timing`.
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "located" => Ok(Self::Located),
+            "step-count" => Ok(Self::StepCount),
+            _ => Err(Error::UnknownChoice {
+                field: "contact_timing",
+                allowed: Self::NAMES,
+                value: name.to_string(),
+            }),
+        }
+    }
 }
 
 /// What kind of contact a record is.
@@ -311,4 +351,38 @@ pub fn integrate_system_stepped<S: SystemStepper>(
         run.after_step(stop, interrupt)?;
     }
     Ok(run.finish(stepper))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::timeout;
+
+    #[test]
+    fn stepping_names_parse_to_the_kernel_stepping_and_wrong_ones_are_refused() {
+        timeout(10, || {
+            assert_eq!(Stepping::parse("events", "located"), Ok(Stepping::Events));
+            assert_eq!(
+                Stepping::parse("fixed", "step-count"),
+                Ok(Stepping::Fixed {
+                    contact_timing: ContactTiming::StepCount
+                })
+            );
+            // Events locate every instant: counting whole steps contradicts them.
+            assert!(matches!(
+                Stepping::parse("events", "step-count"),
+                Err(Error::Inconsistent(_))
+            ));
+            let wrong = Stepping::parse("fixd", "located").unwrap_err().to_string();
+            assert_eq!(
+                wrong,
+                "stepping must be one of \"events\", \"fixed\", got \"fixd\""
+            );
+            let wrong = ContactTiming::parse("counted").unwrap_err().to_string();
+            assert!(
+                wrong.starts_with("contact_timing must be one of"),
+                "{wrong}"
+            );
+        });
+    }
 }
