@@ -356,11 +356,10 @@ pub fn integrate_system_stepped<S: SystemStepper>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::timeout;
 
     #[test]
     fn stepping_names_parse_to_the_kernel_stepping_and_wrong_ones_are_refused() {
-        timeout(10, || {
+        crate::testing::timeout(10, || {
             assert_eq!(Stepping::parse("events", "located"), Ok(Stepping::Events));
             assert_eq!(
                 Stepping::parse("fixed", "step-count"),
