@@ -4,7 +4,7 @@
 
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
-use super::{Compact, MAX_LEN, MAX_MODES, MAX_WALLS};
+use super::{Compact, Factors, MAX_LEN, MAX_MODES, MAX_WALLS};
 use crate::error::Error;
 use crate::kernel::balance::EnergyWatch;
 use crate::kernel::clock::{Clock, Schedule};
@@ -51,6 +51,21 @@ impl Compact {
             }
         }
         stretch_sized(self, system, f, modes, scratch)
+    }
+
+    /// [`Self::method_steps`] of `method`'s steps for the system's sizes: the
+    /// events' stretches of a method other than RK4 (the implicit Newmark
+    /// family's).
+    #[inline(never)]
+    pub(crate) fn method_stretch<M: ArraySteps>(
+        &self,
+        method: &mut M,
+        system: &Assembly,
+        f: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        method_sized(self, method, system, f, modes, scratch)
     }
 
     /// Plain RK4 steps on the grid, as the event kernel takes them, for as
@@ -169,6 +184,134 @@ impl Compact {
             f.steps += 1;
             // Those rates are the next step's first stage.
             start_valid = releasable;
+            y = end;
+            start_gaps = end_gaps;
+            let state = (&y, len, modes);
+            if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
+                f.unbalanced = Some(failure);
+                break;
+            }
+        }
+        *f.energy = energy;
+        *f.clock = clock;
+        f.y[..len].copy_from_slice(&y[..len]);
+        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+    }
+
+    /// [`Self::stretch`]'s loop for another method's steps ([`ArraySteps`]):
+    /// plain steps on the grid, as the event kernel takes them, for as long as nothing but the
+    /// step itself is due (the kernel's own rule, [`Schedule::plain_step`]),
+    /// with the system's data in registers across them. Each step is the
+    /// kernel's to the bit; one that turns out not to be plain (a gap that
+    /// may cross, a compliant contact at its deepest, a peak inside the step,
+    /// a state no longer finite, an attempt that fails) is taken back, for
+    /// the kernel to take.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn method_steps<M: ArraySteps, const STICKING: bool, const FREE: bool>(
+        &self,
+        method: &mut M,
+        system: &Assembly,
+        n: usize,
+        k: usize,
+        f: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        let d = n + k;
+        let row = 2 * d;
+        let count = self.count.min(MAX_WALLS);
+        let len = f.y.len().min(MAX_LEN);
+        let observed = system.observed();
+        let modes = &modes[..count];
+        let mut y = [0.0; MAX_LEN];
+        y[..len].copy_from_slice(&f.y[..len]);
+        let mut start_gaps = [(0.0, 0.0); MAX_WALLS];
+        start_gaps[..count].copy_from_slice(&f.gaps[..count]);
+        let mut end = [0.0; MAX_LEN];
+        let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
+        let (held, locked, releasable) = passed_over(system, modes);
+        // None in free flight (only a sticking pair releases): the end's
+        // rates then never carry over, known at compile time. (The contact
+        // stretches keep the flag at run time: made a constant there too, a
+        // rattling cantilever's run measured 15 % slower.)
+        let releasable = !FREE && releasable;
+        let factors = self.rate_factors(modes);
+        // In registers through the loop, written back after it.
+        let mut energy = *f.energy;
+        let schedule = *f.schedule;
+        let mut clock = *f.clock;
+        loop {
+            if clock.accepted >= f.max_accepted {
+                f.limited = true;
+                break;
+            }
+            let Some((length, in_window)) = schedule.plain_step(&clock) else {
+                break;
+            };
+            let time = clock.time;
+            let next = time + length;
+            let cache = scratch.first_cache().copied();
+            let at = (modes, &factors);
+            let made = method.step::<STICKING, FREE>(
+                self,
+                system,
+                (n, k),
+                (time, length),
+                &y,
+                at,
+                scratch,
+                &mut end,
+            );
+            self.gaps(d, &end, &mut end_gaps);
+            // What the kernel would do more than count the step: an event
+            // search, a blow-up, a compliant contact's deepest point, a peak
+            // inside the step (or the attempt's failure, which it reports).
+            let mut plain = end[..row].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
+            plain &= made.is_some();
+            plain &= shows_no_event(modes, &held, (&start_gaps, &end_gaps), length);
+            if plain && releasable {
+                // A sticking pair whose constraint force at the step's end
+                // pulls is released: the forces as the event search takes
+                // them.
+                let rates = method.end_rates();
+                self.rates::<true, false>(system, n, k, next, &end, at, scratch, rates);
+                for w in 0..count {
+                    if modes[w] == Mode::Sticking
+                        && !locked[w]
+                        && scratch.force_of(w).unwrap_or(0.0) < 0.0
+                    {
+                        plain = false;
+                    }
+                }
+            }
+            if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
+                plain = false;
+            }
+            if !plain {
+                if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
+                    *cache = saved;
+                }
+                break;
+            }
+            for w in 0..count {
+                if let (Mode::Compliant { .. }, Some(contact)) = (modes[w], &mut f.open[w]) {
+                    contact.max_indentation = contact.max_indentation.max(-end_gaps[w].0);
+                }
+            }
+            if in_window {
+                let kept = observed.min(f.peaks.len());
+                widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
+                *f.recorded_time += length;
+            }
+            clock.time = next;
+            clock.grid += 1;
+            clock.accepted += 1;
+            clock.until_kept = clock.until_kept.saturating_sub(1);
+            f.evaluations += made.unwrap_or(0);
+            f.steps += 1;
+            // Those rates are the next step's start's.
+            method.keep(releasable);
             y = end;
             start_gaps = end_gaps;
             let state = (&y, len, modes);
@@ -330,6 +473,67 @@ fn stretch_sized(
         by_size!(system, |n, k| compact
             .stretch::<false, false>(system, n, k, f, modes, scratch))
     }
+}
+
+/// [`Compact::method_steps`] of `method` for the system's sizes (constants in
+/// each arm).
+#[inline(always)]
+fn method_sized<M: ArraySteps>(
+    compact: &Compact,
+    method: &mut M,
+    system: &Assembly,
+    f: &mut Stretch<'_>,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+) {
+    // Without a sticking pair, no constraint solve is compiled in; in free
+    // flight, no wall's force and no gravity.
+    if modes.contains(&Mode::Sticking) {
+        by_size!(system, |n, k| compact.method_steps::<M, true, false>(
+            method, system, n, k, f, modes, scratch
+        ))
+    } else if compact.free(modes) {
+        by_size!(system, |n, k| compact.method_steps::<M, false, true>(
+            method, system, n, k, f, modes, scratch
+        ))
+    } else {
+        by_size!(system, |n, k| compact.method_steps::<M, false, false>(
+            method, system, n, k, f, modes, scratch
+        ))
+    }
+}
+
+/// A fixed-step method's step in the compact form's arrays, each as the
+/// event kernel takes it through the method's attempt, to the bit: another
+/// method's specialisation than RK4's (the implicit Newmark family's).
+/// [`Compact::method_steps`] takes them in a row: [`Compact::stretch`]'s
+/// loop, whose RK4 steps are its own (made generic over RK4 too, the
+/// throughput example's RK4 events on the general kernel measured 30 %
+/// slower).
+pub(crate) trait ArraySteps {
+    /// The step `length` from `(time, y)` (`at`) into `end` (every room of
+    /// the accumulators), for `n` structure coordinates and `k` dampers
+    /// (`sizes`), in `modes` with their rate factors: the right-hand-side
+    /// evaluations it made, or None where the method's attempt fails (the
+    /// kernel then makes it, and reports why).
+    #[allow(clippy::too_many_arguments)]
+    fn step<const STICKING: bool, const FREE: bool>(
+        &mut self,
+        compact: &Compact,
+        system: &Assembly,
+        sizes: (usize, usize),
+        at: (f64, f64),
+        y: &[f64; MAX_LEN],
+        modes: (&[Mode], &Factors),
+        scratch: &mut Scratch,
+        end: &mut [f64; MAX_LEN],
+    ) -> Option<u64>;
+    /// Room for the rates at the last step's end (a sticking pair's release
+    /// test evaluates them there).
+    fn end_rates(&mut self) -> &mut [f64; MAX_LEN];
+    /// The last step is kept; `end_rates`: whether [`Self::end_rates`]
+    /// holds the rates at its end (the next step's start).
+    fn keep(&mut self, end_rates: bool);
 }
 
 /// [`Compact::fixed_stretch`] for the system's sizes (constants in each arm).

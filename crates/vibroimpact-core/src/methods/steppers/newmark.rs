@@ -3,6 +3,7 @@
 
 use super::SystemStepper;
 use crate::error::{Error, Result};
+use crate::kernel::compact::Stretch;
 use crate::methods::trapezoid::Trapezoid;
 use crate::model::assembly::{Assembly, Mode, Scratch};
 use crate::numerics::linalg;
@@ -39,7 +40,17 @@ pub struct NewmarkFamily {
     dadv: Vec<f64>,
     jacobian: Vec<f64>,
     evaluations: u64,
+    /// Whether plain steps on a system with a compact form are taken in
+    /// the stretches of its fixed-size path ([`sized`]; the same bits).
+    compact: bool,
+    /// Steps taken in those stretches (its test asks that they ran).
+    #[cfg(test)]
+    stretched: u64,
 }
+
+mod sized;
+#[cfg(test)]
+mod sized_tests;
 
 /// Newton iterations allowed per step.
 const NEWTON_ITERATIONS: usize = 40;
@@ -72,6 +83,9 @@ impl NewmarkFamily {
             dadv: vec![0.0; dim * dim],
             jacobian: vec![0.0; dim * dim],
             evaluations: 0,
+            compact: true,
+            #[cfg(test)]
+            stretched: 0,
         }
     }
 
@@ -86,6 +100,14 @@ impl NewmarkFamily {
             system.dim,
             system.state_len(),
         )
+    }
+
+    /// Every step by [`SystemStepper::attempt`], none in the fixed-size
+    /// path's stretches (its test's reference).
+    #[cfg(test)]
+    pub(crate) fn general(mut self) -> Self {
+        self.compact = false;
+        self
     }
 
     /// Chung-Hulbert generalised-alpha with spectral radius `rho` in [0, 1].
@@ -117,6 +139,23 @@ impl SystemStepper for NewmarkFamily {
 
     fn reset(&mut self) {
         self.valid = false;
+    }
+
+    fn takes_stretches(&self, system: &Assembly, fixed: bool) -> bool {
+        // The event kernel's stretches (fixed stepping has none of its own).
+        !fixed && self.compact && system.compact.is_some()
+    }
+
+    fn stretch(
+        &mut self,
+        system: &Assembly,
+        stretch: &mut Stretch<'_>,
+        modes: &[Mode],
+        scratch: &mut Scratch,
+    ) {
+        if let (Some(compact), true) = (&system.compact, self.compact) {
+            self.sized_stretch(compact, system, stretch, modes, scratch);
+        }
     }
 
     fn attempt(

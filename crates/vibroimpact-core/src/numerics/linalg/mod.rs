@@ -16,6 +16,7 @@ mod tests;
 
 pub use eigen::eigenvalues;
 pub use expm::expm;
+pub(crate) use solve::solve_pivoted;
 pub use solve::{solve_in_place, solve_matrix_in_place};
 pub use symmetric::{symmetric_eigen, symmetric_eigenvalues};
 

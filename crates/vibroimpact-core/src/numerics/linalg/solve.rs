@@ -10,10 +10,18 @@ use super::max_abs;
 /// solution of a consistent system. Partial pivoting alone could move an
 /// independent row into a dependent one's place and drop it.
 pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
-    const MOST: usize = 64;
-    if n > MOST {
+    if n > 64 {
         return solve_partial(a, b, n);
     }
+    solve_pivoted::<64>(a, b, n);
+}
+
+/// [`solve_in_place`]'s complete pivoting for `n <= MOST` unknowns, its
+/// stack arrays `MOST` long: inlined, a caller with few unknowns known at
+/// compile time (a fixed-size path) makes the same operations, the same
+/// bits, without a call or arrays of 64.
+#[inline(always)]
+pub(crate) fn solve_pivoted<const MOST: usize>(a: &mut [f64], b: &mut [f64], n: usize) {
     let tiny = 1e-13 * max_abs(&a[..n * n]);
     // Column k of the reduced system is column `columns[k]` of A's.
     let mut columns = [0usize; MOST];
@@ -69,8 +77,21 @@ pub fn solve_in_place(a: &mut [f64], b: &mut [f64], n: usize) {
     // Back to A's column order: unknown k of the reduced system is A's
     // `columns[k]`.
     let mut x = [0.0f64; MOST];
-    for k in 0..n {
-        x[columns[k]] = b[k];
+    if MOST <= 8 {
+        // A few unknowns (a fixed-size caller's): each gathered by a
+        // comparison, not scattered to an index (stores a wide load would
+        // wait on), the same values.
+        for (c, slot) in x[..n].iter_mut().enumerate() {
+            for (&column, &value) in columns[..n].iter().zip(&b[..n]) {
+                if column == c {
+                    *slot = value;
+                }
+            }
+        }
+    } else {
+        for k in 0..n {
+            x[columns[k]] = b[k];
+        }
     }
     b[..n].copy_from_slice(&x[..n]);
 }
