@@ -274,15 +274,17 @@ impl PaperNewmark {
         for k in if FREE { CONTACT } else { MAX_RATES }..MAX_RATES {
             first_walls[k] = y[2 * d + k] + 0.5 * dt * (carried.rates[k] + 0.0);
         }
-        loop {
-            if clock.accepted >= f.max_accepted {
-                f.limited = true;
-                break;
-            }
-            let Some((next, in_window)) = schedule.plain_fixed_step(&clock) else {
-                break;
-            };
+        // The stop rules asked once for the steps they allow in a row (the
+        // most the stretch may take: it is then limited, if all were plain),
+        // as the compact path's fixed stretch asks them.
+        let most = f.max_accepted.saturating_sub(clock.accepted);
+        let allowed = schedule.plain_fixed_run(&clock, most);
+        f.limited = allowed == most;
+        while f.steps < allowed {
+            debug_assert!(schedule.plain_fixed_step(&clock).is_some());
             let time = clock.time;
+            let next = (clock.grid + 1) as f64 * dt;
+            let in_window = schedule.in_window(time, dt);
             let mut end = [0.0; MAX_LEN];
             let mut step = Step {
                 carried,
@@ -316,6 +318,7 @@ impl PaperNewmark {
                 {
                     *cache = saved;
                 }
+                f.limited = false;
                 break;
             }
             for w in 0..if FREE { 0 } else { count } {
@@ -350,6 +353,7 @@ impl PaperNewmark {
             let state = (&y, len, modes);
             if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
                 f.unbalanced = Some(failure);
+                f.limited = false;
                 break;
             }
         }
