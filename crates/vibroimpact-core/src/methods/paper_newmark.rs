@@ -101,7 +101,8 @@ pub struct PaperNewmark {
     /// at a restart are not counted).
     evaluations: u64,
     /// The data in fixed-size arrays where the compact path takes the
-    /// system: its plain fixed steps are taken there ([`sized`]).
+    /// system: its plain steps, fixed or between events, are taken there
+    /// ([`sized`]).
     sized: Option<Box<Sized>>,
 }
 
@@ -523,7 +524,8 @@ impl SystemStepper for PaperNewmark {
     }
 
     fn takes_stretches(&self, _system: &Assembly, fixed: bool) -> bool {
-        fixed
+        // Stepping by events, in the fixed-size arrays alone.
+        fixed || self.sized.is_some()
     }
 
     fn stretch(
@@ -540,10 +542,11 @@ impl SystemStepper for PaperNewmark {
         // terms.
         let free =
             modes.iter().all(|m| *m == Mode::Open) && stretch.open.iter().all(Option::is_none);
-        if free {
-            self.sized_stretch::<true>(system, &sized, stretch, modes, scratch);
-        } else {
-            self.sized_stretch::<false>(system, &sized, stretch, modes, scratch);
+        match (stretch.schedule.fixed.is_some(), free) {
+            (true, true) => self.sized_stretch::<true>(system, &sized, stretch, modes, scratch),
+            (true, false) => self.sized_stretch::<false>(system, &sized, stretch, modes, scratch),
+            (false, true) => self.sized_event_stretch::<true>(system, &sized, stretch, modes),
+            (false, false) => self.sized_event_stretch::<false>(system, &sized, stretch, modes),
         }
         self.sized = Some(sized);
     }

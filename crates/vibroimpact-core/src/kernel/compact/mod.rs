@@ -24,7 +24,9 @@ mod stretch;
 use lanes::LaneLaw;
 pub(crate) use lanes::LANES;
 pub(crate) use lockstep::run_group;
-pub(crate) use stretch::{peak_inside, widen_peaks, ArraySteps, Stretch};
+pub(crate) use stretch::{
+    passed_over, peak_inside, shows_no_event, widen_peaks, ArraySteps, Stretch,
+};
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{

@@ -684,7 +684,7 @@ type WallGaps = [(f64, f64); MAX_WALLS];
 /// sticking damper), the sticking walls of a damper without clearance
 /// (locked), and whether a sticking pair may release.
 #[inline(always)]
-fn passed_over(system: &Assembly, modes: &[Mode]) -> PassedOver {
+pub(crate) fn passed_over(system: &Assembly, modes: &[Mode]) -> PassedOver {
     let mut held = [false; MAX_WALLS];
     let mut locked = [false; MAX_WALLS];
     let mut releasable = false;
@@ -700,7 +700,7 @@ fn passed_over(system: &Assembly, modes: &[Mode]) -> PassedOver {
 /// its start and end shows no event the kernel would search for, and no
 /// compliant contact at its deepest.
 #[inline(always)]
-fn shows_no_event(
+pub(crate) fn shows_no_event(
     modes: &[Mode],
     held: &[bool; MAX_WALLS],
     (start, end): (&WallGaps, &WallGaps),

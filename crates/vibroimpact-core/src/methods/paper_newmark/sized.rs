@@ -6,7 +6,7 @@
 //! own: the same operations in the same order (the same bits; a test holds
 //! them to it), and the kernel's stop rules and records, as
 //! [`crate::kernel::plain_fixed`] takes them, which serves every other
-//! system.
+//! system. Stepping by events, its plain steps between events ([`events`]).
 //!
 //! Besides the sizes, it saves evaluations of the contact law that give
 //! the same values: a step's lagged force is the last step's end force
@@ -29,6 +29,8 @@ use crate::kernel::sized::by_size;
 use crate::model::assembly::{h_dot, Assembly, Mode, Scratch, CONTACT, INPUT, VISCOUS};
 use crate::model::contact::{AnyLaw, ContactLaw};
 use crate::numerics::linalg;
+
+mod events;
 
 /// The most harmonic loads held (a `harmonics` signal's terms).
 const MAX_LOADS: usize = 4;
@@ -272,15 +274,17 @@ impl PaperNewmark {
         for k in if FREE { CONTACT } else { MAX_RATES }..MAX_RATES {
             first_walls[k] = y[2 * d + k] + 0.5 * dt * (carried.rates[k] + 0.0);
         }
-        loop {
-            if clock.accepted >= f.max_accepted {
-                f.limited = true;
-                break;
-            }
-            let Some((next, in_window)) = schedule.plain_fixed_step(&clock) else {
-                break;
-            };
+        // The stop rules asked once for the steps they allow in a row (the
+        // most the stretch may take: it is then limited, if all were plain),
+        // as the compact path's fixed stretch asks them.
+        let most = f.max_accepted.saturating_sub(clock.accepted);
+        let allowed = schedule.plain_fixed_run(&clock, most);
+        f.limited = allowed == most;
+        while f.steps < allowed {
+            debug_assert!(schedule.plain_fixed_step(&clock).is_some());
             let time = clock.time;
+            let next = (clock.grid + 1) as f64 * dt;
+            let in_window = schedule.in_window(time, dt);
             let mut end = [0.0; MAX_LEN];
             let mut step = Step {
                 carried,
@@ -314,6 +318,7 @@ impl PaperNewmark {
                 {
                     *cache = saved;
                 }
+                f.limited = false;
                 break;
             }
             for w in 0..if FREE { 0 } else { count } {
@@ -338,17 +343,7 @@ impl PaperNewmark {
             }
             // Accepted (the method's `finish` has nothing to add).
             carried = step.carried;
-            for i in 0..2 * d {
-                y[i] = end[i];
-            }
-            for k in 0..if FREE { CONTACT } else { MAX_RATES } {
-                y[2 * d + k] = step.accumulators[k];
-            }
-            if FREE && f.steps == 0 {
-                for k in CONTACT..MAX_RATES {
-                    y[2 * d + k] = first_walls[k];
-                }
-            }
+            step.accept_into::<FREE>((d, f.steps == 0), &end, &first_walls, &mut y);
             clock.time = next;
             clock.grid += 1;
             clock.accepted += 1;
@@ -358,6 +353,7 @@ impl PaperNewmark {
             let state = (&y, len, modes);
             if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
                 f.unbalanced = Some(failure);
+                f.limited = false;
                 break;
             }
         }
@@ -385,12 +381,39 @@ impl PaperNewmark {
         modes: &[Mode],
     ) -> ([[f64; MAX_DIM]; MAX_DIM], Carried) {
         let any = self.contacts_of(modes);
-        self.effective(system, dt, any);
+        let inverse = self.sized_inverse(system, (d, dt), any);
+        (inverse, self.sized_carried::<FREE>(sized, d, y, modes))
+    }
+
+    /// The inverse effective matrix for steps `h` with the contacts of
+    /// [`Self::contacts_of`] (`any`: whether there are any), as the kernel's
+    /// attempt takes it ([`Self::effective`]), in an array.
+    #[inline(always)]
+    fn sized_inverse(
+        &mut self,
+        system: &Assembly,
+        (d, h): (usize, f64),
+        any: bool,
+    ) -> [[f64; MAX_DIM]; MAX_DIM] {
+        self.effective(system, h, any);
         let kept = if any { &self.touching } else { &self.apart };
         let mut inverse = [[0.0; MAX_DIM]; MAX_DIM];
         for i in 0..d {
             inverse[i][..d].copy_from_slice(&kept.inverse[i * d..(i + 1) * d]);
         }
+        inverse
+    }
+
+    /// What the first step from `y` in `modes` takes: the method's
+    /// accelerations and rates, and the walls' lagged forces there.
+    #[inline(always)]
+    fn sized_carried<const FREE: bool>(
+        &mut self,
+        sized: &Sized,
+        d: usize,
+        y: &[f64; MAX_LEN],
+        modes: &[Mode],
+    ) -> Carried {
         let rate_count = sized.rate_count.min(MAX_RATES);
         let mut carried = Carried {
             accel: [0.0; MAX_DIM],
@@ -410,7 +433,7 @@ impl PaperNewmark {
                 }
             }
         }
-        (inverse, carried)
+        carried
     }
 
     /// [`Self::step_sized`] and [`Self::end_powers`] in the arrays: the step
@@ -539,6 +562,33 @@ struct Step {
     end: [f64; 2 * MAX_DIM],
     accumulators: [f64; MAX_RATES],
     contact: [(f64, f64); MAX_WALLS],
+}
+
+impl Step {
+    /// The step accepted into the state `y`: its `end` (`d` coordinates)
+    /// and accumulators. Free, the walls' accumulators are left out of the
+    /// steps: `first_walls` after the stretch's first step, as they were
+    /// after the others.
+    #[inline(always)]
+    fn accept_into<const FREE: bool>(
+        &self,
+        (d, first_step): (usize, bool),
+        end: &[f64; MAX_LEN],
+        first_walls: &[f64; MAX_RATES],
+        y: &mut [f64; MAX_LEN],
+    ) {
+        for i in 0..2 * d {
+            y[i] = end[i];
+        }
+        for k in 0..if FREE { CONTACT } else { MAX_RATES } {
+            y[2 * d + k] = self.accumulators[k];
+        }
+        if FREE && first_step {
+            for k in CONTACT..MAX_RATES {
+                y[2 * d + k] = first_walls[k];
+            }
+        }
+    }
 }
 
 impl Sized {
