@@ -504,11 +504,26 @@ impl<'a> Run<'a> {
                 reason: "the state is no longer finite",
             });
         }
-        if self.compliant && self.deepest_indentation(stepper, taken)? {
-            kept_attempt = false;
-        }
-        if self.reduce(stepper, taken)? {
-            kept_attempt = false;
+        let mut probed = self.compliant && self.deepest_indentation(stepper, taken)?;
+        probed |= self.reduce(stepper, taken)?;
+        if probed && kept_attempt {
+            if stepper.carries_solution() {
+                // The probes replaced the stepper's pending data: the kept
+                // step again, the same arithmetic, restores them.
+                let again = &mut self.buffers.probe;
+                stepper.attempt(
+                    system,
+                    time,
+                    &self.y,
+                    taken,
+                    &self.modes,
+                    &mut self.scratch,
+                    again,
+                )?;
+                debug_assert!(again[..row] == self.end[..row]);
+            } else {
+                kept_attempt = false;
+            }
         }
         self.keep(stepper, taken, switched.is_some(), kept_attempt)?;
         Ok(match switched {

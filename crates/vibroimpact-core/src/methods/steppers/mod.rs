@@ -62,6 +62,15 @@ pub trait SystemStepper {
     fn switched_within_step(&mut self) {
         self.reset();
     }
+    /// Whether the data carried from one step to the next are part of the
+    /// method's solution, so that [`Self::reset`] between two steps changes
+    /// it (generalised-alpha's algorithmic accelerations, which are not the
+    /// physical ones). The kernel then takes a kept step again after probing
+    /// inside it (the deepest indentation, a reduction's extremum) instead of
+    /// restarting the method: what is recorded never changes the run.
+    fn carries_solution(&self) -> bool {
+        false
+    }
     /// Whether the method creates energy at a contact by construction (the
     /// founding paper's Newmark, whose contact force lags one step: its
     /// Table 1 collision rebounds at 1.0015 of the approach speed at its

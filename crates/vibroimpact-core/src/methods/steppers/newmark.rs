@@ -158,6 +158,12 @@ impl SystemStepper for NewmarkFamily {
         }
     }
 
+    fn carries_solution(&self) -> bool {
+        // Newmark-beta's converged accelerations are the physical ones at
+        // the step's end (to Newton's tolerance); generalised-alpha's are not.
+        self.alpha_m != 0.0 || self.alpha_f != 0.0
+    }
+
     fn attempt(
         &mut self,
         system: &Assembly,
