@@ -13,4 +13,5 @@ pub(crate) mod records;
 pub mod reductions;
 pub(crate) mod run;
 pub(crate) mod sized;
+mod start;
 pub(crate) mod stepwise;
