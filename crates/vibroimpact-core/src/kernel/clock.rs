@@ -49,6 +49,19 @@ pub(crate) struct Clock {
     pub(crate) next_strobe: f64,
 }
 
+impl Clock {
+    /// A plain step accepted on the grid, ending at `next` (s): the next grid
+    /// point, one more step taken, one step fewer to the next history row.
+    /// What every stretch of plain steps does after each of its steps.
+    #[inline(always)]
+    pub(crate) fn plain_step_to(&mut self, next: f64) {
+        self.time = next;
+        self.grid += 1;
+        self.accepted += 1;
+        self.until_kept = self.until_kept.saturating_sub(1);
+    }
+}
+
 /// What a run's options fix about its steps (see [`Clock`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Schedule {

@@ -96,10 +96,7 @@ pub(crate) fn plain_fixed_steps<S: SystemStepper + ?Sized>(
             f.unbalanced = Some(failure);
             break;
         }
-        f.clock.time = next;
-        f.clock.grid += 1;
-        f.clock.accepted += 1;
-        f.clock.until_kept = f.clock.until_kept.saturating_sub(1);
+        f.clock.plain_step_to(next);
         // (The stepper counts its own evaluations.)
         f.steps += 1;
         f.y.copy_from_slice(f.end);

@@ -176,10 +176,7 @@ impl Compact {
                 widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
                 *f.recorded_time += length;
             }
-            clock.time = next;
-            clock.grid += 1;
-            clock.accepted += 1;
-            clock.until_kept = clock.until_kept.saturating_sub(1);
+            clock.plain_step_to(next);
             f.evaluations += 4;
             f.steps += 1;
             // Those rates are the next step's first stage.
@@ -304,10 +301,7 @@ impl Compact {
                 widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
                 *f.recorded_time += length;
             }
-            clock.time = next;
-            clock.grid += 1;
-            clock.accepted += 1;
-            clock.until_kept = clock.until_kept.saturating_sub(1);
+            clock.plain_step_to(next);
             f.evaluations += made.unwrap_or(0);
             f.steps += 1;
             // Those rates are the next step's start's.
@@ -422,10 +416,7 @@ impl Compact {
                 widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
                 *f.recorded_time += dt;
             }
-            clock.time = next;
-            clock.grid += 1;
-            clock.accepted += 1;
-            clock.until_kept = clock.until_kept.saturating_sub(1);
+            clock.plain_step_to(next);
             taken += 1;
             for e in 0..room {
                 y[e] = end[e];

@@ -344,10 +344,7 @@ impl PaperNewmark {
             // Accepted (the method's `finish` has nothing to add).
             carried = step.carried;
             step.accept_into::<FREE>((d, f.steps == 0), &end, &first_walls, &mut y);
-            clock.time = next;
-            clock.grid += 1;
-            clock.accepted += 1;
-            clock.until_kept = clock.until_kept.saturating_sub(1);
+            clock.plain_step_to(next);
             f.steps += 1;
             start_gaps = end_gaps;
             let state = (&y, len, modes);
