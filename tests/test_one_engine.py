@@ -61,44 +61,14 @@ def general_text(solver: dict[str, Any]) -> str:
     )
 
 
-# The two-mass call runs on the 0.1 kernel until the general kernel keeps the earlier
-# issues' bars for it and is as fast as 0.1 on every method (throughput example, quiet
-# machine, sixth stop, general against 0.1 in the same run): the Newmark family is there
-# (paper's Newmark fixed 1.01e8 against 9.2e7 steps/s, with events 5.9e7 against 4.8e7,
-# newmark-implicit 2.60e7 against 2.30e7, generalized-alpha 2.63e7 against 2.30e7) and
-# RK4 with events is level (5.31e7 against 5.34e7); DOP853 at rtol 1e-10 takes 20.5 us a
-# collision against 0.1's 10.1 us (issue 3's goal 20 us), DOPRI5 29.1 against 20.3 us, and
-# a short run's set-up costs several us more (`vibroimpact paper`'s Table 3 ranks methods
-# by CPU time).
-_ON_THE_0_1_KERNEL = pytest.mark.xfail(
-    strict=True,
-    reason="the two-mass call runs on the 0.1 kernel until the general kernel is as fast "
-    "on every method (DOP853 at rtol 1e-10 20.5 us a collision against 0.1's 10.1 us and "
-    "issue 3's 20 us; fixed RK4 6.2e7 against 7.8e7 steps/s; a short run's set-up)",
-)
-
-
-def _events(solver: dict[str, Any], name: str) -> Any:
-    return pytest.param(solver, id=name, marks=_ON_THE_0_1_KERNEL)
-
-
+# The two-mass call runs the preset on the general kernel: every method and stepping.
 SOLVERS = [
-    _events({"method": "rk4", "stepping": "events", "dt": 1e-4}, "rk4"),
-    _events({"method": "dop853", "rtol": 1e-10, "atol": 1e-13}, "dop853"),
-    _events({"method": "dopri5", "rtol": 1e-9, "atol": 1e-13}, "dopri5"),
-    _events({"method": "newmark-implicit", "dt": 1e-4}, "newmark-implicit"),
-    _events({"method": "generalized-alpha", "dt": 1e-4}, "generalized-alpha"),
-    pytest.param(
-        {"method": "rk4", "stepping": "fixed", "dt": 1e-4},
-        id="rk4-fixed",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="two-mass fixed RK4 stays on the 0.1 kernel until the general kernel's "
-            "keeps numba's pace (6.2e7 against numba's 7.1e7 and 0.1's 7.8e7 steps/s, "
-            "throughput example, sixth stop)",
-        ),
-    ),
-    # The general kernel's fixed-step Newmark is 0.1's to the bit.
+    pytest.param({"method": "rk4", "stepping": "events", "dt": 1e-4}, id="rk4"),
+    pytest.param({"method": "dop853", "rtol": 1e-10, "atol": 1e-13}, id="dop853"),
+    pytest.param({"method": "dopri5", "rtol": 1e-9, "atol": 1e-13}, id="dopri5"),
+    pytest.param({"method": "newmark-implicit", "dt": 1e-4}, id="newmark-implicit"),
+    pytest.param({"method": "generalized-alpha", "dt": 1e-4}, id="generalized-alpha"),
+    pytest.param({"method": "rk4", "stepping": "fixed", "dt": 1e-4}, id="rk4-fixed"),
     pytest.param({"method": "newmark", "stepping": "fixed", "dt": 1e-4}, id="newmark-fixed"),
     pytest.param(
         {"method": "newmark", "stepping": "fixed", "contact_timing": "step-count", "dt": 1e-4},

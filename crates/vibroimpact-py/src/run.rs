@@ -7,6 +7,7 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
+use vibroimpact_core::kernel::events::{PairContact, SystemSolution};
 use vibroimpact_core::methods::registry as core_registry;
 
 use crate::convert::*;
@@ -53,7 +54,7 @@ pub(crate) const CONTACT_COLUMNS: [&str; 9] = [
     "energy_change",
 ];
 
-pub(crate) fn record_values(r: &core::ContactRecord) -> [f64; 9] {
+pub(crate) fn record_values(r: &PairContact) -> [f64; 9] {
     [
         r.onset,
         r.separation,
@@ -72,12 +73,12 @@ pub(crate) fn record_values(r: &core::ContactRecord) -> [f64; 9] {
 /// ``duration``, ``rebound_speed``, ``restitution`` and ``energy_change``.
 #[pyclass(frozen, module = "vibroimpact._core")]
 pub(crate) struct ContactTable {
-    records: Vec<core::ContactRecord>,
+    records: Vec<PairContact>,
     columns: [OnceLock<Py<PyArray1<f64>>>; 9],
 }
 
 impl ContactTable {
-    fn new(records: Vec<core::ContactRecord>) -> Self {
+    fn new(records: Vec<PairContact>) -> Self {
         Self {
             records,
             columns: Default::default(),
@@ -430,24 +431,45 @@ pub(crate) fn simulate(
     )?;
     let parsed = settings.method;
     let (sys, con, init) = (system.0, contact.0, initial.0);
-    // The 0.1 kernel, every method: the general kernel runs this system 2 to 5
-    // times slower, past issue 3's and bench_steps' bars (issue 24's note); a
-    // vibroimpact.System of it runs there.
+    // The one kernel runs the preset (`ImpactDamper::assembly`): the state is
+    // `[w, y, w', y']`, the one pair the damper.
     let sol = released(py, |interrupt| {
-        core::simulate(&sys, &con, &init, &settings, interrupt)
+        core_registry::two_mass::simulate(&sys, &con, &init, &settings, interrupt)
     })?;
-    let h = sol.history;
+    let SystemSolution {
+        time,
+        states,
+        contacts,
+        final_state,
+        contact_forces,
+        ..
+    } = sol;
+    let column = |k: usize| {
+        states
+            .iter()
+            .skip(k)
+            .step_by(4)
+            .copied()
+            .collect::<Vec<_>>()
+    };
+    let history = [column(0), column(2), column(1), column(3)];
+    let [w, wv, y, yv] = history;
+    let forces = if contact_forces.len() == time.len() {
+        contact_forces
+    } else {
+        vec![0.0; time.len()]
+    };
     Ok(Solution {
-        rows: h.time.len(),
+        rows: time.len(),
         history: [
-            Column::new(h.time),
-            Column::new(h.main_displacement),
-            Column::new(h.main_velocity),
-            Column::new(h.impact_displacement),
-            Column::new(h.impact_velocity),
-            Column::new(h.contact_force),
+            Column::new(time),
+            Column::new(w),
+            Column::new(wv),
+            Column::new(y),
+            Column::new(yv),
+            Column::new(forces),
         ],
-        contacts: Py::new(py, ContactTable::new(sol.contacts))?,
+        contacts: Py::new(py, ContactTable::new(contacts))?,
         steps: sol.steps,
         rejected_steps: sol.rejected_steps,
         rhs_evaluations: sol.rhs_evaluations,
@@ -455,7 +477,7 @@ pub(crate) fn simulate(
         final_time: sol.final_time,
         energy_growth: sol.energy_growth,
         energy_residual: sol.energy_residual,
-        final_state: InitialState(sol.final_state),
+        final_state: InitialState(core::State::of_vector(&final_state)),
         method: parsed.name(),
         stepping: match settings.stepping {
             core::Stepping::Fixed => "fixed",

@@ -39,9 +39,8 @@ def load(source: str | os.PathLike[str]) -> System:
     the structure's coordinate, impact mass as the damper's). Its ``[output]`` is kept,
     and its ``[solver]`` with its stepping written out (0.1's default is ``"fixed"`` for
     ``"newmark"`` and ``"rk4"``, 0.2's ``"events"``), so that the general kernel runs the
-    file's method as the file asks (on the general kernel, where ``vibroimpact simulate``
-    of the file runs the 0.1 kernel: the paper's fixed-step Newmark the same bit for bit,
-    the other methods to round-off).
+    file's method as the file asks, bit for bit as ``vibroimpact simulate`` of the file
+    runs it (both run the general kernel).
     """
     if isinstance(source, str) and "\n" in source:
         return loads(source)

@@ -11,6 +11,7 @@ mod defaults;
 mod forcing;
 mod limits;
 mod table;
+pub mod two_mass;
 
 pub use defaults::{ModelKind, RunDefaults, RUN_DEFAULTS, SYSTEM, TWO_MASS};
 pub use forcing::{check_forcing_period, ForcingPlan};

@@ -1,0 +1,52 @@
+//! The two-mass impact damper's run: the preset ([`ImpactDamper::assembly`])
+//! on the one kernel, with the method and stepping its settings name. What
+//! the binding's two-mass `simulate` and the paper's tables run.
+
+use crate::error::Result;
+use crate::kernel::events::SystemSolution;
+use crate::legacy::settings::{Method, Settings};
+use crate::methods::registry::{AnyStepper, Options};
+use crate::model::contact::Contact;
+use crate::model::impact_damper::{ImpactDamper, State};
+
+/// The registry options `method` carries (the others at their defaults).
+pub fn options_of(method: &Method) -> Options {
+    let mut options = Options::default();
+    match *method {
+        Method::Newmark { beta, gamma } | Method::NewmarkImplicit { beta, gamma } => {
+            (options.beta, options.gamma) = (beta, gamma);
+        }
+        Method::GeneralizedAlpha { spectral_radius } => options.spectral_radius = spectral_radius,
+        Method::Dopri5(t) | Method::Dop853(t) => (options.rtol, options.atol) = (t.rtol, t.atol),
+        Method::Rk4 => {}
+    }
+    options
+}
+
+/// Integrates `system` with `contact` from `start` as `settings` say, on
+/// the general kernel: the state is `[w, y, w', y']` (main then impact
+/// mass), the one pair the damper. A start with the impact mass inside a
+/// wall is refused naming both displacements. `interrupt` is polled.
+pub fn simulate(
+    system: &ImpactDamper,
+    contact: &Contact,
+    start: &State,
+    settings: &Settings,
+    interrupt: &mut dyn FnMut() -> bool,
+) -> Result<SystemSolution> {
+    start.check_apart(system.clearance)?;
+    let assembly = system.assembly(contact)?;
+    let y0 = start.vector(&assembly)?;
+    let mut stepper = AnyStepper::new(
+        &assembly,
+        settings.method.name(),
+        &options_of(&settings.method),
+    )?;
+    stepper.integrate_stepped(
+        &assembly,
+        &y0,
+        &settings.run_options(),
+        settings.kernel_stepping(),
+        interrupt,
+    )
+}
