@@ -20,8 +20,13 @@
 //! - [`analysis`]: settling, shooting for periodic orbits, studies of many
 //!   runs on every core and lockstep ensembles.
 //! - [`numerics`]: small dense linear algebra, Hermite interpolation, series.
-//! - [`legacy`]: the 0.1 two-mass kernel ([`simulate`]), to be replaced by
-//!   the two-mass preset on the general kernel (issue 24).
+//! - [`legacy`]: parts of the 0.1 two-mass kernel that the lockstep
+//!   ensemble and verification tests still use, to be deleted (issue 24).
+//!   No run of the API goes through it.
+//!
+//! The two-mass impact damper's run is the preset on the general kernel:
+//! [`simulate`] (from [`methods::registry::two_mass`]) with its [`Settings`],
+//! returning a [`SystemSolution`] whose contacts are [`PairContact`]s.
 //!
 //! Every run is bounded in steps and memory and checks its energy balance.
 
@@ -35,13 +40,11 @@ pub mod numerics;
 pub mod testing;
 
 pub use error::{Error, Result};
+pub use kernel::events::{PairContact, SystemSolution};
 pub use kernel::memory::MAX_RECORD_BYTES;
-pub use legacy::records::{ContactRecord, History, Solution};
-pub use legacy::run::simulate;
-pub use legacy::settings::{
-    ContactTiming, Method, MethodOptions, Settings, Stepping, DEFAULT_ENERGY_TOLERANCE,
-    DEFAULT_MAX_ROWS,
+pub use methods::registry::two_mass::{
+    simulate, ContactTiming, Method, MethodOptions, Settings, Stepping, Tolerances,
+    DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
 };
-pub use legacy::steppers::Tolerances;
 pub use model::contact::{Contact, ContactLaw, LawKind};
 pub use model::impact_damper::{ImpactDamper, State};

@@ -9,8 +9,9 @@ mod common;
 use vibroimpact_core::analysis::ensemble::{
     run_ensemble, EnsembleOptions, Member, MemberResult, LANES,
 };
+use vibroimpact_core::legacy::run::simulate;
 use vibroimpact_core::{
-    simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
+    Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
 };
 
 fn contact(kind: LawKind) -> Contact {
@@ -58,7 +59,7 @@ fn options(steps: u64) -> EnsembleOptions {
     }
 }
 
-fn single(member: &Member, dt: f64, steps: u64) -> vibroimpact_core::Solution {
+fn single(member: &Member, dt: f64, steps: u64) -> vibroimpact_core::legacy::records::Solution {
     let settings = Settings::new(
         Method::Rk4,
         Some(dt),

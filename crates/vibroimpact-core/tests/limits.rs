@@ -11,12 +11,14 @@ use vibroimpact_core::error::Error;
 use vibroimpact_core::legacy::equations::{Excitation, Free, Model};
 use vibroimpact_core::legacy::events::integrate_events;
 use vibroimpact_core::legacy::integrators::Rk4;
+use vibroimpact_core::legacy::records::Solution;
 use vibroimpact_core::legacy::run::integrate;
+use vibroimpact_core::legacy::run::simulate;
 use vibroimpact_core::legacy::steppers::{Dop853Stepper, Rk4Stepper, Tolerances};
 use vibroimpact_core::model::contact::{Hertz, HysterHertz};
 use vibroimpact_core::{
-    simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, Solution, State,
-    Stepping, DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
+    Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
+    DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
 };
 
 const NEWMARK: Method = Method::Newmark {
@@ -157,7 +159,10 @@ fn the_defaults_are_what_the_docs_say() {
         assert_eq!(DEFAULT_MAX_ROWS, 20_000_000);
         assert_eq!(DEFAULT_ENERGY_TOLERANCE, 0.05);
         // A history row is six f64 columns (48 bytes), a contact nine (72).
-        assert_eq!(std::mem::size_of::<vibroimpact_core::ContactRecord>(), 72);
+        assert_eq!(
+            std::mem::size_of::<vibroimpact_core::legacy::records::ContactRecord>(),
+            72
+        );
         let s = settings(Method::Rk4, Some(1e-4), 0.1, None);
         assert!(s.history);
         assert_eq!(s.max_rows, DEFAULT_MAX_ROWS);

@@ -4,6 +4,7 @@
 mod common;
 
 use vibroimpact_core::legacy::equations::{Free, Mode, Model};
+use vibroimpact_core::legacy::run::simulate;
 use vibroimpact_core::legacy::steppers::{
     to_vector, Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper, Stepper, Tolerances,
 };
@@ -12,7 +13,7 @@ use vibroimpact_core::model::closed_forms::{
 };
 use vibroimpact_core::model::contact::Hertz;
 use vibroimpact_core::{
-    simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
+    Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
 };
 
 /// A damped main oscillator whose impact mass never touches (huge clearance).

@@ -4,12 +4,12 @@
 mod common;
 
 use vibroimpact_core::legacy::equations::{Free, Model};
+use vibroimpact_core::legacy::records::Solution;
+use vibroimpact_core::legacy::run::simulate;
 use vibroimpact_core::model::closed_forms::{
     goldsmith_contact_duration, goldsmith_max_indentation,
 };
-use vibroimpact_core::{
-    simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, Solution, State,
-};
+use vibroimpact_core::{Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State};
 
 const NEWMARK: Method = Method::Newmark {
     beta: 0.25,

@@ -6,7 +6,7 @@ use crate::kernel::events::{
 };
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::kernel::reductions::ReduceOptions;
-use crate::legacy::settings::{self, Method, Settings};
+use crate::methods::registry::two_mass::{self as settings, Method, Settings};
 use crate::methods::steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 use crate::model::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
 use crate::model::closed_forms::linear_contact_duration;
@@ -89,7 +89,7 @@ fn legacy(
     start: &State,
     method: Method,
     (dt, t_end, timing, tolerance): (f64, f64, ContactTiming, f64),
-) -> crate::Solution {
+) -> crate::legacy::records::Solution {
     let timing = match timing {
         ContactTiming::Located => settings::ContactTiming::Located,
         ContactTiming::StepCount => settings::ContactTiming::StepCount,
@@ -126,7 +126,7 @@ fn worst(
     system: &ImpactDamper,
     dt: f64,
     ours: &SystemSolution,
-    theirs: &crate::Solution,
+    theirs: &crate::legacy::records::Solution,
     label: &str,
 ) -> [f64; 8] {
     assert_eq!(ours.contacts.len(), theirs.contacts.len(), "{label}");

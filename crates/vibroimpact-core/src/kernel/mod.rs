@@ -1,7 +1,7 @@
 pub(crate) mod balance;
 pub(crate) mod clock;
 pub(crate) mod compact;
-pub(crate) mod contact_balance;
+pub mod contact_balance;
 pub(crate) mod contacts;
 pub mod events;
 pub mod fixed;

@@ -15,8 +15,8 @@ use crate::legacy::records::{
     check_start, external_work, open_record, speed_squared_integral, ContactRecord, EnergyLedger,
     Records, Solution,
 };
-use crate::legacy::settings::Settings;
 use crate::legacy::steppers::{to_state, to_vector, Attempt, Stepper, Vector};
+use crate::methods::registry::two_mass::Settings;
 use crate::methods::step_control::{rejects, StepControl};
 use crate::model::contact::ContactLaw;
 use crate::model::impact_damper::State;

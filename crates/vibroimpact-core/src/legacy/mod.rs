@@ -3,5 +3,4 @@ pub mod events;
 pub mod integrators;
 pub mod records;
 pub mod run;
-pub mod settings;
 pub mod steppers;

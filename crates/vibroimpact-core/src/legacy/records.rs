@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::kernel::memory::{self, NoRoom, MAX_RECORD_BYTES};
 use crate::legacy::equations::{Excitation, Model};
-use crate::legacy::settings::Settings;
+use crate::methods::registry::two_mass::Settings;
 use crate::model::contact::ContactLaw;
 use crate::model::impact_damper::State;
 use std::collections::TryReserveError;

@@ -181,21 +181,13 @@ fn combine<const S: usize>(y: &Vector, h: f64, b: &[f64; S], k: &[Vector; S]) ->
     out
 }
 
-/// Tolerances of the adaptive methods: `rtol` relative, `atol` absolute (in
-/// the units of each variable: m and m/s).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerances {
-    pub rtol: f64,
-    pub atol: f64,
-}
+pub use crate::methods::registry::two_mass::Tolerances;
 
-impl Tolerances {
-    /// The weight of variable `n` in the error norm (the non-conservative work
-    /// is an output, not controlled).
-    #[inline(always)]
-    fn scale(&self, y: &Vector, end: &Vector, n: usize) -> f64 {
-        self.atol + self.rtol * y[n].abs().max(end[n].abs())
-    }
+/// The weight of variable `n` in the error norm (the non-conservative work
+/// is an output, not controlled).
+#[inline(always)]
+fn scale(tolerances: &Tolerances, y: &Vector, end: &Vector, n: usize) -> f64 {
+    tolerances.atol + tolerances.rtol * y[n].abs().max(end[n].abs())
 }
 
 /// Classical fourth-order Runge-Kutta, fixed step: the fixed-step kernel's
@@ -293,7 +285,7 @@ impl EmbeddedPair for Dopri5 {
                 .zip(k.iter())
                 .map(|(ei, ki)| ei * ki[n])
                 .sum();
-            let ratio = h * e / tolerances.scale(y, &end, n);
+            let ratio = h * e / scale(tolerances, y, &end, n);
             sum += ratio * ratio;
         }
         (end, (sum / 4.0).sqrt(), k[6])
@@ -400,7 +392,7 @@ impl EmbeddedPair for Dop853 {
         let e3 = weighted!(DOP853_E3[0], k[0]; DOP853_E3[5], k[5]; DOP853_E3[6], k[6]; DOP853_E3[7], k[7]; DOP853_E3[8], k[8]; DOP853_E3[9], k[9]; DOP853_E3[10], k[10]; DOP853_E3[11], k[11]; DOP853_E3[12], last);
         let (mut err5, mut err3) = (0.0, 0.0);
         for n in 0..4 {
-            let scale = tolerances.scale(y, &end, n);
+            let scale = scale(tolerances, y, &end, n);
             err5 += (e5[n] / scale) * (e5[n] / scale);
             err3 += (e3[n] / scale) * (e3[n] / scale);
         }

@@ -6,7 +6,7 @@ use super::settings::{Analysis, StudySettings};
 
 use crate::analysis::ensemble::{run_ensemble, EnsembleOptions, Member};
 use crate::error::{Error, Result};
-use crate::legacy::settings::{ContactTiming, Method, Settings, Stepping};
+use crate::methods::registry::two_mass::{ContactTiming, Method, Settings, Stepping};
 use crate::model::assembly::{PairLaw, SystemSpec};
 use crate::model::impact_damper::{ImpactDamper, State};
 

@@ -574,13 +574,13 @@ fn both_runs(
     contact: &Contact,
     start: State,
     (dt, t_end): (f64, f64),
-    timing: crate::legacy::settings::ContactTiming,
+    timing: crate::methods::registry::two_mass::ContactTiming,
 ) -> (
     crate::legacy::records::Solution,
     crate::kernel::events::SystemSolution,
 ) {
     use crate::kernel::events::{integrate_system_stepped, ContactTiming, RunOptions, Stepping};
-    use crate::legacy::settings::{self, Method, Settings};
+    use crate::methods::registry::two_mass::{self as settings, Method, Settings};
     let newmark = Method::Newmark {
         beta: 0.25,
         gamma: 0.5,
@@ -622,7 +622,7 @@ fn both_runs(
 #[test]
 fn fixed_steps_on_the_general_kernel_are_0_1_s_run() {
     crate::testing::timeout(60, || {
-        use crate::legacy::settings::ContactTiming;
+        use crate::methods::registry::two_mass::ContactTiming;
         // The paper's collision, and tests/test_one_engine.py's rattle (a
         // released main mass on a stiff spring, contacts on both walls, the
         // main damper and the contact damper acting): 0.1's run to the bit,
@@ -687,7 +687,7 @@ fn a_contact_open_at_the_end_of_fixed_steps_reports_0_1_s_dissipation() {
         let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.01).unwrap();
         let damper = ImpactDamper::new(1.0, 40.0, 0.01, 0.25, 0.01).unwrap();
         let start = State::new(0.05, 0.02, 0.05, 0.0).unwrap();
-        let timing = crate::legacy::settings::ContactTiming::Located;
+        let timing = crate::methods::registry::two_mass::ContactTiming::Located;
         let (old, new) = both_runs(damper, &contact, start, (1e-4, 3.0), timing);
         let (a, b) = (old.contacts.last().unwrap(), new.contacts.last().unwrap());
         assert!(a.separation.is_nan() && b.separation.is_nan());

@@ -2,9 +2,12 @@
 //! on the one kernel, with the method and stepping its settings name. What
 //! the binding's two-mass `simulate` and the paper's tables run.
 
+mod settings;
+
+pub use settings::*;
+
 use crate::error::Result;
 use crate::kernel::events::SystemSolution;
-use crate::legacy::settings::{Method, Settings};
 use crate::methods::registry::{AnyStepper, Options};
 use crate::model::contact::Contact;
 use crate::model::impact_damper::{ImpactDamper, State};

@@ -3,9 +3,17 @@
 //! rows, energy balance), checked before it starts.
 
 use crate::error::{Error, Result};
+use crate::kernel::contact_balance::CONTACT_CREATION_LIMIT;
 use crate::kernel::events::{self, RunOptions};
-use crate::legacy::steppers::Tolerances;
 use crate::methods::registry::{self, ATOL, RTOL};
+
+/// Tolerances of the adaptive methods: `rtol` relative, `atol` absolute (in
+/// the units of each variable: m and m/s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    pub rtol: f64,
+    pub atol: f64,
+}
 
 /// The relative tolerance (`rtol`) a method with error control takes, and
 /// its description: an error control looser than a tenth controls nothing
@@ -30,19 +38,6 @@ pub const ATOL_ALLOWED: &str = ATOL.allowed;
 /// binding's, the Python scenario's) reads these.
 pub const MAX_ENERGY_TOLERANCE: f64 = registry::ENERGY_TOLERANCE.high;
 pub const ENERGY_TOLERANCE_ALLOWED: &str = registry::ENERGY_TOLERANCE.allowed;
-
-/// The most energy one contact may create, relative to the energy in play,
-/// whatever `energy_tolerance` says. A contact can only lose energy; what
-/// it gains is the method's error, which at the coarsest steps that resolve
-/// a contact (ten steps across it) stays below 1e-2 for every method but the
-/// founding paper's lagged Newmark (generalized-alpha 6e-3, the others
-/// below 1e-3; dop853 and dopri5 1e-8), where a two-body rebound ratio is
-/// within 0.5 % of 1. The paper's Newmark creates energy at every contact by
-/// construction (it rebounds at 1.0016 of the approach speed at its own
-/// dt = 1e-4 s, 1.05 at 1e-3 s): that is the error `vibroimpact paper`
-/// reproduces and documents, so its runs are bounded by `energy_tolerance`
-/// alone.
-pub const CONTACT_CREATION_LIMIT: f64 = 1e-2;
 
 /// An `energy_tolerance` in (0, [`MAX_ENERGY_TOLERANCE`]]: the registry's check.
 pub fn checked_energy_tolerance(tolerance: f64) -> Result<f64> {
