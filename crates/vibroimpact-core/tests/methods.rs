@@ -1,25 +1,31 @@
-//! Orders of the steppers on a smooth problem with a closed form, and every
-//! method's event-driven run of the Table 1 collision.
+//! Orders of the general kernel's steppers on a smooth problem with a
+//! closed form, and every method's event-driven run of the Table 1 collision
+//! (the two-mass preset on the general kernel).
 
 mod common;
 
-use vibroimpact_core::legacy::equations::{Free, Mode, Model};
-use vibroimpact_core::legacy::run::simulate;
-use vibroimpact_core::legacy::steppers::{
-    to_vector, Dop853Stepper, Dopri5Stepper, NewmarkFamily, Rk4Stepper, Stepper, Tolerances,
-};
+use vibroimpact_core::methods::registry::{two_mass, AnyStepper};
+use vibroimpact_core::methods::steppers::SystemStepper;
+use vibroimpact_core::model::assembly::{Assembly, Mode, Scratch};
 use vibroimpact_core::model::closed_forms::{
     goldsmith_contact_duration, goldsmith_max_indentation,
 };
-use vibroimpact_core::model::contact::Hertz;
 use vibroimpact_core::{
-    Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
+    simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
+    Tolerances,
 };
 
-/// A damped main oscillator whose impact mass never touches (huge clearance).
-fn oscillator() -> Model<Hertz, Free> {
+/// A damped main oscillator whose impact mass never touches (huge
+/// clearance), and its start `w(0) = 1`.
+fn oscillator() -> (Assembly, Vec<f64>) {
     let system = ImpactDamper::new(1.0, 4.0, 0.1, 0.25, 10.0).unwrap();
-    Model::new(&system, Hertz { stiffness: 3000.0 }, 0.0, Free)
+    let contact = Contact::new(LawKind::Hertz, 3000.0, None, 0.0).unwrap();
+    let assembly = system.assembly(&contact).unwrap();
+    let y0 = State::new(1.0, 0.0, 0.0, 0.0)
+        .unwrap()
+        .vector(&assembly)
+        .unwrap();
+    (assembly, y0)
 }
 
 /// w(t) of `w'' + c w' + k w = 0`, `w(0) = 1`, `w'(0) = 0` (M = 1).
@@ -30,25 +36,38 @@ fn exact_w(t: f64) -> f64 {
     (-sigma * t).exp() * ((omega * t).cos() + sigma / omega * (omega * t).sin())
 }
 
-/// Error at t = 2 s of fixed steps `h` with any stepper.
-fn error<S: Stepper>(stepper: &mut S, h: f64) -> f64 {
-    let model = oscillator();
-    let start = State::new(1.0, 0.0, 0.0, 0.0).unwrap();
-    let mut y = to_vector(&start, 0.0);
+/// Error at t = 2 s of fixed steps `h` (the adaptive methods' error
+/// estimates ignored) with any stepper.
+fn error_with<S: SystemStepper>(stepper: &mut S, h: f64) -> f64 {
+    let (system, mut y) = oscillator();
+    let modes = vec![Mode::Open; system.interaction_count()];
+    let mut scratch = Scratch::new(&system);
+    let mut end = y.clone();
     let n = (2.0 / h).round() as usize;
-    stepper.reset(&model, 0.0, &y, Mode::Free);
+    stepper.reset();
     for i in 0..n {
-        y = stepper
-            .attempt(&model, i as f64 * h, &y, h, Mode::Free)
-            .unwrap()
-            .end;
+        stepper
+            .attempt(&system, i as f64 * h, &y, h, &modes, &mut scratch, &mut end)
+            .unwrap();
         stepper.accept();
+        y.copy_from_slice(&end);
     }
     (y[0] - exact_w(n as f64 * h)).abs()
 }
 
-fn order<S: Stepper>(mut make: impl FnMut() -> S, steps: &[f64]) -> f64 {
-    let errors: Vec<f64> = steps.iter().map(|&h| error(&mut make(), h)).collect();
+fn error(method: &Method, h: f64) -> f64 {
+    let (system, _) = oscillator();
+    let options = two_mass::options_of(method);
+    match AnyStepper::new(&system, method.name(), &options).unwrap() {
+        AnyStepper::Rk(mut s) => error_with(&mut s, h),
+        AnyStepper::Newmark(mut s) => error_with(&mut s, h),
+        AnyStepper::Paper(mut s) => error_with(&mut s, h),
+        AnyStepper::Exact(mut s) => error_with(&mut s, h),
+    }
+}
+
+fn order(method: Method, steps: &[f64]) -> f64 {
+    let errors: Vec<f64> = steps.iter().map(|&h| error(&method, h)).collect();
     let (first, last) = (errors[0], errors[errors.len() - 1]);
     (first / last).ln() / (steps[0] / steps[steps.len() - 1]).ln()
 }
@@ -61,11 +80,14 @@ fn each_method_converges_at_its_order_on_a_smooth_problem() {
             atol: 1e-6,
         };
         let cases: [(&str, f64, f64); 6] = [
-            ("rk4", order(Rk4Stepper::default, &[0.1, 0.05, 0.025]), 4.0),
+            ("rk4", order(Method::Rk4, &[0.1, 0.05, 0.025]), 4.0),
             (
                 "newmark-implicit",
                 order(
-                    || NewmarkFamily::newmark(0.25, 0.5, false),
+                    Method::NewmarkImplicit {
+                        beta: 0.25,
+                        gamma: 0.5,
+                    },
                     &[0.1, 0.05, 0.025],
                 ),
                 2.0,
@@ -73,7 +95,9 @@ fn each_method_converges_at_its_order_on_a_smooth_problem() {
             (
                 "generalized-alpha",
                 order(
-                    || NewmarkFamily::generalized_alpha(0.8),
+                    Method::GeneralizedAlpha {
+                        spectral_radius: 0.8,
+                    },
                     &[0.1, 0.05, 0.025],
                 ),
                 2.0,
@@ -81,19 +105,22 @@ fn each_method_converges_at_its_order_on_a_smooth_problem() {
             (
                 "newmark (lagged, free flight)",
                 order(
-                    || NewmarkFamily::newmark(0.25, 0.5, true),
+                    Method::Newmark {
+                        beta: 0.25,
+                        gamma: 0.5,
+                    },
                     &[0.1, 0.05, 0.025],
                 ),
                 2.0,
             ),
             (
                 "dopri5",
-                order(|| Dopri5Stepper::new(loose), &[0.1, 0.05, 0.025]),
+                order(Method::Dopri5(loose), &[0.1, 0.05, 0.025]),
                 5.0,
             ),
             (
                 "dop853",
-                order(|| Dop853Stepper::new(loose), &[0.4, 0.2, 0.1]),
+                order(Method::Dop853(loose), &[0.4, 0.2, 0.1]),
                 8.0,
             ),
         ];

@@ -11,6 +11,12 @@ impl Assembly {
         2 * self.dim + CONTACT + self.interactions.len()
     }
 
+    /// Interactions (a pair's walls, each with its law): the length of the
+    /// modes a stepper is given.
+    pub fn interaction_count(&self) -> usize {
+        self.interactions.len()
+    }
+
     /// Whether any pair is rigid (only those stick or take impacts).
     pub fn has_rigid(&self) -> bool {
         self.interactions
