@@ -7,18 +7,14 @@
 
 mod common;
 
+use std::f64::consts::TAU;
 use vibroimpact_core::error::Error;
-use vibroimpact_core::legacy::equations::{Excitation, Free, Model};
-use vibroimpact_core::legacy::events::integrate_events;
-use vibroimpact_core::legacy::integrators::Rk4;
-use vibroimpact_core::legacy::records::Solution;
-use vibroimpact_core::legacy::run::integrate;
-use vibroimpact_core::legacy::run::simulate;
-use vibroimpact_core::legacy::steppers::{Dop853Stepper, Rk4Stepper, Tolerances};
-use vibroimpact_core::model::contact::{Hertz, HysterHertz};
+use vibroimpact_core::methods::registry::{two_mass, AnyStepper};
+use vibroimpact_core::model::assembly::{Assembly, Excitation, Load};
+use vibroimpact_core::model::signals::Signal;
 use vibroimpact_core::{
-    Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
-    DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
+    simulate, Contact, ContactTiming, ImpactDamper, LawKind, Method, Settings, State, Stepping,
+    SystemSolution, Tolerances, DEFAULT_ENERGY_TOLERANCE, DEFAULT_MAX_ROWS,
 };
 
 const NEWMARK: Method = Method::Newmark {
@@ -88,7 +84,7 @@ fn run(
     contact: &Contact,
     start: &State,
     s: &Settings,
-) -> Result<Solution, Error> {
+) -> Result<SystemSolution, Error> {
     simulate(system, contact, start, s, &mut || false)
 }
 
@@ -158,11 +154,6 @@ fn the_defaults_are_what_the_docs_say() {
     common::timeout(60, || {
         assert_eq!(DEFAULT_MAX_ROWS, 20_000_000);
         assert_eq!(DEFAULT_ENERGY_TOLERANCE, 0.05);
-        // A history row is six f64 columns (48 bytes), a contact nine (72).
-        assert_eq!(
-            std::mem::size_of::<vibroimpact_core::legacy::records::ContactRecord>(),
-            72
-        );
         let s = settings(Method::Rk4, Some(1e-4), 0.1, None);
         assert!(s.history);
         assert_eq!(s.max_rows, DEFAULT_MAX_ROWS);
@@ -197,7 +188,7 @@ fn a_fixed_step_history_beyond_max_rows_is_refused_up_front() {
 }
 
 /// The rows and contacts a RowLimit error reports.
-fn kept(result: Result<Solution, Error>) -> (u64, u64, f64) {
+fn kept(result: Result<SystemSolution, Error>) -> (u64, u64, f64) {
     match result {
         Err(Error::RowLimit {
             rows,
@@ -245,37 +236,31 @@ fn a_run_without_history_returns_the_same_contacts_and_end() {
             &s.with_limits(false, None, None).unwrap(),
         )
         .unwrap();
-        assert!(bare.history.time.is_empty() && bare.history.time.capacity() == 0);
+        assert!(bare.time.is_empty() && bare.time.capacity() == 0);
         assert_eq!(bare.contacts, full.contacts);
         assert_eq!(bare.final_state, full.final_state);
-        assert_eq!(full.history.time.len(), 200_001);
+        assert_eq!(full.time.len(), 200_001);
     });
 }
 
 // --------------------------------------------------------------- the start
 
 #[test]
-fn both_kernels_refuse_a_start_inside_the_wall_and_take_one_at_it() {
+fn both_steppings_refuse_a_start_inside_the_wall_and_take_one_at_it() {
     common::timeout(60, || {
         let system = table1();
-        let model = Model::new(&system, Hertz { stiffness: 3000.0 }, 0.01, Free);
-        let s = settings(Method::Rk4, Some(1e-4), 0.01, Some(Stepping::Fixed));
-        let inside = State::new(0.0, 0.0, 0.012, 0.0).unwrap();
-        let fixed = integrate(&model, &mut Rk4, &inside, &s, 4, &mut || false);
-        let events = integrate_events(&model, &mut Rk4Stepper::default(), &inside, &s, &mut || {
-            false
-        });
-        for text in [message(fixed), message(events)] {
+        for stepping in [Stepping::Fixed, Stepping::Events] {
+            let s = settings(Method::Rk4, Some(1e-4), 0.01, Some(stepping));
+            let inside = State::new(0.0, 0.0, 0.012, 0.0).unwrap();
+            let text = message(run(&system, &hertz(), &inside, &s));
             assert!(text.contains("initial state"), "{text}");
             assert!(text.contains("2.000000e-3 m inside the wall"), "{text}");
-        }
-        for at_wall in [
-            State::new(0.0, 0.0, 0.01, 0.1).unwrap(),
-            State::new(0.05, 0.0, 0.04, 0.0).unwrap(), // 1e-2 to round-off
-        ] {
-            assert!(integrate(&model, &mut Rk4, &at_wall, &s, 4, &mut || false).is_ok());
-            let mut stepper = Rk4Stepper::default();
-            assert!(integrate_events(&model, &mut stepper, &at_wall, &s, &mut || false).is_ok());
+            for at_wall in [
+                State::new(0.0, 0.0, 0.01, 0.1).unwrap(),
+                State::new(0.05, 0.0, 0.04, 0.0).unwrap(), // 1e-2 to round-off
+            ] {
+                assert!(run(&system, &hertz(), &at_wall, &s).is_ok());
+            }
         }
     });
 }
@@ -365,8 +350,8 @@ fn the_damper_work_is_counted_as_accurately_as_the_method_runs() {
                 "{method:?}: {}",
                 sol.energy_residual
             );
-            let left = 0.5 * sol.final_state.main_velocity.powi(2)
-                + 0.5 * sol.final_state.main_displacement.powi(2);
+            // The final state is [w, y, w', y'].
+            let left = 0.5 * sol.final_state[2].powi(2) + 0.5 * sol.final_state[0].powi(2);
             assert!(left < 0.1 * 0.5 * 0.1 * 0.1);
         }
     });
@@ -393,47 +378,41 @@ fn without_a_main_damper_each_contact_loses_what_it_dissipates() {
     });
 }
 
-/// `F(t) = amplitude cos(omega t)` on the main mass.
-#[derive(Debug, Clone, Copy)]
-struct Harmonic {
-    amplitude: f64,
-    omega: f64,
-}
-
-impl Excitation for Harmonic {
-    const IS_FREE: bool = false;
-    fn main_force(&self, time: f64) -> f64 {
-        self.amplitude * (self.omega * time).cos()
-    }
-}
-
 #[test]
 fn a_forced_run_balances_with_the_external_work() {
     common::timeout(60, || {
         // Driven near resonance from rest, the masses start rattling: most of the energy in
         // play is the force's work, so leaving it out of the balance would miss by ~100 %.
-        let system = table1();
-        let force = Harmonic {
-            amplitude: 0.02,
-            omega: 1.0,
+        // The Table 1 system with F(t) = 0.02 cos(t) N on the main mass.
+        let contact = Contact::new(LawKind::HysterHertz, 3000.0, Some(0.8), 0.01).unwrap();
+        let mut spec = table1().spec(&contact).unwrap();
+        spec.excitations.push(Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(0.02, 1.0 / TAU, 0.0).unwrap(),
+        });
+        let system = Assembly::new(&spec).unwrap();
+        let y0 = State::new(0.0, 0.0, 0.0, 0.0)
+            .unwrap()
+            .vector(&system)
+            .unwrap();
+        let forced = |s: Settings| {
+            let options = two_mass::options_of(&s.method);
+            let mut stepper = AnyStepper::new(&system, s.method.name(), &options).unwrap();
+            let (options, stepping) = (s.run_options(), s.kernel_stepping());
+            stepper
+                .integrate_stepped(&system, &y0, &options, stepping, &mut || false)
+                .unwrap()
         };
-        let model = Model::new(
-            &system,
-            HysterHertz::exact(3000.0, 0.8).unwrap(),
-            0.01,
-            force,
+        let fixed = forced(
+            settings(Method::Rk4, Some(1e-3), 60.0, Some(Stepping::Fixed))
+                .with_limits(false, None, Some(1e-4))
+                .unwrap(),
         );
-        let start = State::new(0.0, 0.0, 0.0, 0.0).unwrap();
-        let s = settings(Method::Rk4, Some(1e-3), 60.0, Some(Stepping::Fixed))
-            .with_limits(false, None, Some(1e-4))
-            .unwrap();
-        let fixed = integrate(&model, &mut Rk4, &start, &s, 4, &mut || false).unwrap();
-        let adaptive = settings(Method::Dop853(TIGHT), None, 60.0, None)
-            .with_limits(false, None, Some(1e-6))
-            .unwrap();
-        let mut stepper = Dop853Stepper::new(TIGHT);
-        let events =
-            integrate_events(&model, &mut stepper, &start, &adaptive, &mut || false).unwrap();
+        let events = forced(
+            settings(Method::Dop853(TIGHT), None, 60.0, None)
+                .with_limits(false, None, Some(1e-6))
+                .unwrap(),
+        );
         // RK4 in the paper's fixed stepping straddles the contact instants (first order there).
         for (sol, bound) in [(fixed, 1e-4), (events, 1e-7)] {
             assert!(sol.contacts.len() >= 4, "{}", sol.contacts.len());
