@@ -597,3 +597,5 @@ mod sized;
 mod sized_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod two_mass_tests;
