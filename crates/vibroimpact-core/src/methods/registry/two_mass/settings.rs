@@ -44,31 +44,8 @@ pub fn checked_energy_tolerance(tolerance: f64) -> Result<f64> {
     registry::ENERGY_TOLERANCE.check(tolerance)
 }
 
-/// How contact instants are reported.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ContactTiming {
-    /// Onset and separation located inside the step (cubic Hermite root of
-    /// the indentation on the step's end values and rates).
-    Located,
-    /// The founding paper's way: the first sample in contact and the first
-    /// sample out of it, so durations are whole multiples of `dt`.
-    StepCount,
-}
-
-impl ContactTiming {
-    pub const NAMES: &'static str = "\"located\", \"step-count\"";
-    pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "located" => Ok(Self::Located),
-            "step-count" => Ok(Self::StepCount),
-            _ => Err(Error::UnknownChoice {
-                field: "contact_timing",
-                allowed: Self::NAMES,
-                value: name.to_string(),
-            }),
-        }
-    }
-}
+/// How a fixed-step run times contact instants: the kernel's own.
+pub use crate::kernel::events::ContactTiming;
 
 /// Options of the methods, by name; each method reads the ones it uses:
 /// the registry's, with its defaults.
@@ -415,10 +392,7 @@ impl Settings {
         match self.stepping {
             Stepping::Events => events::Stepping::Events,
             Stepping::Fixed => events::Stepping::Fixed {
-                contact_timing: match self.timing {
-                    ContactTiming::Located => events::ContactTiming::Located,
-                    ContactTiming::StepCount => events::ContactTiming::StepCount,
-                },
+                contact_timing: self.timing,
             },
         }
     }
