@@ -1,9 +1,10 @@
 """Studies with ``stepping = "fixed"``: the runs advanced in lockstep by the core's
 ensemble kernel. Each run is the fixed-step RK4 run that ``vi.simulate`` makes of the
 same two-mass damper (its contacts, and its history's peak and RMS, to round-off in the
-sums: the lanes' states are the single run's bit for bit); the event-driven study of the same grid agrees to the methods' accuracy; the same results
-whatever the number of threads; a run that blows up fails alone; scenarios the kernel
-cannot take are refused naming the key."""
+sums: the lanes' states are the single run's bit for bit); the event-driven study of the
+same grid agrees to the methods' accuracy; the same results whatever the number of
+threads; a run that blows up fails alone; scenarios the kernel cannot take are refused
+naming the key."""
 
 from __future__ import annotations
 

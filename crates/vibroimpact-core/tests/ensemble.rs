@@ -84,7 +84,7 @@ fn single(member: &Member, dt: f64, steps: u64) -> SystemSolution {
 
 #[test]
 fn every_lane_is_the_fixed_step_kernels_run_bit_for_bit() {
-    common::timeout(60, || {
+    common::timeout(180, || {
         for kind in [
             LawKind::Hertz,
             LawKind::Linear,
@@ -131,7 +131,7 @@ fn every_lane_is_the_fixed_step_kernels_run_bit_for_bit() {
 
 #[test]
 fn a_lane_crossing_from_wall_to_wall_in_a_step_is_the_kernels_run() {
-    common::timeout(60, || {
+    common::timeout(180, || {
         // No clearance: the loose mass leaves one wall indenting the other
         // within a step, which the kernel then takes again with both walls'
         // forces (the one still in contact, the one entered).

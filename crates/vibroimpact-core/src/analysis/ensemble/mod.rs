@@ -166,7 +166,7 @@ fn energy(system: &Assembly, s: &State) -> f64 {
 }
 
 /// The lanes of `group` with their constants from `systems`.
-fn lanes_of<L: LaneLaw>(group: &[Member], systems: &[Assembly]) -> Lanes<L> {
+fn lanes_of<L: LaneLaw>(group: &[Member], systems: &[&Assembly]) -> Lanes<L> {
     let zeros = [0.0; LANES];
     let mut lanes = Lanes {
         state: Quad {
@@ -224,11 +224,21 @@ fn run_group<L: LaneLaw>(
     options: &EnsembleOptions,
     interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<MemberResult>> {
-    let mut systems = Vec::with_capacity(LANES);
+    // Each lane's assembly, made once for lanes in a row of the same system
+    // (a study varying the start: Assembly::new in every lane tripled the
+    // per-run overhead).
+    let mut assemblies: Vec<Assembly> = Vec::with_capacity(LANES);
+    let mut which = [0; LANES];
     for l in 0..LANES {
         let m = padded(group, l);
-        systems.push(m.system.assembly(&m.contact)?);
+        let previous = padded(group, l.saturating_sub(1));
+        let same = l > 0 && previous.system == m.system && previous.contact == m.contact;
+        if !same {
+            assemblies.push(m.system.assembly(&m.contact)?);
+        }
+        which[l] = assemblies.len() - 1;
     }
+    let systems: [&Assembly; LANES] = std::array::from_fn(|l| &assemblies[which[l]]);
     let mut lanes = lanes_of::<L>(group, &systems);
     let mut tallies = tallies_of(group, &systems, &mut lanes, options);
     for (l, tally) in tallies.iter_mut().enumerate() {
@@ -272,7 +282,7 @@ fn run_group<L: LaneLaw>(
 /// the kernel refuses fails the lane.
 fn tallies_of<L: LaneLaw>(
     group: &[Member],
-    systems: &[Assembly],
+    systems: &[&Assembly],
     lanes: &mut Lanes<L>,
     options: &EnsembleOptions,
 ) -> Vec<Tally> {
@@ -297,7 +307,7 @@ fn tallies_of<L: LaneLaw>(
                 peak: 0.0,
                 squares: 0.0,
                 failed,
-                energy_start: energy(&systems[l], &s),
+                energy_start: energy(systems[l], &s),
             }
         })
         .collect()
@@ -324,7 +334,7 @@ fn first_kept(options: &EnsembleOptions) -> u64 {
 fn check_lanes<L: LaneLaw>(
     lanes: &mut Lanes<L>,
     tallies: &mut [Tally],
-    systems: &[Assembly],
+    systems: &[&Assembly],
     t: f64,
     options: &EnsembleOptions,
 ) {
@@ -338,7 +348,7 @@ fn check_lanes<L: LaneLaw>(
                 "numerical blow-up by t = {t:.6e} s: the state is no longer finite (reduce dt)"
             ));
         } else {
-            let energy = energy(&systems[l], &s);
+            let energy = energy(systems[l], &s);
             let allowed = tally.energy_start * (1.0 + options.energy_tolerance);
             if energy > allowed && energy - tally.energy_start > 1e-300 {
                 tally.failed = Some(format!(
