@@ -1,10 +1,10 @@
 """Studies with ``stepping = "fixed"``: the runs advanced in lockstep by the core's
 ensemble kernel. Each run is the fixed-step RK4 run that ``vi.simulate`` makes of the
-same two-mass damper (its contacts, and its history's peak and RMS: to O(dt^4) until the
-ensemble takes the general kernel's step at each onset, see ``ONSET_STEP``); the
-event-driven study of the same grid agrees to the methods' accuracy; the same results
-whatever the number of threads; a run that blows up fails alone; scenarios the kernel
-cannot take are refused naming the key."""
+same two-mass damper (its contacts, and its history's peak and RMS, to round-off in the
+sums: the lanes' states are the single run's bit for bit); the event-driven study of the
+same grid agrees to the methods' accuracy; the same results whatever the number of
+threads; a run that blows up fails alone; scenarios the kernel cannot take are refused
+naming the key."""
 
 from __future__ import annotations
 
@@ -57,15 +57,6 @@ chunk_size = 5
 """
 
 
-# The two-mass ``vi.simulate`` runs the general kernel, whose fixed step in which a contact
-# begins is taken again with the contact's force acting past the wall; the ensemble keeps
-# the 0.1 kernel's step (the force a function of the state in every stage) until it moves
-# to the general kernel's arithmetic (issue 24). The two differ by that step's O(dt^4)
-# at each onset: up to 1.2e-7 of the peak and 1.4e-8 of the RMS here (dt = 1e-4 s), 1e-12
-# before.
-ONSET_STEP = 5e-7
-
-
 def load(tmp_path: Path, text: str) -> st.Study:
     return load_study(tmp_path / "study.toml", text)
 
@@ -89,14 +80,14 @@ def test_each_run_is_the_fixed_step_kernels_run(tmp_path: Path) -> None:
             point = ds.sel({"initial.damper_velocity.0": velocity, "damper.0.clearance": clearance})
             assert point["impacts"].item() == len(sol.contacts.onset) > 0
             w = sol.main_displacement
-            # RMS: the trapezoidal rule over the same step ends.
+            # RMS: the trapezoidal rule over the same step ends (summed in another order).
             rms = np.sqrt(np.trapezoid(w * w, dx=DT) / T_END)
-            assert point["rms"].item() == pytest.approx(rms, rel=ONSET_STEP)
+            assert point["rms"].item() == pytest.approx(rms, rel=1e-12)
             # Peak: at least the largest step end, above it only by the located
             # extremum inside a step (the curvature over one step: ~ (w dt)^2).
             peak = point["peak"].item()
             top = np.abs(w).max()
-            assert top * (1 - ONSET_STEP) <= peak <= top * (1 + 1e-7 + ONSET_STEP)
+            assert top <= peak <= top * (1 + 1e-7)
 
 
 def test_fixed_and_event_stepping_agree_to_the_methods_accuracy(tmp_path: Path) -> None:

@@ -20,8 +20,8 @@
 //! - [`analysis`]: settling, shooting for periodic orbits, studies of many
 //!   runs on every core and lockstep ensembles.
 //! - [`numerics`]: small dense linear algebra, Hermite interpolation, series.
-//! - [`legacy`]: parts of the 0.1 two-mass kernel that the lockstep
-//!   ensemble and verification tests still use, to be deleted (issue 24).
+//! - [`legacy`]: parts of the 0.1 two-mass kernel that the throughput
+//!   example and a verification test still use, to be deleted (issue 24).
 //!   No run of the API goes through it.
 //!
 //! The two-mass impact damper's run is the preset on the general kernel:

@@ -34,8 +34,7 @@ pub trait Integrator {
 /// One classical RK4 step of `y' = f(t, y)` from `(time, y)`: stage points
 /// `y + (h/2) k` and `y + h k`, the end `y + (h/6) (k1 + 2 (k2 + k3) + k4)`.
 /// The one RK4 of the two-mass system, for the fixed-step kernel ([`Rk4`])
-/// and the event-driven one ([`crate::legacy::steppers::Rk4Stepper`]) alike;
-/// `ensemble.rs` repeats these operations lane by lane (tested bit for bit).
+/// and the event-driven one ([`crate::legacy::steppers::Rk4Stepper`]) alike.
 /// Systems of any size step with `system_steppers::ExplicitRk` on slices
 /// (the same tableau, summed as the other explicit methods are).
 #[inline(always)]

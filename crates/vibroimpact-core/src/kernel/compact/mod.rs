@@ -21,7 +21,7 @@ mod lane_steps;
 mod lanes;
 mod lockstep;
 mod stretch;
-use lanes::LaneLaw;
+pub(crate) use lanes::LaneLaw;
 pub(crate) use lanes::LANES;
 pub(crate) use lockstep::run_group;
 pub(crate) use stretch::{

@@ -3,11 +3,19 @@
 //! lane loop into vector instructions (AVX-512 or AVX2 where the processor
 //! has them, chosen at run time; SSE2 otherwise).
 //!
-//! Each lane is the run the fixed-step kernel ([`crate::legacy::run::integrate`]
-//! with [`crate::legacy::integrators::Rk4`]) makes of its member, bit for bit: the
-//! same operations in the same order (the contact branch becomes a select,
-//! which changes no result), the same provisional approach-rate latch while
-//! apart and the same located onset rate in contact. What a lane keeps is
+//! A declared specialisation of the one fixed RK4 for the two-mass preset
+//! ([`ImpactDamper::assembly`]): each lane is the general kernel's fixed-step
+//! run of its member ([`crate::methods::registry::two_mass::simulate`] with
+//! RK4, `stepping = "fixed"`, located contacts), bit for bit. The stages are
+//! the compact path's ([`crate::kernel::compact`]: its rates and tableau
+//! weights, term for term in its order, the preset's constants read from its
+//! assembly; the two walls' branch becomes a select on the side, which
+//! changes no result since only one wall can be indented), and the contact
+//! modes are the kernel's fixed stepping's ([`crate::kernel::fixed`]): a
+//! wall apart feels no force; a step that ends a wall indented is taken
+//! again with that wall's force, latched at the indentation rate of the
+//! step's start; an onset latches the rate located on the cubic Hermite
+//! interpolant of the gap; a separation opens the wall. What a lane keeps is
 //! reduced: its contacts (counted, onsets located in the step by the cubic
 //! Hermite interpolant), the main mass's peak |w| (step ends, and extrema
 //! located inside steps by the same interpolant) and RMS (trapezoidal rule
@@ -23,9 +31,14 @@
 
 use rayon::prelude::*;
 
+mod step;
+
+use step::{rk4, Lanes, OneWall, Quad, V};
+
 use crate::error::{Error, Result};
-use crate::legacy::equations::{Free, Model};
-use crate::model::contact::{Contact, ContactLaw, Hertz, HysterHertz, LawKind, Linear};
+use crate::kernel::compact::LaneLaw;
+use crate::model::assembly::{Assembly, InteractionLaw, Mode};
+use crate::model::contact::{Contact, Hertz, HysterHertz, LawKind, Linear};
 use crate::model::impact_damper::{ImpactDamper, State};
 use crate::numerics::hermite;
 
@@ -102,18 +115,11 @@ pub fn run_ensemble(
         members
             .par_chunks(LANES)
             .map(|group| match kind {
-                LawKind::Hertz => run_group(group, options, interrupt, |c| Hertz {
-                    stiffness: c.stiffness,
-                }),
-                LawKind::Linear => run_group(group, options, interrupt, |c| Linear {
-                    stiffness: c.stiffness,
-                }),
-                LawKind::HysterHertz => run_group(group, options, interrupt, |c| {
-                    HysterHertz::paper(c.stiffness, c.restitution)
-                }),
-                LawKind::HertzDamped => run_group(group, options, interrupt, |c| {
-                    HysterHertz::rebounding_at(c.stiffness, c.restitution)
-                }),
+                LawKind::Hertz => run_group::<Hertz>(group, options, interrupt),
+                LawKind::Linear => run_group::<Linear>(group, options, interrupt),
+                LawKind::HysterHertz | LawKind::HertzDamped => {
+                    run_group::<HysterHertz>(group, options, interrupt)
+                }
             })
             .collect()
     });
@@ -124,58 +130,10 @@ pub fn run_ensemble(
     Ok(results)
 }
 
-/// A quantity of every lane's state `(w, w', y, y')`: the state itself, or
-/// its rate (a stage's slopes).
-#[derive(Clone, Copy)]
-struct Quad {
-    w: [f64; LANES],
-    wv: [f64; LANES],
-    y: [f64; LANES],
-    yv: [f64; LANES],
-}
-
-impl Quad {
-    /// Lane `l`'s state.
-    #[inline(always)]
-    fn lane(&self, l: usize) -> State {
-        State {
-            main_displacement: self.w[l],
-            main_velocity: self.wv[l],
-            impact_displacement: self.y[l],
-            impact_velocity: self.yv[l],
-        }
-    }
-
-    /// `self + h k`, lane by lane (RK4's stage points).
-    #[inline(always)]
-    fn offset(&self, h: f64, k: &Quad) -> Quad {
-        Quad {
-            w: std::array::from_fn(|l| self.w[l] + h * k.w[l]),
-            wv: std::array::from_fn(|l| self.wv[l] + h * k.wv[l]),
-            y: std::array::from_fn(|l| self.y[l] + h * k.y[l]),
-            yv: std::array::from_fn(|l| self.yv[l] + h * k.yv[l]),
-        }
-    }
-}
-
-/// The lanes' state and constants, structure of arrays.
-#[derive(Clone, Copy)]
-struct Lanes<L: ContactLaw> {
-    state: Quad,
-    damping_per_mass: [f64; LANES],
-    stiffness_per_mass: [f64; LANES],
-    inverse_main: [f64; LANES],
-    inverse_impact: [f64; LANES],
-    clearance: [f64; LANES],
-    contact_damping: [f64; LANES],
-    law: [L; LANES],
-}
-
 /// What the rare work of each lane keeps.
 struct Tally {
-    /// Side of the open contact (0 when apart).
-    side: f64,
-    approach: f64,
+    /// Each wall's contact open.
+    open: [bool; 2],
     contacts: u64,
     peak: f64,
     squares: f64,
@@ -189,32 +147,100 @@ fn padded(group: &[Member], l: usize) -> &Member {
     &group[l.min(group.len() - 1)]
 }
 
-fn run_group<L: ContactLaw>(
+/// Every wall in compliant contact: the energy's modes (each indented
+/// wall's elastic energy counted).
+const ALL_COMPLIANT: [Mode; 2] = [Mode::Compliant {
+    approach_rate: 0.0,
+    indented_only: true,
+}; 2];
+
+/// Lane `l`'s stored energy (J) at `s`, as the kernel sums it.
+fn energy(system: &Assembly, s: &State) -> f64 {
+    let y = [
+        s.main_displacement,
+        s.impact_displacement,
+        s.main_velocity,
+        s.impact_velocity,
+    ];
+    system.energy(&y, &ALL_COMPLIANT)
+}
+
+/// The lanes of `group` with their constants from `systems`.
+fn lanes_of<L: LaneLaw>(group: &[Member], systems: &[&Assembly]) -> Lanes<L> {
+    let zeros = [0.0; LANES];
+    let mut lanes = Lanes {
+        state: Quad {
+            w: zeros,
+            wv: zeros,
+            y: zeros,
+            yv: zeros,
+        },
+        stiffness: zeros,
+        damping: zeros,
+        h: [zeros; 2],
+        offset: [zeros; 2],
+        push: [[zeros; 2]; 2],
+        parts: [zeros; 2],
+        contact_damping: zeros,
+        active: [zeros; 2],
+        approach: [zeros; 2],
+        factor: [zeros; 2],
+        one: OneWall {
+            active: zeros,
+            sign: zeros,
+            offset: zeros,
+            approach: zeros,
+            factor: zeros,
+            push: [zeros; 2],
+        },
+        law: std::marker::PhantomData,
+    };
+    for (l, system) in systems.iter().enumerate() {
+        lanes.state.set(l, &padded(group, l).initial);
+        let parts = system.compact_parts().expect("the preset is modal");
+        let [k, c, _, _] = parts.diagonals[0];
+        (lanes.stiffness[l], lanes.damping[l]) = (k, c);
+        let walls = &system.interactions;
+        lanes.h[0][l] = walls[0].h[0];
+        lanes.h[1][l] = walls[0].h[1];
+        for w in 0..2 {
+            lanes.offset[w][l] = walls[w].offset;
+            lanes.push[w][0][l] = walls[w].push[0];
+            lanes.push[w][1][l] = walls[w].push[1];
+        }
+        if let InteractionLaw::Compliant { law, damping } = &walls[0].law {
+            let damping = *damping;
+            let law = L::of(law).expect("the group's law");
+            [lanes.parts[0][l], lanes.parts[1][l]] = law.parts();
+            lanes.contact_damping[l] = damping;
+        }
+        lanes.sync(l);
+    }
+    lanes
+}
+
+fn run_group<L: LaneLaw>(
     group: &[Member],
     options: &EnsembleOptions,
     interrupt: &(dyn Fn() -> bool + Sync),
-    law_of: impl Fn(&Contact) -> L,
 ) -> Result<Vec<MemberResult>> {
-    let models: [Model<L, Free>; LANES] = std::array::from_fn(|l| {
+    // Each lane's assembly, made once for lanes in a row of the same system
+    // (a study varying the start: Assembly::new in every lane tripled the
+    // per-run overhead).
+    let mut assemblies: Vec<Assembly> = Vec::with_capacity(LANES);
+    let mut which = [0; LANES];
+    for l in 0..LANES {
         let m = padded(group, l);
-        Model::new(&m.system, law_of(&m.contact), m.contact.damping, Free)
-    });
-    let mut lanes = Lanes {
-        state: Quad {
-            w: std::array::from_fn(|l| padded(group, l).initial.main_displacement),
-            wv: std::array::from_fn(|l| padded(group, l).initial.main_velocity),
-            y: std::array::from_fn(|l| padded(group, l).initial.impact_displacement),
-            yv: std::array::from_fn(|l| padded(group, l).initial.impact_velocity),
-        },
-        damping_per_mass: models.map(|m| m.damping_per_mass),
-        stiffness_per_mass: models.map(|m| m.stiffness_per_mass),
-        inverse_main: models.map(|m| m.inverse_main_mass),
-        inverse_impact: models.map(|m| m.inverse_impact_mass),
-        clearance: models.map(|m| m.clearance),
-        contact_damping: models.map(|m| m.contact_damping),
-        law: models.map(|m| m.law),
-    };
-    let mut tallies = tallies_of(group, &models, options);
+        let previous = padded(group, l.saturating_sub(1));
+        let same = l > 0 && previous.system == m.system && previous.contact == m.contact;
+        if !same {
+            assemblies.push(m.system.assembly(&m.contact)?);
+        }
+        which[l] = assemblies.len() - 1;
+    }
+    let systems: [&Assembly; LANES] = std::array::from_fn(|l| &assemblies[which[l]]);
+    let mut lanes = lanes_of::<L>(group, &systems);
+    let mut tallies = tallies_of(group, &systems, &mut lanes, options);
     for (l, tally) in tallies.iter_mut().enumerate() {
         if tally.failed.is_some() {
             park(&mut lanes, tally, l);
@@ -232,17 +258,9 @@ fn run_group<L: ContactLaw>(
     let mut n = 0u64;
     while n < options.steps {
         let stop = (n + CHECK_INTERVAL).min(options.steps);
-        advance(
-            &mut lanes,
-            &mut tallies,
-            &models,
-            n,
-            stop,
-            first_kept,
-            options,
-        );
+        advance(&mut lanes, &mut tallies, n, stop, first_kept, options);
         n = stop;
-        check_lanes(&mut lanes, &mut tallies, &models, n as f64 * dt, options);
+        check_lanes(&mut lanes, &mut tallies, &systems, n as f64 * dt, options);
         if interrupt() {
             return Err(Error::Interrupted {
                 time: n as f64 * dt,
@@ -258,31 +276,38 @@ fn run_group<L: ContactLaw>(
     ))
 }
 
-/// Each lane's tally at the start: its open contact, if any (counted where
-/// recorded from the start), and whether its start is refused.
-fn tallies_of<L: ContactLaw>(
+/// Each lane's tally at the start, and its walls' modes: a wall indented
+/// at the start is a contact (counted where recorded from the start),
+/// latched at its indentation rate (the kernel's resumed contact); a start
+/// the kernel refuses fails the lane.
+fn tallies_of<L: LaneLaw>(
     group: &[Member],
-    models: &[Model<L, Free>; LANES],
+    systems: &[&Assembly],
+    lanes: &mut Lanes<L>,
     options: &EnsembleOptions,
 ) -> Vec<Tally> {
     (0..LANES)
         .map(|l| {
-            let s = padded(group, l).initial;
-            let model = &models[l];
-            let start = model.contact(&s, model.side(&s) * s.relative_velocity());
-            let failed = crate::legacy::records::check_start(model, &s)
+            let member = padded(group, l);
+            let s = member.initial;
+            let failed = s
+                .check_apart(member.system.clearance)
                 .err()
                 .map(|e| e.to_string());
-            let open = start.indentation > 0.0;
+            let mut open = [false; 2];
+            for (w, (gap, rate)) in lanes.gaps(l, &s).into_iter().enumerate() {
+                if gap < 0.0 {
+                    open[w] = true;
+                    lanes.activate(l, w, -rate);
+                }
+            }
             Tally {
-                side: if open { start.side } else { 0.0 },
-                approach: start.rate,
-                // A contact open at the start is one (as in the kernel's table).
-                contacts: u64::from(open && options.record_from <= 0.0),
+                open,
+                contacts: u64::from((open[0] || open[1]) && options.record_from <= 0.0),
                 peak: 0.0,
                 squares: 0.0,
                 failed,
-                energy_start: model.energy(&s),
+                energy_start: energy(systems[l], &s),
             }
         })
         .collect()
@@ -306,10 +331,10 @@ fn first_kept(options: &EnsembleOptions) -> u64 {
 /// The lanes' check at time `t` (s) after a stretch of steps: a state no
 /// longer finite, or energy created beyond the tolerance, fails its lane,
 /// which is parked.
-fn check_lanes<L: ContactLaw>(
+fn check_lanes<L: LaneLaw>(
     lanes: &mut Lanes<L>,
     tallies: &mut [Tally],
-    models: &[Model<L, Free>; LANES],
+    systems: &[&Assembly],
     t: f64,
     options: &EnsembleOptions,
 ) {
@@ -323,7 +348,7 @@ fn check_lanes<L: ContactLaw>(
                 "numerical blow-up by t = {t:.6e} s: the state is no longer finite (reduce dt)"
             ));
         } else {
-            let energy = models[l].energy(&s);
+            let energy = energy(systems[l], &s);
             let allowed = tally.energy_start * (1.0 + options.energy_tolerance);
             if energy > allowed && energy - tally.energy_start > 1e-300 {
                 tally.failed = Some(format!(
@@ -342,7 +367,7 @@ fn check_lanes<L: ContactLaw>(
 
 /// The results of the group's `members` lanes (the padding dropped), the
 /// peak and RMS over the steps from `first_kept` on (`kept_steps` of them).
-fn results_of<L: ContactLaw>(
+fn results_of<L: LaneLaw>(
     members: usize,
     lanes: &Lanes<L>,
     tallies: &[Tally],
@@ -391,19 +416,18 @@ fn results_of<L: ContactLaw>(
 }
 
 /// A failed lane is parked at rest, apart: no more events, no NaN.
-fn park<L: ContactLaw>(lanes: &mut Lanes<L>, tally: &mut Tally, l: usize) {
-    tally.side = 0.0;
-    lanes.state.w[l] = 0.0;
-    lanes.state.wv[l] = 0.0;
-    lanes.state.y[l] = 0.0;
-    lanes.state.yv[l] = 0.0;
+fn park<L: LaneLaw>(lanes: &mut Lanes<L>, tally: &mut Tally, l: usize) {
+    tally.open = [false; 2];
+    lanes.state.set(l, &State::default());
+    for w in 0..2 {
+        lanes.deactivate(l, w);
+    }
 }
 
 /// Steps `n .. stop`, with the widest vector instructions the processor has.
-fn advance<L: ContactLaw>(
+fn advance<L: LaneLaw>(
     lanes: &mut Lanes<L>,
     tallies: &mut [Tally],
-    models: &[Model<L, Free>; LANES],
     n: u64,
     stop: u64,
     first_kept: u64,
@@ -413,14 +437,14 @@ fn advance<L: ContactLaw>(
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the processor has the features the function is built for.
-            return unsafe { advance_avx512(lanes, tallies, models, n, stop, first_kept, options) };
+            return unsafe { advance_avx512(lanes, tallies, n, stop, first_kept, options) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: as above.
-            return unsafe { advance_avx2(lanes, tallies, models, n, stop, first_kept, options) };
+            return unsafe { advance_avx2(lanes, tallies, n, stop, first_kept, options) };
         }
     }
-    steps(lanes, tallies, models, n, stop, first_kept, options)
+    steps(lanes, tallies, n, stop, first_kept, options)
 }
 
 /// [`steps`] compiled for a processor feature (the same operations, so the
@@ -429,164 +453,89 @@ macro_rules! steps_with {
     ($name:ident, $feature:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feature)]
-        unsafe fn $name<L: ContactLaw>(
+        unsafe fn $name<L: LaneLaw>(
             lanes: &mut Lanes<L>,
             tallies: &mut [Tally],
-            models: &[Model<L, Free>; LANES],
             n: u64,
             stop: u64,
             first_kept: u64,
             options: &EnsembleOptions,
         ) {
-            steps(lanes, tallies, models, n, stop, first_kept, options)
+            steps(lanes, tallies, n, stop, first_kept, options)
         }
     };
 }
 steps_with!(advance_avx512, "avx512f");
 steps_with!(advance_avx2, "avx2");
 
-/// The rates of every lane's state, `(w', w'', y', y'')`: the velocities and
-/// [`Model::accelerations`] of an unforced model, with the contact branch as
-/// selects (the same operations on the lanes that touch; the side is the
-/// sign of `y - w` there, as [`Model::side`] finds it, since the clearance
-/// is >= 0).
+/// Steps `n .. stop` of every lane, then the rare work of the lanes that
+/// need it, and the reductions.
 #[inline(always)]
-fn derivative<L: ContactLaw>(lanes: &Lanes<L>, s: &Quad, approach: &[f64; LANES]) -> Quad {
-    let mut rate = Quad {
-        w: s.wv,
-        wv: [0.0; LANES],
-        y: s.yv,
-        yv: [0.0; LANES],
-    };
-    for l in 0..LANES {
-        // As Model::structural_acceleration.
-        let main = (-lanes.damping_per_mass[l]) * s.wv[l] - lanes.stiffness_per_mass[l] * s.w[l];
-        let u = s.y[l] - s.w[l];
-        let touching = u.abs() > lanes.clearance[l];
-        let side = if u > 0.0 { 1.0 } else { -1.0 };
-        let indentation = side * u - lanes.clearance[l];
-        let speed = side * (s.yv[l] - s.wv[l]);
-        let total =
-            lanes.law[l].force(indentation, speed, approach[l]) + lanes.contact_damping[l] * speed;
-        let push = side * total;
-        rate.wv[l] = if touching {
-            main + push * lanes.inverse_main[l]
-        } else {
-            main
-        };
-        rate.yv[l] = if touching {
-            -push * lanes.inverse_impact[l]
-        } else {
-            0.0
-        };
-    }
-    rate
-}
-
-/// Steps `n .. stop` of every lane: [`crate::legacy::integrators::Rk4`]'s stages in
-/// its order, then the rare work of the lanes that need it.
-#[inline(always)]
-fn steps<L: ContactLaw>(
+fn steps<L: LaneLaw>(
     lanes: &mut Lanes<L>,
     tallies: &mut [Tally],
-    models: &[Model<L, Free>; LANES],
     n: u64,
     stop: u64,
     first_kept: u64,
     options: &EnsembleOptions,
 ) {
     let dt = options.dt;
-    let half = 0.5 * dt;
-    let sixth = dt / 6.0;
-    let mut approach: [f64; LANES] = std::array::from_fn(|l| tallies[l].approach);
-    // The side of each lane's open contact, 0 for a lane apart.
-    let mut open_side: [f64; LANES] = std::array::from_fn(|l| tallies[l].side);
-    let mut squares: [f64; LANES] = std::array::from_fn(|l| tallies[l].squares);
-    let mut peak: [f64; LANES] = std::array::from_fn(|l| tallies[l].peak);
+    let mut squares: V = std::array::from_fn(|l| tallies[l].squares);
+    let mut peak: V = std::array::from_fn(|l| tallies[l].peak);
     for step in n..stop {
         let s = lanes.state;
-        // The provisional latch of the lanes apart (the fixed-step kernel's),
-        // for the laws that read it.
-        if L::USES_APPROACH_RATE {
+        lanes.state = rk4::<true, L>(lanes, &s, dt);
+        let kept = step + 1 >= first_kept;
+        let mut rare = false;
+        for l in 0..LANES {
+            let e = &lanes.state;
+            // A wall's contact begins where an open wall's gap ends below
+            // zero, ends where an active wall's does not; an extremum of w
+            // where w' changes sign.
+            let hx = lanes.h[0][l] * e.w[l] + lanes.h[1][l] * e.y[l];
+            let closed0 = lanes.offset[0][l] + hx < 0.0;
+            let closed1 = lanes.offset[1][l] + -hx < 0.0;
+            let changes =
+                (closed0 != (lanes.active[0][l] != 0.0)) | (closed1 != (lanes.active[1][l] != 0.0));
+            let turns = (s.wv[l] > 0.0) != (e.wv[l] > 0.0);
+            rare |= changes | (turns & kept);
+        }
+        if rare {
             for l in 0..LANES {
-                let u = s.y[l] - s.w[l];
-                let v = s.yv[l] - s.wv[l];
-                let side = if u > 0.0 || (u == 0.0 && v >= 0.0) {
-                    1.0
-                } else {
-                    -1.0
-                };
-                if open_side[l] == 0.0 {
-                    approach[l] = side * v;
-                }
+                tallies[l].peak = peak[l];
+            }
+            rare_work(lanes, tallies, &s, step, first_kept, options);
+            for l in 0..LANES {
+                peak[l] = tallies[l].peak;
             }
         }
-        let k1 = derivative(lanes, &s, &approach);
-        let k2 = derivative(lanes, &s.offset(half, &k1), &approach);
-        let k3 = derivative(lanes, &s.offset(half, &k2), &approach);
-        let k4 = derivative(lanes, &s.offset(dt, &k3), &approach);
-        let mut rare = false;
-        let kept = step + 1 >= first_kept;
-        // The trapezoidal rule: the first recorded end counts half.
-        let weight = if step + 1 == first_kept { 0.5 } else { 1.0 };
-        let sum = |a: f64, b: f64, c: f64, d: f64| sixth * (a + 2.0 * (b + c) + d);
-        for l in 0..LANES {
-            let w1 = s.w[l] + sum(k1.w[l], k2.w[l], k3.w[l], k4.w[l]);
-            let wv1 = s.wv[l] + sum(k1.wv[l], k2.wv[l], k3.wv[l], k4.wv[l]);
-            let y1 = s.y[l] + sum(k1.y[l], k2.y[l], k3.y[l], k4.y[l]);
-            let yv1 = s.yv[l] + sum(k1.yv[l], k2.yv[l], k3.yv[l], k4.yv[l]);
-            lanes.state.w[l] = w1;
-            lanes.state.wv[l] = wv1;
-            lanes.state.y[l] = y1;
-            lanes.state.yv[l] = yv1;
-            let u1 = y1 - w1;
-            // A contact opens where |u| passes d, closes where the open
-            // side's indentation is no longer positive; an extremum of w
-            // where w' changes sign.
-            let d = lanes.clearance[l];
-            let indented = open_side[l] * u1 - d > 0.0;
-            let changes = if open_side[l] != 0.0 {
-                !indented
-            } else {
-                u1.abs() > d
-            };
-            let turns = (s.wv[l] > 0.0) != (wv1 > 0.0);
-            rare |= changes | (turns & kept);
-            if kept {
+        if kept {
+            // The trapezoidal rule: the first recorded end counts half.
+            let weight = if step + 1 == first_kept { 0.5 } else { 1.0 };
+            for l in 0..LANES {
+                let w1 = lanes.state.w[l];
                 squares[l] += weight * w1 * w1;
                 peak[l] = peak[l].max(w1.abs());
             }
         }
-        if rare {
-            for l in 0..LANES {
-                tallies[l].approach = approach[l];
-                tallies[l].squares = squares[l];
-                tallies[l].peak = peak[l];
-            }
-            rare_work(lanes, tallies, models, &s, step, first_kept, options);
-            for l in 0..LANES {
-                approach[l] = tallies[l].approach;
-                open_side[l] = tallies[l].side;
-                peak[l] = tallies[l].peak;
-            }
-        }
     }
     for l in 0..LANES {
-        tallies[l].approach = approach[l];
         tallies[l].squares = squares[l];
         tallies[l].peak = peak[l];
     }
 }
 
-/// The rare work after step `step` (from `step dt` to `(step + 1) dt`): a
-/// contact opening (its onset and rate located on the cubic Hermite
-/// interpolant of the gap, the rate latched as the fixed-step kernel does)
-/// or closing, and an extremum of w located inside the step.
+/// The rare work after step `step` (from `step dt` to `(step + 1) dt`, from
+/// `old`), as the kernel's fixed step does it: the lanes whose open wall
+/// ends the step indented take it again with that wall's force (latched at
+/// its indentation rate at the step's start), and a wall so given its
+/// force that still ends apart is open again; then each wall's onset (its
+/// time and rate located on the cubic Hermite interpolant of the gap, the
+/// rate latched) or separation; and an extremum of w inside a recorded step.
 #[inline(never)]
-fn rare_work<L: ContactLaw>(
-    lanes: &Lanes<L>,
+fn rare_work<L: LaneLaw>(
+    lanes: &mut Lanes<L>,
     tallies: &mut [Tally],
-    models: &[Model<L, Free>; LANES],
     old: &Quad,
     step: u64,
     first_kept: u64,
@@ -594,28 +543,60 @@ fn rare_work<L: ContactLaw>(
 ) {
     let dt = options.dt;
     let t = step as f64 * dt;
+    let mut again = [false; LANES];
+    for l in 0..LANES {
+        if tallies[l].failed.is_some() {
+            continue;
+        }
+        let (start, end) = (
+            lanes.gaps(l, &old.lane(l)),
+            lanes.gaps(l, &lanes.state.lane(l)),
+        );
+        for w in 0..2 {
+            if lanes.active[w][l] == 0.0 && end[w].0 < 0.0 {
+                lanes.activate(l, w, -start[w].1);
+                again[l] = true;
+            }
+        }
+    }
+    if again.contains(&true) {
+        let retaken = rk4::<false, L>(lanes, old, dt);
+        for l in (0..LANES).filter(|&l| again[l]) {
+            let end = retaken.lane(l);
+            lanes.state.set(l, &end);
+            for (w, (gap, _)) in lanes.gaps(l, &end).into_iter().enumerate() {
+                if !tallies[l].open[w] && gap >= 0.0 {
+                    lanes.deactivate(l, w);
+                }
+            }
+        }
+    }
     for l in 0..LANES {
         let tally = &mut tallies[l];
         if tally.failed.is_some() {
             continue;
         }
-        let s0 = old.lane(l);
-        let s1 = lanes.state.lane(l);
-        let d = models[l].clearance;
-        if tally.side == 0.0 {
-            if s1.relative_displacement().abs() > d {
-                let side = models[l].side(&s1);
-                let onset = models[l].onset_in_step(&s0, &s1, side, dt);
-                tally.side = side;
-                tally.approach = onset.rate;
-                if t + onset.theta * dt >= options.record_from {
+        let (s0, s1) = (old.lane(l), lanes.state.lane(l));
+        let (start, end) = (lanes.gaps(l, &s0), lanes.gaps(l, &s1));
+        for w in 0..2 {
+            // The indentation and its rate times the step (the kernel's data).
+            let (i0, i1) = (-start[w].0, -end[w].0);
+            let (m0, m1) = (-start[w].1 * dt, -end[w].1 * dt);
+            if !tally.open[w] && i1 > 0.0 {
+                let theta = if i0 <= 0.0 {
+                    hermite::root(i0, i1, m0, m1)
+                } else {
+                    0.0
+                };
+                let rate = hermite::eval(i0, i1, m0, m1, theta).1 / dt;
+                tally.open[w] = true;
+                lanes.activate(l, w, rate);
+                if t + theta * dt >= options.record_from {
                     tally.contacts += 1;
                 }
-            }
-        } else {
-            let indented = tally.side * s1.relative_displacement() - d > 0.0;
-            if !indented {
-                tally.side = 0.0;
+            } else if tally.open[w] && i1 <= 0.0 {
+                tally.open[w] = false;
+                lanes.deactivate(l, w);
             }
         }
         // An extremum of w inside a recorded step.
