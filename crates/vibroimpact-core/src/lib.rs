@@ -20,9 +20,6 @@
 //! - [`analysis`]: settling, shooting for periodic orbits, studies of many
 //!   runs on every core and lockstep ensembles.
 //! - [`numerics`]: small dense linear algebra, Hermite interpolation, series.
-//! - [`legacy`]: parts of the 0.1 two-mass kernel that the throughput
-//!   example and a verification test still use, to be deleted (issue 24).
-//!   No run of the API goes through it.
 //!
 //! The two-mass impact damper's run is the preset on the general kernel:
 //! [`simulate`] (from [`methods::registry::two_mass`]) with its [`Settings`],
@@ -33,7 +30,6 @@
 pub mod analysis;
 pub mod error;
 pub mod kernel;
-pub mod legacy;
 pub mod methods;
 pub mod model;
 pub mod numerics;
