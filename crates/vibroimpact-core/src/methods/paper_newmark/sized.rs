@@ -265,7 +265,11 @@ impl PaperNewmark {
         y[..len].copy_from_slice(&f.y[..len]);
         let mut start_gaps = [(0.0, 0.0); MAX_WALLS];
         start_gaps[..count].copy_from_slice(&f.gaps[..count]);
-        let (inverse, mut carried) = self.sized_start::<FREE>(system, sized, (d, dt), &y, modes);
+        let (inverse, first) = self.sized_start::<FREE>(system, sized, (d, dt), &y, modes);
+        // Two buffers the steps alternate between (the step's start's and
+        // its end's), swapped where one is accepted: no copy per step.
+        let (mut start_buffer, mut end_buffer) = (first, first);
+        let (mut carried, mut next_carried) = (&mut start_buffer, &mut end_buffer);
         let (mut energy, mut end_gaps) = (*f.energy, [(0.0, 0.0); MAX_WALLS]);
         // Free, the walls' accumulators change in the first step alone, as
         // the step sums them (their rates are +0 at its end, and each later
@@ -287,12 +291,12 @@ impl PaperNewmark {
             let in_window = schedule.in_window(time, dt);
             let mut end = [0.0; MAX_LEN];
             let mut step = Step {
-                carried,
                 end: [0.0; 2 * MAX_DIM],
                 accumulators: [0.0; MAX_RATES],
                 contact: [(0.0, 0.0); MAX_WALLS],
             };
-            self.sized_step::<FREE>(sized, (n, d), (time, dt), (&y, &inverse), &mut step, modes);
+            let steps = (&*carried, &mut *next_carried, &mut step);
+            self.sized_step::<FREE>(sized, (n, d), (time, dt), (&y, &inverse), steps, modes);
             for i in 0..d {
                 end[i] = step.end[i];
                 end[d + i] = step.end[MAX_DIM + i];
@@ -327,7 +331,7 @@ impl PaperNewmark {
                     fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
                     // The power press takes, where its numbers are the
                     // accumulator's.
-                    match sized.pressed_power(w, d, &end, modes[w], &step) {
+                    match sized.pressed_power(w, d, &end, modes[w], (&step, &*next_carried)) {
                         Some(power) => fixed::pressed(oc, power, dt),
                         None => {
                             let at = end;
@@ -342,7 +346,7 @@ impl PaperNewmark {
                 *f.recorded_time += dt;
             }
             // Accepted (the method's `finish` has nothing to add).
-            carried = step.carried;
+            std::mem::swap(&mut carried, &mut next_carried);
             step.accept_into::<FREE>((d, f.steps == 0), &end, &first_walls, &mut y);
             clock.plain_step_to(next);
             f.steps += 1;
@@ -435,7 +439,8 @@ impl PaperNewmark {
 
     /// [`Self::step_sized`] and [`Self::end_powers`] in the arrays: the step
     /// `h` from `(time, y)` with the inverse effective matrix of the modes,
-    /// from and into `step`.
+    /// from what the start `carried` and into `step` and what its end
+    /// carries (`next`: every value the next step reads written).
     #[inline(always)]
     fn sized_step<const FREE: bool>(
         &self,
@@ -443,13 +448,12 @@ impl PaperNewmark {
         (n, d): (usize, usize),
         (time, h): (f64, f64),
         (y, inverse): (&[f64; MAX_LEN], &[[f64; MAX_DIM]; MAX_DIM]),
-        step: &mut Step,
+        (carried, next, step): (&Carried, &mut Carried, &mut Step),
         modes: &[Mode],
     ) {
         let (beta, gamma) = (self.beta, self.gamma);
         let (db, dg) = ((0.5 - beta) * h * h, (1.0 - gamma) * h);
         let (mut xp, mut vp) = ([0.0; MAX_DIM], [0.0; MAX_DIM]);
-        let carried = &mut step.carried;
         for i in 0..d {
             let a = carried.accel[i];
             xp[i] = y[i] + h * y[d + i] + db * a;
@@ -522,7 +526,7 @@ impl PaperNewmark {
             rates[INPUT] += values[l] * linalg::dot(&load.shape[..d], &v[..d]);
         }
         for w in 0..count {
-            carried.lagged[w] = false;
+            next.lagged[w] = false;
             let Mode::Compliant { approach_rate, .. } = modes[w] else {
                 continue;
             };
@@ -530,7 +534,7 @@ impl PaperNewmark {
             let (indentation, rate) = wall.indentation(d, &x, &v);
             let (force, elastic) = if indentation > 0.0 {
                 let (force, elastic) = wall.law.force_and_elastic(indentation, rate, approach_rate);
-                (carried.lag[w], carried.lagged[w]) = (force, true);
+                (next.lag[w], next.lagged[w]) = (force, true);
                 (force, elastic)
             } else {
                 (0.0, 0.0)
@@ -543,19 +547,18 @@ impl PaperNewmark {
         for k in 0..if FREE { CONTACT } else { MAX_RATES } {
             step.accumulators[k] = y[2 * d + k] + 0.5 * h * (carried.rates[k] + rates[k]);
         }
-        carried.accel = accel;
-        carried.rates = rates;
+        next.accel = accel;
+        next.rates = rates;
         step.end[..MAX_DIM].copy_from_slice(&x);
         step.end[MAX_DIM..].copy_from_slice(&v);
     }
 }
 
-/// A step: what it carries, its end's coordinates and velocities (each
-/// `MAX_DIM` wide) and accumulators, each wall's indentation and rate at
-/// its end (where in contact mode).
+/// A step: its end's coordinates and velocities (each `MAX_DIM` wide) and
+/// accumulators, each wall's indentation and rate at its end (where in
+/// contact mode).
 #[derive(Clone, Copy)]
 struct Step {
-    carried: Carried,
     end: [f64; 2 * MAX_DIM],
     accumulators: [f64; MAX_RATES],
     contact: [(f64, f64); MAX_WALLS],
@@ -600,7 +603,7 @@ impl Sized {
         d: usize,
         end: &[f64; MAX_LEN],
         mode: Mode,
-        step: &Step,
+        (step, carried): (&Step, &Carried),
     ) -> Option<f64> {
         let Mode::Compliant { .. } = mode else {
             return None;
@@ -611,7 +614,7 @@ impl Sized {
         let (i1, r1) = step.contact[w];
         (indentation.to_bits() == i1.to_bits() && rate.to_bits() == r1.to_bits()).then(|| {
             if indentation > 0.0 {
-                step.carried.rates[CONTACT + w]
+                carried.rates[CONTACT + w]
             } else {
                 0.0
             }

@@ -105,7 +105,11 @@ impl PaperNewmark {
         start_gaps[..count].copy_from_slice(&f.gaps[..count]);
         let mut end_gaps = [(0.0, 0.0); MAX_WALLS];
         let any = self.contacts_of(modes);
-        let mut carried: Carried = self.sized_carried::<FREE>(sized, d, &y, modes);
+        let first: Carried = self.sized_carried::<FREE>(sized, d, &y, modes);
+        // Two buffers the steps alternate between (the step's start's and
+        // its end's), swapped where one is accepted: no copy per step.
+        let (mut start_buffer, mut end_buffer) = (first, first);
+        let (mut carried, mut next_carried) = (&mut start_buffer, &mut end_buffer);
         let mut inverses = Inverses {
             steps: [u64::MAX; 2],
             inverse: [[[0.0; MAX_DIM]; MAX_DIM]; 2],
@@ -131,13 +135,13 @@ impl PaperNewmark {
                 }
             }
             let mut step = Step {
-                carried,
                 end: [0.0; 2 * MAX_DIM],
                 accumulators: [0.0; MAX_RATES],
                 contact: [(0.0, 0.0); MAX_WALLS],
             };
             let at = (&y, inverse);
-            self.sized_step::<FREE>(sized, (n, d), (time, length), at, &mut step, modes);
+            let steps = (&*carried, &mut *next_carried, &mut step);
+            self.sized_step::<FREE>(sized, (n, d), (time, length), at, steps, modes);
             let mut end = [0.0; MAX_LEN];
             for i in 0..d {
                 end[i] = step.end[i];
@@ -175,7 +179,7 @@ impl PaperNewmark {
                 *f.recorded_time += length;
             }
             // Accepted (the method's `finish` has nothing to add).
-            carried = step.carried;
+            std::mem::swap(&mut carried, &mut next_carried);
             step.accept_into::<FREE>((d, f.steps == 0), &end, &first_walls, &mut y);
             clock.plain_step_to(next);
             f.steps += 1;
