@@ -59,6 +59,7 @@ pub(super) fn check<S: SystemStepper>(system: &Assembly, stepper: &S) -> Result<
 /// The power of compliant interaction `i`'s dissipative forces at state `y`
 /// with the approach rate `approach` latched (W; 0 apart): 0.1's
 /// `contact_dissipation`.
+#[inline(always)]
 fn dissipation(system: &Assembly, i: usize, y: &[f64], approach: f64) -> f64 {
     let InteractionLaw::Compliant { law, damping } = system.interactions[i].law else {
         return 0.0;
@@ -66,8 +67,10 @@ fn dissipation(system: &Assembly, i: usize, y: &[f64], approach: f64) -> f64 {
     let (gap, rate) = system.gap(i, y);
     let (indentation, rate) = (-gap, -rate);
     if indentation > 0.0 {
-        let total = law.force(indentation, rate, approach) + damping * rate;
-        (total - law.elastic_force(indentation)) * rate
+        // Both forces from one evaluation (one square root for the Hertz
+        // laws), the same bits as `force` and `elastic_force` apart.
+        let (force, elastic) = law.force_and_elastic(indentation, rate, approach);
+        (force + damping * rate - elastic) * rate
     } else {
         0.0
     }
