@@ -24,20 +24,35 @@ impl Compact {
         modes: &[Mode],
         scratch: &mut Scratch,
     ) {
+        // Free flight and contact in functions of their own (sharing one,
+        // free flight's loop measured slower).
+        let free = self.free(modes) && f.open.iter().all(Option::is_none);
         #[cfg(target_arch = "x86_64")]
         if f.schedule.fixed.is_some() {
             // Out of the events' stretches, which it would grow.
             if std::arch::is_x86_feature_detected!("avx512f") {
                 // SAFETY: the processor has the feature the function is built for.
-                return unsafe { fixed_avx512(self, system, f, modes, scratch) };
+                return unsafe {
+                    if free {
+                        fixed_free_avx512(self, system, f, modes, scratch)
+                    } else {
+                        fixed_contact_avx512(self, system, f, modes, scratch)
+                    }
+                };
             }
             if std::arch::is_x86_feature_detected!("avx2") {
                 // SAFETY: as above.
-                return unsafe { fixed_avx2(self, system, f, modes, scratch) };
+                return unsafe {
+                    if free {
+                        fixed_free_avx2(self, system, f, modes, scratch)
+                    } else {
+                        fixed_contact_avx2(self, system, f, modes, scratch)
+                    }
+                };
             }
         }
         if f.schedule.fixed.is_some() {
-            return fixed_baseline(self, system, f, modes, scratch);
+            return fixed_baseline(self, system, f, modes, scratch, free);
         }
         #[cfg(target_arch = "x86_64")]
         {
@@ -329,7 +344,7 @@ impl Compact {
     /// the kernel to take. No pair sticks in fixed stepping (no rigid pair).
     /// `FREE`: free flight ([`Compact::free`]).
     #[inline(always)]
-    pub(crate) fn fixed_stretch<const FREE: bool>(
+    pub(crate) fn fixed_stretch<const FREE: bool, const OUTSIDE: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -360,76 +375,112 @@ impl Compact {
         let mut taken = 0;
         // The state's rooms a step writes: the rest is never read.
         let room = (2 * d + CONTACT + MAX_WALLS).min(MAX_LEN);
-        while taken < allowed {
-            debug_assert!(schedule.plain_fixed_step(&clock).is_some());
-            let time = clock.time;
-            let next = (clock.grid + 1) as f64 * dt;
-            let in_window = schedule.in_window(time, dt);
-            let cache = scratch.first_cache().copied();
-            self.step::<false, FREE>(
-                system,
-                n,
-                k,
-                time,
-                &y,
-                dt,
-                (modes, &factors),
-                scratch,
-                &mut stages,
-                false,
-                &mut end,
-            );
-            let mut plain = end[..2 * d].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
-            if FREE {
-                // No contact: none may begin (the gaps themselves are
-                // needed only where the stretch ends).
-                plain &= !self.indented(d, &end);
-            } else {
-                self.gaps(d, &end, &mut end_gaps);
-                for w in 0..count {
-                    // Indented at the end exactly where in contact: no onset
-                    // or separation in the step.
-                    plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
+        // `OUTSIDE` (free flight before the recorded window): the loop calls
+        // nothing (a call in it, even one not made, keeps the state in
+        // memory rather than in registers), so the energy balance, due every
+        // few steps, is made between runs of steps, and a step into the
+        // window is left to the kernel.
+        let mut due = None;
+        'steps: loop {
+            if let Some(check) = due.take() {
+                let copy = y;
+                let state = (&copy[..len], modes);
+                if let Err(failure) = energy.balance(system, state, check, clock.time) {
+                    f.unbalanced = Some(failure);
+                    f.limited = false;
+                    break 'steps;
                 }
             }
-            if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
-                plain = false;
-            }
-            if !plain {
-                if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
-                    *cache = saved;
+            while taken < allowed {
+                debug_assert!(schedule.plain_fixed_step(&clock).is_some());
+                let time = clock.time;
+                let next = (clock.grid + 1) as f64 * dt;
+                let in_window = schedule.in_window(time, dt);
+                if OUTSIDE && in_window {
+                    f.limited = false;
+                    break 'steps;
                 }
-                f.limited = false;
-                break;
-            }
-            for w in 0..if FREE { 0 } else { count } {
-                if let Some(oc) = f.open[w].as_mut() {
-                    let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
-                    fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
-                    // A copy: the state's address stays untaken (in registers).
-                    let at = end;
-                    fixed::press(system, w, oc, &at[..len], modes[w], dt);
+                let in_window = !OUTSIDE && in_window;
+                // The force's signal cache, to put back if the step is taken back.
+                let cache = if OUTSIDE && self.force.is_none() {
+                    None
+                } else {
+                    scratch.first_cache().copied()
+                };
+                self.step::<false, FREE>(
+                    system,
+                    n,
+                    k,
+                    time,
+                    &y,
+                    dt,
+                    (modes, &factors),
+                    scratch,
+                    &mut stages,
+                    false,
+                    &mut end,
+                );
+                let mut plain = end[..2 * d].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
+                if FREE {
+                    // No contact: none may begin (the gaps themselves are
+                    // needed only where the stretch ends).
+                    plain &= !self.indented(d, &end);
+                } else {
+                    self.gaps(d, &end, &mut end_gaps);
+                    for w in 0..count {
+                        // Indented at the end exactly where in contact: no onset
+                        // or separation in the step.
+                        plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
+                    }
+                }
+                if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
+                    plain = false;
+                }
+                if !plain {
+                    if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
+                        *cache = saved;
+                    }
+                    f.limited = false;
+                    break 'steps;
+                }
+                for w in 0..if FREE { 0 } else { count } {
+                    if let Some(oc) = f.open[w].as_mut() {
+                        let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
+                        fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+                        // A copy: the state's address stays untaken (in registers).
+                        let at = end;
+                        fixed::press(system, w, oc, &at[..len], modes[w], dt);
+                    }
+                }
+                if in_window {
+                    let kept = observed.min(f.peaks.len());
+                    widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
+                    *f.recorded_time += dt;
+                }
+                clock.plain_step_to(next);
+                taken += 1;
+                for e in 0..room {
+                    y[e] = end[e];
+                }
+                if !FREE {
+                    start_gaps = end_gaps;
+                }
+                if OUTSIDE {
+                    due = energy.due(clock.accepted, false, next);
+                    if due.is_some() {
+                        continue 'steps;
+                    }
+                } else {
+                    let state = (&y, len, modes);
+                    if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next)
+                    {
+                        f.unbalanced = Some(failure);
+                        f.limited = false;
+                        break 'steps;
+                    }
                 }
             }
-            if in_window {
-                let kept = observed.min(f.peaks.len());
-                widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
-                *f.recorded_time += dt;
-            }
-            clock.plain_step_to(next);
-            taken += 1;
-            for e in 0..room {
-                y[e] = end[e];
-            }
-            if !FREE {
-                start_gaps = end_gaps;
-            }
-            let state = (&y, len, modes);
-            if let Err(failure) = energy.after_step_of(system, state, clock.accepted, next) {
-                f.unbalanced = Some(failure);
-                f.limited = false;
-                break;
-            }
+            break;
         }
         f.steps += taken;
         f.evaluations += 4 * taken;
@@ -527,26 +578,40 @@ pub(crate) trait ArraySteps {
     fn keep(&mut self, end_rates: bool);
 }
 
-/// [`Compact::fixed_stretch`] for the system's sizes (constants in each arm).
+/// [`Compact::fixed_stretch`] in free flight for the system's sizes
+/// (constants in each arm): before the recorded window, without its code.
 #[inline(always)]
-fn fixed_sized(
+fn fixed_free_sized(
     compact: &Compact,
     system: &Assembly,
     f: &mut Stretch<'_>,
     modes: &[Mode],
     scratch: &mut Scratch,
 ) {
-    if compact.free(modes) && f.open.iter().all(Option::is_none) {
+    if f.schedule.in_window(f.clock.time, f.schedule.dt) {
         by_size!(system, |n, k| compact
-            .fixed_stretch::<true>(system, n, k, f, modes, scratch))
+            .fixed_stretch::<true, false>(system, n, k, f, modes, scratch))
     } else {
         by_size!(system, |n, k| compact
-            .fixed_stretch::<false>(system, n, k, f, modes, scratch))
+            .fixed_stretch::<true, true>(system, n, k, f, modes, scratch))
     }
 }
 
-/// [`fixed_sized`] for the baseline processor, out of line (its arms'
-/// arrays kept out of the caller's frame).
+/// [`Compact::fixed_stretch`] in contact for the system's sizes.
+#[inline(always)]
+fn fixed_contact_sized(
+    compact: &Compact,
+    system: &Assembly,
+    f: &mut Stretch<'_>,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+) {
+    by_size!(system, |n, k| compact
+        .fixed_stretch::<false, false>(system, n, k, f, modes, scratch))
+}
+
+/// The fixed stretches for the baseline processor, out of line (their
+/// arms' arrays kept out of the caller's frame).
 #[inline(never)]
 fn fixed_baseline(
     compact: &Compact,
@@ -554,11 +619,16 @@ fn fixed_baseline(
     f: &mut Stretch<'_>,
     modes: &[Mode],
     scratch: &mut Scratch,
+    free: bool,
 ) {
-    fixed_sized(compact, system, f, modes, scratch)
+    if free {
+        fixed_free_sized(compact, system, f, modes, scratch)
+    } else {
+        fixed_contact_sized(compact, system, f, modes, scratch)
+    }
 }
 
-/// [`stretch_sized`] (or [`fixed_sized`]) compiled for a processor feature.
+/// [`stretch_sized`] (or a fixed stretch's) compiled for a processor feature.
 macro_rules! stretch_with {
     ($name:ident, $sized:ident, $feature:literal) => {
         #[cfg(target_arch = "x86_64")]
@@ -576,8 +646,10 @@ macro_rules! stretch_with {
 }
 stretch_with!(stretch_avx512, stretch_sized, "avx512f");
 stretch_with!(stretch_avx2, stretch_sized, "avx2");
-stretch_with!(fixed_avx512, fixed_sized, "avx512f");
-stretch_with!(fixed_avx2, fixed_sized, "avx2");
+stretch_with!(fixed_free_avx512, fixed_free_sized, "avx512f");
+stretch_with!(fixed_free_avx2, fixed_free_sized, "avx2");
+stretch_with!(fixed_contact_avx512, fixed_contact_sized, "avx512f");
+stretch_with!(fixed_contact_avx2, fixed_contact_sized, "avx2");
 
 /// `n` values of `y` from `from`, copied: a runtime index into the state
 /// itself would keep the compact path's state in memory rather than in
