@@ -24,11 +24,12 @@ impl Compact {
         modes: &[Mode],
         scratch: &mut Scratch,
     ) {
-        // Free flight and contact in functions of their own (sharing one,
-        // free flight's loop measured slower).
-        let free = self.free(modes) && f.open.iter().all(Option::is_none);
+        // Fixed steps: free flight and contact in functions of their own
+        // (sharing one, free flight's loop measured slower).
+        let fixed = f.schedule.fixed.is_some();
+        let free = fixed && self.free(modes) && f.open.iter().all(Option::is_none);
         #[cfg(target_arch = "x86_64")]
-        if f.schedule.fixed.is_some() {
+        if fixed {
             // Out of the events' stretches, which it would grow.
             if std::arch::is_x86_feature_detected!("avx512f") {
                 // SAFETY: the processor has the feature the function is built for.
@@ -51,7 +52,7 @@ impl Compact {
                 };
             }
         }
-        if f.schedule.fixed.is_some() {
+        if fixed {
             return fixed_baseline(self, system, f, modes, scratch, free);
         }
         #[cfg(target_arch = "x86_64")]
