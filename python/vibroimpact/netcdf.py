@@ -7,8 +7,8 @@ strings are variable-length strings (read back as ``str``), booleans int8 with t
 attribute ``dtype = "bool"`` (read back as ``bool``), and numeric variables are
 compressed (gzip level :data:`COMPRESSION_LEVEL` after HDF5's byte shuffle) in chunks of
 at most :data:`CHUNK_BYTES` (:func:`chunks`: a study's metric is usually one chunk, read
-and decompressed at once). ``xr.open_dataset(path)`` opens the file with its default engine, and
-also the NetCDF 3 files of earlier versions (by SciPy, a dependency).
+and decompressed at once). ``xr.open_dataset(path)`` opens the file with its default
+engine, and also the NetCDF 3 files of earlier versions (by SciPy, a dependency).
 
 The same Dataset gives the same bytes: h5py records no creation or modification time
 (``track_times`` is off, the default it sets on every dataset) and HDF5 lays out the
@@ -27,8 +27,8 @@ from typing import Any
 from vibroimpact import arguments
 from vibroimpact.output import UsageError, written_whole
 
-#: gzip's level for the numeric variables: 4 keeps most of level 9's gain on float64
-#: metrics at a fraction of its time.
+#: gzip's level for the numeric variables: on a 200 000-run study of float64 and int64
+#: metrics, level 4 wrote 49.8 % of the raw bytes in 124 ms, level 9 49.7 % in 654 ms.
 COMPRESSION_LEVEL = 4
 
 #: The most bytes (uncompressed) in one chunk: HDF5's chunk cache holds 1 MiB per
