@@ -238,7 +238,7 @@ def test_the_netcdf_file_holds_the_dataset(tmp_path: Path) -> None:
     study = load(scenario(tmp_path, BASE + STEADY))
     out = tmp_path / "out.nc"
     ds = st.run(study, out)
-    with xr.open_dataset(out, engine="scipy") as back:
+    with xr.open_dataset(out) as back:
         assert back.attrs["input_hash"] == study.fingerprint()
         assert back.attrs["analysis"] == "steady-state"
         for name in ("status", "peak", "amplitude", "settled", "energy_dissipated"):
@@ -307,7 +307,7 @@ def test_the_study_command_writes_the_file(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     summary = json.loads(done.stdout)
     assert summary["runs"] == 12 and summary["failed"] == 0
-    with xr.open_dataset(out, engine="scipy") as ds:
+    with xr.open_dataset(out) as ds:
         assert ds["amplitude"].shape == (4, 3, 1)
 
 
@@ -552,7 +552,7 @@ def test_the_axes_carry_their_units(tmp_path: Path) -> None:
     ds = st.run(load(scenario(tmp_path, BASE + STEADY)), tmp_path / "out.nc")
     assert ds["damper.0.clearance"].attrs["units"] == "m"
     assert ds["excitation.0.frequency"].attrs["units"] == "Hz"
-    with xr.open_dataset(tmp_path / "out.nc", engine="scipy") as back:
+    with xr.open_dataset(tmp_path / "out.nc") as back:
         assert back["excitation.0.frequency"].attrs["units"] == "Hz"
 
 

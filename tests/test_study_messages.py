@@ -141,7 +141,7 @@ def test_settled_is_a_boolean_in_the_file_and_the_store_a_failed_runs_false(
         result = steady_state(runner(data), settle_periods=60, record_periods=10, tolerance=1e-6)
         point = ds.sel({"damper.0.clearance": 0.01, "excitation.0.frequency": frequency})
         assert point["settled"].item() is result.settled
-    stores = [xr.open_dataset(tmp_path / "out.nc", engine="scipy")]
+    stores = [xr.open_dataset(tmp_path / "out.nc")]
     try:
         import zarr  # noqa: F401
 

@@ -137,7 +137,7 @@ def test_seeds_differ_and_repeat_whatever_the_threads_and_chunks(
     ds = st.run(single, tmp_path / "single.nc", threads=1)
     import xarray as xr
 
-    with xr.open_dataset(whole, engine="scipy") as back:
+    with xr.open_dataset(whole) as back:
         assert back["rms"].values.tolist() == ds["rms"].values.tolist()
 
 

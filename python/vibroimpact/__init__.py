@@ -88,6 +88,7 @@ from vibroimpact.model import *  # noqa: F403  (the parts and System: model.__al
 from vibroimpact.model.load import load, loads
 from vibroimpact.model.run import TEXTS as _TEXTS
 from vibroimpact.model.run import simulate
+from vibroimpact.netcdf import write_netcdf
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
 from vibroimpact.study import study_of
 from vibroimpact.summary import to_pandas, to_xarray
@@ -177,4 +178,5 @@ __all__ = [
     "study_of",
     "to_pandas",
     "to_xarray",
+    "write_netcdf",
 ]

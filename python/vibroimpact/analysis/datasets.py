@@ -6,7 +6,8 @@ Each function takes what an analysis of :mod:`vibroimpact.analysis`,
 a ``long_name`` and, for a physical quantity, its SI ``units`` (UDUNITS spelling,
 as CF asks: ``"m"``, ``"m s-1"``, ``"rad"``, ``"1"`` for a dimensionless one).
 
-A sweep written as NetCDF::
+A sweep written as a NetCDF 4 file (:func:`vibroimpact.netcdf.write_netcdf`, also
+``vibroimpact.write_netcdf``)::
 
     import vibroimpact as vi
     from vibroimpact.analysis import sweep
@@ -14,15 +15,17 @@ A sweep written as NetCDF::
 
     data = vi.load_scenario("examples/frf_impact_damper.toml").data
     points = sweep(data, "excitation.0.frequency", [9.0, 10.0, 11.0])
-    sweep_dataset(points, "excitation.0.frequency").to_netcdf("frf.nc", engine="scipy")
+    vi.write_netcdf(sweep_dataset(points, "excitation.0.frequency"), "frf.nc")
 
-Every Dataset can be written as NetCDF3 by SciPy (``engine="scipy"``, no netCDF C
-library needed) and read back equal: numbers are float64 or int32; booleans are kept
-as ``bool`` and written by xarray as int8 with the attribute ``dtype = "bool"``
-(read back as ``bool``); strings are kept as ``str`` and written as fixed-width
-character arrays (read back as ``str``); complex Floquet multipliers are split
-into real and imaginary parts; lists of records that NetCDF attributes cannot hold
-(a basin's attractors) are a JSON string attribute.
+and read with ``xr.open_dataset("frf.nc")``. Every Dataset is written as NetCDF 4 (HDF5,
+by h5netcdf: no netCDF C library needed) and read back identical, dtypes included:
+numbers are float64 or int64, compressed in the file; booleans are kept as ``bool``
+(written by xarray as int8 with the attribute ``dtype = "bool"``, read back as ``bool``);
+strings are kept as ``str`` (variable-length strings in the file); complex Floquet
+multipliers are split into real and imaginary parts (NetCDF has no complex type);
+lists of records that NetCDF attributes cannot hold (a basin's attractors) are a JSON
+string attribute. ``Dataset.to_netcdf(path)`` with xarray's default engine writes the
+same content, uncompressed and not whole-or-nothing.
 
 State vectors use the analyses' flat state ``(x, v)``: the ``n`` structure
 coordinates' then the ``k`` dampers' displacements, then the same velocities. A
@@ -100,7 +103,7 @@ def _state_coords(size: int, n: int | None, k: int | None) -> dict[str, Any]:
 
 
 def _strings(values: Sequence[str]) -> NDArray[np.str_]:
-    """Strings as a NumPy unicode array (written as NetCDF3 characters)."""
+    """Strings as a NumPy unicode array (written as NetCDF 4 variable-length strings)."""
     return np.array(list(values), dtype=str)
 
 
@@ -273,7 +276,7 @@ def sweep_dataset(
             ),
             "coordinate": (
                 "coordinate",
-                np.arange(n, dtype=np.int32),
+                np.arange(n, dtype=np.int64),
                 _attrs("structure coordinate (index)"),
             ),
             **positions,
@@ -322,9 +325,10 @@ def bifurcation_dataset(
                 f"state), got shape {strobe.shape}"
             )
     samples = max((len(s) for s in good), default=0)
-    samples = max(samples, 1)  # a zero-length dimension is NetCDF3's unlimited one
+    # At least one sample: where every run failed each point still has its row (NaN).
+    samples = max(samples, 1)
     strobe = np.full((len(points), samples, width), np.nan)
-    counts = np.zeros(len(points), dtype=np.int32)
+    counts = np.zeros(len(points), dtype=np.int64)
     for i, p in enumerate(points):
         if p.strobe.size:
             strobe[i, : len(p.strobe)] = p.strobe
@@ -355,7 +359,7 @@ def bifurcation_dataset(
             ),
             "sample": (
                 "sample",
-                np.arange(1, samples + 1, dtype=np.int32),
+                np.arange(1, samples + 1, dtype=np.int64),
                 _attrs("forcing periods after settling", _ONE),
             ),
             **_state_coords(width, n, k),
@@ -374,8 +378,7 @@ def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
     impact section: ``impact_phase`` (rad, in [0, 2 pi) of the forcing period),
     ``impact_speed`` (m s-1, the approach speed) and ``impact_pair`` (the pair's
     name, such as ``"damper 0"``). Attributes: ``structure_coordinates`` (n) and
-    ``dampers`` (k). With no impact the ``impact`` dimension has length 0 (NetCDF3
-    writes it as its unlimited dimension)."""
+    ``dampers`` (k). With no impact the ``impact`` dimension has length 0."""
     arguments.instance("section", section, Section, "vibroimpact.analysis.poincare")
     _count("n", n, 0)
     _count("k", k, 0)
@@ -415,7 +418,7 @@ def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
         coords={
             "sample": (
                 "sample",
-                np.arange(1, len(strobe) + 1, dtype=np.int32),
+                np.arange(1, len(strobe) + 1, dtype=np.int64),
                 _attrs("forcing periods after settling", _ONE),
             ),
             **_state_coords(width, n, k),
@@ -439,7 +442,7 @@ def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
     (``result.first`` and ``result.second``), each with the attribute ``name``
     (``x_name``, ``y_name``: the state entry, such as
     ``"structure_displacement.0"``) and its ``units`` (m or m s-1, told from the
-    name). Variable ``label`` (``x`` x ``y``, int32): the attractor reached from
+    name). Variable ``label`` (``x`` x ``y``, int64): the attractor reached from
     each start, an index into the attractors; -1 where the run did not settle, -2
     where it failed, -3 where the start is not admissible; its attributes
     ``flag_values`` and ``flag_meanings`` name the negative ones (CF). Attributes:
@@ -461,10 +464,10 @@ def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
         data_vars={
             "label": (
                 ("x", "y"),
-                labels.astype(np.int32),
+                labels.astype(np.int64),
                 _attrs(
                     "attractor reached",
-                    flag_values=np.array([-3, -2, -1], dtype=np.int32),
+                    flag_values=np.array([-3, -2, -1], dtype=np.int64),
                     flag_meanings="inadmissible_start run_failed not_settled",
                     comment=_LABELS,
                 ),
@@ -579,7 +582,7 @@ def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:
             "value": _value_coord([p.value for p in points], branch.parameter, units),
             "coordinate": (
                 "coordinate",
-                np.arange(branch.n, dtype=np.int32),
+                np.arange(branch.n, dtype=np.int64),
                 _attrs("structure coordinate (index)"),
             ),
             "bifurcation": ("bifurcation", _strings(kinds), _attrs("kind of bifurcation")),

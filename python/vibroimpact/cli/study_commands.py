@@ -33,15 +33,16 @@ def add_command(sub: Any) -> None:
     """Register ``study`` on the command line's subparsers."""
     parser = sub.add_parser(
         "study",
-        help="a grid of runs varying [study.axes], metrics into a NetCDF file or Zarr store",
+        help="a grid of runs varying [study.axes], metrics into a NetCDF 4 file or Zarr store",
         description=(
             "Run every combination of the [study.axes] values of a 0.2 scenario on all "
             "cores (or --workers N), each run reduced to the [study] metrics, and write "
             "them as an xarray Dataset (one dimension per axis, a status variable, the "
-            "reasons of failed runs in its attributes) in NetCDF (--out RESULT.nc) or Zarr "
-            "(--out RESULT.zarr, needs vibroimpact[zarr]). Finished chunks are kept beside "
-            "the output (OUT.parts/): a study interrupted or killed resumes where it "
-            "stopped when run again, and gives the same file or store."
+            "reasons of failed runs in its attributes) in NetCDF 4 (--out RESULT.nc: HDF5 "
+            "by h5netcdf, 64-bit integers, strings, compressed; xr.open_dataset reads it) "
+            "or Zarr (--out RESULT.zarr, needs vibroimpact[zarr]). Finished chunks are kept "
+            "beside the output (OUT.parts/): a study interrupted or killed resumes where "
+            "it stopped when run again, and gives the same file or store."
         ),
     )
     parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [study]")
@@ -50,7 +51,7 @@ def add_command(sub: Any) -> None:
         type=Path,
         required=True,
         metavar="RESULT.nc|RESULT.zarr",
-        help="NetCDF file (.nc) or Zarr store (.zarr; needs vibroimpact[zarr]) to write",
+        help="NetCDF 4 file (.nc) or Zarr store (.zarr; needs vibroimpact[zarr]) to write",
     )
     parser.add_argument(
         "--workers",

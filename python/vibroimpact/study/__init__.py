@@ -1,6 +1,7 @@
 """Studies: a grid of runs of one 0.2 scenario with some of its parameters varied,
 run on every core by the Rust core (rayon, the GIL released), each reduced to
-metrics; the result an xarray Dataset written as a NetCDF file (``RESULT.nc``) or a Zarr
+metrics; the result an xarray Dataset written as a NetCDF 4 file (``RESULT.nc``, see
+:mod:`vibroimpact.netcdf`) or a Zarr
 store (``RESULT.zarr``, with the optional zarr package), chunk by chunk so that an
 interrupted study resumes where it stopped and gives the same file or store.
 

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact import arguments
+from vibroimpact.netcdf import write_netcdf
 from vibroimpact.output import UsageError, remove_stale, written_whole
 from vibroimpact.study.assembly import assemble
 from vibroimpact.study.grid import Study, chunk_part
@@ -54,8 +55,9 @@ def run(
     notice: Callable[[str], None] | None = None,
     resume: str = "run the same study into the same output again",
 ) -> Any:
-    """Run ``study`` into ``out``, by its suffix the NetCDF file ``RESULT.nc`` or the
-    Zarr store ``RESULT.zarr`` (needs zarr; see :func:`output_kind`), chunk by chunk:
+    """Run ``study`` into ``out``, by its suffix the NetCDF 4 file ``RESULT.nc``
+    (:func:`vibroimpact.netcdf.write_netcdf`) or the Zarr store ``RESULT.zarr`` (needs
+    zarr; see :func:`output_kind`), chunk by chunk:
     each finished chunk is kept in ``OUT.parts/`` (written whole), so a study
     interrupted or killed loses at most the chunks in flight and, run again, goes on
     where it stopped; the output is written whole at the end (the same file or store as
@@ -137,8 +139,7 @@ def run(
         if kind == ".zarr":
             _write_zarr(dataset, out)
         else:
-            with written_whole(out, binary=True) as f:
-                f.write(dataset.to_netcdf(engine="scipy"))
+            write_netcdf(dataset, out)
     except BaseException as stop:
         if any(path.exists() for path in path_of):
             stop.add_note(

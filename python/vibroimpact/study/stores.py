@@ -1,4 +1,4 @@
-"""Where a study is written: its output's kind (a NetCDF file or a Zarr store) checked
+"""Where a study is written: its output's kind (a NetCDF 4 file or a Zarr store) checked
 before it runs, and a Zarr store written whole or not at all."""
 
 from __future__ import annotations
@@ -10,22 +10,26 @@ from pathlib import Path
 from typing import Any
 
 from vibroimpact import arguments
+from vibroimpact.netcdf import netcdf4_missing
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in
 
 # What a study's output may end in, and what each suffix writes.
-OUTPUTS = {".nc": "a NetCDF file", ".zarr": "a Zarr store"}
+OUTPUTS = {".nc": "a NetCDF 4 file", ".zarr": "a Zarr store"}
 
 
 def output_kind(out: Path) -> str:
     """The suffix of ``out`` that decides its format (``.nc`` or ``.zarr``), checked
-    before a study runs: another suffix, a Zarr store without the zarr package, or a
-    ``.zarr`` path that holds something other than a Zarr store (which the store
+    before a study runs: another suffix, a NetCDF file without h5netcdf and h5py (see
+    :func:`vibroimpact.netcdf.netcdf4_missing`), a Zarr store without the zarr package,
+    or a ``.zarr`` path that holds something other than a Zarr store (which the store
     would replace) raise :class:`UsageError`."""
     out = arguments.path("out", out)
     kind = out.suffix.lower()
     if kind not in OUTPUTS:
         allowed = " or ".join(f"{suffix} ({what})" for suffix, what in OUTPUTS.items())
         raise UsageError(f"--out {out}: must end in {allowed}")
+    if kind == ".nc" and (missing := netcdf4_missing()) is not None:
+        raise UsageError(f"--out {out}: {missing}")
     if kind == ".zarr":
         try:
             importlib.import_module("zarr")
