@@ -12,7 +12,7 @@ from typing import Any
 from vibroimpact import arguments
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in
 
-# What a study's output may end in, and what each suffix writes.
+#: What a study's output may end in, and what each suffix writes.
 OUTPUTS = {".nc": "a NetCDF file", ".zarr": "a Zarr store"}
 
 
