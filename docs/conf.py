@@ -38,6 +38,8 @@ html_theme = "alabaster"
 html_theme_options = {"description": vibroimpact.__doc__.splitlines()[0].split(": ", 1)[1]}
 # MathJax is loaded by the reader's browser from its CDN; the build downloads nothing.
 templates_path: list[str] = []
+# Quotes stay as written: the scenario values they enclose are TOML strings.
+smartquotes = False
 
 nitpicky = True
 # Types of other packages and typing's private aliases: documented elsewhere, not here.

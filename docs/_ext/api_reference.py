@@ -66,15 +66,26 @@ class PublicApi(SphinxDirective):
             if kind == "data":
                 text = comments.get(attr)
                 if not text:
-                    LOG.warning("public name %s has no #: comment", qualified, location=self.get_location())
+                    LOG.warning(
+                        "public name %s has no #: comment", qualified, location=self.get_location()
+                    )
                     text = ""
                 value = repr(obj)
                 if len(value) > 60:
                     value = f"{type(obj).__name__} (see the text)"
-                lines += [f".. py:data:: {qualified}", f"   :value: {value}", "", f"   {text}", ""]
+                lines += [
+                    f".. py:data:: {attr}",
+                    f"   :module: {name}",
+                    f"   :value: {value}",
+                    "",
+                    f"   {text}",
+                    "",
+                ]
                 continue
             if not inspect.getdoc(obj):
-                LOG.warning("public name %s has no docstring", qualified, location=self.get_location())
+                LOG.warning(
+                    "public name %s has no docstring", qualified, location=self.get_location()
+                )
             documented[id(obj)] = qualified
             if kind == "class":
                 lines += [f".. autoclass:: {qualified}", "   :members:", ""]
@@ -107,7 +118,9 @@ def resolve_short_name(
     entry = domain.objects[names[0]]
     from sphinx.util.nodes import make_refnode
 
-    return make_refnode(app.builder, node["refdoc"], entry.docname, entry.node_id, contnode, names[0])
+    return make_refnode(
+        app.builder, node["refdoc"], entry.docname, entry.node_id, contnode, names[0]
+    )
 
 
 def setup(app: Sphinx) -> dict[str, Any]:

@@ -55,14 +55,26 @@ def _argument(action: argparse.Action, parser: argparse.ArgumentParser) -> list[
 
 def _command(title: str, parser: argparse.ArgumentParser) -> list[str]:
     usage = parser.format_usage().removeprefix("usage: ").strip()
-    lines = [title, "-" * len(title), "", _escaped(parser.description or ""), "", ".. code-block:: text", ""]
+    lines = [
+        title,
+        "-" * len(title),
+        "",
+        _escaped(parser.description or ""),
+        "",
+        ".. code-block:: text",
+        "",
+    ]
     lines += ["   " + line for line in usage.splitlines()] + [""]
     for action in parser._actions:
         if isinstance(action, argparse._HelpAction | argparse._SubParsersAction):
             continue
         lines += _argument(action, parser)
     if parser.epilog:
-        lines += [".. code-block:: text", ""] + ["   " + line for line in parser.epilog.splitlines()] + [""]
+        lines += (
+            [".. code-block:: text", ""]
+            + ["   " + line for line in parser.epilog.splitlines()]
+            + [""]
+        )
     return lines
 
 

@@ -65,7 +65,13 @@ class RunCommand(SphinxDirective):
                     argv, cwd=work, capture_output=True, text=True, timeout=300, check=False
                 )
                 if done.returncode != 0:
-                    LOG.warning("%s: exit %d: %s", command, done.returncode, done.stderr, location=self.get_location())
+                    LOG.warning(
+                        "%s: exit %d: %s",
+                        command,
+                        done.returncode,
+                        done.stderr,
+                        location=self.get_location(),
+                    )
                 printed += [f"$ {command}", done.stdout.rstrip()]
         code = "\n".join(self.content)
         return _blocks(code, "sh", "\n".join(printed))

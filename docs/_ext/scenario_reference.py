@@ -42,7 +42,7 @@ def _default(value: Any, required: object) -> str:
 def _system_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
     """Section -> (how it is written, key -> (type, default)) of the systems' schema."""
     structure: dict[str, tuple[str, Any]] = {"kind": ("string", schema._REQ)}
-    for kind, keys in schema._STRUCTURE.items():
+    for keys in schema._STRUCTURE.values():
         for key, (kind_type, default) in keys.items():
             shown = default if key not in structure else structure[key][1]
             structure[key] = (kind_type, shown)
@@ -90,7 +90,13 @@ def _table(
     for section, (written, keys) in sections.items():
         texts = described.get(section, {})
         for extra in sorted(set(texts) - set(keys)):
-            LOG.warning("%s %s.%s: described but not in the schema", title, section, extra, location=location)
+            LOG.warning(
+                "%s %s.%s: described but not in the schema",
+                title,
+                section,
+                extra,
+                location=location,
+            )
         lines += [
             f"``{written}``",
             "~" * (len(written) + 4),
@@ -108,7 +114,13 @@ def _table(
         ]
         for key, (kind, default) in keys.items():
             if key not in texts:
-                LOG.warning("%s %s.%s: no description in scenario_keys", title, section, key, location=location)
+                LOG.warning(
+                    "%s %s.%s: no description in scenario_keys",
+                    title,
+                    section,
+                    key,
+                    location=location,
+                )
                 unit, allowed, meaning = None, None, ""
             else:
                 unit, allowed, meaning = texts[key]
@@ -130,7 +142,9 @@ class ScenarioFormat(SphinxDirective):
 
     def run(self) -> list[nodes.Node]:
         if self.arguments[0] == "two-mass":
-            lines = _table("two-mass", _two_mass_sections(), TWO_MASS, two_mass._REQUIRED, self.get_location())
+            lines = _table(
+                "two-mass", _two_mass_sections(), TWO_MASS, two_mass._REQUIRED, self.get_location()
+            )
         else:
             lines = _table("system", _system_sections(), SYSTEM, schema._REQ, self.get_location())
         node = nodes.section()

@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt
 
 import vibroimpact as vi
 
+# The gallery runs from docs/gallery_src; the scenarios are in the repository's examples/.
 EXAMPLES = Path.cwd().parents[1] / "examples"
 system = vi.load(EXAMPLES / "bouncing_ball.toml")
 sol = vi.simulate(system)
