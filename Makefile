@@ -1,11 +1,12 @@
 # Verbs for a newcomer. `make test` is the README's test command.
-.PHONY: help install test lint bench paper
+.PHONY: help install test lint bench paper docs
 help:
 	@echo "make install  - pip install the package with its test tools"
 	@echo "make test     - every test, Rust and Python (what .ci/run runs)"
 	@echo "make lint     - cargo fmt/clippy, ruff, mypy, stubtest"
 	@echo "make bench    - throughput and call overhead benchmarks"
 	@echo "make paper    - reproduce the founding paper into paper-results/"
+	@echo "make docs     - the documentation site into docs/_build/html (warnings are errors)"
 
 install:
 	pip install ".[test]"
@@ -30,3 +31,6 @@ bench:
 
 paper:
 	vibroimpact paper
+
+docs:
+	python -m sphinx -W --keep-going -b html docs docs/_build/html

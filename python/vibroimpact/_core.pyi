@@ -46,22 +46,35 @@ __all__ = [
     "run_study",
 ]
 
+#: The package's version, as in pyproject.toml.
 __version__: str
+#: The default ``max_rows``: the most history rows plus contacts a run may keep (2e7).
 DEFAULT_MAX_ROWS: int
+#: The most bytes all that a run keeps (history, stroboscopic states, contacts) may take
+#: (2 GiB).
 MAX_RECORD_BYTES: int
+#: The most samples a signal (a recorded one's, or a scenario's array) may hold.
 MAX_SIGNAL_SAMPLES: int
+#: The default ``energy_tolerance``: the relative miss allowed in a run's energy balance.
 DEFAULT_ENERGY_TOLERANCE: float
+#: The range ``[low, high]`` of ``rtol`` of the adaptive methods (dimensionless).
 RTOL_RANGE: tuple[float, float]
+#: The largest ``atol`` of the adaptive methods (m and m/s); it must be above 0.
 ATOL_MAX: float
+#: The largest ``energy_tolerance``: a residual as large as all the energy in play.
 MAX_ENERGY_TOLERANCE: float
+#: The most dampers and stops a system may have in all.
 MAX_PAIRS: int
+#: The most ``[output]`` points and moments a run may follow.
 MAX_POINTS: int
-# The core's registry: method -> {"kind", "steppings", "options": {name: {"default",
-# "low", "high", "low_open", "allowed"}}}; METHOD_OPTIONS: every run's options.
+#: The core's registry: method -> {"kind", "steppings", "options": {name: {"default",
+#: "low", "high", "low_open", "allowed"}}}.
 METHODS: dict[str, dict[str, Any]]
+#: Every run's options, as in :data:`METHODS`: name -> {"default", "low", "high",
+#: "low_open", "allowed"}.
 METHOD_OPTIONS: dict[str, dict[str, Any]]
-# Each model kind's ("two-mass", "system") defaults: {"method", "fixed_by_default",
-# "contact_timing"}.
+#: Each model kind's ("two-mass", "system") defaults: {"method", "fixed_by_default",
+#: "contact_timing"}.
 RUN_DEFAULTS: dict[str, dict[str, Any]]
 
 _FloatArray = npt.NDArray[np.float64]

@@ -177,7 +177,7 @@ def history_dataset(sol: Any) -> Any:
 
 
 def to_pandas(contacts: Any) -> Any:
-    """A contact table as a ``pandas.DataFrame`` (see :func:`contacts_frame`): the
+    """A contact table as a ``pandas.DataFrame`` (see ``contacts_frame``): the
     two-mass run's ``sol.contacts`` (a ``ContactTable``, compiled, without methods of
     Python's) as a 0.2 run's ``sol.contacts.to_pandas()``."""
     if not hasattr(contacts, "columns") or not hasattr(contacts, "to_dicts"):
@@ -188,7 +188,7 @@ def to_pandas(contacts: Any) -> Any:
 
 
 def to_xarray(sol: Any) -> Any:
-    """A run's history as an ``xarray.Dataset`` (see :func:`history_dataset`): the
+    """A run's history as an ``xarray.Dataset`` (see ``history_dataset``): the
     two-mass run's ``Solution`` as a 0.2 run's ``sol.to_xarray()``."""
     if not hasattr(sol, "t") or not hasattr(sol, "contacts"):
         raise InvalidInputError(

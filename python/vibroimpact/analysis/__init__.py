@@ -20,7 +20,7 @@ xarray Datasets in :mod:`~vibroimpact.analysis.datasets` and as plots in
 :mod:`~vibroimpact.analysis.plots` (neither imported here: xarray and matplotlib load on use).
 """
 
-from vibroimpact.analysis.continuation import Branch, continue_orbit
+from vibroimpact.analysis.continuation import Branch, BranchPoint, continue_orbit
 from vibroimpact.analysis.limits import (
     MAX_PERIODS,
     MAX_POINTS,
@@ -76,6 +76,7 @@ __all__ = [
     "Basins",
     "BifurcationPoint",
     "Branch",
+    "BranchPoint",
     "MAX_PERIODS",
     "MAX_POINTS",
     "MAX_STARTS",

@@ -55,7 +55,7 @@ class BranchPoint:
     #: parameter at which the crossing multiplier's modulus reaches 1 (bisection along
     #: the arc), or at which the parameter turns (a fold: where the stability changes
     #: there, so located; otherwise the extremum of its cubic along the arc, see
-    #: :func:`vibroimpact.analysis.crossings._fold`).
+    #: ``vibroimpact.analysis.crossings._fold``).
     crossings: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:

@@ -28,8 +28,8 @@ class Orbit:
     iterations: int
     residual: float
     monodromy: np.ndarray = field(repr=False)
-    #: The largest |displacement| (m) on the orbit at each of ``[output] points``, and
-    #: |bending moment| (N m) at each of ``[output] moments``.
+    #: The largest ``|displacement|`` (m) on the orbit at each of ``[output] points``, and
+    #: ``|bending moment|`` (N m) at each of ``[output] moments``.
     point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
 

@@ -178,7 +178,7 @@ class Runner:
         return self._run(state, count * self.period, record=record, strobe=strobe)
 
     def map(self, state: np.ndarray, count: int) -> np.ndarray:
-        """The stroboscopic map over ``count`` periods, run :data:`SETTLE_CHUNK` periods
+        """The stroboscopic map over ``count`` periods, run ``SETTLE_CHUNK`` periods
         at a time: a run keeps its contacts, which settling never reads (ten million
         periods of a bouncing ball had kept 20 million, 1.6 GB, up to the row limit)."""
         check_periods("", "count", whole_count("count", count, 1), 1)
@@ -246,7 +246,7 @@ PROBE_PERIODS = 1000
 
 def check_kept(run: Runner, state: np.ndarray, count: int, name: str) -> None:
     """Refuse up front a recording of ``count`` periods from ``state`` whose contacts,
-    at the rate of its first :data:`PROBE_PERIODS`, would pass ``[solver] max_rows``
+    at the rate of its first ``PROBE_PERIODS``, would pass ``[solver] max_rows``
     (``poincare --settle 0 --periods 10000000`` of a bouncing ball had run 15 s into
     1.2 GB before the row limit stopped it). ``name`` is the count's name."""
     if count < 10 * PROBE_PERIODS:

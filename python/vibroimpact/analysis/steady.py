@@ -59,7 +59,7 @@ def _recorded_by_period(
 @dataclass
 class SteadyState:
     """A steady response (SI units): per structure coordinate the located
-    ``amplitude`` (largest |displacement|, m) and ``rms`` (m) over the recorded
+    ``amplitude`` (largest ``|displacement|``, m) and ``rms`` (m) over the recorded
     periods, and the same of the structure at each of ``[output] points``
     (``point_amplitude``, ``point_rms``); ``impacts_per_period``; ``settled`` and the
     ``period`` (in forcing periods) after which the stroboscopic state repeats, or

@@ -39,6 +39,7 @@ _ANALYSIS_METRICS = {
     "steady-state": _STEADY_METRICS,
     "orbit": ("amplitude", "impacts_per_period", "stable", "largest_multiplier"),
 }
+#: Every metric a study can keep (each analysis keeps some of them).
 METRICS = (*_STEADY_METRICS, "stable", "largest_multiplier")
 _ANALYSES = tuple(_ANALYSIS_METRICS)
 _STUDY = {

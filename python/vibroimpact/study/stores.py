@@ -13,7 +13,7 @@ from vibroimpact import arguments
 from vibroimpact.netcdf import netcdf4_missing
 from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in
 
-# What a study's output may end in, and what each suffix writes.
+#: What a study's output may end in, and what each suffix writes.
 OUTPUTS = {".nc": "a NetCDF 4 file", ".zarr": "a Zarr store"}
 
 

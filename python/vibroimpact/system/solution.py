@@ -115,7 +115,7 @@ class SystemSolution:
     grazing_contacts: int
     method: str
     pairs: list[str] = field(default_factory=list)
-    #: Per structure coordinate, from ``record_from`` on: the largest |displacement|
+    #: Per structure coordinate, from ``record_from`` on: the largest ``|displacement|``
     #: (m, located where the velocity changes sign or at an impact) and the RMS (m);
     #: NaN where nothing was recorded (no ``record_from``).
     peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -129,13 +129,13 @@ class SystemSolution:
     structure: dict[str, Any] = field(default_factory=dict)
     #: The points ``[output] points`` follows (as a damper's ``at``: m from a
     #: cantilever's clamp, or a coordinate index), and from ``record_from`` on the
-    #: largest |displacement| (m, located) and the RMS (m) of the structure at each;
+    #: largest ``|displacement|`` (m, located) and the RMS (m) of the structure at each;
     #: NaN where nothing was recorded.
     points: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
     point_rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: The positions along a cantilever (m from the clamp) ``[output] moments``
-    #: follows, and from ``record_from`` on the largest |bending moment| (N m) and its
+    #: follows, and from ``record_from`` on the largest ``|bending moment|`` (N m) and its
     #: RMS (N m) at each.
     moments: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))

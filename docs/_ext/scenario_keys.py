@@ -1,0 +1,217 @@
+"""What each scenario key means, for the format reference (``scenario_reference``).
+
+The keys, their types, defaults and the solver's ranges come from the code (the schemas in
+``vibroimpact.system.schema`` and ``vibroimpact.scenario.two_mass``, the core registry
+``vibroimpact.METHOD_OPTIONS``, the units of ``vibroimpact.analysis.units``). This table adds
+the meaning, and the unit and range where the code holds none. The build fails on a key of
+a schema missing here, on an entry here that no schema has, and on a unit here that differs
+from the code's: so the reference cannot drift from the format.
+
+section -> key -> (unit or None, range or None, meaning).
+"""
+
+from __future__ import annotations
+
+_LAW = {
+    "law": (None, None, "the contact law"),
+    "stiffness": (
+        'N m-1.5 (N m-1 for "linear")',
+        "> 0",
+        'the compliant law\'s stiffness K_hz (k1 for "linear"); not for "rigid"',
+    ),
+    "restitution": (
+        "1",
+        '[0, 1] for "rigid", (0, 1] for "hyster-hertz" and "hertz-damped"',
+        "Newton's coefficient e (\"rigid\") or the compliant law's target rebound ratio",
+    ),
+    "damping": ("N s m-1", ">= 0", "the contact damper c1 (compliant laws only)"),
+}
+_POINT = "a coordinate index, or m from the clamp along a cantilever"
+_SOLVER = {
+    "method": (None, None, "the integration method"),
+    "dt": ("s", "> 0", "the step of the fixed-step methods, the first step of the adaptive"),
+    "t_end": ("s", "> 0", "the end of the run (fixed steps: rounded up to whole steps)"),
+    "stepping": (
+        None,
+        '"fixed" or "events"',
+        '"events" locates every contact to round-off; "fixed" (the fixed-step methods, '
+        "compliant laws) does not cut steps at contacts",
+    ),
+    "beta": (None, None, "Newmark's beta"),
+    "gamma": (None, None, "Newmark's gamma"),
+    "spectral_radius": (None, None, "generalized-alpha's high-frequency spectral radius"),
+    "rtol": (None, None, "the adaptive methods' relative tolerance"),
+    "atol": ("m and m s-1", None, "the adaptive methods' absolute tolerance"),
+    "max_steps": (None, None, "the most steps a run may take"),
+    "contact_timing": (
+        None,
+        '"located" or "step-count"',
+        "fixed stepping: contact instants located inside the step, or counted in whole steps "
+        "as the founding paper did",
+    ),
+    "energy_tolerance": (
+        "1",
+        "(0, 1]",
+        "the relative miss allowed in the run's energy balance",
+    ),
+    "max_rows": ("1", ">= 1", "the most history rows plus contacts a run may keep"),
+}
+_OUTPUT = {
+    "every": ("1", ">= 1", "keep every N-th step of the history"),
+    "history": (None, "true or false", "false keeps no history at all"),
+}
+
+TWO_MASS = {
+    "system": {
+        "main_mass": ("kg", "> 0", "M, the main mass"),
+        "stiffness": ("N m-1", "> 0", "K, the main spring"),
+        "damping": ("N s m-1", ">= 0", "C, the main damper"),
+        "impact_mass": ("kg", "> 0", "m, the loose impact mass"),
+        "clearance": ("m", ">= 0", "d, the clearance on each side of the impact mass"),
+    },
+    "contact": {
+        **_LAW,
+        "law": (None, '"hertz", "hyster-hertz", "hertz-damped" or "linear"', "the contact law"),
+        "restitution": (
+            "1",
+            '(0, 1]; required by "hyster-hertz" and "hertz-damped" only',
+            "the law's restitution e",
+        ),
+    },
+    "initial": {
+        "main_displacement": ("m", None, "w at t = 0"),
+        "main_velocity": ("m s-1", None, "w' at t = 0"),
+        "impact_displacement": ("m", None, "y at t = 0"),
+        "impact_velocity": ("m s-1", None, "y' at t = 0"),
+    },
+    "solver": _SOLVER,
+    "output": _OUTPUT,
+}
+
+SYSTEM = {
+    "structure": {
+        "kind": (None, '"oscillator", "matrices" or "cantilever"', "the kind of structure"),
+        "mass": (
+            "kg",
+            "> 0; matrices: symmetric positive definite",
+            "the oscillator's mass, or the mass matrix (an array of rows)",
+        ),
+        "stiffness": (
+            "N m-1",
+            ">= 0; matrices: symmetric positive semi-definite",
+            "the oscillator's spring, or the stiffness matrix",
+        ),
+        "damping": (
+            "N s m-1",
+            ">= 0; matrices: symmetric positive semi-definite (default zeros)",
+            "the oscillator's damper, or the damping matrix",
+        ),
+        "length": ("m", "> 0", "the cantilever's length"),
+        "youngs_modulus": ("Pa", "> 0", "Young's modulus E"),
+        "second_moment": ("m4", "> 0", "the second moment of area I of the section"),
+        "mass_per_length": ("kg m-1", "> 0", "the mass per unit length"),
+        "modes": ("1", "[1, 200]", "the modes kept (modal coordinates)"),
+        "damping_ratio": ("1", ">= 0", "every mode's damping ratio"),
+    },
+    "damper": {
+        "mass": ("kg", "> 0", "the loose mass"),
+        "at": (None, _POINT, "the point it rattles against"),
+        "clearance": ("m", ">= 0", "the clearance on each side"),
+        "lower_clearance": ("m", ">= 0", "the clearance below (instead of clearance)"),
+        "upper_clearance": ("m", ">= 0", "the clearance above (instead of clearance)"),
+        **_LAW,
+        "law": (
+            None,
+            '"rigid", "hertz", "hyster-hertz", "hertz-damped" or "linear"',
+            "the contact law",
+        ),
+    },
+    "stop": {
+        "at": (None, _POINT, "the point that hits the stop"),
+        "side": (
+            None,
+            '"upper" or "lower"',
+            '"upper" keeps the point at or below +gap, "lower" at or above -gap',
+        ),
+        "gap": ("m", None, "the distance to the stop"),
+        "against": (
+            None,
+            _POINT,
+            "a second point that carries the stop, so that the two pound on each other",
+        ),
+        **_LAW,
+        "law": (
+            None,
+            '"rigid", "hertz", "hyster-hertz", "hertz-damped" or "linear"',
+            "the contact law",
+        ),
+    },
+    "gravity": {"acceleration": ("m s-2", ">= 0", "along -x, on every mass")},
+    "excitation": {
+        "kind": (
+            None,
+            '"force" or "base"',
+            "a force at a point, or a support acceleration (every coordinate is relative to "
+            "the base)",
+        ),
+        "at": (None, _POINT, 'the point a force acts at (kind "force" only)'),
+        "signal": (
+            None,
+            '"harmonic", "sweep", "harmonics", "recorded", "white-noise" or "kanai-tajimi"',
+            "the signal's shape",
+        ),
+        "amplitude": (
+            "N (force) or m s-2 (base)",
+            None,
+            '"harmonic": amplitude cos(2 pi frequency t + phase); "sweep" likewise',
+        ),
+        "frequency": ("Hz", "> 0", '"harmonic"\'s frequency'),
+        "phase": ("rad", None, '"harmonic" and "sweep" (default 0)'),
+        "start_frequency": ("Hz", "> 0", '"sweep"\'s frequency at t = 0'),
+        "end_frequency": ("Hz", "> 0", '"sweep"\'s frequency at its duration'),
+        "duration": (
+            "s",
+            "> 0",
+            '"sweep", "white-noise", "kanai-tajimi": how long (default t_end)',
+        ),
+        "sweep": (None, '"linear" or "logarithmic"', '"sweep"\'s law of frequency'),
+        "amplitudes": ("N (force) or m s-2 (base)", None, '"harmonics": one per term'),
+        "frequencies": ("Hz", "> 0", '"harmonics": one per amplitude'),
+        "phases": ("rad", None, '"harmonics": one per amplitude (default 0)'),
+        "file": (
+            None,
+            "a CSV of time and value, at most 64 MiB",
+            '"recorded": read relative to the scenario',
+        ),
+        "time": ("s", "increasing strictly, at least two", '"recorded": the sample times'),
+        "value": ("N (force) or m s-2 (base)", None, '"recorded": the samples'),
+        "scale": ("1", None, '"recorded": a factor on every value (default 1)'),
+        "intensity": (
+            "N2 s (force) or m2 s-3 (base)",
+            ">= 0",
+            '"white-noise", "kanai-tajimi": two-sided spectral density S0 per rad/s',
+        ),
+        "cutoff_frequency": ("Hz", "> 0", "random signals: the band's upper end"),
+        "ground_frequency": ("Hz", "> 0", '"kanai-tajimi": the ground filter\'s frequency'),
+        "ground_damping": ("1", "> 0", '"kanai-tajimi": the ground filter\'s damping ratio'),
+        "seed": ("1", "a whole number", "random signals: the same seed, the same samples"),
+    },
+    "initial": {
+        "structure_displacement": ("m", None, "the structure's coordinates at t = 0 (zeros)"),
+        "structure_velocity": ("m s-1", None, "their rates at t = 0 (zeros)"),
+        "damper_displacement": ("m", None, "each loose mass's own displacement (zeros)"),
+        "damper_velocity": ("m s-1", None, "each loose mass's velocity (zeros)"),
+    },
+    "solver": _SOLVER,
+    "output": {
+        **_OUTPUT,
+        "record_from": ("s", ">= 0", "keep the history, contacts and reductions from this time"),
+        "strobe_period": ("s", "> 0", "keep the state once every period (Poincare section)"),
+        "points": (None, _POINT, "structure points whose displacement every reduction follows"),
+        "moments": (
+            "m",
+            "[0, length], a cantilever only",
+            "positions from the clamp whose bending moment E I w'' (N m) every reduction follows",
+        ),
+    },
+}

@@ -1,0 +1,158 @@
+"""``.. scenario-format::``: every section and key of the scenario files, from the code.
+
+Two tables per format: the two-mass damper's (``[system]``, ``[contact]``, ...; the schema of
+``vibroimpact.scenario.two_mass``) and the systems' (``[structure]``, ``[[damper]]``, ...;
+``vibroimpact.system.schema``). Types and defaults are the schemas', the solver's ranges the
+core registry's (``vibroimpact.METHOD_OPTIONS``), the choices of ``method`` the registry's
+names, units those of ``vibroimpact.analysis.units`` where it knows them; ``scenario_keys``
+adds meanings. A key without a description, a description of no key or a unit that differs
+from the code's is a warning (an error under ``-W``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from docutils import nodes
+from docutils.statemachine import StringList
+from scenario_keys import SYSTEM, TWO_MASS
+from sphinx.application import Sphinx
+from sphinx.util import logging
+from sphinx.util.docutils import SphinxDirective
+from sphinx.util.nodes import nested_parse_with_titles
+
+import vibroimpact as vi
+from vibroimpact.analysis.units import parameter_units
+from vibroimpact.scenario import two_mass
+from vibroimpact.system import schema
+
+LOG = logging.getLogger(__name__)
+
+
+def _default(value: Any, required: object) -> str:
+    if value is required:
+        return "required"
+    if value is None or value == ():
+        return "—"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return f"``{value!r}``".replace("'", '"')
+
+
+def _system_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
+    """Section -> (how it is written, key -> (type, default)) of the systems' schema."""
+    structure: dict[str, tuple[str, Any]] = {"kind": ("string", schema._REQ)}
+    for keys in schema._STRUCTURE.values():
+        for key, (kind_type, default) in keys.items():
+            shown = default if key not in structure else structure[key][1]
+            structure[key] = (kind_type, shown)
+    return {
+        "structure": ("[structure]", structure),
+        "damper": ("[[damper]]", schema._DAMPER),
+        "stop": ("[[stop]]", schema._STOP),
+        "gravity": ("[gravity]", schema._GRAVITY),
+        "excitation": ("[[excitation]]", schema._EXCITATION),
+        "initial": ("[initial]", schema._INITIAL),
+        "solver": ("[solver]", schema._SOLVER),
+        "output": ("[output]", schema._OUTPUT),
+    }
+
+
+def _two_mass_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
+    return {name: (f"[{name}]", keys) for name, keys in two_mass._SCHEMA.items()}
+
+
+def _allowed(section: str, key: str, written: str | None) -> str:
+    """The range or choices of a key: the core registry's where it has them."""
+    if section == "solver" and key == "method":
+        return ", ".join(f'"{name}"' for name in vi.METHODS)
+    if section == "solver" and key in vi.METHOD_OPTIONS:
+        return str(vi.METHOD_OPTIONS[key]["allowed"])
+    return written or ""
+
+
+def _unit(section: str, key: str, written: str | None, where: str) -> str:
+    """The code's unit of a key (``vibroimpact.analysis.units``), else the table's."""
+    code = parameter_units(f"{section}.{key}")
+    if code is not None and written is not None and code != written:
+        LOG.warning("%s: the unit %r differs from the code's %r", where, written, code)
+    return code or written or ""
+
+
+def _table(
+    title: str,
+    sections: dict[str, tuple[str, dict[str, tuple[str, Any]]]],
+    described: dict[str, dict[str, tuple[str | None, str | None, str]]],
+    required: object,
+    location: Any,
+) -> list[str]:
+    lines: list[str] = []
+    for section, (written, keys) in sections.items():
+        texts = described.get(section, {})
+        for extra in sorted(set(texts) - set(keys)):
+            LOG.warning(
+                "%s %s.%s: described but not in the schema",
+                title,
+                section,
+                extra,
+                location=location,
+            )
+        lines += [
+            f"``{written}``",
+            "~" * (len(written) + 4),
+            "",
+            ".. list-table::",
+            "   :header-rows: 1",
+            "   :widths: 16 10 12 12 22 28",
+            "",
+            "   * - key",
+            "     - type",
+            "     - default",
+            "     - unit (SI)",
+            "     - allowed",
+            "     - meaning",
+        ]
+        for key, (kind, default) in keys.items():
+            if key not in texts:
+                LOG.warning(
+                    "%s %s.%s: no description in scenario_keys",
+                    title,
+                    section,
+                    key,
+                    location=location,
+                )
+                unit, allowed, meaning = None, None, ""
+            else:
+                unit, allowed, meaning = texts[key]
+            where = f"{title} {section}.{key}"
+            lines += [
+                f"   * - ``{key}``",
+                f"     - {kind}",
+                f"     - {_default(default, required)}",
+                f"     - {_unit(section, key, unit, where) or '—'}",
+                f"     - {_allowed(section, key, allowed) or '—'}",
+                f"     - {meaning}",
+            ]
+        lines.append("")
+    return lines
+
+
+class ScenarioFormat(SphinxDirective):
+    required_arguments = 1  # "two-mass" or "system"
+
+    def run(self) -> list[nodes.Node]:
+        if self.arguments[0] == "two-mass":
+            lines = _table(
+                "two-mass", _two_mass_sections(), TWO_MASS, two_mass._REQUIRED, self.get_location()
+            )
+        else:
+            lines = _table("system", _system_sections(), SYSTEM, schema._REQ, self.get_location())
+        node = nodes.section()
+        node.document = self.state.document
+        nested_parse_with_titles(self.state, StringList(lines, source="<scenario schema>"), node)
+        return node.children
+
+
+def setup(app: Sphinx) -> dict[str, Any]:
+    app.add_directive("scenario-format", ScenarioFormat)
+    return {"parallel_read_safe": True, "version": "1"}
