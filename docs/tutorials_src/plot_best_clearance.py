@@ -23,7 +23,6 @@ import tempfile
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 import vibroimpact as vi
 import vibroimpact.study
@@ -60,22 +59,29 @@ amplitude = result["amplitude"].sel(coordinate=0)
 worst = amplitude.max("excitation.0.frequency")
 best_clearance = float(worst.idxmin("damper.0.clearance"))
 bare_worst = float(worst.sel({"damper.0.clearance": 0.050}))
-print(f"best clearance {1e3 * best_clearance:.0f} mm: worst amplitude "
-      f"{1e3 * float(worst.min()):.2f} mm against {1e3 * bare_worst:.2f} mm bare")
+print(
+    f"best clearance {1e3 * best_clearance:.0f} mm: worst amplitude "
+    f"{1e3 * float(worst.min()):.2f} mm against {1e3 * bare_worst:.2f} mm bare"
+)
 
 fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8), layout="constrained")
 mesh = left.pcolormesh(
-    result["excitation.0.frequency"], 1e3 * result["damper.0.clearance"][:-1],
-    1e3 * amplitude[:-1], shading="nearest", cmap="viridis",
+    result["excitation.0.frequency"],
+    1e3 * result["damper.0.clearance"][:-1],
+    1e3 * amplitude[:-1],
+    shading="nearest",
+    cmap="viridis",
 )
 fig.colorbar(mesh, ax=left, label="amplitude (mm)")
-left.set(xlabel="forcing frequency (Hz)", ylabel="clearance (mm)",
-         title="Steady amplitude")
+left.set(xlabel="forcing frequency (Hz)", ylabel="clearance (mm)", title="Steady amplitude")
 right.plot(1e3 * worst["damper.0.clearance"][:-1], 1e3 * worst[:-1], "o-")
 right.axhline(1e3 * bare_worst, ls="--", color="0.5", label="no impacts (50 mm)")
 right.axvline(1e3 * best_clearance, color="tab:red", lw=0.8, label="best")
-right.set(xlabel="clearance (mm)", ylabel="worst amplitude over 9-11 Hz (mm)",
-          title="Worst case over the band")
+right.set(
+    xlabel="clearance (mm)",
+    ylabel="worst amplitude over 9-11 Hz (mm)",
+    title="Worst case over the band",
+)
 right.legend()
 
 # %%

@@ -21,6 +21,7 @@ installed). From the command line the same is
 # The impact damper of the first tutorials, its steady amplitude over its clearance and
 # the forcing frequency: 6 x 12 = 72 runs in chunks of 8.
 import logging
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -59,8 +60,13 @@ out = folder / "study.nc"
 # Interrupting a build by hand is not possible, so the progress callback (called as each
 # chunk is kept) raises ``KeyboardInterrupt`` after the third chunk, as Ctrl-C would.
 # The error's note says what is kept and how to resume.
-cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                       dashboard_address=None, silence_logs=logging.ERROR)
+cluster = LocalCluster(
+    n_workers=1,
+    threads_per_worker=2,
+    processes=False,
+    dashboard_address=None,
+    silence_logs=logging.ERROR,
+)
 
 
 def stop_after_three(done: int, total: int, rate: float) -> None:
@@ -69,8 +75,7 @@ def stop_after_three(done: int, total: int, rate: float) -> None:
 
 
 try:
-    vibroimpact.study.run(study, out, dask=cluster.scheduler_address,
-                          progress=stop_after_three)
+    vibroimpact.study.run(study, out, dask=cluster.scheduler_address, progress=stop_after_three)
 except KeyboardInterrupt as stop:
     print("interrupted:", *stop.__notes__)
 kept = sorted(p.name for p in (folder / "study.nc.parts").glob("chunk-*.npz"))
@@ -82,8 +87,7 @@ print(f"kept: {kept}; the output exists: {out.exists()}")
 # The same call again: the kept chunks are read back, the others run on the cluster, and
 # the file is written whole.
 notices: list[str] = []
-resumed = vibroimpact.study.run(study, out, dask=cluster.scheduler_address,
-                                notice=notices.append)
+resumed = vibroimpact.study.run(study, out, dask=cluster.scheduler_address, notice=notices.append)
 cluster.close()
 print(*notices)
 resumed_bytes = out.read_bytes()
@@ -100,11 +104,15 @@ print("byte for byte the same:", resumed_bytes == uninterrupted_bytes)
 
 with xr.open_dataset(out) as dataset:
     amplitude = dataset["amplitude"].sel(coordinate=0).load()
+shutil.rmtree(folder)
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
 for clearance in amplitude["damper.0.clearance"].values:
-    ax.plot(amplitude["excitation.0.frequency"],
-            1e3 * amplitude.sel({"damper.0.clearance": clearance}),
-            "o-", ms=3, label=f"{1e3 * clearance:.0f} mm")
-ax.set(xlabel="forcing frequency (Hz)", ylabel="steady amplitude (mm)",
-       title="The resumed study")
+    ax.plot(
+        amplitude["excitation.0.frequency"],
+        1e3 * amplitude.sel({"damper.0.clearance": clearance}),
+        "o-",
+        ms=3,
+        label=f"{1e3 * clearance:.0f} mm",
+    )
+ax.set(xlabel="forcing frequency (Hz)", ylabel="steady amplitude (mm)", title="The resumed study")
 ax.legend(title="clearance", ncols=2)

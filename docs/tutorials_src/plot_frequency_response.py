@@ -44,22 +44,40 @@ print(f"{len(unsettled)} of {len(damped_points)} points with the damper did not 
 # %%
 # The figure
 # ----------
-# Up and down are drawn apart; an unsettled point gets a bar from the smallest to the
-# largest of its periods' peaks. The damper halves the resonant peak, and near 9 and
-# 10.3 Hz its response does not repeat: the loose mass's impacts are irregular there.
+# Up and down are drawn apart; an unsettled point is circled in red, with a bar from the
+# smallest of its recorded periods' peaks (``least_period_peak``) to the largest (its
+# ``amplitude``). The damper lowers the peak and moves it down in frequency (the loose mass
+# adds to the moving mass); from 8.8 to 10.5 Hz its response often does not repeat: the
+# impacts come at irregular phases there, and up and down differ.
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
-ax.plot([p.value for p in bare_points], 1e3 * bare_amplitude, "--", color="0.5",
-        label="no damper")
+ax.plot([p.value for p in bare_points], 1e3 * bare_amplitude, "--", color="0.5", label="no damper")
 for direction, marker in (("up", "^"), ("down", "v")):
     points = [p for p in damped_points if p.direction == direction]
-    ax.plot([p.value for p in points], [1e3 * p.amplitude[0] for p in points],
-            marker=marker, ms=4, lw=0.8, label=f"damper, sweep {direction}")
+    ax.plot(
+        [p.value for p in points],
+        [1e3 * p.amplitude[0] for p in points],
+        marker=marker,
+        ms=4,
+        lw=0.8,
+        label=f"damper, sweep {direction}",
+    )
 for p in unsettled:
-    low, high = 1e3 * np.min(p.least_period_peak), 1e3 * np.max(p.least_period_peak)
-    ax.plot([p.value, p.value], [low, high], color="tab:red", lw=2, alpha=0.6)
-ax.plot([], [], color="tab:red", lw=2, alpha=0.6, label="unsettled: spread of peaks")
-ax.set(xlabel="forcing frequency (Hz)", ylabel="amplitude of the structure (mm)",
-       title="Frequency response, 5 N")
+    low, high = 1e3 * np.min(p.least_period_peak), 1e3 * p.amplitude[0]
+    ax.plot([p.value, p.value], [low, high], color="tab:red", lw=2)
+ax.plot(
+    [p.value for p in unsettled],
+    [1e3 * p.amplitude[0] for p in unsettled],
+    "o",
+    mfc="none",
+    mec="tab:red",
+    ms=8,
+    label="unsettled (bar: spread of peaks)",
+)
+ax.set(
+    xlabel="forcing frequency (Hz)",
+    ylabel="amplitude of the structure (mm)",
+    title="Frequency response, 5 N",
+)
 ax.legend()
 
 # %%
@@ -68,6 +86,8 @@ ax.legend()
 # Each point also has the linear amplitude of the bare structure at its frequency and the
 # reduction ``1 - amplitude / linear_amplitude``.
 at_resonance = [p for p in damped_points if p.value == 10.0 and p.direction == "up"][0]
-print(f"at 10 Hz: {1e3 * at_resonance.amplitude[0]:.2f} mm against "
-      f"{1e3 * at_resonance.linear_amplitude[0]:.2f} mm bare; settled: "
-      f"{at_resonance.settled}, impacts per period: {at_resonance.impacts_per_period}")
+print(
+    f"at 10 Hz: {1e3 * at_resonance.amplitude[0]:.2f} mm against "
+    f"{1e3 * at_resonance.linear_amplitude[0]:.2f} mm bare; settled: "
+    f"{at_resonance.settled}, impacts per period: {at_resonance.impacts_per_period}"
+)

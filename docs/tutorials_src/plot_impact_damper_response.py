@@ -26,9 +26,7 @@ import vibroimpact as vi
 MASS, STIFFNESS, DAMPING = 1.0, 3947.8, 2.513  # kg, N/m, N s/m
 LOOSE_MASS, CLEARANCE, RESTITUTION = 0.05, 0.005, 0.6  # kg, m, -
 structure = vi.Oscillator(mass=MASS, stiffness=STIFFNESS, damping=DAMPING)
-damper = vi.Damper(
-    mass=LOOSE_MASS, at=0, clearance=CLEARANCE, law="rigid", restitution=RESTITUTION
-)
+damper = vi.Damper(mass=LOOSE_MASS, at=0, clearance=CLEARANCE, law="rigid", restitution=RESTITUTION)
 
 # %%
 # Free response
@@ -48,8 +46,13 @@ print(f"{len(free.contacts)} impacts; energy (J): {free.energy}")
 fig, ax = plt.subplots(figsize=(7, 3.5), layout="constrained")
 ax.plot(free.t, 1e3 * free.structure_displacement[:, 0], label="structure x")
 ax.plot(free.t, 1e3 * free.damper_displacement[:, 0], label="loose mass y", lw=0.8)
-ax.plot(free.contacts.onset, 1e3 * np.interp(free.contacts.onset, free.t,
-        free.damper_displacement[:, 0]), "k.", ms=4, label="impacts")
+ax.plot(
+    free.contacts.onset,
+    1e3 * np.interp(free.contacts.onset, free.t, free.damper_displacement[:, 0]),
+    "k.",
+    ms=4,
+    label="impacts",
+)
 ax.set(xlabel="time (s)", ylabel="displacement (mm)", title="Free response")
 ax.legend()
 
@@ -58,8 +61,10 @@ ax.legend()
 # approach speed and the energy dissipated of every impact.
 m_eff = MASS * LOOSE_MASS / (MASS + LOOSE_MASS)
 newton_loss = 0.5 * m_eff * (1 - RESTITUTION**2) * free.contacts.approach_speed**2
-print("largest difference from Newton's loss (J):",
-      float(np.max(np.abs(free.contacts.energy_dissipated - newton_loss))))
+print(
+    "largest difference from Newton's loss (J):",
+    float(np.max(np.abs(free.contacts.energy_dissipated - newton_loss))),
+)
 
 # %%
 # Forced response
@@ -77,16 +82,18 @@ omega = 2 * np.pi * FREQUENCY
 linear_amplitude = FORCE / abs(STIFFNESS - MASS * omega**2 + 1j * omega * DAMPING)
 late = forced.t > 2.0
 forced_amplitude = float(np.max(np.abs(forced.structure_displacement[late, 0])))
-print(f"steady amplitude: {1e3 * forced_amplitude:.2f} mm with the damper, "
-      f"{1e3 * linear_amplitude:.2f} mm without")
+print(
+    f"steady amplitude: {1e3 * forced_amplitude:.2f} mm with the damper, "
+    f"{1e3 * linear_amplitude:.2f} mm without"
+)
 
 fig, ax = plt.subplots(figsize=(7, 3.5), layout="constrained")
-ax.plot(forced_bare.t, 1e3 * forced_bare.structure_displacement[:, 0], label="no damper",
-        color="0.6")
+ax.plot(
+    forced_bare.t, 1e3 * forced_bare.structure_displacement[:, 0], label="no damper", color="0.6"
+)
 ax.plot(forced.t, 1e3 * forced.structure_displacement[:, 0], label="with the damper")
 ax.axhline(1e3 * linear_amplitude, ls="--", color="0.3", lw=0.8)
-ax.set(xlabel="time (s)", ylabel="structure displacement (mm)",
-       title="Forced at 10 Hz, 5 N")
+ax.set(xlabel="time (s)", ylabel="structure displacement (mm)", title="Forced at 10 Hz, 5 N")
 ax.legend(loc="lower right")
 
 # %%

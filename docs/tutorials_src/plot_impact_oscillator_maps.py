@@ -36,8 +36,11 @@ def ball_on_table(gamma: float) -> vi.System:
         stops=[vi.Stop(at=0, side="lower", gap=0.0, law="rigid", restitution=RESTITUTION)],
         gravity=vi.Gravity(acceleration=GRAVITY),
         # The phase puts t = 0 in the middle of a flight of the period-one orbit.
-        excitations=[vi.Base(signal=vi.Harmonic(amplitude=gamma * GRAVITY,
-                                                frequency=FREQUENCY, phase=5.2226))],
+        excitations=[
+            vi.Base(
+                signal=vi.Harmonic(amplitude=gamma * GRAVITY, frequency=FREQUENCY, phase=5.2226)
+            )
+        ],
         initial=vi.Initial(structure_displacement=[0.015], structure_velocity=[0.16]),
         solver=vi.Solver(method="exact", t_end=1.0),
     )
@@ -50,19 +53,30 @@ def ball_on_table(gamma: float) -> vi.System:
 # and the approach speed of each impact over the next 32 is sampled: one value on a
 # period-one orbit, two after the flip, many in chaos.
 gammas = np.linspace(1.2, 2.2, 81)
-diagram = vi.bifurcation(ball_on_table(1.2), "excitation.0.amplitude", gammas * GRAVITY,
-                         settle_periods=200, sample_periods=32, sample="impact-velocity")
+diagram = vi.bifurcation(
+    ball_on_table(1.2),
+    "excitation.0.amplitude",
+    gammas * GRAVITY,
+    settle_periods=200,
+    sample_periods=32,
+    sample="impact-velocity",
+)
 omega = 2 * np.pi * FREQUENCY
-gamma_flip = np.hypot(np.pi * (1 - RESTITUTION) / (1 + RESTITUTION),
-                      2 * (1 + RESTITUTION**2) / (1 + RESTITUTION) ** 2)
+gamma_flip = np.hypot(
+    np.pi * (1 - RESTITUTION) / (1 + RESTITUTION), 2 * (1 + RESTITUTION**2) / (1 + RESTITUTION) ** 2
+)
 fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
 for point in diagram:
     ax.plot(np.full(len(point.samples), point.value / GRAVITY), point.samples, ",k")
 ax.axvline(gamma_flip, color="tab:red", lw=0.8, label=r"$\Gamma_{\rm flip}$ (Holmes)")
-ax.axhline(2 * np.pi * GRAVITY / (omega * (1 + RESTITUTION)), color="tab:blue", lw=0.8,
-           ls="--", label=r"$2\pi g/(\omega(1+e))$")
-ax.set(xlabel=r"$\Gamma = A\omega^2/g$", ylabel="impact speed (m/s)",
-       title="Bifurcation diagram")
+ax.axhline(
+    2 * np.pi * GRAVITY / (omega * (1 + RESTITUTION)),
+    color="tab:blue",
+    lw=0.8,
+    ls="--",
+    label=r"$2\pi g/(\omega(1+e))$",
+)
+ax.set(xlabel=r"$\Gamma = A\omega^2/g$", ylabel="impact speed (m/s)", title="Bifurcation diagram")
 ax.legend(loc="upper left")
 
 # %%
@@ -71,13 +85,18 @@ ax.legend(loc="upper left")
 # The impact section: each impact's phase in the forcing period and its speed, after
 # settling. At :math:`\Gamma = 1.4` the period-one orbit is one point; at 2.1 the impacts
 # spread over a strange attractor.
-sections = {gamma: vi.poincare(ball_on_table(gamma), settle_periods=200, periods=400)
-            for gamma in (1.4, 2.1)}
+sections = {
+    gamma: vi.poincare(ball_on_table(gamma), settle_periods=200, periods=400)
+    for gamma in (1.4, 2.1)
+}
 fig, axes = plt.subplots(1, 2, figsize=(9, 3.8), layout="constrained")
 for ax, (gamma, section) in zip(axes, sections.items(), strict=True):
     ax.plot(section.impact_phase, section.impact_speed, ".", ms=2)
-    ax.set(xlabel="impact phase (rad)", ylabel="impact speed (m/s)",
-           title=rf"$\Gamma = {gamma}$: {len(section.impact_speed)} impacts")
+    ax.set(
+        xlabel="impact phase (rad)",
+        ylabel="impact speed (m/s)",
+        title=rf"$\Gamma = {gamma}$: {len(section.impact_speed)} impacts",
+    )
 
 # %%
 # Basins of attraction
@@ -88,14 +107,19 @@ for ax, (gamma, section) in zip(axes, sections.items(), strict=True):
 # on its height (m) and velocity (m/s): indices 0 and 1 of the flat state (x, v).
 heights = np.linspace(0.0, 0.03, 21)
 speeds = np.linspace(-0.4, 0.4, 21)
-basins = vi.basins(ball_on_table(1.2), (0, heights), (1, speeds), settle_periods=200,
-                   record_periods=20)
+basins = vi.basins(
+    ball_on_table(1.2), (0, heights), (1, speeds), settle_periods=200, record_periods=20
+)
 for index, attractor in enumerate(basins.attractors):
     share = np.mean(basins.labels == index)
     print(f"attractor {index}: {attractor}, {100 * share:.0f} % of the starts")
 fig, ax = plt.subplots(figsize=(5.5, 4), layout="constrained")
-mesh = ax.pcolormesh(1e3 * heights, speeds, basins.labels.T, shading="nearest",
-                     cmap="tab10", vmin=-3, vmax=6)
-ax.set(xlabel="initial height (mm)", ylabel="initial velocity (m/s)",
-       title=r"Basins at $\Gamma = 1.2$ (label: attractor; -1 unsettled)")
+mesh = ax.pcolormesh(
+    1e3 * heights, speeds, basins.labels.T, shading="nearest", cmap="tab10", vmin=-3, vmax=6
+)
+ax.set(
+    xlabel="initial height (mm)",
+    ylabel="initial velocity (m/s)",
+    title=r"Basins at $\Gamma = 1.2$ (label: attractor; -1 unsettled)",
+)
 fig.colorbar(mesh, ax=ax, label="attractor")

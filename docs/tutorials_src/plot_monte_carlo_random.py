@@ -38,8 +38,7 @@ import vibroimpact.study
 MASS, FREQUENCY, ZETA = 1.0, 2.0, 0.05  # kg, Hz, -
 INTENSITY, CUTOFF, RUNS = 1e-4, 50.0, 400  # (m/s^2)^2 / (rad/s), Hz, realisations
 omega_n = 2 * np.pi * FREQUENCY
-structure = vi.Oscillator(mass=MASS, stiffness=MASS * omega_n**2,
-                          damping=2 * ZETA * MASS * omega_n)
+structure = vi.Oscillator(mass=MASS, stiffness=MASS * omega_n**2, damping=2 * ZETA * MASS * omega_n)
 noise = vi.Base(signal=vi.WhiteNoise(intensity=INTENSITY, cutoff_frequency=CUTOFF, seed=0))
 ensemble = {
     "analysis": "run",
@@ -58,12 +57,15 @@ def mean_squares(system: vi.System) -> np.ndarray:
     return np.asarray(result["rms"].sel(coordinate=0)) ** 2
 
 
-bare = mean_squares(vi.System(structure=structure, excitations=[noise], solver=solver,
-                              analyses={"study": ensemble}))
+bare = mean_squares(
+    vi.System(structure=structure, excitations=[noise], solver=solver, analyses={"study": ensemble})
+)
 theory = np.pi * INTENSITY / (2 * ZETA * omega_n**3)
 standard_error = bare.std(ddof=1) / np.sqrt(RUNS)
-print(f"Monte Carlo {bare.mean():.4e} m^2 +- {standard_error:.1e} (one standard error), "
-      f"theory {theory:.4e} m^2: ratio {bare.mean() / theory:.4f}")
+print(
+    f"Monte Carlo {bare.mean():.4e} m^2 +- {standard_error:.1e} (one standard error), "
+    f"theory {theory:.4e} m^2: ratio {bare.mean() / theory:.4f}"
+)
 
 # %%
 # With an impact damper
@@ -72,16 +74,28 @@ print(f"Monte Carlo {bare.mean():.4e} m^2 +- {standard_error:.1e} (one standard 
 # response's standard deviation of 1.3 mm) and a rigid restitution of 0.5. Event-driven
 # RK4 locates each impact.
 damper = vi.Damper(mass=0.05, at=0, clearance=0.003, law="rigid", restitution=0.5)
-damped = mean_squares(vi.System(structure=structure, dampers=[damper], excitations=[noise],
-                                solver=solver, analyses={"study": ensemble}))
-print(f"with the damper: mean square {damped.mean():.4e} m^2, "
-      f"{100 * (1 - np.sqrt(damped.mean() / theory)):.0f} % less RMS than the bare theory")
+damped = mean_squares(
+    vi.System(
+        structure=structure,
+        dampers=[damper],
+        excitations=[noise],
+        solver=solver,
+        analyses={"study": ensemble},
+    )
+)
+print(
+    f"with the damper: mean square {damped.mean():.4e} m^2, "
+    f"{100 * (1 - np.sqrt(damped.mean() / theory)):.0f} % less RMS than the bare theory"
+)
 
 fig, ax = plt.subplots(figsize=(7, 3.8), layout="constrained")
 bins = np.linspace(0, 1e3 * np.sqrt(max(bare.max(), damped.max())), 40)
 ax.hist(1e3 * np.sqrt(bare), bins=bins, alpha=0.6, label="bare")
 ax.hist(1e3 * np.sqrt(damped), bins=bins, alpha=0.6, label="with the damper")
 ax.axvline(1e3 * np.sqrt(theory), color="k", lw=1, label=r"theory $\sigma_x$ (bare)")
-ax.set(xlabel="RMS displacement of a 40 s record (mm)", ylabel="realisations",
-       title=f"{RUNS} realisations of white noise")
+ax.set(
+    xlabel="RMS displacement of a 40 s record (mm)",
+    ylabel="realisations",
+    title=f"{RUNS} realisations of white noise",
+)
 ax.legend()
