@@ -89,6 +89,7 @@ from vibroimpact.model.load import load, loads
 from vibroimpact.model.run import TEXTS as _TEXTS
 from vibroimpact.model.run import simulate
 from vibroimpact.netcdf import write_netcdf
+from vibroimpact.notebook import add_views as _add_views
 from vibroimpact.scenario import Scenario, ScenarioError, load_scenario, parse_scenario
 from vibroimpact.study import study_of
 from vibroimpact.summary import to_pandas, to_xarray
@@ -111,6 +112,8 @@ def _equality_only(*classes: type) -> None:
 
 
 _equality_only(ImpactDamper, Contact, InitialState)
+# The two-mass run's results get the 0.2 results' views (to_xarray, to_pandas, HTML).
+_add_views(Solution, ContactTable)
 
 # Arguments of the wrong type named (PyO3's TypeError names none).
 check_solver = _typed(**_TEXTS)(_check_solver)

@@ -51,7 +51,9 @@ from vibroimpact.analysis.continuation import Branch
 from vibroimpact.analysis.limits import AnalysisError
 from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
 from vibroimpact.analysis.sweeps import SweepPoint, reductions
-from vibroimpact.analysis.units import (
+from vibroimpact.messages import shown
+from vibroimpact.output import json_text
+from vibroimpact.units import (
     _M,
     _M_S,
     _NM,
@@ -60,8 +62,6 @@ from vibroimpact.analysis.units import (
     parameter_units,
     state_names,
 )
-from vibroimpact.messages import shown
-from vibroimpact.output import json_text
 
 __all__ = [
     "basins_dataset",

@@ -17,9 +17,9 @@ from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
 from vibroimpact.analysis.runs import Runner
 from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
 from vibroimpact.analysis.sweeps import SweepPoint, shown_amplitudes, shown_label, shown_values
-from vibroimpact.analysis.units import parameter_units
 from vibroimpact.output import written_whole
 from vibroimpact.system import SystemSolution, split_observed
+from vibroimpact.units import parameter_units
 
 
 @contextmanager

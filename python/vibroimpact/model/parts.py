@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from vibroimpact.system import _GRAVITY, _STRUCTURE
+from vibroimpact.system import _GRAVITY, _STRUCTURE, system_spec
 
 _Numbers = tuple[float, ...]
 _Rows = tuple[tuple[float, ...], ...]
@@ -119,15 +119,48 @@ class Cantilever(Structure):
     """A clamped-free Euler-Bernoulli beam in ``modes`` modal coordinates: ``length``
     (m), ``youngs_modulus`` (Pa), ``second_moment`` (m^4), ``mass_per_length`` (kg/m),
     ``damping_ratio`` of every mode; its points are positions along it (m from the
-    clamp)."""
+    clamp).
+
+    Or from its section and material: in place of ``second_moment`` a ``section``,
+    ``"rectangle"`` (``width``, ``height``, m; bending about the axis parallel to the
+    width), ``"circle"`` (``diameter``) or ``"tube"`` (``outer_diameter``,
+    ``inner_diameter``); in place of ``mass_per_length`` a ``density`` (kg/m^3, times
+    the section's area); a ``material``, ``"steel"`` (structural, E = 200 GPa, 7850
+    kg/m^3), ``"aluminium"`` (6061-T6, 68.9 GPa, 2700 kg/m^3) or ``"titanium"``
+    (Ti-6Al-4V, 114 GPa, 4430 kg/m^3), for Young's modulus and the density, each
+    overridden by ``youngs_modulus`` or ``density`` where given. One way per quantity:
+    ``section`` with ``second_moment``, or ``density`` with ``mass_per_length``, is an
+    error (see :mod:`vibroimpact.system.beam`, the sources of the materials' values).
+    ``resolved()`` gives the values the beam is simulated with.
+
+    >>> tube = Cantilever(length=0.5, section="tube", outer_diameter=0.02,
+    ...                   inner_diameter=0.016, material="steel", modes=3)
+    >>> f"{tube.resolved()['second_moment']:.4e} m^4"
+    '4.6370e-09 m^4'
+    """
 
     kind: ClassVar[str] = "cantilever"
     length: float
-    youngs_modulus: float
-    second_moment: float
-    mass_per_length: float
+    youngs_modulus: float | None = None
+    second_moment: float | None = None
+    mass_per_length: float | None = None
     modes: int
     damping_ratio: float = _default(_STRUCTURE["cantilever"], "damping_ratio")
+    section: str | None = None
+    width: float | None = None
+    height: float | None = None
+    diameter: float | None = None
+    outer_diameter: float | None = None
+    inner_diameter: float | None = None
+    material: str | None = None
+    density: float | None = None
+
+    def resolved(self) -> dict[str, Any]:
+        """The beam as simulated (the checked ``[structure]``): ``length`` (m),
+        ``youngs_modulus`` (Pa), ``second_moment`` (m^4), ``mass_per_length`` (kg/m),
+        ``modes``, ``damping_ratio``, whether given or made from the section and the
+        material."""
+        return dict(system_spec(self.to_dict())["structure"])
 
 
 # -------------------------------------------------------------- interactions

@@ -30,6 +30,7 @@ from vibroimpact.model.parts import (
     Structure,
 )
 from vibroimpact.model.toml_text import toml_text
+from vibroimpact.notebook import system_html
 from vibroimpact.system import (
     _INITIAL,
     _OUTPUT,
@@ -121,6 +122,11 @@ class System:
             if getattr(self, f.name) not in (None, (), {})
         )
         return f"System({given})"
+
+    def _repr_html_(self) -> str:
+        """A summary table for notebooks: the structure, each damper, stop and
+        excitation with its units, and the settings given."""
+        return system_html(self)
 
     def _check(self) -> None:
         """Every value through the scenario's schema (its errors, word for word)."""

@@ -10,11 +10,11 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import __version__
-from vibroimpact.analysis.units import parameter_units
 from vibroimpact.study.axes import _is_seed
 from vibroimpact.study.grid import Study, _plain
 from vibroimpact.study.settings import PER_COORDINATE, base_metrics
 from vibroimpact.system import split_observed
+from vibroimpact.units import parameter_units
 
 # The metrics that are yes or no: booleans in the Dataset.
 _FLAGS = ("settled", "stable")

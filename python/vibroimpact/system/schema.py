@@ -6,7 +6,12 @@ A system is described by the same sections as a TOML scenario (SI units):
   ``"matrices"`` (``mass``, ``stiffness``, ``damping`` as n x n arrays of rows; M
   symmetric positive definite, K and C symmetric positive semi-definite) or
   ``"cantilever"`` (``length``, ``youngs_modulus``, ``second_moment``,
-  ``mass_per_length``, ``modes``, ``damping_ratio``; modal coordinates).
+  ``mass_per_length``, ``modes``, ``damping_ratio``; modal coordinates). In place of
+  ``second_moment`` a ``section`` (``"rectangle"``: ``width``, ``height``;
+  ``"circle"``: ``diameter``; ``"tube"``: ``outer_diameter``, ``inner_diameter``; m),
+  in place of ``mass_per_length`` a ``density`` (kg/m^3) times its area, and a
+  ``material`` (``"steel"``, ``"aluminium"``, ``"titanium"``) for Young's modulus and
+  the density: see :mod:`vibroimpact.system.beam`.
 - ``damper`` (a list): a loose mass (``mass``, kg) rattling against the point ``at``
   (a coordinate index, or m along a cantilever) with ``clearance`` on each side or
   ``lower_clearance`` and ``upper_clearance`` (m), and a ``law``.
@@ -57,6 +62,7 @@ from vibroimpact._core import (
 from vibroimpact._core import linear_parts as _linear_parts
 from vibroimpact.arguments import directory, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
+from vibroimpact.system.beam import DIMENSIONS, resolve_cantilever
 from vibroimpact.system.record_file import check_record, read_record
 
 _NUMBER, _TEXT, _WHOLE, _NUMBERS, _MATRIX = "number", "string", "whole number", "array", "matrix"
@@ -70,13 +76,19 @@ _STRUCTURE: dict[str, dict[str, tuple[str, Any]]] = {
         "damping": (_NUMBER, 0.0),
     },
     "matrices": {"mass": (_MATRIX, _REQ), "stiffness": (_MATRIX, _REQ), "damping": (_MATRIX, None)},
+    # Young's modulus, the second moment and the mass per length are each given
+    # directly or by a material and a section (resolved by .beam; one way each).
     "cantilever": {
         "length": (_NUMBER, _REQ),
-        "youngs_modulus": (_NUMBER, _REQ),
-        "second_moment": (_NUMBER, _REQ),
-        "mass_per_length": (_NUMBER, _REQ),
+        "youngs_modulus": (_NUMBER, None),
+        "second_moment": (_NUMBER, None),
+        "mass_per_length": (_NUMBER, None),
         "modes": (_WHOLE, _REQ),
         "damping_ratio": (_NUMBER, 0.0),
+        "section": (_TEXT, None),
+        **{key: (_NUMBER, None) for key in DIMENSIONS},
+        "material": (_TEXT, None),
+        "density": (_NUMBER, None),
     },
 }
 _LAW: dict[str, tuple[str, Any]] = {
@@ -492,11 +504,13 @@ def system_spec(
     _choice("[structure] ", "kind", kind, tuple(_STRUCTURE))
     schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[str(kind)]}
     spec: dict[str, Any] = {"structure": _table("[structure] ", structure, schema)}
-    if kind == "cantilever" and not 1 <= spec["structure"]["modes"] <= 200:
-        raise _fail(
-            "[structure] modes: ",
-            f"must be a whole number in [1, 200], got {spec['structure']['modes']}",
-        )
+    if kind == "cantilever":
+        if not 1 <= spec["structure"]["modes"] <= 200:
+            raise _fail(
+                "[structure] modes: ",
+                f"must be a whole number in [1, 200], got {spec['structure']['modes']}",
+            )
+        spec["structure"] = resolve_cantilever(spec["structure"])
     if kind == "matrices" and spec["structure"]["damping"] is None:
         size = len(spec["structure"]["mass"])
         spec["structure"]["damping"] = [[0.0] * size for _ in range(size)]

@@ -11,6 +11,7 @@ import numpy as np
 from vibroimpact._core import (
     InvalidInputError,
 )
+from vibroimpact.notebook import solution_html
 from vibroimpact.summary import contacts_frame, contacts_repr, history_dataset, solution_repr
 from vibroimpact.system.schema import (
     moment_weights,
@@ -178,6 +179,11 @@ class SystemSolution:
 
     def __repr__(self) -> str:
         return solution_repr(self)
+
+    def _repr_html_(self) -> str:
+        """A summary table for notebooks: method, steps, contacts, energy (J), final
+        time (s)."""
+        return solution_html(self)
 
     def to_xarray(self) -> Any:
         """The history as an ``xarray.Dataset`` over ``time`` (s), with named

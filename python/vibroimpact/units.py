@@ -1,6 +1,7 @@
 """The SI units (UDUNITS spelling, as CF asks: ``"m"``, ``"m s-1"``, ``"1"`` for a
 dimensionless one) of a scenario's parameters and of the analyses' flat state ``(x, v)``,
-and the names of its entries: what the Datasets, a study's axes and the plots label."""
+and the names of its entries: what the Datasets, a study's axes, the plots and the notebook
+tables label (here, outside the analyses, which import the model that the tables show)."""
 
 from __future__ import annotations
 
@@ -41,6 +42,12 @@ _KEY_UNITS = {
     "youngs_modulus": "Pa",
     "second_moment": "m4",
     "mass_per_length": "kg m-1",
+    "width": _M,
+    "height": _M,
+    "diameter": _M,
+    "outer_diameter": _M,
+    "inner_diameter": _M,
+    "density": "kg m-3",
     "acceleration": "m s-2",
     "structure_displacement": _M,
     "damper_displacement": _M,
