@@ -2,7 +2,7 @@
 
 The keys, their types, defaults and the solver's ranges come from the code (the schemas in
 ``vibroimpact.system.schema`` and ``vibroimpact.scenario.two_mass``, the core registry
-``vibroimpact.METHOD_OPTIONS``, the units of ``vibroimpact.analysis.units``). This table adds
+``vibroimpact.METHOD_OPTIONS``, the units of ``vibroimpact.units``). This table adds
 the meaning, and the unit and range where the code holds none. The build fails on a key of
 a schema missing here, on an entry here that no schema has, and on a unit here that differs
 from the code's: so the reference cannot drift from the format.
@@ -107,9 +107,29 @@ SYSTEM = {
             "the oscillator's damper, or the damping matrix",
         ),
         "length": ("m", "> 0", "the cantilever's length"),
-        "youngs_modulus": ("Pa", "> 0", "Young's modulus E"),
-        "second_moment": ("m4", "> 0", "the second moment of area I of the section"),
-        "mass_per_length": ("kg m-1", "> 0", "the mass per unit length"),
+        "youngs_modulus": ("Pa", "> 0", "Young's modulus E (else the material's)"),
+        "second_moment": (
+            "m4",
+            "> 0",
+            "the second moment of area I of the section (or give section and its dimensions)",
+        ),
+        "mass_per_length": (
+            "kg m-1",
+            "> 0",
+            "the mass per unit length (or give density or material, and a section)",
+        ),
+        "section": (None, '"rectangle", "circle" or "tube"', "the beam's cross-section"),
+        "width": ("m", "> 0", "a rectangle's width (bending about the axis along it)"),
+        "height": ("m", "> 0", "a rectangle's height, in the plane of bending"),
+        "diameter": ("m", "> 0", "a circle's diameter"),
+        "outer_diameter": ("m", "> 0", "a tube's outer diameter"),
+        "inner_diameter": ("m", "> 0 and < outer_diameter", "a tube's inner diameter"),
+        "material": (
+            None,
+            '"steel", "aluminium" or "titanium"',
+            "a named material's Young's modulus and density (cited in vibroimpact.system.beam)",
+        ),
+        "density": ("kg m-3", "> 0", "the material's density (instead of mass_per_length)"),
         "modes": ("1", "[1, 200]", "the modes kept (modal coordinates)"),
         "damping_ratio": ("1", ">= 0", "every mode's damping ratio"),
     },

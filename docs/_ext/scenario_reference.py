@@ -4,7 +4,7 @@ Two tables per format: the two-mass damper's (``[system]``, ``[contact]``, ...; 
 ``vibroimpact.scenario.two_mass``) and the systems' (``[structure]``, ``[[damper]]``, ...;
 ``vibroimpact.system.schema``). Types and defaults are the schemas', the solver's ranges the
 core registry's (``vibroimpact.METHOD_OPTIONS``), the choices of ``method`` the registry's
-names, units those of ``vibroimpact.analysis.units`` where it knows them; ``scenario_keys``
+names, units those of ``vibroimpact.units`` where it knows them; ``scenario_keys``
 adds meanings. A key without a description, a description of no key or a unit that differs
 from the code's is a warning (an error under ``-W``).
 """
@@ -22,9 +22,9 @@ from sphinx.util.docutils import SphinxDirective
 from sphinx.util.nodes import nested_parse_with_titles
 
 import vibroimpact as vi
-from vibroimpact.analysis.units import parameter_units
 from vibroimpact.scenario import two_mass
 from vibroimpact.system import schema
+from vibroimpact.units import parameter_units
 
 LOG = logging.getLogger(__name__)
 
@@ -72,7 +72,7 @@ def _allowed(section: str, key: str, written: str | None) -> str:
 
 
 def _unit(section: str, key: str, written: str | None, where: str) -> str:
-    """The code's unit of a key (``vibroimpact.analysis.units``), else the table's."""
+    """The code's unit of a key (``vibroimpact.units``), else the table's."""
     code = parameter_units(f"{section}.{key}")
     if code is not None and written is not None and code != written:
         LOG.warning("%s: the unit %r differs from the code's %r", where, written, code)

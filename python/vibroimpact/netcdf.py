@@ -103,11 +103,11 @@ def netcdf_bytes(dataset: Any) -> bytes:
 def write_netcdf(dataset: Any, path: str | Path) -> None:
     """Write the xarray Dataset ``dataset`` to ``path`` as a NetCDF 4 file (64-bit
     integers, strings as strings, numeric variables compressed: see
-    :mod:`vibroimpact.netcdf`), whole or not at all: a temporary file beside ``path``
+    ``vibroimpact.netcdf``), whole or not at all: a temporary file beside ``path``
     renamed over it once on disk, so a failed or interrupted write leaves an existing
     file as it was. The same Dataset writes the same bytes. Read it with
     ``xr.open_dataset(path)``. A path that cannot be written raises
-    :class:`~vibroimpact.output.UsageError` naming it."""
+    ``UsageError`` (a ``ValueError``) naming it."""
     path = arguments.path("path", path)
     data = netcdf_bytes(dataset)
     with written_whole(path, binary=True) as f:

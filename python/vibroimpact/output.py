@@ -55,9 +55,10 @@ def json_text(value: Any) -> str:
     return json.dumps(json_safe(value), allow_nan=False)
 
 
-class UsageError(Exception):
+class UsageError(ValueError):
     """Bad input found by the command line or the jobs it runs, such as an output
-    path that cannot be written (exit status 2)."""
+    path that cannot be written (exit status 2; a ``ValueError``, as every bad input is
+    in Python)."""
 
 
 def _regular_or_absent(path: Path) -> os.stat_result | None:

@@ -130,7 +130,7 @@ class Cantilever(Structure):
     (Ti-6Al-4V, 114 GPa, 4430 kg/m^3), for Young's modulus and the density, each
     overridden by ``youngs_modulus`` or ``density`` where given. One way per quantity:
     ``section`` with ``second_moment``, or ``density`` with ``mass_per_length``, is an
-    error (see :mod:`vibroimpact.system.beam`, the sources of the materials' values).
+    error (see ``vibroimpact.system.beam``, the sources of the materials' values).
     ``resolved()`` gives the values the beam is simulated with.
 
     >>> tube = Cantilever(length=0.5, section="tube", outer_diameter=0.02,

@@ -56,7 +56,7 @@ def run(
     resume: str = "run the same study into the same output again",
 ) -> Any:
     """Run ``study`` into ``out``, by its suffix the NetCDF 4 file ``RESULT.nc``
-    (:func:`vibroimpact.netcdf.write_netcdf`) or the Zarr store ``RESULT.zarr`` (needs
+    (:func:`vibroimpact.write_netcdf`) or the Zarr store ``RESULT.zarr`` (needs
     zarr; see :func:`output_kind`), chunk by chunk:
     each finished chunk is kept in ``OUT.parts/`` (written whole), so a study
     interrupted or killed loses at most the chunks in flight and, run again, goes on

@@ -20,7 +20,7 @@ OUTPUTS = {".nc": "a NetCDF 4 file", ".zarr": "a Zarr store"}
 def output_kind(out: Path) -> str:
     """The suffix of ``out`` that decides its format (``.nc`` or ``.zarr``), checked
     before a study runs: another suffix, a NetCDF file without h5netcdf and h5py (see
-    :func:`vibroimpact.netcdf.netcdf4_missing`), a Zarr store without the zarr package,
+    ``vibroimpact.netcdf.netcdf4_missing``), a Zarr store without the zarr package,
     or a ``.zarr`` path that holds something other than a Zarr store (which the store
     would replace) raise :class:`UsageError`."""
     out = arguments.path("out", out)
