@@ -12,11 +12,14 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE / "_ext"))
-# A checkout without an installed package builds from its own sources (the compiled core
-# must be beside them, as after `pip install -e .` or a copied _core*.so).
-sys.path.insert(0, str(HERE.parent / "python"))
-
-import vibroimpact  # noqa: E402
+# The installed package (`pip install .` puts the compiled core there, not in the sources);
+# a checkout without one builds from its own sources, where the compiled core must be beside
+# them (as after `pip install -e .` or a copied _core*.so).
+try:
+    import vibroimpact
+except ImportError:
+    sys.path.insert(0, str(HERE.parent / "python"))
+    import vibroimpact
 
 project = "vibroimpact"
 author = "the vibroimpact developers"

@@ -69,7 +69,10 @@ def test_the_abi3_wheel_installs_and_runs_without_rust(tmp_path: Path) -> None:
     assert shutil.which("rustc", path=env["PATH"]) is None
     python = str(bin_dir / "python")
     subprocess.run(
-        [python, "-m", "pip", "install", "--no-deps", "--no-index", "-q", str(wheel)],
+        # --ignore-installed: the interpreter's own vibroimpact (`pip install .`) would
+        # otherwise count as installed, and the wheel be skipped.
+        [python, "-m", "pip", "install", "--no-deps", "--no-index", "--ignore-installed", "-q"]
+        + [str(wheel)],
         check=True,
         env=env,
         cwd=tmp_path,
