@@ -1,5 +1,5 @@
 # Verbs for a newcomer. `make test` is the README's test command.
-.PHONY: help install test lint bench paper docs
+.PHONY: help install test lint bench paper docs readme-figure
 help:
 	@echo "make install  - pip install the package with its test tools"
 	@echo "make test     - every test, Rust and Python (what .ci/run runs)"
@@ -7,6 +7,7 @@ help:
 	@echo "make bench    - throughput and call overhead benchmarks"
 	@echo "make paper    - reproduce the founding paper into paper-results/"
 	@echo "make docs     - the documentation site into docs/_build/html (warnings are errors)"
+	@echo "make readme-figure - the README's figure, docs/_static/frf_impact_damper.png"
 
 install:
 	pip install ".[test]"
@@ -34,3 +35,7 @@ paper:
 
 docs:
 	python -m sphinx -W --keep-going -b html docs docs/_build/html
+
+# The README's figure: the frequency response its example draws, kept small in the repository.
+readme-figure:
+	vibroimpact sweep examples/frf_impact_damper.toml --plot docs/_static/frf_impact_damper.png

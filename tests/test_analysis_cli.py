@@ -19,6 +19,8 @@ from typing import Any
 
 import pytest
 
+import docs_blocks
+
 ROOT = Path(__file__).resolve().parents[1]
 BALL_TABLE = ROOT / "examples" / "bouncing_ball_table.toml"
 FRF = ROOT / "examples" / "frf_impact_damper.toml"
@@ -502,23 +504,14 @@ def test_help_lists_orbit_and_sweep(run_cli: RunCli) -> None:
     assert "--plot" in sweep_help.stdout
 
 
-# ------------------------------------------------------------------------- README
+# ------------------------------------------------------- the documentation's analyses page
 
-README = (ROOT / "README.md").read_text(encoding="utf-8")
-
-
-def readme_section(title: str) -> str:
-    start = README.index(f"## {title}\n")
-    end = README.find("\n## ", start + 1)
-    return README[start:end]
+ANALYSES = docs_blocks.section("analyses", "Forced response and periodic orbits")
 
 
-ANALYSES = readme_section("Forced response and periodic orbits")
-
-
-def test_readme_analysis_commands_work_as_written(tmp_path: Path) -> None:
+def test_the_docs_analysis_commands_work_as_written(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "examples", tmp_path / "examples")
-    (block,) = re.findall(r"```sh\n(.*?)```", ANALYSES, flags=re.S)
+    (block,) = docs_blocks.blocks(ANALYSES, "sh")
     commands = [line for line in block.splitlines() if line.strip()]
     assert {shlex.split(c)[1] for c in commands} == {"orbit", "sweep"}
     for command in commands:
@@ -538,11 +531,11 @@ def test_readme_analysis_commands_work_as_written(tmp_path: Path) -> None:
     assert (tmp_path / "frf.png").read_bytes().startswith(PNG_SIGNATURE)
 
 
-def test_readme_analysis_snippet_runs_and_its_comments_are_true(
+def test_the_docs_analysis_snippet_runs_and_its_comments_are_true(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    (code,) = re.findall(r"```python\n(.*?)```", ANALYSES, flags=re.S)
-    exec(compile(code, "README.md", "exec"), {})
+    (code,) = docs_blocks.blocks(ANALYSES, "python")
+    exec(compile(code, "analyses.rst", "exec"), {})
     lines = capsys.readouterr().out.splitlines()
     claims = [m.group(1).strip() for m in re.finditer(r"print\(.*?#(.*)$", code, flags=re.M)]
     assert len(lines) == len(claims) == 4
@@ -558,8 +551,8 @@ def test_readme_analysis_snippet_runs_and_its_comments_are_true(
                 assert g == w, (printed, claim)
 
 
-def test_readme_sweep_block_is_the_example_with_every_key() -> None:
-    (block,) = [b for b in re.findall(r"```toml\n(.*?)```", ANALYSES, flags=re.S)]
+def test_the_docs_sweep_block_is_the_example_with_every_key() -> None:
+    (block,) = docs_blocks.blocks(ANALYSES, "toml")
     documented = tomllib.loads(block)
     example = tomllib.loads(FRF.read_text(encoding="utf-8"))
     assert documented["sweep"].keys() >= {

@@ -16,14 +16,15 @@ from pathlib import Path
 import pytest
 
 import vibroimpact as vi
+from docs_blocks import blocks, page
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
-README = (ROOT / "README.md").read_text(encoding="utf-8")
-# The README's scenario block documents the format the same way.
-README_SCENARIOS = [
-    b
-    for b in re.findall(r"```toml\n(.*?)```", README, flags=re.S)
+# The README's and the documentation pages' scenario blocks document the format the same way.
+DOCUMENTED_SCENARIOS = [
+    (name, b)
+    for name in ("README", "scenario_format", "model", "analyses")
+    for b in blocks(page(name), "toml")
     if "[system]" in b or "[structure]" in b
 ]
 NOT_A_CHOICE = "not-a-choice"
@@ -75,13 +76,18 @@ def test_the_parser_finds_choice_lists_and_their_continuations() -> None:
 
 
 DOCUMENTED = [(p.name, p.read_text(encoding="utf-8")) for p in EXAMPLES] + [
-    ("README.md", text) for text in README_SCENARIOS
+    (f"{name} block {i}", text) for i, (name, text) in enumerate(DOCUMENTED_SCENARIOS)
 ]
 
 
-def test_the_examples_and_the_readme_list_choices() -> None:
+def test_the_examples_and_the_docs_list_choices() -> None:
     # Otherwise the test below would check nothing.
-    assert EXAMPLES and README_SCENARIOS
+    assert EXAMPLES and {name for name, _ in DOCUMENTED_SCENARIOS} == {
+        "README",
+        "scenario_format",
+        "model",
+        "analyses",
+    }
     assert sum(len(choice_lists(text)) for _, text in DOCUMENTED) >= 6
 
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+import docs_blocks
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER
 from vibroimpact.analysis import AnalysisError, with_parameter
@@ -154,7 +155,7 @@ def test_a_recorded_file_above_the_limit_is_refused(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     assert record_file.MAX_RECORDED_FILE_BYTES == 64 * 2**20
-    assert "64 MiB" in (ROOT / "README.md").read_text(encoding="utf-8")
+    assert "file is at most 64 MiB" in docs_blocks.prose(docs_blocks.section("limits", "Limits"))
     (tmp_path / "rec.csv").write_text("".join(f"{i},0\n" for i in range(100)))
     parse_scenario(RECORDED.format(file="rec.csv"), "s.toml", tmp_path)  # fits
     monkeypatch.setattr(record_file, "MAX_RECORDED_FILE_BYTES", 100)

@@ -24,7 +24,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import re
 import shlex
 import shutil
 import subprocess
@@ -40,6 +39,7 @@ from numpy.typing import NDArray
 from scipy.linalg import expm
 from scipy.optimize import minimize_scalar
 
+import docs_blocks
 import vibroimpact as vi
 from orbit_checks import spectrum_distance, state_error  # noqa: E402
 from vibroimpact import analysis as an
@@ -1032,22 +1032,14 @@ def test_help_lists_the_new_commands(run_cli: RunCli) -> None:
 
 
 # --------------------------------------------------------------------------------------
-# README
-
-README = (ROOT / "README.md").read_text(encoding="utf-8")
+# The documentation's analyses page
 
 
-def readme_section(title: str) -> str:
-    start = README.index(f"## {title}\n")
-    end = README.find("\n## ", start + 1)
-    return README[start:end]
-
-
-def test_readme_map_commands_work_as_written(tmp_path: Path) -> None:
-    # The section's ```sh block holds the orbit and sweep commands (test_analysis_cli);
-    # the commands of these analyses are in its ```shell block.
-    section = readme_section("Forced response and periodic orbits")
-    (block,) = re.findall(r"```shell\n(.*?)```", section, flags=re.S)
+def test_the_docs_map_commands_work_as_written(tmp_path: Path) -> None:
+    # The section's "sh" block holds the orbit and sweep commands (test_analysis_cli);
+    # the commands of these analyses are in its "shell" block.
+    analyses = docs_blocks.section("analyses", "Forced response and periodic orbits")
+    (block,) = docs_blocks.blocks(analyses, "shell")
     commands = [line for line in block.splitlines() if line.strip()]
     verbs = {shlex.split(c)[1] for c in commands}
     assert verbs == {"continue", "bifurcation", "poincare", "basins"}

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+import docs_blocks
 import vibroimpact as vi
 from test_public_inputs import FLOAT_ARGUMENTS, VALID, names
 from vibroimpact._core import check_solver
@@ -151,11 +152,10 @@ def test_the_command_line_says_so_in_one_line(
 # ------------------------------------------------------------------------------ 2. memory
 
 
-def test_the_default_row_cap_and_tolerance_are_the_cores_and_the_readmes() -> None:
+def test_the_default_row_cap_and_tolerance_are_the_cores_and_the_docs() -> None:
     assert vi.DEFAULT_MAX_ROWS == 20_000_000
     assert vi.DEFAULT_ENERGY_TOLERANCE == 0.05
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    limits = " ".join(readme.split("## Limits", 1)[1].split("\n## ", 1)[0].split())
+    limits = docs_blocks.prose(docs_blocks.section("limits", "Limits"))
     assert "20 million" in limits and "5 %" in limits
     for key in ("max_steps", "max_rows", "history", "every", "energy_tolerance", "t_end"):
         assert f"`{key}" in limits, key

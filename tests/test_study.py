@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+import docs_blocks
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER, assert_refused  # noqa: E402
 from vibroimpact import study as st
@@ -343,15 +344,14 @@ def test_a_study_whose_every_run_fails_exits_1_with_its_file_written(tmp_path: P
         assert ("every one of the 2 runs failed" in done.stderr) == bool(status)
 
 
-def test_the_readme_study_commands_work_as_written(tmp_path: Path) -> None:
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    section = readme.split("## Studies", 1)[1].split("\n## ", 1)[0]
-    shell = section.split("```sh\n", 1)[1].split("```", 1)[0].strip()
-    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+def test_the_docs_study_commands_work_as_written(tmp_path: Path) -> None:
+    studies = docs_blocks.section("analyses", "Studies")
+    shell = docs_blocks.blocks(studies, "sh")[0].strip()
+    code = docs_blocks.blocks(studies, "python")[0]
     root = Path(__file__).resolve().parents[1]
     argv = shell.split()
     assert argv[:2] == ["vibroimpact", "study"]
-    # Run where the README is, the output kept out of the checkout.
+    # Run where the page says (the checkout's root), the output kept out of the checkout.
     (tmp_path / "examples").symlink_to(root / "examples")
     done = subprocess.run(
         [sys.executable, "-m", "vibroimpact", *argv[1:]],

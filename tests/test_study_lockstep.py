@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+import docs_blocks
 import vibroimpact as vi
 from study_checks import assert_refused, load_study  # noqa: E402
 from vibroimpact import study as st
@@ -195,11 +196,10 @@ def test_what_the_lockstep_kernel_cannot_take_exits_2_naming_the_key(
     assert_refused(done, words, tmp_path / "r.nc")
 
 
-def test_the_readme_lockstep_block_runs(tmp_path: Path) -> None:
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    section = readme.split("### Lockstep ensembles", 1)[1].split("\n## ", 1)[0]
-    block = section.split("```toml\n", 1)[1].split("```", 1)[0]
-    # Fewer runs than the README's 10000, to keep the test short.
+def test_the_docs_lockstep_block_runs(tmp_path: Path) -> None:
+    lockstep = docs_blocks.section("analyses", "Lockstep ensembles")
+    block = docs_blocks.blocks(lockstep, "toml")[0]
+    # Fewer runs than the page's 10000, to keep the test short.
     assert "count = 10000" in block
     ds = st.run(
         load(tmp_path, BASE + block.replace("count = 10000", "count = 16")), tmp_path / "r.nc"

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+import docs_blocks
 import vibroimpact as vi
 from vibroimpact.cli import command as cli
 from vibroimpact.cli import main
@@ -404,8 +405,10 @@ def test_the_report_lists_exactly_the_files_written(paper_run: tuple[Path, str])
     assert "work_precision.png" in names and "report.md" in names
     wrote = re.search(r"wrote (.*) to ", stdout)
     assert wrote is not None and sorted(wrote.group(1).split(", ")) == files_in(out)
-    # The README's description of the job names them all too.
-    described = README[README.index("`vibroimpact paper` writes") :].split("\n\n")[0]
+    # The command line page's description of the job names them all too.
+    cli_page = docs_blocks.page("cli")
+    paragraph = cli_page[cli_page.index("``vibroimpact paper`` writes") :].split("\n\n")[0]
+    described = docs_blocks.prose(paragraph)
     for name in files_in(out):
         assert f"`{name}`" in described, name
 
@@ -555,18 +558,18 @@ def test_the_table_and_help_say_what_dissipated_means(
         main(["simulate", "--help"])
     described = " ".join(capsys.readouterr().out.split())
     assert cli.ENERGY_DISSIPATED_TEXT in described and cli.ENERGY_CHANGE_TEXT in described
-    readme = " ".join(README.split())
-    assert "work of the contact's dissipative forces" in readme
-    assert "mechanical energy at separation minus at onset" in readme
+    cli_page = docs_blocks.prose(docs_blocks.page("cli"))
+    assert "work of the contact's dissipative forces" in cli_page
+    assert "mechanical energy at separation minus at onset" in cli_page
 
 
-def test_the_readme_figures_for_the_default_run_are_its_own(
+def test_the_docs_figures_for_the_default_run_are_its_own(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     status, out, _ = run_main(capsys, "simulate", "--json")
     assert status == 0
     (contact,) = json.loads(out)["contacts"]
-    text = " ".join(README.split())
+    text = docs_blocks.prose(docs_blocks.page("cli"))
     claim = re.search(
         r"rebounds at ([0-9.]+) of the approach speed while ([0-9.e-]+) J are dissipated, "
         r"and the system gains ([0-9.e-]+) J",
