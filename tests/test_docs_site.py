@@ -25,7 +25,8 @@ from vibroimpact.system import schema
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
-PAGES = ["index", "getting_started", "model", "api", "scenario_format", "cli", "development"]
+PAGES = ["index", "getting_started", "model", "methods", "api", "scenario_format", "cli"]
+PAGES += ["development"]
 PACKAGES = ["vibroimpact", *(f"vibroimpact.{p}" for p in ("analysis", "study", "system"))]
 PACKAGES += [f"vibroimpact.{p}" for p in ("model", "scenario", "cli", "paper")]
 
