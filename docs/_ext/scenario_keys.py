@@ -64,7 +64,7 @@ _OUTPUT = {
 TWO_MASS = {
     "system": {
         "main_mass": ("kg", "> 0", "M, the main mass"),
-        "stiffness": ("N m-1", "> 0", "K, the main spring"),
+        "stiffness": ("N m-1", ">= 0", "K, the main spring"),
         "damping": ("N s m-1", ">= 0", "C, the main damper"),
         "impact_mass": ("kg", "> 0", "m, the loose impact mass"),
         "clearance": ("m", ">= 0", "d, the clearance on each side of the impact mass"),
@@ -185,10 +185,18 @@ SYSTEM = {
             None,
             '"harmonic": amplitude cos(2 pi frequency t + phase); "sweep" likewise',
         ),
-        "frequency": ("Hz", "> 0", '"harmonic"\'s frequency'),
+        "frequency": ("Hz", ">= 0", '"harmonic"\'s frequency'),
         "phase": ("rad", None, '"harmonic" and "sweep" (default 0)'),
-        "start_frequency": ("Hz", "> 0", '"sweep"\'s frequency at t = 0'),
-        "end_frequency": ("Hz", "> 0", '"sweep"\'s frequency at its duration'),
+        "start_frequency": (
+            "Hz",
+            '>= 0 (linear sweep), > 0 ("logarithmic")',
+            '"sweep"\'s frequency at t = 0',
+        ),
+        "end_frequency": (
+            "Hz",
+            '>= 0 (linear sweep), > 0 ("logarithmic")',
+            '"sweep"\'s frequency at its duration',
+        ),
         "duration": (
             "s",
             "> 0",
@@ -214,7 +222,11 @@ SYSTEM = {
         "cutoff_frequency": ("Hz", "> 0", "random signals: the band's upper end"),
         "ground_frequency": ("Hz", "> 0", '"kanai-tajimi": the ground filter\'s frequency'),
         "ground_damping": ("1", "> 0", '"kanai-tajimi": the ground filter\'s damping ratio'),
-        "seed": ("1", "a whole number", "random signals: the same seed, the same samples"),
+        "seed": (
+            "1",
+            "a whole number",
+            "random signals (required): the same seed, the same samples",
+        ),
     },
     "initial": {
         "structure_displacement": ("m", None, "the structure's coordinates at t = 0 (zeros)"),

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, TypeVar
 
-from vibroimpact._core import InvalidInputError
+from vibroimpact._core import InvalidInputError, PreparedSystem
 from vibroimpact.arguments import directory
 from vibroimpact.messages import shown
 from vibroimpact.model.parts import (
@@ -129,23 +129,28 @@ class System:
         return system_html(self)
 
     def _check(self) -> None:
-        """Every value through the scenario's schema (its errors, word for word)."""
+        """Every value through the scenario's schema (its errors, word for word), then
+        through the core, which holds the model's ranges (a damper's mass > 0, a
+        frequency >= 0, ...): a System that is built is one that runs, and a bad value is
+        refused where it is written, not when it is first simulated."""
         sections = self.to_dict()
         model = self.model_sections()
         if self.solver is not None and self.solver.t_end is not None:
-            prepare_system(
+            run = prepare_system(
                 **model,
                 solver=sections["solver"],
                 output=sections.get("output"),
                 base_dir=self.base_dir,
             )
+            PreparedSystem(run.binding_spec(), **run.method_arguments())
             return
         initial = model.pop("initial")
         try:
-            system_spec(**model, base_dir=self.base_dir)
+            spec = system_spec(**model, base_dir=self.base_dir)
         except RecursionError:
             raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
         _table("[initial] ", {} if initial is None else initial, _INITIAL)
+        _core_check(spec)
 
     def model_sections(self) -> dict[str, Any]:
         """The model's sections as :func:`vibroimpact.system.prepare_system` takes them
@@ -226,7 +231,7 @@ class System:
             # A table the parts cannot take (an unknown key, a missing kind): the
             # schema's error names it.
             model = {name: sections.get(name) for name in known}
-            system_spec(
+            spec = system_spec(
                 model["structure"],
                 model["damper"] or (),
                 model["stop"] or (),
@@ -244,6 +249,8 @@ class System:
                 for key in table:
                     if key not in schema:
                         raise _unknown_key(f"[{name}] ", key, list(schema), "allowed:") from None
+            # A key the core requires (a random signal's seed): its error names it.
+            _core_check(spec)
             raise
 
     @classmethod
@@ -333,3 +340,11 @@ def sections_of(data: Any, base_dir: Path | None = None) -> tuple[Mapping[str, A
             f"scenario) or a vibroimpact.System, got {shown(data)}"
         )
     return data, base_dir
+
+
+def _core_check(spec: dict[str, Any]) -> None:
+    """The model's ranges and required keys, which the core holds (a damper's mass > 0, a
+    frequency >= 0, a random signal's seed), checked on the schema's ``spec`` as a run
+    checks them: its error names the key. Any run length: these checks do not depend on it."""
+    binding = {**spec, "gravity": spec["gravity"]["acceleration"], "points": [], "moments": []}
+    PreparedSystem(binding, t_end=1.0)
