@@ -18,6 +18,7 @@ from vibroimpact.analysis.limits import whole_count
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
 from vibroimpact.analysis.runs import _prepare
 from vibroimpact.model.system import System, sections_of
+from vibroimpact.study.beam_axes import beam_corners, resolve_beam_axes
 from vibroimpact.study.limits import StudyError, check_threads
 from vibroimpact.study.settings import base_metrics, study_settings
 
@@ -81,12 +82,20 @@ class Study:
         if random:
             columns += [draws[index[-1]] for draws in random.values()]
         values = np.column_stack(columns) if columns else np.zeros((0, 0))
+        paths = list(self.settings["axes"]) + list(random)
+        if len(values):
+            paths, values = resolve_beam_axes(self.data["structure"], paths, values)
+        elif paths:
+            # No run: the beam's axes checked at the corners of their ranges.
+            every = [*axes, *random.values()]
+            paths = resolve_beam_axes(self.data["structure"], paths, beam_corners(paths, every))[0]
+            values = np.zeros((0, len(paths)))
         solver = prepared.solver
         s = self.settings
         raw: dict[str, Any] = run_study(
             prepared.binding_spec(),
             [list(prepared.initial[k]) for k in _INITIAL],
-            paths=list(self.settings["axes"]) + list(random),
+            paths=paths,
             values=np.ascontiguousarray(values.ravel(), dtype=float),
             method=solver["method"],
             dt=solver["dt"],

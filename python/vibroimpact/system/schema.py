@@ -488,6 +488,27 @@ def structure_coordinates(structure: Mapping[str, Any]) -> int:
     return len(structure["mass"])
 
 
+def structure_spec(structure: Any) -> dict[str, Any]:
+    """The ``[structure]`` table checked, its defaults filled and a cantilever's section
+    and material resolved to what the core takes (see :func:`system_spec`)."""
+    if not isinstance(structure, Mapping):
+        raise _fail("", f"[structure] must be a table, got {shown(structure)}")
+    kind = structure.get("kind")
+    _choice("[structure] ", "kind", kind, tuple(_STRUCTURE))
+    schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[str(kind)]}
+    table = _table("[structure] ", structure, schema)
+    if kind == "cantilever":
+        if not 1 <= table["modes"] <= 200:
+            raise _fail(
+                "[structure] modes: ", f"must be a whole number in [1, 200], got {table['modes']}"
+            )
+        table = resolve_cantilever(table)
+    if kind == "matrices" and table["damping"] is None:
+        size = len(table["mass"])
+        table["damping"] = [[0.0] * size for _ in range(size)]
+    return table
+
+
 def system_spec(
     structure: Any,
     damper: Any = (),
@@ -498,22 +519,7 @@ def system_spec(
 ) -> dict[str, Any]:
     """The sections of a system, checked and with their defaults filled (see the module
     docstring); errors name the section and key."""
-    if not isinstance(structure, Mapping):
-        raise _fail("", f"[structure] must be a table, got {shown(structure)}")
-    kind = structure.get("kind")
-    _choice("[structure] ", "kind", kind, tuple(_STRUCTURE))
-    schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[str(kind)]}
-    spec: dict[str, Any] = {"structure": _table("[structure] ", structure, schema)}
-    if kind == "cantilever":
-        if not 1 <= spec["structure"]["modes"] <= 200:
-            raise _fail(
-                "[structure] modes: ",
-                f"must be a whole number in [1, 200], got {spec['structure']['modes']}",
-            )
-        spec["structure"] = resolve_cantilever(spec["structure"])
-    if kind == "matrices" and spec["structure"]["damping"] is None:
-        size = len(spec["structure"]["mass"])
-        spec["structure"]["damping"] = [[0.0] * size for _ in range(size)]
+    spec: dict[str, Any] = {"structure": structure_spec(structure)}
     damper_tables, stop_tables = _list("damper", damper), _list("stop", stop)
     if len(damper_tables) + len(stop_tables) > MAX_PAIRS:
         # Before any is read: simultaneous impacts solve over every pair, a matrix
