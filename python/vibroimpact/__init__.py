@@ -125,7 +125,7 @@ run_study = _typed()(_run_study)
 run_study.__doc__ = (
     "The low-level kernel of a study: runs one chunk of runs, without checks of the\n"
     "settings, files or resumption. To run a study, use\n"
-    "``vibroimpact.study.run(vibroimpact.study_of(system), \"study.nc\")`` (it calls this\n"
+    '``vibroimpact.study.run(vibroimpact.study_of(system), "study.nc")`` (it calls this\n'
     "for each chunk and writes the Dataset; ``vibroimpact study`` on the command line).\n\n"
     + (_run_study.__doc__ or "")
 )
