@@ -48,7 +48,12 @@ def probes(text: str) -> tuple[list[float], list[float]] | None:
 
 def ranged_keys() -> Iterator[tuple[str, str, str, str]]:
     """(format, section, key, range) of every key whose range is a plain bound."""
-    for form, table in (("system", scenario_keys.SYSTEM), ("two-mass", scenario_keys.TWO_MASS)):
+    for form, table in (
+        ("system", scenario_keys.SYSTEM),
+        ("two-mass", scenario_keys.TWO_MASS),
+        # The analyses' sections are a system scenario's: probed in the examples holding them.
+        ("system", scenario_keys.ANALYSES),
+    ):
         for section, keys in table.items():
             for key, (_, span, _) in keys.items():
                 if span is not None and probes(span) is not None:
@@ -120,8 +125,58 @@ t_end = 0.01
 [output]
 strobe_period = 0.001
 """
+# The analyses' keys the examples leave to their defaults; the basins' axes as tables of
+# their own, so that they are probed as a section.
+_ANALYSES = """
+[sweep]
+parameter = "excitation.0.frequency"
+start = 8.0
+stop = 12.0
+count = 5
+tolerance = 1e-6
+
+[continuation]
+parameter = "excitation.0.frequency"
+stop = 12.0
+max_points = 50
+tolerance = 1e-9
+
+[basins]
+settle_periods = 20
+record_periods = 5
+tolerance = 1e-6
+
+[basins.x]
+state = "structure_displacement.0"
+start = -0.01
+stop = 0.01
+count = 3
+
+[basins.y]
+state = "structure_velocity.0"
+start = -0.1
+stop = 0.1
+count = 3
+
+[study]
+analysis = "orbit"
+orbit_periods = 1
+record_from = 0.1
+tolerance = 1e-6
+samples = 2
+seed = 3
+
+[study.axes]
+"damper.0.clearance" = [0.004, 0.005]
+
+[study.random]
+"damper.0.mass" = { uniform = [0.04, 0.06] }
+"""
 SYNTHETIC = [_BASE.format(signal=signal) for signal in _SIGNALS]
 SYNTHETIC += [_BEAM.format(beam=beam) for beam in _BEAMS]
+SYNTHETIC += [
+    _BASE.format(signal='signal = "harmonic"\namplitude = 1.0\nfrequency = 10.0') + _ANALYSES
+]
 
 
 def examples_setting(section: str, key: str) -> Iterator[tuple[Path, str]]:
@@ -130,10 +185,14 @@ def examples_setting(section: str, key: str) -> Iterator[tuple[Path, str]]:
     scenarios = [(p, p.read_text(encoding="utf-8")) for p in sorted(ROOT.glob("examples/*.toml"))]
     scenarios += [(ROOT / "examples" / f"synthetic_{i}.toml", t) for i, t in enumerate(SYNTHETIC)]
     for path, text in scenarios:
-        part = tomllib.loads(text).get(section)
-        if isinstance(part, list):
-            part = part[0] if part else None
-        if not isinstance(part, dict):
+        part: object = tomllib.loads(text)
+        for name in section.split("."):  # "basins.x": [basins.x]
+            part = part.get(name) if isinstance(part, dict) else None
+            if isinstance(part, list):
+                part = part[0] if part else None
+        # An inline table ([basins] x = {...}) has no header for with_value to find.
+        header = rf"^\[\[?{re.escape(section)}\]\]?"
+        if not isinstance(part, dict) or not re.search(header, text, flags=re.M):
             continue
         value = part.get(key)
         if isinstance(value, int | float) and not isinstance(value, bool):

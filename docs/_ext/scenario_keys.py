@@ -1,7 +1,8 @@
 """What each scenario key means, for the format reference (``scenario_reference``).
 
 The keys, their types, defaults and the solver's ranges come from the code (the schemas in
-``vibroimpact.system.schema`` and ``vibroimpact.scenario.two_mass``, the core registry
+``vibroimpact.system.schema`` and ``vibroimpact.scenario.two_mass``, the analyses' in
+``vibroimpact.analysis.settings`` and ``vibroimpact.study.settings``, the core registry
 ``vibroimpact.METHOD_OPTIONS``, the units of ``vibroimpact.units``). This table adds
 the meaning, and the unit and range where the code holds none. The build fails on a key of
 a schema missing here, on an entry here that no schema has, and on a unit here that differs
@@ -39,7 +40,7 @@ _SOLVER = {
     ),
     "beta": (None, None, "Newmark's beta"),
     "gamma": (None, None, "Newmark's gamma"),
-    "spectral_radius": (None, None, "generalized-alpha's high-frequency spectral radius"),
+    "spectral_radius": ("1", None, "generalized-alpha's high-frequency spectral radius"),
     "rtol": (None, None, "the adaptive methods' relative tolerance"),
     "atol": ("m and m s-1", None, "the adaptive methods' absolute tolerance"),
     "max_steps": (None, None, "the most steps a run may take"),
@@ -72,6 +73,11 @@ TWO_MASS = {
     "contact": {
         **_LAW,
         "law": (None, '"hertz", "hyster-hertz", "hertz-damped" or "linear"', "the contact law"),
+        "stiffness": (
+            'N m-1.5 (N m-1 for "linear")',
+            "> 0",
+            'the law\'s stiffness K_hz (k1 for "linear")',
+        ),
         "restitution": (
             "1",
             '(0, 1]; required by "hyster-hertz" and "hertz-damped" only',
@@ -153,7 +159,7 @@ SYSTEM = {
             '"upper" or "lower"',
             '"upper" keeps the point at or below +gap, "lower" at or above -gap',
         ),
-        "gap": ("m", None, "the distance to the stop"),
+        "gap": ("m", ">= 0", "the distance to the stop"),
         "against": (
             None,
             _POINT,
@@ -237,13 +243,149 @@ SYSTEM = {
     "solver": _SOLVER,
     "output": {
         **_OUTPUT,
-        "record_from": ("s", ">= 0", "keep the history, contacts and reductions from this time"),
+        "record_from": (
+            "s",
+            ">= 0",
+            "the located peaks and RMS (peak, rms, point_*, moment_*) from this time on; the "
+            "history, contacts, strobe and energy balance still start at t = 0",
+        ),
         "strobe_period": ("s", "> 0", "keep the state once every period (Poincare section)"),
         "points": (None, _POINT, "structure points whose displacement every reduction follows"),
         "moments": (
             "m",
             "[0, length], a cantilever only",
             "positions from the clamp whose bending moment E I w'' (N m) every reduction follows",
+        ),
+    },
+}
+
+_PARAMETER = 'a dotted path to a number of the scenario, such as "excitation.0.frequency"'
+_SETTLE = (
+    "1",
+    ">= 0",
+    "forcing periods run and forgotten before recording (settle plus record: at most 10^7)",
+)
+_RECORD = ("1", ">= 1", "forcing periods recorded once settled")
+_SETTLED = (
+    "1",
+    "> 0",
+    "the stroboscopic state repeats within this, relative to the size of the motion",
+)
+_VALUES_AXIS = {
+    "start": ("the parameter's", 'finite; > 0 for spacing = "log"', "the first value"),
+    "stop": ("the parameter's", 'finite; > 0 for spacing = "log"', "the last value"),
+    "count": ("1", ">= 1", "how many values, start and stop among them"),
+    "spacing": (None, '"linear" or "log"', "even steps, or an even ratio"),
+}
+
+ANALYSES = {
+    "sweep": {
+        **_VALUES_AXIS,
+        "parameter": (None, _PARAMETER, "the parameter swept"),
+        "count": ("1", "[1, 100000]", "how many values, start and stop among them"),
+        "direction": (
+            None,
+            '"up", "down" or "both"',
+            "each value starts from the last one's settled state: in increasing order, "
+            'decreasing, or "up" then "down" (hysteresis)',
+        ),
+        "settle_periods": _SETTLE,
+        "record_periods": _RECORD,
+        "tolerance": _SETTLED,
+        "sample": (
+            None,
+            '"displacement", "impact-velocity" or "impact-phase"',
+            "bifurcation only: coordinate 0's displacement once a period (m), or at each "
+            "impact its approach speed (m s-1) or its phase w t modulo 2 pi (rad)",
+        ),
+        "pair": (
+            None,
+            'a pair of the scenario, such as "stop 0" or "damper 1"',
+            'bifurcation, "impact-velocity" and "impact-phase" only: whose impacts (default '
+            "every pair's)",
+        ),
+    },
+    "continuation": {
+        "parameter": (None, _PARAMETER, "the parameter continued, from the scenario's value"),
+        "stop": ("the parameter's", None, "the value the branch is continued to"),
+        "periods": ("1", "[1, 10000000]", "K: the orbit's period in forcing periods"),
+        "step": ("the parameter's", "> 0", "the step along the branch, about (default chosen)"),
+        "max_points": ("1", "[2, 100000]", "the most points the branch may have"),
+        "tolerance": ("1", "> 0", "the shooting's Newton tolerance on the orbit"),
+    },
+    "basins": {
+        "x": (None, "a table: state, start, stop, count", "the grid's first axis"),
+        "y": (None, "a table: state, start, stop, count", "its second, another entry"),
+        "settle_periods": _SETTLE,
+        "record_periods": _RECORD,
+        "tolerance": _SETTLED,
+    },
+    "basins.x": {
+        "state": (
+            None,
+            '"structure_displacement", "structure_velocity", "damper_displacement" or '
+            '"damper_velocity" with an index, such as "structure_displacement.0"',
+            "the entry of [initial] the axis varies",
+        ),
+        "start": ("m or m s-1", "finite", "its first value"),
+        "stop": ("m or m s-1", "finite", "its last value"),
+        "count": ("1", ">= 1", "how many values (x count times y count at most 10^6)"),
+    },
+    "study": {
+        "analysis": (
+            None,
+            '"run", "steady-state" or "orbit"',
+            '"run": each point to [solver] t_end; "steady-state": settle then record; '
+            '"orbit": settle, then shoot a periodic orbit and its stability',
+        ),
+        "metrics": (
+            None,
+            '"peak", "rms", "impacts", "energy_dissipated" (run, steady-state); '
+            '"amplitude", "impacts_per_period", "settled" (steady-state); "amplitude", '
+            '"impacts_per_period", "stable", "largest_multiplier" (orbit); "point_peak", '
+            '"point_rms", "point_amplitude", "moment_peak"...',
+            'what each point keeps (default "peak", "rms", "impacts"; an orbit\'s four for '
+            '"orbit")',
+        ),
+        "settle_periods": _SETTLE,
+        "record_periods": _RECORD,
+        "orbit_periods": ("1", ">= 1", '"orbit": K, the orbit\'s period in forcing periods'),
+        "record_from": (
+            "s",
+            ">= 0",
+            '"run": metrics from this time on (default [output] record_from, else 0)',
+        ),
+        "tolerance": _SETTLED,
+        "chunk_size": ("1", ">= 1", "runs per chunk: the most an interruption can lose"),
+        "samples": (
+            "1",
+            "0 without [study.random], >= 1 with it",
+            "the random draws at each point of the grid",
+        ),
+        "seed": ("1", "a whole number", "the seed of every [study.random] draw"),
+        "stepping": (
+            None,
+            '"events" or "fixed"',
+            '"fixed" runs the points in lockstep at [solver] dt (analysis = "run"; '
+            'metrics "peak", "rms", "impacts")',
+        ),
+        "axes": (None, "see [study.axes]", "the grid: one axis per parameter"),
+        "random": (None, "see [study.random]", "parameters drawn at random for each sample"),
+    },
+    "study.axes": {
+        "<parameter>": (
+            "the parameter's",
+            "a list of numbers, or a table: start, stop, count, spacing",
+            'a dotted path such as "damper.0.mass" (quoted) = its values; the study runs '
+            "every combination (10^7 runs at most)",
+        ),
+    },
+    "study.random": {
+        "<parameter>": (
+            "the parameter's",
+            "{uniform = [low, high]}, {normal = [mean, std]}; a seed: {from = N}",
+            "a dotted path (quoted) = its distribution, drawn [study] samples times "
+            "(a seed: N, N + 1, ...)",
         ),
     },
 }

@@ -4,9 +4,11 @@ Two tables per format: the two-mass damper's (``[system]``, ``[contact]``, ...; 
 ``vibroimpact.scenario.two_mass``) and the systems' (``[structure]``, ``[[damper]]``, ...;
 ``vibroimpact.system.schema``). Types and defaults are the schemas', the solver's ranges the
 core registry's (``vibroimpact.METHOD_OPTIONS``), the choices of ``method`` the registry's
-names, units those of ``vibroimpact.units`` where it knows them; ``scenario_keys``
-adds meanings. A key without a description, a description of no key or a unit that differs
-from the code's is a warning (an error under ``-W``).
+names (for the two-mass damper, those its loader accepts), units those of
+``vibroimpact.units`` where it knows them; ``scenario_keys`` adds meanings. A third table
+holds the analyses' sections (``vibroimpact.analysis.settings``,
+``vibroimpact.study.settings``). A key without a description, a description of no key or
+a unit that differs from the code's is a warning (an error under ``-W``).
 """
 
 from __future__ import annotations
@@ -15,14 +17,17 @@ from typing import Any
 
 from docutils import nodes
 from docutils.statemachine import StringList
-from scenario_keys import SYSTEM, TWO_MASS
+from scenario_keys import ANALYSES, SYSTEM, TWO_MASS
 from sphinx.application import Sphinx
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 from sphinx.util.nodes import nested_parse_with_titles
 
 import vibroimpact as vi
+from vibroimpact._core import check_solver
+from vibroimpact.analysis import settings as analysis_settings
 from vibroimpact.scenario import two_mass
+from vibroimpact.study import settings as study_settings
 from vibroimpact.system import schema
 from vibroimpact.units import parameter_units
 
@@ -58,14 +63,52 @@ def _system_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
     }
 
 
+def _analysis_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
+    """Section -> (how it is written, key -> (type, default)) of the analyses' sections:
+    the schemas their checks read (``vibroimpact.analysis.settings``,
+    ``vibroimpact.study.settings``), with the keys those checks read beside them."""
+    study = {
+        **study_settings._STUDY,
+        # Read beside the schema by study_settings: the default follows the analysis.
+        "metrics": ("array of strings", None),
+        "axes": ("table", schema._REQ),
+        "random": ("table", None),
+    }
+    return {
+        "sweep": ("[sweep]", analysis_settings._SWEEP),
+        "continuation": ("[continuation]", analysis_settings._CONTINUATION),
+        "basins": ("[basins]", analysis_settings._BASINS),
+        "basins.x": ("[basins] x and y", analysis_settings._AXIS),
+        "study": ("[study]", study),
+        # Keyed by the parameters' paths: one row for the form of every entry.
+        "study.axes": ("[study.axes]", {"<parameter>": ("array or table", schema._REQ)}),
+        "study.random": ("[study.random]", {"<parameter>": ("table", None)}),
+    }
+
+
 def _two_mass_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
     return {name: (f"[{name}]", keys) for name, keys in two_mass._SCHEMA.items()}
 
 
-def _allowed(section: str, key: str, written: str | None) -> str:
+def _two_mass_methods() -> list[str]:
+    """The registry's methods the two-mass damper's check accepts (the core keeps that
+    format's own list, which it does not export: "exact" is for systems only)."""
+    accepted = []
+    for name in vi.METHODS:
+        try:
+            check_solver(t_end=1.0, dt=1e-3, method=name)
+        except vi.InvalidInputError as err:
+            if not str(err).startswith("method "):
+                raise  # refused for another reason: the probe itself is wrong
+            continue
+        accepted.append(name)
+    return accepted
+
+
+def _allowed(section: str, key: str, written: str | None, methods: list[str]) -> str:
     """The range or choices of a key: the core registry's where it has them."""
     if section == "solver" and key == "method":
-        return ", ".join(f'"{name}"' for name in vi.METHODS)
+        return ", ".join(f'"{name}"' for name in methods)
     if section == "solver" and key in vi.METHOD_OPTIONS:
         return str(vi.METHOD_OPTIONS[key]["allowed"])
     return written or ""
@@ -84,6 +127,7 @@ def _table(
     sections: dict[str, tuple[str, dict[str, tuple[str, Any]]]],
     described: dict[str, dict[str, tuple[str | None, str | None, str]]],
     required: object,
+    methods: list[str],
     location: Any,
 ) -> list[str]:
     lines: list[str] = []
@@ -130,7 +174,7 @@ def _table(
                 f"     - {kind}",
                 f"     - {_default(default, required)}",
                 f"     - {_unit(section, key, unit, where) or '—'}",
-                f"     - {_allowed(section, key, allowed) or '—'}",
+                f"     - {_allowed(section, key, allowed, methods) or '—'}",
                 f"     - {meaning}",
             ]
         lines.append("")
@@ -138,15 +182,36 @@ def _table(
 
 
 class ScenarioFormat(SphinxDirective):
-    required_arguments = 1  # "two-mass" or "system"
+    required_arguments = 1  # "two-mass", "system" or "analyses"
 
     def run(self) -> list[nodes.Node]:
         if self.arguments[0] == "two-mass":
             lines = _table(
-                "two-mass", _two_mass_sections(), TWO_MASS, two_mass._REQUIRED, self.get_location()
+                "two-mass",
+                _two_mass_sections(),
+                TWO_MASS,
+                two_mass._REQUIRED,
+                _two_mass_methods(),
+                self.get_location(),
+            )
+        elif self.arguments[0] == "analyses":
+            lines = _table(
+                "analyses",
+                _analysis_sections(),
+                ANALYSES,
+                schema._REQ,
+                list(vi.METHODS),
+                self.get_location(),
             )
         else:
-            lines = _table("system", _system_sections(), SYSTEM, schema._REQ, self.get_location())
+            lines = _table(
+                "system",
+                _system_sections(),
+                SYSTEM,
+                schema._REQ,
+                list(vi.METHODS),
+                self.get_location(),
+            )
         node = nodes.section()
         node.document = self.state.document
         nested_parse_with_titles(self.state, StringList(lines, source="<scenario schema>"), node)

@@ -120,6 +120,15 @@ check_solver = _typed(**_TEXTS)(_check_solver)
 cantilever_mode_shape = _typed(derivative=int)(_cantilever_mode_shape)
 goldsmith_contact_duration = _typed(exact_constant=bool)(_goldsmith_contact_duration)
 run_study = _typed()(_run_study)
+# The binding's own text says what a chunk does; a reader looking for a study's call
+# should find the public one first.
+run_study.__doc__ = (
+    "The low-level kernel of a study: runs one chunk of runs, without checks of the\n"
+    "settings, files or resumption. To run a study, use\n"
+    '``vibroimpact.study.run(vibroimpact.study_of(system), "study.nc")`` (it calls this\n'
+    "for each chunk and writes the Dataset; ``vibroimpact study`` on the command line).\n\n"
+    + (_run_study.__doc__ or "")
+)
 
 __all__ = [
     "run_study",

@@ -75,7 +75,13 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
         return _KEY_UNITS[key]
     if section == "structure" and key == "stiffness":
         return "N m-1"
-    if section == "solver" and key in ("rtol", "energy_tolerance", "beta", "gamma"):
+    if section == "solver" and key in (
+        "rtol",
+        "energy_tolerance",
+        "beta",
+        "gamma",
+        "spectral_radius",
+    ):
         return _ONE
     if section == "solver" and key == "atol":
         return None  # m and m s-1 alike

@@ -158,6 +158,9 @@ def basins_settings(table: Any) -> dict[str, Any]:
         )
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
         check_periods("[basins] ", key, out[key], low)
+    if not out["tolerance"] > 0:
+        # As [sweep]'s: read only when the basins ran, a tolerance of 0 or less was taken.
+        raise AnalysisError(f"[basins] tolerance: must be > 0, got {out['tolerance']}")
     check_total(
         ("[basins] settle_periods", out["settle_periods"]),
         ("record_periods", out["record_periods"]),

@@ -35,10 +35,14 @@ class SystemContacts:
     ``restitution`` and ``energy_change`` (a sticking pair's is NaN too); a
     contact that started at rest (its approach, m/s, at round-off: a body set down on a
     stop, an elastic contact ringing about its static indentation) was never an impact and
-    has NaN ``restitution``. A damped Hertz law (``"hyster-hertz"``, ``"hertz-damped"``)
-    takes its damping from the approach speed, but never from one slower than
-    ``sqrt(2 a delta_s)``, the speed the pressing ``a`` (m/s^2) gives over the static
-    indentation ``delta_s = (m a / K)^(2/3)`` (m): a body set down on it settles there.
+    has NaN ``restitution``. ``restitution`` is the rebound over the approach speed (the
+    pair's relative normal speeds), the law's ``e`` only where nothing else acts while the
+    bodies touch: a structure's forcing and springs can drive a slow contact off faster than
+    it came (a ratio above 1, the forcing's work; see the model page). A damped Hertz law
+    (``"hyster-hertz"``, ``"hertz-damped"``) takes its damping from the approach speed, but
+    never from one slower than ``sqrt(2 a delta_s)``, the speed the pressing ``a`` (m/s^2)
+    gives over the static indentation ``delta_s = (m a / K)^(2/3)`` (m): a body set down on
+    it settles there.
     """
 
     pair: list[str]
