@@ -24,6 +24,7 @@ from vibroimpact.model.parts import (
     Oscillator,
     Output,
     Part,
+    PartKeywordError,
     Signal,
     Solver,
     Stop,
@@ -227,7 +228,7 @@ class System:
             raise InvalidInputError("missing section [structure]")
         try:
             return cls._of_tables(sections, base_dir)
-        except (TypeError, KeyError, AttributeError):
+        except (PartKeywordError, TypeError, KeyError, AttributeError):
             # A table the parts cannot take (an unknown key, a missing kind): the
             # schema's error names it.
             model = {name: sections.get(name) for name in known}
