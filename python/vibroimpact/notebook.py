@@ -58,6 +58,7 @@ def system_rows(system: Any) -> Rows:
         resolved = system.structure.resolved()
         shown = {k: resolved[k] for k in ("youngs_modulus", "second_moment", "mass_per_length")}
         rows.append(("beam as simulated", _keys("structure", shown, sections)))
+    rows.append(("natural frequencies", _frequencies(system)))
     for name in ("damper", "stop", "excitation"):
         for j, table in enumerate(sections.get(name, ())):
             label = f"{name} {j}" + (f" ({table['kind']})" if name == "excitation" else "")
@@ -69,6 +70,23 @@ def system_rows(system: Any) -> Rows:
     if analyses:
         rows.append(("analyses", ", ".join(f"[{name}]" for name in analyses)))
     return rows
+
+
+def _frequencies(system: Any, shown: int = 5) -> str:
+    """The structure's first natural frequencies (Hz, dampers free), and with the
+    dampers' masses attached where there are dampers."""
+    # Imported here: the modes take a System, whose module imports this one.
+    from vibroimpact.model.modes import natural_modes
+
+    def listed(frequencies: Any) -> str:
+        more = ", ..." if len(frequencies) > shown else ""
+        return ", ".join(f"{f:.4g}" for f in frequencies[:shown]) + more + " Hz"
+
+    text = f"structure: {listed(natural_modes(system).frequencies)}"
+    if system.dampers:
+        attached = natural_modes(system, attach_dampers=True).frequencies
+        text += f"; dampers' masses attached: {listed(attached)}"
+    return text
 
 
 def _contact_counts(contacts: Any) -> str:

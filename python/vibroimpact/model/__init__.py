@@ -26,6 +26,9 @@ from vibroimpact.model.parts import (
 )
 from vibroimpact.model.system import System
 
+# After System, which it takes.
+from vibroimpact.model.modes import NaturalModes, natural_modes  # noqa: E402  isort: skip
+
 __all__ = [
     "Base",
     "Cantilever",
@@ -37,6 +40,7 @@ __all__ = [
     "Initial",
     "KanaiTajimi",
     "Matrices",
+    "NaturalModes",
     "Oscillator",
     "Output",
     "Recorded",
@@ -47,4 +51,5 @@ __all__ = [
     "Sweep",
     "System",
     "WhiteNoise",
+    "natural_modes",
 ]
