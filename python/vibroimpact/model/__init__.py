@@ -3,6 +3,7 @@ of a TOML scenario, written as one (:meth:`System.to_toml`) and read from any sc
 file by :func:`vibroimpact.model.load.load` (not imported here: reading a scenario
 checks its analyses' tables, and the analyses take a System)."""
 
+from vibroimpact.model.modes import NaturalModes, natural_modes
 from vibroimpact.model.parts import (
     Base,
     Cantilever,
@@ -25,9 +26,6 @@ from vibroimpact.model.parts import (
     WhiteNoise,
 )
 from vibroimpact.model.system import System
-
-# After System, which it takes.
-from vibroimpact.model.modes import NaturalModes, natural_modes  # noqa: E402  isort: skip
 
 __all__ = [
     "Base",

@@ -5,14 +5,19 @@ rigidly at their points (the two limits of an impact damper: rattling free, or s
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.linalg
 
 from vibroimpact import arguments
-from vibroimpact.model.system import System
+from vibroimpact._core import InvalidInputError
+from vibroimpact.messages import shown
 from vibroimpact.system import linear_parts, point_weights, system_spec
+
+if TYPE_CHECKING:
+    # Not at run time: the System's summary shows these modes (model.system imports this).
+    from vibroimpact.model.system import System
 
 
 @dataclass(frozen=True)
@@ -56,7 +61,8 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
     ``modes`` clamped-free modes, exact for the structure alone; with masses attached a
     Rayleigh-Ritz approximation from above, closer the more modes are kept). Stops add
     neither mass nor stiffness here."""
-    arguments.instance("system", system, System, "vibroimpact.System")
+    if not callable(getattr(system, "model_sections", None)):
+        raise InvalidInputError(f"system: must be a vibroimpact.System, got {shown(system)}")
     attach = arguments.flag("attach_dampers", attach_dampers)
     sections = system.model_sections()
     parts = linear_parts(sections["structure"], damper=sections["damper"])
@@ -74,3 +80,18 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
     # Round-off can leave a rigid-body mode's eigenvalue a hair below zero.
     frequencies = np.sqrt(np.clip(eigenvalues, 0.0, None)) / (2 * np.pi)
     return NaturalModes(frequencies, shapes, mass, stiffness.copy(), structure)
+
+
+def frequencies_summary(system: System, shown_modes: int = 5) -> str:
+    """The first natural frequencies (Hz) of ``system``'s structure, and with the
+    dampers' masses attached where it has dampers: the row of its notebook summary."""
+
+    def listed(frequencies: np.ndarray) -> str:
+        more = ", ..." if len(frequencies) > shown_modes else ""
+        return ", ".join(f"{f:.4g}" for f in frequencies[:shown_modes]) + more + " Hz"
+
+    text = f"structure: {listed(natural_modes(system).frequencies)}"
+    if system.dampers:
+        attached = natural_modes(system, attach_dampers=True).frequencies
+        text += f"; dampers' masses attached: {listed(attached)}"
+    return text
