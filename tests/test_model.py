@@ -110,7 +110,7 @@ def test_parts_are_frozen_hashable_and_hold_arrays_as_tuples() -> None:
     assert hash(harmonics) == hash(vi.Harmonics(amplitudes=[1.0, 2.0], frequencies=[5, 10]))
     with pytest.raises(AttributeError):
         harmonics.amplitudes = (3.0,)  # type: ignore[misc]
-    with pytest.raises(TypeError):
+    with pytest.raises(vi.InvalidInputError, match="takes keywords only"):
         vi.Oscillator(1.0, 1.0)  # type: ignore[misc]  # keyword-only
     matrices = vi.Matrices(mass=np.eye(2), stiffness=[[2.0, -1.0], [-1.0, 2.0]])
     assert matrices.mass == ((1.0, 0.0), (0.0, 1.0))

@@ -45,10 +45,12 @@ def _keys(path: str, table: Mapping[str, Any], sections: Mapping[str, Any]) -> s
     )
 
 
-def system_rows(system: Any) -> Rows:
+def system_rows(system: Any, natural: str = "") -> Rows:
     """The rows of a :class:`~vibroimpact.System`'s table: the structure (and, for a beam
     given by its section or material, the values it is simulated with), each damper,
-    stop and excitation, gravity, the initial state and the run settings given."""
+    stop and excitation, gravity, the initial state and the run settings given;
+    ``natural``, the natural frequencies' row (see
+    :func:`vibroimpact.model.modes.frequencies_summary`)."""
     sections = system.to_dict()
     structure = sections["structure"]
     rows: Rows = [(f"structure ({structure['kind']})", _keys("structure", structure, sections))]
@@ -58,6 +60,8 @@ def system_rows(system: Any) -> Rows:
         resolved = system.structure.resolved()
         shown = {k: resolved[k] for k in ("youngs_modulus", "second_moment", "mass_per_length")}
         rows.append(("beam as simulated", _keys("structure", shown, sections)))
+    if natural:
+        rows.append(("natural frequencies", natural))
     for name in ("damper", "stop", "excitation"):
         for j, table in enumerate(sections.get(name, ())):
             label = f"{name} {j}" + (f" ({table['kind']})" if name == "excitation" else "")
@@ -118,9 +122,9 @@ def solution_rows(sol: Any) -> Rows:
     return rows
 
 
-def system_html(system: Any) -> str:
-    """A System as an HTML table (its ``_repr_html_``)."""
-    return html_table("vibroimpact.System", system_rows(system))
+def system_html(system: Any, natural: str = "") -> str:
+    """A System as an HTML table (its ``_repr_html_``), with the row ``natural``."""
+    return html_table("vibroimpact.System", system_rows(system, natural))
 
 
 def solution_html(sol: Any) -> str:

@@ -173,7 +173,44 @@ def history_dataset(sol: Any) -> Any:
     n, k = sol.structure_displacement.shape[1], sol.damper_displacement.shape[1]
     coordinates = {"structure_coordinate": np.arange(n), "damper": np.arange(k)}
     energy = {f"energy_{key}": value for key, value in sol.energy.items()}
-    return xr.Dataset(arrays, coords=time | coordinates, attrs=attrs | energy)
+    followed, followed_at = _followed(sol)
+    return xr.Dataset(
+        arrays | followed, coords=time | coordinates | followed_at, attrs=attrs | energy
+    )
+
+
+def _followed(sol: Any) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The structure at ``[output] points`` (displacement over time, its recorded peak
+    and RMS; m) over the dimension ``point`` and a cantilever's bending moment at
+    ``[output] moments`` (N m) over ``moment_position``, each labelled by where it is
+    (m from the clamp, or a coordinate index): the CSV's ``point_displacement_j`` and
+    ``bending_moment_j`` columns."""
+    points, moments = np.asarray(sol.points), np.asarray(sol.moments)
+    beam = sol.structure.get("kind") == "cantilever"
+    where = (
+        {"units": "m", "long_name": "position along the beam from the clamp"}
+        if beam
+        else {"units": "1", "long_name": "structure coordinate index"}
+    )
+    arrays: dict[str, Any] = {}
+    coordinates: dict[str, Any] = {}
+    followed = (
+        ("point", points, "point_displacement", sol.displacement_at, "point", "m"),
+        ("moment_position", moments, "bending_moment", sol.moment_at, "moment", "N m"),
+    )
+    for dim, positions, name, value_at, stem, unit in followed:
+        if not len(positions):
+            continue
+        coordinates[dim] = (dim, positions, where)
+        values = np.column_stack([value_at(at) for at in positions])
+        arrays[name] = (("time", dim), values, {"units": unit})
+        for statistic in ("peak", "rms"):
+            arrays[f"{stem}_{statistic}"] = (
+                dim,
+                getattr(sol, f"{stem}_{statistic}"),
+                {"units": unit},
+            )
+    return arrays, coordinates
 
 
 def to_pandas(contacts: Any) -> Any:

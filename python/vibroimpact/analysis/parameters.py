@@ -5,13 +5,14 @@ in the flat state ``(x, v)``."""
 from __future__ import annotations
 
 import copy
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.analysis.limits import AnalysisError, whole_count
+from vibroimpact.messages import shown
 
 _SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
 
@@ -23,7 +24,12 @@ def forcing_period(data: Mapping[str, Any]) -> float:
     15 Hz: 0.2 s). The core's rule, the one studies apply."""
     arguments.sections("data", data)
     parts: list[tuple[str, list[float] | None]] = []
-    for excitation in data.get("excitation", ()) or ():
+    excitations = data.get("excitation", ()) or ()
+    if isinstance(excitations, Mapping):
+        excitations = [excitations]  # one table, as the schema takes it
+    if isinstance(excitations, str | bytes) or not isinstance(excitations, Sequence):
+        raise AnalysisError(f"[[excitation]] must be a list of tables, got {shown(excitations)}")
+    for excitation in excitations:
         table = excitation if isinstance(excitation, Mapping) else {}
         signal = str(table.get("signal"))
         given: list[Any]

@@ -12,10 +12,13 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.continuation import Branch
 from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
+from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import Runner
 from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
+from vibroimpact.analysis.steady import linear_response
 from vibroimpact.analysis.sweeps import SweepPoint, shown_amplitudes, shown_label, shown_values
 from vibroimpact.output import written_whole
 from vibroimpact.system import SystemSolution, split_observed
@@ -74,6 +77,34 @@ def _unit(parameter: str, data: Any = None) -> str:
     return f" ({units})" if units else ""
 
 
+#: How many values of the parameter the linear curve of a sweep's plot is drawn at: its
+#: closed form costs about 0.1 ms a value, and a resonance of damping ratio 0.01 is
+#: 2 % of its frequency wide, missed between the sweep's own values (a 1 Hz grid showed
+#: 0.065 m at 20 Hz for a linear peak of 0.126 m at 20.4 Hz).
+LINEAR_CURVE_VALUES = 1000
+
+
+def _linear_curve(
+    parameter: str, points: list[SweepPoint], data: Any, shown: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """The linear structure's amplitude of kind ``shown`` across the sweep's range, on a
+    fine grid (with the sweep's own values) from the closed form; at the sweep's values
+    only where the scenario's sections ``data`` are not given."""
+    values = np.array([p.value for p in points])
+    at_points = np.array([shown_values(p, shown)[1][0] for p in points])
+    order = np.argsort(values, kind="stable")
+    if data is None or not np.all(np.isfinite(values)):
+        return values[order], at_points[order]
+    grid = np.union1d(np.linspace(values.min(), values.max(), LINEAR_CURVE_VALUES), values)
+    kind = {"coordinate": 0, "point": 1, "moment": 2}[shown]
+    try:
+        linear = [linear_response(with_parameter(data, parameter, float(v)))[kind][0] for v in grid]
+    except InvalidInputError:
+        # A value the closed form cannot take (the sweep marked its run failed).
+        return values[order], at_points[order]
+    return grid, np.array(linear)
+
+
 def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any = None) -> None:
     """Amplitude of structure coordinate 0 (of the structure at the first of
     ``[output] points``, or else of the first bending moment of ``[output] moments``,
@@ -89,12 +120,8 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
         return float(shown_values(p, shown)[0][0])
 
     with _figure(path, size=(8, 5.5)) as (fig, ax):
-        values = np.array([p.value for p in points])
-        order = np.argsort(values, kind="stable")
-        linear = np.array([shown_values(p, shown)[1][0] for p in points])
-        ax.plot(
-            values[order], linear[order], "k--", lw=1, label="without dampers and stops (linear)"
-        )
+        grid, linear = _linear_curve(parameter, points, data, shown)
+        ax.plot(grid, linear, "k--", lw=1, label="without dampers and stops (linear)")
         for direction, marker in (("up", "^"), ("down", "v")):
             chosen = [p for p in points if p.direction == direction]
             if chosen:

@@ -229,7 +229,10 @@ def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Ru
     (as parsed from TOML)."""
     data, base_dir = sections_of(data, base_dir)
     base_dir = arguments.directory("base_dir", base_dir)
-    prepared, period = _prepare(data, base_dir), forcing_period(data)
+    # The forcing first: a system without a harmonic excitation has no orbit to find,
+    # whatever its solver lacks (an unforced system had been refused for its dt).
+    period = forcing_period(data)
+    prepared = _prepare(data, base_dir)
     prepared.check_forcing_period(period)
     return Runner(prepared, period)
 

@@ -3,6 +3,7 @@ of a TOML scenario, written as one (:meth:`System.to_toml`) and read from any sc
 file by :func:`vibroimpact.model.load.load` (not imported here: reading a scenario
 checks its analyses' tables, and the analyses take a System)."""
 
+from vibroimpact.model.modes import NaturalModes, natural_modes
 from vibroimpact.model.parts import (
     Base,
     Cantilever,
@@ -37,6 +38,7 @@ __all__ = [
     "Initial",
     "KanaiTajimi",
     "Matrices",
+    "NaturalModes",
     "Oscillator",
     "Output",
     "Recorded",
@@ -47,4 +49,5 @@ __all__ = [
     "Sweep",
     "System",
     "WhiteNoise",
+    "natural_modes",
 ]

@@ -12,13 +12,15 @@ table.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
-from vibroimpact.system import _GRAVITY, _STRUCTURE, system_spec
+from vibroimpact._core import InvalidInputError
+from vibroimpact.system import _GRAVITY, _STRUCTURE, _unknown_key, system_spec
 
 _Numbers = tuple[float, ...]
 _Rows = tuple[tuple[float, ...], ...]
@@ -42,6 +44,51 @@ def _plain(value: Any) -> Any:
     if isinstance(value, tuple):
         return [_plain(v) for v in value]
     return value
+
+
+class PartKeywordError(InvalidInputError):
+    """A part given a keyword it does not take, or not given one it needs (a
+    ``ValueError``): the message names the part and the key, with the closest allowed key
+    as a suggestion, as a scenario file's error does."""
+
+
+_T = TypeVar("_T")
+
+
+def keywords_checked(cls: type[_T]) -> type[_T]:
+    """``cls`` (a part's dataclass) whose constructor refuses an unknown keyword (``did
+    you mean``), a missing required one and positional values by name, raising
+    :class:`PartKeywordError` where the dataclass raised a bare ``TypeError``."""
+    fields = dataclasses.fields(cls)  # type: ignore[arg-type]
+    names = [f.name for f in fields]
+    required = [
+        f.name
+        for f in fields
+        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
+    where = f"{cls.__name__}: "
+    init: Callable[..., None] = cls.__init__
+
+    @functools.wraps(init)
+    def checked_init(self: Any, *args: Any, **keywords: Any) -> None:
+        if args:
+            raise PartKeywordError(
+                f"{where}takes keywords only ({', '.join(f'{n}=...' for n in names)}), "
+                f"got {len(args)} positional value{'s' if len(args) > 1 else ''}"
+            )
+        for key in keywords:
+            if key not in names:
+                error = _unknown_key(where, key, names, "allowed:")
+                raise PartKeywordError(str(error))
+        missing = [name for name in required if name not in keywords]
+        if missing:
+            raise PartKeywordError(
+                f"{where}missing key {missing[0]!r} (required: {', '.join(required)})"
+            )
+        init(self, **keywords)
+
+    cls.__init__ = checked_init  # type: ignore[method-assign]
+    return cls
 
 
 class Part:
@@ -90,6 +137,7 @@ class Structure(Part):
         return {"kind": self.kind, **super().to_dict()}
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Oscillator(Structure):
     """One mode: ``mass`` (kg), ``stiffness`` (N/m), ``damping`` (N s/m). Its one
@@ -101,6 +149,7 @@ class Oscillator(Structure):
     damping: float = _default(_STRUCTURE["oscillator"], "damping")
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Matrices(Structure):
     """``mass`` (kg, symmetric positive definite), ``stiffness`` (N/m) and ``damping``
@@ -114,6 +163,7 @@ class Matrices(Structure):
     damping: _Rows | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Cantilever(Structure):
     """A clamped-free Euler-Bernoulli beam in ``modes`` modal coordinates: ``length``
@@ -166,6 +216,7 @@ class Cantilever(Structure):
 # -------------------------------------------------------------- interactions
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Damper(Part):
     """A ``[[damper]]``: a loose ``mass`` (kg) rattling against the point ``at`` (a
@@ -187,6 +238,7 @@ class Damper(Part):
     damping: float | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Stop(Part):
     """A ``[[stop]]``: the point ``at`` hits a stop fixed to the base, ``side =
@@ -213,6 +265,7 @@ class Signal(Part):
     kind: ClassVar[str]
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Harmonic(Signal):
     """``amplitude * cos(2 pi frequency t + phase)``: ``frequency`` in Hz, ``phase`` in
@@ -224,6 +277,7 @@ class Harmonic(Signal):
     phase: float | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Sweep(Signal):
     """A harmonic whose frequency goes from ``start_frequency`` to ``end_frequency``
@@ -239,6 +293,7 @@ class Sweep(Signal):
     phase: float | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Harmonics(Signal):
     """A sum of harmonics: as many ``amplitudes``, ``frequencies`` (Hz) and ``phases``
@@ -251,6 +306,7 @@ class Harmonics(Signal):
     phases: _Numbers | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Recorded(Signal):
     """A record: ``file`` (a CSV of time in s and value; relative paths from the
@@ -265,6 +321,7 @@ class Recorded(Signal):
     scale: float | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class WhiteNoise(Signal):
     """Band-limited white noise: two-sided spectral density ``intensity`` S0 per rad/s
@@ -278,6 +335,7 @@ class WhiteNoise(Signal):
     duration: float | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class KanaiTajimi(Signal):
     """White noise through the Kanai-Tajimi ground filter of ``ground_frequency`` (Hz)
@@ -297,6 +355,7 @@ SIGNALS: tuple[type[Signal], ...] = (Harmonic, Sweep, Harmonics, Recorded, White
 # --------------------------------------------------------------- excitations
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Force(Part):
     """A ``[[excitation]]`` of kind ``"force"``: ``signal`` (N) acting at the point
@@ -309,6 +368,7 @@ class Force(Part):
         return {"kind": "force", "at": self.at, **_signal_keys(self.signal)}
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Base(Part):
     """A ``[[excitation]]`` of kind ``"base"``: the support's acceleration ``signal``
@@ -331,6 +391,7 @@ def _signal_keys(signal: Any) -> dict[str, Any]:
 # ------------------------------------------------- gravity, initial, settings
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Gravity(Part):
     """``[gravity]``: ``acceleration`` (m/s^2, along -x, on every mass)."""
@@ -338,6 +399,7 @@ class Gravity(Part):
     acceleration: float = _default(_GRAVITY, "acceleration")
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Initial(Part):
     """``[initial]``: the state at t = 0 as arrays (m, m/s; zeros where empty): the
@@ -360,6 +422,7 @@ class Initial(Part):
         return {key: value for key, value in super().to_dict().items() if value}
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Solver(Part):
     """``[solver]``: ``method`` (``"rk4"``, ``"dopri5"``, ``"dop853"``,
@@ -385,6 +448,7 @@ class Solver(Part):
     contact_timing: str | None = None
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class Output(Part):
     """``[output]``: keep ``every`` N-th step of the history (``history = False``

@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 from vibroimpact._core import InvalidInputError, PreparedSystem
 from vibroimpact.arguments import directory
 from vibroimpact.messages import shown
+from vibroimpact.model.modes import frequencies_summary
 from vibroimpact.model.parts import (
     SIGNALS,
     Base,
@@ -24,6 +25,7 @@ from vibroimpact.model.parts import (
     Oscillator,
     Output,
     Part,
+    PartKeywordError,
     Signal,
     Solver,
     Stop,
@@ -125,8 +127,9 @@ class System:
 
     def _repr_html_(self) -> str:
         """A summary table for notebooks: the structure, each damper, stop and
-        excitation with its units, and the settings given."""
-        return system_html(self)
+        excitation with its units, the structure's first natural frequencies, and the
+        settings given."""
+        return system_html(self, frequencies_summary(self))
 
     def _check(self) -> None:
         """Every value through the scenario's schema (its errors, word for word), then
@@ -227,7 +230,7 @@ class System:
             raise InvalidInputError("missing section [structure]")
         try:
             return cls._of_tables(sections, base_dir)
-        except (TypeError, KeyError, AttributeError):
+        except (PartKeywordError, TypeError, KeyError, AttributeError):
             # A table the parts cannot take (an unknown key, a missing kind): the
             # schema's error names it.
             model = {name: sections.get(name) for name in known}
