@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import scipy.linalg
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
@@ -73,6 +72,9 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
         for j, damper in enumerate(system.dampers):
             weights = point_weights(structure, damper.at, f"dampers[{j}].at")
             mass += parts["mass"][n + j, n + j] * np.outer(weights, weights)
+    # Imported here: scipy.linalg at import time doubled `import vibroimpact` (+150 ms).
+    import scipy.linalg
+
     eigenvalues, shapes = scipy.linalg.eigh(stiffness, mass)
     # Each shape's sign fixed (its largest entry positive): eigh's is arbitrary.
     largest = shapes[np.abs(shapes).argmax(axis=0), np.arange(shapes.shape[1])]
