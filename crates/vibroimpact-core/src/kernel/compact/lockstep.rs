@@ -220,15 +220,8 @@ impl<'a> Lockstep<'a> {
     ) -> [V; 4] {
         let mut values = [[0.0; LANES]; 4];
         if let Some((signals, harmonics)) = group.signals() {
-            let times = stage_times(time, self.dt);
-            for s in 0..4 {
-                // RK4's middle stages share a time: each cache holds that value already
-                // (a call would change nothing and return it).
-                values[s] = if s > 0 && times[s].to_bits() == times[s - 1].to_bits() {
-                    values[s - 1]
-                } else {
-                    self.stage_caches.values(signals, harmonics, live, times[s])
-                };
+            for (value, t) in values.iter_mut().zip(stage_times(time, self.dt)) {
+                *value = self.stage_caches.values(signals, harmonics, live, t);
             }
         }
         values
