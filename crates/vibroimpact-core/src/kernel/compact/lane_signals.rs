@@ -133,15 +133,6 @@ impl LaneCaches {
         live: &[bool; LANES],
         time: f64,
     ) -> V {
-        // Every lane's cache at `time` already (RK4's middle stages share a time; the
-        // reductions' start is the last step's end): each would return its value.
-        let mut held = true;
-        for l in 0..LANES {
-            held &= !live[l] | (self.time[l].to_bits() == time.to_bits());
-        }
-        if held {
-            return self.value;
-        }
         let mut cold = *live;
         if let Some(harmonics) = harmonics {
             cold = self.turn(harmonics, live, time);
