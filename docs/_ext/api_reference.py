@@ -16,12 +16,11 @@ from pathlib import Path
 from typing import Any
 
 from docutils import nodes
-from docutils.statemachine import StringList
+from generated import parsed
 from sphinx.application import Sphinx
 from sphinx.pycode import ModuleAnalyzer
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
-from sphinx.util.nodes import nested_parse_with_titles
 
 LOG = logging.getLogger(__name__)
 
@@ -91,10 +90,7 @@ class PublicApi(SphinxDirective):
                 lines += [f".. autoclass:: {qualified}", "   :members:", ""]
             else:
                 lines += [f".. autofunction:: {qualified}", ""]
-        node = nodes.section()
-        node.document = self.state.document
-        nested_parse_with_titles(self.state, StringList(lines, source=f"<{name}.__all__>"), node)
-        return node.children
+        return parsed(self, lines, f"<{name}.__all__>")
 
 
 def resolve_short_name(

@@ -11,10 +11,9 @@ import argparse
 from typing import Any
 
 from docutils import nodes
-from docutils.statemachine import StringList
+from generated import parsed
 from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
-from sphinx.util.nodes import nested_parse_with_titles
 
 from vibroimpact.cli.command import _parser
 
@@ -84,10 +83,7 @@ class CliReference(SphinxDirective):
         lines = _command(f"{parser.prog}", parser)
         for name, sub in _subcommands(parser).items():
             lines += _command(f"{parser.prog} {name}", sub)
-        node = nodes.section()
-        node.document = self.state.document
-        nested_parse_with_titles(self.state, StringList(lines, source="<vibroimpact parser>"), node)
-        return node.children
+        return parsed(self, lines, "<vibroimpact parser>")
 
 
 def setup(app: Sphinx) -> dict[str, Any]:

@@ -16,12 +16,11 @@ from __future__ import annotations
 from typing import Any
 
 from docutils import nodes
-from docutils.statemachine import StringList
+from generated import parsed
 from scenario_keys import ANALYSES, SYSTEM, TWO_MASS
 from sphinx.application import Sphinx
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
-from sphinx.util.nodes import nested_parse_with_titles
 
 import vibroimpact as vi
 from vibroimpact._core import check_solver
@@ -185,37 +184,18 @@ class ScenarioFormat(SphinxDirective):
     required_arguments = 1  # "two-mass", "system" or "analyses"
 
     def run(self) -> list[nodes.Node]:
-        if self.arguments[0] == "two-mass":
-            lines = _table(
-                "two-mass",
-                _two_mass_sections(),
-                TWO_MASS,
-                two_mass._REQUIRED,
-                _two_mass_methods(),
-                self.get_location(),
-            )
-        elif self.arguments[0] == "analyses":
-            lines = _table(
-                "analyses",
-                _analysis_sections(),
-                ANALYSES,
-                schema._REQ,
-                list(vi.METHODS),
-                self.get_location(),
-            )
+        kind = self.arguments[0]
+        if kind == "two-mass":
+            sections, meanings, required = _two_mass_sections(), TWO_MASS, two_mass._REQUIRED
+            methods = _two_mass_methods()
+        elif kind == "analyses":
+            sections, meanings, required = _analysis_sections(), ANALYSES, schema._REQ
+            methods = list(vi.METHODS)
         else:
-            lines = _table(
-                "system",
-                _system_sections(),
-                SYSTEM,
-                schema._REQ,
-                list(vi.METHODS),
-                self.get_location(),
-            )
-        node = nodes.section()
-        node.document = self.state.document
-        nested_parse_with_titles(self.state, StringList(lines, source="<scenario schema>"), node)
-        return node.children
+            kind, sections, meanings, required = "system", _system_sections(), SYSTEM, schema._REQ
+            methods = list(vi.METHODS)
+        lines = _table(kind, sections, meanings, required, methods, self.get_location())
+        return parsed(self, lines, "<scenario schema>")
 
 
 def setup(app: Sphinx) -> dict[str, Any]:
