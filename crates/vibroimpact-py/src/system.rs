@@ -80,6 +80,9 @@ impl Ready {
         let system_spec = system_spec(spec, t_end)?;
         let system = Assembly::new(&system_spec).map_err(to_py)?;
         let stepper = AnyStepper::new(&system, method, options).map_err(to_py)?;
+        stepper
+            .check_stepping(&system, limits.stepping)
+            .map_err(to_py)?;
         Ok(Self {
             system,
             stepper,

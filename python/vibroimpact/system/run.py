@@ -210,20 +210,6 @@ class PreparedRun:
         )
 
 
-def _check_fixed_laws(spec: Mapping[str, Any]) -> None:
-    """Fixed steps take compliant laws only: refused as the core refuses it when the run
-    starts (its message, its pair numbering: the dampers, then the stops), so that a
-    System holding such a solver is refused where it is built."""
-    laws = [pair["law"] for pair in (*spec["damper"], *spec["stop"])]
-    if "rigid" in laws:
-        raise _fail(
-            "",
-            f'stepping = "fixed" takes compliant contact laws only (pair {laws.index("rigid")} '
-            "is rigid): give it a compliant law (hertz, hyster-hertz, hertz-damped, linear) "
-            'or use stepping = "events"',
-        )
-
-
 def prepare_system(
     structure: Any,
     *,
@@ -262,8 +248,6 @@ def prepare_system(
             f'"fixed" takes a fixed-step method ({", ".join(_FIXED_STEP)}), '
             f"not {solver['method']!r}",
         )
-    if solver["stepping"] == "fixed":
-        _check_fixed_laws(spec)
     _check_settings(solver)
     # every, max_steps and max_rows are whole numbers >= 1 (the schema's WHOLE_RANGES).
     # The up-front limits (strobe_period > 0, steps, the fastest mode and forcing against

@@ -34,7 +34,7 @@ use crate::numerics::hermite;
 
 /// Whether `stepper` may step `system` fixed: a fixed-step method, every
 /// pair compliant.
-pub(super) fn check<S: SystemStepper>(system: &Assembly, stepper: &S) -> Result<()> {
+pub(crate) fn check<S: SystemStepper>(system: &Assembly, stepper: &S) -> Result<()> {
     if stepper.is_adaptive() || stepper.is_exact() {
         return Err(Error::Inconsistent(format!(
             "stepping = \"fixed\" takes a fixed-step method (rk4, newmark, newmark-implicit, \

@@ -26,6 +26,7 @@ use crate::error::{Error, Result};
 use crate::kernel::events::{
     integrate_system, integrate_system_stepped, RunOptions, Stepping, SystemSolution,
 };
+use crate::kernel::fixed;
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::methods::exact::ExactFlow;
 use crate::methods::paper_newmark::PaperNewmark;
@@ -107,6 +108,21 @@ impl AnyStepper {
             // gaps between step ends).
             Self::Exact(flow) => Some(fit(dt.unwrap_or(f64::INFINITY).min(flow.step()).min(t_end))),
             _ => dt.map(fit),
+        }
+    }
+
+    /// Whether this method may step `system` as `stepping` asks: fixed steps take a
+    /// fixed-step method and compliant pairs only. The check a run makes when it starts
+    /// ([`crate::kernel::fixed`]), for a caller preparing runs to refuse them up front.
+    pub fn check_stepping(&self, system: &Assembly, stepping: Stepping) -> Result<()> {
+        if stepping == Stepping::Events {
+            return Ok(());
+        }
+        match self {
+            Self::Rk(s) => fixed::check(system, s),
+            Self::Newmark(s) => fixed::check(system, s),
+            Self::Paper(s) => fixed::check(system, s),
+            Self::Exact(s) => fixed::check(system, s),
         }
     }
 
