@@ -3,3 +3,4 @@ pub mod lanes;
 pub mod settling;
 pub mod shooting;
 pub mod study;
+pub mod tangent;

@@ -11,6 +11,7 @@ use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactKind, Open};
 use crate::kernel::impacts;
 use crate::kernel::locate::{any_compliant, crossed, event_value};
+use crate::kernel::observe::EventView;
 use crate::kernel::run::{loss_slot, Run};
 use crate::methods::step_control::initial_step;
 use crate::methods::steppers::SystemStepper;
@@ -139,6 +140,11 @@ impl Run<'_> {
         };
         let mut any = false;
         let mut rigid = false;
+        if let Some(watch) = self.watch.as_mut() {
+            watch.before.copy_from_slice(&self.y[..2 * system.dim]);
+            watch.modes_before.copy_from_slice(&self.modes);
+            watch.jumps.clear();
+        }
         self.just_switched.iter_mut().for_each(|s| *s = false);
         for i in 0..self.modes.len() {
             let mode = self.modes[i];
@@ -182,6 +188,9 @@ impl Run<'_> {
                 &mut self.buffers.work,
                 &mut self.just_switched,
             );
+            if let Some(watch) = self.watch.as_mut() {
+                self.impacts.jumps(&mut watch.jumps);
+            }
         }
         if any {
             self.count_close_events(stepper, rigid)?;
@@ -194,6 +203,17 @@ impl Run<'_> {
             // Before the contacts kept begin: what closed is dropped (a
             // contact across their start may stay; it is dropped at the end).
             self.contacts.retain(|c| c.onset >= from);
+        }
+        if let Some(watch) = self.watch.as_mut() {
+            watch.observer.event(&EventView {
+                time,
+                located,
+                before: &watch.before,
+                after: &self.y[..2 * system.dim],
+                modes_before: &watch.modes_before,
+                modes_after: &self.modes,
+                jumps: &watch.jumps,
+            })?;
         }
         Ok(())
     }

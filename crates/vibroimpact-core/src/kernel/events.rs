@@ -23,6 +23,7 @@ pub use crate::kernel::balance::EnergyBalance;
 use crate::kernel::clock::Stop;
 use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::memory::MAX_RECORD_BYTES;
+use crate::kernel::observe::{EventObserver, Watch};
 use crate::kernel::reductions::{ReduceOptions, Reductions};
 use crate::kernel::run::Run;
 use crate::methods::steppers::SystemStepper;
@@ -334,7 +335,44 @@ pub fn integrate_system_stepped<S: SystemStepper>(
         }
         return Ok(run.finish(stepper));
     }
-    while run.clock.time < options.t_end {
+    by_events(&mut run, stepper, interrupt)?;
+    Ok(run.finish(stepper))
+}
+
+/// [`integrate_system_within`] with `observer` told of the run's start, of
+/// each event (the states and modes either side, the rigid pairs' jumps)
+/// and of its end: what the tangent flow is made of
+/// ([`crate::kernel::observe`]). Steps are cut at events.
+pub fn integrate_system_observed<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    initial: &[f64],
+    options: &RunOptions,
+    interrupt: &mut dyn FnMut() -> bool,
+    record_limit: u64,
+    observer: &mut dyn EventObserver,
+) -> Result<SystemSolution> {
+    let stepping = Stepping::Events;
+    let mut run = Run::new(system, stepper, initial, options, stepping, record_limit)?;
+    let (dim, count) = (system.dim, system.interactions.len());
+    observer.start(run.clock.time, &run.y[..2 * dim], &run.modes)?;
+    run.watch = Some(Watch::new(observer, dim, count));
+    by_events(&mut run, stepper, interrupt)?;
+    if let Some(watch) = run.watch.take() {
+        watch
+            .observer
+            .finish(run.clock.time, &run.y[..2 * dim], &run.modes)?;
+    }
+    Ok(run.finish(stepper))
+}
+
+/// The run's steps, each cut at the earliest event it shows, to its end.
+fn by_events<S: SystemStepper>(
+    run: &mut Run<'_>,
+    stepper: &mut S,
+    interrupt: &mut dyn FnMut() -> bool,
+) -> Result<()> {
+    while run.clock.time < run.options.t_end {
         // Plain steps in a row, where the stepper takes them at once (each
         // as the kernel's step would, to the bit); the step after them is
         // the kernel's.
@@ -350,7 +388,7 @@ pub fn integrate_system_stepped<S: SystemStepper>(
         }
         run.after_step(stop, interrupt)?;
     }
-    Ok(run.finish(stepper))
+    Ok(())
 }
 
 #[cfg(test)]

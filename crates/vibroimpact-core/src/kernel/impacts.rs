@@ -28,6 +28,7 @@
 //! flights falling by the mass ratio: summed, both rest).
 
 use crate::kernel::events::{ContactKind, Open, PairContact};
+use crate::kernel::observe::Jump;
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 use crate::numerics::linalg;
 
@@ -147,6 +148,27 @@ impl Impacts {
             grazes,
             just_switched,
         ) || any
+    }
+
+    /// The members the last event's impulses acted on (or held as
+    /// equalities), each with the restitution its rate was resolved to
+    /// (`u+ = -e u-`; 0 where it stuck, was held or touched at rest): the
+    /// event's reset map, for the tangent flow ([`crate::kernel::observe`]).
+    pub(crate) fn jumps(&self, out: &mut Vec<Jump>) {
+        out.clear();
+        for (s, &i) in self.members.iter().enumerate() {
+            if self.lcp.z[s] == 0.0 && !self.lcp.bilateral[s] {
+                continue;
+            }
+            let restitution = match (self.roles[s], self.stuck[s]) {
+                (Role::Impact { restitution, .. }, None) if self.before[s] < 0.0 => restitution,
+                _ => 0.0,
+            };
+            out.push(Jump {
+                interaction: i,
+                restitution,
+            });
+        }
     }
 
     /// The roles of the rigid pairs marked touching at `time`: impact,

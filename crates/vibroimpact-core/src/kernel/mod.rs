@@ -8,6 +8,7 @@ pub mod fixed;
 pub(crate) mod impacts;
 pub(crate) mod locate;
 pub mod memory;
+pub mod observe;
 pub(crate) mod plain_fixed;
 pub(crate) mod records;
 pub mod reductions;

@@ -14,6 +14,7 @@ use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{
     event_value, find_crossing, locate, may_cross, past, Buffers, Crossing, Gaps, Location,
 };
+use crate::kernel::observe::Watch;
 use crate::kernel::reductions::{reduce_step, Reductions};
 use crate::methods::step_control::{rejects, StepControl};
 use crate::methods::steppers::SystemStepper;
@@ -113,6 +114,9 @@ pub(super) struct Run<'a> {
     pub(super) contact_forces: Vec<f64>,
     /// History rows the first growth makes room for (see `first_rows` in kernel::start).
     pub(super) first_rows: usize,
+    /// The observer told of each event, with what it is shown (see
+    /// [`crate::kernel::observe`]); None for a plain run.
+    pub(super) watch: Option<Watch<'a>>,
 }
 
 impl<'a> Run<'a> {

@@ -208,6 +208,7 @@ impl<'a> Run<'a> {
             poll_every: interrupt_interval(system.dim),
             timed_polls: system.dim > TIMED_POLLS_BEYOND,
             last_poll: std::time::Instant::now(),
+            watch: None,
         };
         run.start(stepper)?;
         Ok(run)

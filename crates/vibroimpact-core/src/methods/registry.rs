@@ -24,10 +24,12 @@ pub use table::{
 
 use crate::error::{Error, Result};
 use crate::kernel::events::{
-    integrate_system, integrate_system_stepped, RunOptions, Stepping, SystemSolution,
+    integrate_system, integrate_system_observed, integrate_system_stepped, RunOptions, Stepping,
+    SystemSolution,
 };
 use crate::kernel::fixed;
 use crate::kernel::memory::MAX_RECORD_BYTES;
+use crate::kernel::observe::EventObserver;
 use crate::methods::exact::ExactFlow;
 use crate::methods::paper_newmark::PaperNewmark;
 use crate::methods::steppers::{ExplicitRk, NewmarkFamily};
@@ -139,6 +141,33 @@ impl AnyStepper {
             Self::Newmark(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Paper(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Exact(s) => integrate_system(system, s, y0, options, interrupt),
+        }
+    }
+
+    /// [`Self::integrate`] with `observer` told of the run's start, events
+    /// and end (see [`crate::kernel::observe`]; steps cut at events).
+    pub fn integrate_observed(
+        &mut self,
+        system: &Assembly,
+        y0: &[f64],
+        options: &RunOptions,
+        interrupt: &mut dyn FnMut() -> bool,
+        observer: &mut dyn EventObserver,
+    ) -> Result<SystemSolution> {
+        let limit = MAX_RECORD_BYTES;
+        match self {
+            Self::Rk(s) => {
+                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+            }
+            Self::Newmark(s) => {
+                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+            }
+            Self::Paper(s) => {
+                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+            }
+            Self::Exact(s) => {
+                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+            }
         }
     }
 

@@ -1,0 +1,156 @@
+//! The saltation matrix of an event: the jump of the tangent flow where the
+//! located pair's gap `g` reaches zero, the reset map `R` acts and the
+//! rates change from `f-` to `f+`:
+//! `S = R + (f+ - R f-) grad(g)^T / (grad(g) . f-)`.
+
+use crate::kernel::observe::EventView;
+use crate::model::assembly::{Assembly, Mode, Scratch};
+use crate::numerics::linalg;
+
+/// A closing speed below this fraction of the speeds in play is a touch at
+/// rest or a grazing: the kernel's own threshold for a pair leaving its
+/// wall (see `kernel::impacts`).
+const GRAZING_SPEED: f64 = 1e-9;
+
+/// What the event was, for the flow's report.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Outcome {
+    /// A grazing: the located pair's closing speed (m/s, of round-off), the
+    /// pair neither sticking nor resting after it.
+    pub grazing: Option<f64>,
+}
+
+/// Buffers for [`Saltation::matrix`], made once per flow.
+pub(super) struct Saltation {
+    scratch: Scratch,
+    full: Vec<f64>,
+    minus: Vec<f64>,
+    plus: Vec<f64>,
+    reset: Vec<f64>,
+    column: Vec<f64>,
+    coupling: Vec<f64>,
+}
+
+impl Saltation {
+    pub(super) fn new(system: &Assembly) -> Self {
+        let (len, d) = (system.state_len(), system.dim);
+        Self {
+            scratch: Scratch::new(system),
+            full: vec![0.0; len],
+            minus: vec![0.0; len],
+            plus: vec![0.0; len],
+            reset: vec![0.0; d * d],
+            column: Vec::new(),
+            coupling: Vec::new(),
+        }
+    }
+
+    /// The velocities' reset map `R_v = I - Push_A W^-1 (I + E) H_A` of the
+    /// pairs the impulses acted on (`A`, each resolved to `u+ = -e u-`), into
+    /// `self.reset` (row-major `dim x dim`).
+    fn reset_map(&mut self, system: &Assembly, view: &EventView<'_>) {
+        let d = system.dim;
+        self.reset.iter_mut().for_each(|v| *v = 0.0);
+        for i in 0..d {
+            self.reset[i * d + i] = 1.0;
+        }
+        let m = view.jumps.len();
+        if m == 0 {
+            return;
+        }
+        let its = &system.interactions;
+        for c in 0..d {
+            self.coupling.clear();
+            for a in view.jumps {
+                for b in view.jumps {
+                    let w = linalg::dot(&its[a.interaction].h, &its[b.interaction].push);
+                    self.coupling.push(w);
+                }
+            }
+            self.column.clear();
+            self.column.extend(
+                view.jumps
+                    .iter()
+                    .map(|j| -(1.0 + j.restitution) * its[j.interaction].h[c]),
+            );
+            linalg::solve_in_place(&mut self.coupling, &mut self.column, m);
+            for (j, z) in view.jumps.iter().zip(&self.column) {
+                for (r, p) in its[j.interaction].push.iter().enumerate() {
+                    self.reset[r * d + c] += p * z;
+                }
+            }
+        }
+    }
+
+    /// The saltation matrix of `view`'s event into `out` (row-major `2 dim x
+    /// 2 dim`).
+    pub(super) fn matrix(
+        &mut self,
+        system: &Assembly,
+        view: &EventView<'_>,
+        out: &mut [f64],
+    ) -> Outcome {
+        let (d, size) = (system.dim, 2 * system.dim);
+        self.reset_map(system, view);
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for i in 0..d {
+            out[i * size + i] = 1.0;
+            for j in 0..d {
+                out[(d + i) * size + d + j] = self.reset[i * d + j];
+            }
+        }
+        let located = view.located;
+        let side = match view.modes_before[located] {
+            Mode::Open => 1.0,
+            Mode::Compliant { .. } => -1.0,
+            // A release: the constraint force is zero there, so the rates
+            // are continuous and the flow smooth (no time shift).
+            Mode::Sticking => return Outcome { grazing: None },
+        };
+        let h = &system.interactions[located].h;
+        let closing = side * linalg::dot(h, &view.before[d..size]);
+        let speeds = view.before[d..size]
+            .iter()
+            .chain(&view.after[d..size])
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        if closing.abs() <= GRAZING_SPEED * speeds.max(f64::MIN_POSITIVE) {
+            // No crossing to shift in time: a landing at rest (the pair
+            // sticks or rests, its perturbations projected out by the reset),
+            // else a grazing, where the flow has no derivative.
+            let rests = view.modes_after[located] == Mode::Sticking
+                || view.jumps.iter().any(|j| j.interaction == located);
+            return Outcome {
+                grazing: (!rests).then_some(closing.abs()),
+            };
+        }
+        self.rates(system, view.time, view.before, view.modes_before, false);
+        self.rates(system, view.time, view.after, view.modes_after, true);
+        // f+ - R f-: the velocities' jump, then the accelerations'.
+        for r in 0..size {
+            let reset_minus = if r < d {
+                self.minus[r]
+            } else {
+                let row = &self.reset[(r - d) * d..(r - d + 1) * d];
+                linalg::dot(row, &self.minus[d..size])
+            };
+            let jump = (self.plus[r] - reset_minus) * side / closing;
+            for (c, hc) in h.iter().enumerate() {
+                out[r * size + c] += jump * hc;
+            }
+        }
+        Outcome { grazing: None }
+    }
+
+    /// The rates at `time` in state `y` (`x` then `v`) and `modes`, into
+    /// `self.plus` (`after`) or `self.minus`.
+    fn rates(&mut self, system: &Assembly, time: f64, y: &[f64], modes: &[Mode], after: bool) {
+        let size = 2 * system.dim;
+        self.full[..size].copy_from_slice(y);
+        let out = if after {
+            &mut self.plus
+        } else {
+            &mut self.minus
+        };
+        system.rates(time, &self.full, modes, &mut self.scratch, out);
+    }
+}

@@ -1,0 +1,190 @@
+//! The tangent flow against central differences of whole runs and against
+//! the identities an impacting flow satisfies exactly.
+
+use super::lyapunov::orthonormalise;
+use super::*;
+use crate::kernel::events::RunOptions;
+use crate::methods::registry::{AnyStepper, Options};
+use crate::model::assembly::{initial_state, Damper, Excitation, Load, PairLaw, SystemSpec};
+use crate::model::signals::Signal;
+use crate::model::structure::Structure;
+
+const RESTITUTION: f64 = 0.6;
+const DAMPING: f64 = 2.0;
+const MASS: f64 = 1.0;
+
+/// A forced damped oscillator carrying a rigid impact damper.
+fn damper_system() -> Assembly {
+    forced_damper(60.0, 8.0)
+}
+
+/// The damper's system forced at `frequency` (Hz) with `amplitude` (N).
+fn forced_damper(frequency: f64, amplitude: f64) -> Assembly {
+    let spec = SystemSpec {
+        structure: Structure::oscillator(MASS, 3000.0, DAMPING).unwrap(),
+        dampers: vec![Damper {
+            mass: 0.05,
+            at: 0.0,
+            lower_clearance: 0.01,
+            upper_clearance: 0.01,
+            law: PairLaw::rigid(RESTITUTION).unwrap(),
+        }],
+        stops: vec![],
+        gravity: 0.0,
+        excitations: vec![Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(frequency, amplitude, 0.0).unwrap(),
+        }],
+        points: vec![],
+        moments: vec![],
+    };
+    Assembly::new(&spec).unwrap()
+}
+
+fn options(t_end: f64, dt: Option<f64>) -> RunOptions {
+    RunOptions {
+        dt,
+        t_end,
+        every: 1,
+        keep_history: false,
+        max_steps: 100_000_000,
+        max_rows: 1_000_000,
+        energy_tolerance: 1e-6,
+        reduce: Default::default(),
+    }
+}
+
+/// The end state (`x` then `v`) and the tangent flow of a run to `t_end`.
+fn run(system: &Assembly, y0: &[f64], t_end: f64) -> (Vec<f64>, Vec<f64>, u64) {
+    let mut stepper = AnyStepper::new(system, "exact", &Options::default()).unwrap();
+    let dt = stepper.step(None, t_end, f64::INFINITY);
+    let mut flow = Tangent::product(system).unwrap();
+    let solution = stepper
+        .integrate_observed(system, y0, &options(t_end, dt), &mut || false, &mut flow)
+        .unwrap();
+    let size = 2 * system.dim;
+    assert!(flow.grazings().is_empty());
+    (
+        solution.final_state[..size].to_vec(),
+        flow.matrix().to_vec(),
+        flow.impacts(),
+    )
+}
+
+fn start(system: &Assembly) -> Vec<f64> {
+    initial_state(system, &[0.004], &[-0.2], &[0.002], &[0.3]).unwrap()
+}
+
+fn determinant(a: &[f64], n: usize) -> f64 {
+    let mut a = a.to_vec();
+    let mut det = 1.0;
+    for c in 0..n {
+        let p = (c..n)
+            .max_by(|&i, &j| a[i * n + c].abs().total_cmp(&a[j * n + c].abs()))
+            .unwrap();
+        if p != c {
+            for k in 0..n {
+                a.swap(c * n + k, p * n + k);
+            }
+            det = -det;
+        }
+        det *= a[c * n + c];
+        for r in c + 1..n {
+            let f = a[r * n + c] / a[c * n + c];
+            for k in c..n {
+                a[r * n + k] -= f * a[c * n + k];
+            }
+        }
+    }
+    det
+}
+
+#[test]
+fn the_tangent_map_is_the_runs_central_differences() {
+    crate::testing::timeout(60, || {
+        let system = damper_system();
+        let y0 = start(&system);
+        let t_end = 0.4;
+        let (_, tangent, impacts) = run(&system, &y0, t_end);
+        assert!(impacts >= 6, "{impacts} impacts");
+        let size = 2 * system.dim;
+        let scales = [1e-3, 1e-3, 0.1, 0.1];
+        let mut worst = 0.0f64;
+        for c in 0..size {
+            let h = 1e-7 * scales[c];
+            let mut plus = y0.clone();
+            plus[c] += h;
+            let mut minus = y0.clone();
+            minus[c] -= h;
+            let (p, _, _) = run(&system, &plus, t_end);
+            let (m, _, _) = run(&system, &minus, t_end);
+            for r in 0..size {
+                let difference = (p[r] - m[r]) / (2.0 * h);
+                let exact = tangent[r * size + c];
+                // Scaled as the state's coordinates are.
+                let error = (difference - exact).abs() * scales[c] / scales[r];
+                worst = worst.max(error / (1.0 + exact.abs() * scales[c] / scales[r]));
+            }
+        }
+        assert!(worst < 1e-5, "worst scaled difference {worst:e}");
+    });
+}
+
+#[test]
+fn each_impact_multiplies_phase_volume_by_the_square_of_its_restitution() {
+    crate::testing::timeout(60, || {
+        // Liouville between impacts (volume shrinks as exp(trace A t), trace
+        // A = -c / M: the damper flies freely) and e^2 at each impact.
+        // Forced near resonance, the damper rattles without sticking.
+        let system = forced_damper(9.0, 40.0);
+        let y0 = start(&system);
+        for t_end in [0.1, 0.3] {
+            let (_, tangent, impacts) = run(&system, &y0, t_end);
+            let det = determinant(&tangent, 2 * system.dim);
+            let expected =
+                RESTITUTION.powi(2 * impacts as i32) * (-DAMPING / MASS * t_end).exp();
+            assert!(
+                ((det - expected) / expected).abs() < 1e-10,
+                "t_end {t_end}: det {det:e} against {expected:e} ({impacts} impacts)"
+            );
+        }
+        // Over many impacts the product is ill-conditioned; its QR's
+        // logarithms sum to log |det| to round-off.
+        let t_end = 20.0;
+        let mut stepper = AnyStepper::new(&system, "exact", &Options::default()).unwrap();
+        let dt = stepper.step(None, t_end, f64::INFINITY);
+        let mut flow = Tangent::orthonormal(&system).unwrap();
+        stepper
+            .integrate_observed(&system, &y0, &options(t_end, dt), &mut || false, &mut flow)
+            .unwrap();
+        let impacts = flow.impacts() as f64;
+        assert!(impacts > 30.0, "{impacts} impacts");
+        let sum: f64 = flow.logs().iter().sum();
+        let expected = 2.0 * impacts * RESTITUTION.ln() - DAMPING / MASS * t_end;
+        assert!(
+            ((sum - expected) / expected).abs() < 1e-11,
+            "sum of logarithms {sum} against {expected}"
+        );
+    });
+}
+
+#[test]
+fn orthonormalising_keeps_the_stretches_logarithms() {
+    crate::testing::timeout(10, || {
+        // An upper-triangular matrix's QR has its diagonal as R (up to signs).
+        let a = [2.0, 1.0, 3.0, 0.0, 0.5, -1.0, 0.0, 0.0, 0.25];
+        let mut q = a.to_vec();
+        let mut logs = vec![0.0; 3];
+        orthonormalise(&mut q, 3, &mut logs);
+        for (l, d) in logs.iter().zip([2.0f64, 0.5, 0.25]) {
+            assert!((l - d.ln()).abs() < 1e-14, "{l} against {}", d.ln());
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                let dot: f64 = (0..3).map(|k| q[k * 3 + i] * q[k * 3 + j]).sum();
+                let expected = if i == j { 1.0 } else { 0.0 };
+                assert!((dot - expected).abs() < 1e-14);
+            }
+        }
+    });
+}

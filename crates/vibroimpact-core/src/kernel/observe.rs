@@ -1,0 +1,67 @@
+//! What a run shows an observer at its start, at each event and at its end:
+//! the states either side of the event's jump and the modes either side of
+//! its switches, with the rigid pairs the event's impulses acted on. The
+//! tangent flow ([`crate::analysis::tangent`]) is made of these: the flow
+//! between two events is smooth in one set of modes, and each event is a
+//! reset map with its saltation. A run without an observer pays nothing.
+
+use crate::error::Result;
+use crate::model::assembly::Mode;
+
+/// A rigid pair the event's impulses acted on (or held): its interaction
+/// and the restitution the event gave it, the relative rate after being
+/// `-restitution` times the one before (0: it stuck, or touched at rest).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jump {
+    pub interaction: usize,
+    pub restitution: f64,
+}
+
+/// One event of a run.
+#[derive(Debug, Clone, Copy)]
+pub struct EventView<'a> {
+    /// s.
+    pub time: f64,
+    /// The interaction whose event value was located (the others switched
+    /// at the same instant).
+    pub located: usize,
+    /// The state (`x` then `v`, `2 dim` values) and modes before the event
+    /// and after it.
+    pub before: &'a [f64],
+    pub after: &'a [f64],
+    pub modes_before: &'a [Mode],
+    pub modes_after: &'a [Mode],
+    /// The rigid pairs the impulses acted on, in the order the event's
+    /// complementarity problem took them; empty where no rigid pair did.
+    pub jumps: &'a [Jump],
+}
+
+/// Told of a run's start, events and end.
+pub trait EventObserver {
+    /// The run starts at `time` (s) from state `y` (`x` then `v`) in `modes`.
+    fn start(&mut self, time: f64, y: &[f64], modes: &[Mode]) -> Result<()>;
+    /// An event: see [`EventView`].
+    fn event(&mut self, view: &EventView<'_>) -> Result<()>;
+    /// The run ends at `time` in state `y` and `modes`.
+    fn finish(&mut self, time: f64, y: &[f64], modes: &[Mode]) -> Result<()>;
+}
+
+/// What a run keeps for its observer: the state and modes before the event
+/// being handled, and the jumps of its impulses.
+pub(crate) struct Watch<'o> {
+    pub(crate) observer: &'o mut dyn EventObserver,
+    pub(crate) before: Vec<f64>,
+    pub(crate) modes_before: Vec<Mode>,
+    pub(crate) jumps: Vec<Jump>,
+}
+
+impl<'o> Watch<'o> {
+    pub(crate) fn new(observer: &'o mut dyn EventObserver, dim: usize, count: usize) -> Self {
+        Self {
+            observer,
+            before: vec![0.0; 2 * dim],
+            modes_before: vec![Mode::Open; count],
+            jumps: Vec::with_capacity(count),
+        }
+    }
+}
