@@ -40,6 +40,8 @@ ORBIT_FIELDS = {
     "state",
     "floquet_multipliers",
     "stable",
+    "jacobian",
+    "grazings",
     "impacts_per_period",
     "amplitude",
     "periods",

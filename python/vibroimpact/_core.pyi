@@ -325,8 +325,14 @@ class PreparedSystem:
         tolerance: float,
         max_iterations: int,
         forcing_period: float | None = None,
+        jacobian: str = "differences",
     ) -> dict[str, Any]: ...
 
+def tangent_map(prepared: PreparedSystem, state: list[float], t_end: float) -> dict[str, Any]: ...
+def lyapunov_spectrum(
+    prepared: PreparedSystem, state: list[float], block_time: float, blocks: int
+) -> dict[str, Any]: ...
+def tangent_refusal(prepared: PreparedSystem) -> str | None: ...
 def simulate(
     system: ImpactDamper,
     contact: Contact,

@@ -83,6 +83,14 @@ def text(name: str, value: Any) -> str:
     return value
 
 
+def choice(name: str, value: Any, allowed: tuple[str, ...]) -> str:
+    """One of the strings ``allowed``."""
+    if not isinstance(value, str) or value not in allowed:
+        listed = ", ".join(f'"{a}"' for a in allowed)
+        raise InvalidInputError(f"{name}: must be one of {listed}, got {shown(value)}")
+    return value
+
+
 def number(name: str, value: Any) -> float:
     """A finite real number (an int, a float or a NumPy real; not a boolean)."""
     real = _real(value)

@@ -13,6 +13,7 @@ mod inputs;
 mod registry;
 mod run;
 mod system;
+mod tangent;
 
 use errors::*;
 use helpers::*;
@@ -45,6 +46,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system::linear_parts, m)?)?;
     m.add_class::<system::PreparedSystem>()?;
     m.add_function(wrap_pyfunction!(system::run_study, m)?)?;
+    m.add_function(wrap_pyfunction!(tangent::tangent_map, m)?)?;
+    m.add_function(wrap_pyfunction!(tangent::lyapunov_spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(tangent::tangent_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
     // Internal (not in __all__): vibroimpact.analyses.forcing_period wraps it.

@@ -63,9 +63,9 @@ impl Limits {
 }
 
 /// A checked system with its method, ready to run from any state.
-struct Ready {
-    system: Assembly,
-    stepper: AnyStepper,
+pub(crate) struct Ready {
+    pub(crate) system: Assembly,
+    pub(crate) stepper: AnyStepper,
     limits: Limits,
 }
 
@@ -105,20 +105,18 @@ impl Ready {
         })
     }
 
-    /// Integrate from `y0` (the caller holds no GIL).
-    fn integrate(
-        &mut self,
-        y0: &[f64],
+    /// The options of a run to `t_end` (see [`Self::integrate`]).
+    pub(crate) fn options(
+        &self,
         t_end: f64,
         history: (bool, u64),
         record_from: Option<f64>,
         strobe_period: Option<f64>,
-        interrupt: &mut dyn FnMut() -> bool,
-    ) -> core::Result<core::kernel::events::SystemSolution> {
+    ) -> RunOptions {
         let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
         let limits = self.limits;
         let dt = self.stepper.step(limits.dt, t_end, strobe_period);
-        let options = RunOptions {
+        RunOptions {
             dt,
             t_end,
             every: history.1,
@@ -132,8 +130,21 @@ impl Ready {
                 mean_square: true,
                 contacts_from: f64::NEG_INFINITY,
             },
-        };
-        let (system, stepping) = (&self.system, limits.stepping);
+        }
+    }
+
+    /// Integrate from `y0` (the caller holds no GIL).
+    fn integrate(
+        &mut self,
+        y0: &[f64],
+        t_end: f64,
+        history: (bool, u64),
+        record_from: Option<f64>,
+        strobe_period: Option<f64>,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> core::Result<core::kernel::events::SystemSolution> {
+        let options = self.options(t_end, history, record_from, strobe_period);
+        let (system, stepping) = (&self.system, self.limits.stepping);
         if stepping == Stepping::Events {
             return self.stepper.integrate(system, y0, &options, interrupt);
         }
@@ -154,6 +165,30 @@ impl Ready {
         }
     }
 
+    /// The full state of the flat state `z` (x then v).
+    pub(crate) fn full_state(&self, z: &[f64]) -> core::Result<Vec<f64>> {
+        full_state(&self.system, z)
+    }
+
+    /// The stroboscopic map over `t_end` from the flat state `z` with its
+    /// Jacobian from the tangent flow (row-major).
+    fn map_tangent(
+        &mut self,
+        z: &[f64],
+        t_end: f64,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> core::Result<(Vec<f64>, Vec<f64>)> {
+        let y0 = self.full_state(z)?;
+        let options = self.options(t_end, (false, 1), None, None);
+        let Self {
+            system, stepper, ..
+        } = self;
+        let mut flow = core::analysis::tangent::Tangent::product(system)?;
+        let end = stepper.integrate_observed(system, &y0, &options, interrupt, &mut flow)?;
+        let size = 2 * system.dim;
+        Ok((end.final_state[..size].to_vec(), flow.matrix().to_vec()))
+    }
+
     /// The stroboscopic map over `t_end` from the flat state `z` (x then v).
     fn map(
         &mut self,
@@ -169,12 +204,19 @@ impl Ready {
     }
 }
 
+/// The full state (with the energy accumulators) of `system`'s flat state `z`
+/// (x then v).
+pub(crate) fn full_state(system: &Assembly, z: &[f64]) -> core::Result<Vec<f64>> {
+    let (n, d) = (system.n, system.dim);
+    resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..]])
+}
+
 /// A 0.2 system checked once, with its method, to run many times from any
 /// state (the analyses' stroboscopic maps): see `vibroimpact.analyses`.
 #[pyclass(frozen, module = "vibroimpact._core")]
 pub struct PreparedSystem {
     /// A run at a time: the method's buffers are the system's.
-    ready: std::sync::Mutex<Ready>,
+    pub(crate) ready: std::sync::Mutex<Ready>,
 }
 
 #[pymethods]
@@ -269,7 +311,8 @@ impl PreparedSystem {
     /// released. `forcing_period` (s, default `t_end`) sets the scale of the
     /// motion (see `core::analysis::shooting::shoot`). Returns `state`, `monodromy`
     /// (flat, row-major), `converged`, `iterations`, `residual`.
-    #[pyo3(signature = (state, t_end, *, tolerance, max_iterations, forcing_period = None))]
+    #[pyo3(signature = (state, t_end, *, tolerance, max_iterations, forcing_period = None, jacobian = "differences"))]
+    #[allow(clippy::too_many_arguments)]
     fn shoot<'py>(
         &self,
         py: Python<'py>,
@@ -280,9 +323,19 @@ impl PreparedSystem {
         #[pyo3(from_py_with = crate::convert::optional::forcing_period)] forcing_period: Option<
             f64,
         >,
+        jacobian: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
         T_END.check(t_end).map_err(to_py)?;
         TOLERANCE.check(tolerance).map_err(to_py)?;
+        let tangent = match jacobian {
+            "tangent" => true,
+            "differences" => false,
+            other => {
+                return Err(InvalidInputError::new_err(format!(
+                    "jacobian must be \"tangent\" or \"differences\", got {other:?}"
+                )))
+            }
+        };
         let forcing_period = FORCING_PERIOD
             .check(forcing_period.unwrap_or(t_end))
             .map_err(to_py)?;
@@ -297,14 +350,27 @@ impl PreparedSystem {
             )));
         }
         let ready: &mut Ready = &mut ready;
+        if tangent {
+            core::analysis::tangent::check(&ready.system).map_err(to_py)?;
+        }
         let shot = released(py, |interrupt| {
-            core::analysis::shooting::shoot(
-                &mut |z| ready.map(z, t_end, interrupt),
-                &state,
-                forcing_period,
-                tolerance,
-                max_iterations,
-            )
+            if tangent {
+                core::analysis::shooting::shoot_by_tangent(
+                    &mut |z| ready.map_tangent(z, t_end, interrupt),
+                    &state,
+                    forcing_period,
+                    tolerance,
+                    max_iterations,
+                )
+            } else {
+                core::analysis::shooting::shoot(
+                    &mut |z| ready.map(z, t_end, interrupt),
+                    &state,
+                    forcing_period,
+                    tolerance,
+                    max_iterations,
+                )
+            }
         })?;
         let out = PyDict::new(py);
         out.set_item("state", shot.state.into_pyarray(py))?;

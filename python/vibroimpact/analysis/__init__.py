@@ -15,7 +15,8 @@ front), :mod:`~vibroimpact.analysis.parameters` (the sections read and varied),
 :mod:`~vibroimpact.analysis.runs` (the :class:`Runner`), :mod:`~vibroimpact.analysis.steady`,
 :mod:`~vibroimpact.analysis.sweeps`, :mod:`~vibroimpact.analysis.orbits`,
 :mod:`~vibroimpact.analysis.settings` (the analyses' sections of a scenario),
-:mod:`~vibroimpact.analysis.continuation`, :mod:`~vibroimpact.analysis.maps`; the results as
+:mod:`~vibroimpact.analysis.continuation`, :mod:`~vibroimpact.analysis.maps`,
+:mod:`~vibroimpact.analysis.lyapunov`; the results as
 xarray Datasets in :mod:`~vibroimpact.analysis.datasets` and as plots in
 :mod:`~vibroimpact.analysis.plots` (neither imported here: xarray and matplotlib load on use).
 """
@@ -30,6 +31,7 @@ from vibroimpact.analysis.limits import (
     check_total,
     whole_count,
 )
+from vibroimpact.analysis.lyapunov import Lyapunov, lyapunov, lyapunov_runner
 from vibroimpact.analysis.maps import (
     Basins,
     BifurcationPoint,
@@ -77,6 +79,7 @@ __all__ = [
     "BifurcationPoint",
     "Branch",
     "BranchPoint",
+    "Lyapunov",
     "MAX_PERIODS",
     "MAX_POINTS",
     "MAX_STARTS",
@@ -100,6 +103,8 @@ __all__ = [
     "from_carried",
     "linear_amplitude",
     "linear_response",
+    "lyapunov",
+    "lyapunov_runner",
     "orbit",
     "poincare",
     "reductions",

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact.analysis.limits import whole_count
+from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run
 from vibroimpact.model.system import System
 from vibroimpact.summary import summarised
@@ -28,6 +28,12 @@ class Orbit:
     iterations: int
     residual: float
     monodromy: np.ndarray = field(repr=False)
+    #: How the monodromy was made: ``"tangent"`` (the tangent flow through the impacts,
+    #: exact) or ``"differences"`` (central differences of whole runs).
+    jacobian: str = "differences"
+    #: Grazings met on the orbit's tangent flow: ``(time s, pair, closing speed m/s)``,
+    #: where the flow has no derivative (the multipliers are then one-sided).
+    grazings: list[tuple[float, str, float]] = field(default_factory=list)
     #: The largest ``|displacement|`` (m) on the orbit at each of ``[output] points``, and
     #: ``|bending moment|`` (N m) at each of ``[output] moments``.
     point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -52,22 +58,31 @@ def orbit(
     periods: int = 1,
     tolerance: float = 1e-10,
     max_iterations: int = 40,
+    jacobian: str = "auto",
 ) -> Orbit:
     """Shoot for an orbit of ``periods`` forcing periods from ``state`` (default the
     scenario's ``[initial]``): Newton's method on ``P(z) - z = 0``, ``P`` the
-    stroboscopic map over ``periods`` periods, its Jacobian by central finite
-    differences (across impacts: the saltation is in the differences). At the orbit
-    the Jacobian is the monodromy matrix; its eigenvalues are the Floquet multipliers
-    and the orbit is stable when all lie inside the unit circle. Newton steps that
-    would start inside a wall are halved. ``run``: a :class:`Runner` or a
-    :class:`~vibroimpact.System`."""
+    stroboscopic map over ``periods`` periods. Its Jacobian (``jacobian``):
+    ``"tangent"``, the tangent flow carried through every impact by its saltation
+    matrix (exact; every pair rigid); ``"differences"``, central finite differences of
+    whole runs (across impacts the saltation is in the differences); ``"auto"`` (the
+    default), the tangent flow where the system has it. At the orbit the Jacobian is
+    the monodromy matrix; its eigenvalues are the Floquet multipliers and the orbit is
+    stable when all lie inside the unit circle. Newton steps that would start inside a
+    wall are halved. ``run``: a :class:`Runner` or a :class:`~vibroimpact.System`."""
     run = as_runner(run)
     state = checked_run(run, state)
     periods = whole_count("periods", periods, 1)
     arguments.positive("tolerance", tolerance)
     max_iterations = whole_count("max_iterations", max_iterations, 1)
+    jacobian = arguments.choice("jacobian", jacobian, ("auto", "tangent", "differences"))
+    refusal = run.tangent_refusal()
+    if jacobian == "auto":
+        jacobian = "differences" if refusal else "tangent"
+    elif jacobian == "tangent" and refusal:
+        raise AnalysisError(f"jacobian: {refusal}")
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
-    shot = run.shoot(z, periods, tolerance, max_iterations)
+    shot = run.shoot(z, periods, tolerance, max_iterations, jacobian)
     size = len(z)
     z = np.asarray(shot["state"], dtype=float)
     jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
@@ -75,6 +90,9 @@ def orbit(
     iterations = int(shot["iterations"])
     residual = float(shot["residual"])
     multipliers = np.linalg.eigvals(jac)
+    grazings: list[tuple[float, str, float]] = []
+    if jacobian == "tangent":
+        grazings = [tuple(g) for g in run.tangent(z, periods * run.period)["grazings"]]
     recorded = run.periods(z, periods, record=True)
     amplitude, point_amplitude, moment_amplitude = run.amplitudes(recorded)
     return Orbit(
@@ -87,6 +105,8 @@ def orbit(
         iterations=iterations,
         residual=residual,
         monodromy=jac,
+        jacobian=jacobian,
+        grazings=grazings,
         point_amplitude=point_amplitude,
         moment_amplitude=moment_amplitude,
     )

@@ -14,6 +14,7 @@ import numpy as np
 
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.continuation import Branch
+from vibroimpact.analysis.lyapunov import Lyapunov
 from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import Runner
@@ -415,3 +416,30 @@ def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
         for set_label, name in ((ax.set_xlabel, x), (ax.set_ylabel, y)):
             units = dataset[name].attrs.get("units")
             set_label(f"{name} ({units})" if units else name)
+
+
+def plot_lyapunov(path: Path, found: Lyapunov) -> None:
+    """Each Lyapunov exponent's estimate against the time averaged over (its
+    convergence), the final values with their standard errors at the right."""
+    with _figure(path) as (fig, ax):
+        finite = np.isfinite(found.exponents)
+        for j in np.flatnonzero(finite):
+            line = ax.plot(found.running_time, found.running[:, j], ".-", label=f"λ{j + 1}")
+            error = found.standard_error[j]
+            if np.isfinite(error):
+                ax.errorbar(
+                    found.running_time[-1],
+                    found.exponents[j],
+                    yerr=error,
+                    color=line[0].get_color(),
+                    capsize=4,
+                )
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_xlabel("time averaged over (s)")
+        ax.set_ylabel("Lyapunov exponent (1/s)")
+        lost = int(np.count_nonzero(~finite))
+        ax.set_title(
+            f"{found.impacts} impacts" + (f"; {lost} direction(s) lost to sticking" if lost else "")
+        )
+        ax.legend()
+        ax.grid(alpha=0.3)

@@ -16,6 +16,8 @@ from vibroimpact._core import (
     InvalidInputError,
     PreparedSystem,
     SimulationError,
+    tangent_map,
+    tangent_refusal,
 )
 from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
@@ -190,11 +192,34 @@ class Runner:
         assert z is not None  # count >= 1: the loop ran
         return z
 
+    def tangent_refusal(self) -> str | None:
+        """Why this system's tangent flow cannot be made exactly (a compliant pair),
+        or None where it can (every pair rigid)."""
+        return tangent_refusal(self.system())
+
+    def tangent(self, state: np.ndarray, t_end: float) -> dict[str, Any]:
+        """The tangent map of a run of ``t_end`` s from ``state``: ``state`` (the
+        end's), ``matrix`` (d end state / d start state), ``impacts`` and ``grazings``
+        (see :func:`vibroimpact._core.tangent_map`)."""
+        z = arguments.state("state", state, 2 * (self.n + self.k))
+        assert z is not None
+        raw = tangent_map(self.system(), [float(v) for v in z], float(t_end))
+        size = len(z)
+        raw["matrix"] = np.asarray(raw["matrix"], dtype=float).reshape(size, size)
+        self.runs += 1
+        return raw
+
     def shoot(
-        self, state: np.ndarray, count: int, tolerance: float, max_iterations: int
+        self,
+        state: np.ndarray,
+        count: int,
+        tolerance: float,
+        max_iterations: int,
+        jacobian: str = "differences",
     ) -> dict[str, Any]:
         """Newton's shooting over ``count`` periods from ``state``, in the core (see
-        :func:`orbit`)."""
+        :func:`orbit`), its Jacobian by the tangent flow (``jacobian = "tangent"``) or
+        central differences."""
         check_periods("", "count", whole_count("count", count, 1), 1)
         if len(state) != 2 * (self.n + self.k):
             raise AnalysisError(
@@ -206,6 +231,7 @@ class Runner:
             tolerance=tolerance,
             max_iterations=max_iterations,
             forcing_period=self.period,
+            jacobian=jacobian,
         )
         self.runs += int(shot["maps"])
         return shot

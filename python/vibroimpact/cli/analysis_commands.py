@@ -34,6 +34,7 @@ from vibroimpact.analysis import (
     sweep,
     sweep_values,
 )
+from vibroimpact.cli.tangent_commands import run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
@@ -60,6 +61,8 @@ def run_orbit(args: argparse.Namespace) -> int:
         "state": found.arrays(run.n, run.k),
         "floquet_multipliers": [[float(m.real), float(m.imag)] for m in found.floquet_multipliers],
         "stable": found.stable,
+        "jacobian": found.jacobian,
+        "grazings": [{"time": t, "pair": p, "speed": v} for t, p, v in found.grazings],
         "impacts_per_period": found.impacts_per_period,
         "amplitude": [float(a) for a in found.amplitude],
         **(
@@ -494,5 +497,6 @@ COMMANDS = {
         "poincare": run_poincare,
         "basins": run_basins,
         "continue": run_continue,
+        "lyapunov": run_lyapunov,
     }.items()
 }

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from vibroimpact.analysis import BIFURCATION_SAMPLES
+from vibroimpact.cli.tangent_commands import add_tangent_parsers
 
 
 def add_commands(sub: Any) -> None:
@@ -21,9 +22,10 @@ def add_commands(sub: Any) -> None:
             "period of the harmonic excitations), from the scenario's [initial] state: "
             "prints whether it converged, "
             "the state on the orbit at t = 0 (the four arrays of [initial], SI), the Floquet "
-            "multipliers (eigenvalues of the monodromy matrix, by finite differences through "
-            "the impacts), stability, impacts per forcing period and the amplitude (largest "
-            "|structure displacement| over the orbit, m, per coordinate)."
+            "multipliers (eigenvalues of the monodromy matrix: the tangent flow through the "
+            "impacts where every pair is rigid, else finite differences), stability, "
+            "impacts per forcing period and the amplitude (largest |structure "
+            "displacement| over the orbit, m, per coordinate)."
         ),
     )
     orbit_parser.add_argument("scenario", type=Path, help="scenario file (.toml, [structure])")
@@ -132,6 +134,7 @@ def add_commands(sub: Any) -> None:
         ),
     )
     _outputs(cont, "scenario file (.toml) with [continuation]", "plot the branch")
+    add_tangent_parsers(sub)
 
 
 def _outputs(parser: argparse.ArgumentParser, scenario: str, plot: str) -> None:

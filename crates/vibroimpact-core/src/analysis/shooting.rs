@@ -1,7 +1,9 @@
 //! Shooting for periodic orbits: Newton's method on `P(z) - z = 0`, `P` a
-//! stroboscopic map, with a central-difference Jacobian (across impacts the
-//! differences include the saltation). At the orbit the Jacobian is the
-//! monodromy matrix, whose eigenvalues are the Floquet multipliers.
+//! stroboscopic map, with its Jacobian from the tangent flow through the
+//! impacts ([`shoot_by_tangent`], exact) or by central differences
+//! ([`shoot`]: across impacts the differences include the saltation). At the
+//! orbit the Jacobian is the monodromy matrix, whose eigenvalues are the
+//! Floquet multipliers.
 
 use crate::analysis::settling;
 use crate::error::{Error, Result};
@@ -45,6 +47,101 @@ pub fn shoot(
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<Shot> {
+    let mut by = Differences { map };
+    newton(&mut by, z0, forcing_period, tolerance, max_iterations)
+}
+
+/// [`shoot`] with the Jacobian of the tangent flow: `run` maps `z` and
+/// returns its image with the derivative of the image by `z` (row-major),
+/// each Newton iteration's one run giving both.
+pub fn shoot_by_tangent(
+    run: &mut TangentMap<'_>,
+    z0: &[f64],
+    forcing_period: f64,
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<Shot> {
+    let mut by = ByTangent { run, last: None };
+    newton(&mut by, z0, forcing_period, tolerance, max_iterations)
+}
+
+/// A map that returns its image with its Jacobian (row-major).
+pub type TangentMap<'m> = dyn FnMut(&[f64]) -> Result<(Vec<f64>, Vec<f64>)> + 'm;
+
+/// How Newton's method evaluates the map and its Jacobian.
+trait Evaluate {
+    fn map(&mut self, z: &[f64]) -> Result<Vec<f64>>;
+    /// The Jacobian at `z`, whose image is `image`; `scale` is the motion's
+    /// size per coordinate; `maps` counts the maps evaluated.
+    fn jacobian(
+        &mut self,
+        z: &[f64],
+        image: &[f64],
+        scale: &[f64],
+        maps: &mut usize,
+    ) -> Result<Vec<f64>>;
+}
+
+/// Central differences of the map.
+struct Differences<'m> {
+    map: &'m mut dyn FnMut(&[f64]) -> Result<Vec<f64>>,
+}
+
+impl Evaluate for Differences<'_> {
+    fn map(&mut self, z: &[f64]) -> Result<Vec<f64>> {
+        (self.map)(z)
+    }
+
+    fn jacobian(
+        &mut self,
+        z: &[f64],
+        image: &[f64],
+        scale: &[f64],
+        maps: &mut usize,
+    ) -> Result<Vec<f64>> {
+        jacobian(self.map, z, image, scale, maps)
+    }
+}
+
+/// The tangent flow: each map's run carries its Jacobian, kept for the
+/// iteration that asks for it.
+struct ByTangent<'m> {
+    run: &'m mut TangentMap<'m>,
+    last: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+impl Evaluate for ByTangent<'_> {
+    fn map(&mut self, z: &[f64]) -> Result<Vec<f64>> {
+        let (image, matrix) = (self.run)(z)?;
+        self.last = Some((z.to_vec(), matrix));
+        Ok(image)
+    }
+
+    fn jacobian(
+        &mut self,
+        z: &[f64],
+        _image: &[f64],
+        _scale: &[f64],
+        maps: &mut usize,
+    ) -> Result<Vec<f64>> {
+        match self.last.take() {
+            Some((at, matrix)) if at == z => Ok(matrix),
+            _ => {
+                *maps += 1;
+                Ok((self.run)(z)?.1)
+            }
+        }
+    }
+}
+
+/// Newton's method on `P(z) = z` (see [`shoot`]).
+fn newton(
+    by: &mut dyn Evaluate,
+    z0: &[f64],
+    forcing_period: f64,
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<Shot> {
     let size = z0.len();
     let dim = size / 2;
     let mut maps = 0usize;
@@ -64,7 +161,7 @@ pub fn shoot(
     };
     let mut z = z0.to_vec();
     maps += 1;
-    let mut image = map(&z)?;
+    let mut image = by.map(&z)?;
     let residual_of = |z: &[f64], image: &[f64], scale: &[f64]| {
         (0..size)
             .map(|i| (image[i] - z[i]).abs() / scale[i])
@@ -80,7 +177,7 @@ pub fn shoot(
             converged = true;
             break;
         }
-        let jac = jacobian(map, &z, &image, &scale, &mut maps)?;
+        let jac = by.jacobian(&z, &image, &scale, &mut maps)?;
         let mut system = jac.clone();
         for i in 0..size {
             system[i * size + i] -= 1.0;
@@ -91,7 +188,7 @@ pub fn shoot(
         let stalled = loop {
             let trial: Vec<f64> = z.iter().zip(&step).map(|(z, s)| z + factor * s).collect();
             maps += 1;
-            match map(&trial) {
+            match by.map(&trial) {
                 Ok(next) => {
                     z = trial;
                     image = next;
@@ -118,7 +215,7 @@ pub fn shoot(
         converged = residual <= tolerance;
     }
     let scale = scales(&z, &image);
-    let monodromy = jacobian(map, &z, &image, &scale, &mut maps)?;
+    let monodromy = by.jacobian(&z, &image, &scale, &mut maps)?;
     Ok(Shot {
         state: z,
         monodromy,

@@ -104,6 +104,13 @@ impl<'a> Run<'a> {
         record_limit: u64,
     ) -> Result<Self> {
         let (len, d, count) = (system.state_len(), system.dim, system.interactions.len());
+        if initial.len() != len {
+            return Err(Error::Inconsistent(format!(
+                "the initial state must have {len} values (x, v and the energy \
+                 accumulators), got {}",
+                initial.len()
+            )));
+        }
         let adaptive = stepper.is_adaptive();
         let timing = Self::timing(stepping);
         if timing.is_some() {

@@ -48,6 +48,9 @@ pub struct LyapunovSpectrum {
     /// Each exponent's standard error over the blocks, 1/s (NaN for one
     /// block, or an exponent infinite in any block).
     pub standard_error: Vec<f64>,
+    /// The estimates after each block (1/s, row-major `blocks x 2 dim`, each
+    /// row in the order of `exponents`): the spectrum's convergence.
+    pub running: Vec<f64>,
     /// The time averaged over, s.
     pub time: f64,
     /// Events whose impulses acted over that time.
@@ -55,22 +58,28 @@ pub struct LyapunovSpectrum {
     pub grazings: Vec<Grazing>,
 }
 
+/// One block's run: from a start state, with the flow told of its events, to
+/// its end state.
+pub type BlockRun<'r> = dyn FnMut(&[f64], &mut Tangent<'_>) -> Result<Vec<f64>> + 'r;
+
 /// The spectrum of `system` from `y0` over `blocks` runs of `block_time` s
 /// each, each from the last one's end: `run` integrates one block from its
-/// start state with the flow told of its events and returns its end state
-/// (`x` then `v`, and the accumulators the system's state holds).
+/// start state (the system's full state, [`Assembly::state_len`] values)
+/// with the flow told of its events and returns its end state as the next
+/// block's start (the same length).
 pub fn lyapunov_blocks(
     system: &Assembly,
     y0: &[f64],
     block_time: f64,
     blocks: usize,
-    run: &mut dyn FnMut(&[f64], &mut Tangent<'_>) -> Result<Vec<f64>>,
+    run: &mut BlockRun<'_>,
 ) -> Result<LyapunovSpectrum> {
     let mut flow = Tangent::orthonormal(system)?;
     let size = 2 * system.dim;
     let mut estimates: Vec<Vec<f64>> = Vec::with_capacity(blocks);
+    let mut sums: Vec<Vec<f64>> = Vec::with_capacity(blocks);
     let mut y = y0.to_vec();
-    for _ in 0..blocks {
+    for b in 0..blocks {
         let before = flow.logs().to_vec();
         y = run(&y, &mut flow)?;
         let block: Vec<f64> = flow
@@ -80,6 +89,8 @@ pub fn lyapunov_blocks(
             .map(|(after, before)| (after - before) / block_time)
             .collect();
         estimates.push(block);
+        let elapsed = block_time * (b + 1) as f64;
+        sums.push(flow.logs().iter().map(|l| l / elapsed).collect());
     }
     let time = block_time * blocks as f64;
     let exponents: Vec<f64> = flow.logs().iter().map(|l| l / time).collect();
@@ -99,6 +110,10 @@ pub fn lyapunov_blocks(
     Ok(LyapunovSpectrum {
         exponents: order.iter().map(|&j| exponents[j]).collect(),
         standard_error: order.iter().map(|&j| standard_error[j]).collect(),
+        running: sums
+            .iter()
+            .flat_map(|row| order.iter().map(move |&j| row[j]))
+            .collect(),
         time,
         impacts: flow.impacts(),
         grazings: flow.grazings().to_vec(),

@@ -44,6 +44,8 @@ pub struct Grazing {
     /// s.
     pub time: f64,
     pub interaction: usize,
+    /// Its pair (index into [`Assembly::pairs`]).
+    pub pair: usize,
     /// The closing speed, m/s (of round-off).
     pub speed: f64,
 }
@@ -244,6 +246,7 @@ impl EventObserver for Tangent<'_> {
             self.grazings.push(Grazing {
                 time: view.time,
                 interaction: view.located,
+                pair: self.system.interactions[view.located].pair,
                 speed,
             });
         }

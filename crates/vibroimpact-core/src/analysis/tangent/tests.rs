@@ -141,8 +141,7 @@ fn each_impact_multiplies_phase_volume_by_the_square_of_its_restitution() {
         for t_end in [0.1, 0.3] {
             let (_, tangent, impacts) = run(&system, &y0, t_end);
             let det = determinant(&tangent, 2 * system.dim);
-            let expected =
-                RESTITUTION.powi(2 * impacts as i32) * (-DAMPING / MASS * t_end).exp();
+            let expected = RESTITUTION.powi(2 * impacts as i32) * (-DAMPING / MASS * t_end).exp();
             assert!(
                 ((det - expected) / expected).abs() < 1e-10,
                 "t_end {t_end}: det {det:e} against {expected:e} ({impacts} impacts)"

@@ -1,0 +1,138 @@
+//! The tangent flow of a prepared system (see `core::analysis::tangent`):
+//! its map over a run and its Lyapunov spectrum, each computed with the GIL
+//! released.
+
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use vibroimpact_core as core;
+use vibroimpact_core::analysis::tangent::{self, Grazing, Tangent};
+use vibroimpact_core::methods::registry::T_END;
+
+use crate::errors::{released, to_py, InvalidInputError};
+use crate::system::{full_state, PreparedSystem, Ready};
+
+/// The prepared system's run state, locked, with `state` checked to be `2 dim`
+/// values and the system able to carry a tangent flow.
+fn ready_for<'a>(
+    prepared: &'a PreparedSystem,
+    state: &[f64],
+) -> PyResult<std::sync::MutexGuard<'a, Ready>> {
+    let ready = prepared
+        .ready
+        .lock()
+        .map_err(|_| InvalidInputError::new_err("a run of this system failed; make it again"))?;
+    let size = 2 * ready.system.dim;
+    if state.len() != size {
+        return Err(InvalidInputError::new_err(format!(
+            "state must have {size} values (x then v), got {}",
+            state.len()
+        )));
+    }
+    tangent::check(&ready.system).map_err(to_py)?;
+    Ok(ready)
+}
+
+/// The grazings as a list of `(time s, pair name, closing speed m/s)`.
+fn grazings<'py>(
+    py: Python<'py>,
+    system: &core::model::assembly::Assembly,
+    found: &[Grazing],
+) -> PyResult<Bound<'py, PyList>> {
+    let rows: Vec<(f64, String, f64)> = found
+        .iter()
+        .map(|g| (g.time, system.pairs[g.pair].clone(), g.speed))
+        .collect();
+    PyList::new(py, rows)
+}
+
+/// The tangent map of a run of `t_end` s from the flat state `state` (x then
+/// v): `state` (the end's), `matrix` (the derivative of the end state by the
+/// start state, row-major), `impacts` (events whose impulses acted) and
+/// `grazings` (list of `(time, pair, speed)`, where the flow has no
+/// derivative).
+#[pyfunction]
+pub fn tangent_map<'py>(
+    py: Python<'py>,
+    prepared: &PreparedSystem,
+    state: Vec<f64>,
+    #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    T_END.check(t_end).map_err(to_py)?;
+    let mut guard = ready_for(prepared, &state)?;
+    let ready: &mut Ready = &mut guard;
+    let (end, matrix, impacts, found) = released(py, |interrupt| {
+        let y0 = ready.full_state(&state)?;
+        let options = ready.options(t_end, (false, 1), None, None);
+        let Ready {
+            system, stepper, ..
+        } = ready;
+        let mut flow = Tangent::product(system)?;
+        let end = stepper.integrate_observed(system, &y0, &options, interrupt, &mut flow)?;
+        let size = 2 * system.dim;
+        Ok((
+            end.final_state[..size].to_vec(),
+            flow.matrix().to_vec(),
+            flow.impacts(),
+            flow.grazings().to_vec(),
+        ))
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("state", end.into_pyarray(py))?;
+    out.set_item("matrix", matrix.into_pyarray(py))?;
+    out.set_item("impacts", impacts)?;
+    out.set_item("grazings", grazings(py, &ready.system, &found)?)?;
+    Ok(out)
+}
+
+/// The Lyapunov spectrum from the flat state `state` over `blocks` runs of
+/// `block_time` s each, each from the last one's end (see
+/// `core::analysis::tangent::lyapunov_blocks`): `exponents` (1/s,
+/// descending), `standard_error` (over the blocks), `time` (s), `impacts`,
+/// `grazings`.
+#[pyfunction]
+pub fn lyapunov_spectrum<'py>(
+    py: Python<'py>,
+    prepared: &PreparedSystem,
+    state: Vec<f64>,
+    #[pyo3(from_py_with = crate::convert::arg::t_end)] block_time: f64,
+    blocks: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    T_END.check(block_time).map_err(to_py)?;
+    if blocks == 0 {
+        return Err(InvalidInputError::new_err("blocks must be at least 1"));
+    }
+    let mut guard = ready_for(prepared, &state)?;
+    let ready: &mut Ready = &mut guard;
+    let spectrum = released(py, |interrupt| {
+        let y0 = ready.full_state(&state)?;
+        let options = ready.options(block_time, (false, 1), None, None);
+        let Ready {
+            system, stepper, ..
+        } = ready;
+        let system: &core::model::assembly::Assembly = system;
+        tangent::lyapunov_blocks(system, &y0, block_time, blocks, &mut |y, flow| {
+            let end = stepper.integrate_observed(system, y, &options, interrupt, flow)?;
+            full_state(system, &end.final_state[..2 * system.dim])
+        })
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("exponents", spectrum.exponents.into_pyarray(py))?;
+    out.set_item("standard_error", spectrum.standard_error.into_pyarray(py))?;
+    out.set_item("running", spectrum.running.into_pyarray(py))?;
+    out.set_item("time", spectrum.time)?;
+    out.set_item("impacts", spectrum.impacts)?;
+    out.set_item("grazings", grazings(py, &ready.system, &spectrum.grazings)?)?;
+    Ok(out)
+}
+
+/// Why the prepared system's tangent flow cannot be made exactly (a
+/// compliant pair), or None where it can.
+#[pyfunction]
+pub fn tangent_refusal(prepared: &PreparedSystem) -> PyResult<Option<String>> {
+    let ready = prepared
+        .ready
+        .lock()
+        .map_err(|_| InvalidInputError::new_err("a run of this system failed; make it again"))?;
+    Ok(tangent::check(&ready.system).err().map(|e| e.to_string()))
+}
