@@ -44,6 +44,9 @@ __all__ = [
     "linear_parts",
     "PreparedSystem",
     "run_study",
+    "tangent_map",
+    "lyapunov_spectrum",
+    "tangent_refusal",
 ]
 
 #: The package's version, as in pyproject.toml.
