@@ -290,6 +290,7 @@ def run_study(
     mean_square: bool = True,
     stepping: str | None = None,
     orbit_periods: int = 1,
+    lyapunov: bool = False,
 ) -> dict[str, Any]: ...
 
 @final

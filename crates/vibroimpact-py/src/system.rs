@@ -553,11 +553,12 @@ pub fn linear_parts<'py>(
 /// copy of the system and runs it, on `threads` threads (0: all cores), with
 /// the GIL released. Returns the metrics as flat arrays, one row a run.
 /// `analysis = "orbit"` settles, then shoots for an orbit of `orbit_periods`
-/// forcing periods (its multipliers, amplitude and impacts).
+/// forcing periods (its multipliers, amplitude and impacts). `lyapunov`
+/// carries the tangent flow for the largest Lyapunov exponent (1/s).
 /// `stepping = "fixed"` runs them as a lockstep ensemble of fixed RK4 steps
 /// (one mass, one compliant damper, unforced; see `core::analysis::ensemble`).
 #[pyfunction]
-#[pyo3(signature = (spec, initial, *, paths, values, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, energy_tolerance=None, mean_square=true, stepping=None, orbit_periods=1))]
+#[pyo3(signature = (spec, initial, *, paths, values, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, energy_tolerance=None, mean_square=true, stepping=None, orbit_periods=1, lyapunov=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_study<'py>(
     py: Python<'py>,
@@ -586,6 +587,7 @@ pub fn run_study<'py>(
     mean_square: bool,
     stepping: Option<&str>,
     orbit_periods: u64,
+    lyapunov: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     use core::analysis::study::{run_study as study, Parameter, StudySettings};
     let options = Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
@@ -633,6 +635,7 @@ pub fn run_study<'py>(
         analysis,
         mean_square,
         lockstep: lockstep_of(stepping)?,
+        lyapunov,
     };
     let results = released(py, |interrupt| {
         // The runs go on the study's threads, where Python's signals cannot be
@@ -740,5 +743,6 @@ fn study_dict<'py>(
     out.set_item("settled", flat(&|r| vec![r.settled]))?;
     out.set_item("stable", flat(&|r| vec![r.stable]))?;
     out.set_item("largest_multiplier", flat(&|r| vec![r.largest_multiplier]))?;
+    out.set_item("largest_lyapunov", flat(&|r| vec![r.largest_lyapunov]))?;
     Ok(out)
 }

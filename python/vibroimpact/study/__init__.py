@@ -15,6 +15,7 @@ The ``[study]`` section::
     metrics = ["peak", "rms", "impacts", "energy_dissipated",
                "amplitude", "impacts_per_period", "settled"]
                # orbit: "amplitude", "impacts_per_period", "stable", "largest_multiplier"
+               # any analysis: "largest_lyapunov" (1/s; every pair rigid)
                # default: "peak", "rms", "impacts"; for an orbit, its four
     chunk_size = 1024              # runs a chunk (what a resume can lose at most)
 
@@ -59,13 +60,21 @@ the order of ``[study.random]``) at every grid point. SI units.
 
 ``analysis = "orbit"`` settles each point for ``settle_periods`` forcing periods, then
 shoots for an orbit of ``orbit_periods`` periods from there (Newton's method with the
-central-difference monodromy, as :func:`vibroimpact.analysis.orbit`, in the core): ``stable``
+monodromy of the tangent flow through the impacts where every pair is rigid, else of
+central differences, as :func:`vibroimpact.analysis.orbit`, in the core): ``stable``
 is true when it converged and every Floquet multiplier is inside the unit circle,
 ``largest_multiplier`` the largest multiplier's modulus, ``amplitude`` and
-``impacts_per_period`` those of the orbit. A point whose shooting fails (no orbit near its
+``impacts_per_period`` those of the orbit, ``largest_lyapunov`` its largest multiplier's
+``ln |mu| / T``. A point whose shooting fails (no orbit near its
 settled state) is recorded with its reason. Both periodic analyses use the common period
 of the excitations (see :func:`vibroimpact.analysis.forcing_period`): other forcing is
 refused, and a point an axis makes aperiodic fails with its reason.
+
+``largest_lyapunov`` of a run or a steady state is the largest Lyapunov exponent (1/s) of
+its recorded time, from the tangent flow carried through every impact by its saltation
+matrix and re-orthonormalised after each (see :func:`vibroimpact.lyapunov`): a chaos map
+over two parameters is one study with two axes. It takes rigid pairs (a compliant one is
+refused up front).
 
 ``stepping = "fixed"`` runs a study of the two-mass impact damper (one mass on a spring,
 one ``[[damper]]`` with equal clearances and a compliant law, no stops, gravity or

@@ -43,6 +43,11 @@ _DESCRIPTIONS = {
         "1",
     ),
     "largest_multiplier": ("modulus of the orbit's largest Floquet multiplier", "1"),
+    "largest_lyapunov": (
+        "largest Lyapunov exponent, by the tangent flow through the impacts over the "
+        "recorded time (an orbit's: ln |largest multiplier| / its period; > 0: chaos)",
+        "1/s",
+    ),
 }
 
 

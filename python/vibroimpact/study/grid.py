@@ -117,6 +117,9 @@ class Study:
             # None: the core registry's default stepping.
             stepping=s.get("stepping"),
             orbit_periods=s.get("orbit_periods", 1),
+            # The tangent flow is carried only where its exponent is kept (an orbit's
+            # comes from its multipliers).
+            lyapunov="largest_lyapunov" in s["metrics"] and s["analysis"] != "orbit",
         )
         return raw
 
@@ -212,6 +215,7 @@ _METRIC_KEYS = (
     "settled",
     "stable",
     "largest_multiplier",
+    "largest_lyapunov",
 )
 
 

@@ -32,12 +32,18 @@ from vibroimpact.system import (
 )
 
 # What each analysis keeps; every metric.
-_RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated")
+_RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated", "largest_lyapunov")
 _STEADY_METRICS = (*_RUN_METRICS, "amplitude", "impacts_per_period", "settled")
 _ANALYSIS_METRICS = {
     "run": _RUN_METRICS,
     "steady-state": _STEADY_METRICS,
-    "orbit": ("amplitude", "impacts_per_period", "stable", "largest_multiplier"),
+    "orbit": (
+        "amplitude",
+        "impacts_per_period",
+        "stable",
+        "largest_multiplier",
+        "largest_lyapunov",
+    ),
 }
 #: Every metric a study can keep (each analysis keeps some of them).
 METRICS = (*_STEADY_METRICS, "stable", "largest_multiplier")

@@ -114,6 +114,7 @@ pub(super) fn run_lockstep(
                 settled: nan,
                 stable: nan,
                 largest_multiplier: nan,
+                largest_lyapunov: nan,
             }
         })
         .collect())

@@ -5,6 +5,7 @@ use super::run::{run_options, stepper_of};
 use super::settings::{Analysis, StudySettings};
 
 use crate::analysis::settling::{self, MAX_PERIOD};
+use crate::analysis::tangent::{self, Tangent};
 use crate::error::{Error, Result};
 use crate::kernel::events::{ContactKind, RunOptions, SystemSolution};
 use crate::kernel::reductions::ReduceOptions;
@@ -39,6 +40,10 @@ pub struct RunMetrics {
     /// inside the unit circle, else 0; the largest multiplier's modulus.
     pub stable: f64,
     pub largest_multiplier: f64,
+    /// The largest Lyapunov exponent, 1/s: over the recorded time (runs and
+    /// steady states, where asked), or `ln |largest multiplier| / T` of an
+    /// orbit of `T` s.
+    pub largest_lyapunov: f64,
 }
 
 /// An orbit study's run: settle, shoot, then one more orbit recorded.
@@ -78,9 +83,19 @@ pub(super) fn orbit_metrics(
     } else {
         y0[..2 * d].to_vec()
     };
-    let mut run_from = |z: &[f64], options: &RunOptions| -> Result<SystemSolution> {
+    // A run from the flat state `z`, the tangent flow told of its events
+    // where one is given.
+    let mut run_from = |z: &[f64],
+                        options: &RunOptions,
+                        flow: Option<&mut Tangent<'_>>|
+     -> Result<SystemSolution> {
         let y = resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..2 * d]])?;
-        let run = stepper.integrate(system, &y, options, &mut || interrupt());
+        let run = match flow {
+            Some(flow) => {
+                stepper.integrate_observed(system, &y, options, &mut || interrupt(), flow)
+            }
+            None => stepper.integrate(system, &y, options, &mut || interrupt()),
+        };
         if run.is_err() {
             // A run stopped part way may leave work in the method (the exact
             // flow's pending energies): the next starts with a fresh one.
@@ -88,13 +103,28 @@ pub(super) fn orbit_metrics(
         }
         run
     };
-    let shot = shooting::shoot(
-        &mut |z| Ok(run_from(z, &span_options)?.final_state),
-        &z,
-        period,
-        ORBIT_TOLERANCE,
-        ORBIT_ITERATIONS,
-    )?;
+    let shot = if tangent::check(system).is_ok() {
+        // The monodromy from the tangent flow through the impacts (exact).
+        shooting::shoot_by_tangent(
+            &mut |z| {
+                let mut flow = Tangent::product(system)?;
+                let end = run_from(z, &span_options, Some(&mut flow))?.final_state;
+                Ok((end, flow.matrix().to_vec()))
+            },
+            &z,
+            period,
+            ORBIT_TOLERANCE,
+            ORBIT_ITERATIONS,
+        )?
+    } else {
+        shooting::shoot(
+            &mut |z| Ok(run_from(z, &span_options, None)?.final_state),
+            &z,
+            period,
+            ORBIT_TOLERANCE,
+            ORBIT_ITERATIONS,
+        )?
+    };
     if !shot.converged {
         let refused = shot
             .refusal
@@ -115,7 +145,7 @@ pub(super) fn orbit_metrics(
         .iter()
         .map(|(re, im)| re.hypot(*im))
         .fold(0.0f64, f64::max);
-    let orbit = run_from(&z, &record_options)?;
+    let orbit = run_from(&z, &record_options, None)?;
     let impacts = orbit
         .contacts
         .iter()
@@ -133,6 +163,7 @@ pub(super) fn orbit_metrics(
         settled: nan,
         stable: f64::from(u8::from(shot.converged && largest < 1.0)),
         largest_multiplier: largest,
+        largest_lyapunov: largest.ln() / span,
     })
 }
 
@@ -217,5 +248,6 @@ pub(super) fn metrics_of(
         settled,
         stable: f64::NAN,
         largest_multiplier: f64::NAN,
+        largest_lyapunov: f64::NAN,
     }
 }

@@ -7,6 +7,7 @@ use super::lockstep::run_lockstep;
 use super::metrics::{metrics_of, orbit_metrics, recorded_periods, RunMetrics};
 use super::parameters::{Parameter, Target};
 use super::settings::{Analysis, StudySettings};
+use crate::analysis::tangent::{self, Tangent};
 use crate::error::{Error, Result};
 use crate::kernel::events::RunOptions;
 use crate::kernel::reductions::ReduceOptions;
@@ -30,6 +31,13 @@ pub fn run_study(
         // Refused up front on the base scenario; an axis may still make a
         // point aperiodic, which then fails alone.
         forcing_period(spec)?;
+    }
+    if settings.lyapunov {
+        // Every run alike would fail on a compliant pair, which no axis
+        // changes: refused up front.
+        if let Ok(system) = Assembly::new(spec) {
+            tangent::check(&system)?;
+        }
     }
     if settings.method == "exact" {
         // Every run alike would fail on a law's or a signal's kind, which no
@@ -109,6 +117,7 @@ pub(super) fn failed_run(spec: &SystemSpec, reason: String) -> RunMetrics {
         settled: f64::NAN,
         stable: f64::NAN,
         largest_multiplier: f64::NAN,
+        largest_lyapunov: f64::NAN,
     }
 }
 
@@ -242,6 +251,17 @@ pub(super) fn measured_on(
             contacts_from: record_from,
         },
     );
+    if settings.lyapunov {
+        // The tangent flow over the recorded time, re-orthonormalised at
+        // each event: its largest stretch rate.
+        let mut flow = Tangent::orthonormal(system)?.from_time(record_from);
+        let sol =
+            stepper.integrate_observed(system, &y0, &options, &mut || interrupt(), &mut flow)?;
+        let mut metrics = metrics_of(system, &sol, (record_from, strobe_period), settings);
+        let largest = flow.logs().iter().fold(f64::NEG_INFINITY, |m, l| m.max(*l));
+        metrics.largest_lyapunov = largest / (t_end - record_from);
+        return Ok(metrics);
+    }
     let sol = stepper.integrate(system, &y0, &options, &mut || interrupt())?;
     Ok(metrics_of(
         system,

@@ -20,6 +20,10 @@ pub struct StudySettings {
     /// unforced ([`crate::analysis::ensemble`]), or of any small modal system the
     /// compact path takes ([`crate::analysis::lanes`]).
     pub lockstep: bool,
+    /// Whether to carry the tangent flow for the largest Lyapunov exponent
+    /// (runs and steady states: over the recorded time; orbits: from the
+    /// largest multiplier).
+    pub lyapunov: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -99,6 +99,9 @@ pub struct Tangent<'s> {
     grazings: Vec<Grazing>,
     /// Events whose impulses acted.
     impacts: u64,
+    /// The time from which the flow is carried (s): events before it only
+    /// set the modes.
+    from: f64,
 }
 
 /// The key of a set of modes: the flow's matrix depends on which pairs
@@ -141,7 +144,16 @@ impl<'s> Tangent<'s> {
             product: vec![0.0; size * size],
             grazings: Vec::new(),
             impacts: 0,
+            from: f64::NEG_INFINITY,
         })
+    }
+
+    /// The flow carried from `time` (s) on, not from the run's start: the
+    /// derivative of the end state by the state at `time` (a study's
+    /// recorded window, after its settling).
+    pub fn from_time(mut self, time: f64) -> Self {
+        self.from = time;
+        self
     }
 
     /// The derivative of the end state by the start state (row-major `2 dim
@@ -228,12 +240,16 @@ impl<'s> Tangent<'s> {
 
 impl EventObserver for Tangent<'_> {
     fn start(&mut self, time: f64, _y: &[f64], modes: &[Mode]) -> Result<()> {
-        self.since = time;
+        self.since = time.max(self.from);
         self.modes.copy_from_slice(modes);
         Ok(())
     }
 
     fn event(&mut self, view: &EventView<'_>) -> Result<()> {
+        if view.time <= self.from {
+            self.modes.copy_from_slice(view.modes_after);
+            return Ok(());
+        }
         // The modes before the event are the stretch's (the kernel switches
         // modes only at events).
         self.modes.copy_from_slice(view.modes_before);
