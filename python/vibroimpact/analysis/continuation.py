@@ -31,6 +31,7 @@ from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.crossings import _CLASSES, _flags, _kind, _largest
 from vibroimpact.analysis.limits import AnalysisError, whole_count
+from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
 from vibroimpact.analysis.runs import Runner, runner
@@ -91,6 +92,12 @@ class Branch:
     stopped: str
     n: int
     k: int
+    #: The bifurcations located exactly (Newton on the extended system, where every pair
+    #: is rigid): see :mod:`vibroimpact.analysis.located`.
+    bifurcations: list[Bifurcation] = field(default_factory=list)
+    #: With ``switch``: the period-doubled branch born at the first flip (None where
+    #: none was found).
+    switched: Branch | None = None
 
 
 #: A continuation's step (arclength, in the parameter's unit) as fractions of the range
@@ -109,13 +116,16 @@ def continue_orbit(
     tolerance: float = 1e-9,
     base_dir: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
+    switch: bool = False,
 ) -> Branch:
     """Continue the K-period orbit found from the scenario's ``[initial]`` (at the
     scenario's value of ``parameter``) towards ``stop``, with arclength steps of
     about ``step`` (in units of the parameter; default 1/50 of the range), at most
     ``max_points`` orbits. Stops at ``stop``, at ``max_points``, or when the
-    corrector fails even with small steps. ``data``: a :class:`~vibroimpact.System` or a
-    scenario's sections."""
+    corrector fails even with small steps. Bifurcations are located exactly where every
+    pair is rigid (:attr:`Branch.bifurcations`); with ``switch``, the continuation goes
+    on from the first flip along the period-doubled branch (:attr:`Branch.switched`).
+    ``data``: a :class:`~vibroimpact.System` or a scenario's sections."""
     data, base_dir = sections_of(data, base_dir)
     arguments.text("parameter", parameter)
     stop = arguments.number("stop", stop)
@@ -123,6 +133,7 @@ def continue_orbit(
     arguments.positive("tolerance", tolerance)
     base_dir = arguments.directory("base_dir", base_dir)
     arguments.callback("progress", progress)
+    switch = arguments.flag("switch", switch)
     start_value = _value_of(data, parameter)
     if stop == start_value:
         raise AnalysisError(f"stop: must be a finite value other than the start {start_value:g}")
@@ -171,7 +182,77 @@ def continue_orbit(
     points, stopped = arc.trace(
         first.state, start_value, first_run.period, ds, stop, max_points, progress
     )
-    return Branch(parameter, periods, points, stopped, first_run.n, first_run.k)
+    branch = Branch(
+        parameter, periods, points, stopped, first_run.n, first_run.k, arc.bifurcations
+    )
+    flips = [b for b in arc.bifurcations if b.kind == "flip"]
+    if switch and flips:
+        branch.switched = _doubled(
+            data, parameter, flips[0], (stop, periods, step, max_points, tolerance), base_dir
+        )
+    return branch
+
+
+def _doubled(
+    data: Mapping[str, Any],
+    parameter: str,
+    flip: Bifurcation,
+    settings: tuple[float, int, float | None, int, float],
+    base_dir: Path | None,
+) -> Branch | None:
+    """The period-doubled branch born at ``flip``, continued towards ``stop``: its first
+    orbit (2K periods) shot for a little beyond the flip, from the flip's orbit moved
+    along the eigenvector of its multiplier -1 (the period-two orbit's two states lie
+    either side of it, at a distance growing as the square root of the parameter's
+    distance). None where no period-doubled orbit is found there."""
+    stop, periods, step, max_points, tolerance = settings
+    span = stop - flip.value
+    n = len(flip.state) // 2
+    beyond = flip.value + 1e-3 * span
+    changed = with_parameter(data, parameter, beyond)
+    run = runner(changed, base_dir)
+    monodromy = run.tangent(flip.state, periods * run.period)["matrix"]
+    values, vectors = np.linalg.eig(monodromy)
+    vector = np.real(vectors[:, int(np.argmin(np.abs(values + 1.0)))])
+    size = max(float(np.max(np.abs(flip.state[:n]))), 1e-12)
+    vector *= size / max(float(np.max(np.abs(vector[:n]))), 1e-300)
+    for amount in (0.03, 0.1, 0.01, 0.3):
+        for sign in (1.0, -1.0):
+            start = flip.state + sign * amount * vector
+            try:
+                found = orbit(run, start, periods=2 * periods, tolerance=tolerance)
+            except InvalidInputError:
+                continue
+            half = run.map(found.state, periods)
+            distinct = float(np.max(np.abs(half - found.state)[:n])) > 1e-6 * size
+            if not (found.converged and distinct):
+                continue
+            seeded = _seeded(changed, found.state, n)
+            return continue_orbit(
+                seeded,
+                parameter,
+                stop=stop,
+                periods=2 * periods,
+                step=step,
+                max_points=max_points,
+                tolerance=tolerance,
+                base_dir=base_dir,
+            )
+    return None
+
+
+def _seeded(data: Mapping[str, Any], state: np.ndarray, n: int) -> dict[str, Any]:
+    """``data`` with its ``[initial]`` the flat ``state`` (``n`` structure
+    coordinates, then the dampers'; displacements, then velocities)."""
+    out = copy.deepcopy(dict(data))
+    d = len(state) // 2
+    out["initial"] = {
+        "structure_displacement": [float(v) for v in state[:n]],
+        "structure_velocity": [float(v) for v in state[d : d + n]],
+        "damper_displacement": [float(v) for v in state[n:d]],
+        "damper_velocity": [float(v) for v in state[d + n :]],
+    }
+    return out
 
 
 @dataclass(eq=False)
@@ -194,6 +275,11 @@ class _Arc:
     shiftable: bool = False
     size: int = 0
     scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: Whether the state's derivatives come from the tangent flow (where every pair is
+    #: rigid), not from differences.
+    tangent_flow: bool = True
+    #: The bifurcations located along the branch so far.
+    bifurcations: list[Bifurcation] = field(default_factory=list)
 
     def run_at(self, p: float, fraction: float | None = None) -> Runner:
         try:
@@ -211,46 +297,58 @@ class _Arc:
         return out
 
     def jacobian(self, u: np.ndarray, centre: np.ndarray | None = None) -> np.ndarray:
-        # ``centre``: the residual at ``u``, where the caller has it. Central
-        # differences; where the forward and backward ones disagree beyond the map's
-        # curvature, the step straddles a grazing (one side touches a wall the orbit
-        # misses): that column again with steps a hundred times shorter, the most
-        # consistent kept (as the core's shooting does).
+        # ``centre``: the residual at ``u``, where the caller has it. The state's
+        # columns from the tangent flow through the impacts where every pair is rigid
+        # (exact), else central differences; the parameter's by central differences.
         jac = np.zeros((self.size, self.size + 1))
         if centre is None:
             centre = self.residual(u)
-        for j in range(self.size + 1):
-            h = 1e-6 * max(abs(u[j]), 1e-3 if j == self.size else 1.0)
-            best: tuple[float, np.ndarray] | None = None
-            for _ in range(3):
-                sides: list[np.ndarray | None] = []
-                for sign in (1.0, -1.0):
-                    moved = u.copy()
-                    moved[j] += sign * h
-                    try:
-                        sides.append(self.residual(moved))
-                    except InvalidInputError:
-                        # That side starts inside a wall: one-sided from the other.
-                        sides.append(None)
-                up, down = sides
-                if up is None and down is None:
-                    raise AnalysisError("both sides of a difference step start inside a wall")
-                if up is None or down is None:
-                    one_sided = (up - centre) / h if down is None else (centre - down) / h
-                    best = (0.0, one_sided)
-                    break
-                forward, backward = (up - centre) / h, (centre - down) / h
-                size_of = float(np.max(np.abs(forward) + np.abs(backward)))
-                gap = float(np.max(np.abs(forward - backward)))
-                disagreement = gap / size_of if size_of > 0 else 0.0
-                if best is None or disagreement < best[0]:
-                    best = (disagreement, (up - down) / (2 * h))
-                if disagreement <= 1e-2:
-                    break
-                h *= 1e-2
-            assert best is not None  # one step at least is taken
-            jac[:, j] = best[1]
+        z = u[: self.size] * self.scale[: self.size]
+        p = float(u[self.size] * self.scale[self.size])
+        run = self.run_at(p)
+        by_tangent = self.tangent_flow and run.tangent_refusal() is None
+        if by_tangent:
+            monodromy = run.tangent(z, self.periods * run.period)["matrix"]
+            scale = self.scale[: self.size]
+            jac[:, : self.size] = (monodromy - np.eye(self.size)) * scale[None, :] / scale[:, None]
+        for j in [self.size] if by_tangent else range(self.size + 1):
+            jac[:, j] = self._difference(u, j, centre)
         return jac
+
+    def _difference(self, u: np.ndarray, j: int, centre: np.ndarray) -> np.ndarray:
+        """Column ``j`` of the residual's Jacobian by central differences. Where the
+        forward and backward ones disagree beyond the map's curvature, the step
+        straddles a grazing (one side touches a wall the orbit misses): the column
+        again with steps a hundred times shorter, the most consistent kept (as the
+        core's shooting does)."""
+        h = 1e-6 * max(abs(u[j]), 1e-3 if j == self.size else 1.0)
+        best: tuple[float, np.ndarray] | None = None
+        for _ in range(3):
+            sides: list[np.ndarray | None] = []
+            for sign in (1.0, -1.0):
+                moved = u.copy()
+                moved[j] += sign * h
+                try:
+                    sides.append(self.residual(moved))
+                except InvalidInputError:
+                    # That side starts inside a wall: one-sided from the other.
+                    sides.append(None)
+            up, down = sides
+            if up is None and down is None:
+                raise AnalysisError("both sides of a difference step start inside a wall")
+            if up is None or down is None:
+                return (up - centre) / h if down is None else (centre - down) / h
+            forward, backward = (up - centre) / h, (centre - down) / h
+            size_of = float(np.max(np.abs(forward) + np.abs(backward)))
+            gap = float(np.max(np.abs(forward - backward)))
+            disagreement = gap / size_of if size_of > 0 else 0.0
+            if best is None or disagreement < best[0]:
+                best = (disagreement, (up - down) / (2 * h))
+            if disagreement <= 1e-2:
+                break
+            h *= 1e-2
+        assert best is not None  # one step at least is taken
+        return best[1]
 
     def tangent(self, jac: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
         t: np.ndarray = np.asarray(np.linalg.svd(jac)[2][-1])
@@ -347,29 +445,32 @@ class _Arc:
         t: np.ndarray,
         h: float,
         ends: tuple[BranchPoint, BranchPoint],
-    ) -> tuple[float, np.ndarray] | None:
+    ) -> tuple[float, np.ndarray, np.ndarray] | None:
         """Where ``measure`` of the multipliers changes sign between ``u`` (the point
         ``ends[0]``) and the point ``h`` along ``t`` (``ends[1]``): bisection on the arc
         (each trial an orbit and its multipliers) to a thousandth of the step. The
-        parameter there, and the multipliers on the side where ``measure`` > 0; None
-        where it does not change sign or a trial orbit cannot be found."""
+        parameter there, the multipliers on the side where ``measure`` > 0 and the
+        scaled unknowns of the last trial; None where it does not change sign or a trial
+        orbit cannot be found."""
         first, last = (measure(p.floquet_multipliers) for p in ends)
         if (first > 0) == (last > 0):
             return None
         lo, hi = 0.0, 1.0
         (below, low), (above, high) = ((p.value, p.floquet_multipliers) for p in ends)
+        last_trial = u
         while hi - lo > 1e-3:
             mid = 0.5 * (lo + hi)
             found = self.correct(u + mid * h * t, t)
             if found is None:
                 return None
+            last_trial = found[0]
             multipliers = self.multipliers_of(self.jacobian(*found))
             value = float(found[0][self.size] * self.scale[self.size])
             if (measure(multipliers) > 0) == (first > 0):
                 lo, below, low = mid, value, multipliers
             else:
                 hi, above, high = mid, value, multipliers
-        return 0.5 * (below + above), (high if last > 0 else low)
+        return 0.5 * (below + above), (high if last > 0 else low), last_trial
 
     def trace(
         self,
@@ -422,6 +523,7 @@ class _Arc:
             chord = float(np.linalg.norm(corrected - u)) * self.scale[self.size]
             flags, crossings = _flags(points[-1], candidate, t, new_t, self.size, chord)
             ends = (points[-1], candidate)
+            located_from: dict[str, np.ndarray] = {}
             if candidate.stable != points[-1].stable and "grazing" not in flags:
                 # The stability changes: where the first multiplier crosses the circle,
                 # and which kind it is there (two crossings of one class-based reading
@@ -433,11 +535,28 @@ class _Arc:
                     flags = [f for f in flags if f not in _CLASSES and f != name] + [name]
                     crossings = {k: v for k, v in crossings.items() if k in flags}
                     crossings[name] = found[0]
+                    located_from[name] = found[2]
             else:
                 for name in [f for f in flags if f in _CLASSES]:
                     found = self.locate(functools.partial(_largest, name=name), u, t, h, ends)
                     if found is not None:
                         crossings[name] = found[0]
+                        located_from[name] = found[2]
+            for name in [f for f in flags if f != "grazing"]:
+                # Located exactly: Newton on the extended system from the bisection's
+                # last orbit (or the nearer end).
+                start = located_from.get(name, corrected)
+                refined = refine(self, name, start)
+                if refined is not None:
+                    crossings[name] = refined[0].value
+                    self.bifurcations.append(
+                        Bifurcation(
+                            name,
+                            refined[0].value,
+                            refined[0].state,
+                            refined[0].floquet_multipliers,
+                        )
+                    )
             candidate.flags, candidate.crossings = flags, crossings
             points.append(candidate)
             # An orbit grown well beyond the scale (towards a resonance) rescales the

@@ -341,29 +341,34 @@ def plot_basins(path: Path, result: Basins, x_name: str, y_name: str) -> None:
 
 
 def plot_branch(path: Path, branch: Branch, data: Any = None) -> None:
-    """Amplitude of structure coordinate 0 along the branch: stable solid, unstable
-    dashed, bifurcations marked."""
+    """Amplitude of structure coordinate 0 along the branch (and the period-doubled
+    one it switched to, in a lighter shade): stable solid, unstable dashed,
+    bifurcations marked."""
     with _figure(path) as (fig, ax):
-        values = [p.value for p in branch.points]
-        amplitude = [p.amplitude[0] for p in branch.points]
-        for i in range(1, len(values)):
-            stable = branch.points[i].stable and branch.points[i - 1].stable
-            ax.plot(
-                values[i - 1 : i + 1],
-                amplitude[i - 1 : i + 1],
-                "-" if stable else "--",
-                color="tab:blue" if stable else "tab:red",
-                lw=1.2,
-            )
-        for p in branch.points:
-            for flag in p.flags:
-                ax.annotate(flag, (p.value, p.amplitude[0]), fontsize=7)
-                ax.plot([p.value], [p.amplitude[0]], "ko", ms=3)
-        ax.plot([], [], "-", color="tab:blue", label="stable")
-        ax.plot([], [], "--", color="tab:red", label="unstable")
+        shades = (("tab:blue", "tab:red"), ("tab:cyan", "tab:orange"))
+        shown = [branch] + ([branch.switched] if branch.switched is not None else [])
+        for (steady, unsteady), part in zip(shades, shown, strict=False):
+            values = [p.value for p in part.points]
+            amplitude = [p.amplitude[0] for p in part.points]
+            for i in range(1, len(values)):
+                stable = part.points[i].stable and part.points[i - 1].stable
+                ax.plot(
+                    values[i - 1 : i + 1],
+                    amplitude[i - 1 : i + 1],
+                    "-" if stable else "--",
+                    color=steady if stable else unsteady,
+                    lw=1.2,
+                )
+            for p in part.points:
+                for flag in p.flags:
+                    ax.annotate(flag, (p.value, p.amplitude[0]), fontsize=7)
+                    ax.plot([p.value], [p.amplitude[0]], "ko", ms=3)
+            ax.plot([], [], "-", color=steady, label=f"{part.periods}-period, stable")
+            ax.plot([], [], "--", color=unsteady, label=f"{part.periods}-period, unstable")
         ax.set_xlabel(f"{branch.parameter}{_unit(branch.parameter, data)}")
         ax.set_ylabel("amplitude of structure coordinate 0 (m)")
-        ax.set_title(f"{branch.periods}-period orbits")
+        located = ", ".join(f"{b.kind} at {b.value:.10g}" for b in branch.bifurcations)
+        ax.set_title(f"{branch.periods}-period orbits" + (f"; {located}" if located else ""))
         ax.legend()
         ax.grid(alpha=0.3)
 

@@ -77,13 +77,16 @@ _CONTINUATION = {
     "step": (_NUMBER, None),
     "max_points": (_WHOLE, 200),
     "tolerance": (_NUMBER, 1e-9),
+    # At a located flip, go on along the period-doubled branch.
+    "switch": ("boolean", False),
 }
 
 
 def continuation_settings(table: Any) -> dict[str, Any]:
     """The ``[continuation]`` section checked, with its defaults: ``parameter`` (a
     dotted path, continued from the scenario's value), ``stop``, ``periods`` (K),
-    ``step`` (about, in the parameter's unit), ``max_points``, ``tolerance``."""
+    ``step`` (about, in the parameter's unit), ``max_points``, ``tolerance``, ``switch``
+    (at a located flip, go on along the period-doubled branch)."""
     out = _table("[continuation] ", table, _CONTINUATION)
     with_parameter_path_check(out["parameter"], "[continuation]")
     check_periods("[continuation] ", "periods", out["periods"], 1)

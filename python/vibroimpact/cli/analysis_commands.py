@@ -241,6 +241,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
             pair=pair,
             base_dir=scenario.base_dir,
             progress=_progress(show),
+            switch=settings["switch"],
         )
     except AnalysisError as err:
         # The function's sample_periods is the section's record_periods; its pair,
@@ -437,17 +438,7 @@ def run_continue(args: argparse.Namespace) -> int:
     if args.plot:
         plots.plot_branch(args.plot, branch, scenario.data)
     if args.json:
-        print(
-            json_text(
-                {
-                    "parameter": branch.parameter,
-                    "periods": branch.periods,
-                    "stopped": branch.stopped,
-                    "points": [p.to_dict(branch.n, branch.k) for p in branch.points],
-                    "cpu_time": cpu_time,
-                }
-            )
-        )
+        print(json_text({**_branch_dict(branch), "cpu_time": cpu_time}))
         return 0
     print(
         f"{args.scenario}: {len(branch.points)} orbits of {branch.periods} period(s) along "
@@ -463,9 +454,35 @@ def run_continue(args: argparse.Namespace) -> int:
             f"{largest:.6f}  {'stable' if p.stable else 'unstable'}  "
             f"{p.impacts_per_period:g} impacts/period  {flags}"
         )
+    for b in branch.bifurcations:
+        print(f"{b.kind} located at {branch.parameter} = {b.value!r}")
+    if branch.switched is not None:
+        s = branch.switched
+        print(
+            f"period-doubled branch ({s.periods} periods): {len(s.points)} orbits, "
+            f"stopped: {s.stopped}"
+            + "".join(f"; {b.kind} located at {b.value!r}" for b in s.bifurcations)
+        )
     if args.plot:
         print(f"plot written to {args.plot}")
     return 0
+
+
+def _branch_dict(branch: Any) -> dict[str, Any]:
+    """A continued branch as JSON: its points, located bifurcations and (with
+    ``switch``) the period-doubled branch."""
+    return {
+        "parameter": branch.parameter,
+        "periods": branch.periods,
+        "stopped": branch.stopped,
+        "points": [p.to_dict(branch.n, branch.k) for p in branch.points],
+        "bifurcations": [b.to_dict(branch.n, branch.k) for b in branch.bifurcations],
+        **(
+            {"switched": _branch_dict(branch.switched)}
+            if branch.switched is not None
+            else {}
+        ),
+    }
 
 
 def _naming_the_file(

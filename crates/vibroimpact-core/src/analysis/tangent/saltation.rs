@@ -3,7 +3,7 @@
 //! rates change from `f-` to `f+`:
 //! `S = R + (f+ - R f-) grad(g)^T / (grad(g) . f-)`.
 
-use crate::kernel::observe::EventView;
+use crate::kernel::observe::{EventView, Jump};
 use crate::model::assembly::{Assembly, Mode, Scratch};
 use crate::numerics::linalg;
 
@@ -48,33 +48,33 @@ impl Saltation {
     /// The velocities' reset map `R_v = I - Push_A W^-1 (I + E) H_A` of the
     /// pairs the impulses acted on (`A`, each resolved to `u+ = -e u-`), into
     /// `self.reset` (row-major `dim x dim`).
-    fn reset_map(&mut self, system: &Assembly, view: &EventView<'_>) {
+    fn reset_map(&mut self, system: &Assembly, jumps: &[Jump]) {
         let d = system.dim;
         self.reset.iter_mut().for_each(|v| *v = 0.0);
         for i in 0..d {
             self.reset[i * d + i] = 1.0;
         }
-        let m = view.jumps.len();
+        let m = jumps.len();
         if m == 0 {
             return;
         }
         let its = &system.interactions;
         for c in 0..d {
             self.coupling.clear();
-            for a in view.jumps {
-                for b in view.jumps {
+            for a in jumps {
+                for b in jumps {
                     let w = linalg::dot(&its[a.interaction].h, &its[b.interaction].push);
                     self.coupling.push(w);
                 }
             }
             self.column.clear();
             self.column.extend(
-                view.jumps
+                jumps
                     .iter()
                     .map(|j| -(1.0 + j.restitution) * its[j.interaction].h[c]),
             );
             linalg::solve_in_place(&mut self.coupling, &mut self.column, m);
-            for (j, z) in view.jumps.iter().zip(&self.column) {
+            for (j, z) in jumps.iter().zip(&self.column) {
                 for (r, p) in its[j.interaction].push.iter().enumerate() {
                     self.reset[r * d + c] += p * z;
                 }
@@ -83,15 +83,55 @@ impl Saltation {
     }
 
     /// The saltation matrix of `view`'s event into `out` (row-major `2 dim x
-    /// 2 dim`).
+    /// 2 dim`). Where pairs start to stick, its rows are projected onto their
+    /// constraints (gaps and rates held), so that the directions they lose
+    /// are lost to round-off of the rows, not carried as the round-off of a
+    /// difference `1 + (v+ - v-) / u` that the growth elsewhere multiplies.
     pub(super) fn matrix(
         &mut self,
         system: &Assembly,
         view: &EventView<'_>,
         out: &mut [f64],
     ) -> Outcome {
+        let outcome = self.jump_matrix(system, view, out);
+        let sticking: Vec<Jump> = view
+            .jumps
+            .iter()
+            .filter(|j| view.modes_after[j.interaction] == Mode::Sticking)
+            .map(|j| Jump {
+                interaction: j.interaction,
+                restitution: 0.0,
+            })
+            .collect();
+        if !sticking.is_empty() {
+            self.reset_map(system, &sticking);
+            let (d, size) = (system.dim, 2 * system.dim);
+            let mut column = vec![0.0; d];
+            for block in [0, d] {
+                for c in 0..size {
+                    for (r, value) in column.iter_mut().enumerate() {
+                        *value = (0..d)
+                            .map(|k| self.reset[r * d + k] * out[(block + k) * size + c])
+                            .sum();
+                    }
+                    for (r, value) in column.iter().enumerate() {
+                        out[(block + r) * size + c] = *value;
+                    }
+                }
+            }
+        }
+        outcome
+    }
+
+    /// [`Self::matrix`] before the projection.
+    fn jump_matrix(
+        &mut self,
+        system: &Assembly,
+        view: &EventView<'_>,
+        out: &mut [f64],
+    ) -> Outcome {
         let (d, size) = (system.dim, 2 * system.dim);
-        self.reset_map(system, view);
+        self.reset_map(system, view.jumps);
         out.iter_mut().for_each(|v| *v = 0.0);
         for i in 0..d {
             out[i * size + i] = 1.0;
@@ -114,11 +154,22 @@ impl Saltation {
             .chain(&view.after[d..size])
             .fold(0.0f64, |m, v| m.max(v.abs()));
         if closing.abs() <= GRAZING_SPEED * speeds.max(f64::MIN_POSITIVE) {
-            // No crossing to shift in time: a landing at rest (the pair
-            // sticks or rests, its perturbations projected out by the reset),
-            // else a grazing, where the flow has no derivative.
+            // No crossing to shift in time: a landing at rest, else a grazing,
+            // where the flow has no derivative.
             let rests = view.modes_after[located] == Mode::Sticking
                 || view.jumps.iter().any(|j| j.interaction == located);
+            if rests {
+                // The limit of a plastic impact's saltation as its speed goes
+                // to zero: the displacements projected as the velocities are
+                // (`I + (v+ - v-) h^T / u` is `R_v` there), a perturbation off
+                // the wall landing back on it, and the accelerations' jump
+                // vanishing with the speed (`a+ = R_v a-` once stuck).
+                for i in 0..d {
+                    for j in 0..d {
+                        out[i * size + j] = self.reset[i * d + j];
+                    }
+                }
+            }
             return Outcome {
                 grazing: (!rests).then_some(closing.abs()),
             };
