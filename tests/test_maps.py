@@ -213,15 +213,17 @@ def test_the_flip_is_bracketed_and_located_to_a_thousandth_of_the_step(step: flo
     assert abs(after.crossings["flip"] - flip) <= 1e-3 * (after.value - before.value)
 
 
-def test_a_smaller_step_locates_the_flip_closer() -> None:
-    errors = []
+def test_the_flip_is_located_to_round_off_whatever_the_step() -> None:
+    # Newton on the extended system from the bisection along the arc (the multipliers
+    # from the tangent flow): Holmes's closed form to round-off, for a coarse step as
+    # for a fine one (the bisection alone had 1.5e-4 of it at step 0.3).
     for step in (0.3, 0.01):
         table, branch = holmes_branch(step)
         (crossing,) = [p.crossings["flip"] for p in branch.points if "flip" in p.flags]
-        errors.append(abs(crossing / (table.flip() * table.g) - 1))
-    # Bisection to a thousandth of the step: the error falls with the step.
-    assert errors[1] < 1e-5
-    assert errors[1] < errors[0] / 10
+        assert abs(crossing / (table.flip() * table.g) - 1) < 1e-12, step
+        (located,) = branch.bifurcations
+        assert located.kind == "flip" and located.value == crossing
+        assert abs(min(located.floquet_multipliers.real) + 1) < 1e-10
 
 
 def test_bifurcation_diagram_has_one_point_below_the_flip_and_two_above() -> None:
@@ -743,7 +745,15 @@ def test_continue_command_on_its_example(run_cli: RunCli, tmp_path: Path) -> Non
     plot = tmp_path / "branch.png"
     out = run_json(run_cli, "continue", str(CONTINUATION), "--plot", str(plot))
     assert_png(plot)
-    assert set(out) == {"parameter", "periods", "stopped", "points", "cpu_time"}
+    assert set(out) == {
+        "parameter",
+        "periods",
+        "stopped",
+        "points",
+        "bifurcations",
+        "switched",
+        "cpu_time",
+    }
     assert out["parameter"] == AMPLITUDE and out["periods"] == 1
     assert out["stopped"] == "reached stop"
     points = out["points"]
@@ -761,8 +771,21 @@ def test_continue_command_on_its_example(run_cli: RunCli, tmp_path: Path) -> Non
         assert p["impacts_per_period"] == 1
     (flagged,) = [p for p in points if p["flags"]]
     assert flagged["flags"] == ["flip"] and set(flagged["crossings"]) == {"flip"}
-    # Located by bisection along the arc, to a thousandth of the step (1.2 m/s^2).
-    assert flagged["crossings"]["flip"] == pytest.approx(flip, abs=2e-3)
+    # Located by Newton on the extended system: Holmes's closed form to round-off.
+    assert flagged["crossings"]["flip"] == pytest.approx(flip, rel=1e-12)
+    (located,) = out["bifurcations"]
+    assert located["kind"] == "flip" and located["value"] == flagged["crossings"]["flip"]
+    assert set(located) == {"kind", "value", "state", "floquet_multipliers"}
+    # switch = true: the period-two branch born there, each orbit two impacts in two
+    # periods, its product of multipliers e^4 (two impacts, no damping).
+    doubled = out["switched"]
+    assert doubled["periods"] == 2 and doubled["points"]
+    e = table.e
+    for p in doubled["points"]:
+        assert p["impacts_per_period"] == 1
+        m = [complex(*v) for v in p["floquet_multipliers"]]
+        assert abs(m[0] * m[1] - e**4) < 1e-9
+        assert p["value"] > located["value"]
     text = run_cli("continue", str(CONTINUATION))
     assert text.returncode == 0 and "flip at" in text.stdout and "reached stop" in text.stdout
 

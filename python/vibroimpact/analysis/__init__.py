@@ -22,6 +22,7 @@ xarray Datasets in :mod:`~vibroimpact.analysis.datasets` and as plots in
 """
 
 from vibroimpact.analysis.continuation import Branch, BranchPoint, continue_orbit
+from vibroimpact.analysis.curves import Curve, CurvePoint, curve, curve_regions
 from vibroimpact.analysis.limits import (
     MAX_PERIODS,
     MAX_POINTS,
@@ -31,6 +32,7 @@ from vibroimpact.analysis.limits import (
     check_total,
     whole_count,
 )
+from vibroimpact.analysis.located import Bifurcation
 from vibroimpact.analysis.lyapunov import Lyapunov, lyapunov, lyapunov_runner
 from vibroimpact.analysis.maps import (
     Basins,
@@ -53,6 +55,7 @@ from vibroimpact.analysis.settings import (
     SETTINGS,
     basins_settings,
     continuation_settings,
+    curve_settings,
     sweep_settings,
 )
 from vibroimpact.analysis.steady import (
@@ -74,6 +77,9 @@ from vibroimpact.analysis.sweeps import (
 
 __all__ = [
     "AnalysisError",
+    "Bifurcation",
+    "Curve",
+    "CurvePoint",
     "BIFURCATION_SAMPLES",
     "Basins",
     "BifurcationPoint",
@@ -98,6 +104,9 @@ __all__ = [
     "check_total",
     "checked_run",
     "continuation_settings",
+    "curve",
+    "curve_regions",
+    "curve_settings",
     "continue_orbit",
     "forcing_period",
     "from_carried",

@@ -34,7 +34,7 @@ from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import forcing_period, with_parameter
-from vibroimpact.analysis.runs import Runner, runner
+from vibroimpact.analysis.runs import Runner, runner, state_arrays
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
@@ -60,16 +60,9 @@ class BranchPoint:
     crossings: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:
-        d = n + k
-        s = self.state
         return {
             "value": self.value,
-            "state": {
-                "structure_displacement": [float(v) for v in s[:n]],
-                "structure_velocity": [float(v) for v in s[d : d + n]],
-                "damper_displacement": [float(v) for v in s[n:d]],
-                "damper_velocity": [float(v) for v in s[d + n :]],
-            },
+            "state": state_arrays(self.state, n, k),
             "floquet_multipliers": [
                 [float(m.real), float(m.imag)] for m in self.floquet_multipliers
             ],
@@ -182,9 +175,7 @@ def continue_orbit(
     points, stopped = arc.trace(
         first.state, start_value, first_run.period, ds, stop, max_points, progress
     )
-    branch = Branch(
-        parameter, periods, points, stopped, first_run.n, first_run.k, arc.bifurcations
-    )
+    branch = Branch(parameter, periods, points, stopped, first_run.n, first_run.k, arc.bifurcations)
     flips = [b for b in arc.bifurcations if b.kind == "flip"]
     if switch and flips:
         branch.switched = _doubled(
@@ -245,13 +236,7 @@ def _seeded(data: Mapping[str, Any], state: np.ndarray, n: int) -> dict[str, Any
     """``data`` with its ``[initial]`` the flat ``state`` (``n`` structure
     coordinates, then the dampers'; displacements, then velocities)."""
     out = copy.deepcopy(dict(data))
-    d = len(state) // 2
-    out["initial"] = {
-        "structure_displacement": [float(v) for v in state[:n]],
-        "structure_velocity": [float(v) for v in state[d : d + n]],
-        "damper_displacement": [float(v) for v in state[n:d]],
-        "damper_velocity": [float(v) for v in state[d + n :]],
-    }
+    out["initial"] = state_arrays(state, n, len(state) // 2 - n)
     return out
 
 
@@ -337,7 +322,8 @@ class _Arc:
             if up is None and down is None:
                 raise AnalysisError("both sides of a difference step start inside a wall")
             if up is None or down is None:
-                return (up - centre) / h if down is None else (centre - down) / h
+                one_sided: np.ndarray = (up - centre) / h if down is None else (centre - down) / h
+                return one_sided
             forward, backward = (up - centre) / h, (centre - down) / h
             size_of = float(np.max(np.abs(forward) + np.abs(backward)))
             gap = float(np.max(np.abs(forward - backward)))
@@ -546,7 +532,10 @@ class _Arc:
                 # Located exactly: Newton on the extended system from the bisection's
                 # last orbit (or the nearer end).
                 start = located_from.get(name, corrected)
-                refined = refine(self, name, start)
+                # Between the two points, or a step beyond them (a fold lies beyond).
+                reach = abs(candidate.value - points[-1].value)
+                low = min(candidate.value, points[-1].value) - reach
+                refined = refine(self, name, start, (low, low + 3 * reach))
                 if refined is not None:
                     crossings[name] = refined[0].value
                     self.bifurcations.append(

@@ -13,6 +13,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from vibroimpact.analysis.runs import state_arrays
+
 if TYPE_CHECKING:
     from vibroimpact.analysis.continuation import BranchPoint, _Arc
 
@@ -34,17 +36,10 @@ class Bifurcation:
     floquet_multipliers: np.ndarray
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:
-        d = n + k
-        s = self.state
         return {
             "kind": self.kind,
             "value": self.value,
-            "state": {
-                "structure_displacement": [float(v) for v in s[:n]],
-                "structure_velocity": [float(v) for v in s[d : d + n]],
-                "damper_displacement": [float(v) for v in s[n:d]],
-                "damper_velocity": [float(v) for v in s[d + n :]],
-            },
+            "state": state_arrays(self.state, n, k),
             "floquet_multipliers": [
                 [float(m.real), float(m.imag)] for m in self.floquet_multipliers
             ],
@@ -77,13 +72,31 @@ def _g(arc: _Arc, kind: str, w: np.ndarray) -> float:
     return test_value(kind, np.linalg.eigvals(monodromy))
 
 
-def refine(arc: _Arc, kind: str, start: np.ndarray) -> tuple[BranchPoint, np.ndarray] | None:
+def refine(
+    arc: _Arc, kind: str, start: np.ndarray, within: tuple[float, float] | None = None
+) -> tuple[BranchPoint, np.ndarray] | None:
     """The bifurcation of ``kind`` near the scaled unknowns ``start`` by Newton's method
     on the extended system: its branch point and scaled unknowns, or None where Newton
-    does not converge (or the system has no tangent flow)."""
-    if not arc.tangent_flow or arc.run_at(
-        float(start[arc.size] * arc.scale[arc.size])
-    ).tangent_refusal():
+    does not converge, leaves the parameter's interval ``within`` or starts a run inside
+    a wall (or the system has no tangent flow)."""
+    try:
+        found = _newton(arc, kind, start)
+    except (ValueError, ArithmeticError, RuntimeError, np.linalg.LinAlgError):
+        # A Newton step into a wall (an InvalidInputError) or a run that cannot
+        # complete there: not located.
+        return None
+    if found is None or within is None:
+        return found
+    low, high = min(within), max(within)
+    return found if low <= found[0].value <= high else None
+
+
+def _newton(arc: _Arc, kind: str, start: np.ndarray) -> tuple[BranchPoint, np.ndarray] | None:
+    """:func:`refine`'s iterations."""
+    if (
+        not arc.tangent_flow
+        or arc.run_at(float(start[arc.size] * arc.scale[arc.size])).tangent_refusal()
+    ):
         return None
     w = start.copy()
     step = 1e-7
@@ -100,10 +113,7 @@ def refine(arc: _Arc, kind: str, start: np.ndarray) -> tuple[BranchPoint, np.nda
             down[j] -= step
             gradient[j] = (_g(arc, kind, up) - _g(arc, kind, down)) / (2 * step)
         system = np.vstack([jac, gradient[None, :]])
-        try:
-            delta = np.linalg.solve(system, np.concatenate([f, [g]]))
-        except np.linalg.LinAlgError:
-            return None
+        delta = np.linalg.solve(system, np.concatenate([f, [g]]))
         w = w - delta
         p = float(w[arc.size] * arc.scale[arc.size])
         moved = abs(float(delta[arc.size] * arc.scale[arc.size]))

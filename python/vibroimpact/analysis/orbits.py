@@ -9,7 +9,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact.analysis.limits import AnalysisError, whole_count
-from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run
+from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run, state_arrays
 from vibroimpact.model.system import System
 from vibroimpact.summary import summarised
 
@@ -41,14 +41,7 @@ class Orbit:
 
     def arrays(self, n: int, k: int) -> dict[str, list[float]]:
         """The state as the four arrays of ``[initial]``."""
-        d = n + k
-        s = self.state
-        return {
-            "structure_displacement": [float(v) for v in s[:n]],
-            "structure_velocity": [float(v) for v in s[d : d + n]],
-            "damper_displacement": [float(v) for v in s[n:d]],
-            "damper_velocity": [float(v) for v in s[d + n :]],
-        }
+        return state_arrays(self.state, n, k)
 
 
 def orbit(

@@ -14,6 +14,7 @@ import numpy as np
 
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.continuation import Branch
+from vibroimpact.analysis.curves import Curve
 from vibroimpact.analysis.lyapunov import Lyapunov
 from vibroimpact.analysis.maps import Basins, BifurcationPoint, Section
 from vibroimpact.analysis.parameters import with_parameter
@@ -446,5 +447,25 @@ def plot_lyapunov(path: Path, found: Lyapunov) -> None:
         ax.set_title(
             f"{found.impacts} impacts" + (f"; {lost} direction(s) lost to sticking" if lost else "")
         )
+        ax.legend()
+        ax.grid(alpha=0.3)
+
+
+def plot_curve(
+    path: Path, found: Curve, regions: list[tuple[str, float, float]], data: Any = None
+) -> None:
+    """A curve of bifurcations in the plane of its two parameters (the second along x),
+    with the regions it bounds labelled where they were read."""
+    with _figure(path) as (fig, ax):
+        x = [p.values[found.second] for p in found.points]
+        y = [p.values[found.parameter] for p in found.points]
+        ax.plot(x, y, "-", color="tab:purple", lw=1.5, label=f"{found.kind}")
+        ax.plot(x[:1], y[:1], "ko", ms=4, label="located first")
+        for label, at_x, at_y in regions:
+            ax.annotate(label, (at_x, at_y), fontsize=8, ha="center", va="center")
+            ax.plot([at_x], [at_y], ".", color="0.4", ms=3)
+        ax.set_xlabel(f"{found.second}{_unit(found.second, data)}")
+        ax.set_ylabel(f"{found.parameter}{_unit(found.parameter, data)}")
+        ax.set_title(f"{found.kind} of {found.periods}-period orbits: {len(found.points)} points")
         ax.legend()
         ax.grid(alpha=0.3)

@@ -237,6 +237,18 @@ class Runner:
         return shot
 
 
+def state_arrays(state: np.ndarray, n: int, k: int) -> dict[str, list[float]]:
+    """A flat state (``n`` structure coordinates then ``k`` dampers; displacements,
+    then velocities) as the four arrays of ``[initial]``, SI."""
+    d = n + k
+    return {
+        "structure_displacement": [float(v) for v in state[:n]],
+        "structure_velocity": [float(v) for v in state[d : d + n]],
+        "damper_displacement": [float(v) for v in state[n:d]],
+        "damper_velocity": [float(v) for v in state[d + n :]],
+    }
+
+
 def as_runner(run: Runner | System) -> Runner:
     """The analyses' entry: a :class:`~vibroimpact.System` as its :class:`Runner`
     (anything else as it is, for :func:`checked_run` to check)."""

@@ -171,9 +171,52 @@ def basins_settings(table: Any) -> dict[str, Any]:
     return out
 
 
+#: The bifurcations a two-parameter curve follows.
+CURVE_KINDS = ("flip", "fold", "neimark-sacker")
+_CURVE = {
+    "kind": (_TEXT, _REQ),
+    "parameter": (_TEXT, _REQ),
+    "start": (_NUMBER, _REQ),
+    "stop": (_NUMBER, _REQ),
+    "second": (_TEXT, _REQ),
+    "second_stop": (_NUMBER, _REQ),
+    "step": (_NUMBER, _REQ),
+    "periods": (_WHOLE, 1),
+    "max_points": (_WHOLE, 200),
+    "tolerance": (_NUMBER, 1e-9),
+}
+
+
+def curve_settings(table: Any) -> dict[str, Any]:
+    """The ``[curve]`` section checked, with its defaults: ``kind`` (the bifurcation
+    followed: ``"flip"``, ``"fold"``, ``"neimark-sacker"``), ``parameter`` (a dotted path:
+    the bifurcation is first located along the orbit's branch from ``start`` to ``stop``
+    of it), ``second`` (a dotted path, followed from the scenario's value to
+    ``second_stop`` in steps of ``step``), ``periods`` (K), ``max_points``,
+    ``tolerance``."""
+    out = _table("[curve] ", table, _CURVE)
+    _choice("[curve] ", "kind", out["kind"], CURVE_KINDS)
+    with_parameter_path_check(out["parameter"], "[curve]")
+    with_parameter_path_check(out["second"], "[curve] second:")
+    if out["parameter"] == out["second"]:
+        raise AnalysisError(f"[curve] second: must be another parameter than {out['parameter']!r}")
+    check_periods("[curve] ", "periods", out["periods"], 1)
+    if out["start"] == out["stop"]:
+        raise AnalysisError(f"[curve] stop: must differ from start {out['start']!r}")
+    for key in ("step", "tolerance"):
+        if not out[key] > 0:
+            raise AnalysisError(f"[curve] {key}: must be > 0, got {out[key]}")
+    if not 2 <= out["max_points"] <= MAX_POINTS:
+        raise AnalysisError(
+            f"[curve] max_points: must be in [2, {MAX_POINTS}], got {out['max_points']}"
+        )
+    return out
+
+
 #: Sections of analyses, checked when a scenario is read.
 SETTINGS: dict[str, Callable[[Any], dict[str, Any]]] = {
     "sweep": sweep_settings,
     "continuation": continuation_settings,
+    "curve": curve_settings,
     "basins": basins_settings,
 }

@@ -34,7 +34,7 @@ from vibroimpact.analysis import (
     sweep,
     sweep_values,
 )
-from vibroimpact.cli.tangent_commands import run_lyapunov
+from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
@@ -241,7 +241,6 @@ def run_bifurcation(args: argparse.Namespace) -> int:
             pair=pair,
             base_dir=scenario.base_dir,
             progress=_progress(show),
-            switch=settings["switch"],
         )
     except AnalysisError as err:
         # The function's sample_periods is the section's record_periods; its pair,
@@ -431,6 +430,7 @@ def run_continue(args: argparse.Namespace) -> int:
             tolerance=settings["tolerance"],
             base_dir=scenario.base_dir,
             progress=_progress(show),
+            switch=settings["switch"],
         )
     if show:
         print(file=sys.stderr)
@@ -477,11 +477,7 @@ def _branch_dict(branch: Any) -> dict[str, Any]:
         "stopped": branch.stopped,
         "points": [p.to_dict(branch.n, branch.k) for p in branch.points],
         "bifurcations": [b.to_dict(branch.n, branch.k) for b in branch.bifurcations],
-        **(
-            {"switched": _branch_dict(branch.switched)}
-            if branch.switched is not None
-            else {}
-        ),
+        **({"switched": _branch_dict(branch.switched)} if branch.switched is not None else {}),
     }
 
 
@@ -515,5 +511,6 @@ COMMANDS = {
         "basins": run_basins,
         "continue": run_continue,
         "lyapunov": run_lyapunov,
+        "curve": run_curve,
     }.items()
 }

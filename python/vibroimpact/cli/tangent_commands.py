@@ -1,5 +1,5 @@
-"""The tangent-dynamics commands (``lyapunov``): their arguments, what each runs, its
-output and plots."""
+"""The tangent-dynamics commands (``lyapunov``, ``curve``): their arguments, what each
+runs, its output and plots."""
 
 from __future__ import annotations
 
@@ -8,14 +8,22 @@ import time
 from pathlib import Path
 from typing import Any
 
-from vibroimpact.analysis import check_periods, lyapunov, lyapunov_runner, plots
+from vibroimpact.analysis import (
+    check_periods,
+    curve,
+    curve_regions,
+    curve_settings,
+    lyapunov,
+    lyapunov_runner,
+    plots,
+)
 from vibroimpact.output import UsageError, json_text
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
 
 
 def add_tangent_parsers(sub: Any) -> None:
-    """Register ``lyapunov`` on the command line's subparsers."""
+    """Register ``lyapunov`` and ``curve`` on the command line's subparsers."""
     parser = sub.add_parser(
         "lyapunov",
         help="the Lyapunov spectrum of a 0.2 scenario through its impacts (exact)",
@@ -42,6 +50,27 @@ def add_tangent_parsers(sub: Any) -> None:
         type=Path,
         metavar="FILE.png",
         help="plot each exponent's estimate against the time averaged over",
+    )
+    curve_parser = sub.add_parser(
+        "curve",
+        help="a curve of bifurcations in two parameters, from a [curve] section",
+        description=(
+            "Locate the [curve] kind of bifurcation (flip, fold or neimark-sacker) of the "
+            "K-period orbit (periods) along its branch in [curve] parameter, from start to "
+            "stop (the orbit found from [initial] at start), by Newton's method on the "
+            "extended system with the Floquet multipliers of the tangent flow through the "
+            "impacts; then follow it as [curve] second steps by step from the scenario's "
+            "value to second_stop. Prints each point's two values; --json gives points "
+            "[{values, state, floquet_multipliers}]. Every pair must be rigid."
+        ),
+    )
+    curve_parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [curve]")
+    curve_parser.add_argument("--json", action="store_true", help="print one JSON object")
+    curve_parser.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="plot the curve in its plane, with the regions it bounds labelled",
     )
 
 
@@ -97,6 +126,62 @@ def run_lyapunov(args: argparse.Namespace) -> int:
             f"{len(found.grazings)} grazing(s), where the flow has no derivative: the first "
             f"at {found.grazings[0][0]:.6g} s ({found.grazings[0][1]})"
         )
+    if args.plot:
+        lines.append(f"plot written to {args.plot}")
+    print("\n".join(lines))
+    return 0
+
+
+def run_curve(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
+    if not isinstance(scenario, SystemScenario):
+        raise UsageError(f"{args.scenario}: curve takes a 0.2 scenario (a [structure] section)")
+    if "curve" not in scenario.data:
+        raise UsageError(f"{args.scenario}: curve needs a [curve] section")
+    settings = curve_settings(scenario.data["curve"])
+    start = time.perf_counter()
+    found = curve(
+        scenario.data,
+        settings["kind"],
+        settings["parameter"],
+        start=settings["start"],
+        stop=settings["stop"],
+        second=settings["second"],
+        second_stop=settings["second_stop"],
+        step=settings["step"],
+        periods=settings["periods"],
+        max_points=settings["max_points"],
+        tolerance=settings["tolerance"],
+        base_dir=scenario.base_dir,
+    )
+    cpu_time = time.perf_counter() - start
+    if args.plot:
+        regions = curve_regions(found, scenario.data, scenario.base_dir)
+        plots.plot_curve(args.plot, found, regions, scenario.data)
+    if args.json:
+        print(
+            json_text(
+                {
+                    "kind": found.kind,
+                    "parameter": found.parameter,
+                    "second": found.second,
+                    "periods": found.periods,
+                    "stopped": found.stopped,
+                    "points": [p.to_dict(found.n, found.k) for p in found.points],
+                    "cpu_time": cpu_time,
+                }
+            )
+        )
+        return 0
+    lines = [
+        f"{args.scenario}: {len(found.points)} points of the {found.kind} curve of "
+        f"{found.periods}-period orbits in {cpu_time:.3f} s; stopped: {found.stopped}",
+        f"{found.second:>24}  {found.parameter}",
+        *(
+            f"{p.values[found.second]:>24.10g}  {p.values[found.parameter]:.12g}"
+            for p in found.points
+        ),
+    ]
     if args.plot:
         lines.append(f"plot written to {args.plot}")
     print("\n".join(lines))

@@ -47,7 +47,7 @@ from vibroimpact.system import (
 _P = TypeVar("_P", bound=Part)
 
 #: The sections of analyses and studies a System carries as read (see ``analyses``).
-ANALYSIS_SECTIONS = ("sweep", "continuation", "basins", "study")
+ANALYSIS_SECTIONS = ("sweep", "continuation", "basins", "curve", "study")
 _STRUCTURES: dict[str, type[Structure]] = {c.kind: c for c in (Oscillator, Matrices, Cantilever)}
 _SIGNAL_OF: dict[str, type[Signal]] = {c.kind: c for c in SIGNALS}
 

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
+from vibroimpact.model.system import ANALYSIS_SECTIONS
 from vibroimpact.output import finite_or_none, written_whole
 from vibroimpact.system import (
     _FIXED_STEP,
@@ -35,10 +36,7 @@ SECTIONS = (
     "initial",
     "solver",
     "output",
-    "sweep",
-    "continuation",
-    "basins",
-    "study",
+    *ANALYSIS_SECTIONS,
 )
 
 
