@@ -49,6 +49,7 @@ from vibroimpact.analysis.parameters import (
     with_parameter,
     with_parameter_path_check,
 )
+from vibroimpact.analysis.sensitivities import Derivative, orbit_derivatives
 from vibroimpact.analysis.runs import Runner, as_runner, check_kept, checked_run, runner
 from vibroimpact.analysis.settings import (
     BIFURCATION_SAMPLES,
@@ -79,6 +80,7 @@ __all__ = [
     "AnalysisError",
     "Bifurcation",
     "Curve",
+    "Derivative",
     "CurvePoint",
     "BIFURCATION_SAMPLES",
     "Basins",
@@ -115,6 +117,7 @@ __all__ = [
     "lyapunov",
     "lyapunov_runner",
     "orbit",
+    "orbit_derivatives",
     "poincare",
     "reductions",
     "runner",

@@ -24,6 +24,7 @@ from vibroimpact.analysis import (
     check_total,
     continue_orbit,
     orbit,
+    orbit_derivatives,
     plots,
     poincare,
     runner,
@@ -55,6 +56,17 @@ def run_orbit(args: argparse.Namespace) -> int:
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
     found = orbit(run, periods=args.periods, tolerance=args.tolerance)
+    derivatives = (
+        orbit_derivatives(
+            scenario.data,
+            found,
+            args.derivative,
+            periods=args.periods,
+            base_dir=scenario.base_dir,
+        )
+        if args.derivative
+        else {}
+    )
     cpu_time = time.perf_counter() - start
     summary = {
         "converged": found.converged,
@@ -79,6 +91,11 @@ def run_orbit(args: argparse.Namespace) -> int:
                 "moment_amplitude": [float(a) for a in found.moment_amplitude],
             }
             if len(run.moments)
+            else {}
+        ),
+        **(
+            {"derivatives": {path: d.to_dict() for path, d in derivatives.items()}}
+            if derivatives
             else {}
         ),
         "periods": args.periods,
@@ -118,6 +135,11 @@ def run_orbit(args: argparse.Namespace) -> int:
     ]
     for key, values in summary["state"].items():
         lines.append(f"{key} = [{', '.join(f'{v:.12g}' for v in values)}]")
+    for path, d in derivatives.items():
+        lines.append(
+            f"d/d {path}: state [{', '.join(f'{v:.6g}' for v in d.state)}], amplitude "
+            f"[{', '.join(f'{v:.6g}' for v in d.amplitude)}]"
+        )
     if args.plot:
         lines.append(f"plot written to {args.plot}")
     print("\n".join(lines))

@@ -38,6 +38,16 @@ def add_commands(sub: Any) -> None:
         default=1e-10,
         help="largest |P(z) - z| relative to the largest displacement and velocity (1e-10)",
     )
+    orbit_parser.add_argument(
+        "--derivative",
+        action="append",
+        metavar="PATH",
+        default=[],
+        help="also the orbit's derivatives in this parameter (a dotted path such as "
+        '"damper.0.clearance"; repeatable), by the implicit function theorem on the '
+        "shooting equations: its state at t = 0 and its amplitude per structure "
+        "coordinate, per unit of the parameter",
+    )
     orbit_parser.add_argument("--json", action="store_true", help="print one JSON object")
     orbit_parser.add_argument(
         "--plot",
