@@ -49,8 +49,8 @@ from vibroimpact.analysis.parameters import (
     with_parameter,
     with_parameter_path_check,
 )
-from vibroimpact.analysis.sensitivities import Derivative, orbit_derivatives
 from vibroimpact.analysis.runs import Runner, as_runner, check_kept, checked_run, runner
+from vibroimpact.analysis.sensitivities import Derivative, orbit_derivatives
 from vibroimpact.analysis.settings import (
     BIFURCATION_SAMPLES,
     SETTINGS,
