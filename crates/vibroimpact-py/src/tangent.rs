@@ -95,18 +95,27 @@ pub fn lyapunov_spectrum<'py>(
     py: Python<'py>,
     prepared: &PreparedSystem,
     state: Vec<f64>,
-    #[pyo3(from_py_with = crate::convert::arg::t_end)] block_time: f64,
-    blocks: usize,
+    #[pyo3(from_py_with = crate::convert::arg::block_time)] block_time: f64,
+    #[pyo3(from_py_with = crate::convert::blocks_arg)] blocks: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    T_END.check(block_time).map_err(to_py)?;
-    if blocks == 0 {
-        return Err(InvalidInputError::new_err("blocks must be at least 1"));
+    if !(block_time.is_finite() && block_time > 0.0) {
+        return Err(InvalidInputError::new_err(format!(
+            "block_time must be a finite number of seconds > 0, got {block_time}"
+        )));
     }
+    if !(1..=1_000_000).contains(&blocks) {
+        return Err(InvalidInputError::new_err(format!(
+            "blocks must be a whole number in [1, 1000000], got {blocks}"
+        )));
+    }
+    let blocks = blocks as usize;
     let mut guard = ready_for(prepared, &state)?;
     let ready: &mut Ready = &mut guard;
     let spectrum = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
-        let options = ready.options(block_time, (false, 1), None, None);
+        let mut options = ready.options(block_time, (false, 1), None, None);
+        // The spectrum reads no contact: none kept.
+        options.reduce.contacts_from = f64::INFINITY;
         let Ready {
             system, stepper, ..
         } = ready;

@@ -123,12 +123,16 @@ macro_rules! by_name {
     };
 }
 
-by_name!(arg, real -> f64: approach_rate, approach_speed, area, clearance, cpu_time, damping, density, error, error_weight, forcing_period, hertz_stiffness, impact_displacement, impact_mass, impact_velocity, indentation, length, main_displacement, main_mass, main_velocity, max_cpu_time, max_error, other_poisson_ratio, other_youngs_modulus, poisson_ratio, radius, rate, record_from, second_moment, stiffness, t_end, tolerance, x, youngs_modulus);
+by_name!(arg, real -> f64: approach_rate, approach_speed, area, block_time, clearance, cpu_time, damping, density, error, error_weight, forcing_period, hertz_stiffness, impact_displacement, impact_mass, impact_velocity, indentation, length, main_displacement, main_mass, main_velocity, max_cpu_time, max_error, other_poisson_ratio, other_youngs_modulus, poisson_ratio, radius, rate, record_from, second_moment, stiffness, t_end, tolerance, x, youngs_modulus);
 by_name!(optional, real_or_none -> Option<f64>: atol, beta, dt, energy_tolerance, forcing_period, gamma, other_radius, position, record_from, restitution, rtol, spectral_radius, strobe_period);
 by_name!(named_text, text -> String: law);
 
 pub(crate) fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
     whole("every", value)
+}
+
+pub(crate) fn blocks_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
+    whole("blocks", value)
 }
 
 pub(crate) fn max_steps_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {

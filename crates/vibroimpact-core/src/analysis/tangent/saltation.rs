@@ -124,12 +124,7 @@ impl Saltation {
     }
 
     /// [`Self::matrix`] before the projection.
-    fn jump_matrix(
-        &mut self,
-        system: &Assembly,
-        view: &EventView<'_>,
-        out: &mut [f64],
-    ) -> Outcome {
+    fn jump_matrix(&mut self, system: &Assembly, view: &EventView<'_>, out: &mut [f64]) -> Outcome {
         let (d, size) = (system.dim, 2 * system.dim);
         self.reset_map(system, view.jumps);
         out.iter_mut().for_each(|v| *v = 0.0);

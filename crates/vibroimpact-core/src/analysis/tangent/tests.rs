@@ -56,7 +56,17 @@ fn options(t_end: f64, dt: Option<f64>) -> RunOptions {
 
 /// The end state (`x` then `v`) and the tangent flow of a run to `t_end`.
 fn run(system: &Assembly, y0: &[f64], t_end: f64) -> (Vec<f64>, Vec<f64>, u64) {
-    let mut stepper = AnyStepper::new(system, "exact", &Options::default()).unwrap();
+    run_with(system, y0, t_end, "exact")
+}
+
+/// [`run`] by `method` (an adaptive one at rtol 1e-12).
+fn run_with(system: &Assembly, y0: &[f64], t_end: f64, method: &str) -> (Vec<f64>, Vec<f64>, u64) {
+    let tight = Options {
+        rtol: 1e-12,
+        atol: 1e-15,
+        ..Options::default()
+    };
+    let mut stepper = AnyStepper::new(system, method, &tight).unwrap();
     let dt = stepper.step(None, t_end, f64::INFINITY);
     let mut flow = Tangent::product(system).unwrap();
     let solution = stepper
@@ -102,10 +112,20 @@ fn determinant(a: &[f64], n: usize) -> f64 {
 #[test]
 fn the_tangent_map_is_the_runs_central_differences() {
     crate::testing::timeout(60, || {
+        for method in ["exact", "dop853"] {
+            central_differences_of(method);
+        }
+    });
+}
+
+/// The tangent map of a run by `method` against the central differences of
+/// its end states.
+fn central_differences_of(method: &str) {
+    {
         let system = damper_system();
         let y0 = start(&system);
         let t_end = 0.4;
-        let (_, tangent, impacts) = run(&system, &y0, t_end);
+        let (_, tangent, impacts) = run_with(&system, &y0, t_end, method);
         assert!(impacts >= 6, "{impacts} impacts");
         let size = 2 * system.dim;
         let scales = [1e-3, 1e-3, 0.1, 0.1];
@@ -116,8 +136,8 @@ fn the_tangent_map_is_the_runs_central_differences() {
             plus[c] += h;
             let mut minus = y0.clone();
             minus[c] -= h;
-            let (p, _, _) = run(&system, &plus, t_end);
-            let (m, _, _) = run(&system, &minus, t_end);
+            let (p, _, _) = run_with(&system, &plus, t_end, method);
+            let (m, _, _) = run_with(&system, &minus, t_end, method);
             for r in 0..size {
                 let difference = (p[r] - m[r]) / (2.0 * h);
                 let exact = tangent[r * size + c];
@@ -126,8 +146,8 @@ fn the_tangent_map_is_the_runs_central_differences() {
                 worst = worst.max(error / (1.0 + exact.abs() * scales[c] / scales[r]));
             }
         }
-        assert!(worst < 1e-5, "worst scaled difference {worst:e}");
-    });
+        assert!(worst < 1e-5, "{method}: worst scaled difference {worst:e}");
+    }
 }
 
 #[test]
