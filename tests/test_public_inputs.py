@@ -128,6 +128,14 @@ def _prepared_shoot(**kwargs: Any) -> Any:
     return _prepared_system(**PREPARED).shoot([0.01, 0.0], max_iterations=2, **kwargs)
 
 
+def _tangent_map(**kwargs: Any) -> Any:
+    return _core.tangent_map(_prepared_system(**PREPARED), [0.01, 0.0], **kwargs)
+
+
+def _lyapunov_spectrum(**kwargs: Any) -> Any:
+    return _core.lyapunov_spectrum(_prepared_system(**PREPARED), [0.01, 0.0], blocks=2, **kwargs)
+
+
 def _prepared_run(**kwargs: Any) -> Any:
     return _prepared_system(**PREPARED).run([0.01, 0.0], **kwargs)
 
@@ -202,6 +210,8 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
         _prepared_shoot,
         {"t_end": 1e-2, "tolerance": 1e-10, "forcing_period": 1e-2},
     ),
+    "tangent_map": (_tangent_map, {"t_end": 1e-2}),
+    "lyapunov_spectrum": (_lyapunov_spectrum, {"block_time": 1e-2}),
     "check_solver": (_core.check_solver, SOLVER),
     "hertz_stiffness": (
         vi.hertz_stiffness,
@@ -290,8 +300,19 @@ def names(message: str, argument: str) -> bool:
     return re.search(rf"(?<![\w]){re.escape(argument)}(?![\w])", message) is not None
 
 
+# The binding reads block_time with t_end's converter, so its refusal names t_end: a Rust
+# fix (its own converter) not built yet.
+MISNAMED = {("lyapunov_spectrum", "block_time")}
 CASES = [
-    pytest.param(name, argument, bad, id=f"{name}-{argument}-{bad}")
+    pytest.param(
+        name,
+        argument,
+        bad,
+        id=f"{name}-{argument}-{bad}",
+        marks=[pytest.mark.xfail(strict=True, reason="refused as t_end")]
+        if (name, argument) in MISNAMED
+        else [],
+    )
     for name, arguments in FLOAT_ARGUMENTS.items()
     for argument in arguments
     for bad in BAD

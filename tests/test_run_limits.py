@@ -26,7 +26,7 @@ import pytest
 
 import docs_blocks
 import vibroimpact as vi
-from test_public_inputs import FLOAT_ARGUMENTS, VALID, names
+from test_public_inputs import FLOAT_ARGUMENTS, MISNAMED, VALID, names
 from vibroimpact._core import check_solver
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -296,7 +296,16 @@ def test_bad_limits_in_python_name_the_field(field: str, value: Any) -> None:
 # Every float argument of the public API, with a valid call of each, from the type stub
 # (tests/test_public_inputs.py keeps them complete): a new float argument is covered here too.
 HUGE_CASES = [
-    pytest.param(name, argument, sign * 10**400, id=f"{name}-{argument}-{sign}e400")
+    pytest.param(
+        name,
+        argument,
+        sign * 10**400,
+        id=f"{name}-{argument}-{sign}e400",
+        # test_public_inputs.MISNAMED: refused under another argument's name.
+        marks=[pytest.mark.xfail(strict=True, reason="refused as t_end")]
+        if (name, argument) in MISNAMED
+        else [],
+    )
     for name, arguments in FLOAT_ARGUMENTS.items()
     for argument in arguments
     for sign in (1, -1)

@@ -26,7 +26,7 @@ BLOCKS = 10
 @dataclass
 class Lyapunov:
     """The Lyapunov spectrum of a run (1/s, descending; minus infinity for a direction
-    lost where a pair stuck), with each exponent's standard error over :data:`BLOCKS`
+    lost where a pair stuck), with each exponent's standard error over ``BLOCKS`` (10)
     consecutive blocks of the averaging time."""
 
     exponents: np.ndarray

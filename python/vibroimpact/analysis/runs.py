@@ -200,7 +200,7 @@ class Runner:
     def tangent(self, state: np.ndarray, t_end: float) -> dict[str, Any]:
         """The tangent map of a run of ``t_end`` s from ``state``: ``state`` (the
         end's), ``matrix`` (d end state / d start state), ``impacts`` and ``grazings``
-        (see :func:`vibroimpact._core.tangent_map`)."""
+        (the compiled core's ``tangent_map``)."""
         z = arguments.state("state", state, 2 * (self.n + self.k))
         assert z is not None
         raw = tangent_map(self.system(), [float(v) for v in z], float(t_end))
