@@ -37,7 +37,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 from scipy.linalg import expm
-from scipy.optimize import minimize_scalar
+from scipy.optimize import brentq, minimize_scalar
 
 import docs_blocks
 import vibroimpact as vi
@@ -141,8 +141,16 @@ class Table:
         return np.array(self.relative(gamma, (self.tm - t0) % self.period), dtype=float)
 
     def amplitude(self, gamma: float) -> float:
-        """The largest height of the ball above the table over the orbit."""
-        return bounded_max(lambda d: self.relative(gamma, d)[0], 0.0, self.period)
+        """The largest height of the ball above the table over the orbit: at a zero of
+        the relative velocity, to round-off (the sampled maximum refined by a bounded
+        search had ~1e-9 of it, too coarse for a difference of two amplitudes)."""
+        grid = np.linspace(0.0, self.period, 2001)
+        v = np.array([self.relative(gamma, float(d))[1] for d in grid])
+        tops = [
+            brentq(lambda d: self.relative(gamma, d)[1], grid[i], grid[i + 1], xtol=1e-16)
+            for i in np.flatnonzero((v[:-1] > 0) & (v[1:] <= 0))
+        ]
+        return max(self.relative(gamma, float(t))[0] for t in tops)
 
     def jacobian(self, gamma: float) -> Array:
         e = self.e

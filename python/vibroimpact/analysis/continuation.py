@@ -532,8 +532,11 @@ class _Arc:
                 # Located exactly: Newton on the extended system from the bisection's
                 # last orbit (or the nearer end).
                 start = located_from.get(name, corrected)
-                # Between the two points, or a step beyond them (a fold lies beyond).
-                reach = abs(candidate.value - points[-1].value)
+                # Between the two points, or up to the arc between them beyond (a fold
+                # lies beyond both, by as much as the chord: near the turn their values
+                # differ by far less than their distance from it, so a reach of their
+                # difference alone had refused a fold located to 1e-14).
+                reach = max(abs(candidate.value - points[-1].value), chord)
                 low = min(candidate.value, points[-1].value) - reach
                 refined = refine(self, name, start, (low, low + 3 * reach))
                 if refined is not None:
@@ -589,16 +592,20 @@ def _shifted(data: dict[str, Any], fraction: float) -> dict[str, Any]:
     return out
 
 
-def _value_of(data: Mapping[str, Any], parameter: str) -> float:
+def _value_of(
+    data: Mapping[str, Any],
+    parameter: str,
+    name: str = "parameter",
+    why: str = "continuation starts from the scenario's value",
+) -> float:
+    """The scenario's value of the dotted path ``parameter``; errors name it as ``name``
+    and say ``why`` the value must be set."""
     node: Any = data
     for key in parameter.split("."):
         try:
             node = node[int(key)] if isinstance(node, list) else node[key]
         except (KeyError, IndexError, ValueError, TypeError):
-            raise AnalysisError(
-                f"parameter {parameter!r}: not set in the scenario (continuation starts "
-                "from the scenario's value)"
-            ) from None
+            raise AnalysisError(f"{name} {parameter!r}: not set in the scenario ({why})") from None
     if isinstance(node, bool) or not isinstance(node, int | float):
-        raise AnalysisError(f"parameter {parameter!r}: must be a number, got {node!r}")
+        raise AnalysisError(f"{name} {parameter!r}: must be a number, got {node!r}")
     return float(node)

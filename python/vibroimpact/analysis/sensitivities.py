@@ -69,7 +69,7 @@ def orbit_derivatives(
     for path in paths:
         arguments.text("derivative", path)
         with_parameter_path_check(path, "")
-        value = _value_of(data, path)
+        value = _value_of(data, path, "derivative", "the derivative is taken at its value")
         h = RELATIVE_STEP * (abs(value) if value else 1.0)
         runs = [runner(with_parameter(data, path, value + s * h), base_dir) for s in (1.0, -1.0)]
         up, down = (run.map(found.state, periods) for run in runs)

@@ -1,0 +1,474 @@
+"""The tangent-dynamics analyses of issue 26 against closed forms: bifurcations located
+by Newton on the extended system (a flip, a fold), the period-doubled branch switched
+to at a flip, two-parameter flip curves (``vibroimpact.analysis.curve`` and ``vibroimpact
+curve``), orbit sensitivities (``orbit_derivatives``, ``vibroimpact orbit --derivative``)
+and the study metric ``largest_lyapunov``.
+
+Every expected value is derived here (formulas of /work/shared/reference/forced-oracles.md):
+
+- Ball on a vibrating table (Holmes 1982): the period-one orbit, its impact map's
+  Jacobian, the flip at ``Gamma_flip(e)`` and, for the Lyapunov exponent, the orbit's
+  monodromy at t = 0 in the scenario's own coordinates, built here from the free flight
+  and the impact's saltation matrix.
+- One-sided impact oscillator (Shaw and Holmes 1983): the two period-one orbits (the
+  quadratic in the impact speed) meet where its discriminant vanishes: a fold.
+- A forced damped linear oscillator: ``Q = F0 / (k - m w^2 + i c w)``.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+from scipy.linalg import expm
+from scipy.optimize import brentq
+
+import vibroimpact as vi
+from study_checks import assert_refused, load_study
+from test_analyses import EXACT, SH, holmes_flip, shaw_holmes_orbits, shaw_holmes_scenario
+from test_maps import (
+    BALL_TABLE,
+    STATE_KEYS,
+    Table,
+    assert_one_line_error,
+    assert_png,
+    edited,
+    load,
+    write,
+)
+from vibroimpact import analysis as an
+from vibroimpact import study as st
+
+Array = NDArray[np.float64]
+RunCli = Callable[..., subprocess.CompletedProcess[str]]
+
+ROOT = Path(__file__).resolve().parents[1]
+FLIP_CURVE = ROOT / "examples" / "ball_table_flip_curve.toml"
+AMPLITUDE = "excitation.0.amplitude"
+RESTITUTION = "stop.0.restitution"
+
+
+def relative_error(found: Any, expected: Any) -> float:
+    found, expected = np.asarray(found, dtype=float), np.asarray(expected, dtype=float)
+    return float(np.max(np.abs(found - expected) / np.abs(expected)))
+
+
+def central(f: Callable[[float], Any], x: float, relative: float = 1e-5) -> Array:
+    """The central difference of the closed form ``f`` at ``x`` (its error ~1e-10 of
+    the derivative at this step, its round-off ~1e-11)."""
+    h = relative * abs(x)
+    out: Array = (np.asarray(f(x + h), dtype=float) - np.asarray(f(x - h), dtype=float)) / (2 * h)
+    return out
+
+
+# ------------------------------------------------------------- a flip curve (Holmes)
+
+
+def flip_acceleration(e: float, g: float) -> float:
+    """Holmes's flip of the period-one orbit, as the table's acceleration amplitude."""
+    return holmes_flip(e) * g
+
+
+def test_the_flip_curve_is_holmes_closed_form() -> None:
+    data = load(FLIP_CURVE)
+    g = data["gravity"]["acceleration"]
+    found = an.curve(
+        data, "flip", AMPLITUDE, start=11.772, stop=17.0, second=RESTITUTION,
+        second_stop=0.7, step=0.01,
+    )  # fmt: skip
+    assert found.stopped == "reached second_stop" and found.kind == "flip"
+    restitutions = [p.values[RESTITUTION] for p in found.points]
+    assert restitutions[0] == 0.5 and restitutions[-1] == pytest.approx(0.7, abs=1e-12)
+    assert len(found.points) == 21 and np.all(np.diff(restitutions) > 0)
+    for p in found.points:
+        e = p.values[RESTITUTION]
+        assert abs(p.values[AMPLITUDE] / flip_acceleration(e, g) - 1) < 1e-10, e
+        # Holmes's orbit there, whose multipliers are -1 and e^2 / -1 (det = e^2).
+        expected = table_with(data, e).orbit_state(holmes_flip(e))
+        assert relative_error(p.state, expected) < 1e-8, e
+        assert np.sort(p.floquet_multipliers.real) == pytest.approx([-1, -(e**2)], abs=1e-9)
+
+
+def test_curve_refuses_a_range_without_a_flip() -> None:
+    # The flip lies at 14.98 m/s^2 at e = 0.5: none between 11.772 and 12.5.
+    with pytest.raises(ValueError, match=r"no flip .* located along excitation.0.amplitude"):
+        an.curve(
+            load(FLIP_CURVE), "flip", AMPLITUDE, start=11.772, stop=12.5,
+            second=RESTITUTION, second_stop=0.6, step=0.05,
+        )  # fmt: skip
+
+
+CURVE_FIELDS = {"kind", "parameter", "second", "periods", "stopped", "points", "cpu_time"}
+
+
+@pytest.mark.timeout(90)
+def test_curve_command_on_its_example(run_cli: RunCli, tmp_path: Path) -> None:
+    data = load(FLIP_CURVE)
+    g = data["gravity"]["acceleration"]
+    plot = tmp_path / "curve.png"
+    done = run_cli("curve", str(FLIP_CURVE), "--json", "--plot", str(plot))
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert set(out) == CURVE_FIELDS
+    assert (out["kind"], out["parameter"], out["second"]) == ("flip", AMPLITUDE, RESTITUTION)
+    assert out["periods"] == 1 and out["stopped"] == "reached second_stop"
+    assert len(out["points"]) == 101
+    for p in out["points"]:
+        assert set(p) == {"values", "state", "floquet_multipliers"}
+        e = p["values"][RESTITUTION]
+        assert abs(p["values"][AMPLITUDE] / flip_acceleration(e, g) - 1) < 1e-10, e
+        assert set(p["state"]) == STATE_KEYS and p["state"]["damper_displacement"] == []
+        assert min(re for re, _ in p["floquet_multipliers"]) == pytest.approx(-1, abs=1e-9)
+    assert out["points"][-1]["values"][RESTITUTION] == pytest.approx(0.8, abs=1e-12)
+    assert_png(plot)
+
+
+CURVE_BAD = [
+    (('kind = "flip"', 'kind = "grazing"'), ["[curve] kind", '"flip"', '"fold"']),
+    (("step = 0.003", "step = 0.003\ncolour = 1"), ["[curve]", "colour"]),
+    (('second = "stop.0.restitution"', 'second = "excitation.0.amplitude"'), ["second"]),
+    (("step = 0.003", "step = 0.0"), ["[curve] step", "> 0"]),
+    (("step = 0.003", "step = -0.01"), ["[curve] step", "> 0"]),
+    (("stop = 17.0", "stop = 11.772"), ["[curve] stop", "start"]),
+    (("stop = 17.0", "stop = 12.5"), ["no flip", "located", "12.5"]),
+]
+
+
+@pytest.mark.parametrize(("change", "words"), CURVE_BAD, ids=[w[0] for _, w in CURVE_BAD])
+def test_bad_curve_sections_exit_2_naming_the_key(
+    run_cli: RunCli, tmp_path: Path, change: tuple[str, str], words: list[str]
+) -> None:
+    path = write(tmp_path, "curve.toml", edited(FLIP_CURVE, change))
+    assert_one_line_error(run_cli("curve", str(path)), *words)
+
+
+# -------------------------------------------------- a fold (Shaw and Holmes' oscillator)
+
+# Above resonance (1 Hz) the impacting orbits bend towards larger frequencies: at 1.3 Hz
+# the two period-one orbits (a node and a saddle) meet at a fold as the force falls, both
+# admissible there (the linear response 0.009 m misses the stop at 0.05 m).
+FOLD_F, FOLD_E = 1.3, 0.8
+
+
+def shaw_holmes_at(force: float) -> list[dict[str, Any]]:
+    """The period-one orbits of Shaw and Holmes's oscillator at the force ``force`` (N)."""
+    saved = SH["F0"]
+    SH["F0"] = force
+    try:
+        return shaw_holmes_orbits(FOLD_F, FOLD_E)
+    finally:
+        SH["F0"] = saved
+
+
+def discriminant(force: float) -> float:
+    """The quadratic in the impact speed's discriminant at ``force`` (N), as a function
+    of the force alone: its roots are where two period-one orbits are born."""
+    m, k, c, gap, e = SH["m"], SH["k"], SH["c"], SH["gap"], FOLD_E
+    w = 2 * math.pi * FOLD_F
+    phi = expm(np.array([[0.0, 1.0], [-k / m, -c / m]]) / FOLD_F)
+    amp = force / math.hypot(k - m * w * w, c * w)
+    e1 = np.array([0.0, 1.0])
+    u = np.linalg.solve(np.eye(2) - phi, e1 + e * phi @ e1)
+    qa = (u[0] / amp) ** 2 + (u[1] / (w * amp)) ** 2
+    qb = 2 * gap * u[0] / amp**2
+    qc = (gap / amp) ** 2 - 1
+    return float(qb * qb - 4 * qa * qc)
+
+
+def test_the_fold_of_the_impact_oscillator_is_located_exactly() -> None:
+    fold = brentq(discriminant, 0.2, 0.3, xtol=1e-15)
+    below, above = shaw_holmes_at(0.999 * fold), shaw_holmes_at(1.001 * fold)
+    assert below == [] and len(above) == 2 and all(o["admissible"] for o in above)
+    moduli = sorted(max(abs(np.linalg.eigvals(o["monodromy"]))) for o in above)
+    assert moduli[0] < 1 < moduli[1]  # a node and a saddle meet there
+    # Continued down in the force from the stable orbit at 1.5 times the fold.
+    (start, _) = shaw_holmes_at(1.5 * fold)
+    assert start["admissible"] and max(abs(np.linalg.eigvals(start["monodromy"]))) < 1
+    w = 2 * math.pi * FOLD_F
+    data = shaw_holmes_scenario(FOLD_F, FOLD_E, w * (start["t0"] + 0.5 / FOLD_F), EXACT)
+    data["excitation"][0]["amplitude"] = 1.5 * fold
+    mid = start["mid"]
+    data["initial"] = {"structure_displacement": [mid[0]], "structure_velocity": [mid[1]]}
+    branch = an.continue_orbit(data, AMPLITUDE, stop=0.5 * fold, max_points=40)
+    values = [p.value for p in branch.points]
+    turn = int(np.argmin(values))
+    assert 0 < turn < len(values) - 1 and values[turn] > fold  # it turns back at the fold
+    (located,) = [b for b in branch.bifurcations if b.kind == "fold"]
+    # Newton on the extended system lands on the discriminant's root (1e-14 measured;
+    # the window it is accepted in had refused it: the points either side of the turn
+    # lay 2e-3 above it, nine times their own difference).
+    assert abs(located.value / fold - 1) < 1e-8
+    assert np.max(located.floquet_multipliers.real) == pytest.approx(1.0, abs=1e-9)
+    # det = e^2 exp(-c T / m) at every orbit, the fold's too.
+    det = FOLD_E**2 * math.exp(-SH["c"] / (SH["m"] * FOLD_F))
+    assert np.prod(located.floquet_multipliers).real == pytest.approx(det, rel=1e-9)
+    # Past the turn the branch is the saddle: a multiplier above 1.
+    assert branch.points[turn + 1].stable is False
+    assert max(abs(branch.points[turn + 1].floquet_multipliers)) > 1
+
+
+# ---------------------------------------------------- the period-doubled branch (Holmes)
+
+
+@pytest.mark.timeout(90)
+def test_switching_at_the_flip_follows_genuine_period_two_orbits() -> None:
+    data = load(FLIP_CURVE)
+    table = Table(data)
+    flip = flip_acceleration(table.e, table.g)
+    stop = 17.0
+    branch = an.continue_orbit(data, AMPLITUDE, stop=stop, switch=True)
+    (first,) = [b for b in branch.bifurcations if b.kind == "flip"]
+    assert abs(first.value / flip - 1) < 1e-12
+    doubled = branch.switched
+    assert doubled is not None and doubled.periods == 2 and len(doubled.points) > 5
+    # Born at the flip: shot a thousandth of the remaining range beyond it.
+    assert 0 < doubled.points[0].value - flip <= 1.001e-3 * (stop - flip)
+    for p in doubled.points:
+        moved = copy.deepcopy(data)
+        moved["excitation"][0]["amplitude"] = p.value
+        run = an.runner(moved)
+        once, twice = run.map(p.state, 1), run.map(p.state, 2)
+        size = float(np.max(np.abs(p.state)))
+        assert np.max(np.abs(twice - p.state)) < 1e-8 * size, p.value  # P(P(z)) = z
+        assert np.max(np.abs(once - p.state)) > 1e-4 * size, p.value  # P(z) != z
+        # Two impacts over the orbit, each taking e^2 of the phase-space volume.
+        assert np.prod(p.floquet_multipliers).real == pytest.approx(table.e**4, rel=1e-9)
+        assert p.impacts_per_period == 1
+    # Its own flip, where the period-two orbit doubles again.
+    (second,) = [b for b in doubled.bifurcations if b.kind == "flip"]
+    assert flip < second.value < stop
+    assert np.min(second.floquet_multipliers.real) == pytest.approx(-1, abs=1e-9)
+    before = [p for p in doubled.points if p.value < second.value]
+    assert before and all(p.stable for p in before)
+
+
+# ------------------------------------------------------------------- sensitivities
+
+OSC_M, OSC_K, OSC_C, OSC_F0, OSC_F = 1.5, 600.0, 3.0, 2.0, 3.0
+
+
+def oscillator(f: float = OSC_F, k: float = OSC_K, f0: float = OSC_F0) -> tuple[Array, float]:
+    """The forced damped oscillator's orbit state at t = 0 and its amplitude |Q|."""
+    w = 2 * math.pi * f
+    q = f0 / (k - OSC_M * w * w + 1j * OSC_C * w)
+    return np.array([q.real, -w * q.imag]), abs(q)
+
+
+def test_derivatives_of_a_linear_orbit_are_those_of_its_closed_form() -> None:
+    data = {
+        "structure": {"kind": "oscillator", "mass": OSC_M, "stiffness": OSC_K, "damping": OSC_C},
+        "excitation": [
+            {
+                "kind": "force",
+                "at": 0,
+                "signal": "harmonic",
+                "amplitude": OSC_F0,
+                "frequency": OSC_F,
+            }
+        ],
+        "solver": dict(EXACT),
+    }
+    found = an.orbit(an.runner(data), np.zeros(2))
+    assert found.converged
+    paths = {"excitation.0.frequency": "f", "structure.stiffness": "k", AMPLITUDE: "f0"}
+    derivatives = an.orbit_derivatives(data, found, list(paths))
+    assert set(derivatives) == set(paths)
+    values = {"f": OSC_F, "k": OSC_K, "f0": OSC_F0}
+    for path, key in paths.items():
+        state = central(lambda x, key=key: oscillator(**{key: x})[0], values[key])
+        amplitude = central(lambda x, key=key: oscillator(**{key: x})[1], values[key])
+        assert relative_error(derivatives[path].state, state) < 1e-6, path
+        assert relative_error(derivatives[path].amplitude, [amplitude]) < 1e-6, path
+
+
+def table_with(data: dict[str, Any], restitution: float) -> Table:
+    changed = copy.deepcopy(data)
+    changed["stop"][0]["restitution"] = restitution
+    return Table(changed)
+
+
+def ball_derivatives(data: dict[str, Any]) -> dict[str, tuple[Array, Array]]:
+    """d state and d amplitude of Holmes's orbit in the acceleration amplitude (per
+    m/s^2) and the restitution, by central differences of the closed form."""
+    table = Table(data)
+    gamma = table.gamma()
+    return {
+        AMPLITUDE: (
+            central(table.orbit_state, gamma) / table.g,
+            central(table.amplitude, gamma) / table.g,
+        ),
+        RESTITUTION: (
+            central(lambda e: table_with(data, e).orbit_state(gamma), table.e),
+            central(lambda e: table_with(data, e).amplitude(gamma), table.e),
+        ),
+    }
+
+
+def test_derivatives_of_the_ball_on_the_table_are_those_of_holmes_orbit() -> None:
+    data = load(BALL_TABLE)
+    found = an.orbit(an.runner(data))
+    assert found.converged
+    derivatives = an.orbit_derivatives(data, found, [AMPLITUDE, RESTITUTION])
+    for path, (state, amplitude) in ball_derivatives(data).items():
+        assert relative_error(derivatives[path].state, state) < 1e-6, path
+        assert relative_error(derivatives[path].amplitude, [amplitude]) < 1e-6, path
+    with pytest.raises(ValueError, match=r"^derivative 'stop.0.law': must be a number"):
+        an.orbit_derivatives(data, found, ["stop.0.law"])
+
+
+def test_orbit_command_prints_the_derivatives(run_cli: RunCli) -> None:
+    done = run_cli(
+        "orbit", str(BALL_TABLE), "--derivative", AMPLITUDE, "--derivative", RESTITUTION, "--json"
+    )
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert set(out["derivatives"]) == {AMPLITUDE, RESTITUTION}
+    for path, (state, amplitude) in ball_derivatives(load(BALL_TABLE)).items():
+        assert set(out["derivatives"][path]) == {"state", "amplitude"}
+        assert relative_error(out["derivatives"][path]["state"], state) < 1e-6, path
+        assert relative_error(out["derivatives"][path]["amplitude"], [amplitude]) < 1e-6, path
+    assert "derivatives" not in json.loads(run_cli("orbit", str(BALL_TABLE), "--json").stdout)
+    text = run_cli("orbit", str(BALL_TABLE), "--derivative", AMPLITUDE)
+    assert text.returncode == 0 and f"d/d {AMPLITUDE}: state [" in text.stdout
+    for bad in ("stop.0.bogus", "excitation.3.amplitude", "stop.0.law"):
+        done = run_cli("orbit", str(BALL_TABLE), "--derivative", bad, "--json")
+        assert_one_line_error(done, "derivative", repr(bad))
+
+
+# ---------------------------------------------------------- the study's Lyapunov metric
+
+G = 9.81  # m/s^2, the examples' gravity
+
+
+def ball_study(tmp_path: Path, gamma: float, restitutions: list[float], study: str) -> Any:
+    """A study of the ball-on-table example at ``gamma`` over the restitution."""
+    text = edited(BALL_TABLE, ("amplitude = 11.772 ", f"amplitude = {gamma * G!r} "))
+    text += f"{study}\n[study.axes]\n{RESTITUTION!r} = {restitutions}\n"
+    tmp_path.mkdir(exist_ok=True)
+    return st.run(load_study(tmp_path / "study.toml", text), tmp_path / "out.nc")
+
+
+def steady(settle: int, record: int) -> str:
+    return (
+        '[study]\nanalysis = "steady-state"\n'
+        f"settle_periods = {settle}\nrecord_periods = {record}\n"
+        'metrics = ["largest_lyapunov", "impacts"]\n'
+    )
+
+
+def ball_runner(gamma: float, e: float) -> an.Runner:
+    data = load(BALL_TABLE)
+    data["excitation"][0]["amplitude"] = gamma * G
+    data["stop"][0]["restitution"] = e
+    return an.lyapunov_runner(data)
+
+
+@pytest.mark.timeout(90)
+def test_a_steady_state_studys_lyapunov_exponent_is_positive_for_the_chaotic_ball(
+    tmp_path: Path,
+) -> None:
+    # e = 0.9, Gamma = 5: chaos (Gamma_flip(0.9) = 1.0; see test_tangent).
+    assert 5.0 > holmes_flip(0.9)
+    run = ball_runner(5.0, 0.9)
+    # Over a short time, the very computation of vibroimpact.lyapunov (the same
+    # trajectory from [initial], the tangent flow over the recorded periods) to
+    # round-off (3e-14 measured: chaos amplifies the two runs' round-off, 1e-8 after 30
+    # periods, so longer windows agree only statistically).
+    short = ball_study(tmp_path / "short", 5.0, [0.9], steady(5, 8))
+    expected = vi.lyapunov(run, settle=5, periods=8).largest
+    assert abs(float(short["largest_lyapunov"].values[0]) / expected - 1) < 1e-12
+    # Over 2000 periods: positive, and within 4 standard errors of lyapunov's estimate
+    # over the same window (two samples of one time average once the runs have parted).
+    long = ball_study(tmp_path / "long", 5.0, [0.9], steady(100, 2000))
+    assert int(long["status"].values[0]) == 0
+    found = float(long["largest_lyapunov"].values[0])
+    reference = vi.lyapunov(run, settle=100, periods=2000)
+    assert reference.largest > 10 * reference.standard_error[0]  # chaotic
+    assert found > 0
+    assert abs(found - reference.largest) < 4 * reference.standard_error[0] * math.sqrt(2)
+
+
+def holmes_monodromy(table: Table, gamma: float) -> Array:
+    """The period-one orbit's monodromy from t = 0 in the scenario's coordinates (the
+    ball's height above the table and its rate): free flight to the impact (the tangent
+    flow [[1, t], [0, 1]]: the forcing is additive), the saltation matrix of a rigid
+    impact on a lower stop, ``[[-e, 0], [(a+ + e a-) / v-, -e]]`` (the acceleration
+    ``-g - table's`` the same either side), then free flight to the period's end."""
+    e, w = table.e, table.w
+    phi = table.phi(gamma)
+    to_impact = (phi / w - table.tm) % table.period  # from t = 0
+    approach = -table.closing()  # the relative velocity before the impact
+    acceleration = -table.g + gamma * table.g * math.sin(phi)
+    saltation = np.array([[-e, 0.0], [(1 + e) * acceleration / approach, -e]])
+
+    def flight(t: float) -> Array:
+        return np.array([[1.0, t], [0.0, 1.0]])
+
+    out: Array = flight(table.period - to_impact) @ saltation @ flight(to_impact)
+    return out
+
+
+def test_a_stable_orbits_lyapunov_exponent_is_its_multipliers_log_rate(tmp_path: Path) -> None:
+    gamma, e, settle, record = 1.2, 0.5, 60, 400
+    table = table_with(load(BALL_TABLE), e)
+    monodromy = holmes_monodromy(table, gamma)
+    # The oracle: Holmes's multipliers (a complex pair of modulus e).
+    holmes = np.linalg.eigvals(table.jacobian(gamma))
+    assert np.sort_complex(np.linalg.eigvals(monodromy)) == pytest.approx(
+        np.sort_complex(holmes), abs=1e-12
+    )
+    rate = math.log(e) / table.period
+    ds = ball_study(tmp_path, gamma, [e], steady(settle, record))
+    found = float(ds["largest_lyapunov"].values[0])
+    # Settled 60 periods (the transient shrinks by e = 0.5 each), the tangent flow over
+    # the recorded ones is M^R: the largest stretch of its QR, R's diagonal (any
+    # re-orthonormalisation between gives the same), from the identity.
+    stretches = np.abs(np.diag(np.linalg.qr(np.linalg.matrix_power(monodromy, record))[1]))
+    assert found == pytest.approx(np.log(stretches).max() / (record * table.period), rel=1e-9)
+    # So within ln(cond(V)) / (R T) of ln|mu| / T (V the eigenvectors: M^R's stretches
+    # lie within cond(V) of |mu|^R; in metres and m/s, V is far from orthogonal), 1e-2
+    # of it here.
+    vectors = np.linalg.eig(monodromy)[1]
+    bound = math.log(np.linalg.cond(vectors)) / (record * table.period)
+    assert 0 < bound < 0.015 * abs(rate)
+    assert abs(found - rate) <= bound
+
+
+def test_an_orbit_studys_lyapunov_exponent_is_its_largest_multipliers_log_rate(
+    tmp_path: Path,
+) -> None:
+    orbit = (
+        '[study]\nanalysis = "orbit"\nsettle_periods = 30\n'
+        'metrics = ["largest_multiplier", "largest_lyapunov", "stable"]\n'
+    )
+    restitutions = [0.5, 0.6]
+    ds = ball_study(tmp_path, 1.2, restitutions, orbit)
+    period = 1 / Table(load(BALL_TABLE)).f
+    for i, e in enumerate(restitutions):
+        largest = float(ds["largest_multiplier"].values[i])
+        assert bool(ds["stable"].values[i]) and largest == pytest.approx(e, rel=1e-9)
+        found = float(ds["largest_lyapunov"].values[i])
+        assert found == pytest.approx(math.log(largest) / period, rel=1e-12)
+
+
+def test_a_study_of_largest_lyapunov_refuses_a_compliant_law(
+    run_cli: RunCli, tmp_path: Path
+) -> None:
+    text = edited(
+        BALL_TABLE,
+        ('law = "rigid" ', 'law = "hertz" '),
+        ("restitution = 0.5", "stiffness = 1e6"),
+        ('method = "exact" ', 'method = "dopri5"'),
+    )
+    axes = '\n[study.axes]\n"gravity.acceleration" = [9.81]\n'
+    path = write(tmp_path, "hertz.toml", text + steady(10, 10) + axes)
+    out = tmp_path / "out.nc"
+    assert_refused(run_cli("study", str(path), "--out", str(out)), ["stop 0", "compliant"], out)
