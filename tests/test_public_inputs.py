@@ -300,18 +300,12 @@ def names(message: str, argument: str) -> bool:
     return re.search(rf"(?<![\w]){re.escape(argument)}(?![\w])", message) is not None
 
 
-# The binding reads block_time with t_end's converter, so its refusal names t_end: a Rust
-# fix (its own converter) not built yet.
-MISNAMED = {("lyapunov_spectrum", "block_time")}
 CASES = [
     pytest.param(
         name,
         argument,
         bad,
         id=f"{name}-{argument}-{bad}",
-        marks=[pytest.mark.xfail(strict=True, reason="refused as t_end")]
-        if (name, argument) in MISNAMED
-        else [],
     )
     for name, arguments in FLOAT_ARGUMENTS.items()
     for argument in arguments

@@ -26,7 +26,7 @@ import pytest
 
 import docs_blocks
 import vibroimpact as vi
-from test_public_inputs import FLOAT_ARGUMENTS, MISNAMED, VALID, names
+from test_public_inputs import FLOAT_ARGUMENTS, VALID, names
 from vibroimpact._core import check_solver
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -301,10 +301,6 @@ HUGE_CASES = [
         argument,
         sign * 10**400,
         id=f"{name}-{argument}-{sign}e400",
-        # test_public_inputs.MISNAMED: refused under another argument's name.
-        marks=[pytest.mark.xfail(strict=True, reason="refused as t_end")]
-        if (name, argument) in MISNAMED
-        else [],
     )
     for name, arguments in FLOAT_ARGUMENTS.items()
     for argument in arguments

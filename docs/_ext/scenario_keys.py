@@ -312,6 +312,36 @@ ANALYSES = {
         "step": ("the parameter's", "> 0", "the step along the branch, about (default chosen)"),
         "max_points": ("1", "[2, 100000]", "the most points the branch may have"),
         "tolerance": ("1", "> 0", "the shooting's Newton tolerance on the orbit"),
+        "switch": (
+            None,
+            "true or false",
+            "at the first located flip, go on along the period-doubled branch (JSON switched)",
+        ),
+    },
+    "curve": {
+        "kind": (
+            None,
+            '"flip", "fold" or "neimark-sacker"',
+            "the bifurcation followed (every pair rigid: the multipliers come from the "
+            "tangent flow)",
+        ),
+        "parameter": (
+            None,
+            _PARAMETER,
+            "the first parameter: the bifurcation is located along the orbit's branch in it",
+        ),
+        "start": ("the parameter's", "finite", "where the branch starts (the orbit found there)"),
+        "stop": ("the parameter's", "finite, not start", "where the search for it ends"),
+        "second": (None, _PARAMETER + ", not parameter", "the second parameter, followed"),
+        "second_stop": (
+            "the second's",
+            "finite",
+            "where the curve ends (it starts at the scenario's value of second)",
+        ),
+        "step": ("the second's", "> 0", "the step in the second parameter (halved where needed)"),
+        "periods": ("1", "[1, 10000000]", "K: the orbit's period in forcing periods"),
+        "max_points": ("1", "[2, 100000]", "the most points the curve may have"),
+        "tolerance": ("1", "> 0", "the Newton tolerance on the orbit"),
     },
     "basins": {
         "x": (None, "a table: state, start, stop, count", "the grid's first axis"),
@@ -342,7 +372,8 @@ ANALYSES = {
             None,
             '"peak", "rms", "impacts", "energy_dissipated" (run, steady-state); '
             '"amplitude", "impacts_per_period", "settled" (steady-state); "amplitude", '
-            '"impacts_per_period", "stable", "largest_multiplier" (orbit); "point_peak", '
+            '"impacts_per_period", "stable", "largest_multiplier" (orbit); '
+            '"largest_lyapunov" (any: 1/s, every pair rigid); "point_peak", '
             '"point_rms", "point_amplitude", "moment_peak"...',
             'what each point keeps (default "peak", "rms", "impacts"; an orbit\'s four for '
             '"orbit")',

@@ -76,6 +76,7 @@ def _analysis_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
     return {
         "sweep": ("[sweep]", analysis_settings._SWEEP),
         "continuation": ("[continuation]", analysis_settings._CONTINUATION),
+        "curve": ("[curve]", analysis_settings._CURVE),
         "basins": ("[basins]", analysis_settings._BASINS),
         "basins.x": ("[basins] x and y", analysis_settings._AXIS),
         "study": ("[study]", study),

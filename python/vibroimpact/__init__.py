@@ -68,6 +68,9 @@ from vibroimpact._core import (
     goldsmith_max_indentation,
     hertz_stiffness,
     linear_contact_duration,
+    lyapunov_spectrum,
+    tangent_map,
+    tangent_refusal,
 )
 from vibroimpact._core import cantilever_mode_shape as _cantilever_mode_shape
 from vibroimpact._core import check_solver as _check_solver
@@ -133,6 +136,9 @@ run_study.__doc__ = (
 
 __all__ = [
     "run_study",
+    "tangent_map",
+    "lyapunov_spectrum",
+    "tangent_refusal",
     "linear_parts",
     "PreparedSystem",
     "DEFAULT_ENERGY_TOLERANCE",

@@ -86,7 +86,7 @@ class Branch:
     n: int
     k: int
     #: The bifurcations located exactly (Newton on the extended system, where every pair
-    #: is rigid): see :mod:`vibroimpact.analysis.located`.
+    #: is rigid), each a :class:`~vibroimpact.analysis.Bifurcation`.
     bifurcations: list[Bifurcation] = field(default_factory=list)
     #: With ``switch``: the period-doubled branch born at the first flip (None where
     #: none was found).

@@ -1,7 +1,7 @@
 """Two-parameter curves of bifurcations (flip, fold, Neimark-Sacker) of forced 0.2
 systems: the bifurcation first located along the orbit's branch in one parameter
 (:func:`~vibroimpact.analysis.continue_orbit`, then Newton on the extended system, see
-:mod:`~vibroimpact.analysis.located`), then followed as a second parameter steps, each
+``vibroimpact.analysis.located``), then followed as a second parameter steps, each
 point Newton's method on the extended system ``P_p(z) - z = 0, g(z, p) = 0`` from the
 last two points' extrapolation. The multipliers come from the tangent flow through the
 impacts: every pair must be rigid. SI units."""
