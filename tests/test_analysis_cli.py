@@ -515,7 +515,13 @@ def test_the_docs_analysis_commands_work_as_written(tmp_path: Path) -> None:
     shutil.copytree(ROOT / "examples", tmp_path / "examples")
     blocks = docs_blocks.blocks(ANALYSES, "sh")
     commands = [line for block in blocks for line in block.splitlines() if line.strip()]
-    assert {shlex.split(c)[1] for c in commands} == {"orbit", "sweep", "lyapunov"}
+    assert {shlex.split(c)[1] for c in commands} == {
+        "orbit",
+        "sweep",
+        "lyapunov",
+        "continue",
+        "curve",
+    }
     for command in commands:
         argv = shlex.split(command)
         assert argv[0] == "vibroimpact", command
@@ -532,6 +538,7 @@ def test_the_docs_analysis_commands_work_as_written(tmp_path: Path) -> None:
             json.loads(done.stdout)
     assert (tmp_path / "frf.png").read_bytes().startswith(PNG_SIGNATURE)
     assert (tmp_path / "convergence.png").read_bytes().startswith(PNG_SIGNATURE)
+    assert (tmp_path / "flip_curve.png").read_bytes().startswith(PNG_SIGNATURE)
 
 
 def test_the_docs_analysis_snippet_runs_and_its_comments_are_true(

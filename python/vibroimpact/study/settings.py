@@ -34,16 +34,12 @@ from vibroimpact.system import (
 # What each analysis keeps; every metric.
 _RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated", "largest_lyapunov")
 _STEADY_METRICS = (*_RUN_METRICS, "amplitude", "impacts_per_period", "settled")
+#: What an orbit study keeps by default.
+_ORBIT_DEFAULT = ("amplitude", "impacts_per_period", "stable", "largest_multiplier")
 _ANALYSIS_METRICS = {
     "run": _RUN_METRICS,
     "steady-state": _STEADY_METRICS,
-    "orbit": (
-        "amplitude",
-        "impacts_per_period",
-        "stable",
-        "largest_multiplier",
-        "largest_lyapunov",
-    ),
+    "orbit": (*_ORBIT_DEFAULT, "largest_lyapunov"),
 }
 #: Every metric a study can keep (each analysis keeps some of them).
 METRICS = (*_STEADY_METRICS, "stable", "largest_multiplier")
@@ -114,7 +110,7 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
     _choice("[study] ", "analysis", out["analysis"], _ANALYSES)
     _choice("[study] ", "stepping", out["stepping"], _STEPPINGS)
     # By default what the analysis keeps (an orbit's own metrics, none of a run's).
-    default = _ANALYSIS_METRICS["orbit"] if out["analysis"] == "orbit" else _FIXED_METRICS
+    default = _ORBIT_DEFAULT if out["analysis"] == "orbit" else _FIXED_METRICS
     metrics = table.get("metrics", list(default))
     if isinstance(metrics, str) or not isinstance(metrics, Sequence) or not metrics:
         raise StudyError(f"[study] metrics: must be a list of names, got {metrics!r:.60}")
