@@ -74,7 +74,10 @@ enum Keep {
     /// The product: the derivative of the end state by the start state.
     Product,
     /// Re-orthonormalised after each event (Benettin's QR): the sum of the
-    /// logarithms of the stretches of each direction.
+    /// logarithms of the stretches of each direction. (Every 16 events
+    /// instead, the saltations' shears had made the columns parallel to
+    /// round-off between two QRs: a forced damper's sum of exponents was 12
+    /// times too small.)
     Orthonormal { logs: Vec<f64> },
 }
 
@@ -94,7 +97,10 @@ pub struct Tangent<'s> {
     /// The linear flow's matrix `A` of each set of modes met.
     flows: Vec<(Vec<u8>, Vec<f64>)>,
     saltation: Saltation,
+    expm: linalg::Expm,
     factor: Vec<f64>,
+    /// The stretch's flow before an event's saltation.
+    stretch: Vec<f64>,
     product: Vec<f64>,
     grazings: Vec<Grazing>,
     /// Events whose impulses acted.
@@ -140,7 +146,9 @@ impl<'s> Tangent<'s> {
             modes: vec![Mode::Open; system.interactions.len()],
             flows: Vec::new(),
             saltation: Saltation::new(system),
+            expm: linalg::Expm::new(size),
             factor: vec![0.0; size * size],
+            stretch: vec![0.0; size * size],
             product: vec![0.0; size * size],
             grazings: Vec::new(),
             impacts: 0,
@@ -224,8 +232,8 @@ impl<'s> Tangent<'s> {
         let modes = std::mem::take(&mut self.modes);
         let slot = self.flow_matrix(&modes);
         self.modes = modes;
-        let scaled: Vec<f64> = self.flows[slot].1.iter().map(|v| v * tau).collect();
-        self.factor = linalg::expm(&scaled, self.size);
+        self.expm
+            .compute(&self.flows[slot].1, tau, &mut self.factor);
     }
 
     /// `matrix <- factor matrix`, then re-orthonormalised where asked.
@@ -253,11 +261,17 @@ impl EventObserver for Tangent<'_> {
         // The modes before the event are the stretch's (the kernel switches
         // modes only at events).
         self.modes.copy_from_slice(view.modes_before);
-        if view.time > self.since {
+        // The stretch's flow, then the event's saltation: one factor (one QR).
+        let stretch = view.time > self.since;
+        if stretch {
             self.smooth(view.time);
-            self.apply();
+            std::mem::swap(&mut self.factor, &mut self.stretch);
         }
         let outcome = self.saltation.matrix(self.system, view, &mut self.factor);
+        if stretch {
+            linalg::matmul(&self.factor, &self.stretch, &mut self.product, self.size);
+            std::mem::swap(&mut self.factor, &mut self.product);
+        }
         if let Some(speed) = outcome.grazing {
             self.grazings.push(Grazing {
                 time: view.time,

@@ -15,7 +15,7 @@ mod symmetric;
 mod tests;
 
 pub use eigen::eigenvalues;
-pub use expm::expm;
+pub use expm::{expm, Expm};
 pub(crate) use solve::solve_pivoted;
 pub use solve::{solve_in_place, solve_matrix_in_place};
 pub use symmetric::{symmetric_eigen, symmetric_eigenvalues};
