@@ -367,6 +367,7 @@ pub fn integrate_system_observed<S: SystemStepper>(
 }
 
 /// The run's steps, each cut at the earliest event it shows, to its end.
+#[inline(always)]
 fn by_events<S: SystemStepper>(
     run: &mut Run<'_>,
     stepper: &mut S,
