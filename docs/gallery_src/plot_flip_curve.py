@@ -17,23 +17,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import vibroimpact as vi
-from vibroimpact.analysis import curve
+from vibroimpact.analysis import curve_of
 
 # The gallery runs from docs/gallery_src; the scenarios are in the repository's examples/.
 EXAMPLES = Path.cwd().parents[1] / "examples"
 scenario = vi.load_scenario(EXAMPLES / "ball_table_flip_curve.toml")
-settings = scenario.data["curve"]
-found = curve(
-    scenario.data,
-    settings["kind"],
-    settings["parameter"],
-    start=settings["start"],
-    stop=settings["stop"],
-    second=settings["second"],
-    second_stop=settings["second_stop"],
-    step=settings["step"],
-    base_dir=scenario.base_dir,
-)
+found = curve_of(scenario.data, scenario.base_dir)  # as `vibroimpact curve` runs it
 G = 9.81  # m/s^2, the scenario's gravity
 e = np.array([p.values[found.second] for p in found.points])
 gamma = np.array([p.values[found.parameter] for p in found.points]) / G

@@ -22,7 +22,7 @@ xarray Datasets in :mod:`~vibroimpact.analysis.datasets` and as plots in
 """
 
 from vibroimpact.analysis.continuation import Branch, BranchPoint, continue_orbit
-from vibroimpact.analysis.curves import Curve, CurvePoint, curve, curve_regions
+from vibroimpact.analysis.curves import Curve, CurvePoint, curve, curve_of, curve_regions
 from vibroimpact.analysis.limits import (
     MAX_PERIODS,
     MAX_POINTS,
@@ -107,6 +107,7 @@ __all__ = [
     "checked_run",
     "continuation_settings",
     "curve",
+    "curve_of",
     "curve_regions",
     "curve_settings",
     "continue_orbit",

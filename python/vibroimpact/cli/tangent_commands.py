@@ -10,9 +10,8 @@ from typing import Any
 
 from vibroimpact.analysis import (
     check_periods,
-    curve,
+    curve_of,
     curve_regions,
-    curve_settings,
     lyapunov,
     lyapunov_runner,
     plots,
@@ -138,22 +137,8 @@ def run_curve(args: argparse.Namespace) -> int:
         raise UsageError(f"{args.scenario}: curve takes a 0.2 scenario (a [structure] section)")
     if "curve" not in scenario.data:
         raise UsageError(f"{args.scenario}: curve needs a [curve] section")
-    settings = curve_settings(scenario.data["curve"])
     start = time.perf_counter()
-    found = curve(
-        scenario.data,
-        settings["kind"],
-        settings["parameter"],
-        start=settings["start"],
-        stop=settings["stop"],
-        second=settings["second"],
-        second_stop=settings["second_stop"],
-        step=settings["step"],
-        periods=settings["periods"],
-        max_points=settings["max_points"],
-        tolerance=settings["tolerance"],
-        base_dir=scenario.base_dir,
-    )
+    found = curve_of(scenario.data, scenario.base_dir)
     cpu_time = time.perf_counter() - start
     if args.plot:
         regions = curve_regions(found, scenario.data, scenario.base_dir)
