@@ -140,10 +140,8 @@ impl Run<'_> {
         };
         let mut any = false;
         let mut rigid = false;
-        if let Some(watch) = self.watch.as_mut() {
-            watch.before.copy_from_slice(&self.y[..2 * system.dim]);
-            watch.modes_before.copy_from_slice(&self.modes);
-            watch.jumps.clear();
+        if self.watch.is_some() {
+            self.watch_before();
         }
         self.just_switched.iter_mut().for_each(|s| *s = false);
         for i in 0..self.modes.len() {
@@ -188,8 +186,8 @@ impl Run<'_> {
                 &mut self.buffers.work,
                 &mut self.just_switched,
             );
-            if let Some(watch) = self.watch.as_mut() {
-                self.impacts.jumps(&mut watch.jumps);
+            if self.watch.is_some() {
+                self.watch_jumps();
             }
         }
         if any {
@@ -204,12 +202,45 @@ impl Run<'_> {
             // contact across their start may stay; it is dropped at the end).
             self.contacts.retain(|c| c.onset >= from);
         }
+        if self.watch.is_some() {
+            self.watch_event(time, located)?;
+        }
+        Ok(())
+    }
+
+    /// An observed run (see [`crate::kernel::observe`]): the state and modes
+    /// before the event being handled. Out of line, so that a plain run's
+    /// event handling is the code it was.
+    #[cold]
+    #[inline(never)]
+    fn watch_before(&mut self) {
+        if let Some(watch) = self.watch.as_mut() {
+            watch.before.copy_from_slice(&self.y[..2 * self.system.dim]);
+            watch.modes_before.copy_from_slice(&self.modes);
+            watch.jumps.clear();
+        }
+    }
+
+    /// An observed run: the rigid pairs the event's impulses acted on.
+    #[cold]
+    #[inline(never)]
+    fn watch_jumps(&mut self) {
+        if let Some(watch) = self.watch.as_mut() {
+            self.impacts.jumps(&mut watch.jumps);
+        }
+    }
+
+    /// An observed run: the event shown to the observer.
+    #[cold]
+    #[inline(never)]
+    fn watch_event(&mut self, time: f64, located: usize) -> Result<()> {
+        let dim = self.system.dim;
         if let Some(watch) = self.watch.as_mut() {
             watch.observer.event(&EventView {
                 time,
                 located,
                 before: &watch.before,
-                after: &self.y[..2 * system.dim],
+                after: &self.y[..2 * dim],
                 modes_before: &watch.modes_before,
                 modes_after: &self.modes,
                 jumps: &watch.jumps,

@@ -252,15 +252,15 @@ pub(super) fn measured_on(
         },
     );
     if settings.lyapunov {
-        // The tangent flow over the recorded time, re-orthonormalised at
-        // each event: its largest stretch rate.
-        let mut flow = Tangent::orthonormal(system)?.from_time(record_from);
-        let sol =
-            stepper.integrate_observed(system, &y0, &options, &mut || interrupt(), &mut flow)?;
-        let mut metrics = metrics_of(system, &sol, (record_from, strobe_period), settings);
-        let largest = flow.logs().iter().fold(f64::NEG_INFINITY, |m, l| m.max(*l));
-        metrics.largest_lyapunov = largest / (t_end - record_from);
-        return Ok(metrics);
+        return with_lyapunov(
+            system,
+            stepper,
+            &y0,
+            &options,
+            (record_from, strobe_period),
+            settings,
+            interrupt,
+        );
     }
     let sol = stepper.integrate(system, &y0, &options, &mut || interrupt())?;
     Ok(metrics_of(
@@ -269,6 +269,28 @@ pub(super) fn measured_on(
         (record_from, strobe_period),
         settings,
     ))
+}
+
+/// [`measured_on`]'s run with the tangent flow over the recorded time (from
+/// `record_from`, s), re-orthonormalised at each event: its largest stretch
+/// rate is the largest Lyapunov exponent. Out of line, so that a plain run's
+/// code is what it was.
+#[inline(never)]
+fn with_lyapunov(
+    system: &Assembly,
+    stepper: &mut AnyStepper,
+    y0: &[f64],
+    options: &RunOptions,
+    (record_from, strobe_period): (f64, f64),
+    settings: &StudySettings,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> Result<RunMetrics> {
+    let mut flow = Tangent::orthonormal(system)?.from_time(record_from);
+    let sol = stepper.integrate_observed(system, y0, options, &mut || interrupt(), &mut flow)?;
+    let mut metrics = metrics_of(system, &sol, (record_from, strobe_period), settings);
+    let largest = flow.logs().iter().fold(f64::NEG_INFINITY, |m, l| m.max(*l));
+    metrics.largest_lyapunov = largest / (options.t_end - record_from);
+    Ok(metrics)
 }
 
 /// A study run's options: no history, the study's limits.

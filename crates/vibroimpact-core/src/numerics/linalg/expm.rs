@@ -163,9 +163,15 @@ impl Expm {
             self.v[p] += self.inner[p];
         }
         // (V - U) R = V + U, R into `out`.
-        for p in 0..n * n {
-            self.tmp[p] = self.v[p] - self.u[p];
-            out[p] = self.v[p] + self.u[p];
+        for (((t, o), v), u) in self
+            .tmp
+            .iter_mut()
+            .zip(out.iter_mut())
+            .zip(&self.v)
+            .zip(&self.u)
+        {
+            *t = v - u;
+            *o = v + u;
         }
         solve_matrix_in_place(&mut self.tmp, out, n);
         for _ in 0..squarings {
