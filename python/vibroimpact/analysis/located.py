@@ -59,7 +59,7 @@ def test_value(kind: str, multipliers: np.ndarray) -> float:
         complex_ones = m[np.abs(m.imag) > 1e-9]
         if not complex_ones.size:
             return float("nan")
-        return float(np.min(np.abs(complex_ones)) - 1.0) if complex_ones.size else 0.0
+        return float(np.min(np.abs(complex_ones)) - 1.0)
     raise ValueError(f"kind: no test function for {kind!r}")
 
 

@@ -267,6 +267,32 @@ impl Open {
     }
 }
 
+/// The run's steps, each cut at the earliest event it shows, to `t_end`:
+/// one loop for the plain and the observed run, written in place in each (a
+/// function, called out of line or inlined from there, had made the plain
+/// runs' event handling slower: the events study of bench_lockstep.py
+/// 0.40 -> 0.44-0.48 s).
+macro_rules! by_events {
+    ($run:ident, $stepper:ident, $interrupt:ident, $t_end:expr) => {
+        while $run.clock.time < $t_end {
+            // Plain steps in a row, where the stepper takes them at once (each
+            // as the kernel's step would, to the bit); the step after them is
+            // the kernel's.
+            if $run.stretches && $run.clock.accepted > 0 && $run.fast_steps($stepper, $interrupt)? {
+                continue;
+            }
+            let stop = $run.step($stepper)?;
+            match stop {
+                Stop::End => break,
+                Stop::Retry => continue,
+                Stop::Event { interaction } => $run.at_event($stepper, interaction)?,
+                Stop::Step | Stop::RecordWindow | Stop::Strobe => {}
+            }
+            $run.after_step(stop, $interrupt)?;
+        }
+    };
+}
+
 /// Integrates `system` from `initial` (see [`crate::model::assembly::initial_state`]).
 pub fn integrate_system<S: SystemStepper>(
     system: &Assembly,
@@ -335,25 +361,7 @@ pub fn integrate_system_stepped<S: SystemStepper>(
         }
         return Ok(run.finish(stepper));
     }
-    // The loop of `by_events`, written in place: called out of line (or
-    // inlined from there), it had made the plain runs' event handling slower
-    // (the events study of bench_lockstep.py 0.40 -> 0.44-0.48 s).
-    while run.clock.time < options.t_end {
-        // Plain steps in a row, where the stepper takes them at once (each
-        // as the kernel's step would, to the bit); the step after them is
-        // the kernel's.
-        if run.stretches && run.clock.accepted > 0 && run.fast_steps(stepper, interrupt)? {
-            continue;
-        }
-        let stop = run.step(stepper)?;
-        match stop {
-            Stop::End => break,
-            Stop::Retry => continue,
-            Stop::Event { interaction } => run.at_event(stepper, interaction)?,
-            Stop::Step | Stop::RecordWindow | Stop::Strobe => {}
-        }
-        run.after_step(stop, interrupt)?;
-    }
+    by_events!(run, stepper, interrupt, options.t_end);
     Ok(run.finish(stepper))
 }
 
@@ -375,39 +383,13 @@ pub fn integrate_system_observed<S: SystemStepper>(
     let (dim, count) = (system.dim, system.interactions.len());
     observer.start(run.clock.time, &run.y[..2 * dim], &run.modes)?;
     run.watch = Some(Watch::new(observer, dim, count));
-    by_events(&mut run, stepper, interrupt)?;
+    by_events!(run, stepper, interrupt, options.t_end);
     if let Some(watch) = run.watch.take() {
         watch
             .observer
             .finish(run.clock.time, &run.y[..2 * dim], &run.modes)?;
     }
     Ok(run.finish(stepper))
-}
-
-/// The run's steps, each cut at the earliest event it shows, to its end (an
-/// observed run's; a plain run's loop is the same, in place).
-fn by_events<S: SystemStepper>(
-    run: &mut Run<'_>,
-    stepper: &mut S,
-    interrupt: &mut dyn FnMut() -> bool,
-) -> Result<()> {
-    while run.clock.time < run.options.t_end {
-        // Plain steps in a row, where the stepper takes them at once (each
-        // as the kernel's step would, to the bit); the step after them is
-        // the kernel's.
-        if run.stretches && run.clock.accepted > 0 && run.fast_steps(stepper, interrupt)? {
-            continue;
-        }
-        let stop = run.step(stepper)?;
-        match stop {
-            Stop::End => break,
-            Stop::Retry => continue,
-            Stop::Event { interaction } => run.at_event(stepper, interaction)?,
-            Stop::Step | Stop::RecordWindow | Stop::Strobe => {}
-        }
-        run.after_step(stop, interrupt)?;
-    }
-    Ok(())
 }
 
 #[cfg(test)]

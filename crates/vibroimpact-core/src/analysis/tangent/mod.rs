@@ -171,14 +171,6 @@ impl<'s> Tangent<'s> {
         &self.matrix
     }
 
-    /// Start again from the identity (the sums of logarithms are kept).
-    pub fn restart(&mut self) {
-        self.matrix.iter_mut().for_each(|v| *v = 0.0);
-        for i in 0..self.size {
-            self.matrix[i * self.size + i] = 1.0;
-        }
-    }
-
     /// The sums of the logarithms of each direction's stretches so far (an
     /// orthonormalised flow; empty for a product).
     pub fn logs(&self) -> &[f64] {
