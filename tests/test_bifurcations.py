@@ -132,7 +132,7 @@ def test_curve_command_on_its_example(run_cli: RunCli, tmp_path: Path) -> None:
 
 
 CURVE_BAD = [
-    (('kind = "flip"', 'kind = "grazing"'), ["[curve] kind", '"flip"', '"fold"']),
+    (('kind = "flip"', 'kind = "cusp"'), ["[curve] kind", '"flip"', '"grazing"']),
     (("step = 0.003", "step = 0.003\ncolour = 1"), ["[curve]", "colour"]),
     (('second = "stop.0.restitution"', 'second = "excitation.0.amplitude"'), ["second"]),
     (("step = 0.003", "step = 0.0"), ["[curve] step", "> 0"]),

@@ -321,9 +321,9 @@ ANALYSES = {
     "curve": {
         "kind": (
             None,
-            '"flip", "fold" or "neimark-sacker"',
+            '"flip", "fold", "neimark-sacker" or "grazing"',
             "the bifurcation followed (every pair rigid: the multipliers come from the "
-            "tangent flow)",
+            "tangent flow; a grazing: where the orbit touches a stop at zero speed)",
         ),
         "parameter": (
             None,

@@ -49,6 +49,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tangent::tangent_map, m)?)?;
     m.add_function(wrap_pyfunction!(tangent::lyapunov_spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(tangent::tangent_refusal, m)?)?;
+    m.add_function(wrap_pyfunction!(tangent::interactions, m)?)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
     // Internal (not in __all__): vibroimpact.analyses.forcing_period wraps it.

@@ -219,6 +219,27 @@ pub struct PreparedSystem {
     pub(crate) ready: std::sync::Mutex<Ready>,
 }
 
+impl PreparedSystem {
+    /// The run state, locked (a run at a time), with `state`, where given,
+    /// checked to be the system's `2 dim` values.
+    pub(crate) fn locked(
+        &self,
+        state: Option<&[f64]>,
+    ) -> PyResult<std::sync::MutexGuard<'_, Ready>> {
+        let ready = self.ready.lock().map_err(|_| {
+            InvalidInputError::new_err("a run of this system failed; make it again")
+        })?;
+        let size = 2 * ready.system.dim;
+        match state {
+            Some(state) if state.len() != size => Err(InvalidInputError::new_err(format!(
+                "state must have {size} values (x then v), got {}",
+                state.len()
+            ))),
+            _ => Ok(ready),
+        }
+    }
+}
+
 #[pymethods]
 impl PreparedSystem {
     /// Check `spec` (the sections, as `simulate_system` takes them) and make
@@ -275,18 +296,9 @@ impl PreparedSystem {
         #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
         #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let mut ready = self.ready.lock().map_err(|_| {
-            InvalidInputError::new_err("a run of this system failed; make it again")
-        })?;
+        let mut ready = self.locked(Some(&state))?;
         let system = &ready.system;
         let (n, d) = (system.n, system.dim);
-        if state.len() != 2 * d {
-            return Err(InvalidInputError::new_err(format!(
-                "state must have {} values (x then v), got {}",
-                2 * d,
-                state.len()
-            )));
-        }
         T_END.check(t_end).map_err(to_py)?;
         record_from
             .map(|v| RECORD_FROM.check(v))
@@ -339,16 +351,7 @@ impl PreparedSystem {
         let forcing_period = FORCING_PERIOD
             .check(forcing_period.unwrap_or(t_end))
             .map_err(to_py)?;
-        let mut ready = self.ready.lock().map_err(|_| {
-            InvalidInputError::new_err("a run of this system failed; make it again")
-        })?;
-        if state.len() != 2 * ready.system.dim {
-            return Err(InvalidInputError::new_err(format!(
-                "state must have {} values (x then v), got {}",
-                2 * ready.system.dim,
-                state.len()
-            )));
-        }
+        let mut ready = self.locked(Some(&state))?;
         let ready: &mut Ready = &mut ready;
         if tangent {
             core::analysis::tangent::check(&ready.system).map_err(to_py)?;

@@ -8,6 +8,7 @@ use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::analysis::tangent::{self, Grazing, Tangent};
 use vibroimpact_core::methods::registry::T_END;
+use vibroimpact_core::model::assembly::Scratch;
 
 use crate::errors::{released, to_py, InvalidInputError};
 use crate::system::{full_state, PreparedSystem, Ready};
@@ -18,17 +19,7 @@ fn ready_for<'a>(
     prepared: &'a PreparedSystem,
     state: &[f64],
 ) -> PyResult<std::sync::MutexGuard<'a, Ready>> {
-    let ready = prepared
-        .ready
-        .lock()
-        .map_err(|_| InvalidInputError::new_err("a run of this system failed; make it again"))?;
-    let size = 2 * ready.system.dim;
-    if state.len() != size {
-        return Err(InvalidInputError::new_err(format!(
-            "state must have {size} values (x then v), got {}",
-            state.len()
-        )));
-    }
+    let ready = prepared.locked(Some(state))?;
     tangent::check(&ready.system).map_err(to_py)?;
     Ok(ready)
 }
@@ -47,7 +38,7 @@ fn grazings<'py>(
 }
 
 /// The tangent map of a run of `t_end` s from the flat state `state` (x then
-/// v): `state` (the end's), `matrix` (the derivative of the end state by the
+/// v): `state` (the end's), `rate` (its derivative in time there), `matrix` (the derivative of the end state by the
 /// start state, row-major), `impacts` (events whose impulses acted) and
 /// `grazings` (list of `(time, pair, speed)`, where the flow has no
 /// derivative).
@@ -61,7 +52,7 @@ pub fn tangent_map<'py>(
     T_END.check(t_end).map_err(to_py)?;
     let mut guard = ready_for(prepared, &state)?;
     let ready: &mut Ready = &mut guard;
-    let (end, matrix, impacts, found) = released(py, |interrupt| {
+    let (end, rate, matrix, impacts, found) = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
         let options = ready.options(t_end, (false, 1), None, None);
         let Ready {
@@ -70,8 +61,16 @@ pub fn tangent_map<'py>(
         let mut flow = Tangent::product(system)?;
         let end = stepper.integrate_observed(system, &y0, &options, interrupt, &mut flow)?;
         let size = 2 * system.dim;
+        // The state's rate at the end, in the end's modes: a gap's second
+        // derivative there (a grazing's location, `vibroimpact.analysis.grazing`).
+        let full = full_state(system, &end.final_state[..size])?;
+        let mut rate = vec![0.0; full.len()];
+        let mut scratch = Scratch::new(system);
+        system.rates(end.final_time, &full, flow.modes(), &mut scratch, &mut rate);
+        rate.truncate(size);
         Ok((
             end.final_state[..size].to_vec(),
+            rate,
             flow.matrix().to_vec(),
             flow.impacts(),
             flow.grazings().to_vec(),
@@ -79,6 +78,7 @@ pub fn tangent_map<'py>(
     })?;
     let out = PyDict::new(py);
     out.set_item("state", end.into_pyarray(py))?;
+    out.set_item("rate", rate.into_pyarray(py))?;
     out.set_item("matrix", matrix.into_pyarray(py))?;
     out.set_item("impacts", impacts)?;
     out.set_item("grazings", grazings(py, &ready.system, &found)?)?;
@@ -139,9 +139,27 @@ pub fn lyapunov_spectrum<'py>(
 /// compliant pair), or None where it can.
 #[pyfunction]
 pub fn tangent_refusal(prepared: &PreparedSystem) -> PyResult<Option<String>> {
-    let ready = prepared
-        .ready
-        .lock()
-        .map_err(|_| InvalidInputError::new_err("a run of this system failed; make it again"))?;
+    let ready = prepared.locked(None)?;
     Ok(tangent::check(&ready.system).err().map(|e| e.to_string()))
+}
+
+/// Each interaction (a wall of a pair) of the prepared system: `pair` (its
+/// pair's name, as the contact table gives it), `h` (over all coordinates,
+/// dense) and `offset` (m), its gap being `offset + h . x`.
+#[pyfunction]
+pub fn interactions<'py>(
+    py: Python<'py>,
+    prepared: &PreparedSystem,
+) -> PyResult<Bound<'py, PyList>> {
+    let ready = prepared.locked(None)?;
+    let system = &ready.system;
+    let out = PyList::empty(py);
+    for it in system.interactions() {
+        let row = PyDict::new(py);
+        row.set_item("pair", system.pairs[it.pair].clone())?;
+        row.set_item("h", it.h.clone().into_pyarray(py))?;
+        row.set_item("offset", it.offset)?;
+        out.append(row)?;
+    }
+    Ok(out)
 }

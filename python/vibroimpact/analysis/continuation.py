@@ -12,6 +12,9 @@ direction along the branch reverses), a ``flip`` (a multiplier crosses -1), a
 ``neimark-sacker`` (a complex pair leaves the unit circle), a ``branch`` (a real
 multiplier crosses +1 without a fold) and ``grazing`` (the number of impacts per
 period changes: then alone, since the two orbits lie on different smooth branches).
+Where every pair is rigid, each is then located by Newton's method on an extended system
+(``vibroimpact.analysis.located``, and ``vibroimpact.analysis.grazing`` for grazings,
+where a branch may also end).
 SI units.
 """
 
@@ -30,6 +33,7 @@ import numpy as np
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.crossings import _CLASSES, _flags, _kind, _largest
+from vibroimpact.analysis.grazing import grazing_ahead, grazings_between
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.orbits import orbit
@@ -458,6 +462,21 @@ class _Arc:
                 hi, above, high = mid, value, multipliers
         return 0.5 * (below + above), (high if last > 0 else low), last_trial
 
+    def ended(self, points: list[BranchPoint], u: np.ndarray) -> str:
+        """Why the corrector failed beyond the last point: at a grazing (located, and
+        kept among the bifurcations), or not known."""
+        if self.tangent_flow and len(points) >= 2:
+            travel = points[-1].value - points[-2].value
+            touch = grazing_ahead(self, points[-1], u, 4 * abs(travel))
+            # Ahead only: one behind was passed (and located) already.
+            if touch is not None and (touch.value - points[-1].value) * travel >= 0:
+                self.bifurcations.append(touch.bifurcation())
+                return (
+                    f"grazing: the orbit touches {touch.pair} at {self.parameter} = "
+                    f"{touch.value:.12g} (beyond it, it strikes it)"
+                )
+        return "corrector failed (the branch may end, or turn too sharply)"
+
     def trace(
         self,
         state: np.ndarray,
@@ -489,7 +508,7 @@ class _Arc:
                     break
                 h *= 0.5
             if solved is None:
-                stopped = "corrector failed (the branch may end, or turn too sharply)"
+                stopped = self.ended(points, u)
                 break
             corrected = solved[0]
             jac = self.jacobian(*solved)
@@ -549,6 +568,16 @@ class _Arc:
                             refined[0].floquet_multipliers,
                         )
                     )
+            if "grazing" in flags and new_t[self.size] * (candidate.value - points[-1].value) < 0:
+                # Across a grazing the two branches' tangents differ in the state (one
+                # strikes the stop): the parameter goes on the way it went.
+                new_t = -new_t
+            if "grazing" in flags and self.tangent_flow:
+                reach = max(abs(candidate.value - points[-1].value), chord)
+                low = min(candidate.value, points[-1].value) - reach
+                for touch in grazings_between(self, ends, (u, corrected), (low, low + 3 * reach)):
+                    crossings["grazing"] = touch.value
+                    self.bifurcations.append(touch.bifurcation())
             candidate.flags, candidate.crossings = flags, crossings
             points.append(candidate)
             # An orbit grown well beyond the scale (towards a resonance) rescales the

@@ -1,10 +1,11 @@
-"""Two-parameter curves of bifurcations (flip, fold, Neimark-Sacker) of forced 0.2
-systems: the bifurcation first located along the orbit's branch in one parameter
+"""Two-parameter curves of bifurcations (flip, fold, Neimark-Sacker, grazing) of forced
+0.2 systems: the bifurcation first located along the orbit's branch in one parameter
 (:func:`~vibroimpact.analysis.continue_orbit`, then Newton on the extended system, see
 ``vibroimpact.analysis.located``), then followed as a second parameter steps, each
 point Newton's method on the extended system ``P_p(z) - z = 0, g(z, p) = 0`` from the
-last two points' extrapolation. The multipliers come from the tangent flow through the
-impacts: every pair must be rigid. SI units."""
+last two points' extrapolation (a grazing's: ``P_p(z) - z = 0`` with the stop's gap and
+its rate zero at the touch, see ``vibroimpact.analysis.grazing``). The multipliers come
+from the tangent flow through the impacts: every pair must be rigid. SI units."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact.analysis.continuation import _Arc, _value_of, continue_orbit
+from vibroimpact.analysis.grazing import locate_grazing, struck
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.parameters import with_parameter
@@ -83,7 +85,8 @@ def curve(
     progress: Callable[[int, int], None] | None = None,
 ) -> Curve:
     """The curve of bifurcations of ``kind`` (``"flip"``, ``"fold"``,
-    ``"neimark-sacker"``) of the ``periods``-period orbit: located first along the
+    ``"neimark-sacker"``, ``"grazing"``: where the orbit touches a stop at zero speed) of
+    the ``periods``-period orbit: located first along the
     branch in ``parameter`` from ``start`` to ``stop`` (the orbit found from the
     scenario's ``[initial]`` at ``start``), then followed in ``second`` from the
     scenario's value towards ``second_stop`` in steps of ``step`` (halved where Newton
@@ -133,6 +136,9 @@ def curve(
         CurvePoint({parameter: first.value, second: s0}, first.state, first.floquet_multipliers)
     ]
     history = [np.concatenate([first.state, [first.value]]) / scale]
+    if first.time is not None:
+        # A grazing's touch's instant too, in the orbit's periods.
+        history[0] = np.concatenate([history[0], [first.time / (periods * period)]])
     direction = 1.0 if second_stop > s0 else -1.0
     s, h = s0, step
     stopped = "max_points"
@@ -158,23 +164,38 @@ def curve(
             guess = history[-1] + ratio * (history[-1] - history[-2])
         else:
             guess = history[-1]
-        located = refine(arc, kind, guess)
+        located = _locate(arc, first, guess)
         if located is None:
             if h > step / 64:
                 h /= 2
                 continue
             stopped = f"Newton failed at {second} = {trial_s:g} (the curve may end or turn)"
             break
-        point, w = located
-        points.append(
-            CurvePoint(
-                {parameter: point.value, second: trial_s}, point.state, point.floquet_multipliers
-            )
-        )
+        value, state, multipliers, w = located
+        points.append(CurvePoint({parameter: value, second: trial_s}, state, multipliers))
         history.append(w)
         s = trial_s
         h = min(2 * h, step)
     return Curve(kind, parameter, second, periods, points, stopped, n, k, first)
+
+
+def _locate(
+    arc: _Arc, first: Bifurcation, guess: np.ndarray
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The bifurcation of ``first``'s kind (and stop, for a grazing) near the scaled
+    unknowns ``guess``: its parameter's value, state, multipliers and scaled unknowns;
+    None where Newton fails."""
+    if first.kind == "grazing":
+        assert first.pair is not None
+        touch = locate_grazing(arc, first.pair, guess)
+        if touch is None:
+            return None
+        return touch.value, touch.state, touch.floquet_multipliers, touch.unknowns
+    located = refine(arc, first.kind, guess)
+    if located is None:
+        return None
+    point, w = located
+    return point.value, point.state, point.floquet_multipliers, w
 
 
 def curve_of(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Curve:
@@ -206,7 +227,8 @@ def curve_regions(
 ) -> list[tuple[str, float, float]]:
     """The regions the curve bounds, read at its middle point: the orbit shot for a
     little either side of the curve in ``parameter`` (a sixth of the curve's range in
-    it, or a twentieth of its value), each side labelled by its stability. ``(label, second's
+    it, or a twentieth of its value), each side labelled by its stability (and, either
+    side of a grazing curve, by whether the orbit strikes the stop). ``(label, second's
     value, parameter's value)`` for each side where an orbit is found."""
     from vibroimpact.analysis.orbits import orbit
 
@@ -227,5 +249,9 @@ def curve_regions(
         if not shot.converged:
             continue
         label = f"{found.periods}-period orbit " + ("stable" if shot.stable else "unstable")
+        if found.first is not None and found.first.pair is not None:
+            # Either side of a grazing curve: whether the orbit strikes the stop.
+            hit = found.first.pair in struck(runner(moved, base_dir), shot.state, found.periods)
+            label += (", strikes " if hit else ", misses ") + found.first.pair
         regions.append((label, s, p + side * offset))
     return regions

@@ -27,16 +27,20 @@ PARAMETER_TOLERANCE = 1e-12
 @dataclass
 class Bifurcation:
     """A bifurcation located on a branch: its ``kind`` (``"fold"``, ``"flip"``,
-    ``"neimark-sacker"``, ``"branch"``), the parameter's ``value`` there, the orbit's
-    state at t = 0 and its Floquet multipliers (one of them on the unit circle)."""
+    ``"neimark-sacker"``, ``"branch"``, ``"grazing"``), the parameter's ``value`` there,
+    the orbit's state at t = 0 and its Floquet multipliers (one of them on the unit
+    circle, but at a grazing: there the orbit touches a stop at zero speed)."""
 
     kind: str
     value: float
     state: np.ndarray
     floquet_multipliers: np.ndarray
+    #: A grazing's stop (``"stop 0"``) and the instant of the touch after t = 0 (s).
+    pair: str | None = None
+    time: float | None = None
 
     def to_dict(self, n: int, k: int) -> dict[str, Any]:
-        return {
+        out = {
             "kind": self.kind,
             "value": self.value,
             "state": state_arrays(self.state, n, k),
@@ -44,6 +48,10 @@ class Bifurcation:
                 [float(m.real), float(m.imag)] for m in self.floquet_multipliers
             ],
         }
+        if self.pair is not None:
+            out["pair"] = self.pair
+            out["time"] = self.time
+        return out
 
 
 def test_value(kind: str, multipliers: np.ndarray) -> float:

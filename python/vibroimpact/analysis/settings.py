@@ -172,7 +172,7 @@ def basins_settings(table: Any) -> dict[str, Any]:
 
 
 #: The bifurcations a two-parameter curve follows.
-CURVE_KINDS = ("flip", "fold", "neimark-sacker")
+CURVE_KINDS = ("flip", "fold", "neimark-sacker", "grazing")
 _CURVE = {
     "kind": (_TEXT, _REQ),
     "parameter": (_TEXT, _REQ),

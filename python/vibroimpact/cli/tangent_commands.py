@@ -54,7 +54,8 @@ def add_tangent_parsers(sub: Any) -> None:
         "curve",
         help="a curve of bifurcations in two parameters, from a [curve] section",
         description=(
-            "Locate the [curve] kind of bifurcation (flip, fold or neimark-sacker) of the "
+            "Locate the [curve] kind of bifurcation (flip, fold, neimark-sacker or grazing: "
+            "where the orbit touches a stop at zero speed) of the "
             "K-period orbit (periods) along its branch in [curve] parameter, from start to "
             "stop (the orbit found from [initial] at start), by Newton's method on the "
             "extended system with the Floquet multipliers of the tangent flow through the "

@@ -185,6 +185,11 @@ impl<'s> Tangent<'s> {
         &self.grazings
     }
 
+    /// The modes of the stretch the flow is in (at a run's end, its last).
+    pub fn modes(&self) -> &[Mode] {
+        &self.modes
+    }
+
     /// Events whose impulses acted.
     pub fn impacts(&self) -> u64 {
         self.impacts

@@ -2,11 +2,16 @@
 //! of one wall: when it lands, whether its mirror holds it, its scale, its
 //! release from sticking.
 
-use super::{Assembly, Mode};
+use super::{Assembly, Interaction, Mode};
 use crate::kernel::sized::by_size;
 use crate::numerics::linalg;
 
 impl Assembly {
+    /// The interactions (each wall of each pair), in the order of the modes.
+    pub fn interactions(&self) -> &[Interaction] {
+        &self.interactions
+    }
+
     /// The gap of interaction `i` and its rate at state `y`.
     #[inline(always)]
     pub fn gap(&self, i: usize, y: &[f64]) -> (f64, f64) {
