@@ -99,6 +99,19 @@ def frf_data() -> dict[str, Any]:
     return tomllib.loads(FRF.read_text(encoding="utf-8"))
 
 
+@pytest.mark.timeout(60)
+def test_a_damper_at_rest_leaves_the_structures_derivative_defined() -> None:
+    # 7 Hz: the damper never reaches its walls and stays where it started (multipliers
+    # 1: I - M singular in its state alone). The structure is the linear oscillator.
+    (point,) = sweep(frf_data(), "excitation.0.frequency", [7.0], derivatives=[AMPLITUDE])
+    assert point.settled and point.impacts_per_period == 0 and point.derivatives is not None
+    w = 2 * math.pi * 7.0
+    expected = 1 / abs(STIFFNESS - MASS * w * w + 1j * DAMPING * w)
+    assert point.derivatives[AMPLITUDE].amplitude[0] == pytest.approx(expected, rel=1e-8)
+    # The damper's own state does not move with the force.
+    assert np.all(point.derivatives[AMPLITUDE].state[[1, 3]] == 0.0)
+
+
 def orbit_amplitude(data: dict[str, Any], path: str, value: float, state: np.ndarray) -> float:
     found = orbit(runner(with_parameter(data, path, value)), state, tolerance=1e-12)
     assert found.converged and found.impacts_per_period > 0

@@ -51,7 +51,7 @@ def _figure(
     if mosaic is None:
         fig, axes = plt.subplots(rows, cols, figsize=size)
     else:
-        fig, axes = plt.subplot_mosaic(mosaic, figsize=size)
+        fig, axes = plt.subplot_mosaic(mosaic, figsize=size)  # type: ignore[arg-type]  # stub: HashableList
     try:
         yield fig, axes
         fig.tight_layout()
