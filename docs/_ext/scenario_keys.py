@@ -292,6 +292,13 @@ ANALYSES = {
         "settle_periods": _SETTLE,
         "record_periods": _RECORD,
         "tolerance": _SETTLED,
+        "derivatives": (
+            None,
+            "an array of dotted paths to numbers of the scenario",
+            "sweep only: at each point, the derivatives of the orbit through its settled "
+            "state in each (its amplitude's, m per unit of the parameter), as --derivative "
+            "(default none)",
+        ),
         "sample": (
             None,
             '"displacement", "impact-velocity" or "impact-phase"',

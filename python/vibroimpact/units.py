@@ -107,6 +107,16 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
     return None
 
 
+def derivative_units(unit: str, parameter: str, data: Mapping[str, Any] | None = None) -> str:
+    """The unit of a derivative of a quantity in ``unit`` by the scenario parameter
+    ``parameter`` (see :func:`parameter_units`), in words: ``"m per N"``, ``"m"`` for a
+    dimensionless parameter, ``"m per unit of PATH"`` where its unit cannot be told."""
+    per = parameter_units(parameter, data)
+    if per == _ONE:
+        return unit
+    return f"{unit} per {per}" if per else f"{unit} per unit of {parameter}"
+
+
 def _entry(data: Mapping[str, Any], parts: list[str]) -> Mapping[str, Any] | None:
     """The table of a dotted path's section (the list entry, for ``[[damper]]`` etc.)."""
     node: Any = data.get(parts[0])

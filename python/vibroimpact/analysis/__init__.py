@@ -50,7 +50,12 @@ from vibroimpact.analysis.parameters import (
     with_parameter_path_check,
 )
 from vibroimpact.analysis.runs import Runner, as_runner, check_kept, checked_run, runner
-from vibroimpact.analysis.sensitivities import Derivative, orbit_derivatives
+from vibroimpact.analysis.sensitivities import (
+    Derivative,
+    derivative_paths,
+    orbit_derivatives,
+    settled_derivatives,
+)
 from vibroimpact.analysis.settings import (
     BIFURCATION_SAMPLES,
     SETTINGS,
@@ -70,6 +75,7 @@ from vibroimpact.analysis.sweeps import (
     from_carried,
     reductions,
     shown_amplitudes,
+    shown_derivative,
     shown_label,
     shown_values,
     sweep,
@@ -119,6 +125,9 @@ __all__ = [
     "lyapunov_runner",
     "orbit",
     "orbit_derivatives",
+    "derivative_paths",
+    "settled_derivatives",
+    "shown_derivative",
     "poincare",
     "reductions",
     "runner",

@@ -21,22 +21,37 @@ from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import Runner
 from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
 from vibroimpact.analysis.steady import linear_response
-from vibroimpact.analysis.sweeps import SweepPoint, shown_amplitudes, shown_label, shown_values
+from vibroimpact.analysis.sweeps import (
+    SweepPoint,
+    shown_amplitudes,
+    shown_derivative,
+    shown_label,
+    shown_values,
+)
 from vibroimpact.output import written_whole
 from vibroimpact.system import SystemSolution, split_observed
-from vibroimpact.units import parameter_units
+from vibroimpact.units import derivative_units, parameter_units
 
 
 @contextmanager
 def _figure(
-    path: Path, rows: int = 1, cols: int = 1, size: tuple[float, float] = (7, 4.5)
+    path: Path,
+    rows: int = 1,
+    cols: int = 1,
+    size: tuple[float, float] = (7, 4.5),
+    mosaic: list[list[str]] | None = None,
 ) -> Iterator[Any]:
+    """A figure of ``rows`` x ``cols`` axes (or of the named axes of ``mosaic``, a
+    dict), written to ``path`` whole when the block ends."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(rows, cols, figsize=size)
+    if mosaic is None:
+        fig, axes = plt.subplots(rows, cols, figsize=size)
+    else:
+        fig, axes = plt.subplot_mosaic(mosaic, figsize=size)  # type: ignore[arg-type]  # stub: HashableList
     try:
         yield fig, axes
         fig.tight_layout()
@@ -107,7 +122,14 @@ def _linear_curve(
     return grid, np.array(linear)
 
 
-def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any = None) -> None:
+def plot_sweep(
+    path: Path,
+    parameter: str,
+    points: list[SweepPoint],
+    data: Any = None,
+    *,
+    derivatives: list[str] | tuple[str, ...] = (),
+) -> None:
     """Amplitude of structure coordinate 0 (of the structure at the first of
     ``[output] points``, or else of the first bending moment of ``[output] moments``,
     where there are: see :func:`shown_amplitudes`) against the parameter, each
@@ -115,63 +137,113 @@ def plot_sweep(path: Path, parameter: str, points: list[SweepPoint], data: Any =
     settle (no period of at most 8 forcing periods: chaos, or a slow transient) are
     marked, with the spread of their periods' peaks (smallest to largest); points
     whose run failed are marked on the parameter axis. The legend sits beside the
-    axes, off the curves."""
+    axes, off the curves. With ``derivatives`` (paths the sweep's points hold, see
+    :attr:`SweepPoint.derivatives`), beside it one axes per path: the amplitude's
+    derivative in it, against the same parameter axis."""
+    if not derivatives:
+        with _figure(path, size=(8, 5.5)) as (fig, ax):
+            _frequency_response(ax, parameter, points, data)
+        return
+    mosaic = [["response", f"d {p}"] for p in derivatives]
+    size = (14.0, max(5.5, 3.0 * len(derivatives)))
+    with _figure(path, size=size, mosaic=mosaic) as (fig, axes):
+        _frequency_response(axes["response"], parameter, points, data)
+        _sensitivities(axes, parameter, points, data, derivatives)
+
+
+def _sensitivities(
+    axes: dict[str, Any],
+    parameter: str,
+    points: list[SweepPoint],
+    data: Any,
+    derivatives: list[str] | tuple[str, ...],
+) -> None:
+    """The shown amplitude's derivative in each path of ``derivatives`` against the
+    parameter, each direction, on ``axes["d PATH"]`` (sharing the response's axis)."""
     shown, unit = shown_amplitudes(points[0])
-
-    def amplitude(p: SweepPoint) -> float:
-        return float(shown_values(p, shown)[0][0])
-
-    with _figure(path, size=(8, 5.5)) as (fig, ax):
-        grid, linear = _linear_curve(parameter, points, data, shown)
-        ax.plot(grid, linear, "k--", lw=1, label="without dampers and stops (linear)")
+    for index, d_path in enumerate(derivatives):
+        ax = axes[f"d {d_path}"]
+        ax.sharex(axes["response"])
         for direction, marker in (("up", "^"), ("down", "v")):
             chosen = [p for p in points if p.direction == direction]
             if chosen:
                 ax.plot(
                     [p.value for p in chosen],
-                    [amplitude(p) for p in chosen],
+                    [shown_derivative(p, shown, d_path) for p in chosen],
                     marker=marker,
                     ms=3,
                     lw=1,
-                    label=f"with them, sweep {direction}",
+                    label=f"sweep {direction}",
                 )
-        unsettled = [p for p in points if not p.settled and not p.error]
-        if unsettled:
-            least = [_least_shown(p, shown) for p in unsettled]
-            ax.vlines(
-                [p.value for p in unsettled],
-                least,
-                [amplitude(p) for p in unsettled],
-                colors="tab:red",
-                lw=2.5,
-                alpha=0.6,
-                label="not settled: spread of the periods' peaks",
-            )
-            ax.plot(
-                [p.value for p in unsettled],
-                [amplitude(p) for p in unsettled],
-                "o",
-                ms=6,
-                mfc="none",
-                mec="tab:red",
-                label="not settled (no period of at most 8 forcing periods)",
-            )
-        failed = [p.value for p in points if p.error]
-        if failed:
-            ax.plot(
-                failed,
-                [0.0] * len(failed),
-                "kx",
-                ms=7,
-                transform=ax.get_xaxis_transform(),
-                clip_on=False,
-                label="run failed (see the table or --json)",
-            )
-        ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
-        ax.set_ylabel(f"{shown_label(points[0], shown)} ({unit})")
-        # Below the axes: inside, it had covered the peak.
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8)
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_ylabel(
+            f"d amplitude / d {d_path}\n({derivative_units(unit, d_path, data)})", fontsize=8
+        )
         ax.grid(alpha=0.3)
+        if index == 0:
+            ax.set_title("the orbit's sensitivity (none where no orbit is found)", fontsize=9)
+            ax.legend(fontsize=8)
+        if index == len(derivatives) - 1:
+            ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
+
+
+def _frequency_response(ax: Any, parameter: str, points: list[SweepPoint], data: Any) -> None:
+    """The frequency response panel of :func:`plot_sweep` on ``ax``."""
+    shown, unit = shown_amplitudes(points[0])
+
+    def amplitude(p: SweepPoint) -> float:
+        return float(shown_values(p, shown)[0][0])
+
+    grid, linear = _linear_curve(parameter, points, data, shown)
+    ax.plot(grid, linear, "k--", lw=1, label="without dampers and stops (linear)")
+    for direction, marker in (("up", "^"), ("down", "v")):
+        chosen = [p for p in points if p.direction == direction]
+        if chosen:
+            ax.plot(
+                [p.value for p in chosen],
+                [amplitude(p) for p in chosen],
+                marker=marker,
+                ms=3,
+                lw=1,
+                label=f"with them, sweep {direction}",
+            )
+    unsettled = [p for p in points if not p.settled and not p.error]
+    if unsettled:
+        least = [_least_shown(p, shown) for p in unsettled]
+        ax.vlines(
+            [p.value for p in unsettled],
+            least,
+            [amplitude(p) for p in unsettled],
+            colors="tab:red",
+            lw=2.5,
+            alpha=0.6,
+            label="not settled: spread of the periods' peaks",
+        )
+        ax.plot(
+            [p.value for p in unsettled],
+            [amplitude(p) for p in unsettled],
+            "o",
+            ms=6,
+            mfc="none",
+            mec="tab:red",
+            label="not settled (no period of at most 8 forcing periods)",
+        )
+    failed = [p.value for p in points if p.error]
+    if failed:
+        ax.plot(
+            failed,
+            [0.0] * len(failed),
+            "kx",
+            ms=7,
+            transform=ax.get_xaxis_transform(),
+            clip_on=False,
+            label="run failed (see the table or --json)",
+        )
+    ax.set_xlabel(f"{parameter}{_unit(parameter, data)}")
+    ax.set_ylabel(f"{shown_label(points[0], shown)} ({unit})")
+    # Below the axes: inside, it had covered the peak.
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8)
+    ax.grid(alpha=0.3)
 
 
 def _least_shown(point: SweepPoint, shown: str) -> float:

@@ -5,44 +5,82 @@ impacts where every pair is rigid, else central differences) and ``dP/dp`` the m
 derivative in the parameter (a central difference of two runs of the map from the
 orbit's own state). The amplitudes' derivatives: central differences of the orbits'
 located peaks at ``p +- h``, each run from the state the theorem predicts there (so no
-Newton solve). SI units: per unit of the parameter."""
+Newton solve). SI units: per unit of the parameter. A sweep's points take theirs from the
+orbit through each point's settled state (:func:`settled_derivatives`)."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from vibroimpact import arguments
+from vibroimpact._core import SimulationError
 from vibroimpact.analysis.continuation import _value_of
 from vibroimpact.analysis.limits import AnalysisError
-from vibroimpact.analysis.orbits import Orbit
+from vibroimpact.analysis.orbits import Orbit, orbit
 from vibroimpact.analysis.parameters import with_parameter, with_parameter_path_check
-from vibroimpact.analysis.runs import runner
+from vibroimpact.analysis.runs import Runner, runner
+from vibroimpact.analysis.steady import SteadyState
 from vibroimpact.model.system import System, sections_of
 
 #: The parameter's step in the differences, relative to its value (absolute where the
 #: value is 0): a map's central difference errs by ``h^2`` and by round-off over ``h``.
 RELATIVE_STEP = 1e-6
 
+#: ``I - M`` counts as singular below this smallest singular value, relative to its
+#: largest: a free damper's multipliers are 1 to round-off.
+SINGULAR = 1e-9
+
+
+class UndefinedDerivativeError(AnalysisError):
+    """An orbit with no derivatives: not converged, or ``I - M`` singular in the
+    structure's state (a fold)."""
+
 
 @dataclass
 class Derivative:
     """The derivatives of an orbit in one parameter: of its state at t = 0 (flat,
-    displacements then velocities) and of its amplitude per structure coordinate (the
-    largest ``|displacement|`` over the orbit), per unit of the parameter."""
+    displacements then velocities), of its amplitude per structure coordinate (the
+    largest ``|displacement|`` over the orbit, m), and of the structure's at each of
+    ``[output] points`` (m) and the bending moment's at each of ``[output] moments``
+    (N m), per unit of the parameter."""
 
     state: np.ndarray
     amplitude: np.ndarray
+    point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def to_dict(self) -> dict[str, list[float]]:
+        followed = {
+            key: [float(v) for v in values]
+            for key, values in (
+                ("point_amplitude", self.point_amplitude),
+                ("moment_amplitude", self.moment_amplitude),
+            )
+            if len(values)
+        }
         return {
             "state": [float(v) for v in self.state],
             "amplitude": [float(v) for v in self.amplitude],
+            **followed,
         }
+
+
+def derivative_paths(data: Mapping[str, Any], paths: Sequence[str] | str) -> list[str]:
+    """``paths`` checked as parameters of the scenario ``data`` that derivatives can be
+    taken in: dotted paths into its sections, each set to a number."""
+    if isinstance(paths, str):
+        paths = [paths]
+    arguments.instance("derivatives", paths, Sequence, "a list of dotted paths")
+    for path in paths:
+        arguments.text("derivative", path)
+        with_parameter_path_check(path, "")
+        _value_of(data, path, "derivative", "the derivative is taken at its value")
+    return list(paths)
 
 
 def orbit_derivatives(
@@ -60,23 +98,73 @@ def orbit_derivatives(
     data, base_dir = sections_of(data, base_dir)
     arguments.instance("found", found, Orbit, "vibroimpact.analysis.orbit(...)")
     if not found.converged:
-        raise AnalysisError("found: the orbit did not converge; its derivatives are not defined")
-    if isinstance(paths, str):
-        paths = [paths]
+        raise UndefinedDerivativeError(
+            "found: the orbit did not converge; its derivatives are not defined"
+        )
+    paths = derivative_paths(data, paths)
     out: dict[str, Derivative] = {}
     size = len(found.state)
-    inverse = np.linalg.inv(np.eye(size) - found.monodromy)
+    structure: list[int] = []
     for path in paths:
-        arguments.text("derivative", path)
-        with_parameter_path_check(path, "")
-        value = _value_of(data, path, "derivative", "the derivative is taken at its value")
+        value = _value_of(data, path)
         h = RELATIVE_STEP * (abs(value) if value else 1.0)
         runs = [runner(with_parameter(data, path, value + s * h), base_dir) for s in (1.0, -1.0)]
         up, down = (run.map(found.state, periods) for run in runs)
-        state = inverse @ ((up - down) / (2 * h))
+        n, d = runs[0].n, runs[0].n + runs[0].k
+        structure = [*range(n), *range(d, d + n)]
+        state = _orbit_shift(np.eye(size) - found.monodromy, (up - down) / (2 * h), structure)
         amplitudes = []
         for sign, run in zip((1.0, -1.0), runs, strict=True):
             recorded = run.periods(found.state + sign * h * state, periods, record=True)
-            amplitudes.append(run.amplitudes(recorded)[0])
-        out[path] = Derivative(state, (amplitudes[0] - amplitudes[1]) / (2 * h))
+            amplitudes.append(run.amplitudes(recorded))
+        out[path] = Derivative(
+            state, *((up - down) / (2 * h) for up, down in zip(*amplitudes, strict=True))
+        )
     return out
+
+
+def _orbit_shift(matrix: np.ndarray, rhs: np.ndarray, structure: list[int]) -> np.ndarray:
+    """The solution of ``matrix @ x = rhs`` (``I - M`` and ``dP/dp``). Where ``matrix`` is
+    singular only in the dampers' state (a damper at rest between its walls, free to sit
+    anywhere: multipliers 1), the orbits form a family that moves the structure alike:
+    the least-norm solution, if the equations hold. Anything else singular (a fold, whose
+    orbit does not go on smoothly) has no derivative."""
+    u, sigma, vt = np.linalg.svd(matrix)
+    kept = sigma > SINGULAR * sigma[0]
+    shift: np.ndarray = vt[kept].T @ ((u[:, kept].T @ rhs) / sigma[kept])
+    if kept.all():
+        return shift
+    free = vt[~kept]
+    residual = np.linalg.norm(matrix @ shift - rhs)
+    if np.max(np.abs(free[:, structure]), initial=0.0) > 1e-6 or residual > 1e-6 * max(
+        float(np.linalg.norm(rhs)), 1e-300
+    ):
+        raise UndefinedDerivativeError(
+            "found: I - M is singular (a Floquet multiplier of 1 that moves the structure: "
+            "a fold); the derivatives are not defined there"
+        )
+    return shift
+
+
+def settled_derivatives(
+    data: Mapping[str, Any],
+    run: Runner,
+    steady: SteadyState,
+    paths: Sequence[str],
+    base_dir: Path | None = None,
+) -> dict[str, Derivative] | None:
+    """The derivatives (see :func:`orbit_derivatives`) of the orbit through a steady
+    response's last state, of its stroboscopic period (1 where none was found), or None
+    where there is no such orbit to differentiate: the shooting did not converge, it
+    failed, or (for a response that did not settle) the orbit it found is unstable, not
+    the motion the response tends to. ``data``: the scenario's sections that ``run``
+    runs."""
+    periods = steady.period or 1
+    try:
+        found = orbit(run, steady.state, periods=periods)
+        if not found.converged or not (steady.settled or found.stable):
+            return None
+        return orbit_derivatives(data, found, paths, periods=periods, base_dir=base_dir)
+    except (SimulationError, ArithmeticError, UndefinedDerivativeError):
+        # A run that blew up or cannot go on near the orbit, or I - M singular (a fold).
+        return None

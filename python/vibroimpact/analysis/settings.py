@@ -16,6 +16,7 @@ from vibroimpact.analysis.limits import (
 )
 from vibroimpact.analysis.parameters import with_parameter_path_check
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
+from vibroimpact.system.schema import _TEXTS
 
 _DIRECTIONS = ("up", "down", "both")
 _SPACINGS = ("linear", "log")
@@ -29,6 +30,8 @@ _SWEEP = {
     "settle_periods": (_WHOLE, 200),
     "record_periods": (_WHOLE, 50),
     "tolerance": (_NUMBER, 1e-6),
+    # Read by sweep only: the parameters each point's orbit is differentiated in.
+    "derivatives": (_TEXTS, ()),
     # Read by bifurcation only: what it samples, and at which pair's impacts.
     "sample": (_TEXT, "displacement"),
     "pair": (_TEXT, None),
@@ -45,7 +48,8 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     dotted path such as ``"excitation.0.frequency"``), ``start``, ``stop``, ``count``
     (>= 1), ``spacing`` (``"linear"`` or ``"log"``), ``direction`` (``"up"``,
     ``"down"``, ``"both"``), ``settle_periods`` (>= 0), ``record_periods`` (>= 1),
-    the stroboscopic ``tolerance`` of settling, and for bifurcation ``sample`` (see
+    the stroboscopic ``tolerance`` of settling, for sweep ``derivatives`` (dotted paths:
+    each point's orbit is differentiated in them), and for bifurcation ``sample`` (see
     :data:`BIFURCATION_SAMPLES`) and ``pair`` (whose impacts it samples)."""
     out = _table("[sweep] ", table, _SWEEP)
     _choice("[sweep] ", "direction", out["direction"], _DIRECTIONS)
@@ -67,6 +71,11 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     if not math.isfinite(out["start"]) or not math.isfinite(out["stop"]):
         raise AnalysisError("[sweep] start, stop: must be finite")
     with_parameter_path_check(out["parameter"])
+    for path in out["derivatives"]:
+        try:
+            with_parameter_path_check(path, "")
+        except AnalysisError as err:
+            raise AnalysisError(f"[sweep] derivatives: {err}") from None
     return out
 
 

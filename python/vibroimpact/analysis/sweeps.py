@@ -18,6 +18,7 @@ from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.limits import AnalysisError
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner
+from vibroimpact.analysis.sensitivities import Derivative, derivative_paths, settled_derivatives
 from vibroimpact.analysis.settings import _DIRECTIONS
 from vibroimpact.analysis.steady import SteadyState, linear_response, steady_state
 from vibroimpact.messages import shown
@@ -65,6 +66,10 @@ class SweepPoint:
     #: Where the response did not settle, the smallest of the periods' peaks (see
     #: :attr:`SteadyState.least_period_peak`).
     least_period_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: With ``sweep(..., derivatives=paths)``: the derivatives of the orbit through the
+    #: point's settled state in each path (see :func:`settled_derivatives`), or None
+    #: where there is no orbit to differentiate; empty where none were asked for.
+    derivatives: dict[str, Derivative] | None = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         def floats(a: np.ndarray) -> list[float | None]:
@@ -92,6 +97,15 @@ class SweepPoint:
             "reduction": _reductions(self.amplitude, self.linear_amplitude),
             **followed,
             **({"error": self.error} if self.error else {}),
+            **(
+                {}
+                if self.derivatives == {}
+                else {
+                    "derivatives": None
+                    if self.derivatives is None
+                    else {path: d.to_dict() for path, d in self.derivatives.items()}
+                }
+            ),
         }
 
 
@@ -114,6 +128,16 @@ def shown_values(point: SweepPoint, shown: str) -> tuple[np.ndarray, np.ndarray,
     if shown == "moment":
         return point.moment_amplitude, point.linear_moment_amplitude, point.moment_rms
     return point.amplitude, point.linear_amplitude, point.rms
+
+
+def shown_derivative(point: SweepPoint, shown: str, path: str) -> float:
+    """The derivative in ``path`` (per unit of it) of the first amplitude of kind
+    ``shown`` (see :func:`shown_amplitudes`): NaN where the point has none."""
+    if not point.derivatives or path not in point.derivatives:
+        return math.nan
+    d = point.derivatives[path]
+    values = {"point": d.point_amplitude, "moment": d.moment_amplitude}.get(shown, d.amplitude)
+    return float(values[0]) if len(values) else math.nan
 
 
 def shown_label(point: SweepPoint, shown: str) -> str:
@@ -176,6 +200,7 @@ def sweep(
     tolerance: float = 1e-6,
     base_dir: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
+    derivatives: Sequence[str] = (),
 ) -> list[SweepPoint]:
     """A stepped sweep of ``parameter`` (a dotted path into the scenario's sections)
     over ``values`` (sorted: ``"up"`` is towards larger values whatever their order as
@@ -184,9 +209,13 @@ def sweep(
     that jumps and hysteresis show (from ``[initial]`` where that state is not
     admissible: see :func:`from_carried`). A point whose run fails is reported with
     its error (and the next starts from the last good state). ``data``: a
-    :class:`~vibroimpact.System` or a scenario's sections."""
+    :class:`~vibroimpact.System` or a scenario's sections. ``derivatives``: dotted
+    paths such as ``"damper.0.clearance"``; at each point, the derivatives of the
+    orbit through its settled state in each (:attr:`SweepPoint.derivatives`, per unit
+    of the parameter; see :func:`settled_derivatives`)."""
     data, base_dir = sections_of(data, base_dir)
     arguments.text("parameter", parameter)
+    paths = derivative_paths(data, derivatives)
     values = sorted(arguments.numbers("values", values).tolist())
     _choice("", "direction", direction, _DIRECTIONS)
     base_dir = arguments.directory("base_dir", base_dir)
@@ -255,6 +284,11 @@ def sweep(
             else:
                 error = None
                 state = result.state
+            derived: dict[str, Derivative] | None = {}
+            if paths:
+                derived = (
+                    None if error else settled_derivatives(changed, run, result, paths, base_dir)
+                )
             points.append(
                 SweepPoint(
                     value=value,
@@ -274,6 +308,7 @@ def sweep(
                     moment_rms=result.moment_rms,
                     linear_moment_amplitude=linear_moments,
                     least_period_peak=result.least_period_peak,
+                    derivatives=derived,
                 )
             )
             if progress is not None:

@@ -29,6 +29,7 @@ from vibroimpact.analysis import (
     poincare,
     runner,
     shown_amplitudes,
+    shown_derivative,
     shown_label,
     shown_values,
     state_index,
@@ -39,6 +40,7 @@ from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
+from vibroimpact.units import derivative_units
 
 
 def _system(path: Path) -> SystemScenario:
@@ -154,6 +156,7 @@ def run_sweep(args: argparse.Namespace) -> int:
             f"{args.scenario}: sweep needs a [sweep] section (parameter, start, stop, count)"
         )
     values = sweep_values(settings)
+    derivatives = args.derivative or settings["derivatives"]
     start = time.perf_counter()
     show = sys.stderr.isatty() and not args.json
 
@@ -172,13 +175,16 @@ def run_sweep(args: argparse.Namespace) -> int:
             tolerance=settings["tolerance"],
             base_dir=scenario.base_dir,
             progress=progress,
+            derivatives=derivatives,
         )
     finally:
         if show:
             print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     if args.plot:
-        plots.plot_sweep(args.plot, settings["parameter"], points, scenario.data)
+        plots.plot_sweep(
+            args.plot, settings["parameter"], points, scenario.data, derivatives=derivatives
+        )
     if args.json:
         print(
             json_text(
@@ -208,10 +214,14 @@ def run_sweep(args: argparse.Namespace) -> int:
         f"rms{name}",
         "impacts/period",
         "settled",
+        *(f"d amplitude{name} / d {path}" for path in derivatives),
     ]
     if shown != "coordinate":
         print(f"({shown_label(points[0], shown)}, {unit})")
-    print("  ".join(f"{h:>14}" for h in head))
+    for path in derivatives:
+        print(f"(d amplitude{name} / d {path}: {derivative_units(unit, path, scenario.data)})")
+    widths = [max(14, len(h)) for h in head]
+    print("  ".join(f"{h:>{w}}" for h, w in zip(head, widths, strict=True)))
     for p in points:
         amplitude, linear, rms = shown_values(p, shown)
         cells = [
@@ -222,6 +232,10 @@ def run_sweep(args: argparse.Namespace) -> int:
             f"{rms[0]:>14.6g}",
             f"{p.impacts_per_period:>14.4g}",
             f"{str(p.settled):>14}",
+            *(
+                f"{shown_derivative(p, shown, path):>{w}.6g}"
+                for path, w in zip(derivatives, widths[len(head) - len(derivatives) :], strict=True)
+            ),
         ]
         print("  ".join(cells) + (f"  error: {p.error}" if p.error else ""))
     if args.plot:

@@ -71,12 +71,24 @@ def add_commands(sub: Any) -> None:
         ),
     )
     sweep_parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [sweep]")
+    sweep_parser.add_argument(
+        "--derivative",
+        action="append",
+        metavar="PATH",
+        default=[],
+        help="also, at each point, the derivatives of the orbit through its settled state "
+        'in this parameter (a dotted path such as "damper.0.clearance"; repeatable; '
+        "default [sweep] derivatives), as orbit --derivative: its state at t = 0 and its "
+        "amplitudes, per unit of the parameter (m per its unit); null where the orbit "
+        "is not found",
+    )
     sweep_parser.add_argument("--json", action="store_true", help="print one JSON object")
     sweep_parser.add_argument(
         "--plot",
         type=Path,
         metavar="FILE.png",
-        help="plot the response against the parameter, with and without the dampers",
+        help="plot the response against the parameter, with and without the dampers "
+        "(with derivatives, d amplitude / d PATH beside it)",
     )
 
     bif = sub.add_parser(

@@ -67,6 +67,7 @@ from vibroimpact.system.record_file import check_record, read_record
 
 _NUMBER, _TEXT, _WHOLE, _NUMBERS, _MATRIX = "number", "string", "whole number", "array", "matrix"
 _REQ = object()
+_TEXTS = "array of strings"
 
 # The keys of each section: (type, default; _REQ where required, None where optional).
 _STRUCTURE: dict[str, dict[str, tuple[str, Any]]] = {
@@ -341,6 +342,10 @@ def _value(where: str, kind: str, value: Any) -> Any:
                 raise _fail(f"{where[:-2]}[{i}]: ", f"must be a finite number, got {value[i]}")
             return list(value.tolist())
         return [_value(f"{where[:-2]}[{i}]: ", _NUMBER, v) for i, v in enumerate(value)]
+    if kind == _TEXTS:
+        if isinstance(value, str | bytes) or not _is_array(value, 1):
+            raise _fail(where, f"must be an array of strings, got {shown(value)}")
+        return [_value(f"{where[:-2]}[{i}]: ", _TEXT, v) for i, v in enumerate(value)]
     # _MATRIX: an array of rows.
     if isinstance(value, str | bytes) or not _is_array(value, 2):
         raise _fail(where, f"must be an array of rows (n x n), got {shown(value)}")
