@@ -47,6 +47,7 @@ __all__ = [
     "tangent_map",
     "lyapunov_spectrum",
     "tangent_refusal",
+    "interactions",
 ]
 
 #: The package's version, as in pyproject.toml.

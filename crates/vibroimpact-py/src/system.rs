@@ -172,11 +172,14 @@ impl Ready {
 
     /// The stroboscopic map over `t_end` from the flat state `z` with its
     /// Jacobian from the tangent flow (row-major).
+    /// Its grazings into `grazed` (the last map's: the orbit's, once Newton's
+    /// method has converged, as `shoot` returns it).
     fn map_tangent(
         &mut self,
         z: &[f64],
         t_end: f64,
         interrupt: &mut dyn FnMut() -> bool,
+        grazed: &mut Vec<core::analysis::tangent::Grazing>,
     ) -> core::Result<(Vec<f64>, Vec<f64>)> {
         let y0 = self.full_state(z)?;
         let options = self.options(t_end, (false, 1), None, None);
@@ -186,6 +189,8 @@ impl Ready {
         let mut flow = core::analysis::tangent::Tangent::product(system)?;
         let end = stepper.integrate_observed(system, &y0, &options, interrupt, &mut flow)?;
         let size = 2 * system.dim;
+        grazed.clear();
+        grazed.extend_from_slice(flow.grazings());
         Ok((end.final_state[..size].to_vec(), flow.matrix().to_vec()))
     }
 
@@ -322,7 +327,8 @@ impl PreparedSystem {
     /// method with a central-difference Jacobian, all in the core with the GIL
     /// released. `forcing_period` (s, default `t_end`) sets the scale of the
     /// motion (see `core::analysis::shooting::shoot`). Returns `state`, `monodromy`
-    /// (flat, row-major), `converged`, `iterations`, `residual`.
+    /// (flat, row-major), `converged`, `iterations`, `residual`, `maps`, and by
+    /// the tangent flow `grazings` (the last map's: the orbit's when converged).
     #[pyo3(signature = (state, t_end, *, tolerance, max_iterations, forcing_period = None, jacobian = "differences"))]
     #[allow(clippy::too_many_arguments)]
     fn shoot<'py>(
@@ -356,10 +362,11 @@ impl PreparedSystem {
         if tangent {
             core::analysis::tangent::check(&ready.system).map_err(to_py)?;
         }
+        let mut grazed = Vec::new();
         let shot = released(py, |interrupt| {
             if tangent {
                 core::analysis::shooting::shoot_by_tangent(
-                    &mut |z| ready.map_tangent(z, t_end, interrupt),
+                    &mut |z| ready.map_tangent(z, t_end, interrupt, &mut grazed),
                     &state,
                     forcing_period,
                     tolerance,
@@ -382,6 +389,12 @@ impl PreparedSystem {
         out.set_item("iterations", shot.iterations)?;
         out.set_item("residual", shot.residual)?;
         out.set_item("maps", shot.maps)?;
+        if tangent {
+            out.set_item(
+                "grazings",
+                crate::tangent::grazings(py, &ready.system, &grazed)?,
+            )?;
+        }
         Ok(out)
     }
 }

@@ -25,7 +25,7 @@ fn ready_for<'a>(
 }
 
 /// The grazings as a list of `(time s, pair name, closing speed m/s)`.
-fn grazings<'py>(
+pub(crate) fn grazings<'py>(
     py: Python<'py>,
     system: &core::model::assembly::Assembly,
     found: &[Grazing],
@@ -39,7 +39,8 @@ fn grazings<'py>(
 
 /// The tangent map of a run of `t_end` s from the flat state `state` (x then
 /// v): `state` (the end's), `rate` (its derivative in time there), `matrix` (the derivative of the end state by the
-/// start state, row-major), `impacts` (events whose impulses acted) and
+/// start state, row-major), `impacts` (events whose impulses acted, or where a
+/// compliant contact began) and
 /// `grazings` (list of `(time, pair, speed)`, where the flow has no
 /// derivative).
 #[pyfunction]

@@ -12,7 +12,7 @@ direction along the branch reverses), a ``flip`` (a multiplier crosses -1), a
 ``neimark-sacker`` (a complex pair leaves the unit circle), a ``branch`` (a real
 multiplier crosses +1 without a fold) and ``grazing`` (the number of impacts per
 period changes: then alone, since the two orbits lie on different smooth branches).
-Where every pair is rigid, each is then located by Newton's method on an extended system
+Each is then located by Newton's method on an extended system
 (``vibroimpact.analysis.located``, and ``vibroimpact.analysis.grazing`` for grazings,
 where a branch may also end).
 SI units.
@@ -37,7 +37,7 @@ from vibroimpact.analysis.grazing import grazing_ahead, grazings_between
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.orbits import orbit
-from vibroimpact.analysis.parameters import forcing_period, with_parameter
+from vibroimpact.analysis.parameters import shifted, with_parameter
 from vibroimpact.analysis.runs import Runner, runner, state_arrays
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
@@ -274,7 +274,7 @@ class _Arc:
         try:
             changed = with_parameter(self.data, self.parameter, p)
             return runner(
-                _shifted(changed, self.section if fraction is None else fraction), self.base_dir
+                shifted(changed, self.section if fraction is None else fraction), self.base_dir
             )
         except InvalidInputError as err:
             raise AnalysisError(f"{self.parameter} = {p:g}: {err}") from None
@@ -287,7 +287,7 @@ class _Arc:
 
     def jacobian(self, u: np.ndarray, centre: np.ndarray | None = None) -> np.ndarray:
         # ``centre``: the residual at ``u``, where the caller has it. The state's
-        # columns from the tangent flow through the impacts where every pair is rigid
+        # columns from the tangent flow through the impacts and contacts
         # (exact), else central differences; the parameter's by central differences.
         jac = np.zeros((self.size, self.size + 1))
         if centre is None:
@@ -599,26 +599,6 @@ class _Arc:
                 stopped = "reached stop"
                 break
         return points, stopped
-
-
-def _shifted(data: dict[str, Any], fraction: float) -> dict[str, Any]:
-    """``data`` with its harmonic excitations started ``fraction`` of the forcing period
-    later (each phase advanced by its frequency times that time): t = 0 then is that
-    instant of the original forcing."""
-    if not fraction:
-        return data
-    out = copy.deepcopy(data)
-    delay = fraction * forcing_period(out)
-    for e in out.get("excitation", ()):
-        if e.get("signal") == "harmonic":
-            e["phase"] = float(e.get("phase", 0.0)) + 2 * math.pi * e["frequency"] * delay
-        elif e.get("signal") == "harmonics":
-            phases = list(e.get("phases", [0.0] * len(e["frequencies"])))
-            e["phases"] = [
-                float(ph) + 2 * math.pi * f * delay
-                for ph, f in zip(phases, e["frequencies"], strict=True)
-            ]
-    return out
 
 
 def _value_of(

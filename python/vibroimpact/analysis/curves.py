@@ -5,7 +5,7 @@
 point Newton's method on the extended system ``P_p(z) - z = 0, g(z, p) = 0`` from the
 last two points' extrapolation (a grazing's: ``P_p(z) - z = 0`` with the stop's gap and
 its rate zero at the touch, see ``vibroimpact.analysis.grazing``). The multipliers come
-from the tangent flow through the impacts: every pair must be rigid. SI units."""
+from the tangent flow through the impacts and contacts. SI units."""
 
 from __future__ import annotations
 

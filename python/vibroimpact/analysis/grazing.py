@@ -24,7 +24,7 @@ import numpy as np
 
 from vibroimpact._core import interactions
 from vibroimpact.analysis.located import Bifurcation
-from vibroimpact.analysis.parameters import with_parameter
+from vibroimpact.analysis.parameters import shifted, with_parameter
 from vibroimpact.analysis.runs import Runner, runner
 
 if TYPE_CHECKING:
@@ -81,10 +81,8 @@ class _Wall:
     def at(self, p: float) -> tuple[Runner, np.ndarray, float]:
         """The runs without the stop at ``p``, and its gap's ``h`` and offset (m)."""
         if p not in self._cache:
-            from vibroimpact.analysis.continuation import _shifted
-
             arc = self.arc
-            changed = _shifted(with_parameter(arc.data, arc.parameter, p), arc.section)
+            changed = shifted(with_parameter(arc.data, arc.parameter, p), arc.section)
             full = runner(changed, arc.base_dir)
             row = next(r for r in interactions(full.system()) if r["pair"] == self.pair)
             free = runner(_without_stop(changed, self.index), arc.base_dir)

@@ -33,7 +33,7 @@ class Lyapunov:
     standard_error: np.ndarray
     #: The time averaged over (s), the settling excluded.
     time: float
-    #: Events whose impulses acted over that time.
+    #: Events whose impulses acted, or where a compliant contact began, over that time.
     impacts: int
     #: Forcing periods settled first and averaged over (None: an unforced system,
     #: averaged over ``[solver] t_end``).
@@ -79,7 +79,7 @@ def lyapunov(
     ``periods`` (default 1000), carried through every impact by its saltation matrix
     and re-orthonormalised (QR) after each; the exponents are the logarithms of the
     stretches over the time (1/s). A system without excitation is averaged over
-    ``[solver] t_end`` from ``state``, without settling. Every pair must be rigid. ``run``: a
+    ``[solver] t_end`` from ``state``, without settling. ``run``: a
     :class:`Runner` (see :func:`lyapunov_runner`) or a :class:`~vibroimpact.System`."""
     if isinstance(run, System):
         run = lyapunov_runner(run)

@@ -57,7 +57,8 @@ def orbit(
     scenario's ``[initial]``): Newton's method on ``P(z) - z = 0``, ``P`` the
     stroboscopic map over ``periods`` periods. Its Jacobian (``jacobian``):
     ``"tangent"``, the tangent flow carried through every impact by its saltation
-    matrix (exact; every pair rigid); ``"differences"``, central finite differences of
+    matrix (exact through rigid impacts, to the method's accuracy through compliant
+    contacts); ``"differences"``, central finite differences of
     whole runs (across impacts the saltation is in the differences); ``"auto"`` (the
     default), the tangent flow where the system has it. At the orbit the Jacobian is
     the monodromy matrix; its eigenvalues are the Floquet multipliers and the orbit is
@@ -83,9 +84,8 @@ def orbit(
     iterations = int(shot["iterations"])
     residual = float(shot["residual"])
     multipliers = np.linalg.eigvals(jac)
-    grazings: list[tuple[float, str, float]] = []
-    if jacobian == "tangent":
-        grazings = [tuple(g) for g in run.tangent(z, periods * run.period)["grazings"]]
+    # The last map's grazings: the orbit's (the returned state's own map).
+    grazings = [tuple(g) for g in shot.get("grazings", [])]
     recorded = run.periods(z, periods, record=True)
     amplitude, point_amplitude, moment_amplitude = run.amplitudes(recorded)
     return Orbit(

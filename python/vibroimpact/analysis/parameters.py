@@ -5,6 +5,7 @@ in the flat state ``(x, v)``."""
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -140,3 +141,23 @@ def with_parameter_path_check(path: str, section: str = "[sweep]") -> None:
             "periods, not [solver] t_end, and of [output] follow its points only); choose a "
             "parameter of the system"
         )
+
+
+def shifted(data: dict[str, Any], fraction: float) -> dict[str, Any]:
+    """``data`` with its harmonic excitations started ``fraction`` of the forcing period
+    later (each phase advanced by its frequency times that time): t = 0 then is that
+    instant of the original forcing."""
+    if not fraction:
+        return data
+    out = copy.deepcopy(data)
+    delay = fraction * forcing_period(out)
+    for e in out.get("excitation", ()):
+        if e.get("signal") == "harmonic":
+            e["phase"] = float(e.get("phase", 0.0)) + 2 * math.pi * e["frequency"] * delay
+        elif e.get("signal") == "harmonics":
+            phases = list(e.get("phases", [0.0] * len(e["frequencies"])))
+            e["phases"] = [
+                float(ph) + 2 * math.pi * f * delay
+                for ph, f in zip(phases, e["frequencies"], strict=True)
+            ]
+    return out

@@ -194,7 +194,7 @@ class Runner:
 
     def tangent_refusal(self) -> str | None:
         """Why this system's tangent flow cannot be made exactly (a compliant pair),
-        or None where it can (every pair rigid)."""
+        or None where it can (every law has one)."""
         return tangent_refusal(self.system())
 
     def tangent(self, state: np.ndarray, t_end: float) -> dict[str, Any]:

@@ -1,7 +1,7 @@
 """Sensitivities of a periodic orbit to the scenario's parameters, by the implicit
 function theorem on the shooting equations: at an orbit ``P_p(z) = z``,
 ``dz/dp = (I - M)^-1 dP/dp`` with ``M`` the monodromy (from the tangent flow through the
-impacts where every pair is rigid, else central differences) and ``dP/dp`` the map's
+impacts and contacts, or central differences) and ``dP/dp`` the map's
 derivative in the parameter (a central difference of two runs of the map from the
 orbit's own state). The amplitudes' derivatives: central differences of the orbits'
 located peaks at ``p +- h``, each run from the state the theorem predicts there (so no

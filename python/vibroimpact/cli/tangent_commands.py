@@ -33,7 +33,7 @@ def add_tangent_parsers(sub: Any) -> None:
             "the whole spectrum (1/s, descending; -inf: a direction lost where a pair "
             "stuck, null in JSON) with each exponent's standard error over 10 blocks, the "
             "time averaged over (s) and the impacts in it. An unforced scenario is "
-            "averaged over [solver] t_end from [initial]. Every pair must be rigid."
+            "averaged over [solver] t_end from [initial]."
         ),
     )
     parser.add_argument("scenario", type=Path, help="scenario file (.toml, [structure])")
@@ -61,7 +61,7 @@ def add_tangent_parsers(sub: Any) -> None:
             "extended system with the Floquet multipliers of the tangent flow through the "
             "impacts; then follow it as [curve] second steps by step from the scenario's "
             "value to second_stop. Prints each point's two values; --json gives points "
-            "[{values, state, floquet_multipliers}]. Every pair must be rigid."
+            "[{values, state, floquet_multipliers}]."
         ),
     )
     curve_parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [curve]")

@@ -15,7 +15,7 @@ The ``[study]`` section::
     metrics = ["peak", "rms", "impacts", "energy_dissipated",
                "amplitude", "impacts_per_period", "settled"]
                # orbit: "amplitude", "impacts_per_period", "stable", "largest_multiplier"
-               # any analysis: "largest_lyapunov" (1/s; every pair rigid)
+               # any analysis: "largest_lyapunov" (1/s)
                # default: "peak", "rms", "impacts"; for an orbit, its four
     chunk_size = 1024              # runs a chunk (what a resume can lose at most)
 
@@ -60,7 +60,7 @@ the order of ``[study.random]``) at every grid point. SI units.
 
 ``analysis = "orbit"`` settles each point for ``settle_periods`` forcing periods, then
 shoots for an orbit of ``orbit_periods`` periods from there (Newton's method with the
-monodromy of the tangent flow through the impacts where every pair is rigid, else of
+monodromy of the tangent flow through the impacts and contacts, else of
 central differences, as :func:`vibroimpact.analysis.orbit`, in the core): ``stable``
 is true when it converged and every Floquet multiplier is inside the unit circle,
 ``largest_multiplier`` the largest multiplier's modulus, ``amplitude`` and
@@ -72,9 +72,9 @@ refused, and a point an axis makes aperiodic fails with its reason.
 
 ``largest_lyapunov`` of a run or a steady state is the largest Lyapunov exponent (1/s) of
 its recorded time, from the tangent flow carried through every impact by its saltation
-matrix and re-orthonormalised after each (see :func:`vibroimpact.lyapunov`): a chaos map
-over two parameters is one study with two axes. It takes rigid pairs (a compliant one is
-refused up front).
+matrix (and through compliant contacts by the variational equations) and
+re-orthonormalised after each (see :func:`vibroimpact.lyapunov`): a chaos map over two
+parameters is one study with two axes.
 
 ``stepping = "fixed"`` runs a study of the two-mass impact damper (one mass on a spring,
 one ``[[damper]]`` with equal clearances and a compliant law, no stops, gravity or

@@ -221,6 +221,35 @@ impl Run<'_> {
         }
     }
 
+    /// An observed run whose observer wants steps: the step's start.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn watch_step_start(&mut self) {
+        if let Some(watch) = self.watch.as_mut() {
+            watch.step_time = self.clock.time;
+            watch
+                .step_start
+                .copy_from_slice(&self.y[..2 * self.system.dim]);
+        }
+    }
+
+    /// An observed run whose observer wants steps: the step kept, shown.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn watch_step(&mut self) -> Result<()> {
+        if let Some(watch) = self.watch.as_mut() {
+            let size = 2 * self.system.dim;
+            watch.observer.step(
+                watch.step_time,
+                &watch.step_start,
+                self.clock.time,
+                &self.y[..size],
+                &self.modes,
+            )?;
+        }
+        Ok(())
+    }
+
     /// An observed run: the rigid pairs the event's impulses acted on.
     #[cold]
     #[inline(never)]

@@ -274,6 +274,11 @@ impl Open {
 /// 0.40 -> 0.44-0.48 s).
 macro_rules! by_events {
     ($run:ident, $stepper:ident, $interrupt:ident, $t_end:expr) => {
+        by_events!($run, $stepper, $interrupt, $t_end, false)
+    };
+    // `$steps`: whether an observer is shown each step (`false` in a plain
+    // run, where the check is compiled out).
+    ($run:ident, $stepper:ident, $interrupt:ident, $t_end:expr, $steps:expr) => {
         while $run.clock.time < $t_end {
             // Plain steps in a row, where the stepper takes them at once (each
             // as the kernel's step would, to the bit); the step after them is
@@ -281,7 +286,13 @@ macro_rules! by_events {
             if $run.stretches && $run.clock.accepted > 0 && $run.fast_steps($stepper, $interrupt)? {
                 continue;
             }
+            if $steps {
+                $run.watch_step_start();
+            }
             let stop = $run.step($stepper)?;
+            if $steps && !matches!(stop, Stop::End | Stop::Retry) {
+                $run.watch_step()?;
+            }
             match stop {
                 Stop::End => break,
                 Stop::Retry => continue,
@@ -382,8 +393,11 @@ pub fn integrate_system_observed<S: SystemStepper>(
     let mut run = Run::new(system, stepper, initial, options, stepping, record_limit)?;
     let (dim, count) = (system.dim, system.interactions.len());
     observer.start(run.clock.time, &run.y[..2 * dim], &run.modes)?;
+    let steps = observer.wants_steps();
+    // Each step the kernel's own, for the observer to be shown.
+    run.stretches &= !steps;
     run.watch = Some(Watch::new(observer, dim, count));
-    by_events!(run, stepper, interrupt, options.t_end);
+    by_events!(run, stepper, interrupt, options.t_end, steps);
     if let Some(watch) = run.watch.take() {
         watch
             .observer

@@ -44,12 +44,35 @@ pub trait EventObserver {
     fn event(&mut self, view: &EventView<'_>) -> Result<()>;
     /// The run ends at `time` in state `y` and `modes`.
     fn finish(&mut self, time: f64, y: &[f64], modes: &[Mode]) -> Result<()>;
+    /// Whether the observer is told of every step ([`Self::step`]); asked
+    /// once, at the run's start. An observer that is not costs nothing per
+    /// step.
+    fn wants_steps(&self) -> bool {
+        false
+    }
+    /// A step kept from `(t0, y0)` to `(t1, y1)` (`x` then `v`) in `modes`,
+    /// the method's own (cut at an event it ends on, before the event's
+    /// switches and jumps, which [`Self::event`] then shows).
+    fn step(
+        &mut self,
+        _t0: f64,
+        _y0: &[f64],
+        _t1: f64,
+        _y1: &[f64],
+        _modes: &[Mode],
+    ) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// What a run keeps for its observer: the state and modes before the event
 /// being handled, and the jumps of its impulses.
 pub(crate) struct Watch<'o> {
     pub(crate) observer: &'o mut dyn EventObserver,
+    /// The time and state at the start of the step being taken (where the
+    /// observer wants steps).
+    pub(crate) step_time: f64,
+    pub(crate) step_start: Vec<f64>,
     pub(crate) before: Vec<f64>,
     pub(crate) modes_before: Vec<Mode>,
     pub(crate) jumps: Vec<Jump>,
@@ -59,6 +82,8 @@ impl<'o> Watch<'o> {
     pub(crate) fn new(observer: &'o mut dyn EventObserver, dim: usize, count: usize) -> Self {
         Self {
             observer,
+            step_time: 0.0,
+            step_start: vec![0.0; 2 * dim],
             before: vec![0.0; 2 * dim],
             modes_before: vec![Mode::Open; count],
             jumps: Vec::with_capacity(count),

@@ -489,6 +489,23 @@ fn hertz_static_indentation(stiffness: f64, effective_mass: f64, pressing: f64) 
 }
 
 impl AnyLaw {
+    /// The force's derivative by the approach rate latched at the onset
+    /// (N per m/s) at `indentation` (m), its `rate` (m/s) and
+    /// that `approach_rate` (m/s): `-K delta^1.5 alpha delta' / v0^2` for the
+    /// hysteretic laws while their factor is positive, else 0.
+    pub fn force_by_approach_rate(&self, indentation: f64, rate: f64, approach_rate: f64) -> f64 {
+        match self {
+            AnyLaw::HysterHertz(law) if indentation > 0.0 && approach_rate > GRAZING_RATE => {
+                let ratio = law.hysteresis / approach_rate;
+                if 1.0 + ratio * rate <= 0.0 {
+                    return 0.0;
+                }
+                -law.elastic_force(indentation) * ratio * rate / approach_rate
+            }
+            _ => 0.0,
+        }
+    }
+
     /// The indentation (m) at which the law's elastic force holds the
     /// effective mass `effective_mass` (kg) pressed at `pressing` (m/s^2, > 0
     /// pressing the bodies together); 0 when nothing presses. The scale of a

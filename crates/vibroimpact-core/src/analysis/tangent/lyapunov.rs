@@ -13,27 +13,36 @@ use crate::model::assembly::Assembly;
 /// (twice-applied modified Gram-Schmidt: orthogonal to round-off even when
 /// the columns are nearly parallel), adding the logarithm of each column's
 /// stretch to `logs`. A column collapsed to zero (a pair that stuck: its
-/// direction is lost) adds minus infinity.
-pub(super) fn orthonormalise(matrix: &mut [f64], size: usize, logs: &mut [f64]) {
+/// direction is lost) adds minus infinity. The rows `extra` (each `size`
+/// long: the latched rates' derivatives, [`super::latched`]) take the same
+/// column operations, so that they stay derivatives along the same columns
+/// (`L R^-1`).
+pub(super) fn orthonormalise(matrix: &mut [f64], size: usize, logs: &mut [f64], extra: &mut [f64]) {
+    let rows = size + extra.len() / size;
+    let at = |i: usize, j: usize| i * size + j;
     for j in 0..size {
         for _ in 0..2 {
             for k in 0..j {
-                let r: f64 = (0..size)
-                    .map(|i| matrix[i * size + k] * matrix[i * size + j])
-                    .sum();
+                let r: f64 = (0..size).map(|i| matrix[at(i, k)] * matrix[at(i, j)]).sum();
                 for i in 0..size {
-                    matrix[i * size + j] -= r * matrix[i * size + k];
+                    matrix[at(i, j)] -= r * matrix[at(i, k)];
+                }
+                for i in size..rows {
+                    extra[at(i - size, j)] -= r * extra[at(i - size, k)];
                 }
             }
         }
         let norm = (0..size)
-            .map(|i| matrix[i * size + j] * matrix[i * size + j])
+            .map(|i| matrix[at(i, j)] * matrix[at(i, j)])
             .sum::<f64>()
             .sqrt();
         logs[j] += norm.ln();
         if norm > 0.0 {
             for i in 0..size {
-                matrix[i * size + j] /= norm;
+                matrix[at(i, j)] /= norm;
+            }
+            for i in size..rows {
+                extra[at(i - size, j)] /= norm;
             }
         }
     }
@@ -53,7 +62,8 @@ pub struct LyapunovSpectrum {
     pub running: Vec<f64>,
     /// The time averaged over, s.
     pub time: f64,
-    /// Events whose impulses acted over that time.
+    /// Events whose impulses acted, or where a compliant contact began, over
+    /// that time.
     pub impacts: u64,
     pub grazings: Vec<Grazing>,
 }

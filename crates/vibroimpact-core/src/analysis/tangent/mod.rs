@@ -20,10 +20,18 @@
 //! where the flow has no derivative: it is counted and reported
 //! ([`Tangent::grazings`]), never differentiated through silently.
 //!
+//! While a compliant contact is on, the flow is not linear: each of the
+//! method's steps is carried by the variational equations with the laws'
+//! exact slopes ([`contact`]); its onset and separation are events whose
+//! saltation holds the jump of the rates (none for Hertz, whose force is
+//! zero at zero indentation; a contact damper's `c g'` for the others).
+//!
 //! The flow is told of events by the one kernel
 //! ([`crate::kernel::observe`]); by concern: this product, the saltation
 //! ([`saltation`]), the Lyapunov exponents ([`lyapunov`]).
 
+mod contact;
+mod latched;
 mod lyapunov;
 mod saltation;
 #[cfg(test)]
@@ -31,10 +39,12 @@ mod tests;
 
 pub use lyapunov::{lyapunov_blocks, LyapunovSpectrum};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::kernel::observe::{EventObserver, EventView};
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 use crate::numerics::linalg;
+use contact::{ContactSteps, Gain};
+use latched::Latched;
 use saltation::Saltation;
 
 /// A grazing met along the run: a pair that touched its wall at a speed of
@@ -50,22 +60,18 @@ pub struct Grazing {
     pub speed: f64,
 }
 
-/// Whether `system`'s tangent flow can be made exactly: every pair rigid
-/// (its structure is linear). Else an error naming the first pair that is
-/// not, and what to do instead.
-pub fn check(system: &Assembly) -> Result<()> {
-    for it in &system.interactions {
-        if let InteractionLaw::Compliant { .. } = it.law {
-            return Err(Error::Inconsistent(format!(
-                "the tangent flow (exact Floquet multipliers, Lyapunov exponents, located \
-                 bifurcations, sensitivities) takes rigid pairs only for now; {} has a \
-                 compliant law: use restitution for a rigid wall, or finite differences \
-                 (orbit jacobian = \"differences\")",
-                system.pairs[it.pair]
-            )));
-        }
-    }
+/// Whether `system`'s tangent flow can be made: every pair's law has one
+/// (rigid, and every compliant law, the hysteretic ones' latched approach
+/// rates carried as rows, [`latched`]). An error would name the first pair
+/// whose law has none, and what to do instead.
+pub fn check(_system: &Assembly) -> Result<()> {
     Ok(())
+}
+
+/// Whether a compliant contact is on: the flow is then not linear, and is
+/// carried step by step ([`ContactSteps`]).
+fn in_contact(modes: &[Mode]) -> bool {
+    modes.iter().any(|m| matches!(m, Mode::Compliant { .. }))
 }
 
 /// What the flow does with each factor of the tangent map.
@@ -97,13 +103,17 @@ pub struct Tangent<'s> {
     /// The linear flow's matrix `A` of each set of modes met.
     flows: Vec<(Vec<u8>, Vec<f64>)>,
     saltation: Saltation,
+    /// The steps while a compliant contact is on (None: every pair rigid).
+    contact: Option<ContactSteps>,
+    /// The hysteretic laws' latched rates (None: no law latches).
+    latched: Option<Latched>,
     expm: linalg::Expm,
     factor: Vec<f64>,
     /// The stretch's flow before an event's saltation.
     stretch: Vec<f64>,
     product: Vec<f64>,
     grazings: Vec<Grazing>,
-    /// Events whose impulses acted.
+    /// Events whose impulses acted, or where a compliant contact began.
     impacts: u64,
     /// The time from which the flow is carried (s): events before it only
     /// set the modes.
@@ -146,6 +156,12 @@ impl<'s> Tangent<'s> {
             modes: vec![Mode::Open; system.interactions.len()],
             flows: Vec::new(),
             saltation: Saltation::new(system),
+            contact: system
+                .interactions
+                .iter()
+                .any(|it| matches!(it.law, InteractionLaw::Compliant { .. }))
+                .then(|| ContactSteps::new(system)),
+            latched: Latched::new(system),
             expm: linalg::Expm::new(size),
             factor: vec![0.0; size * size],
             stretch: vec![0.0; size * size],
@@ -190,7 +206,7 @@ impl<'s> Tangent<'s> {
         &self.modes
     }
 
-    /// Events whose impulses acted.
+    /// Events whose impulses acted, or where a compliant contact began.
     pub fn impacts(&self) -> u64 {
         self.impacts
     }
@@ -208,16 +224,13 @@ impl<'s> Tangent<'s> {
         let mut scratch = Scratch::new(self.system);
         let y = vec![0.0; self.system.state_len()];
         let (mut dadx, mut dadv) = (vec![0.0; d * d], vec![0.0; d * d]);
-        self.system
-            .acceleration_jacobian(&y, modes, &mut scratch, &mut dadx, &mut dadv);
         let mut a = vec![0.0; size * size];
-        for i in 0..d {
-            a[i * size + d + i] = 1.0;
-            for j in 0..d {
-                a[(d + i) * size + j] = dadx[i * d + j];
-                a[(d + i) * size + d + j] = dadv[i * d + j];
-            }
-        }
+        self.system.flow_jacobian(
+            (&y, modes, false),
+            &mut scratch,
+            (&mut dadx, &mut dadv),
+            &mut a,
+        );
         self.flows.push((key(modes).collect(), a));
         self.flows.len() - 1
     }
@@ -233,20 +246,72 @@ impl<'s> Tangent<'s> {
             .compute(&self.flows[slot].1, tau, &mut self.factor);
     }
 
-    /// `matrix <- factor matrix`, then re-orthonormalised where asked.
-    fn apply(&mut self) {
+    /// `matrix <- factor matrix` (plus the step's gain by the latched rates,
+    /// `with_gain`), then re-orthonormalised where asked.
+    fn apply(&mut self, with_gain: bool) {
         linalg::matmul(&self.factor, &self.matrix, &mut self.product, self.size);
+        if let (true, Some(latched)) = (with_gain, self.latched.as_ref()) {
+            latched.add_gain(&mut self.product, self.size);
+        }
         std::mem::swap(&mut self.matrix, &mut self.product);
         if let Keep::Orthonormal { logs } = &mut self.keep {
-            lyapunov::orthonormalise(&mut self.matrix, self.size, logs);
+            let extra = match self.latched.as_mut() {
+                Some(latched) => &mut latched.rows[..],
+                None => &mut [][..],
+            };
+            lyapunov::orthonormalise(&mut self.matrix, self.size, logs, extra);
+        }
+    }
+
+    /// The latched rates' rows at an event: set at a latching contact's
+    /// onset (from the state's derivative just before it: the stretch's
+    /// flow times the matrix), cleared at its separation. An onset whose
+    /// rate is not its closing speed has no derivative: counted with the
+    /// grazings.
+    fn latch(&mut self, view: &EventView<'_>, stretch: bool) {
+        let Some(latched) = self.latched.as_mut() else {
+            return;
+        };
+        let size = self.size;
+        for i in 0..view.modes_after.len() {
+            if !latched.which[i] {
+                continue;
+            }
+            match (view.modes_before[i], view.modes_after[i]) {
+                (Mode::Open, Mode::Compliant { approach_rate, .. }) => {
+                    let event = (view.time, view.before, view.modes_before);
+                    let flow = stretch.then_some(&self.stretch[..]);
+                    if !latched.onset(self.system, event, i, approach_rate, flow, &self.matrix) {
+                        self.grazings.push(Grazing {
+                            time: view.time,
+                            interaction: i,
+                            pair: self.system.interactions[i].pair,
+                            speed: -linalg::dot(
+                                &self.system.interactions[i].h,
+                                &view.before[size / 2..size],
+                            ),
+                        });
+                    }
+                }
+                (Mode::Compliant { .. }, Mode::Open) => latched.separation(i, size),
+                _ => {}
+            }
         }
     }
 }
 
 impl EventObserver for Tangent<'_> {
-    fn start(&mut self, time: f64, _y: &[f64], modes: &[Mode]) -> Result<()> {
+    fn start(&mut self, time: f64, y: &[f64], modes: &[Mode]) -> Result<()> {
         self.since = time.max(self.from);
         self.modes.copy_from_slice(modes);
+        if let Some(latched) = self.latched.as_mut() {
+            // Carried from the start: a resumed contact's rate is the
+            // state's; from later, the state there does not set it.
+            latched.resume(self.system, y, modes);
+            if self.from > time {
+                latched.rows.iter_mut().for_each(|v| *v = 0.0);
+            }
+        }
         Ok(())
     }
 
@@ -259,12 +324,14 @@ impl EventObserver for Tangent<'_> {
         // modes only at events).
         self.modes.copy_from_slice(view.modes_before);
         // The stretch's flow, then the event's saltation: one factor (one QR).
-        let stretch = view.time > self.since;
+        // (In contact, the steps carried the stretch.)
+        let stretch = view.time > self.since && !in_contact(&self.modes);
         if stretch {
             self.smooth(view.time);
             std::mem::swap(&mut self.factor, &mut self.stretch);
         }
         let outcome = self.saltation.matrix(self.system, view, &mut self.factor);
+
         if stretch {
             linalg::matmul(&self.factor, &self.stretch, &mut self.product, self.size);
             std::mem::swap(&mut self.factor, &mut self.product);
@@ -277,17 +344,60 @@ impl EventObserver for Tangent<'_> {
                 speed,
             });
         }
-        self.impacts += u64::from(!view.jumps.is_empty());
-        self.apply();
+        let onset = view
+            .modes_before
+            .iter()
+            .zip(view.modes_after)
+            .any(|(b, a)| *b == Mode::Open && matches!(a, Mode::Compliant { .. }));
+        self.impacts += u64::from(!view.jumps.is_empty() || onset);
+        self.latch(view, stretch);
+        self.apply(false);
         self.since = view.time;
         self.modes.copy_from_slice(view.modes_after);
         Ok(())
     }
 
+    fn wants_steps(&self) -> bool {
+        self.contact.is_some()
+    }
+
+    /// A step while a compliant contact is on: its factor from the
+    /// variational equations ([`ContactSteps`]). Other steps are linear,
+    /// carried whole at the events.
+    fn step(&mut self, t0: f64, y0: &[f64], t1: f64, y1: &[f64], modes: &[Mode]) -> Result<()> {
+        if !in_contact(modes) || t1 <= t0 {
+            return Ok(());
+        }
+        if t0 < self.from {
+            // Before the flow is carried (a study's settling): a step across
+            // its start starts it at the step's end.
+            self.since = self.since.max(t1);
+            return Ok(());
+        }
+        if let Some(contact) = self.contact.as_mut() {
+            let gain = self.latched.as_mut().map(|l| Gain {
+                which: &l.which,
+                gain: &mut l.gain,
+            });
+            let with_gain = gain.is_some();
+            contact.factor(
+                self.system,
+                (t0, y0),
+                (t1, y1),
+                modes,
+                &mut self.factor,
+                gain,
+            );
+            self.apply(with_gain);
+            self.since = t1;
+        }
+        Ok(())
+    }
+
     fn finish(&mut self, time: f64, _y: &[f64], modes: &[Mode]) -> Result<()> {
-        if time > self.since {
+        if time > self.since && !in_contact(&self.modes) {
             self.smooth(time);
-            self.apply();
+            self.apply(false);
         }
         self.since = time;
         self.modes.copy_from_slice(modes);

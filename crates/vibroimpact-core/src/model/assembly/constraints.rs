@@ -54,6 +54,45 @@ impl Assembly {
         dadx: &mut [f64],
         dadv: &mut [f64],
     ) {
+        self.jacobian_of_accelerations(y, modes, scratch, (dadx, dadv), false);
+    }
+
+    /// The Jacobian of the whole first-order flow `y' = (v, a)` at state `y`
+    /// in `modes` into `out` (row-major `2 dim x 2 dim`: `[[0, I], [da/dx,
+    /// da/dv]]`), `dadx` and `dadv` its work space: the tangent flow's. With
+    /// `inside`, each compliant contact's slopes are taken from inside it (at
+    /// an indentation of at least zero): the tangent flow's steps start and
+    /// end on a contact's onset and separation, where a round-off gap of
+    /// either sign would otherwise switch a linear law's stiffness on or off
+    /// for a whole stage.
+    pub fn flow_jacobian(
+        &self,
+        (y, modes, inside): (&[f64], &[Mode], bool),
+        scratch: &mut Scratch,
+        (dadx, dadv): (&mut [f64], &mut [f64]),
+        out: &mut [f64],
+    ) {
+        self.jacobian_of_accelerations(y, modes, scratch, (&mut *dadx, &mut *dadv), inside);
+        let d = self.dim;
+        let size = 2 * d;
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for i in 0..d {
+            out[i * size + d + i] = 1.0;
+            for c in 0..d {
+                out[(d + i) * size + c] = dadx[i * d + c];
+                out[(d + i) * size + d + c] = dadv[i * d + c];
+            }
+        }
+    }
+
+    fn jacobian_of_accelerations(
+        &self,
+        y: &[f64],
+        modes: &[Mode],
+        scratch: &mut Scratch,
+        (dadx, dadv): (&mut [f64], &mut [f64]),
+        inside: bool,
+    ) {
         let (n, d) = (self.n, self.dim);
         let (x, v) = (&y[..d], &y[d..2 * d]);
         dadx.iter_mut().for_each(|a| *a = 0.0);
@@ -74,15 +113,19 @@ impl Assembly {
                     },
                     InteractionLaw::Compliant { law, damping },
                 ) => {
-                    let indentation = -(it.offset + h_dot(&it.h, x));
+                    let mut indentation = -(it.offset + h_dot(&it.h, x));
+                    if inside {
+                        indentation = indentation.max(0.0);
+                    }
                     let rate = -h_dot(&it.h, v);
-                    let (_, by_indentation, by_rate, damping) = if indentation > 0.0 {
-                        let (force, by_indentation, by_rate) =
-                            law.force_derivatives(indentation, rate, approach_rate);
-                        (force, by_indentation, by_rate, damping)
-                    } else {
-                        (0.0, 0.0, 0.0, apart_damping(damping, indented_only))
-                    };
+                    let (_, by_indentation, by_rate, damping) =
+                        if indentation > 0.0 || (inside && indentation == 0.0) {
+                            let (force, by_indentation, by_rate) =
+                                law.force_derivatives(indentation, rate, approach_rate);
+                            (force, by_indentation, by_rate, damping)
+                        } else {
+                            (0.0, 0.0, 0.0, apart_damping(damping, indented_only))
+                        };
                     // lambda(delta, delta'), delta = -(b + h.x): d/dx = -lambda_delta h.
                     for (r, p) in it.push.iter().enumerate() {
                         for (c, h) in it.h.iter().enumerate() {
