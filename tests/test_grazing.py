@@ -98,6 +98,67 @@ def test_the_located_grazing_orbit_is_the_system_s_own_and_touches_at_zero_speed
     assert all(abs(s) < 1e-6 for s in speeds)
 
 
+def _soft_and_rigid() -> dict[str, Any]:
+    """The oscillator between a soft linear stop above (30 mm, 40 N/m), struck all along
+    the branch (the continuation moves its section away from the contacts), and a rigid
+    one 60 mm below, grazed as the frequency rises."""
+    data = _scenario()
+    data["stop"] = [
+        {"at": 0, "side": "upper", "gap": 0.03, "law": "linear", "stiffness": 40.0},
+        {"at": 0, "side": "lower", "gap": 0.06, "law": "rigid", "restitution": 0.8},
+    ]
+    return data
+
+
+def _soft_and_rigid_orbit(data: dict[str, Any], f: float, state: np.ndarray) -> Any:
+    """One period from ``state`` of the soft-and-rigid system missing its rigid stop, by
+    scipy's integration (a test-only oracle) of the piecewise-linear equation
+    m x'' + c x' + k x + 40 (x - 0.03)+ = F0 cos(w t)."""
+    from scipy.integrate import solve_ivp
+
+    m, k, c, f0, _ = _oscillator(data)
+    w = 2 * math.pi * f
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        soft = 40.0 * max(y[0] - 0.03, 0.0)
+        return [y[1], (f0 * math.cos(w * t) - c * y[1] - k * y[0] - soft) / m]
+
+    return solve_ivp(
+        rhs, (0, 1 / f), state, rtol=1e-12, atol=1e-14, max_step=1e-4, dense_output=True
+    )
+
+
+@pytest.mark.timeout(60)
+def test_a_grazing_on_a_moved_section_is_reported_on_the_scenario_s_clock() -> None:
+    # The state is the orbit's at t = 0 of the scenario's forcing, and the time that of
+    # the touch after it, within a period (the section had been moved off the contacts
+    # with the soft stop: the state and time had been on the moved section's clock).
+    data = _soft_and_rigid()
+    branch = continue_orbit(data, FREQUENCY, stop=data["continuation"]["stop"])
+    (found,) = [b for b in branch.bifurcations if b.kind == "grazing"]
+    assert found.pair == "stop 1" and found.time is not None
+    assert 0 <= found.time < 1 / found.value
+    orbit = _soft_and_rigid_orbit(data, found.value, found.state)
+    assert np.max(np.abs(orbit.y[:, -1] - found.state)) < 1e-7
+    x, v = orbit.sol(found.time)
+    assert x == pytest.approx(-0.06, abs=1e-8) and v == pytest.approx(0.0, abs=1e-7)
+
+
+@pytest.mark.timeout(60)
+def test_a_grazing_curve_starts_from_a_grazing_on_a_moved_section() -> None:
+    # Its first guess is the located grazing's state and time (it had failed at its
+    # first step when they were on the moved section's clock).
+    data = _soft_and_rigid()
+    data["curve"] = {**data["curve"], "second": "stop.1.gap", "second_stop": 0.064}
+    found = curve_of(data, GRAZING.parent)
+    assert found.stopped == "reached second_stop" and len(found.points) == 21
+    for p in found.points[:: len(found.points) - 1]:
+        f, gap = p.values[FREQUENCY], p.values["stop.1.gap"]
+        orbit = _soft_and_rigid_orbit(data, f, p.state)
+        assert np.max(np.abs(orbit.y[:, -1] - p.state)) < 1e-7
+        assert float(np.min(orbit.y[0])) == pytest.approx(-gap, abs=1e-7)
+
+
 @pytest.mark.timeout(60)
 def test_a_grazing_crossed_from_the_impacting_side_is_located_and_the_branch_goes_on() -> None:
     # The impacting orbit continued down in the force amplitude meets the orbit that
@@ -165,7 +226,8 @@ def test_cli_reports_the_grazing_and_its_curve(tmp_path: Path) -> None:
     (touch,) = [b for b in out["bifurcations"] if b["kind"] == "grazing"]
     assert set(touch) == {"kind", "value", "state", "floquet_multipliers", "pair", "time"}
     assert touch["value"] == pytest.approx(_grazing_frequency(data, 0.05), rel=1e-10)
-    assert touch["pair"] == "stop 0" and touch["time"] > 0
+    period = 1 / touch["value"]
+    assert touch["pair"] == "stop 0" and 0 <= touch["time"] < period
     plot = tmp_path / "grazing.png"
     done = _cli("curve", str(GRAZING), "--json", "--plot", str(plot))
     assert done.returncode == 0, done.stderr

@@ -364,23 +364,22 @@ class _Arc:
         recorded = run.periods(z, self.periods, record=True)
         kinds = recorded["contacts"]["kind"]
         impacts = sum(1 for kind in kinds if kind in ("impact", "compliant")) / self.periods
-        # The state at t = 0: the rest of the period from the section.
-        at_zero = z
-        if self.section:
-            at_zero = np.asarray(
-                run._run(z, (1.0 - self.section) * run.period, record=False, strobe=False)[
-                    "final_state"
-                ],
-                dtype=float,
-            )
         return BranchPoint(
             value=p,
-            state=at_zero,
+            state=self.at_zero(run, z),
             floquet_multipliers=multipliers,
             stable=bool(np.all(np.abs(multipliers) < 1.0)),
             impacts_per_period=impacts,
             amplitude=run.amplitudes(recorded)[0],
         )
+
+    def at_zero(self, run: Runner, z: np.ndarray) -> np.ndarray:
+        """The state at t = 0 of the scenario's forcing of the orbit through ``z`` on the
+        section: the rest of the period from it (``run`` the system on the section)."""
+        if not self.section:
+            return z
+        rest = (1.0 - self.section) * run.period
+        return np.asarray(run._run(z, rest, record=False, strobe=False)["final_state"], dtype=float)
 
     def clear_of_impacts(self, u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``u`` and ``t`` on a section moved away from the impacts, if one is near."""

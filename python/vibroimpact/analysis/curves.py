@@ -19,7 +19,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact.analysis.continuation import _Arc, _value_of, continue_orbit
-from vibroimpact.analysis.grazing import locate_grazing, struck
+from vibroimpact.analysis.grazing import away_from_zero, locate_grazing, struck
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.parameters import with_parameter
@@ -138,7 +138,8 @@ def curve(
     history = [np.concatenate([first.state, [first.value]]) / scale]
     if first.time is not None:
         # A grazing's touch's instant too, in the orbit's periods.
-        history[0] = np.concatenate([history[0], [first.time / (periods * period)]])
+        span = periods * period
+        history[0] = np.concatenate([history[0], [away_from_zero(first.time, span) / span]])
     direction = 1.0 if second_stop > s0 else -1.0
     s, h = s0, step
     stopped = "max_points"

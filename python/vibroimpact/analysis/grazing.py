@@ -120,7 +120,13 @@ class _Wall:
             curvature = below - 2 * here + above
             if curvature > 0:
                 tau += 0.5 * (below - above) / curvature * (times[1] - times[0])
-        return tau + span if tau < 0.05 * span else tau
+        return away_from_zero(tau, span)
+
+
+def away_from_zero(tau: float, span: float) -> float:
+    """A touch's instant ``tau`` in [0, ``span``) as Newton starts from it: near t = 0
+    a ``span`` later (Newton keeps the instant positive)."""
+    return tau + span if tau < 0.05 * span else tau
 
 
 def struck(run: Runner, state: np.ndarray, periods: int) -> set[str]:
@@ -222,8 +228,14 @@ def _newton(arc: _Arc, wall: _Wall, start: np.ndarray, tau: float | None) -> Gra
         ):
             z, tau = w[:size] * z_scale, float(w[size + 1] * t_scale)
             free = wall.at(p)[0]
-            monodromy = free.tangent(z, arc.periods * free.period)["matrix"]
-            return Grazing(p, z, np.linalg.eigvals(monodromy), wall.pair, tau, w)
+            span = arc.periods * free.period
+            monodromy = free.tangent(z, span)["matrix"]
+            # Reported on the scenario's clock (the arc's section may have moved): the
+            # state at t = 0, the touch within the orbit's span after it.
+            instant = (tau - (1.0 - arc.section) * free.period) % span
+            return Grazing(
+                p, arc.at_zero(free, z), np.linalg.eigvals(monodromy), wall.pair, instant, w
+            )
     return None
 
 
