@@ -397,7 +397,13 @@ pub fn integrate_system_observed<S: SystemStepper>(
     // Each step the kernel's own, for the observer to be shown.
     run.stretches &= !steps;
     run.watch = Some(Watch::new(observer, dim, count));
-    by_events!(run, stepper, interrupt, options.t_end, steps);
+    // The loop written for each (a literal: an observer without steps pays
+    // no check per step).
+    if steps {
+        by_events!(run, stepper, interrupt, options.t_end, true);
+    } else {
+        by_events!(run, stepper, interrupt, options.t_end, false);
+    }
     if let Some(watch) = run.watch.take() {
         watch
             .observer

@@ -18,31 +18,51 @@ use crate::model::assembly::Assembly;
 /// column operations, so that they stay derivatives along the same columns
 /// (`L R^-1`).
 pub(super) fn orthonormalise(matrix: &mut [f64], size: usize, logs: &mut [f64], extra: &mut [f64]) {
-    let rows = size + extra.len() / size;
-    let at = |i: usize, j: usize| i * size + j;
+    if extra.is_empty() {
+        gram_schmidt::<false>(matrix, size, logs, extra);
+    } else {
+        gram_schmidt::<true>(matrix, size, logs, extra);
+    }
+}
+
+/// [`orthonormalise`], the rows `extra` taken where `EXTRA` (compiled out
+/// otherwise: the QR after each event is a rigid spectrum's inner loop).
+fn gram_schmidt<const EXTRA: bool>(
+    matrix: &mut [f64],
+    size: usize,
+    logs: &mut [f64],
+    extra: &mut [f64],
+) {
+    let rows = extra.len() / size;
     for j in 0..size {
         for _ in 0..2 {
             for k in 0..j {
-                let r: f64 = (0..size).map(|i| matrix[at(i, k)] * matrix[at(i, j)]).sum();
+                let r: f64 = (0..size)
+                    .map(|i| matrix[i * size + k] * matrix[i * size + j])
+                    .sum();
                 for i in 0..size {
-                    matrix[at(i, j)] -= r * matrix[at(i, k)];
+                    matrix[i * size + j] -= r * matrix[i * size + k];
                 }
-                for i in size..rows {
-                    extra[at(i - size, j)] -= r * extra[at(i - size, k)];
+                if EXTRA {
+                    for i in 0..rows {
+                        extra[i * size + j] -= r * extra[i * size + k];
+                    }
                 }
             }
         }
         let norm = (0..size)
-            .map(|i| matrix[at(i, j)] * matrix[at(i, j)])
+            .map(|i| matrix[i * size + j] * matrix[i * size + j])
             .sum::<f64>()
             .sqrt();
         logs[j] += norm.ln();
         if norm > 0.0 {
             for i in 0..size {
-                matrix[at(i, j)] /= norm;
+                matrix[i * size + j] /= norm;
             }
-            for i in size..rows {
-                extra[at(i - size, j)] /= norm;
+            if EXTRA {
+                for i in 0..rows {
+                    extra[i * size + j] /= norm;
+                }
             }
         }
     }
