@@ -237,3 +237,19 @@ def test_cli_reports_the_grazing_and_its_curve(tmp_path: Path) -> None:
         gap = p["values"]["stop.0.gap"]
         assert _amplitude(data, p["values"][FREQUENCY]) == pytest.approx(gap, rel=1e-11)
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.timeout(120)
+def test_a_curve_whose_branch_meets_no_grazing_says_which_keys_to_widen(tmp_path: Path) -> None:
+    # The grazing lies at 0.706 Hz: a search that stops at 0.6 Hz finds none.
+    text = GRAZING.read_text(encoding="utf-8").replace(
+        "stop = 0.95                             # ... to here",
+        "stop = 0.6                              # ... to here",
+    )
+    assert "stop = 0.6 " in text
+    path = tmp_path / "short.toml"
+    path.write_text(text, encoding="utf-8")
+    done = _cli("curve", str(path))
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert "no grazing" in line and "[curve] start, stop" in line and "0.6" in line

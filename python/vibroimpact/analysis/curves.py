@@ -121,7 +121,7 @@ def curve(
         raise AnalysisError(
             f"no {kind} of the {periods}-period orbit located along {parameter} from "
             f"{start:g} to {stop:g} at {second} = {s0:g} (located: {seen}; the branch "
-            f"stopped: {branch.stopped}): widen start and stop"
+            f"stopped: {branch.stopped}): widen start and stop ([curve] start, stop)"
         )
     first = found[0]
     n, k = branch.n, branch.k
