@@ -264,9 +264,6 @@ class _Arc:
     shiftable: bool = False
     size: int = 0
     scale: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    #: Whether the state's derivatives come from the tangent flow (where every pair is
-    #: rigid), not from differences.
-    tangent_flow: bool = True
     #: The bifurcations located along the branch so far.
     bifurcations: list[Bifurcation] = field(default_factory=list)
 
@@ -295,7 +292,7 @@ class _Arc:
         z = u[: self.size] * self.scale[: self.size]
         p = float(u[self.size] * self.scale[self.size])
         run = self.run_at(p)
-        by_tangent = self.tangent_flow and run.tangent_refusal() is None
+        by_tangent = run.tangent_refusal() is None
         if by_tangent:
             monodromy = run.tangent(z, self.periods * run.period)["matrix"]
             scale = self.scale[: self.size]
@@ -464,7 +461,7 @@ class _Arc:
     def ended(self, points: list[BranchPoint], u: np.ndarray) -> str:
         """Why the corrector failed beyond the last point: at a grazing (located, and
         kept among the bifurcations), or not known."""
-        if self.tangent_flow and len(points) >= 2:
+        if len(points) >= 2:
             travel = points[-1].value - points[-2].value
             touch = grazing_ahead(self, points[-1], u, 4 * abs(travel))
             # Ahead only: one behind was passed (and located) already.
@@ -571,7 +568,7 @@ class _Arc:
                 # Across a grazing the two branches' tangents differ in the state (one
                 # strikes the stop): the parameter goes on the way it went.
                 new_t = -new_t
-            if "grazing" in flags and self.tangent_flow:
+            if "grazing" in flags:
                 reach = max(abs(candidate.value - points[-1].value), chord)
                 low = min(candidate.value, points[-1].value) - reach
                 for touch in grazings_between(self, ends, (u, corrected), (low, low + 3 * reach)):

@@ -101,10 +101,7 @@ def refine(
 
 def _newton(arc: _Arc, kind: str, start: np.ndarray) -> tuple[BranchPoint, np.ndarray] | None:
     """:func:`refine`'s iterations."""
-    if (
-        not arc.tangent_flow
-        or arc.run_at(float(start[arc.size] * arc.scale[arc.size])).tangent_refusal()
-    ):
+    if arc.run_at(float(start[arc.size] * arc.scale[arc.size])).tangent_refusal():
         return None
     w = start.copy()
     step = 1e-7
