@@ -5,9 +5,9 @@ Sensitivities beside a frequency response
 ``examples/frf_impact_damper.toml`` swept up in frequency, each settled point's periodic
 orbit differentiated in the damper's clearance (``derivatives=``, as ``vibroimpact sweep
 --derivative damper.0.clearance`` does): by the implicit function theorem on the shooting
-equations, ``dz/dp = (I - M)^-1 dP/dp``, the monodromy ``M`` from the tangent flow through
-the impacts. Where the damper rattles, a larger clearance changes the amplitude by
-millimetres per millimetre; below, where it rests, not at all.
+equations, ``dz/dp = (I - M)^-1 dP/dp``, the monodromy ``M`` and ``dP/dp`` from one run of
+the tangent flow through the impacts. Where the damper rattles, a larger clearance changes
+the amplitude by millimetres per millimetre; below, where it rests, not at all.
 """
 
 from pathlib import Path

@@ -71,7 +71,6 @@ from vibroimpact._core import (
     linear_contact_duration,
     lyapunov_spectrum,
     tangent_map,
-    tangent_refusal,
 )
 from vibroimpact._core import cantilever_mode_shape as _cantilever_mode_shape
 from vibroimpact._core import check_solver as _check_solver
@@ -139,7 +138,6 @@ __all__ = [
     "run_study",
     "tangent_map",
     "lyapunov_spectrum",
-    "tangent_refusal",
     "interactions",
     "linear_parts",
     "PreparedSystem",

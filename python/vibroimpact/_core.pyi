@@ -46,7 +46,6 @@ __all__ = [
     "run_study",
     "tangent_map",
     "lyapunov_spectrum",
-    "tangent_refusal",
     "interactions",
 ]
 
@@ -333,11 +332,15 @@ class PreparedSystem:
         jacobian: str = "differences",
     ) -> dict[str, Any]: ...
 
-def tangent_map(prepared: PreparedSystem, state: list[float], t_end: float) -> dict[str, Any]: ...
+def tangent_map(
+    prepared: PreparedSystem,
+    state: list[float],
+    t_end: float,
+    parameters: list[tuple[PreparedSystem, PreparedSystem, float]] = ...,
+) -> dict[str, Any]: ...
 def lyapunov_spectrum(
     prepared: PreparedSystem, state: list[float], block_time: float, blocks: int
 ) -> dict[str, Any]: ...
-def tangent_refusal(prepared: PreparedSystem) -> str | None: ...
 def interactions(prepared: PreparedSystem) -> list[dict[str, Any]]: ...
 def simulate(
     system: ImpactDamper,

@@ -48,7 +48,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system::run_study, m)?)?;
     m.add_function(wrap_pyfunction!(tangent::tangent_map, m)?)?;
     m.add_function(wrap_pyfunction!(tangent::lyapunov_spectrum, m)?)?;
-    m.add_function(wrap_pyfunction!(tangent::tangent_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(tangent::interactions, m)?)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;

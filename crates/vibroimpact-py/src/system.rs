@@ -359,9 +359,6 @@ impl PreparedSystem {
             .map_err(to_py)?;
         let mut ready = self.locked(Some(&state))?;
         let ready: &mut Ready = &mut ready;
-        if tangent {
-            core::analysis::tangent::check(&ready.system).map_err(to_py)?;
-        }
         let mut grazed = Vec::new();
         let shot = released(py, |interrupt| {
             if tangent {

@@ -6,7 +6,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::analysis::tangent::{self, Grazing, Tangent};
+use vibroimpact_core::analysis::tangent::{self, Grazing, Shifted, Tangent};
 use vibroimpact_core::methods::registry::T_END;
 use vibroimpact_core::model::assembly::Scratch;
 
@@ -14,14 +14,28 @@ use crate::errors::{released, to_py, InvalidInputError};
 use crate::system::{full_state, PreparedSystem, Ready};
 
 /// The prepared system's run state, locked, with `state` checked to be `2 dim`
-/// values and the system able to carry a tangent flow.
+/// values.
 fn ready_for<'a>(
     prepared: &'a PreparedSystem,
     state: &[f64],
 ) -> PyResult<std::sync::MutexGuard<'a, Ready>> {
-    let ready = prepared.locked(Some(state))?;
-    tangent::check(&ready.system).map_err(to_py)?;
-    Ok(ready)
+    prepared.locked(Some(state))
+}
+
+/// Each parameter's two systems, made at `p + delta` and `p - delta`.
+fn shifted_systems(
+    parameters: Vec<(PyRef<'_, PreparedSystem>, PyRef<'_, PreparedSystem>, f64)>,
+) -> PyResult<Vec<Shifted>> {
+    parameters
+        .into_iter()
+        .map(|(plus, minus, delta)| {
+            Ok(Shifted {
+                plus: plus.locked(None)?.system.clone(),
+                minus: minus.locked(None)?.system.clone(),
+                delta,
+            })
+        })
+        .collect()
 }
 
 /// The grazings as a list of `(time s, pair name, closing speed m/s)`.
@@ -40,26 +54,31 @@ pub(crate) fn grazings<'py>(
 /// The tangent map of a run of `t_end` s from the flat state `state` (x then
 /// v): `state` (the end's), `rate` (its derivative in time there), `matrix` (the derivative of the end state by the
 /// start state, row-major), `impacts` (events whose impulses acted, or where a
-/// compliant contact began) and
+/// compliant contact began),
 /// `grazings` (list of `(time, pair, speed)`, where the flow has no
-/// derivative).
+/// derivative) and `parameters` (the derivatives of the end state by each of
+/// `parameters`, row-major `2 dim x m`, at fixed `t_end`: each given as the
+/// system made at `p + delta`, the one at `p - delta`, and `delta`).
 #[pyfunction]
+#[pyo3(signature = (prepared, state, t_end, parameters = Vec::new()))]
 pub fn tangent_map<'py>(
     py: Python<'py>,
     prepared: &PreparedSystem,
     state: Vec<f64>,
     #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
+    parameters: Vec<(PyRef<'py, PreparedSystem>, PyRef<'py, PreparedSystem>, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     T_END.check(t_end).map_err(to_py)?;
+    let shifted = shifted_systems(parameters)?;
     let mut guard = ready_for(prepared, &state)?;
     let ready: &mut Ready = &mut guard;
-    let (end, rate, matrix, impacts, found) = released(py, |interrupt| {
+    let (end, rate, matrix, impacts, found, columns) = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
         let options = ready.options(t_end, (false, 1), None, None);
         let Ready {
             system, stepper, ..
         } = ready;
-        let mut flow = Tangent::product(system)?;
+        let mut flow = Tangent::with_parameters(system, shifted)?;
         let end = stepper.integrate_observed(system, &y0, &options, interrupt, &mut flow)?;
         let size = 2 * system.dim;
         // The state's rate at the end, in the end's modes: a gap's second
@@ -75,6 +94,7 @@ pub fn tangent_map<'py>(
             flow.matrix().to_vec(),
             flow.impacts(),
             flow.grazings().to_vec(),
+            flow.parameter_columns().to_vec(),
         ))
     })?;
     let out = PyDict::new(py);
@@ -83,6 +103,7 @@ pub fn tangent_map<'py>(
     out.set_item("matrix", matrix.into_pyarray(py))?;
     out.set_item("impacts", impacts)?;
     out.set_item("grazings", grazings(py, &ready.system, &found)?)?;
+    out.set_item("parameters", columns.into_pyarray(py))?;
     Ok(out)
 }
 
@@ -134,14 +155,6 @@ pub fn lyapunov_spectrum<'py>(
     out.set_item("impacts", spectrum.impacts)?;
     out.set_item("grazings", grazings(py, &ready.system, &spectrum.grazings)?)?;
     Ok(out)
-}
-
-/// Why the prepared system's tangent flow cannot be made exactly (a
-/// compliant pair), or None where it can.
-#[pyfunction]
-pub fn tangent_refusal(prepared: &PreparedSystem) -> PyResult<Option<String>> {
-    let ready = prepared.locked(None)?;
-    Ok(tangent::check(&ready.system).err().map(|e| e.to_string()))
 }
 
 /// Each interaction (a wall of a pair) of the prepared system: `pair` (its

@@ -284,21 +284,20 @@ class _Arc:
 
     def jacobian(self, u: np.ndarray, centre: np.ndarray | None = None) -> np.ndarray:
         # ``centre``: the residual at ``u``, where the caller has it. The state's
-        # columns from the tangent flow through the impacts and contacts
-        # (exact), else central differences; the parameter's by central differences.
+        # columns from the tangent flow through the impacts and contacts (exact); the
+        # parameter's by central differences of the map: two runs of the exact flow cost
+        # less than carrying a parameter's column through every step (the ball on the
+        # table: 0.018 ms against 0.21 ms, equal to the digits a corrector needs).
         jac = np.zeros((self.size, self.size + 1))
         if centre is None:
             centre = self.residual(u)
         z = u[: self.size] * self.scale[: self.size]
         p = float(u[self.size] * self.scale[self.size])
         run = self.run_at(p)
-        by_tangent = run.tangent_refusal() is None
-        if by_tangent:
-            monodromy = run.tangent(z, self.periods * run.period)["matrix"]
-            scale = self.scale[: self.size]
-            jac[:, : self.size] = (monodromy - np.eye(self.size)) * scale[None, :] / scale[:, None]
-        for j in [self.size] if by_tangent else range(self.size + 1):
-            jac[:, j] = self._difference(u, j, centre)
+        monodromy = run.tangent(z, self.periods * run.period)["matrix"]
+        scale = self.scale[: self.size]
+        jac[:, : self.size] = (monodromy - np.eye(self.size)) * scale[None, :] / scale[:, None]
+        jac[:, self.size] = self._difference(u, self.size, centre)
         return jac
 
     def _difference(self, u: np.ndarray, j: int, centre: np.ndarray) -> np.ndarray:

@@ -104,9 +104,6 @@ def curve(
     arguments.positive("tolerance", tolerance)
     s0 = _value_of(data, second)
     at_start = with_parameter(data, parameter, start)
-    refusal = runner(at_start, base_dir).tangent_refusal()
-    if refusal:
-        raise AnalysisError(refusal)
     branch = continue_orbit(
         at_start,
         parameter,

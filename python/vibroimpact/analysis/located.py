@@ -101,8 +101,6 @@ def refine(
 
 def _newton(arc: _Arc, kind: str, start: np.ndarray) -> tuple[BranchPoint, np.ndarray] | None:
     """:func:`refine`'s iterations."""
-    if arc.run_at(float(start[arc.size] * arc.scale[arc.size])).tangent_refusal():
-        return None
     w = start.copy()
     step = 1e-7
     for _ in range(ITERATIONS):

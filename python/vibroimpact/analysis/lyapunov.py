@@ -86,9 +86,6 @@ def lyapunov(
     run = as_runner(run)
     state = checked_run(run, state)
     forced = bool(run.prepared.spec.get("excitation"))
-    refusal = run.tangent_refusal()
-    if refusal:
-        raise AnalysisError(refusal)
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     if forced:
         settle = 100 if settle is None else whole_count("settle", settle, 0)

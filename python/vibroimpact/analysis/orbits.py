@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact.analysis.limits import AnalysisError, whole_count
+from vibroimpact.analysis.limits import whole_count
 from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run, state_arrays
 from vibroimpact.model.system import System
 from vibroimpact.summary import summarised
@@ -70,11 +70,8 @@ def orbit(
     arguments.positive("tolerance", tolerance)
     max_iterations = whole_count("max_iterations", max_iterations, 1)
     jacobian = arguments.choice("jacobian", jacobian, ("auto", "tangent", "differences"))
-    refusal = run.tangent_refusal()
     if jacobian == "auto":
-        jacobian = "differences" if refusal else "tangent"
-    elif jacobian == "tangent" and refusal:
-        raise AnalysisError(f"jacobian: {refusal}")
+        jacobian = "tangent"
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     shot = run.shoot(z, periods, tolerance, max_iterations, jacobian)
     size = len(z)

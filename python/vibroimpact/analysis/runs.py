@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -17,7 +17,6 @@ from vibroimpact._core import (
     PreparedSystem,
     SimulationError,
     tangent_map,
-    tangent_refusal,
 )
 from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
@@ -192,20 +191,28 @@ class Runner:
         assert z is not None  # count >= 1: the loop ran
         return z
 
-    def tangent_refusal(self) -> str | None:
-        """Why this system's tangent flow cannot be made exactly (a compliant pair),
-        or None where it can (every law has one)."""
-        return tangent_refusal(self.system())
-
-    def tangent(self, state: np.ndarray, t_end: float) -> dict[str, Any]:
+    def tangent(
+        self,
+        state: np.ndarray,
+        t_end: float,
+        parameters: Sequence[tuple[Runner, Runner, float]] = (),
+    ) -> dict[str, Any]:
         """The tangent map of a run of ``t_end`` s from ``state``: ``state`` (the
-        end's), ``matrix`` (d end state / d start state), ``impacts`` and ``grazings``
-        (the compiled core's ``tangent_map``)."""
+        end's), ``rate`` (its time derivative there), ``matrix`` (d end state / d start
+        state), ``impacts`` and ``grazings`` (the compiled core's ``tangent_map``); and
+        ``parameters``, the derivatives of the end state by each parameter of
+        ``parameters`` (one column each, at fixed ``t_end``), each given as the
+        runners of the system made at ``p + delta`` and ``p - delta``, and ``delta``:
+        carried by the tangent flow beside the map (the forward sensitivity
+        equations, the rates' and gaps' own quotients between the two systems, see
+        ``core::analysis::tangent::parameters``)."""
         z = arguments.state("state", state, 2 * (self.n + self.k))
         assert z is not None
-        raw = tangent_map(self.system(), [float(v) for v in z], float(t_end))
+        shifted = [(up.system(), down.system(), float(delta)) for up, down, delta in parameters]
+        raw = tangent_map(self.system(), [float(v) for v in z], float(t_end), shifted)
         size = len(z)
         raw["matrix"] = np.asarray(raw["matrix"], dtype=float).reshape(size, size)
+        raw["parameters"] = np.asarray(raw["parameters"], dtype=float).reshape(size, len(shifted))
         self.runs += 1
         return raw
 

@@ -1,12 +1,14 @@
-"""Sensitivities of a periodic orbit to the scenario's parameters, by the implicit
-function theorem on the shooting equations: at an orbit ``P_p(z) = z``,
-``dz/dp = (I - M)^-1 dP/dp`` with ``M`` the monodromy (from the tangent flow through the
-impacts and contacts, or central differences) and ``dP/dp`` the map's
-derivative in the parameter (a central difference of two runs of the map from the
-orbit's own state). The amplitudes' derivatives: central differences of the orbits'
-located peaks at ``p +- h``, each run from the state the theorem predicts there (so no
-Newton solve). SI units: per unit of the parameter. A sweep's points take theirs from the
-orbit through each point's settled state (:func:`settled_derivatives`)."""
+"""Sensitivities of a periodic orbit to the scenario's parameters, by the implicit function
+theorem on the shooting equations: at an orbit ``P_p(z) = z``, ``dz/dp = (I - M)^-1
+dP/dp`` with ``M`` the monodromy and ``dP/dp`` the map's derivative in the parameter,
+both from one run of the tangent flow through the impacts and contacts (its columns by
+the parameters: the forward sensitivity equations, see
+:meth:`~vibroimpact.analysis.runs.Runner.tangent`), plus the end's rate times the move
+of the orbit's period where the parameter moves it (a forcing frequency). The
+amplitudes' derivatives: central differences of the orbits' located peaks at ``p +- h``,
+each run from the state the theorem predicts there (so no Newton solve). SI units: per
+unit of the parameter. A sweep's points take theirs from the orbit through each point's
+settled state (:func:`settled_derivatives`)."""
 
 from __future__ import annotations
 
@@ -28,7 +30,8 @@ from vibroimpact.analysis.steady import SteadyState
 from vibroimpact.model.system import System, sections_of
 
 #: The parameter's step in the differences, relative to its value (absolute where the
-#: value is 0): a map's central difference errs by ``h^2`` and by round-off over ``h``.
+#: value is 0): a map's central difference errs by ``h^2`` and by round-off over ``h``;
+#: the tangent flow's quotients of the rates and gaps take the same step.
 RELATIVE_STEP = 1e-6
 
 #: ``I - M`` counts as singular below this smallest singular value, relative to its
@@ -104,15 +107,18 @@ def orbit_derivatives(
     paths = derivative_paths(data, paths)
     out: dict[str, Derivative] = {}
     size = len(found.state)
-    structure: list[int] = []
+    base = runner(data, base_dir)
+    shifted: list[tuple[Runner, Runner, float]] = []
     for path in paths:
         value = _value_of(data, path)
         h = RELATIVE_STEP * (abs(value) if value else 1.0)
-        runs = [runner(with_parameter(data, path, value + s * h), base_dir) for s in (1.0, -1.0)]
-        up, down = (run.map(found.state, periods) for run in runs)
-        n, d = runs[0].n, runs[0].n + runs[0].k
-        structure = [*range(n), *range(d, d + n)]
-        state = _orbit_shift(np.eye(size) - found.monodromy, (up - down) / (2 * h), structure)
+        up, down = (runner(with_parameter(data, path, value + s * h), base_dir) for s in (1, -1))
+        shifted.append((up, down, h))
+    map_by = map_derivatives(base, found.state, periods, shifted)
+    n, d = base.n, base.n + base.k
+    structure = [*range(n), *range(d, d + n)]
+    for column, (path, (*runs, h)) in enumerate(zip(paths, shifted, strict=True)):
+        state = _orbit_shift(np.eye(size) - found.monodromy, map_by[:, column], structure)
         amplitudes = []
         for sign, run in zip((1.0, -1.0), runs, strict=True):
             recorded = run.periods(found.state + sign * h * state, periods, record=True)
@@ -120,6 +126,24 @@ def orbit_derivatives(
         out[path] = Derivative(
             state, *((up - down) / (2 * h) for up, down in zip(*amplitudes, strict=True))
         )
+    return out
+
+
+def map_derivatives(
+    run: Runner,
+    state: np.ndarray,
+    periods: int,
+    shifted: Sequence[tuple[Runner, Runner, float]],
+) -> np.ndarray:
+    """The derivatives of the stroboscopic map over ``periods`` forcing periods from
+    ``state`` by each parameter of ``shifted`` (its runners at ``p +- delta`` and
+    ``delta``), one column each: the tangent flow's columns at the fixed end, plus the
+    end's rate times the move of the end where the parameter moves the period."""
+    raw = run.tangent(state, periods * run.period, shifted)
+    moved = np.array(
+        [periods * (up.period - down.period) / (2 * delta) for up, down, delta in shifted]
+    )
+    out: np.ndarray = raw["parameters"] + np.outer(np.asarray(raw["rate"], dtype=float), moved)
     return out
 
 

@@ -5,7 +5,7 @@ use super::run::{run_options, stepper_of};
 use super::settings::{Analysis, StudySettings};
 
 use crate::analysis::settling::{self, MAX_PERIOD};
-use crate::analysis::tangent::{self, Tangent};
+use crate::analysis::tangent::Tangent;
 use crate::error::{Error, Result};
 use crate::kernel::events::{ContactKind, RunOptions, SystemSolution};
 use crate::kernel::reductions::ReduceOptions;
@@ -103,28 +103,18 @@ pub(super) fn orbit_metrics(
         }
         run
     };
-    let shot = if tangent::check(system).is_ok() {
-        // The monodromy from the tangent flow through the impacts (exact).
-        shooting::shoot_by_tangent(
-            &mut |z| {
-                let mut flow = Tangent::product(system)?;
-                let end = run_from(z, &span_options, Some(&mut flow))?.final_state;
-                Ok((end, flow.matrix().to_vec()))
-            },
-            &z,
-            period,
-            ORBIT_TOLERANCE,
-            ORBIT_ITERATIONS,
-        )?
-    } else {
-        shooting::shoot(
-            &mut |z| Ok(run_from(z, &span_options, None)?.final_state),
-            &z,
-            period,
-            ORBIT_TOLERANCE,
-            ORBIT_ITERATIONS,
-        )?
-    };
+    // The monodromy from the tangent flow through the impacts and contacts.
+    let shot = shooting::shoot_by_tangent(
+        &mut |z| {
+            let mut flow = Tangent::product(system)?;
+            let end = run_from(z, &span_options, Some(&mut flow))?.final_state;
+            Ok((end, flow.matrix().to_vec()))
+        },
+        &z,
+        period,
+        ORBIT_TOLERANCE,
+        ORBIT_ITERATIONS,
+    )?;
     if !shot.converged {
         let refused = shot
             .refusal

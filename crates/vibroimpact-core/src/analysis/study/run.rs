@@ -7,7 +7,7 @@ use super::lockstep::run_lockstep;
 use super::metrics::{metrics_of, orbit_metrics, recorded_periods, RunMetrics};
 use super::parameters::{Parameter, Target};
 use super::settings::{Analysis, StudySettings};
-use crate::analysis::tangent::{self, Tangent};
+use crate::analysis::tangent::Tangent;
 use crate::error::{Error, Result};
 use crate::kernel::events::RunOptions;
 use crate::kernel::reductions::ReduceOptions;
@@ -31,13 +31,6 @@ pub fn run_study(
         // Refused up front on the base scenario; an axis may still make a
         // point aperiodic, which then fails alone.
         forcing_period(spec)?;
-    }
-    if settings.lyapunov {
-        // Every run alike would fail on a compliant pair, which no axis
-        // changes: refused up front.
-        if let Ok(system) = Assembly::new(spec) {
-            tangent::check(&system)?;
-        }
     }
     if settings.method == "exact" {
         // Every run alike would fail on a law's or a signal's kind, which no

@@ -52,18 +52,27 @@ pub(super) struct ContactSteps {
     k_phi: Vec<f64>,
     /// The step's stretches, as fractions of it (graded at its edges).
     marks: Vec<f64>,
-    /// The gain by the latched rates ([`super::latched`]): its stage, sum
-    /// and rate buffers (`2 dim x interactions`; empty where none latches).
+    /// The extra columns' stage, sum and rate buffers ([`Extra`]).
     stage_g: Vec<f64>,
     sum_g: Vec<f64>,
     k_g: Vec<f64>,
 }
 
-/// A step's gain by the latched approach rates: which interactions latch,
-/// and `G` (row-major `2 dim x interactions`) to fill.
-pub(super) struct Gain<'a> {
-    pub(super) which: &'a [bool],
-    pub(super) gain: &'a mut [f64],
+/// Columns carried beside the map over a step, `X' = J X + B(t, y)`: the
+/// gain by the latched approach rates ([`super::latched`]) and the
+/// derivatives by parameters ([`super::parameters`]).
+pub(super) struct Extra<'a> {
+    /// `X`, row-major `2 dim x columns`, carried from its value in place.
+    pub(super) values: &'a mut [f64],
+    pub(super) columns: usize,
+    pub(super) source: &'a mut dyn Source,
+}
+
+/// The inhomogeneous term `B` of [`Extra`]'s columns.
+pub(super) trait Source {
+    /// `B` at `time`, state `y` (`x` then `v`) and `modes`, added into
+    /// `out` (row-major `2 dim x columns`).
+    fn add(&mut self, system: &Assembly, time: f64, y: &[f64], modes: &[Mode], out: &mut [f64]);
 }
 
 impl ContactSteps {
@@ -105,6 +114,11 @@ impl ContactSteps {
     /// The step's stretches into `self.marks`: the whole, graded towards an
     /// end that is an onset or a separation (towards both from the middle).
     fn grade(&mut self, system: &Assembly, y0: &[f64], y1: &[f64], modes: &[Mode]) {
+        if !super::in_contact(modes) {
+            self.marks.clear();
+            self.marks.extend([0.0, 1.0]);
+            return;
+        }
         let (start, end) = (
             Self::indentation(system, y0, modes),
             Self::indentation(system, y1, modes),
@@ -162,148 +176,121 @@ impl ContactSteps {
     }
 
     /// The tangent factor of the step from `(t0, y0)` to `(t1, y1)` in
-    /// `modes` into `out` (row-major `2 dim x 2 dim`), and its gain by the
-    /// latched rates where asked.
+    /// `modes` into `out` (row-major `2 dim x 2 dim`; None: not asked, a
+    /// step whose map is linear and carried whole at the events), and the
+    /// extra columns carried over it where asked.
     pub(super) fn factor(
         &mut self,
         system: &Assembly,
         (t0, y0): (f64, &[f64]),
         (t1, y1): (f64, &[f64]),
         modes: &[Mode],
-        out: &mut [f64],
-        mut gain: Option<Gain<'_>>,
+        mut out: Option<&mut [f64]>,
+        mut extra: Option<Extra<'_>>,
     ) {
         let d = system.dim;
         let size = 2 * d;
         let h = t1 - t0;
-        let mut fastest = 0.0f64;
+        // The forcing's rate too: a step between contacts may span a period.
+        let mut fastest = std::f64::consts::TAU / (10.0 * system.sticking_step);
         for y in [y0, y1] {
             self.jacobian_at(system, y, modes);
             fastest = fastest.max(self.fastest(d));
         }
         self.grade(system, y0, y1, modes);
         self.state.copy_from_slice(y0);
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for i in 0..size {
-            out[i * size + i] = 1.0;
+        if let Some(out) = out.as_deref_mut() {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            for i in 0..size {
+                out[i * size + i] = 1.0;
+            }
         }
-        if let Some(g) = gain.as_mut() {
-            g.gain.iter_mut().for_each(|v| *v = 0.0);
+        if let Some(x) = extra.as_ref() {
             for buffer in [&mut self.stage_g, &mut self.sum_g, &mut self.k_g] {
-                buffer.resize(g.gain.len(), 0.0);
+                buffer.resize(x.values.len(), 0.0);
             }
         }
         for stretch in 1..self.marks.len() {
             let (from, to) = (self.marks[stretch - 1], self.marks[stretch]);
             let length = (to - from) * h;
-            let least = GRADED;
             let substeps =
-                ((length * fastest / SUBSTEP).ceil() as usize).clamp(least, MOST_SUBSTEPS);
+                ((length * fastest / SUBSTEP).ceil() as usize).clamp(GRADED, MOST_SUBSTEPS);
             let dt = length / substeps as f64;
             for n in 0..substeps {
                 let t = t0 + from * h + n as f64 * dt;
-                self.substep(system, (t, dt), modes, out, gain.as_mut());
+                self.substep(system, (t, dt), modes, out.as_deref_mut(), extra.as_mut());
             }
         }
     }
 
     /// One classical Runge-Kutta substep of `dt` s from `t` of the state in
-    /// `self.state`, the tangent `out` and the gain, in `modes`.
+    /// `self.state`, the tangent `out` and the extra columns, in `modes`.
     fn substep(
         &mut self,
         system: &Assembly,
         (t, dt): (f64, f64),
         modes: &[Mode],
-        out: &mut [f64],
-        gain: Option<&mut Gain<'_>>,
+        out: Option<&mut [f64]>,
+        mut extra: Option<&mut Extra<'_>>,
     ) {
         let size = 2 * system.dim;
+        self.sum_y.iter_mut().for_each(|v| *v = 0.0);
+        self.sum_phi.iter_mut().for_each(|v| *v = 0.0);
+        self.sum_g.iter_mut().for_each(|v| *v = 0.0);
+        for (stage, (offset, weight)) in [(0.0, 1.0), (0.5, 2.0), (0.5, 2.0), (1.0, 1.0)]
+            .into_iter()
+            .enumerate()
         {
-            self.sum_y.iter_mut().for_each(|v| *v = 0.0);
-            self.sum_phi.iter_mut().for_each(|v| *v = 0.0);
-            self.sum_g.iter_mut().for_each(|v| *v = 0.0);
-            for (stage, (offset, weight)) in [(0.0, 1.0), (0.5, 2.0), (0.5, 2.0), (1.0, 1.0)]
-                .into_iter()
-                .enumerate()
-            {
-                if let Some(g) = gain.as_deref() {
-                    for (p, value) in self.stage_g.iter_mut().enumerate() {
-                        *value =
-                            g.gain[p] + offset * dt * if stage == 0 { 0.0 } else { self.k_g[p] };
-                    }
-                }
-                if stage == 0 {
-                    self.stage_y.copy_from_slice(&self.state);
-                    self.stage_phi.copy_from_slice(out);
-                } else {
-                    for i in 0..size {
-                        self.stage_y[i] = self.state[i] + offset * dt * self.k_y[i];
-                    }
-                    for (p, value) in self.stage_phi.iter_mut().enumerate() {
-                        *value = out[p] + offset * dt * self.k_phi[p];
-                    }
-                }
-                self.full[..size].copy_from_slice(&self.stage_y);
-                system.rates(
-                    t + offset * dt,
-                    &self.full,
-                    modes,
-                    &mut self.scratch,
-                    &mut self.rates,
-                );
-                self.k_y.copy_from_slice(&self.rates[..size]);
-                let stage_y = std::mem::take(&mut self.stage_y);
-                self.jacobian_at(system, &stage_y, modes);
-                self.stage_y = stage_y;
-                linalg::matmul(&self.jacobian, &self.stage_phi, &mut self.k_phi, size);
-                if let Some(g) = gain.as_deref() {
-                    self.gain_rate(system, g.which, modes, size);
-                }
-                for i in 0..size {
-                    self.sum_y[i] += weight * self.k_y[i];
-                }
-                for (sum, k) in self.sum_phi.iter_mut().zip(&self.k_phi) {
-                    *sum += weight * k;
-                }
-                for (sum, k) in self.sum_g.iter_mut().zip(&self.k_g) {
-                    *sum += weight * k;
+            let step = if stage == 0 { 0.0 } else { offset * dt };
+            if let Some(x) = extra.as_deref() {
+                for ((value, start), k) in self.stage_g.iter_mut().zip(&*x.values).zip(&self.k_g) {
+                    *value = start + step * k;
                 }
             }
             for i in 0..size {
-                self.state[i] += dt / 6.0 * self.sum_y[i];
+                self.stage_y[i] = self.state[i] + step * self.k_y[i];
             }
+            if let Some(out) = out.as_deref() {
+                for ((value, start), k) in self.stage_phi.iter_mut().zip(out).zip(&self.k_phi) {
+                    *value = start + step * k;
+                }
+            }
+            self.full[..size].copy_from_slice(&self.stage_y);
+            let time = t + offset * dt;
+            system.rates(time, &self.full, modes, &mut self.scratch, &mut self.rates);
+            self.k_y.copy_from_slice(&self.rates[..size]);
+            let stage_y = std::mem::take(&mut self.stage_y);
+            self.jacobian_at(system, &stage_y, modes);
+            if out.is_some() {
+                linalg::matmul(&self.jacobian, &self.stage_phi, &mut self.k_phi, size);
+            }
+            if let Some(x) = extra.as_deref_mut() {
+                let columns = x.columns;
+                linalg::matmul_rect(&self.jacobian, &self.stage_g, &mut self.k_g, size, columns);
+                x.source.add(system, time, &stage_y, modes, &mut self.k_g);
+            }
+            self.stage_y = stage_y;
+            for i in 0..size {
+                self.sum_y[i] += weight * self.k_y[i];
+            }
+            for (sum, k) in self.sum_phi.iter_mut().zip(&self.k_phi) {
+                *sum += weight * k;
+            }
+            for (sum, k) in self.sum_g.iter_mut().zip(&self.k_g) {
+                *sum += weight * k;
+            }
+        }
+        for i in 0..size {
+            self.state[i] += dt / 6.0 * self.sum_y[i];
+        }
+        if let Some(out) = out {
             for (value, sum) in out.iter_mut().zip(&self.sum_phi) {
                 *value += dt / 6.0 * sum;
             }
-            if let Some(g) = gain {
-                for (value, sum) in g.gain.iter_mut().zip(&self.sum_g) {
-                    *value += dt / 6.0 * sum;
-                }
-            }
         }
-    }
-
-    /// The gain's rate `J G + B` at the stage in `self.stage_y` (its
-    /// Jacobian in `self.jacobian`, `G` in `self.stage_g`) into `self.k_g`.
-    fn gain_rate(&mut self, system: &Assembly, which: &[bool], modes: &[Mode], size: usize) {
-        let (d, count) = (system.dim, which.len());
-        for r in 0..size {
-            for i in 0..count {
-                self.k_g[r * count + i] = (0..size)
-                    .map(|k| self.jacobian[r * size + k] * self.stage_g[k * count + i])
-                    .sum();
-            }
-        }
-        for (i, (&latches, &mode)) in which.iter().zip(modes).enumerate() {
-            if !latches {
-                continue;
-            }
-            let by_rate = super::latched::Latched::force_by_rate(system, i, &self.stage_y, mode);
-            if by_rate == 0.0 {
-                continue;
-            }
-            for (r, p) in system.interactions()[i].push.iter().enumerate() {
-                self.k_g[(d + r) * count + i] += p * by_rate;
+        if let Some(x) = extra {
+            for (value, sum) in x.values.iter_mut().zip(&self.sum_g) {
+                *value += dt / 6.0 * sum;
             }
         }
     }

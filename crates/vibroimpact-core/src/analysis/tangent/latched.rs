@@ -26,6 +26,11 @@ pub(super) struct Latched {
     full: Vec<f64>,
     rates: Vec<f64>,
     row: Vec<f64>,
+    /// The last onset's `c_i` (the latched rate's derivative by the state
+    /// just before it) and its time shift's part, `h . a- / h . v-` (per
+    /// unit of the gap's change): a parameter's column reads them.
+    pub(super) onset_row: Vec<f64>,
+    pub(super) onset_shift: f64,
 }
 
 impl Latched {
@@ -56,6 +61,8 @@ impl Latched {
             full: vec![0.0; system.state_len()],
             rates: vec![0.0; system.state_len()],
             row: vec![0.0; size],
+            onset_row: vec![0.0; size],
+            onset_shift: 0.0,
         })
     }
 
@@ -127,6 +134,8 @@ impl Latched {
             self.row[c] = shift * hc;
             self.row[d + c] = -hc;
         }
+        self.onset_row.copy_from_slice(&self.row);
+        self.onset_shift = shift;
         if let Some(stretch) = stretch {
             let c_i = self.row.clone();
             for (col, out) in self.row.iter_mut().enumerate() {

@@ -26,6 +26,10 @@
 //! saltation holds the jump of the rates (none for Hertz, whose force is
 //! zero at zero indentation; a contact damper's `c g'` for the others).
 //!
+//! Where asked, the flow also carries the state's derivatives by
+//! parameters ([`parameters`]): `W' = J W + df/dp` over every step, and
+//! `W+ = S W- + s` at each event, `s` the saltation's moved terms.
+//!
 //! The flow is told of events by the one kernel
 //! ([`crate::kernel::observe`]); by concern: this product, the saltation
 //! ([`saltation`]), the Lyapunov exponents ([`lyapunov`]).
@@ -33,18 +37,23 @@
 mod contact;
 mod latched;
 mod lyapunov;
+#[cfg(test)]
+mod parameter_tests;
+mod parameters;
 mod saltation;
 #[cfg(test)]
 mod tests;
 
 pub use lyapunov::{lyapunov_blocks, LyapunovSpectrum};
+pub use parameters::Shifted;
 
 use crate::error::Result;
 use crate::kernel::observe::{EventObserver, EventView};
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 use crate::numerics::linalg;
-use contact::{ContactSteps, Gain};
+use contact::{ContactSteps, Extra, Source};
 use latched::Latched;
+use parameters::Parameters;
 use saltation::Saltation;
 
 /// A grazing met along the run: a pair that touched its wall at a speed of
@@ -58,14 +67,6 @@ pub struct Grazing {
     pub pair: usize,
     /// The closing speed, m/s (of round-off).
     pub speed: f64,
-}
-
-/// Whether `system`'s tangent flow can be made: every pair's law has one
-/// (rigid, and every compliant law, the hysteretic ones' latched approach
-/// rates carried as rows, [`latched`]). An error would name the first pair
-/// whose law has none, and what to do instead.
-pub fn check(_system: &Assembly) -> Result<()> {
-    Ok(())
 }
 
 /// Whether a compliant contact is on: the flow is then not linear, and is
@@ -103,8 +104,15 @@ pub struct Tangent<'s> {
     /// The linear flow's matrix `A` of each set of modes met.
     flows: Vec<(Vec<u8>, Vec<f64>)>,
     saltation: Saltation,
-    /// The steps while a compliant contact is on (None: every pair rigid).
+    /// The steps while a compliant contact is on, or every step where the
+    /// parameters' columns are carried (None: neither).
     contact: Option<ContactSteps>,
+    /// The derivatives by parameters, where asked.
+    parameters: Option<Parameters>,
+    /// A step's extra columns (the latched gain, then the parameters') and
+    /// an event's new parameter columns.
+    extra: Vec<f64>,
+    moved: Vec<f64>,
     /// The hysteretic laws' latched rates (None: no law latches).
     latched: Option<Latched>,
     expm: linalg::Expm,
@@ -141,7 +149,6 @@ impl<'s> Tangent<'s> {
     }
 
     fn new(system: &'s Assembly, keep: Keep) -> Result<Self> {
-        check(system)?;
         let size = 2 * system.dim;
         let mut matrix = vec![0.0; size * size];
         for i in 0..size {
@@ -162,6 +169,9 @@ impl<'s> Tangent<'s> {
                 .any(|it| matches!(it.law, InteractionLaw::Compliant { .. }))
                 .then(|| ContactSteps::new(system)),
             latched: Latched::new(system),
+            parameters: None,
+            extra: Vec::new(),
+            moved: Vec::new(),
             expm: linalg::Expm::new(size),
             factor: vec![0.0; size * size],
             stretch: vec![0.0; size * size],
@@ -170,6 +180,28 @@ impl<'s> Tangent<'s> {
             impacts: 0,
             from: f64::NEG_INFINITY,
         })
+    }
+
+    /// The product carrying, beside the map, the derivatives of the state
+    /// by each parameter of `shifted` (its system made at `p +- delta`):
+    /// see [`Self::parameter_columns`]. Refused where a shifted system
+    /// differs in shape from `system`.
+    pub fn with_parameters(system: &'s Assembly, shifted: Vec<Shifted>) -> Result<Self> {
+        let mut flow = Self::product(system)?;
+        if !shifted.is_empty() {
+            flow.parameters = Some(Parameters::new(system, shifted)?);
+            flow.contact
+                .get_or_insert_with(|| ContactSteps::new(system));
+        }
+        Ok(flow)
+    }
+
+    /// The derivatives of the end state by the parameters (row-major `2 dim
+    /// x m`, `x` then `v`; empty where none was asked), at a fixed time:
+    /// a parameter that also moves the run's end (a forcing frequency, its
+    /// period) adds the end's rate times that move.
+    pub fn parameter_columns(&self) -> &[f64] {
+        self.parameters.as_ref().map_or(&[], |p| &p.columns)
     }
 
     /// The flow carried from `time` (s) on, not from the run's start: the
@@ -273,6 +305,7 @@ impl<'s> Tangent<'s> {
             return;
         };
         let size = self.size;
+        let mut parameters = self.parameters.as_mut();
         for i in 0..view.modes_after.len() {
             if !latched.which[i] {
                 continue;
@@ -281,7 +314,12 @@ impl<'s> Tangent<'s> {
                 (Mode::Open, Mode::Compliant { approach_rate, .. }) => {
                     let event = (view.time, view.before, view.modes_before);
                     let flow = stretch.then_some(&self.stretch[..]);
-                    if !latched.onset(self.system, event, i, approach_rate, flow, &self.matrix) {
+                    let found =
+                        latched.onset(self.system, event, i, approach_rate, flow, &self.matrix);
+                    if let Some(p) = parameters.as_deref_mut() {
+                        p.onset(i, view.before, found.then_some(latched));
+                    }
+                    if !found {
                         self.grazings.push(Grazing {
                             time: view.time,
                             interaction: i,
@@ -293,7 +331,12 @@ impl<'s> Tangent<'s> {
                         });
                     }
                 }
-                (Mode::Compliant { .. }, Mode::Open) => latched.separation(i, size),
+                (Mode::Compliant { .. }, Mode::Open) => {
+                    latched.separation(i, size);
+                    if let Some(p) = parameters.as_deref_mut() {
+                        p.onset(i, view.before, None);
+                    }
+                }
                 _ => {}
             }
         }
@@ -311,6 +354,9 @@ impl EventObserver for Tangent<'_> {
             if self.from > time {
                 latched.rows.iter_mut().for_each(|v| *v = 0.0);
             }
+        }
+        if let Some(p) = self.parameters.as_mut() {
+            p.latched.iter_mut().for_each(|v| *v = 0.0);
         }
         Ok(())
     }
@@ -331,6 +377,18 @@ impl EventObserver for Tangent<'_> {
             std::mem::swap(&mut self.factor, &mut self.stretch);
         }
         let outcome = self.saltation.matrix(self.system, view, &mut self.factor);
+        if let Some(p) = self.parameters.as_ref() {
+            // W+ = S W- + s, kept aside: an onset's latched rate reads W-.
+            let (size, m) = (self.size, p.count());
+            self.moved.resize(size * m, 0.0);
+            self.extra.resize(size * m, 0.0);
+            self.saltation
+                .parameter_columns(self.system, p, view, &mut self.extra);
+            linalg::matmul_rect(&self.factor, &p.columns, &mut self.moved, size, m);
+            for (value, s) in self.moved.iter_mut().zip(&self.extra) {
+                *value += s;
+            }
+        }
 
         if stretch {
             linalg::matmul(&self.factor, &self.stretch, &mut self.product, self.size);
@@ -351,6 +409,9 @@ impl EventObserver for Tangent<'_> {
             .any(|(b, a)| *b == Mode::Open && matches!(a, Mode::Compliant { .. }));
         self.impacts += u64::from(!view.jumps.is_empty() || onset);
         self.latch(view, stretch);
+        if let Some(p) = self.parameters.as_mut() {
+            std::mem::swap(&mut p.columns, &mut self.moved);
+        }
         self.apply(false);
         self.since = view.time;
         self.modes.copy_from_slice(view.modes_after);
@@ -362,33 +423,69 @@ impl EventObserver for Tangent<'_> {
     }
 
     /// A step while a compliant contact is on: its factor from the
-    /// variational equations ([`ContactSteps`]). Other steps are linear,
-    /// carried whole at the events.
+    /// variational equations ([`ContactSteps`]); other steps are linear,
+    /// carried whole at the events. Every step carries the parameters'
+    /// columns, where asked.
     fn step(&mut self, t0: f64, y0: &[f64], t1: f64, y1: &[f64], modes: &[Mode]) -> Result<()> {
-        if !in_contact(modes) || t1 <= t0 {
+        let on = in_contact(modes);
+        if t1 <= t0 || !(on || self.parameters.is_some()) {
             return Ok(());
         }
         if t0 < self.from {
             // Before the flow is carried (a study's settling): a step across
             // its start starts it at the step's end.
-            self.since = self.since.max(t1);
+            if on {
+                self.since = self.since.max(t1);
+            }
             return Ok(());
         }
-        if let Some(contact) = self.contact.as_mut() {
-            let gain = self.latched.as_mut().map(|l| Gain {
-                which: &l.which,
-                gain: &mut l.gain,
-            });
-            let with_gain = gain.is_some();
-            contact.factor(
-                self.system,
-                (t0, y0),
-                (t1, y1),
-                modes,
-                &mut self.factor,
-                gain,
-            );
-            self.apply(with_gain);
+        let Some(contact) = self.contact.as_mut() else {
+            return Ok(());
+        };
+        let size = self.size;
+        let gains = match (on, self.latched.as_ref()) {
+            (true, Some(latched)) => latched.which.len(),
+            _ => 0,
+        };
+        let m = self.parameters.as_ref().map_or(0, |p| p.count());
+        let columns = gains + m;
+        self.extra.resize(size * columns, 0.0);
+        if let Some(p) = self.parameters.as_ref() {
+            for r in 0..size {
+                let row = &mut self.extra[r * columns..(r + 1) * columns];
+                row[..gains].iter_mut().for_each(|v| *v = 0.0);
+                row[gains..].copy_from_slice(&p.columns[r * m..(r + 1) * m]);
+            }
+        } else {
+            self.extra.iter_mut().for_each(|v| *v = 0.0);
+        }
+        let mut sources = Sources {
+            which: self
+                .latched
+                .as_ref()
+                .filter(|_| gains > 0)
+                .map(|l| &l.which[..]),
+            parameters: self.parameters.as_mut(),
+            columns,
+        };
+        let extra = (columns > 0).then(|| Extra {
+            values: &mut self.extra,
+            columns,
+            source: &mut sources,
+        });
+        let out = on.then_some(&mut self.factor[..]);
+        contact.factor(self.system, (t0, y0), (t1, y1), modes, out, extra);
+        for r in 0..size {
+            let row = &self.extra[r * columns..(r + 1) * columns];
+            if let Some(latched) = self.latched.as_mut().filter(|_| gains > 0) {
+                latched.gain[r * gains..(r + 1) * gains].copy_from_slice(&row[..gains]);
+            }
+            if let Some(p) = self.parameters.as_mut() {
+                p.columns[r * m..(r + 1) * m].copy_from_slice(&row[gains..]);
+            }
+        }
+        if on {
+            self.apply(gains > 0);
             self.since = t1;
         }
         Ok(())
@@ -402,5 +499,47 @@ impl EventObserver for Tangent<'_> {
         self.since = time;
         self.modes.copy_from_slice(modes);
         Ok(())
+    }
+}
+
+/// The extra columns' `B` over a step: the latched rates' gain (a column
+/// per interaction, `M^-1 h^T dF/dv0` where it latches), then each
+/// parameter's `df/dp` plus the gain times its latched rates' derivatives.
+struct Sources<'a> {
+    which: Option<&'a [bool]>,
+    parameters: Option<&'a mut Parameters>,
+    columns: usize,
+}
+
+impl Source for Sources<'_> {
+    fn add(&mut self, system: &Assembly, time: f64, y: &[f64], modes: &[Mode], out: &mut [f64]) {
+        let (d, columns) = (system.dim, self.columns);
+        let gains = self.which.map_or(0, <[bool]>::len);
+        if let Some(which) = self.which {
+            for (i, (&latches, &mode)) in which.iter().zip(modes).enumerate() {
+                let by_rate = if latches {
+                    Latched::force_by_rate(system, i, y, mode)
+                } else {
+                    0.0
+                };
+                if by_rate == 0.0 {
+                    continue;
+                }
+                let m = columns - gains;
+                for (r, p) in system.interactions()[i].push.iter().enumerate() {
+                    let row = &mut out[(d + r) * columns..(d + r + 1) * columns];
+                    row[i] += p * by_rate;
+                    if let Some(parameters) = self.parameters.as_deref() {
+                        let rates = &parameters.latched[i * m..(i + 1) * m];
+                        for (value, l) in row[gains..].iter_mut().zip(rates) {
+                            *value += p * by_rate * l;
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(parameters) = self.parameters.as_deref_mut() {
+            parameters.add_field(time, y, modes, out, (gains, columns));
+        }
     }
 }

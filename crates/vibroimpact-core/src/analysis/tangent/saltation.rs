@@ -3,8 +3,9 @@
 //! rates change from `f-` to `f+`:
 //! `S = R + (f+ - R f-) grad(g)^T / (grad(g) . f-)`.
 
+use super::parameters::Parameters;
 use crate::kernel::observe::{EventView, Jump};
-use crate::model::assembly::{Assembly, Mode, Scratch};
+use crate::model::assembly::{Assembly, Interaction, Mode, Scratch};
 use crate::numerics::linalg;
 
 /// A closing speed below this fraction of the speeds in play is a touch at
@@ -29,6 +30,17 @@ pub(super) struct Saltation {
     reset: Vec<f64>,
     column: Vec<f64>,
     coupling: Vec<f64>,
+    /// The last event's `(f+ - R f-) / (grad(g) . f-)`: the saltation's
+    /// column per unit of the located gap's change (zero where the event
+    /// had no time shift: a release, a grazing, a landing at rest).
+    jump: Vec<f64>,
+    /// Whether the last event was a landing at rest (its displacements
+    /// projected as the velocities are).
+    landed: bool,
+    /// Buffers of [`Self::parameter_columns`].
+    velocities: Vec<f64>,
+    values: Vec<f64>,
+    parameter: Vec<f64>,
 }
 
 impl Saltation {
@@ -42,6 +54,11 @@ impl Saltation {
             reset: vec![0.0; d * d],
             column: Vec::new(),
             coupling: Vec::new(),
+            jump: vec![0.0; 2 * d],
+            landed: false,
+            velocities: vec![0.0; d],
+            values: Vec::new(),
+            parameter: vec![0.0; 2 * d],
         }
     }
 
@@ -94,15 +111,7 @@ impl Saltation {
         out: &mut [f64],
     ) -> Outcome {
         let outcome = self.jump_matrix(system, view, out);
-        let sticking: Vec<Jump> = view
-            .jumps
-            .iter()
-            .filter(|j| view.modes_after[j.interaction] == Mode::Sticking)
-            .map(|j| Jump {
-                interaction: j.interaction,
-                restitution: 0.0,
-            })
-            .collect();
+        let sticking = sticking(view);
         if !sticking.is_empty() {
             self.reset_map(system, &sticking);
             let (d, size) = (system.dim, 2 * system.dim);
@@ -135,6 +144,8 @@ impl Saltation {
             }
         }
         let located = view.located;
+        self.jump.iter_mut().for_each(|v| *v = 0.0);
+        self.landed = false;
         let side = match view.modes_before[located] {
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
@@ -154,6 +165,7 @@ impl Saltation {
             let rests = view.modes_after[located] == Mode::Sticking
                 || view.jumps.iter().any(|j| j.interaction == located);
             if rests {
+                self.landed = true;
                 // The limit of a plastic impact's saltation as its speed goes
                 // to zero: the displacements projected as the velocities are
                 // (`I + (v+ - v-) h^T / u` is `R_v` there), a perturbation off
@@ -180,11 +192,100 @@ impl Saltation {
                 linalg::dot(row, &self.minus[d..size])
             };
             let jump = (self.plus[r] - reset_minus) * side / closing;
+            self.jump[r] = jump;
             for (c, hc) in h.iter().enumerate() {
                 out[r * size + c] += jump * hc;
             }
         }
         Outcome { grazing: None }
+    }
+
+    /// The event's columns by the parameters into `out` (row-major `2 dim x
+    /// m`), after [`Self::matrix`] of the same event: `W+ = S W- + out`.
+    /// They hold the reset moved, `(dR/dp) v-`; the time shift moved by the
+    /// located gap's `dg/dp`; and where pairs land at rest or start to
+    /// stick, their gaps (and rates) held at zero from moved offsets.
+    pub(super) fn parameter_columns(
+        &mut self,
+        system: &Assembly,
+        parameters: &Parameters,
+        view: &EventView<'_>,
+        out: &mut [f64],
+    ) {
+        let (d, size, m) = (system.dim, 2 * system.dim, parameters.count());
+        let sticking = sticking(view);
+        let v_minus = &view.before[d..size];
+        for (j, s) in parameters.shifted.iter().enumerate() {
+            let mut column = std::mem::take(&mut self.parameter);
+            column.iter_mut().for_each(|v| *v = 0.0);
+            // (R(p + delta) - R(p - delta)) v- / (2 delta).
+            for (other, sign) in [(&s.plus, 1.0), (&s.minus, -1.0)] {
+                if view.jumps.is_empty() {
+                    break;
+                }
+                self.values.clear();
+                self.values.extend(view.jumps.iter().map(|jump| {
+                    let e = Parameters::restitution_in(system, other, jump);
+                    (1.0 + e) * linalg::dot(&other.interactions[jump.interaction].h, v_minus)
+                }));
+                self.velocities.copy_from_slice(v_minus);
+                push_back(
+                    &other.interactions,
+                    view.jumps,
+                    &mut self.values,
+                    &mut self.velocities,
+                    &mut self.coupling,
+                );
+                for r in 0..d {
+                    column[d + r] += sign * self.velocities[r] / (2.0 * s.delta);
+                }
+            }
+            let (moved, _) = parameters.gap_by(j, view.located, view.before);
+            for (value, jump) in column.iter_mut().zip(&self.jump) {
+                *value += jump * moved;
+            }
+            if self.landed {
+                self.values.clear();
+                self.values.extend(view.jumps.iter().map(|jump| {
+                    (1.0 + jump.restitution) * parameters.gap_by(j, jump.interaction, view.before).0
+                }));
+                let its = &system.interactions;
+                push_back(
+                    its,
+                    view.jumps,
+                    &mut self.values,
+                    &mut column[..d],
+                    &mut self.coupling,
+                );
+            }
+            if !sticking.is_empty() {
+                self.reset_map(system, &sticking);
+                for block in [0, d] {
+                    self.velocities.copy_from_slice(&column[block..block + d]);
+                    for (r, value) in column[block..block + d].iter_mut().enumerate() {
+                        *value = linalg::dot(&self.reset[r * d..(r + 1) * d], &self.velocities);
+                    }
+                }
+                for (block, state, rate) in [(0, view.before, false), (d, view.after, true)] {
+                    self.values.clear();
+                    self.values.extend(sticking.iter().map(|jump| {
+                        let moved = parameters.gap_by(j, jump.interaction, state);
+                        if rate {
+                            moved.1
+                        } else {
+                            moved.0
+                        }
+                    }));
+                    let its = &system.interactions;
+                    let part = &mut column[block..block + d];
+                    push_back(its, &sticking, &mut self.values, part, &mut self.coupling);
+                }
+            }
+            for (r, value) in column.iter().enumerate() {
+                out[r * m + j] = *value;
+            }
+            self.parameter = column;
+        }
     }
 
     /// The rates at `time` in state `y` (`x` then `v`) and `modes`, into
@@ -198,5 +299,46 @@ impl Saltation {
             &mut self.minus
         };
         system.rates(time, &self.full, modes, &mut self.scratch, out);
+    }
+}
+
+/// The pairs of `view`'s event that start to stick (as jumps of restitution
+/// 0: their constraints' projection).
+fn sticking(view: &EventView<'_>) -> Vec<Jump> {
+    view.jumps
+        .iter()
+        .filter(|j| view.modes_after[j.interaction] == Mode::Sticking)
+        .map(|j| Jump {
+            interaction: j.interaction,
+            restitution: 0.0,
+        })
+        .collect()
+}
+
+/// `out -= sum_a push_a z_a` with `W z = values` (`W_ab = h_a . push_b`
+/// over the pairs `jumps`): what moves those pairs' gaps (or their rates,
+/// `out` velocities) by `-values` (`values` is overwritten).
+fn push_back(
+    its: &[Interaction],
+    jumps: &[Jump],
+    values: &mut [f64],
+    out: &mut [f64],
+    coupling: &mut Vec<f64>,
+) {
+    let m = jumps.len();
+    if m == 0 {
+        return;
+    }
+    coupling.clear();
+    for a in jumps {
+        for b in jumps {
+            coupling.push(linalg::dot(&its[a.interaction].h, &its[b.interaction].push));
+        }
+    }
+    linalg::solve_in_place(coupling, values, m);
+    for (jump, z) in jumps.iter().zip(values.iter()) {
+        for (value, p) in out.iter_mut().zip(&its[jump.interaction].push) {
+            *value -= p * z;
+        }
     }
 }

@@ -25,20 +25,33 @@ fn forced_damper(frequency: f64, amplitude: f64) -> Assembly {
 
 /// The damper's system with its pair's `law`.
 fn forced_with(frequency: f64, amplitude: f64, law: PairLaw) -> Assembly {
+    let signal = Signal::harmonic(frequency, amplitude, 0.0).unwrap();
+    damper_on_oscillator((3000.0, 0.05, 0.01), law, 0.0, signal)
+}
+
+/// An oscillator (1 kg, 2 N s/m, its `stiffness`) driven by `signal` (N) and
+/// carrying a damper (`damper_mass`, `clearance` to each wall) of pair
+/// `law`, under `gravity` (m/s^2).
+pub(super) fn damper_on_oscillator(
+    (stiffness, damper_mass, clearance): (f64, f64, f64),
+    law: PairLaw,
+    gravity: f64,
+    signal: Signal,
+) -> Assembly {
     let spec = SystemSpec {
-        structure: Structure::oscillator(MASS, 3000.0, DAMPING).unwrap(),
+        structure: Structure::oscillator(MASS, stiffness, DAMPING).unwrap(),
         dampers: vec![Damper {
-            mass: 0.05,
+            mass: damper_mass,
             at: 0.0,
-            lower_clearance: 0.01,
-            upper_clearance: 0.01,
+            lower_clearance: clearance,
+            upper_clearance: clearance,
             law,
         }],
         stops: vec![],
-        gravity: 0.0,
+        gravity,
         excitations: vec![Excitation {
             load: Load::Force { at: 0.0 },
-            signal: Signal::harmonic(frequency, amplitude, 0.0).unwrap(),
+            signal,
         }],
         points: vec![],
         moments: vec![],
@@ -46,7 +59,7 @@ fn forced_with(frequency: f64, amplitude: f64, law: PairLaw) -> Assembly {
     Assembly::new(&spec).unwrap()
 }
 
-fn options(t_end: f64, dt: Option<f64>) -> RunOptions {
+pub(super) fn options(t_end: f64, dt: Option<f64>) -> RunOptions {
     RunOptions {
         dt,
         t_end,

@@ -146,6 +146,23 @@ pub fn matmul(a: &[f64], b: &[f64], c: &mut [f64], n: usize) {
     }
 }
 
+/// `C = A B` for row-major `A` (`n x n`) and `B`, `C` (`n x m`).
+pub fn matmul_rect(a: &[f64], b: &[f64], c: &mut [f64], n: usize, m: usize) {
+    for i in 0..n {
+        let row = &mut c[i * m..(i + 1) * m];
+        row.iter_mut().for_each(|v| *v = 0.0);
+        for k in 0..n {
+            let aik = a[i * n + k];
+            if aik == 0.0 {
+                continue;
+            }
+            for (value, b) in row.iter_mut().zip(&b[k * m..(k + 1) * m]) {
+                *value += aik * b;
+            }
+        }
+    }
+}
+
 /// `x^T A x` for a symmetric row-major matrix.
 pub fn quadratic_form(a: &[f64], x: &[f64]) -> f64 {
     let n = x.len();
