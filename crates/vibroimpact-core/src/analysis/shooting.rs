@@ -32,6 +32,24 @@ fn refused(e: &Error) -> bool {
     matches!(e, Error::Inconsistent(_) | Error::InvalidParameter { .. })
 }
 
+/// A Newton iterate whose run fails numerically (it blew up, its energy
+/// balance broke, it chattered or its steps shrank to nothing: a step far
+/// off the orbit, into motions the method's settings do not resolve) is a
+/// bad step too, to be shortened; a run's limits (steps, rows, memory, an
+/// interrupt) are not.
+fn bad_step(e: &Error) -> bool {
+    refused(e)
+        || matches!(
+            e,
+            Error::NumericalBlowUp { .. }
+                | Error::NewtonFailed { .. }
+                | Error::Chattering { .. }
+                | Error::StepSizeTooSmall { .. }
+                | Error::EnergyBalance { .. }
+                | Error::ContactEnergy { .. }
+        )
+}
+
 /// Shoot from `z0` (displacements then velocities) for `P(z) = z`.
 ///
 /// The residual and the Jacobian's steps are scaled by the size of the motion,
@@ -194,11 +212,12 @@ fn newton(
                     image = next;
                     break false;
                 }
-                Err(e) if refused(&e) && factor > 1e-6 => factor *= 0.5,
-                // Even a millionth of the step is inside a wall: the step is
-                // Newton's breakdown (a nearly singular I - J), not a start
-                // the user gave; the shooting stops, not converged.
-                Err(e) if refused(&e) => {
+                Err(e) if bad_step(&e) && factor > 1e-6 => factor *= 0.5,
+                // Even a millionth of the step is inside a wall (or fails):
+                // the step is Newton's breakdown (a nearly singular I - J),
+                // not a start the user gave; the shooting stops, not
+                // converged.
+                Err(e) if bad_step(&e) => {
                     refusal = Some(e.to_string());
                     break true;
                 }
@@ -336,6 +355,29 @@ mod tests {
             // fraction of the next step is admissible.
             assert!((0.0..1e-5).contains(&shot.state[0]), "{}", shot.state[0]);
             assert!(shot.iterations < 40, "{}", shot.iterations);
+        });
+    }
+
+    #[test]
+    fn a_newton_step_whose_run_blows_up_is_shortened() {
+        crate::testing::timeout(60, || {
+            // P(x) = x - (x^3 - 1) / 3 (fixed point 1), its run failing
+            // beyond |x| = 10 as a method's does far off its resolution. From
+            // 0.1 Newton's first step reaches 111: halved, not an error.
+            let mut cubic = |z: &[f64]| -> Result<Vec<f64>> {
+                if z[0].abs() > 10.0 {
+                    return Err(Error::EnergyBalance {
+                        time: 0.1,
+                        residual: 1.0,
+                        scale: 1.0,
+                        tolerance: 1e-6,
+                    });
+                }
+                Ok(vec![z[0] - (z[0].powi(3) - 1.0) / 3.0, 0.5 * z[1]])
+            };
+            let shot = shoot(&mut cubic, &[0.1, 0.0], TAU, 1e-10, 40).unwrap();
+            assert!(shot.converged, "{shot:?}");
+            assert!((shot.state[0] - 1.0).abs() < 1e-9, "{}", shot.state[0]);
         });
     }
 
