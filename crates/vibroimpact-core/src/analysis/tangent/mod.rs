@@ -109,8 +109,9 @@ pub struct Tangent<'s> {
     contact: Option<ContactSteps>,
     /// The derivatives by parameters, where asked.
     parameters: Option<Parameters>,
-    /// A step's extra columns (the latched gain, then the parameters') and
-    /// an event's new parameter columns.
+    /// A step's extra columns (the latched gain, then the parameters'), or
+    /// an event's saltation terms by the parameters; and the event's new
+    /// parameter columns, kept aside until its latched rates are read.
     extra: Vec<f64>,
     moved: Vec<f64>,
     /// The hysteretic laws' latched rates (None: no law latches).
@@ -539,7 +540,7 @@ impl Source for Sources<'_> {
             }
         }
         if let Some(parameters) = self.parameters.as_deref_mut() {
-            parameters.add_field(time, y, modes, out, (gains, columns));
+            parameters.add_field(system, time, y, modes, out, (gains, columns));
         }
     }
 }

@@ -32,8 +32,6 @@ pub struct Shifted {
 /// The columns by the parameters and the buffers they need.
 pub(super) struct Parameters {
     pub(super) shifted: Vec<Shifted>,
-    /// The run's own interactions (its gaps and laws).
-    base: Vec<Interaction>,
     /// `W`: row-major `2 dim x m`.
     pub(super) columns: Vec<f64>,
     /// The latched approach rates' derivatives (row-major `interactions x
@@ -93,7 +91,6 @@ impl Parameters {
         Ok(Self {
             latched: vec![0.0; system.interactions.len() * m],
             columns: vec![0.0; size * m],
-            base: system.interactions.clone(),
             scratches: shifted
                 .iter()
                 .map(|s| [Scratch::new(&s.plus), Scratch::new(&s.minus)])
@@ -109,10 +106,12 @@ impl Parameters {
         self.shifted.len()
     }
 
-    /// `df/dp` at `time`, state `y` (`x` then `v`) and `modes`, added into
-    /// `out`'s columns `first..first + m` (row-major, `stride` columns).
+    /// `df/dp` of `system` (the run's) at `time`, state `y` (`x` then `v`)
+    /// and `modes`, added into `out`'s columns `first..first + m` (row-major,
+    /// `stride` columns).
     pub(super) fn add_field(
         &mut self,
+        system: &Assembly,
         time: f64,
         y: &[f64],
         modes: &[Mode],
@@ -129,7 +128,7 @@ impl Parameters {
                 out[r * stride + first + j] += (self.plus[r] - self.minus[r]) / (2.0 * s.delta);
             }
         }
-        self.contacts_inside(y, modes, out, (first, stride));
+        self.contacts_inside(system, y, modes, out, (first, stride));
     }
 
     /// The compliant contacts' part of [`Self::add_field`] taken from
@@ -144,13 +143,14 @@ impl Parameters {
     /// + push (F_delta delta_p + F_rate rate_p)`.
     fn contacts_inside(
         &self,
+        system: &Assembly,
         y: &[f64],
         modes: &[Mode],
         out: &mut [f64],
         (first, stride): (usize, usize),
     ) {
         let d = y.len() / 2;
-        for (i, (&mode, it)) in modes.iter().zip(&self.base).enumerate() {
+        for (i, (&mode, it)) in modes.iter().zip(&system.interactions).enumerate() {
             let (Mode::Compliant { approach_rate, .. }, InteractionLaw::Compliant { law, damping }) =
                 (mode, it.law)
             else {
@@ -161,13 +161,18 @@ impl Parameters {
             let (_, by_indentation, by_rate) =
                 law.force_derivatives(indentation.max(0.0), rate, approach_rate);
             for (j, s) in self.shifted.iter().enumerate() {
-                let (gap_by, rate_by) = self.gap_by(j, i, y);
+                let gaps = [s.plus.gap(i, y), s.minus.gap(i, y)];
+                let (gap_by, rate_by) = (
+                    (gaps[0].0 - gaps[1].0) / (2.0 * s.delta),
+                    (gaps[0].1 - gaps[1].1) / (2.0 * s.delta),
+                );
                 // d(push F)/dp = Q[push F](run's indentation) + push dF/dp.
                 let slope = -(by_indentation * gap_by + (by_rate + damping) * rate_by);
                 let mut sides = [0.0; 2];
-                for (side, system) in sides.iter_mut().zip([&s.plus, &s.minus]) {
-                    let own = &system.interactions[i];
-                    let (gap, own_rate) = system.gap(i, y);
+                for ((side, shifted), (gap, own_rate)) in
+                    sides.iter_mut().zip([&s.plus, &s.minus]).zip(gaps)
+                {
+                    let own = &shifted.interactions[i];
                     let at_run = contact_force(own, mode, indentation, rate);
                     *side = (at_run - contact_force(own, mode, -gap, -own_rate)) / (2.0 * s.delta);
                 }

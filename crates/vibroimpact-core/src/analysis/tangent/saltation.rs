@@ -71,30 +71,30 @@ impl Saltation {
         for i in 0..d {
             self.reset[i * d + i] = 1.0;
         }
-        let m = jumps.len();
-        if m == 0 {
+        if jumps.is_empty() {
             return;
         }
         let its = &system.interactions;
+        // Column c: the unit velocity e_c less what moves the pairs' rates by
+        // (1 + e) h . e_c.
         for c in 0..d {
-            self.coupling.clear();
-            for a in jumps {
-                for b in jumps {
-                    let w = linalg::dot(&its[a.interaction].h, &its[b.interaction].push);
-                    self.coupling.push(w);
-                }
-            }
             self.column.clear();
             self.column.extend(
                 jumps
                     .iter()
-                    .map(|j| -(1.0 + j.restitution) * its[j.interaction].h[c]),
+                    .map(|j| (1.0 + j.restitution) * its[j.interaction].h[c]),
             );
-            linalg::solve_in_place(&mut self.coupling, &mut self.column, m);
-            for (j, z) in jumps.iter().zip(&self.column) {
-                for (r, p) in its[j.interaction].push.iter().enumerate() {
-                    self.reset[r * d + c] += p * z;
-                }
+            self.velocities.iter_mut().for_each(|v| *v = 0.0);
+            self.velocities[c] = 1.0;
+            push_back(
+                its,
+                jumps,
+                &mut self.column,
+                &mut self.velocities,
+                &mut self.coupling,
+            );
+            for (r, value) in self.velocities.iter().enumerate() {
+                self.reset[r * d + c] = *value;
             }
         }
     }
@@ -219,10 +219,12 @@ impl Saltation {
             let mut column = std::mem::take(&mut self.parameter);
             column.iter_mut().for_each(|v| *v = 0.0);
             // (R(p + delta) - R(p - delta)) v- / (2 delta).
-            for (other, sign) in [(&s.plus, 1.0), (&s.minus, -1.0)] {
-                if view.jumps.is_empty() {
-                    break;
-                }
+            let resets = if view.jumps.is_empty() {
+                &[][..]
+            } else {
+                &[(&s.plus, 1.0), (&s.minus, -1.0)][..]
+            };
+            for &(other, sign) in resets {
                 self.values.clear();
                 self.values.extend(view.jumps.iter().map(|jump| {
                     let e = Parameters::restitution_in(system, other, jump);
