@@ -143,8 +143,16 @@ SYSTEM = {
         "mass": ("kg", "> 0", "the loose mass"),
         "at": (None, _POINT, "the point it rattles against"),
         "clearance": ("m", ">= 0", "the clearance on each side"),
-        "lower_clearance": ("m", ">= 0", "the clearance below (instead of clearance)"),
-        "upper_clearance": ("m", ">= 0", "the clearance above (instead of clearance)"),
+        "lower_clearance": (
+            "m",
+            ">= 0 or inf",
+            "the clearance below (instead of clearance); inf: no wall below",
+        ),
+        "upper_clearance": (
+            "m",
+            ">= 0 or inf",
+            "the clearance above (instead of clearance); inf: no wall above",
+        ),
         **_LAW,
         "law": (
             None,

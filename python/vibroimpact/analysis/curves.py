@@ -3,7 +3,7 @@
 (:func:`~vibroimpact.analysis.continue_orbit`, then Newton on the extended system, see
 ``vibroimpact.analysis.located``), then followed as a second parameter steps, each
 point Newton's method on the extended system ``P_p(z) - z = 0, g(z, p) = 0`` from the
-last two points' extrapolation (a grazing's: ``P_p(z) - z = 0`` with the stop's gap and
+last two points' extrapolation (a grazing's: ``P_p(z) - z = 0`` with the wall's gap and
 its rate zero at the touch, see ``vibroimpact.analysis.grazing``). The multipliers come
 from the tangent flow through the impacts and contacts. SI units."""
 
@@ -84,13 +84,13 @@ def curve(
     base_dir: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Curve:
-    """The curve of bifurcations of ``kind`` (``"flip"``, ``"fold"``,
-    ``"neimark-sacker"``, ``"grazing"``: where the orbit touches a stop at zero speed) of
-    the ``periods``-period orbit: located first along the
-    branch in ``parameter`` from ``start`` to ``stop`` (the orbit found from the
-    scenario's ``[initial]`` at ``start``), then followed in ``second`` from the
-    scenario's value towards ``second_stop`` in steps of ``step`` (halved where Newton
-    fails, down to a 64th), at most ``max_points`` points. ``data``: a
+    """The curve of bifurcations of ``kind`` (``"flip"``, ``"fold"``, ``"neimark-sacker"``,
+    ``"grazing"``: where the orbit touches a wall, a stop or a damper's side, at zero speed)
+    of the ``periods``-period orbit: located first along the branch in ``parameter``
+    from ``start`` to ``stop`` (the orbit found from the scenario's ``[initial]`` at
+    ``start``), then followed in ``second`` from the scenario's value towards
+    ``second_stop`` in steps of ``step`` (halved where Newton fails, down to a 64th), at
+    most ``max_points`` points. ``data``: a
     :class:`~vibroimpact.System` or a scenario's sections."""
     data, base_dir = sections_of(data, base_dir)
     if kind not in CURVE_KINDS:
@@ -180,7 +180,7 @@ def curve(
 def _locate(
     arc: _Arc, first: Bifurcation, guess: np.ndarray
 ) -> tuple[float, np.ndarray, np.ndarray, np.ndarray] | None:
-    """The bifurcation of ``first``'s kind (and stop, for a grazing) near the scaled
+    """The bifurcation of ``first``'s kind (and wall, for a grazing) near the scaled
     unknowns ``guess``: its parameter's value, state, multipliers and scaled unknowns;
     None where Newton fails."""
     if first.kind == "grazing":
@@ -226,7 +226,7 @@ def curve_regions(
     """The regions the curve bounds, read at its middle point: the orbit shot for a
     little either side of the curve in ``parameter`` (a sixth of the curve's range in
     it, or a twentieth of its value), each side labelled by its stability (and, either
-    side of a grazing curve, by whether the orbit strikes the stop). ``(label, second's
+    side of a grazing curve, by whether the orbit strikes the wall). ``(label, second's
     value, parameter's value)`` for each side where an orbit is found."""
     from vibroimpact.analysis.orbits import orbit
 
@@ -248,7 +248,7 @@ def curve_regions(
             continue
         label = f"{found.periods}-period orbit " + ("stable" if shot.stable else "unstable")
         if found.first is not None and found.first.pair is not None:
-            # Either side of a grazing curve: whether the orbit strikes the stop.
+            # Either side of a grazing curve: whether the orbit strikes the wall.
             hit = found.first.pair in struck(runner(moved, base_dir), shot.state, found.periods)
             label += (", strikes " if hit else ", misses ") + found.first.pair
         regions.append((label, s, p + side * offset))

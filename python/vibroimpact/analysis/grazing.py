@@ -1,21 +1,23 @@
-"""Grazings located exactly: the parameter at which a periodic orbit that misses a stop
-comes to touch it at zero speed (the gap's minimum over the orbit reaching zero), by
-Newton's method on the extended system
+"""Grazings located exactly: the parameter at which a periodic orbit that misses a wall
+(a stop, or one side of a damper) comes to touch it at zero speed (the gap's minimum
+over the orbit reaching zero), by Newton's method on the extended system
 
     P_p(z) - z = 0,    g(x(tau)) = 0,    g'(x(tau)) = 0
 
 in the unknowns ``(z, p, tau)``: the orbit's state at t = 0, the parameter and the
-instant of the touch. ``g = offset + h . x`` is the stop's gap. The runs are of the
-system without that stop: on the grazing orbit its impulse is zero, so the orbit found
-is the system's own; without it, an iterate a little beyond the grazing meets no impact
-(whose speed, growing as the square root of the overshoot, would break Newton's
-convergence). The state's columns come from the tangent flow (``P``'s monodromy and the
-flow's derivative up to ``tau``), the instant's from the state's rate there, the
-parameter's from central differences. SI units."""
+instant of the touch. ``g = offset + h . x`` is the wall's gap. The runs are of the
+system without that wall (a stop removed, a damper's side given an infinite clearance):
+on the grazing orbit its impulse is zero, so the orbit found is the system's own;
+without it, an iterate a little beyond the grazing meets no impact (whose speed, growing
+as the square root of the overshoot, would break Newton's convergence). The state's
+columns come from the tangent flow (``P``'s monodromy and the flow's derivative up to
+``tau``), the instant's from the state's rate there, the parameter's from central
+differences. SI units."""
 
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -40,8 +42,9 @@ SAMPLES = 64
 @dataclass
 class Grazing:
     """A grazing located: the parameter's ``value``, the orbit's ``state`` at t = 0,
-    its Floquet multipliers (of the flow that misses the stop: at the grazing the
-    stop's impulse is zero), the ``pair`` grazed (``"stop 0"``) and the ``time`` of the
+    its Floquet multipliers (of the flow that misses the wall: at the grazing the
+    wall's impulse is zero), the wall grazed as ``pair`` (``"stop 0"``, ``"damper 0
+    upper"``) and the ``time`` of the
     touch after t = 0 (s)."""
 
     value: float
@@ -59,33 +62,79 @@ class Grazing:
         )
 
 
-def _without_stop(data: Mapping[str, Any], index: int) -> dict[str, Any]:
-    """``data`` without its ``index``-th stop."""
+#: A damper's two walls, in the order the core lists them, and the sign of each one's
+#: gap row on the loose mass's own coordinate (the upper wall's gap closes as it rises).
+SIDES = {"upper": -1.0, "lower": 1.0}
+
+
+def _tables(data: dict[str, Any], key: str) -> list[Any]:
+    """The ``[[key]]`` tables of ``data`` as a list (a single table is one), set back
+    into ``data`` as that list."""
+    tables = data.get(key, [])
+    data[key] = [tables] if isinstance(tables, Mapping) else list(tables)
+    return data[key]  # type: ignore[no-any-return]
+
+
+def walls(pairs: list[str]) -> list[str]:
+    """The walls of the pairs named ``pairs``: a stop is its own wall (``"stop 0"``),
+    a damper has two (``"damper 0 upper"``, ``"damper 0 lower"``)."""
+    return [
+        wall
+        for pair in pairs
+        for wall in ([f"{pair} {side}" for side in SIDES] if pair.startswith("damper ") else [pair])
+    ]
+
+
+def _without_wall(data: Mapping[str, Any], wall: str) -> dict[str, Any]:
+    """``data`` without the wall named ``wall``: a stop removed, or a damper's side
+    given an infinite clearance (no wall there; the other side's kept as it was)."""
     out = copy.deepcopy(dict(data))
-    stops = list(out.get("stop", ()))
-    del stops[index]
-    out["stop"] = stops
+    words = wall.split()
+    index = int(words[1])
+    if words[0] == "stop":
+        del _tables(out, "stop")[index]
+        return out
+    table = dict(_tables(out, "damper")[index])
+    if "clearance" in table:
+        both = table.pop("clearance")
+        table["lower_clearance"] = table["upper_clearance"] = both
+    table[f"{words[2]}_clearance"] = math.inf
+    out["damper"][index] = table
     return out
 
 
+def _wall_row(system: Any, wall: str) -> dict[str, Any]:
+    """The gap row (``h``, ``offset``) of the wall named ``wall`` in the prepared
+    ``system``: a stop's own, or of a damper's two the one whose ``h`` has the side's
+    sign on the loose mass's coordinate."""
+    words = wall.split()
+    pair = " ".join(words[:2])
+    rows = [r for r in interactions(system) if r["pair"] == pair]
+    if words[0] == "stop":
+        return rows[0]
+    # The dampers' coordinates are the last, in order: damper j's is dim - k + j.
+    dampers = {r["pair"] for r in interactions(system) if r["pair"].startswith("damper ")}
+    coordinate = len(rows[0]["h"]) - len(dampers) + int(words[1])
+    return next(r for r in rows if np.sign(r["h"][coordinate]) == SIDES[words[2]])
+
+
 class _Wall:
-    """One stop of a continuation's system at any parameter: the system's runs without
-    it, and its gap's row (from the system with it, whose offset may be the very
-    parameter)."""
+    """One wall (a stop, or one side of a damper) of a continuation's system at any
+    parameter: the system's runs without it, and its gap's row (from the system with
+    it, whose offset may be the very parameter)."""
 
     def __init__(self, arc: _Arc, pair: str) -> None:
         self.arc, self.pair = arc, pair
-        self.index = int(pair.split()[1])
         self._cache: dict[float, tuple[Runner, np.ndarray, float]] = {}
 
     def at(self, p: float) -> tuple[Runner, np.ndarray, float]:
-        """The runs without the stop at ``p``, and its gap's ``h`` and offset (m)."""
+        """The runs without the wall at ``p``, and its gap's ``h`` and offset (m)."""
         if p not in self._cache:
             arc = self.arc
             changed = shifted(with_parameter(arc.data, arc.parameter, p), arc.section)
             full = runner(changed, arc.base_dir)
-            row = next(r for r in interactions(full.system()) if r["pair"] == self.pair)
-            free = runner(_without_stop(changed, self.index), arc.base_dir)
+            row = _wall_row(full.system(), self.pair)
+            free = runner(_without_wall(changed, self.pair), arc.base_dir)
             if len(self._cache) > 8:
                 self._cache.clear()
             self._cache[p] = (free, np.asarray(row["h"], dtype=float), float(row["offset"]))
@@ -130,15 +179,38 @@ def away_from_zero(tau: float, span: float) -> float:
 
 
 def struck(run: Runner, state: np.ndarray, periods: int) -> set[str]:
-    """The pairs the orbit from ``state`` strikes over ``periods`` forcing periods."""
+    """The walls the orbit from ``state`` strikes over ``periods`` forcing periods
+    (:func:`walls`' names): a damper's side is the wall whose gap is closed at the
+    contact's onset."""
     raw = run.periods(state, periods, record=True)
     names = raw["pairs"]
-    kinds = raw["contacts"]["kind"]
-    return {
-        names[p]
-        for p, kind in zip(raw["contacts"]["pair"], kinds, strict=True)
-        if kind in ("impact", "compliant")
-    }
+    contacts = raw["contacts"]
+    hit: set[str] = set()
+    for p, kind, onset in zip(contacts["pair"], contacts["kind"], contacts["onset"], strict=True):
+        name = names[p]
+        if kind not in ("impact", "compliant"):
+            continue
+        if not name.startswith("damper "):
+            hit.add(name)
+        elif not {f"{name} {side}" for side in SIDES} <= hit:
+            hit.add(_side_struck(run, state, name, float(onset)))
+    return hit
+
+
+def _side_struck(run: Runner, state: np.ndarray, damper: str, onset: float) -> str:
+    """Which wall of ``damper`` a contact at ``onset`` s after ``state``'s t = 0
+    strikes: the one whose gap is the nearer to closed then."""
+    system = run.system()
+    at = np.asarray(state, dtype=float)
+    if onset > 0:
+        at = np.asarray(system.run([float(v) for v in state], onset)["final_state"], dtype=float)
+    sides = [f"{damper} {side}" for side in SIDES]
+    gaps = []
+    for wall in sides:
+        row = _wall_row(system, wall)
+        h = np.asarray(row["h"], dtype=float)
+        gaps.append(abs(float(row["offset"]) + h @ at[: len(h)]))
+    return sides[int(np.argmin(gaps))]
 
 
 def grazings_between(
@@ -148,7 +220,7 @@ def grazings_between(
     within: tuple[float, float],
 ) -> list[Grazing]:
     """The grazings between two points of a branch (scaled ``unknowns`` of each, in
-    the arc's current section) whose number of impacts differs: of each stop one end
+    the arc's current section) whose number of impacts differs: of each wall one end
     strikes and the other misses, located from the end that misses it, kept where the
     parameter lies ``within`` the interval."""
     hit = [
@@ -157,8 +229,6 @@ def grazings_between(
     ]
     found = []
     for pair in sorted(hit[0] ^ hit[1]):
-        if not pair.startswith("stop "):
-            continue
         start = unknowns[0] if pair in hit[1] else unknowns[1]
         located = locate_grazing(arc, pair, start)
         if located is not None and min(within) <= located.value <= max(within):
@@ -169,12 +239,12 @@ def grazings_between(
 def locate_grazing(
     arc: _Arc, pair: str, start: np.ndarray, tau: float | None = None
 ) -> Grazing | None:
-    """The grazing of the stop ``pair`` near the scaled unknowns ``start`` (state and
-    parameter, as a continuation scales them, and optionally the touch's instant in
-    ``periods`` forcing periods, as :attr:`Grazing.unknowns` holds it; an orbit that
-    misses the stop), by Newton's method on the extended system (see the module);
-    ``tau`` the touch's instant (s) where known, else the orbit's least gap. None where
-    Newton does not converge or a run fails there."""
+    """The grazing of the wall ``pair`` (:func:`walls`' names) near the scaled unknowns
+    ``start`` (state and parameter, as a continuation scales them, and optionally the
+    touch's instant in ``periods`` forcing periods, as :attr:`Grazing.unknowns` holds
+    it; an orbit that misses the wall), by Newton's method on the extended system (see
+    the module); ``tau`` the touch's instant (s) where known, else the orbit's least gap.
+    None where Newton does not converge or a run fails there."""
     try:
         return _newton(arc, _Wall(arc, pair), start, tau)
     except (ValueError, ArithmeticError, RuntimeError, np.linalg.LinAlgError, StopIteration):
@@ -242,14 +312,13 @@ def _newton(arc: _Arc, wall: _Wall, start: np.ndarray, tau: float | None) -> Gra
 def grazing_ahead(arc: _Arc, last: BranchPoint, u: np.ndarray, reach: float) -> Grazing | None:
     """The grazing where a branch's corrector failed (past a grazing the map has no
     derivative: the orbit strikes with a speed growing as the square root of the
-    overshoot): of any stop, located from the last point's scaled unknowns ``u``, the
+    overshoot): of any wall, located from the last point's scaled unknowns ``u``, the
     nearest within ``reach`` of its parameter; None where there is none."""
     names = arc.run_at(last.value).periods(last.state, 1, record=True)["pairs"]
     found = [
         located
-        for pair in names
-        if pair.startswith("stop ")
-        and (located := locate_grazing(arc, pair, u)) is not None
+        for pair in walls(names)
+        if (located := locate_grazing(arc, pair, u)) is not None
         and abs(located.value - last.value) <= reach
     ]
     return min(found, key=lambda g: abs(g.value - last.value), default=None)

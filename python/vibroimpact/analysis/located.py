@@ -29,13 +29,14 @@ class Bifurcation:
     """A bifurcation located on a branch: its ``kind`` (``"fold"``, ``"flip"``,
     ``"neimark-sacker"``, ``"branch"``, ``"grazing"``), the parameter's ``value`` there,
     the orbit's state at t = 0 and its Floquet multipliers (one of them on the unit
-    circle, but at a grazing: there the orbit touches a stop at zero speed)."""
+    circle, but at a grazing: there the orbit touches a wall at zero speed)."""
 
     kind: str
     value: float
     state: np.ndarray
     floquet_multipliers: np.ndarray
-    #: A grazing's stop (``"stop 0"``) and the instant of the touch after t = 0 (s).
+    #: A grazing's wall (``"stop 0"``, ``"damper 0 upper"``) and the instant of the
+    #: touch after t = 0 (s).
     pair: str | None = None
     time: float | None = None
 

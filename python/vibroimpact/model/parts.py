@@ -221,7 +221,8 @@ class Cantilever(Structure):
 class Damper(Part):
     """A ``[[damper]]``: a loose ``mass`` (kg) rattling against the point ``at`` (a
     coordinate index, or m along a cantilever) with ``clearance`` (m) on each side, or
-    ``lower_clearance`` and ``upper_clearance``. ``law``: ``"rigid"`` (Newton's
+    ``lower_clearance`` and ``upper_clearance`` (``math.inf``: no wall on that side).
+    ``law``: ``"rigid"`` (Newton's
     ``restitution`` in [0, 1]) or a compliant law, ``"hertz"``, ``"hyster-hertz"``,
     ``"hertz-damped"`` or ``"linear"``, with ``stiffness`` (N/m^1.5; N/m for
     ``"linear"``), ``restitution`` where the law takes one and the contact damper's

@@ -14,7 +14,8 @@ A system is described by the same sections as a TOML scenario (SI units):
   the density: see :mod:`vibroimpact.system.beam`.
 - ``damper`` (a list): a loose mass (``mass``, kg) rattling against the point ``at``
   (a coordinate index, or m along a cantilever) with ``clearance`` on each side or
-  ``lower_clearance`` and ``upper_clearance`` (m), and a ``law``.
+  ``lower_clearance`` and ``upper_clearance`` (m; ``inf``: no wall on that side, as a
+  mass on a floor), and a ``law``.
 - ``stop`` (a list): the point ``at`` hits a stop fixed to the base; ``side = "upper"``
   keeps it at or below ``+gap``, ``"lower"`` at or above ``-gap`` (m); a ``law``. With
   ``against`` (a second point) the stop is carried by that point instead, so that the
@@ -68,6 +69,8 @@ from vibroimpact.system.record_file import check_record, read_record
 _NUMBER, _TEXT, _WHOLE, _NUMBERS, _MATRIX = "number", "string", "whole number", "array", "matrix"
 _REQ = object()
 _TEXTS = "array of strings"
+#: A damper's side: a number, or inf for no wall there.
+_WALL = "number or inf"
 
 # The keys of each section: (type, default; _REQ where required, None where optional).
 _STRUCTURE: dict[str, dict[str, tuple[str, Any]]] = {
@@ -102,8 +105,8 @@ _DAMPER = {
     "mass": (_NUMBER, _REQ),
     "at": (_NUMBER, _REQ),
     "clearance": (_NUMBER, None),
-    "lower_clearance": (_NUMBER, None),
-    "upper_clearance": (_NUMBER, None),
+    "lower_clearance": (_WALL, None),
+    "upper_clearance": (_WALL, None),
     **_LAW,
 }
 _STOP = {
@@ -294,6 +297,10 @@ def _value(where: str, kind: str, value: Any) -> Any:
         return value
     if kind == _WHOLE and type(value) is int and 2 <= value < 2**63:  # above every low
         return value
+    if kind == _WALL:
+        if real(value) == math.inf:
+            return math.inf
+        kind = _NUMBER
     if kind == _NUMBER:
         number = real(value)
         if number is None:
@@ -549,6 +556,17 @@ def system_spec(
                 d[side] = both
             elif both is not None:
                 raise _fail(f"[[damper]] {j}: ", f"give clearance or {side}, not both")
+            elif not d[side] >= 0:
+                raise _fail(
+                    f"[[damper]] {j}: ",
+                    f"{side} must be >= 0 m, or inf for no wall on that side, got {d[side]}",
+                )
+        if d["lower_clearance"] == d["upper_clearance"] == math.inf:
+            raise _fail(
+                f"[[damper]] {j}: ",
+                "lower_clearance and upper_clearance are both inf (no wall): "
+                "give one side a finite clearance",
+            )
         del d["clearance"]
         _check_point(f"damper {j} at", table["at"], d["at"], spec["structure"])
         _check_law(f"[[damper]] {j}: ", d, table)

@@ -147,6 +147,19 @@ fn non_negative_named(name: &str, key: &'static str, value: f64) -> Result<f64> 
     non_negative(key, value).map_err(|e| Error::Inconsistent(format!("{name} {e}")))
 }
 
+/// A damper's clearance: a finite number >= 0 m, or +infinity (no wall).
+fn clearance(name: &str, key: &'static str, value: f64) -> Result<f64> {
+    if value == f64::INFINITY {
+        Ok(value)
+    } else {
+        non_negative(key, value).map_err(|_| {
+            Error::Inconsistent(format!(
+                "{name} {key}: must be a finite number >= 0 m or infinite (no wall), got {value}"
+            ))
+        })
+    }
+}
+
 /// The structure's matrices as the rates read them.
 struct StructureMatrices {
     /// `M^-1`.
@@ -254,8 +267,14 @@ impl Walls {
             let name = format!("damper {j}");
             self.damper_mass
                 .push(positive_named(&name, "mass", d.mass)?);
-            let lower = non_negative_named(&name, "lower_clearance", d.lower_clearance)?;
-            let upper = non_negative_named(&name, "upper_clearance", d.upper_clearance)?;
+            let lower = clearance(&name, "lower_clearance", d.lower_clearance)?;
+            let upper = clearance(&name, "upper_clearance", d.upper_clearance)?;
+            if lower.is_infinite() && upper.is_infinite() {
+                return Err(Error::Inconsistent(format!(
+                    "{name}: lower_clearance and upper_clearance are both infinite (no wall): \
+                     give one side a finite clearance"
+                )));
+            }
             let point = s.point(&format!("{name} at"), d.at)?;
             let law = interaction_law(&name, &d.law)?;
             let pair = self.pairs.len();
@@ -263,6 +282,9 @@ impl Walls {
             // Relative displacement u = z_j - point . q; upper wall: g = upper - u,
             // lower wall: g = lower + u.
             for (sign, offset) in [(-1.0, upper), (1.0, lower)] {
+                if offset.is_infinite() {
+                    continue; // no wall on this side
+                }
                 let mut h = vec![0.0; dim];
                 for i in 0..n {
                     h[i] = -sign * point[i];
@@ -435,4 +457,61 @@ fn followed_rows(spec: &SystemSpec) -> Result<Vec<f64>> {
         point_rows.extend(s.moment_row(&format!("[output] moments[{j}]"), at)?);
     }
     Ok(point_rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::assembly::Damper;
+
+    fn with_clearances(lower: f64, upper: f64) -> SystemSpec {
+        SystemSpec {
+            structure: Structure::oscillator(1.0, 400.0, 0.5).unwrap(),
+            dampers: vec![Damper {
+                mass: 0.05,
+                at: 0.0,
+                lower_clearance: lower,
+                upper_clearance: upper,
+                law: PairLaw::rigid(0.6).unwrap(),
+            }],
+            stops: vec![],
+            gravity: 9.81,
+            excitations: vec![],
+            points: vec![],
+            moments: vec![],
+        }
+    }
+
+    #[test]
+    fn an_infinite_clearance_is_a_side_with_no_wall() {
+        crate::testing::timeout(10, || {
+            // Both walls: the upper's gap closes as the loose mass (coordinate
+            // 1) rises, the lower's as it falls.
+            let both = Assembly::new(&with_clearances(2e-3, 3e-3)).unwrap();
+            let rows: Vec<(f64, f64)> = both
+                .interactions
+                .iter()
+                .map(|it| (it.h[1], it.offset))
+                .collect();
+            assert_eq!(rows, vec![(-1.0, 3e-3), (1.0, 2e-3)]);
+            // No upper wall: the lower alone, as it was.
+            let floor = Assembly::new(&with_clearances(2e-3, f64::INFINITY)).unwrap();
+            assert_eq!(floor.interactions.len(), 1);
+            assert_eq!(floor.interactions[0], both.interactions[1]);
+            assert_eq!(floor.pairs, vec!["damper 0".to_string()]);
+            let ceiling = Assembly::new(&with_clearances(f64::INFINITY, 3e-3)).unwrap();
+            assert_eq!(ceiling.interactions.len(), 1);
+            assert_eq!(ceiling.interactions[0], both.interactions[0]);
+            // Neither: refused, as are a negative and a NaN clearance or -inf.
+            for (lower, upper) in [
+                (f64::INFINITY, f64::INFINITY),
+                (-1e-3, 1e-3),
+                (1e-3, f64::NAN),
+                (f64::NEG_INFINITY, 1e-3),
+            ] {
+                let err = Assembly::new(&with_clearances(lower, upper)).unwrap_err();
+                assert!(err.to_string().contains("damper 0"), "{err}");
+            }
+        });
+    }
 }

@@ -27,15 +27,18 @@ impl PairLaw {
 
 /// A loose mass rattling against a point of the structure, between a lower
 /// and an upper wall: free while `-lower_clearance < z - h.q < upper_clearance`.
+/// An infinite clearance is a side with no wall (a mass on a floor, or one
+/// wall of a damper left out to locate the other's grazing); one side at
+/// least has a wall.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Damper {
     /// kg (> 0).
     pub mass: f64,
     /// The point (a coordinate index, or m along a cantilever).
     pub at: f64,
-    /// m (>= 0).
+    /// m (>= 0, or infinite: no lower wall).
     pub lower_clearance: f64,
-    /// m (>= 0).
+    /// m (>= 0, or infinite: no upper wall).
     pub upper_clearance: f64,
     pub law: PairLaw,
 }
