@@ -133,7 +133,7 @@ def test_the_model_pages_scenario_blocks_run() -> None:
     assert scenario.contact.law == "hyster-hertz" and scenario.every == 1
     (general,) = [b for b in blocks(page("model"), "toml") if "[structure]" in b]
     sol = vibroimpact.parse_scenario(general, "model.rst").run()
-    assert {"damper 0", "stop 0"} >= set(sol.contacts.pair) and len(sol.contacts) > 0
+    assert {"damper 0", "stop 0", "collision 0"} >= set(sol.contacts.pair) and len(sol.contacts) > 0
     e = sol.energy
     scale = abs(e["input_work"]) + e["dissipated"] + abs(e["stored_start"]) + abs(e["stored_end"])
     assert abs(e["residual"]) < 1e-6 * scale

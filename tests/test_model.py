@@ -485,6 +485,19 @@ def test_bad_values_elsewhere_are_named_as_the_file_names_them(tmp_path: Path) -
         ),
         (
             vi.Oscillator(mass=1.0, stiffness=1.0),
+            {
+                "dampers": [
+                    vi.Damper(mass=0.1, at=0, clearance=0.01, law="rigid", restitution=0.5),
+                    vi.Damper(mass=0.1, at=0, clearance=0.01, law="rigid", restitution=0.5),
+                ],
+                "collisions": [
+                    vi.Collision(dampers=(0, 1), gap=0.0, law="rigid", restitution=1.5)
+                ],
+            },
+            '[[collision]] 0: law "rigid" needs restitution in [0, 1]',
+        ),
+        (
+            vi.Oscillator(mass=1.0, stiffness=1.0),
             {"gravity": vi.Gravity(acceleration=-9.81)},
             "[gravity] acceleration: must be >= 0",
         ),
@@ -519,8 +532,9 @@ class _Unchecked:
 
     def __init__(self, structure: Any, parts: dict[str, Any]) -> None:
         self.structure = structure
-        self.dampers: tuple[Any, ...] = ()
+        self.dampers = tuple(parts.get("dampers", ()))
         self.stops: tuple[Any, ...] = ()
+        self.collisions = tuple(parts.get("collisions", ()))
         self.excitations = tuple(parts.get("excitations", ()))
         self.gravity = parts.get("gravity")
         self.initial = parts.get("initial")

@@ -180,6 +180,24 @@ SYSTEM = {
             "the contact law",
         ),
     },
+    "collision": {
+        "dampers": (
+            None,
+            "two different damper indices",
+            "[i, j]: damper i below damper j along the axis",
+        ),
+        "gap": (
+            "m",
+            ">= 0",
+            "their free distance at rest: they touch when i's displacement minus j's reaches it",
+        ),
+        **_LAW,
+        "law": (
+            None,
+            '"rigid", "hertz", "hyster-hertz", "hertz-damped" or "linear"',
+            "the contact law",
+        ),
+    },
     "gravity": {"acceleration": ("m s-2", ">= 0", "along -x, on every mass")},
     "excitation": {
         "kind": (

@@ -95,7 +95,7 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
     if key == "intensity" and section == "excitation":
         # A two-sided spectral density per rad/s: the signal's unit squared times s.
         return {"force": "N2 s", "base": "m2 s-3"}.get(str(entry.get("kind")))
-    if key == "stiffness" and section in ("damper", "stop"):
+    if key == "stiffness" and section in ("damper", "stop", "collision"):
         law = entry.get("law")
         return "N m-1" if law == "linear" else "N m-1.5" if law in _HERTZ_LAWS else None
     if (key == "at" and section in ("damper", "stop", "excitation")) or (

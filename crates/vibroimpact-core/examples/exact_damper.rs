@@ -51,6 +51,7 @@ fn main() {
             upper_clearance: 0.01,
             law: PairLaw::rigid(0.6).unwrap(),
         }],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {
@@ -63,6 +64,7 @@ fn main() {
     let ball = SystemSpec {
         structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
         dampers: vec![],
+        collisions: vec![],
         stops: vec![Stop {
             at: 0.0,
             side: Side::Lower,

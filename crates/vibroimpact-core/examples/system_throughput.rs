@@ -65,6 +65,7 @@ fn main() {
     let mut beam = SystemSpec {
         structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap(),
         dampers: vec![],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {
@@ -150,6 +151,7 @@ fn main() {
     let ball = SystemSpec {
         structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
         dampers: vec![],
+        collisions: vec![],
         stops: vec![Stop {
             at: 0.0,
             side: Side::Lower,
@@ -186,6 +188,7 @@ fn main() {
             upper_clearance: 0.005,
             law: PairLaw::rigid(0.6).unwrap(),
         }],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

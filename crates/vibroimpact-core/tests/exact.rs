@@ -22,6 +22,7 @@ fn spec(structure: Structure) -> SystemSpec {
     SystemSpec {
         structure,
         dampers: vec![],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],

@@ -51,6 +51,7 @@ fn max_error(method: Method, dt: f64) -> f64 {
     let spec = SystemSpec {
         structure,
         dampers: vec![],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

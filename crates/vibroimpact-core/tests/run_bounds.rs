@@ -28,6 +28,7 @@ fn beam() -> (Assembly, Vec<f64>) {
             upper_clearance: 1e-3,
             law: PairLaw::Compliant(Contact::new(LawKind::Hertz, 1e5, None, 0.0).unwrap()),
         }],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],
@@ -153,6 +154,7 @@ fn forced_damper() -> (Assembly, Vec<f64>) {
             upper_clearance: 0.005,
             law: PairLaw::rigid(0.6).unwrap(),
         }],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

@@ -112,8 +112,10 @@ def _impact_samples(
 def _check_pair(run: Runner, sample: str, pair: str | None) -> None:
     if pair is not None:
         spec = run.prepared.spec
-        names = [f"damper {j}" for j in range(len(spec.get("damper", ())))] + [
-            f"stop {j}" for j in range(len(spec.get("stop", ())))
+        names = [
+            f"{kind} {j}"
+            for kind in ("damper", "stop", "collision")
+            for j in range(len(spec.get(kind, ())))
         ]
         if pair not in names:
             raise AnalysisError(

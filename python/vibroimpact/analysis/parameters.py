@@ -14,8 +14,7 @@ from vibroimpact._core import InvalidInputError
 from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.messages import shown
-
-_SECTIONS = ("structure", "damper", "stop", "gravity", "excitation", "initial", "solver", "output")
+from vibroimpact.system import RUN_SECTIONS
 
 
 def forcing_period(data: Mapping[str, Any]) -> float:
@@ -62,9 +61,9 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
     value = arguments.number("value", value)
     out = copy.deepcopy(dict(data))
     parts = path.split(".")
-    if parts[0] not in _SECTIONS or len(parts) < 2:
+    if parts[0] not in RUN_SECTIONS or len(parts) < 2:
         raise AnalysisError(
-            f"parameter {path!r}: must be a dotted path into a section ({', '.join(_SECTIONS)}),"
+            f"parameter {path!r}: must be a dotted path into a section ({', '.join(RUN_SECTIONS)}),"
             ' such as "excitation.0.frequency"'
         )
     with_parameter_path_check(path, "")
@@ -125,10 +124,10 @@ def with_parameter_path_check(path: str, section: str = "[sweep]") -> None:
     index is not a whole number from 0 (``-1`` would count from the end)."""
     parts = path.split(".")
     where = f"{section} parameter" if section else f"parameter {path!r}"
-    if parts[0] not in _SECTIONS or len(parts) < 2 or "" in parts:
+    if parts[0] not in RUN_SECTIONS or len(parts) < 2 or "" in parts:
         raise AnalysisError(
             f"{where}: must be a dotted path into a section "
-            f'({", ".join(_SECTIONS)}), such as "excitation.0.frequency", got {path!r}'
+            f'({", ".join(RUN_SECTIONS)}), such as "excitation.0.frequency", got {path!r}'
         )
     for part in parts[1:]:
         if part.lstrip("+-").isdigit() and not (part.isascii() and part.isdigit()):

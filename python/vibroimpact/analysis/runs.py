@@ -52,6 +52,7 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
         data["structure"],
         damper=data.get("damper", ()),
         stop=data.get("stop", ()),
+        collision=data.get("collision", ()),
         gravity=data.get("gravity"),
         excitation=data.get("excitation", ()),
         initial=data.get("initial"),

@@ -7,6 +7,7 @@ from vibroimpact.model.modes import NaturalModes, natural_modes
 from vibroimpact.model.parts import (
     Base,
     Cantilever,
+    Collision,
     Damper,
     Force,
     Gravity,
@@ -30,6 +31,7 @@ from vibroimpact.model.system import System
 __all__ = [
     "Base",
     "Cantilever",
+    "Collision",
     "Damper",
     "Force",
     "Gravity",

@@ -257,6 +257,25 @@ class Stop(Part):
     damping: float | None = None
 
 
+@keywords_checked
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Collision(Part):
+    """A ``[[collision]]``: two loose masses that strike each other (a multi-unit or
+    particle-column damper). ``dampers = (i, j)``: damper ``i`` below damper ``j``
+    along the axis, touching when the displacement of ``i`` minus that of ``j`` reaches
+    ``gap`` (m, their free distance at rest). ``law`` and its keys as for
+    :class:`Damper`."""
+
+    _arrays: ClassVar[dict[str, int]] = {"dampers": 1}
+
+    dampers: tuple[int, int]
+    gap: float
+    law: str
+    stiffness: float | None = None
+    restitution: float | None = None
+    damping: float | None = None
+
+
 # ------------------------------------------------------------------- signals
 
 

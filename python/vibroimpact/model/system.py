@@ -17,6 +17,7 @@ from vibroimpact.model.parts import (
     SIGNALS,
     Base,
     Cantilever,
+    Collision,
     Damper,
     Force,
     Gravity,
@@ -57,6 +58,7 @@ class System:
     """A vibro-impact system (SI units), built from typed parts named as the sections
     of a TOML scenario: ``structure`` (:class:`Oscillator`, :class:`Matrices` or
     :class:`Cantilever`), ``dampers`` (``[[damper]]``), ``stops`` (``[[stop]]``),
+    ``collisions`` (``[[collision]]``: loose masses striking each other),
     ``excitations`` (``[[excitation]]``: :class:`Force` or :class:`Base`), ``gravity``
     and ``initial``.
 
@@ -77,6 +79,7 @@ class System:
     structure: Structure
     dampers: Sequence[Damper] = ()
     stops: Sequence[Stop] = ()
+    collisions: Sequence[Collision] = ()
     excitations: Sequence[Force | Base] = ()
     gravity: Gravity | None = None
     initial: Initial | None = None
@@ -87,7 +90,7 @@ class System:
 
     def __post_init__(self) -> None:
         _instance("structure", self.structure, Structure, "Oscillator, Matrices or Cantilever")
-        for name, kind in (("dampers", Damper), ("stops", Stop)):
+        for name, kind in (("dampers", Damper), ("stops", Stop), ("collisions", Collision)):
             object.__setattr__(self, name, _parts(name, getattr(self, name), kind, kind.__name__))
         excitations = _parts("excitations", self.excitations, (Force, Base), "Force or Base")
         for j, excitation in enumerate(excitations):
@@ -157,12 +160,14 @@ class System:
 
     def model_sections(self) -> dict[str, Any]:
         """The model's sections as :func:`vibroimpact.system.prepare_system` takes them
-        (``structure``, ``damper``, ``stop``, ``gravity``, ``excitation``, ``initial``)."""
+        (``structure``, ``damper``, ``stop``, ``collision``, ``gravity``, ``excitation``,
+        ``initial``)."""
         sections = self.to_dict()
         return {
             "structure": sections["structure"],
             "damper": sections.get("damper", []),
             "stop": sections.get("stop", []),
+            "collision": sections.get("collision", []),
             "gravity": sections.get("gravity"),
             "excitation": sections.get("excitation", []),
             "initial": sections.get("initial"),
@@ -170,10 +175,11 @@ class System:
 
     def to_dict(self) -> dict[str, Any]:
         """The scenario's sections as ``tomllib`` reads them: ``structure``, ``damper``,
-        ``stop``, ``gravity``, ``excitation`` (lists of tables), ``initial``, ``solver``,
-        ``output`` and the analyses' tables, each where given."""
+        ``stop``, ``collision``, ``gravity``, ``excitation`` (lists of tables),
+        ``initial``, ``solver``, ``output`` and the analyses' tables, each where given."""
         sections: dict[str, Any] = {"structure": self.structure.to_dict()}
-        for name, parts in (("damper", self.dampers), ("stop", self.stops)):
+        listed = (("damper", self.dampers), ("stop", self.stops), ("collision", self.collisions))
+        for name, parts in listed:
             if parts:
                 sections[name] = [part.to_dict() for part in parts]
         if self.gravity is not None:
@@ -219,7 +225,7 @@ class System:
                 f"sections: must be a dict of tables (as tomllib reads a scenario), got "
                 f"{shown(sections)}"
             )
-        known = {"structure", "damper", "stop", "gravity", "excitation", "initial"}
+        known = {"structure", "damper", "stop", "collision", "gravity", "excitation", "initial"}
         for name in sections:
             if name not in known | {"solver", "output", *ANALYSIS_SECTIONS}:
                 raise InvalidInputError(
@@ -241,6 +247,7 @@ class System:
                 model["gravity"],
                 model["excitation"] or (),
                 directory("base_dir", base_dir),
+                collision=model["collision"] or (),
             )
             _table("[initial] ", model["initial"] or {}, _INITIAL)
             for name, schema in (("solver", _SOLVER), ("output", _OUTPUT)):
@@ -267,6 +274,7 @@ class System:
             structure=kind(**structure),
             dampers=_tables(Damper, sections.get("damper")),
             stops=_tables(Stop, sections.get("stop")),
+            collisions=_tables(Collision, sections.get("collision")),
             excitations=[_excitation(dict(e)) for e in _listed(sections.get("excitation"))],
             gravity=_part(Gravity, gravity),
             initial=_part(Initial, sections.get("initial")),

@@ -21,23 +21,14 @@ from vibroimpact.model.system import ANALYSIS_SECTIONS
 from vibroimpact.output import finite_or_none, written_whole
 from vibroimpact.system import (
     _FIXED_STEP,
+    RUN_SECTIONS,
     PreparedRun,
     SystemSolution,
     prepare_system,
     structure_coordinates,
 )
 
-SECTIONS = (
-    "structure",
-    "damper",
-    "stop",
-    "gravity",
-    "excitation",
-    "initial",
-    "solver",
-    "output",
-    *ANALYSIS_SECTIONS,
-)
+SECTIONS = (*RUN_SECTIONS, *ANALYSIS_SECTIONS)
 
 
 @dataclass(frozen=True)
@@ -78,6 +69,7 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
             data["structure"],
             damper=data.get("damper", ()),
             stop=data.get("stop", ()),
+            collision=data.get("collision", ()),
             gravity=data.get("gravity"),
             excitation=data.get("excitation", ()),
             initial=data.get("initial"),

@@ -21,6 +21,7 @@ from vibroimpact.system.schema import (
     _STRUCTURE,
     _TEXT,
     _WHOLE,
+    RUN_SECTIONS,
     SYSTEM_SOLVER_DEFAULTS,
     _choice,
     _fail,
@@ -38,6 +39,7 @@ from vibroimpact.system.solution import SystemContacts, SystemSolution
 
 __all__ = [
     "PreparedRun",
+    "RUN_SECTIONS",
     "SystemContacts",
     "SystemSolution",
     "prepare_system",

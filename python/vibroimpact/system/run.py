@@ -44,6 +44,7 @@ def simulate_system(
     *,
     damper: Any = (),
     stop: Any = (),
+    collision: Any = (),
     gravity: Any = None,
     excitation: Any = (),
     initial: Mapping[str, Any] | None = None,
@@ -71,7 +72,7 @@ def simulate_system(
     """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
 
     The sections are those of a TOML scenario (see the module docstring), as dicts
-    (``damper``, ``stop`` and ``excitation`` as lists of dicts). ``initial`` holds
+    (``damper``, ``stop``, ``collision`` and ``excitation`` as lists of dicts). ``initial`` holds
     ``structure_displacement``, ``structure_velocity``, ``damper_displacement``,
     ``damper_velocity`` (arrays, SI; zeros where left out). ``method``: ``"rk4"``
     (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``),
@@ -101,6 +102,7 @@ def simulate_system(
         structure,
         damper=damper,
         stop=stop,
+        collision=collision,
         gravity=gravity,
         excitation=excitation,
         initial=initial,
@@ -215,6 +217,7 @@ def prepare_system(
     *,
     damper: Any = (),
     stop: Any = (),
+    collision: Any = (),
     gravity: Any = None,
     excitation: Any = (),
     initial: Any = None,
@@ -226,7 +229,9 @@ def prepare_system(
     and fill their defaults; errors name the section and key."""
     base_dir = directory("base_dir", base_dir)
     try:
-        spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
+        spec = system_spec(
+            structure, damper, stop, gravity, excitation, base_dir, collision=collision
+        )
     except RecursionError:
         # Arrays nested thousands deep: no structure has them.
         raise _fail("", "a value is nested too deeply (arrays within arrays)") from None

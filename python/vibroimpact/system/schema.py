@@ -20,6 +20,9 @@ A system is described by the same sections as a TOML scenario (SI units):
   keeps it at or below ``+gap``, ``"lower"`` at or above ``-gap`` (m); a ``law``. With
   ``against`` (a second point) the stop is carried by that point instead, so that the
   two pound on each other: ``"upper"`` keeps ``x_at - x_against <= gap``.
+- ``collision`` (a list): two loose masses that strike each other, ``dampers = [i, j]``
+  (damper i below damper j), touching when damper i's displacement minus damper j's
+  reaches ``gap`` (m); a ``law``.
 - Laws: ``"rigid"`` (Newton's restitution ``restitution`` in [0, 1], located
   instantaneous impacts, chattering summed to its accumulation instant, then
   sticking) or a compliant law of :class:`vibroimpact.Contact` (``stiffness``,
@@ -66,6 +69,18 @@ from vibroimpact.messages import short_numbers, shown
 from vibroimpact.system.beam import DIMENSIONS, resolve_cantilever
 from vibroimpact.system.record_file import check_record, read_record
 
+#: A 0.2 scenario's sections of the system and its run, in the order they are written.
+RUN_SECTIONS = (
+    "structure",
+    "damper",
+    "stop",
+    "collision",
+    "gravity",
+    "excitation",
+    "initial",
+    "solver",
+    "output",
+)
 _NUMBER, _TEXT, _WHOLE, _NUMBERS, _MATRIX = "number", "string", "whole number", "array", "matrix"
 _REQ = object()
 _TEXTS = "array of strings"
@@ -114,6 +129,11 @@ _STOP = {
     "side": (_TEXT, _REQ),
     "gap": (_NUMBER, _REQ),
     "against": (_NUMBER, None),
+    **_LAW,
+}
+_COLLISION = {
+    "dampers": (_NUMBERS, _REQ),
+    "gap": (_NUMBER, _REQ),
     **_LAW,
 }
 _GRAVITY = {"acceleration": (_NUMBER, 9.81)}
@@ -359,6 +379,32 @@ def _value(where: str, kind: str, value: Any) -> Any:
     return [_value(f"{where[:-2]}[{i}]: ", _NUMBERS, row) for i, row in enumerate(value)]
 
 
+def _collisions(tables: list[Any], dampers: int) -> list[dict[str, Any]]:
+    """The ``[[collision]]`` tables checked: ``dampers``, two different damper indices
+    (the lower first), ``gap`` >= 0 m, and a law as for any pair."""
+    out = []
+    for j, table in enumerate(tables):
+        where = f"[[collision]] {j}: "
+        d = _table(where, table, _COLLISION)
+        pair = d["dampers"]
+        if (
+            len(pair) != 2
+            or not all(float(i).is_integer() and 0 <= i < dampers for i in pair)
+            or pair[0] == pair[1]
+        ):
+            raise _fail(
+                where,
+                f"dampers must be two different [[damper]] indices (0 to {dampers - 1}), "
+                f"the lower first, got {shown(table['dampers'])}",
+            )
+        d["dampers"] = [int(i) for i in pair]
+        if not d["gap"] >= 0:
+            raise _fail(where, f"gap must be >= 0 m, got {d['gap']}")
+        _check_law(where, d, table)
+        out.append(d)
+    return out
+
+
 def _too_deep(value: Any, limit: int = 32) -> bool:
     """Whether ``value`` is arrays within arrays more than ``limit`` deep."""
     for _ in range(limit):
@@ -528,18 +574,23 @@ def system_spec(
     gravity: Any = None,
     excitation: Any = (),
     base_dir: Path | None = None,
+    *,
+    collision: Any = (),
 ) -> dict[str, Any]:
     """The sections of a system, checked and with their defaults filled (see the module
     docstring); errors name the section and key."""
     spec: dict[str, Any] = {"structure": structure_spec(structure)}
     damper_tables, stop_tables = _list("damper", damper), _list("stop", stop)
-    if len(damper_tables) + len(stop_tables) > MAX_PAIRS:
+    collision_tables = _list("collision", collision)
+    pairs = len(damper_tables) + len(stop_tables) + len(collision_tables)
+    if pairs > MAX_PAIRS:
         # Before any is read: simultaneous impacts solve over every pair, a matrix
         # that grows as their square (70,000 stops aborted asking for 39 GB).
         raise _fail(
-            "[[damper]], [[stop]]: ",
-            f"at most {MAX_PAIRS} pairs in all, got {len(damper_tables) + len(stop_tables)}",
+            "[[damper]], [[stop]], [[collision]]: ",
+            f"at most {MAX_PAIRS} pairs in all, got {pairs}",
         )
+    collisions = _collisions(collision_tables, len(damper_tables))
     dampers = []
     for j, table in enumerate(damper_tables):
         d = _table(f"[[damper]] {j}: ", table, _DAMPER)
@@ -561,11 +612,12 @@ def system_spec(
                     f"[[damper]] {j}: ",
                     f"{side} must be >= 0 m, or inf for no wall on that side, got {d[side]}",
                 )
-        if d["lower_clearance"] == d["upper_clearance"] == math.inf:
+        held = any(j in c["dampers"] for c in collisions)
+        if d["lower_clearance"] == d["upper_clearance"] == math.inf and not held:
             raise _fail(
                 f"[[damper]] {j}: ",
-                "lower_clearance and upper_clearance are both inf (no wall): "
-                "give one side a finite clearance",
+                "lower_clearance and upper_clearance are both inf (no wall) and no "
+                "[[collision]] holds it: give one side a finite clearance",
             )
         del d["clearance"]
         _check_point(f"damper {j} at", table["at"], d["at"], spec["structure"])
@@ -582,6 +634,7 @@ def system_spec(
         _check_law(f"[[stop]] {j}: ", d, table)
         stops.append(d)
     spec["stop"] = stops
+    spec["collision"] = collisions
     if gravity is None:
         spec["gravity"] = {"acceleration": 0.0}
     else:
@@ -680,6 +733,7 @@ def linear_parts(
     stop: Any = (),
     gravity: Any = None,
     excitation: Any = (),
+    collision: Any = (),
     base_dir: Path | None = None,
 ) -> dict[str, Any]:
     """The system between contacts as a linear one over all its coordinates
@@ -690,7 +744,7 @@ def linear_parts(
     ``shape`` (the load is ``amplitude cos(omega t + phase) shape``, N). Signals
     other than harmonics are refused."""
     base_dir = directory("base_dir", base_dir)
-    spec = system_spec(structure, damper, stop, gravity, excitation, base_dir)
+    spec = system_spec(structure, damper, stop, gravity, excitation, base_dir, collision=collision)
     raw = _linear_parts({**spec, "gravity": spec["gravity"]["acceleration"]})
     dim = raw["n"] + raw["k"]
     return {

@@ -27,6 +27,7 @@ fn spec(system: &ImpactDamper, contact: &Contact) -> SystemSpec {
             upper_clearance: system.clearance,
             law: PairLaw::Compliant(*contact),
         }],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::model::assembly::{
-    Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+    Collision, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
 use vibroimpact_core::model::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::model::structure::Structure;
@@ -227,6 +227,16 @@ pub(crate) fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Syst
             against: optional(d, &place, "against")?,
         });
     }
+    let mut collisions = Vec::new();
+    for (j, d) in entries(spec, "collision")?.iter().enumerate() {
+        let place = format!("collision {j}");
+        let [lower, upper]: [usize; 2] = get(d, &place, "dampers")?;
+        collisions.push(Collision {
+            dampers: [lower, upper],
+            gap: get(d, &place, "gap")?,
+            law: pair_law(d, &place)?,
+        });
+    }
     let mut excitations = Vec::new();
     for (j, d) in entries(spec, "excitation")?.iter().enumerate() {
         let place = format!("excitation {j}");
@@ -251,6 +261,7 @@ pub(crate) fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Syst
         structure: structure(&structure_dict)?,
         dampers,
         stops,
+        collisions,
         gravity: optional(spec, "system", "gravity")?.unwrap_or(0.0),
         excitations,
         points: optional(spec, "output", "points")?.unwrap_or_default(),

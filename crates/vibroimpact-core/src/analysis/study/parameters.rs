@@ -25,6 +25,10 @@ pub enum Target {
     StopRestitution(usize),
     StopStiffness(usize),
     StopDamping(usize),
+    CollisionGap(usize),
+    CollisionRestitution(usize),
+    CollisionStiffness(usize),
+    CollisionDamping(usize),
     Gravity,
     ExcitationAmplitude(usize),
     ExcitationFrequency(usize),
@@ -51,7 +55,8 @@ pub const PATHS: &str = "structure.{mass, stiffness, damping} (kind \"oscillator
      structure.{length, youngs_modulus, second_moment, mass_per_length, damping_ratio} \
      (kind \"cantilever\"; none of kind \"matrices\"), damper.N.{at, mass, clearance, \
      lower_clearance, upper_clearance, restitution, stiffness, damping}, stop.N.{at, gap, \
-     restitution, stiffness, damping}, gravity.acceleration, excitation.N.at (forces), \
+     restitution, stiffness, damping}, collision.N.{gap, restitution, stiffness, damping}, \
+     gravity.acceleration, excitation.N.at (forces), \
      excitation.N.{amplitude, frequency, phase} (harmonic signals), excitation.N.{seed, intensity, cutoff_frequency, \
      duration} (white-noise and kanai-tajimi signals; also ground_frequency, ground_damping \
      for kanai-tajimi), initial.{structure_displacement, structure_velocity, \
@@ -118,6 +123,16 @@ impl Parameter {
                     "restitution" => Target::StopRestitution(i),
                     "stiffness" => Target::StopStiffness(i),
                     "damping" => Target::StopDamping(i),
+                    _ => return Err(bad()),
+                }
+            }
+            ["collision", i, key] => {
+                let i = index(i, spec.collisions.len(), "[[collision]]")?;
+                match *key {
+                    "gap" => Target::CollisionGap(i),
+                    "restitution" => Target::CollisionRestitution(i),
+                    "stiffness" => Target::CollisionStiffness(i),
+                    "damping" => Target::CollisionDamping(i),
                     _ => return Err(bad()),
                 }
             }
@@ -259,6 +274,12 @@ impl Parameter {
             Target::StopRestitution(i) => law(&mut spec.stops[i].law, "restitution")?,
             Target::StopStiffness(i) => law(&mut spec.stops[i].law, "stiffness")?,
             Target::StopDamping(i) => law(&mut spec.stops[i].law, "damping")?,
+            Target::CollisionGap(i) => spec.collisions[i].gap = value,
+            Target::CollisionRestitution(i) => {
+                law(&mut spec.collisions[i].law, "restitution")?;
+            }
+            Target::CollisionStiffness(i) => law(&mut spec.collisions[i].law, "stiffness")?,
+            Target::CollisionDamping(i) => law(&mut spec.collisions[i].law, "damping")?,
             Target::Gravity => spec.gravity = value,
             Target::ExcitationAmplitude(i)
             | Target::ExcitationFrequency(i)
@@ -349,6 +370,7 @@ mod tests {
         SystemSpec {
             structure,
             dampers: vec![],
+            collisions: vec![],
             stops: vec![],
             gravity: 0.0,
             excitations: vec![Excitation {

@@ -47,6 +47,7 @@ pub(super) fn damper_on_oscillator(
             upper_clearance: clearance,
             law,
         }],
+        collisions: vec![],
         stops: vec![],
         gravity,
         excitations: vec![Excitation {

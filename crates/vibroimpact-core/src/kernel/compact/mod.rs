@@ -500,6 +500,7 @@ mod tests {
         SystemSpec {
             structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap(),
             dampers: vec![damper(0.5, 2e-4), damper(0.25, 1e-4)],
+            collisions: vec![],
             stops: vec![],
             gravity,
             excitations: vec![Excitation {
@@ -525,6 +526,7 @@ mod tests {
                 upper_clearance: 3e-3,
                 law: PairLaw::rigid(0.6).unwrap(),
             }],
+            collisions: vec![],
             stops: vec![Stop {
                 at: 0.0,
                 side: Side::Lower,

@@ -60,6 +60,7 @@ fn forced_flow(damping: f64) -> (Assembly, ExactFlow, Vec<f64>) {
             upper_clearance: 0.01,
             law: PairLaw::rigid(0.6).unwrap(),
         }],
+        collisions: vec![],
         stops: vec![],
         gravity: 9.81,
         excitations: vec![Excitation {
@@ -179,6 +180,7 @@ fn near_an_undamped_resonance_the_state_and_its_input_work_keep_their_digits() {
         let spec = SystemSpec {
             structure: Structure::oscillator(1.0, 39.478, 0.0).unwrap(),
             dampers: vec![],
+            collisions: vec![],
             stops: vec![],
             gravity: 0.0,
             excitations: vec![Excitation {

@@ -17,6 +17,7 @@ fn bare(structure: Structure, excitations: Vec<Excitation>) -> Assembly {
     Assembly::new(&SystemSpec {
         structure,
         dampers: vec![],
+        collisions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations,
@@ -368,6 +369,7 @@ fn its_accumulator_rates_are_the_assembly_s() {
                     upper_clearance: 2e-3,
                     law: PairLaw::Compliant(contact),
                 }],
+                collisions: vec![],
                 stops: vec![],
                 gravity: 9.81,
                 excitations: vec![

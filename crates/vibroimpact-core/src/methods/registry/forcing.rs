@@ -186,6 +186,7 @@ mod tests {
         SystemSpec {
             structure: Structure::oscillator(1.0, stiffness, 0.0).unwrap(),
             dampers: vec![],
+            collisions: vec![],
             stops: vec![],
             gravity,
             excitations: vec![Excitation {

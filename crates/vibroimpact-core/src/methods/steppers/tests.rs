@@ -30,6 +30,7 @@ fn beam() -> Assembly {
                 law: PairLaw::rigid(0.5).unwrap(),
             },
         ],
+        collisions: vec![],
         stops: vec![],
         gravity: 9.81,
         excitations: vec![

@@ -233,10 +233,11 @@ impl Walls {
             }
             push
         };
-        let pairs_asked = spec.dampers.len() + spec.stops.len();
+        let pairs_asked = spec.dampers.len() + spec.stops.len() + spec.collisions.len();
         if pairs_asked > MAX_PAIRS {
             return Err(Error::Inconsistent(format!(
-                "[[damper]], [[stop]]: at most {MAX_PAIRS} pairs in all, got {pairs_asked}"
+                "[[damper]], [[stop]], [[collision]]: at most {MAX_PAIRS} pairs in all, \
+                 got {pairs_asked}"
             )));
         }
         let mut walls = Self {
@@ -246,6 +247,7 @@ impl Walls {
         };
         walls.add_dampers(spec, n, dim)?;
         walls.add_stops(spec, n, dim)?;
+        walls.add_collisions(spec, n, dim)?;
         for interaction in &mut walls.interactions {
             interaction.push = full_push(&interaction.h);
             interaction.inverse_mass = linalg::dot(&interaction.h, &interaction.push);
@@ -260,6 +262,25 @@ impl Walls {
         Ok(walls)
     }
 
+    /// A new pair named `name`: its index.
+    fn pair(&mut self, name: String) -> usize {
+        self.pairs.push(name);
+        self.pairs.len() - 1
+    }
+
+    /// A wall of `pair`: the gap `offset + h . x` and its law (its push
+    /// left to fill).
+    fn wall(&mut self, pair: usize, h: Vec<f64>, offset: f64, law: InteractionLaw) {
+        self.interactions.push(Interaction {
+            pair,
+            push: vec![],
+            inverse_mass: 0.0,
+            h,
+            offset,
+            law,
+        });
+    }
+
     /// Each damper's two walls (pushes left to fill).
     fn add_dampers(&mut self, spec: &SystemSpec, n: usize, dim: usize) -> Result<()> {
         let s = &spec.structure;
@@ -269,16 +290,16 @@ impl Walls {
                 .push(positive_named(&name, "mass", d.mass)?);
             let lower = clearance(&name, "lower_clearance", d.lower_clearance)?;
             let upper = clearance(&name, "upper_clearance", d.upper_clearance)?;
-            if lower.is_infinite() && upper.is_infinite() {
+            let collides = spec.collisions.iter().any(|c| c.dampers.contains(&j));
+            if lower.is_infinite() && upper.is_infinite() && !collides {
                 return Err(Error::Inconsistent(format!(
-                    "{name}: lower_clearance and upper_clearance are both infinite (no wall): \
-                     give one side a finite clearance"
+                    "{name}: lower_clearance and upper_clearance are both infinite (no wall) \
+                     and no [[collision]] holds it: give one side a finite clearance"
                 )));
             }
             let point = s.point(&format!("{name} at"), d.at)?;
             let law = interaction_law(&name, &d.law)?;
-            let pair = self.pairs.len();
-            self.pairs.push(name);
+            let pair = self.pair(name);
             // Relative displacement u = z_j - point . q; upper wall: g = upper - u,
             // lower wall: g = lower + u.
             for (sign, offset) in [(-1.0, upper), (1.0, lower)] {
@@ -290,14 +311,7 @@ impl Walls {
                     h[i] = -sign * point[i];
                 }
                 h[n + j] = sign;
-                self.interactions.push(Interaction {
-                    pair,
-                    push: vec![],
-                    inverse_mass: 0.0,
-                    h,
-                    offset,
-                    law,
-                });
+                self.wall(pair, h, offset, law);
             }
         }
         Ok(())
@@ -334,16 +348,33 @@ impl Walls {
             for i in 0..n {
                 h[i] = sign * point[i];
             }
-            let pair = self.pairs.len();
-            self.pairs.push(name);
-            self.interactions.push(Interaction {
-                pair,
-                push: vec![],
-                inverse_mass: 0.0,
-                h,
-                offset: gap,
-                law,
-            });
+            let pair = self.pair(name);
+            self.wall(pair, h, gap, law);
+        }
+        Ok(())
+    }
+
+    /// Each collision's wall: the gap `gap - (z_lower - z_upper)` between
+    /// two loose masses (pushes left to fill).
+    fn add_collisions(&mut self, spec: &SystemSpec, n: usize, dim: usize) -> Result<()> {
+        let k = spec.dampers.len();
+        for (c, collision) in spec.collisions.iter().enumerate() {
+            let name = format!("collision {c}");
+            let [lower, upper] = collision.dampers;
+            if lower >= k || upper >= k || lower == upper {
+                return Err(Error::Inconsistent(format!(
+                    "{name} dampers: must be two different dampers among the {k} \
+                     [[damper]] (0 to {}), got [{lower}, {upper}]",
+                    k.saturating_sub(1)
+                )));
+            }
+            let gap = non_negative_named(&name, "gap", collision.gap)?;
+            let law = interaction_law(&name, &collision.law)?;
+            let mut h = vec![0.0; dim];
+            h[n + lower] = -1.0;
+            h[n + upper] = 1.0;
+            let pair = self.pair(name);
+            self.wall(pair, h, gap, law);
         }
         Ok(())
     }
@@ -474,12 +505,59 @@ mod tests {
                 upper_clearance: upper,
                 law: PairLaw::rigid(0.6).unwrap(),
             }],
+            collisions: vec![],
             stops: vec![],
             gravity: 9.81,
             excitations: vec![],
             points: vec![],
             moments: vec![],
         }
+    }
+
+    #[test]
+    fn a_collision_is_a_wall_between_two_loose_masses() {
+        crate::testing::timeout(10, || {
+            use crate::model::assembly::Collision;
+            let mut spec = with_clearances(2e-3, f64::INFINITY);
+            let mut upper = spec.dampers[0].clone();
+            (upper.mass, upper.lower_clearance, upper.upper_clearance) = (0.2, f64::INFINITY, 0.1);
+            spec.dampers.push(upper);
+            spec.collisions.push(Collision {
+                dampers: [0, 1],
+                gap: 5e-3,
+                law: PairLaw::rigid(0.8).unwrap(),
+            });
+            let system = Assembly::new(&spec).unwrap();
+            assert_eq!(system.pairs, ["damper 0", "damper 1", "collision 0"]);
+            let it = &system.interactions[2];
+            // g = gap - (y_0 - y_1) over (x, y_0, y_1); pushes 1/m on each mass.
+            assert_eq!(
+                (it.h.as_slice(), it.offset),
+                ([0.0, -1.0, 1.0].as_slice(), 5e-3)
+            );
+            assert_eq!(it.push, vec![0.0, -1.0 / 0.05, 1.0 / 0.2]);
+            assert!((it.inverse_mass - (1.0 / 0.05 + 1.0 / 0.2)).abs() < 1e-12);
+            // A damper with no wall at all is held by its collision alone.
+            spec.dampers[1].upper_clearance = f64::INFINITY;
+            assert!(Assembly::new(&spec).is_ok());
+            spec.collisions.clear();
+            let err = Assembly::new(&spec).unwrap_err().to_string();
+            assert!(
+                err.contains("damper 1") && err.contains("[[collision]]"),
+                "{err}"
+            );
+            for (dampers, gap) in [([1, 1], 0.0), ([1, 2], 0.0), ([0, 1], -1e-3)] {
+                // Each names damper 1, so that its lack of walls passes and the
+                // collision's own error is the one met.
+                spec.collisions = vec![Collision {
+                    dampers,
+                    gap,
+                    law: PairLaw::rigid(0.8).unwrap(),
+                }];
+                let err = Assembly::new(&spec).unwrap_err().to_string();
+                assert!(err.contains("collision 0"), "{err}");
+            }
+        });
     }
 
     #[test]

@@ -26,7 +26,9 @@ pub use linear::{HarmonicLoad, LinearParts};
 pub(crate) use rates::{apart_damping, elastic};
 pub use scratch::Scratch;
 pub(crate) use scratch::{rotated, same_increment, Cached, CachedParts, RESYNC};
-pub use spec::{Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec, MAX_PAIRS, MAX_POINTS};
+pub use spec::{
+    Collision, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec, MAX_PAIRS, MAX_POINTS,
+};
 pub use state::{initial_state, resumed_state};
 
 use crate::kernel::compact::Compact;

@@ -98,12 +98,27 @@ pub struct Excitation {
     pub signal: Signal,
 }
 
+/// Two loose masses that strike each other (a multi-unit or particle-column
+/// damper): damper `dampers[0]` below damper `dampers[1]` along the axis,
+/// touching when the displacement of the first minus that of the second
+/// reaches `gap`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Collision {
+    /// Indices into [`SystemSpec::dampers`], the lower first; distinct.
+    pub dampers: [usize; 2],
+    /// m (>= 0): their free distance at rest.
+    pub gap: f64,
+    pub law: PairLaw,
+}
+
 /// Everything a run needs to know about the system.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemSpec {
     pub structure: Structure,
     pub dampers: Vec<Damper>,
     pub stops: Vec<Stop>,
+    /// Loose masses striking each other, after the stops' pairs.
+    pub collisions: Vec<Collision>,
     /// m/s^2 (>= 0), along -x.
     pub gravity: f64,
     pub excitations: Vec<Excitation>,
@@ -120,7 +135,7 @@ pub struct SystemSpec {
 /// coordinates, a peak and a mean square).
 pub const MAX_POINTS: usize = 10_000;
 
-/// The most pairs (dampers and stops) a system may have: simultaneous
+/// The most pairs (dampers, stops and collisions) a system may have: simultaneous
 /// impacts and sticking solve a system over every interaction (its matrix
 /// grows as their square: 70,000 stops asked for 39 GB).
 pub const MAX_PAIRS: usize = 1_000;

@@ -254,6 +254,7 @@ mod tests {
                 upper_clearance: 3e-3,
                 law,
             }],
+            collisions: vec![],
             stops: if stop { stops } else { vec![] },
             gravity: if stop { 9.81 } else { 0.0 },
             excitations: vec![Excitation {

@@ -1,0 +1,271 @@
+"""Loose masses that collide with each other (issue 27): ``[[collision]]`` pairs between
+dampers, checked against closed forms (Newton's restitution with momentum kept, the
+simultaneous impact of a row of touching masses) and scipy's integration of the same
+equations of motion (a Hertz chain, a compliant particle column in a forced cavity)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import vibroimpact as vi
+import vibroimpact.analysis as an
+from test_system import cli
+
+ROOT = Path(__file__).resolve().parents[1]
+COLUMN = ROOT / "examples" / "particle_column.toml"
+FREE = {"lower_clearance": math.inf, "upper_clearance": math.inf}
+
+
+def _masses(masses: list[float], law: dict[str, Any], gaps: list[float], v0: float) -> vi.System:
+    """Loose masses in a row on a still carrier (no wall within reach: the first has a
+    floor 1 m below, the last a ceiling 1 m above), each striking the next across
+    ``gaps``; the first thrown at the others at ``v0`` m/s."""
+    last = len(masses) - 1
+    dampers = [
+        vi.Damper(
+            mass=m,
+            at=0,
+            lower_clearance=1.0 if j == 0 else math.inf,
+            upper_clearance=1.0 if j == last else math.inf,
+            **law,
+        )
+        for j, m in enumerate(masses)
+    ]
+    collisions = [vi.Collision(dampers=(j, j + 1), gap=g, **law) for j, g in enumerate(gaps)]
+    return vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=100.0, damping=0.0),
+        dampers=dampers,
+        collisions=collisions,
+        initial=vi.Initial(damper_velocity=[v0] + [0.0] * last),
+    )
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk4"])
+@pytest.mark.timeout(30)
+def test_two_loose_masses_collide_by_newton_s_restitution_keeping_momentum(method: str) -> None:
+    m1, m2, e, gap = 0.1, 0.3, 0.7, 0.01
+    system = _masses([m1, m2], {"law": "rigid", "restitution": e}, [gap], 1.0)
+    system = system.replace(initial=vi.Initial(damper_velocity=[1.0, -0.5]))
+    step = {"dt": 1e-4} if method == "rk4" else {}
+    sol = vi.simulate(system, method=method, t_end=0.05, **step)
+    (contact,) = sol.contacts.to_pandas().itertuples()
+    closing = 1.5
+    assert contact.pair == "collision 0"
+    assert contact.onset == pytest.approx(gap / closing, rel=1e-12)
+    assert contact.approach_speed == pytest.approx(closing, rel=1e-12)
+    assert contact.rebound_speed == pytest.approx(e * closing, rel=1e-12)
+    reduced = m1 * m2 / (m1 + m2)
+    lost = 0.5 * reduced * (1 - e * e) * closing**2
+    assert contact.energy_dissipated == pytest.approx(lost, rel=1e-12)
+    assert sol.energy["impact"] == pytest.approx(lost, rel=1e-12)
+    # Momentum kept, the relative speed reversed times e.
+    v1, v2 = sol.final_state["damper_velocity"]
+    assert m1 * v1 + m2 * v2 == pytest.approx(m1 * 1.0 + m2 * -0.5, abs=1e-14)
+    assert v2 - v1 == pytest.approx(e * closing, rel=1e-12)
+
+
+@pytest.mark.timeout(30)
+def test_a_rigid_row_struck_at_once_is_not_a_newton_s_cradle() -> None:
+    # Three equal masses, the last two touching, the first arriving at v with e = 1.
+    # Both contacts close at once: the simultaneous impact (one complementarity
+    # problem) leaves the touching pair touching, so the two move as one. Momentum and
+    # energy then give the first -v/3 and the pair 2v/3 each; a Newton's cradle (the
+    # first stops, the last leaves at v) needs the impacts one after the other.
+    for method in ("exact", "dop853"):
+        sol = vi.simulate(
+            _masses([0.1] * 3, {"law": "rigid", "restitution": 1.0}, [0.01, 0.0], 1.0),
+            method=method,
+            t_end=0.05,
+        )
+        assert sol.final_state["damper_velocity"] == pytest.approx(
+            [-1 / 3, 2 / 3, 2 / 3], abs=1e-14
+        )
+        assert abs(sol.energy["residual"]) < 1e-15
+
+
+def _hertz_chain(masses: list[float], stiffness: float, gaps: list[float], v0: float) -> Any:
+    """scipy's integration of the masses' Hertz contacts (a test-only oracle): each
+    pair pushes apart with ``stiffness * overlap^1.5`` while they overlap."""
+    k = len(masses)
+
+    def rates(t: float, y: np.ndarray) -> np.ndarray:
+        x, v = y[:k], y[k:]
+        force = np.zeros(k)
+        for j, g in enumerate(gaps):
+            overlap = x[j] - x[j + 1] - g
+            if overlap > 0:
+                push = stiffness * overlap**1.5
+                force[j] -= push
+                force[j + 1] += push
+        return np.concatenate([v, force / np.array(masses)])
+
+    y0 = np.zeros(2 * k)
+    y0[k] = v0
+    return solve_ivp(rates, (0, 0.05), y0, method="DOP853", rtol=1e-12, atol=1e-15, max_step=1e-6)
+
+
+@pytest.mark.timeout(60)
+def test_a_hertz_row_carries_the_wave_as_scipy_integrates_it() -> None:
+    # The compliant answer for the same row: the contacts act one after the other as
+    # the wave runs along it, nearly a cradle (about -0.07, 0.08, 0.99 of v for three
+    # equal Hertz masses), and no energy is lost.
+    masses, stiffness = [0.1, 0.1, 0.1], 1e9
+    system = _masses(masses, {"law": "hertz", "stiffness": stiffness}, [0.01, 0.0], 1.0)
+    sol = vi.simulate(system, method="dop853", t_end=0.05, rtol=1e-11, atol=1e-14)
+    reference = _hertz_chain(masses, stiffness, [0.01, 0.0], 1.0)
+    velocities = sol.final_state["damper_velocity"]
+    assert velocities == pytest.approx(reference.y[3:, -1], abs=1e-8)
+    assert velocities[2] > 0.99 and -0.08 < velocities[0] < -0.06
+    assert sol.energy["stored_end"] == pytest.approx(sol.energy["stored_start"], rel=1e-10)
+    assert list(sol.contacts.pair) == ["collision 0", "collision 1"]
+
+
+def _column_oracle(data: dict[str, Any], t_end: float) -> np.ndarray:
+    """scipy's integration of a Hertz column (no contact damping) in its forced cavity:
+    the cavity's oscillator, gravity on every mass, each particle's floor and ceiling
+    where it has one, each neighbour's contact."""
+    s, force = data["structure"], data["excitation"][0]
+    dampers, collisions = data["damper"], data["collision"]
+    k = len(dampers)
+    masses = np.array([d["mass"] for d in dampers])
+    w, g = 2 * math.pi * force["frequency"], data["gravity"]["acceleration"]
+
+    def hertz(overlap: float, stiffness: float) -> float:
+        return stiffness * overlap**1.5 if overlap > 0 else 0.0
+
+    def rates(t: float, y: np.ndarray) -> np.ndarray:
+        x, z, vx, vz = y[0], y[1 : k + 1], y[k + 1], y[k + 2 :]
+        on_cavity = force["amplitude"] * math.cos(w * t) - s["stiffness"] * x
+        on_cavity -= s["damping"] * vx + s["mass"] * g
+        on = -masses * g
+        for j, d in enumerate(dampers):
+            relative = z[j] - x
+            below = hertz(-d["lower_clearance"] - relative, d["stiffness"])
+            above = hertz(relative - d["upper_clearance"], d["stiffness"])
+            on[j] += below - above
+            on_cavity += above - below
+        for c in collisions:
+            i, j = c["dampers"]
+            push = hertz(z[i] - z[j] - c["gap"], c["stiffness"])
+            on[i] -= push
+            on[j] += push
+        return np.concatenate([[vx], vz, [on_cavity / s["mass"]], on / masses])
+
+    # Radau at tight tolerance: DOP853 with these tolerances wanders by 4e-9 m/s as its
+    # step cap changes, over the column's contacts.
+    sol = solve_ivp(
+        rates, (0, t_end), np.zeros(2 * k + 2), method="Radau", rtol=1e-10, atol=1e-13,
+        max_step=2e-5,
+    )  # fmt: skip
+    return np.asarray(sol.y[:, -1])
+
+
+@pytest.mark.timeout(120)
+def test_a_hertz_column_in_a_forced_cavity_follows_scipy() -> None:
+    data = vi.load(COLUMN).to_dict()
+    for table in data["damper"] + data["collision"]:
+        table.update(law="hertz", damping=0.0)
+        table.pop("restitution", None)
+    # 50 ms: the floor's contact and each collision's; later, the column's contacts
+    # amplify any difference as a chaotic motion does.
+    t_end = 0.05
+    data["solver"] = {"method": "dop853", "t_end": t_end, "rtol": 1e-11, "atol": 1e-14}
+    sol = vi.simulate(vi.System.from_dict(data))
+    assert {"damper 0", "collision 0", "collision 1", "collision 2", "collision 3"} <= set(
+        sol.contacts.pair
+    )
+    ours = np.concatenate(
+        [
+            sol.final_state["structure_displacement"],
+            sol.final_state["damper_displacement"],
+            sol.final_state["structure_velocity"],
+            sol.final_state["damper_velocity"],
+        ]
+    )
+    theirs = _column_oracle(data, t_end)
+    k = len(data["damper"])
+    assert np.max(np.abs(ours[: k + 1] - theirs[: k + 1])) < 1e-10
+    assert np.max(np.abs(ours[k + 1 :] - theirs[k + 1 :])) < 1e-8
+
+
+@pytest.mark.timeout(60)
+def test_the_particle_column_example_runs_from_the_cli_with_its_ledger_closed(
+    tmp_path: Path,
+) -> None:
+    done = cli("simulate", str(COLUMN), "--json")
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    pairs = {c["pair"] for c in out["contacts"]}
+    assert {f"collision {j}" for j in range(4)} <= pairs and "damper 0" in pairs
+    energy = out["energy"]
+    assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
+    # Each collision's loss is a contact's: the ledger's contact column sums them.
+    losses = sum(c["energy_dissipated"] for c in out["contacts"])
+    assert energy["contact"] == pytest.approx(losses, rel=1e-6)
+
+
+@pytest.mark.timeout(30)
+def test_a_system_with_collisions_round_trips_through_toml() -> None:
+    system = vi.load(COLUMN)
+    assert len(system.collisions) == 4
+    assert system.collisions[0] == vi.Collision(
+        dampers=(0, 1), gap=0.002, law="hertz-damped", stiffness=1e8, restitution=0.6
+    )
+    assert vi.load(system.to_toml()) == system
+    assert math.isinf(system.dampers[2].lower_clearance)
+
+
+@pytest.mark.timeout(60)
+def test_a_study_varies_a_collision_s_gap(tmp_path: Path) -> None:
+    from vibroimpact.study import run
+
+    data = vi.load(COLUMN).to_dict()
+    data["solver"]["t_end"] = 0.3
+    data["study"] = {
+        "axes": {"collision.0.gap": {"start": 0.001, "stop": 0.003, "count": 2}},
+        "metrics": ["impacts"],
+    }
+    result = run(vi.study_of(data), tmp_path / "gap.nc")
+    impacts = result["impacts"].values
+    assert result["collision.0.gap"].values.tolist() == [0.001, 0.003]
+    assert impacts.shape == (2,) and impacts[0] != impacts[1]
+    # The first run is the example's own system with that gap.
+    data["collision"][0]["gap"] = 0.001
+    alone = vi.simulate(vi.System.from_dict({k: v for k, v in data.items() if k != "study"}))
+    assert impacts[0] == len(alone.contacts)
+
+
+@pytest.mark.parametrize(
+    ("collision", "message"),
+    [
+        ({"dampers": [0, 0], "gap": 0.01}, "two different"),
+        ({"dampers": [0, 5], "gap": 0.01}, "two different"),
+        ({"dampers": [0, 1, 2], "gap": 0.01}, "two different"),
+        ({"dampers": [0.5, 1], "gap": 0.01}, "two different"),
+        ({"dampers": [0, 1], "gap": -0.01}, "gap must be >= 0"),
+        ({"dampers": [0, 1], "gap": 0.01, "side": "upper"}, "unknown key 'side'"),
+        ({"dampers": [0, 1]}, "missing key 'gap'"),
+    ],
+)
+@pytest.mark.timeout(30)
+def test_a_bad_collision_is_refused_naming_its_key(collision: dict[str, Any], message: str) -> None:
+    data = vi.load(COLUMN).to_dict()
+    data["collision"] = [collision | {"law": "rigid", "restitution": 0.5}]
+    with pytest.raises(ValueError, match=message) as error:
+        an.runner(data)
+    assert "[[collision]] 0" in str(error.value) and "\n" not in str(error.value)
+
+
+@pytest.mark.timeout(30)
+def test_a_damper_with_no_wall_needs_a_collision_to_hold_it() -> None:
+    data = vi.load(COLUMN).to_dict()
+    data["collision"] = data["collision"][:1]  # particles 2 and 3 now held by nothing
+    with pytest.raises(ValueError, match=r"\[\[damper\]\] 2: .*no \[\[collision\]\] holds it"):
+        an.runner(data)
