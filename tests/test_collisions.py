@@ -269,3 +269,90 @@ def test_a_damper_with_no_wall_needs_a_collision_to_hold_it() -> None:
     data["collision"] = data["collision"][:1]  # particles 2 and 3 now held by nothing
     with pytest.raises(ValueError, match=r"\[\[damper\]\] 2: .*no \[\[collision\]\] holds it"):
         an.runner(data)
+
+
+def still_table(g: float) -> tuple[vi.Oscillator, float]:
+    """A table too heavy for loose masses of grams to move (1e6 kg on a 50 Hz spring),
+    and its sag (m) at rest under gravity ``g`` (m/s^2)."""
+    return (
+        vi.Oscillator(mass=1e6, stiffness=1e6 * (2 * math.pi * 50) ** 2, damping=0.0),
+        -g / (2 * math.pi * 50) ** 2,
+    )
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853"])
+@pytest.mark.timeout(30)
+def test_a_touching_rigid_column_dropped_on_the_floor_lands_as_one_ball(method: str) -> None:
+    # Five touching particles dropped together from h onto the floor of a cavity too
+    # heavy to move: each landing is one impact of the whole column (its contacts
+    # touch at that instant; resolved one after the other they had run up and down the
+    # column 1e-14 s apart without end), so it bounces as one ball of restitution e:
+    # landings at t1 (1 + 2 e + ... + 2 e^(k-1)), t1 = sqrt(2 h / g), at sqrt(2 g h)
+    # e^k, and at rest from t1 (1 + e) / (1 - e).
+    h, e, g, count = 0.05, 0.5, 9.81, 5
+    table, sag = still_table(g)
+    law = {"law": "rigid", "restitution": e}
+    system = vi.System(
+        structure=table,
+        dampers=[
+            vi.Damper(
+                mass=0.01,
+                at=0,
+                lower_clearance=h if j == 0 else math.inf,
+                upper_clearance=math.inf,
+                **law,
+            )
+            for j in range(count)
+        ],
+        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.0, **law) for j in range(count - 1)],
+        gravity=vi.Gravity(acceleration=g),
+        initial=vi.Initial(structure_displacement=[sag], damper_displacement=[sag] * count),
+    )
+    sol = vi.simulate(system, method=method, t_end=0.5)
+    floor = sol.contacts.to_pandas().query("pair == 'damper 0'")
+    t1, v1 = math.sqrt(2 * h / g), math.sqrt(2 * g * h)
+    landings = t1 * (1 + 2 * np.cumsum([0.0, e, e**2]))
+    impacts = floor.query("kind == 'impact'")
+    assert impacts.onset.to_numpy()[:3] == pytest.approx(landings, rel=1e-6)
+    assert impacts.approach_speed.to_numpy()[:3] == pytest.approx(v1 * e ** np.arange(3), rel=1e-6)
+    (rest,) = floor.query("kind == 'sticking'").onset
+    assert rest == pytest.approx(t1 * (1 + e) / (1 - e), rel=1e-6)
+    # No particle ever left another: no collision is an impact; at rest, they stick.
+    collisions = sol.contacts.to_pandas().query("pair != 'damper 0'")
+    assert set(collisions.kind) == {"sticking"} and len(collisions) == count - 1
+    assert collisions.onset.to_numpy() == pytest.approx(rest, rel=1e-4)
+    z = sol.damper_displacement
+    assert np.max(np.abs(z - z[:, :1])) < 1e-12
+
+
+@pytest.mark.parametrize("restitution", [0.3, 0.6])
+@pytest.mark.timeout(60)
+def test_a_forced_rigid_column_of_ten_runs_with_its_ledger_closed(restitution: float) -> None:
+    # A low restitution collapses a column inelastically (impacts ever closer between
+    # three or more particles): the touching particles then move as one, and the run
+    # goes on; the impacts' losses are the ledger's.
+    count = 10
+    law = {"law": "rigid", "restitution": restitution}
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
+        dampers=[
+            vi.Damper(
+                mass=0.01,
+                at=0,
+                lower_clearance=0.002 if j == 0 else math.inf,
+                upper_clearance=0.03 if j == count - 1 else math.inf,
+                **law,
+            )
+            for j in range(count)
+        ],
+        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(count - 1)],
+        gravity=vi.Gravity(acceleration=9.81),
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
+    )
+    for method in ("exact", "dop853"):
+        sol = vi.simulate(system, method=method, t_end=5.0, history=False)
+        energy = sol.energy
+        assert len(sol.contacts) > 100
+        assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
+        losses = float(np.sum(sol.contacts.energy_dissipated))
+        assert energy["impact"] == pytest.approx(losses, rel=1e-9)

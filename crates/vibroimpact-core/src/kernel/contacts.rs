@@ -15,7 +15,7 @@ use crate::kernel::observe::EventView;
 use crate::kernel::run::{loss_slot, Run};
 use crate::methods::step_control::initial_step;
 use crate::methods::steppers::SystemStepper;
-use crate::model::assembly::{Assembly, InteractionLaw, Mode};
+use crate::model::assembly::{Assembly, Interaction, InteractionLaw, Mode};
 use crate::model::contact::{AnyLaw, Hertz, HysterHertz, Linear};
 use crate::numerics::hermite;
 
@@ -144,6 +144,10 @@ impl Run<'_> {
             self.watch_before();
         }
         self.just_switched.iter_mut().for_each(|s| *s = false);
+        // Whether an open pair the event did not cross touches (see
+        // `mark_touching`).
+        let touch = self.touch_band(instant);
+        let mut near = false;
         for i in 0..self.modes.len() {
             let mode = self.modes[i];
             let v = event_value(
@@ -159,6 +163,7 @@ impl Run<'_> {
             if !(i == located || crossed(system, i, mode, v, &self.y))
                 || (mode == Mode::Open && system.held_by_mirror(i, &self.modes))
             {
+                near |= mode == Mode::Open && v <= touch.of(&system.interactions[i]);
                 continue;
             }
             if self.impacts.mark(system, i, mode) {
@@ -170,6 +175,9 @@ impl Run<'_> {
             self.just_switched[i] = true;
             self.check_contact(i, mode, onset)?;
             any = true;
+        }
+        if rigid && near {
+            self.mark_touching(touch);
         }
         if rigid {
             any |= self.impacts.resolve(
@@ -206,6 +214,33 @@ impl Run<'_> {
             self.watch_event(time, located)?;
         }
         Ok(())
+    }
+
+    /// The gaps that touch at an event whose time's round-off is `instant`
+    /// (s): what the state's speeds close within it, or the round-off of
+    /// the gap's scale that a touch's release leaves between two pairs.
+    fn touch_band(&self, instant: f64) -> TouchBand {
+        let d = self.system.dim;
+        let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        TouchBand {
+            closed: instant * largest(&self.y[d..2 * d]),
+            reach: largest(&self.y[..d]),
+        }
+    }
+
+    /// At a rigid event, the open rigid pairs whose gap is within `touch`
+    /// join it: they touch at this instant. (Loose masses touching in a
+    /// column are a few units of round-off apart; resolved one after the
+    /// other, a landing ran up and down the column as impacts 1e-14 s apart,
+    /// without end.)
+    fn mark_touching(&mut self, touch: TouchBand) {
+        let system = self.system;
+        for i in 0..self.modes.len() {
+            let gap = system.gap(i, &self.y).0;
+            if gap <= touch.of(&system.interactions[i]) && !system.held_by_mirror(i, &self.modes) {
+                self.impacts.mark(system, i, self.modes[i]);
+            }
+        }
     }
 
     /// An observed run (see [`crate::kernel::observe`]): the state and modes
@@ -501,5 +536,24 @@ impl Run<'_> {
             h = h.min(ONSET_STEP_FRACTION * contact_time_scale(system, i, speed));
         }
         self.control.h = h;
+    }
+}
+
+/// See [`Run::touch_band`].
+#[derive(Debug, Clone, Copy)]
+struct TouchBand {
+    /// m: what the state's speeds close within the time's round-off.
+    closed: f64,
+    /// m: the largest coordinate.
+    reach: f64,
+}
+
+impl TouchBand {
+    /// Interaction `it`'s band, m: at least 64 units of round-off of (a
+    /// bound on) its gap's scale, four times what a touch's release leaves.
+    #[inline(always)]
+    fn of(&self, it: &Interaction) -> f64 {
+        self.closed
+            .max(64.0 * f64::EPSILON * (it.offset.abs() + it.h_norm * self.reach))
     }
 }

@@ -28,6 +28,7 @@
 //! flights falling by the mass ratio: summed, both rest).
 
 use crate::kernel::events::{ContactKind, Open, PairContact};
+use crate::kernel::locate::wall_round_off;
 use crate::kernel::observe::Jump;
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 use crate::numerics::linalg;
@@ -475,8 +476,11 @@ impl Impacts {
                     // instant its force turns, a zero clearance, a plastic
                     // landing as its wall's pull turns): put it a few units
                     // of round-off off the wall, or the same touch is found
-                    // again at once, without end.
-                    if system.gap(i, y).0 <= 0.0 {
+                    // again at once, without end. (Within the events' band
+                    // of round-off above the wall too: two loose masses
+                    // touching in free fall close at a rate of exactly zero,
+                    // which reads as arriving there.)
+                    if system.gap(i, y).0 <= wall_round_off(system, i, y) {
                         system.release(i, y);
                     }
                 }

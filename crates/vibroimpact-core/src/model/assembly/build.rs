@@ -275,6 +275,7 @@ impl Walls {
             pair,
             push: vec![],
             inverse_mass: 0.0,
+            h_norm: h.iter().map(|v| v.abs()).sum(),
             h,
             offset,
             law,

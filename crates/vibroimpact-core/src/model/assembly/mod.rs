@@ -49,6 +49,8 @@ pub struct Interaction {
     pub pair: usize,
     /// Over all coordinates `x` (dense, length `dim`).
     pub h: Vec<f64>,
+    /// `sum |h_k|`: the gap's scale is at most `|offset| + h_norm max |x_k|`.
+    pub h_norm: f64,
     pub offset: f64,
     /// `M^-1 h^T`: the acceleration per newton of contact force.
     pub push: Vec<f64>,
