@@ -356,3 +356,52 @@ def test_a_forced_rigid_column_of_ten_runs_with_its_ledger_closed(restitution: f
         assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
         losses = float(np.sum(sol.contacts.energy_dissipated))
         assert energy["impact"] == pytest.approx(losses, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("law", "tolerance"),
+    [
+        ({"law": "rigid", "restitution": 0.7}, 1e-6),
+        ({"law": "hertz", "stiffness": 1e7}, 5e-5),
+    ],
+    ids=["rigid", "hertz"],
+)
+@pytest.mark.timeout(60)
+def test_the_tangent_map_goes_through_collisions(law: dict[str, Any], tolerance: float) -> None:
+    # Two particles in a forced cavity, the lower on its floor, the upper under its
+    # ceiling, striking each other: the tangent map over a forcing period against
+    # central differences of whole runs; rigid, its determinant is the phase volume's
+    # identity e^(2 N) exp(-c t / M) (N impacts, the cavity's damper c on its mass M).
+    method = {"method": "exact"} if law["law"] == "rigid" else {"method": "dop853"}
+    tight = {} if law["law"] == "rigid" else {"rtol": 1e-11, "atol": 1e-14}
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
+        dampers=[
+            vi.Damper(mass=0.01, at=0, lower_clearance=0.002, upper_clearance=math.inf, **law),
+            vi.Damper(mass=0.02, at=0, lower_clearance=math.inf, upper_clearance=0.01, **law),
+        ],
+        collisions=[vi.Collision(dampers=(0, 1), gap=0.002, **law)],
+        gravity=vi.Gravity(acceleration=9.81),
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
+        solver=vi.Solver(t_end=1.0, **method, **tight),
+    )
+    run = an.runner(system)
+    state, period = np.array([0.001, 0.0005, 0.001, 0.05, 0.3, -0.2]), 0.1
+    raw = run.tangent(state, period)
+    contacts = run.periods(state, 1, record=True)
+    struck = {contacts["pairs"][p] for p in contacts["contacts"]["pair"]}
+    assert "collision 0" in struck and len(contacts["contacts"]["pair"]) >= 10
+    columns = []
+    for i in range(len(state)):
+        step = np.zeros(len(state))
+        step[i] = 1e-7 * max(abs(state[i]), 1e-3)
+        ahead = run.system().run(list(state + step), period)["final_state"]
+        behind = run.system().run(list(state - step), period)["final_state"]
+        columns.append((np.asarray(ahead) - np.asarray(behind)) / (2 * step[i]))
+    differences = np.array(columns).T
+    error = np.max(np.abs(raw["matrix"] - differences)) / np.max(np.abs(differences))
+    assert error < tolerance
+    if law["law"] == "rigid":
+        impacts = raw["impacts"]
+        volume = law["restitution"] ** (2 * impacts) * math.exp(-9.42 * period / 1.0)
+        assert np.linalg.det(raw["matrix"]) / volume == pytest.approx(1.0, abs=1e-9)
