@@ -43,6 +43,7 @@ def test_every_tutorial_is_tested_here() -> None:
         "impact_oscillator_maps",
         "monte_carlo_random",
         "dask_study",
+        "colliding_masses",
     }
     assert names == tested and (TUTORIALS / "README.rst").is_file()
 
@@ -372,3 +373,36 @@ def test_dask_study_resumed_is_byte_identical_to_an_uninterrupted_one() -> None:
     assert any("resuming from" in n and "6 chunks to run" in n for n in ns["notices"])
     assert ns["resumed_bytes"] == ns["uninterrupted_bytes"]
     assert int(ns["resumed"]["status"].max()) == 0
+
+
+# Loose masses that collide ------------------------------------------------------------
+
+
+def test_colliding_masses_obey_newton_s_law_and_a_row_is_not_a_cradle() -> None:
+    from test_collisions import _hertz_chain
+
+    ns = tutorial("colliding_masses")
+    (contact,) = ns["two"].contacts.to_pandas().itertuples()
+    e, lower, upper = ns["RESTITUTION"], ns["LOWER"], ns["UPPER"]
+    closing = 1.0 + 0.5
+    assert contact.approach_speed == pytest.approx(closing, rel=1e-12)
+    assert contact.rebound_speed == pytest.approx(e * closing, rel=1e-12)
+    v = ns["two"].final_state["damper_velocity"]
+    assert lower * v[0] + upper * v[1] == pytest.approx(lower * 1.0 - upper * 0.5, abs=1e-15)
+    reduced = lower * upper / (lower + upper)
+    assert ns["two"].energy["impact"] == pytest.approx(
+        0.5 * reduced * (1 - e * e) * closing**2, rel=1e-12
+    )
+    # The rigid row: momentum and energy with the touching pair moving as one.
+    rigid = ns["ROW_RIGID"].final_state["damper_velocity"]
+    assert rigid == pytest.approx([-1 / 3, 2 / 3, 2 / 3], abs=1e-14)
+    # The Hertz row: scipy's integration of the same three masses.
+    reference = _hertz_chain([0.1, 0.1, 0.1], 1e9, [0.01, 0.0], 1.0)
+    hertz = ns["ROW_HERTZ"].final_state["damper_velocity"]
+    assert hertz == pytest.approx(reference.y[3:, -1], abs=1e-8)
+    # The column's ledgers close, the contacts' loss being the contacts' own.
+    for sol in ns["RUNS"].values():
+        energy = sol.energy
+        assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
+        losses = float(np.sum(sol.contacts.energy_dissipated))
+        assert energy["contact"] == pytest.approx(losses, rel=1e-6)
