@@ -405,3 +405,14 @@ def test_the_tangent_map_goes_through_collisions(law: dict[str, Any], tolerance:
         impacts = raw["impacts"]
         volume = law["restitution"] ** (2 * impacts) * math.exp(-9.42 * period / 1.0)
         assert np.linalg.det(raw["matrix"]) / volume == pytest.approx(1.0, abs=1e-9)
+
+
+@pytest.mark.timeout(30)
+def test_the_column_s_natural_modes_and_notebook_view_take_its_collisions() -> None:
+    # Its middle particles have no wall: only the collisions hold them.
+    system = vi.load(COLUMN)
+    modes = vi.natural_modes(system)
+    expected = math.sqrt(8883.0 / 1.0) / (2 * math.pi)
+    assert modes.frequencies[0] == pytest.approx(expected, rel=1e-12)
+    html = system._repr_html_()
+    assert "collision 3" in html

@@ -269,3 +269,19 @@ def test_cli_reports_the_ceiling_s_grazing_and_its_curve(tmp_path: Path) -> None
     points = json.loads(done.stdout)["points"]
     assert len(points) == 5
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.timeout(30)
+def test_walls_are_stops_and_damper_sides_and_a_one_walled_damper_is_struck_on_it() -> None:
+    from vibroimpact.analysis.grazing import walls
+
+    assert walls(["stop 0", "damper 0", "collision 0"]) == [
+        "stop 0",
+        "damper 0 upper",
+        "damper 0 lower",
+    ]
+    # A box with no ceiling: its ball strikes the floor, the one wall it has.
+    data = _box()
+    data["damper"][0]["upper_clearance"] = math.inf
+    run = an.runner(data)
+    assert struck(run, np.array(ORBIT), 1) == {"damper 0 lower"}

@@ -54,6 +54,7 @@ def _system_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
         "structure": ("[structure]", structure),
         "damper": ("[[damper]]", schema._DAMPER),
         "stop": ("[[stop]]", schema._STOP),
+        "collision": ("[[collision]]", schema._COLLISION),
         "gravity": ("[gravity]", schema._GRAVITY),
         "excitation": ("[[excitation]]", schema._EXCITATION),
         "initial": ("[initial]", schema._INITIAL),

@@ -76,13 +76,16 @@ def _tables(data: dict[str, Any], key: str) -> list[Any]:
 
 
 def walls(pairs: list[str]) -> list[str]:
-    """The walls of the pairs named ``pairs``: a stop is its own wall (``"stop 0"``),
-    a damper has two (``"damper 0 upper"``, ``"damper 0 lower"``)."""
-    return [
-        wall
-        for pair in pairs
-        for wall in ([f"{pair} {side}" for side in SIDES] if pair.startswith("damper ") else [pair])
-    ]
+    """The walls of the pairs named ``pairs`` whose grazing is located: a stop is its
+    own wall (``"stop 0"``), a damper has two (``"damper 0 upper"``, ``"damper 0
+    lower"``); collisions between loose masses are not located."""
+    out: list[str] = []
+    for pair in pairs:
+        if pair.startswith("damper "):
+            out.extend(f"{pair} {side}" for side in SIDES)
+        elif pair.startswith("stop "):
+            out.append(pair)
+    return out
 
 
 def _without_wall(data: Mapping[str, Any], wall: str) -> dict[str, Any]:
@@ -103,19 +106,19 @@ def _without_wall(data: Mapping[str, Any], wall: str) -> dict[str, Any]:
     return out
 
 
-def _wall_row(system: Any, wall: str) -> dict[str, Any]:
+def _wall_row(system: Any, wall: str, dampers: int) -> dict[str, Any] | None:
     """The gap row (``h``, ``offset``) of the wall named ``wall`` in the prepared
-    ``system``: a stop's own, or of a damper's two the one whose ``h`` has the side's
-    sign on the loose mass's coordinate."""
+    ``system`` with ``dampers`` loose masses: a stop's own, or of a damper's two the one
+    whose ``h`` has the side's sign on the loose mass's coordinate; None where that
+    side has no wall."""
     words = wall.split()
     pair = " ".join(words[:2])
     rows = [r for r in interactions(system) if r["pair"] == pair]
     if words[0] == "stop":
         return rows[0]
     # The dampers' coordinates are the last, in order: damper j's is dim - k + j.
-    dampers = {r["pair"] for r in interactions(system) if r["pair"].startswith("damper ")}
-    coordinate = len(rows[0]["h"]) - len(dampers) + int(words[1])
-    return next(r for r in rows if np.sign(r["h"][coordinate]) == SIDES[words[2]])
+    coordinate = len(rows[0]["h"]) - dampers + int(words[1])
+    return next((r for r in rows if np.sign(r["h"][coordinate]) == SIDES[words[2]]), None)
 
 
 class _Wall:
@@ -133,7 +136,9 @@ class _Wall:
             arc = self.arc
             changed = shifted(with_parameter(arc.data, arc.parameter, p), arc.section)
             full = runner(changed, arc.base_dir)
-            row = _wall_row(full.system(), self.pair)
+            row = _wall_row(full.system(), self.pair, full.k)
+            if row is None:
+                raise StopIteration(f"{self.pair}: no such wall")
             free = runner(_without_wall(changed, self.pair), arc.base_dir)
             if len(self._cache) > 8:
                 self._cache.clear()
@@ -204,13 +209,13 @@ def _side_struck(run: Runner, state: np.ndarray, damper: str, onset: float) -> s
     at = np.asarray(state, dtype=float)
     if onset > 0:
         at = np.asarray(system.run([float(v) for v in state], onset)["final_state"], dtype=float)
-    sides = [f"{damper} {side}" for side in SIDES]
-    gaps = []
-    for wall in sides:
-        row = _wall_row(system, wall)
-        h = np.asarray(row["h"], dtype=float)
-        gaps.append(abs(float(row["offset"]) + h @ at[: len(h)]))
-    return sides[int(np.argmin(gaps))]
+    gaps = {}
+    for wall in (f"{damper} {side}" for side in SIDES):
+        row = _wall_row(system, wall, run.k)
+        if row is not None:
+            h = np.asarray(row["h"], dtype=float)
+            gaps[wall] = abs(float(row["offset"]) + h @ at[: len(h)])
+    return min(gaps, key=lambda wall: gaps[wall])
 
 
 def grazings_between(
@@ -228,7 +233,7 @@ def grazings_between(
         for p, u in zip(ends, unknowns, strict=True)
     ]
     found = []
-    for pair in sorted(hit[0] ^ hit[1]):
+    for pair in sorted(set(walls(sorted(hit[0] | hit[1]))) & (hit[0] ^ hit[1])):
         start = unknowns[0] if pair in hit[1] else unknowns[1]
         located = locate_grazing(arc, pair, start)
         if located is not None and min(within) <= located.value <= max(within):

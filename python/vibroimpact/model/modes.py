@@ -64,7 +64,9 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
         raise InvalidInputError(f"system: must be a vibroimpact.System, got {shown(system)}")
     attach = arguments.flag("attach_dampers", attach_dampers)
     sections = system.model_sections()
-    parts = linear_parts(sections["structure"], damper=sections["damper"])
+    parts = linear_parts(
+        sections["structure"], damper=sections["damper"], collision=sections["collision"]
+    )
     n = parts["n"]
     mass, stiffness = parts["mass"][:n, :n].copy(), parts["stiffness"][:n, :n]
     structure = system_spec(sections["structure"])["structure"]
