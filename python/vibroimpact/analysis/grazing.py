@@ -28,6 +28,7 @@ from vibroimpact._core import interactions
 from vibroimpact.analysis.located import Bifurcation
 from vibroimpact.analysis.parameters import shifted, with_parameter
 from vibroimpact.analysis.runs import Runner, runner
+from vibroimpact.model.system import listed_tables
 
 if TYPE_CHECKING:
     from vibroimpact.analysis.continuation import BranchPoint, _Arc
@@ -67,14 +68,6 @@ class Grazing:
 SIDES = {"upper": -1.0, "lower": 1.0}
 
 
-def _tables(data: dict[str, Any], key: str) -> list[Any]:
-    """The ``[[key]]`` tables of ``data`` as a list (a single table is one), set back
-    into ``data`` as that list."""
-    tables = data.get(key, [])
-    data[key] = [tables] if isinstance(tables, Mapping) else list(tables)
-    return data[key]  # type: ignore[no-any-return]
-
-
 def walls(pairs: list[str]) -> list[str]:
     """The walls of the pairs named ``pairs`` whose grazing is located: a stop is its
     own wall (``"stop 0"``), a damper has two (``"damper 0 upper"``, ``"damper 0
@@ -95,9 +88,11 @@ def _without_wall(data: Mapping[str, Any], wall: str) -> dict[str, Any]:
     words = wall.split()
     index = int(words[1])
     if words[0] == "stop":
-        del _tables(out, "stop")[index]
+        out["stop"] = listed_tables(out.get("stop"))
+        del out["stop"][index]
         return out
-    table = dict(_tables(out, "damper")[index])
+    out["damper"] = listed_tables(out.get("damper"))
+    table = dict(out["damper"][index])
     if "clearance" in table:
         both = table.pop("clearance")
         table["lower_clearance"] = table["upper_clearance"] = both

@@ -275,7 +275,7 @@ class System:
             dampers=_tables(Damper, sections.get("damper")),
             stops=_tables(Stop, sections.get("stop")),
             collisions=_tables(Collision, sections.get("collision")),
-            excitations=[_excitation(dict(e)) for e in _listed(sections.get("excitation"))],
+            excitations=[_excitation(dict(e)) for e in listed_tables(sections.get("excitation"))],
             gravity=_part(Gravity, gravity),
             initial=_part(Initial, sections.get("initial")),
             solver=_part(Solver, sections.get("solver")),
@@ -315,7 +315,7 @@ def _parts(name: str, value: Any, kind: type | tuple[type, ...], wanted: str) ->
     return tuple(value)
 
 
-def _listed(value: Any) -> list[Mapping[str, Any]]:
+def listed_tables(value: Any) -> list[Mapping[str, Any]]:
     """An array of tables (or one table) as a list."""
     if value is None:
         return []
@@ -327,7 +327,7 @@ def _part(kind: type[_P], table: Any) -> _P | None:
 
 
 def _tables(kind: type[_P], value: Any) -> list[_P]:
-    return [kind(**table) for table in _listed(value)]
+    return [kind(**table) for table in listed_tables(value)]
 
 
 def _excitation(table: dict[str, Any]) -> Force | Base:
