@@ -52,6 +52,7 @@ fn main() {
             law: PairLaw::rigid(0.6).unwrap(),
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {
@@ -65,6 +66,7 @@ fn main() {
         structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
         dampers: vec![],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![Stop {
             at: 0.0,
             side: Side::Lower,

@@ -40,6 +40,7 @@ fn spec(m: usize) -> SystemSpec {
         structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 2, 0.01).unwrap(),
         dampers: vec![damper(0.5, 1e-4 + 1.6e-5 * j), damper(0.25, 1e-4)],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

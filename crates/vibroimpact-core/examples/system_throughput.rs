@@ -66,6 +66,7 @@ fn main() {
         structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap(),
         dampers: vec![],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {
@@ -152,6 +153,7 @@ fn main() {
         structure: Structure::oscillator(0.2, 0.0, 0.0).unwrap(),
         dampers: vec![],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![Stop {
             at: 0.0,
             side: Side::Lower,
@@ -189,6 +191,7 @@ fn main() {
             law: PairLaw::rigid(0.6).unwrap(),
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

@@ -23,6 +23,7 @@ fn spec(structure: Structure) -> SystemSpec {
         structure,
         dampers: vec![],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],

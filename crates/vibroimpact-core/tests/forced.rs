@@ -52,6 +52,7 @@ fn max_error(method: Method, dt: f64) -> f64 {
         structure,
         dampers: vec![],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

@@ -29,6 +29,7 @@ fn beam() -> (Assembly, Vec<f64>) {
             law: PairLaw::Compliant(Contact::new(LawKind::Hertz, 1e5, None, 0.0).unwrap()),
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],
@@ -155,6 +156,7 @@ fn forced_damper() -> (Assembly, Vec<f64>) {
             law: PairLaw::rigid(0.6).unwrap(),
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

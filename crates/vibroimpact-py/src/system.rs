@@ -506,6 +506,7 @@ fn solution_dict<'py>(
         ("dissipated", e.dissipated),
         ("viscous", e.viscous),
         ("contact", e.contact),
+        ("friction", e.friction),
         ("impact", e.impact),
         ("stored_start", e.stored_start),
         ("stored_end", e.stored_end),

@@ -28,6 +28,7 @@ fn cantilever(m: usize, stiffness: f64) -> SystemSpec {
         structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 2, 0.01).unwrap(),
         dampers: vec![damper(0.5, 2e-4 + 1e-5 * f), damper(0.25, 1e-4)],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![Excitation {

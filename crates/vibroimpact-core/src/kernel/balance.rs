@@ -17,6 +17,8 @@ pub struct EnergyBalance {
     pub dissipated: f64,
     pub viscous: f64,
     pub contact: f64,
+    /// Dry friction's loss (sliding), J.
+    pub friction: f64,
     pub impact: f64,
     pub stored_start: f64,
     pub stored_end: f64,
@@ -32,13 +34,21 @@ pub(crate) fn balance(
 ) -> EnergyBalance {
     let at = 2 * system.dim;
     let (viscous, input_work) = (y[at + VISCOUS], y[at + INPUT]);
-    let contact: f64 = y[at + CONTACT..].iter().sum();
-    let dissipated = viscous + contact + impact;
+    let (mut contact, mut friction) = (0.0, 0.0);
+    for (loss, it) in y[at + CONTACT..].iter().zip(&system.interactions) {
+        if it.law.is_friction() {
+            friction += loss;
+        } else {
+            contact += loss;
+        }
+    }
+    let dissipated = viscous + contact + friction + impact;
     EnergyBalance {
         input_work,
         dissipated,
         viscous,
         contact,
+        friction,
         impact,
         stored_start,
         stored_end,

@@ -105,6 +105,7 @@ impl Run<'_> {
                         .push(oc.close(it.pair, time, rate, dissipated));
                 }
             }
+            Mode::Sliding { .. } | Mode::Stuck { .. } => self.friction_switch(i, time),
             Mode::Sticking => {
                 system.release(i, &mut self.y);
                 self.modes[i] = Mode::Open;
@@ -200,6 +201,11 @@ impl Run<'_> {
         }
         if any {
             self.count_close_events(stepper, rigid)?;
+        }
+        if self.friction {
+            // Impacts change the velocities, and sticking pairs shadow
+            // friction elements on their rows.
+            self.settle_friction(event_time);
         }
         // Impacts change the velocities.
         system.gaps(&self.y, &mut self.gaps.start);

@@ -42,6 +42,13 @@ pub(crate) fn check<S: SystemStepper>(system: &Assembly, stepper: &S) -> Result<
             stepper.name()
         )));
     }
+    if let Some(it) = system.interactions.iter().find(|it| it.law.is_friction()) {
+        return Err(Error::Inconsistent(format!(
+            "stepping = \"fixed\" cannot locate stick-slip ({} has friction): use stepping = \
+             \"events\"",
+            system.pairs[it.pair]
+        )));
+    }
     if let Some(it) = system
         .interactions
         .iter()

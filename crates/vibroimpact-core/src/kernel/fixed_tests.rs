@@ -28,6 +28,7 @@ fn spec(system: &ImpactDamper, contact: &Contact) -> SystemSpec {
             law: PairLaw::Compliant(*contact),
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations: vec![],

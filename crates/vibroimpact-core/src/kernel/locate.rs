@@ -12,7 +12,8 @@ use crate::numerics::hermite;
 
 /// The value whose sign change is interaction `i`'s event: positive on the
 /// side it is on now (open: the gap; compliant contact: the indentation;
-/// sticking: the constraint force).
+/// sticking: the constraint force; sliding: the sliding speed; stuck: the
+/// static force left before it slips).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn event_value(
     system: &Assembly,
@@ -31,6 +32,12 @@ pub(super) fn event_value(
             system.rates(time, y, modes, scratch, work);
             scratch.force_of(i).unwrap_or(0.0)
         }
+        Mode::Sliding { direction } => direction * system.gap(i, y).1,
+        Mode::Stuck { .. } => {
+            system.rates(time, y, modes, scratch, work);
+            let held = scratch.force_of(i).unwrap_or(0.0).abs();
+            system.static_force(i) - held
+        }
     }
 }
 
@@ -41,6 +48,12 @@ pub(super) fn event_value(
 /// past its wall but leaving it (a contact started at a gap of round-off,
 /// its indentation growing) has not crossed back.
 pub(super) fn crossed(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
+    match mode {
+        // Stopped (or reversed): a sliding speed within round-off is zero.
+        Mode::Sliding { .. } => return v <= 0.0,
+        Mode::Stuck { .. } => return v < 0.0,
+        _ => {}
+    }
     if mode == Mode::Sticking {
         // No force holding it (exactly zero, a system at rest on its
         // walls) is released too: it was found as an event, and kept
@@ -61,7 +74,7 @@ pub(super) fn side(mode: Mode) -> f64 {
     match mode {
         Mode::Open => 1.0,
         Mode::Compliant { .. } => -1.0,
-        Mode::Sticking => f64::NAN,
+        Mode::Sticking | Mode::Sliding { .. } | Mode::Stuck { .. } => f64::NAN,
     }
 }
 
@@ -76,6 +89,7 @@ pub(super) fn wall_round_off(system: &Assembly, i: usize, y: &[f64]) -> f64 {
 pub(super) fn past(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -> bool {
     match mode {
         Mode::Sticking => v < 0.0 && !system.locked(i),
+        Mode::Sliding { .. } | Mode::Stuck { .. } => v < 0.0,
         _ => v < -wall_round_off(system, i, y),
     }
 }
@@ -134,7 +148,7 @@ pub(super) fn find_crossing(
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
             Mode::Sticking if system.locked(i) => continue,
-            Mode::Sticking => {
+            Mode::Sticking | Mode::Sliding { .. } | Mode::Stuck { .. } => {
                 let value = event_value(system, i, mode, time + h, end, modes, scratch, work);
                 if value < 0.0 {
                     consider(Crossing {

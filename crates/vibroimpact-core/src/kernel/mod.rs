@@ -5,6 +5,7 @@ pub mod contact_balance;
 pub(crate) mod contacts;
 pub mod events;
 pub mod fixed;
+mod friction;
 pub(crate) mod impacts;
 pub(crate) mod locate;
 pub mod memory;

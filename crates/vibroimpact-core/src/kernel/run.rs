@@ -90,6 +90,8 @@ pub(super) struct Run<'a> {
     pub(super) impacts: Impacts,
     /// Whether a compliant contact is on (modes change only at events).
     pub(super) compliant: bool,
+    /// Whether any friction element acts (its modes settle after events).
+    pub(super) friction: bool,
     /// Whether the signals have kinks (samples) to land on.
     pub(super) kinked: bool,
     /// Whether plain fixed steps go to the stepper's fast path.

@@ -52,7 +52,7 @@ fn all_compliant(system: &Assembly) -> Vec<Mode> {
             approach_rate: 0.0,
             indented_only: false,
         },
-        InteractionLaw::Rigid { .. } => Mode::Open,
+        InteractionLaw::Rigid { .. } | InteractionLaw::Friction { .. } => Mode::Open,
     };
     system.interactions.iter().map(mode).collect()
 }
@@ -202,6 +202,7 @@ impl<'a> Run<'a> {
             on_wall_at_start,
             impacts: Impacts::new(system),
             compliant: false,
+            friction: system.has_friction(),
             kinked: system.has_breakpoints(),
             stretches: !adaptive && stepper.takes_stretches(system, timing.is_some()),
             timing,
@@ -226,6 +227,9 @@ impl<'a> Run<'a> {
     fn start<S: SystemStepper>(&mut self, stepper: &mut S) -> Result<()> {
         let system = self.system;
         self.resume_contacts();
+        if self.friction {
+            self.settle_friction(0.0);
+        }
         if self.timing.is_some() {
             self.resume_fixed();
         }

@@ -120,6 +120,14 @@ impl PaperNewmark {
                     law,
                     damping,
                 }),
+                InteractionLaw::Friction { .. } => {
+                    return Err(Error::Inconsistent(format!(
+                        "method \"newmark\" (the founding paper's) takes compliant contact laws \
+                         only, and {} is dry friction: use \"newmark-implicit\", \"exact\" or \
+                         \"dop853\"",
+                        system.pairs[it.pair]
+                    )))
+                }
                 InteractionLaw::Rigid { .. } => {
                     return Err(Error::Inconsistent(format!(
                         "method \"newmark\" (the founding paper's, its contact force lagged one \

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::model::assembly::{
-    Collision, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+    Collision, Damper, Excitation, Friction, FrictionSite, Load, PairLaw, Side, Stop, SystemSpec,
 };
 use vibroimpact_core::model::signals::{Harmonic, Signal, SweepLaw};
 use vibroimpact_core::model::structure::Structure;
@@ -205,8 +205,17 @@ pub(crate) fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Syst
         .cast_into::<PyDict>()
         .map_err(|_| InvalidInputError::new_err("structure must be a table"))?;
     let mut dampers = Vec::new();
+    let mut frictions = Vec::new();
     for (j, d) in entries(spec, "damper")?.iter().enumerate() {
         let place = format!("damper {j}");
+        if let Some(coefficient) = optional::<f64>(d, &place, "friction")? {
+            frictions.push(Friction {
+                site: FrictionSite::Damper(j),
+                coefficient,
+                static_coefficient: optional(d, &place, "static_friction")?.unwrap_or(coefficient),
+                normal_force: get(d, &place, "normal_force")?,
+            });
+        }
         dampers.push(Damper {
             mass: get(d, &place, "mass")?,
             at: get(d, &place, "at")?,
@@ -237,6 +246,19 @@ pub(crate) fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Syst
             law: pair_law(d, &place)?,
         });
     }
+    for (j, d) in entries(spec, "friction")?.iter().enumerate() {
+        let place = format!("friction {j}");
+        let coefficient: f64 = get(d, &place, "coefficient")?;
+        frictions.push(Friction {
+            site: FrictionSite::Points {
+                at: get(d, &place, "at")?,
+                against: optional(d, &place, "against")?,
+            },
+            coefficient,
+            static_coefficient: optional(d, &place, "static_coefficient")?.unwrap_or(coefficient),
+            normal_force: get(d, &place, "normal_force")?,
+        });
+    }
     let mut excitations = Vec::new();
     for (j, d) in entries(spec, "excitation")?.iter().enumerate() {
         let place = format!("excitation {j}");
@@ -262,6 +284,7 @@ pub(crate) fn system_spec(spec: &Bound<'_, PyDict>, t_end: f64) -> PyResult<Syst
         dampers,
         stops,
         collisions,
+        frictions,
         gravity: optional(spec, "system", "gravity")?.unwrap_or(0.0),
         excitations,
         points: optional(spec, "output", "points")?.unwrap_or_default(),

@@ -371,6 +371,7 @@ mod tests {
             structure,
             dampers: vec![],
             collisions: vec![],
+            frictions: vec![],
             stops: vec![],
             gravity: 0.0,
             excitations: vec![Excitation {

@@ -221,7 +221,7 @@ impl Parameters {
     pub(super) fn restitution_in(system: &Assembly, other: &Assembly, jump: &Jump) -> f64 {
         let law = |a: &Assembly| match a.interactions[jump.interaction].law {
             InteractionLaw::Rigid { restitution } => Some(restitution),
-            InteractionLaw::Compliant { .. } => None,
+            InteractionLaw::Compliant { .. } | InteractionLaw::Friction { .. } => None,
         };
         match (law(system), law(other)) {
             (Some(own), Some(shifted)) if own == jump.restitution => shifted,

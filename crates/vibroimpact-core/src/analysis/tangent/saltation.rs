@@ -152,6 +152,9 @@ impl Saltation {
             // A release: the constraint force is zero there, so the rates
             // are continuous and the flow smooth (no time shift).
             Mode::Sticking => return Outcome { grazing: None },
+            Mode::Sliding { .. } | Mode::Stuck { .. } => {
+                unreachable!("the tangent refuses friction (Tangent::new)")
+            }
         };
         let h = &system.interactions[located].h;
         let closing = side * linalg::dot(h, &view.before[d..size]);

@@ -48,6 +48,7 @@ pub(super) fn damper_on_oscillator(
             law,
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity,
         excitations: vec![Excitation {

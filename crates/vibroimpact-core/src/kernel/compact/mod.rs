@@ -116,6 +116,7 @@ impl Compact {
             || system.interactions.len() > MAX_WALLS
             || parts.forces.len() > 1
             || parts.has_base
+            || system.has_friction()
         {
             return None;
         }
@@ -152,7 +153,7 @@ impl Compact {
             wall.inverse_mass = it.inverse_mass;
             wall.law = match it.law {
                 InteractionLaw::Compliant { law, damping } => Some((law, damping)),
-                InteractionLaw::Rigid { .. } => None,
+                InteractionLaw::Rigid { .. } | InteractionLaw::Friction { .. } => None,
             };
         }
         Some(Self {
@@ -501,6 +502,7 @@ mod tests {
             structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap(),
             dampers: vec![damper(0.5, 2e-4), damper(0.25, 1e-4)],
             collisions: vec![],
+            frictions: vec![],
             stops: vec![],
             gravity,
             excitations: vec![Excitation {
@@ -527,6 +529,7 @@ mod tests {
                 law: PairLaw::rigid(0.6).unwrap(),
             }],
             collisions: vec![],
+            frictions: vec![],
             stops: vec![Stop {
                 at: 0.0,
                 side: Side::Lower,

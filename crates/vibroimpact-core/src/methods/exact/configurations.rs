@@ -18,20 +18,51 @@ pub(super) const STEPS_PER_PERIOD: f64 = 8.0;
 pub(super) const OPEN: u8 = 0;
 pub(super) const STICKING: u8 = 1;
 pub(super) const TOUCHING: u8 = 2;
+/// A friction element sliding up (its row's rate > 0), down, or stuck.
+pub(super) const SLIDING_UP: u8 = 3;
+pub(super) const SLIDING_DOWN: u8 = 4;
+pub(super) const STUCK: u8 = 5;
 
-/// Whether `key` is the configuration of `modes`.
+/// Whether `m` is the configuration of `modes` (a stuck friction element's
+/// place too: its constraint's offset).
 #[inline(always)]
-pub(super) fn fits(key: &[u8], modes: &[Mode]) -> bool {
-    key.iter().zip(modes).all(|(s, mode)| *s == state_of(mode))
+pub(super) fn fits(m: &Modes, modes: &[Mode]) -> bool {
+    m.key
+        .iter()
+        .zip(modes)
+        .all(|(s, mode)| *s == state_of(mode))
+        && (m.offsets.is_empty() || offsets_of(modes) == m.offsets)
 }
 
 #[inline(always)]
 pub(super) fn state_of(mode: &Mode) -> u8 {
     match mode {
-        Mode::Open => OPEN,
+        // A shadowed stuck element: the rigid pair's constraint holds it.
+        Mode::Open | Mode::Stuck { shadowed: true, .. } => OPEN,
         Mode::Sticking => STICKING,
         Mode::Compliant { .. } => TOUCHING,
+        Mode::Sliding { direction } if *direction > 0.0 => SLIDING_UP,
+        Mode::Sliding { .. } => SLIDING_DOWN,
+        Mode::Stuck { .. } => STUCK,
     }
+}
+
+/// Each stuck friction element's offset (NaN for the other interactions),
+/// or nothing where none is stuck.
+fn offsets_of(modes: &[Mode]) -> Vec<f64> {
+    if !modes.iter().any(|m| state_of(m) == STUCK) {
+        return Vec::new();
+    }
+    modes
+        .iter()
+        .map(|m| match m {
+            Mode::Stuck {
+                offset,
+                shadowed: false,
+            } => *offset,
+            _ => f64::NAN,
+        })
+        .collect()
 }
 
 /// The flow of one configuration (which pairs stick, which linear contacts
@@ -40,6 +71,8 @@ pub(super) fn state_of(mode: &Mode) -> u8 {
 #[derive(Debug, Clone)]
 pub(super) struct Modes {
     pub(super) key: Vec<u8>,
+    /// Each stuck friction element's offset (see [`offsets_of`]).
+    pub(super) offsets: Vec<f64>,
     pub(super) configuration: Configuration,
     pub(super) oscillators: Vec<Oscillator>,
     pub(super) matrix: Option<MatrixFlow>,
@@ -95,7 +128,12 @@ pub(super) fn near_resonance(
 }
 
 impl ExactFlow {
-    pub(super) fn modes_of(parts: &LinearParts, system: &Assembly, key: &[u8]) -> Result<Modes> {
+    pub(super) fn modes_of(
+        parts: &LinearParts,
+        system: &Assembly,
+        key: &[u8],
+        offsets: &[f64],
+    ) -> Result<Modes> {
         let chosen = |state: u8| {
             system
                 .interactions
@@ -104,9 +142,15 @@ impl ExactFlow {
                 .filter(move |(_, s)| **s == state)
                 .map(|(it, _)| it)
         };
-        let constraints: Vec<(&[f64], f64)> = chosen(STICKING)
+        let mut constraints: Vec<(&[f64], f64)> = chosen(STICKING)
             .map(|it| (it.h.as_slice(), it.offset))
             .collect();
+        // A stuck friction element holds its row where it stuck.
+        for (i, (it, state)) in system.interactions.iter().zip(key).enumerate() {
+            if *state == STUCK {
+                constraints.push((it.h.as_slice(), offsets[i]));
+            }
+        }
         // A touching linear contact pushes with k delta + c delta', delta =
         // -(h.x + offset): stiffness k h h^T and damping c h h^T on top, and
         // the load -k offset h.
@@ -127,6 +171,16 @@ impl ExactFlow {
                 }
             }
         }
+        // A sliding one pushes with its kinetic force against the sliding.
+        for (direction, state) in [(1.0, SLIDING_UP), (-1.0, SLIDING_DOWN)] {
+            for it in chosen(state) {
+                if let InteractionLaw::Friction { kinetic_force, .. } = it.law {
+                    for i in 0..dim {
+                        parts.constant[i] -= direction * kinetic_force * it.h[i];
+                    }
+                }
+            }
+        }
         let mut names: Vec<String> = chosen(STICKING)
             .map(|it| format!("{} sticking", system.pairs[it.pair]))
             .collect();
@@ -136,7 +190,11 @@ impl ExactFlow {
         } else {
             format!("the system with {}", names.join(" and "))
         };
-        let touching = key.contains(&TOUCHING);
+        names.extend(chosen(STUCK).map(|it| format!("{} stuck", system.pairs[it.pair])));
+        // Sliding friction's loss is a contact's: taken from the rates.
+        let touching = key
+            .iter()
+            .any(|s| [TOUCHING, SLIDING_UP, SLIDING_DOWN].contains(s));
         let step = |fastest: f64| std::f64::consts::TAU / (STEPS_PER_PERIOD * fastest);
         match Configuration::classical(&parts, &constraints, &what)? {
             Some(configuration) => {
@@ -157,6 +215,7 @@ impl ExactFlow {
                 let from_rest = near_resonance(&configuration, &oscillators);
                 Ok(Modes {
                     key: key.to_vec(),
+                    offsets: offsets.to_vec(),
                     closed_form: configuration.harmonics.len() <= 1 && from_rest.is_empty(),
                     from_rest,
                     configuration,
@@ -170,6 +229,7 @@ impl ExactFlow {
                 let flow = MatrixFlow::new(&parts, &constraints, &what)?;
                 Ok(Modes {
                     key: key.to_vec(),
+                    offsets: offsets.to_vec(),
                     configuration: Configuration::empty(),
                     oscillators: Vec::new(),
                     step: step(flow.fastest),
@@ -186,7 +246,7 @@ impl ExactFlow {
     #[inline(always)]
     pub(super) fn select(&mut self, system: &Assembly, modes: &[Mode]) -> Result<usize> {
         // The modes of the last call, most often.
-        if fits(&self.modes[self.selected].key, modes) {
+        if fits(&self.modes[self.selected], modes) {
             return Ok(self.selected);
         }
         self.select_other(system, modes)
@@ -195,13 +255,27 @@ impl ExactFlow {
     #[cold]
     #[inline(never)]
     pub(super) fn select_other(&mut self, system: &Assembly, modes: &[Mode]) -> Result<usize> {
-        self.selected = match self.modes.iter().position(|m| fits(&m.key, modes)) {
+        self.selected = match self.modes.iter().position(|m| fits(m, modes)) {
             Some(index) => index,
             None => {
                 let key: Vec<u8> = modes.iter().map(state_of).collect();
-                let made = Self::modes_of(&self.parts, system, &key)?;
-                self.modes.push(made);
-                self.modes.len() - 1
+                let offsets = offsets_of(modes);
+                let made = Self::modes_of(&self.parts, system, &key, &offsets)?;
+                // A stuck friction element's place changes at each sticking:
+                // its configuration takes the place of the last one's.
+                let stale = (!offsets.is_empty())
+                    .then(|| self.modes.iter().position(|m| m.key == key))
+                    .flatten();
+                match stale {
+                    Some(index) => {
+                        self.modes[index] = made;
+                        index
+                    }
+                    None => {
+                        self.modes.push(made);
+                        self.modes.len() - 1
+                    }
+                }
             }
         };
         Ok(self.selected)

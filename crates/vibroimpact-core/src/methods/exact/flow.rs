@@ -51,7 +51,7 @@ impl ExactFlow {
     /// (compliant laws, signals other than harmonics, non-classical damping).
     pub fn new(system: &Assembly) -> Result<Self> {
         let parts = Self::takes(system)?;
-        let free = Self::modes_of(&parts, system, &vec![OPEN; system.interactions.len()])?;
+        let free = Self::modes_of(&parts, system, &vec![OPEN; system.interactions.len()], &[])?;
         let step = free.step;
         let dim = system.dim;
         Ok(Self {
@@ -85,6 +85,7 @@ impl ExactFlow {
             !matches!(
                 it.law,
                 InteractionLaw::Rigid { .. }
+                    | InteractionLaw::Friction { .. }
                     | InteractionLaw::Compliant {
                         law: AnyLaw::Linear(_),
                         ..

@@ -61,6 +61,7 @@ fn forced_flow(damping: f64) -> (Assembly, ExactFlow, Vec<f64>) {
             law: PairLaw::rigid(0.6).unwrap(),
         }],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 9.81,
         excitations: vec![Excitation {
@@ -181,6 +182,7 @@ fn near_an_undamped_resonance_the_state_and_its_input_work_keep_their_digits() {
             structure: Structure::oscillator(1.0, 39.478, 0.0).unwrap(),
             dampers: vec![],
             collisions: vec![],
+            frictions: vec![],
             stops: vec![],
             gravity: 0.0,
             excitations: vec![Excitation {

@@ -30,6 +30,7 @@ fn beam() -> SystemSpec {
         structure: Structure::cantilever(0.5, 7e10, 1e-10, 0.27, 3, 0.01).unwrap(),
         dampers: vec![damper(0.5, 2e-4, damped), damper(0.25, 1e-4, hyster)],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![Stop {
             at: 0.4,
             side: Side::Lower,

@@ -18,6 +18,7 @@ fn bare(structure: Structure, excitations: Vec<Excitation>) -> Assembly {
         structure,
         dampers: vec![],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 0.0,
         excitations,
@@ -370,6 +371,7 @@ fn its_accumulator_rates_are_the_assembly_s() {
                     law: PairLaw::Compliant(contact),
                 }],
                 collisions: vec![],
+                frictions: vec![],
                 stops: vec![],
                 gravity: 9.81,
                 excitations: vec![

@@ -187,6 +187,7 @@ mod tests {
             structure: Structure::oscillator(1.0, stiffness, 0.0).unwrap(),
             dampers: vec![],
             collisions: vec![],
+            frictions: vec![],
             stops: vec![],
             gravity,
             excitations: vec![Excitation {

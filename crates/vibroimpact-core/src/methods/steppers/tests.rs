@@ -31,6 +31,7 @@ fn beam() -> Assembly {
             },
         ],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 9.81,
         excitations: vec![

@@ -2,7 +2,7 @@
 //! matrices, the walls of each pair with their pushes, the excitations'
 //! loads, the time scales and the followed points; every input checked.
 
-use super::spec::{Load, PairLaw, Side, SystemSpec, MAX_PAIRS, MAX_POINTS};
+use super::spec::{FrictionSite, Load, PairLaw, Side, SystemSpec, MAX_PAIRS, MAX_POINTS};
 use super::{Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw};
 use crate::error::{non_negative, positive, Error, Result};
 use crate::kernel::compact::Compact;
@@ -36,6 +36,8 @@ impl Assembly {
         let mirrors_previous = (0..interactions.len())
             .map(|i| {
                 i > 0
+                    && !interactions[i].law.is_friction()
+                    && !interactions[i - 1].law.is_friction()
                     && interactions[i]
                         .h
                         .iter()
@@ -233,11 +235,12 @@ impl Walls {
             }
             push
         };
-        let pairs_asked = spec.dampers.len() + spec.stops.len() + spec.collisions.len();
+        let pairs_asked =
+            spec.dampers.len() + spec.stops.len() + spec.collisions.len() + spec.frictions.len();
         if pairs_asked > MAX_PAIRS {
             return Err(Error::Inconsistent(format!(
-                "[[damper]], [[stop]], [[collision]]: at most {MAX_PAIRS} pairs in all, \
-                 got {pairs_asked}"
+                "[[damper]], [[stop]], [[collision]], [[friction]]: at most {MAX_PAIRS} pairs \
+                 in all, got {pairs_asked}"
             )));
         }
         let mut walls = Self {
@@ -248,6 +251,7 @@ impl Walls {
         walls.add_dampers(spec, n, dim)?;
         walls.add_stops(spec, n, dim)?;
         walls.add_collisions(spec, n, dim)?;
+        walls.add_frictions(spec, n, dim)?;
         for interaction in &mut walls.interactions {
             interaction.push = full_push(&interaction.h);
             interaction.inverse_mass = linalg::dot(&interaction.h, &interaction.push);
@@ -291,11 +295,16 @@ impl Walls {
                 .push(positive_named(&name, "mass", d.mass)?);
             let lower = clearance(&name, "lower_clearance", d.lower_clearance)?;
             let upper = clearance(&name, "upper_clearance", d.upper_clearance)?;
-            let collides = spec.collisions.iter().any(|c| c.dampers.contains(&j));
+            let collides = spec.collisions.iter().any(|c| c.dampers.contains(&j))
+                || spec
+                    .frictions
+                    .iter()
+                    .any(|f| f.site == FrictionSite::Damper(j) && f.normal_force > 0.0);
             if lower.is_infinite() && upper.is_infinite() && !collides {
                 return Err(Error::Inconsistent(format!(
                     "{name}: lower_clearance and upper_clearance are both infinite (no wall) \
-                     and no [[collision]] holds it: give one side a finite clearance"
+                     and neither a [[collision]] nor friction holds it: give one side a finite \
+                     clearance"
                 )));
             }
             let point = s.point(&format!("{name} at"), d.at)?;
@@ -376,6 +385,79 @@ impl Walls {
             h[n + upper] = 1.0;
             let pair = self.pair(name);
             self.wall(pair, h, gap, law);
+        }
+        Ok(())
+    }
+}
+
+impl Walls {
+    /// Each friction element's row: a damper's displacement relative to its
+    /// carrier, or a point's relative to another's or to the base (pushes
+    /// left to fill). Its "gap" is not a distance: only its rate, the
+    /// sliding velocity, is read.
+    fn add_frictions(&mut self, spec: &SystemSpec, n: usize, dim: usize) -> Result<()> {
+        let s = &spec.structure;
+        let k = spec.dampers.len();
+        for (f, friction) in spec.frictions.iter().enumerate() {
+            let (name, h) = match friction.site {
+                FrictionSite::Damper(j) => {
+                    let name = format!("damper {j} friction");
+                    if j >= k {
+                        return Err(Error::Inconsistent(format!(
+                            "{name}: there are {k} [[damper]]"
+                        )));
+                    }
+                    let point = s.point(&format!("damper {j} at"), spec.dampers[j].at)?;
+                    let mut h = vec![0.0; dim];
+                    for i in 0..n {
+                        h[i] = -point[i];
+                    }
+                    h[n + j] = 1.0;
+                    (name, h)
+                }
+                FrictionSite::Points { at, against } => {
+                    let name = format!("friction {f}");
+                    let mut point = s.point(&format!("{name} at"), at)?;
+                    if let Some(against) = against {
+                        let other = s.point(&format!("{name} against"), against)?;
+                        for (p, c) in point.iter_mut().zip(&other) {
+                            *p -= c;
+                        }
+                        if point.iter().all(|p| *p == 0.0) {
+                            return Err(Error::Inconsistent(format!(
+                                "{name} against: {against} moves as at = {at} does, so they \
+                                 never slide on each other: choose another point"
+                            )));
+                        }
+                    }
+                    let mut h = vec![0.0; dim];
+                    h[..n].copy_from_slice(&point);
+                    (name, h)
+                }
+            };
+            let kinetic = non_negative_named(&name, "coefficient", friction.coefficient)?;
+            let normal = non_negative_named(&name, "normal_force", friction.normal_force)?;
+            let held =
+                non_negative_named(&name, "static_coefficient", friction.static_coefficient)?;
+            if held < kinetic {
+                return Err(Error::Inconsistent(format!(
+                    "{name} static_coefficient: must be >= the kinetic coefficient {kinetic}, \
+                     got {held}"
+                )));
+            }
+            if kinetic * normal == 0.0 && held * normal == 0.0 {
+                continue; // no force: no element
+            }
+            let pair = self.pair(name);
+            self.wall(
+                pair,
+                h,
+                0.0,
+                InteractionLaw::Friction {
+                    kinetic_force: kinetic * normal,
+                    static_force: held * normal,
+                },
+            );
         }
         Ok(())
     }
@@ -507,6 +589,7 @@ mod tests {
                 law: PairLaw::rigid(0.6).unwrap(),
             }],
             collisions: vec![],
+            frictions: vec![],
             stops: vec![],
             gravity: 9.81,
             excitations: vec![],

@@ -134,7 +134,13 @@ impl Assembly {
                         }
                     }
                 }
-                (Mode::Sticking, _) => {
+                (
+                    Mode::Sticking
+                    | Mode::Stuck {
+                        shadowed: false, ..
+                    },
+                    _,
+                ) => {
                     scratch.sticking[sticking] = i;
                     sticking += 1;
                 }

@@ -2,7 +2,7 @@
 //! of one wall: when it lands, whether its mirror holds it, its scale, its
 //! release from sticking.
 
-use super::{Assembly, Interaction, Mode};
+use super::{Assembly, Interaction, InteractionLaw, Mode};
 use crate::kernel::sized::by_size;
 use crate::numerics::linalg;
 
@@ -88,6 +88,28 @@ impl Assembly {
             let (a, b) = (self.interactions[i].offset, self.interactions[j].offset);
             (a + b).abs() <= 4.0 * f64::EPSILON * (a.abs() + b.abs())
         })
+    }
+
+    /// The most friction element `i` holds while stuck, N (0 for a wall).
+    #[inline]
+    pub fn static_force(&self, i: usize) -> f64 {
+        match self.interactions[i].law {
+            InteractionLaw::Friction { static_force, .. } => static_force,
+            _ => 0.0,
+        }
+    }
+
+    /// The round-off of interaction `i`'s rate at state `y`, m/s: a sliding
+    /// speed this small is zero.
+    pub fn rate_round_off(&self, i: usize, y: &[f64]) -> f64 {
+        let d = self.dim;
+        let it = &self.interactions[i];
+        let scale: f64 =
+            it.h.iter()
+                .zip(&y[d..2 * d])
+                .map(|(h, v)| (h * v).abs())
+                .sum();
+        8.0 * f64::EPSILON * scale
     }
 
     /// The scale of interaction `i`'s gap at state `y`, m: its offset and

@@ -27,7 +27,8 @@ pub(crate) use rates::{apart_damping, elastic};
 pub use scratch::Scratch;
 pub(crate) use scratch::{rotated, same_increment, Cached, CachedParts, RESYNC};
 pub use spec::{
-    Collision, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec, MAX_PAIRS, MAX_POINTS,
+    Collision, Damper, Excitation, Friction, FrictionSite, Load, PairLaw, Side, Stop, SystemSpec,
+    MAX_PAIRS, MAX_POINTS,
 };
 pub use state::{initial_state, resumed_state};
 
@@ -38,8 +39,28 @@ use crate::model::signals::Signal;
 /// The law of one interaction, ready for the kernel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum InteractionLaw {
-    Compliant { law: AnyLaw, damping: f64 },
-    Rigid { restitution: f64 },
+    Compliant {
+        law: AnyLaw,
+        damping: f64,
+    },
+    Rigid {
+        restitution: f64,
+    },
+    /// Coulomb friction along the row `h` (its rate the sliding velocity):
+    /// the sliding force and the most the sides hold while stuck, N.
+    Friction {
+        kinetic_force: f64,
+        static_force: f64,
+    },
+}
+
+impl InteractionLaw {
+    /// Whether this is a friction element (no wall: its row's rate is a
+    /// sliding velocity).
+    #[inline(always)]
+    pub fn is_friction(&self) -> bool {
+        matches!(self, Self::Friction { .. })
+    }
 }
 
 /// One wall of a pair: a gap `offset + h . x` and its law.
@@ -179,6 +200,19 @@ pub enum Mode {
     /// A rigid pair moving together after a chattering sequence: the gap
     /// and its rate stay zero, held by a constraint force.
     Sticking,
+    /// A friction element sliding along `direction` (+1 or -1, the sign of
+    /// its row's rate), under the kinetic force against it.
+    Sliding {
+        direction: f64,
+    },
+    /// A friction element stuck: its row's rate held at zero by a
+    /// constraint force within the static force, at `h . x + offset = 0`;
+    /// `shadowed` while a sticking rigid pair holds the same row (that
+    /// pair's constraint then carries the force, one constraint per row).
+    Stuck {
+        offset: f64,
+        shadowed: bool,
+    },
 }
 
 impl Mode {
@@ -192,7 +226,16 @@ impl Mode {
         match self {
             Mode::Open => g1 < 0.0 || (r0 < 0.0 && r1 > 0.0),
             Mode::Compliant { .. } => g1 > 0.0 || (r0 > 0.0 && r1 < 0.0),
-            Mode::Sticking => true,
+            Mode::Sticking | Mode::Stuck { .. } => true,
+            // Sliding ends where the sliding velocity reaches zero.
+            Mode::Sliding { direction } => direction * r1 <= 0.0,
         }
+    }
+
+    /// Whether this is a constraint (a rigid pair sticking or a friction
+    /// element stuck), held by a force the rates solve for.
+    #[inline(always)]
+    pub fn is_held(&self) -> bool {
+        matches!(self, Mode::Sticking | Mode::Stuck { .. })
     }
 }

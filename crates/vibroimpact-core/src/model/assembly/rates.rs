@@ -203,9 +203,24 @@ impl Assembly {
                     }
                     *loss = (total - elastic) * rate;
                 }
-                (Mode::Sticking, _) => {
+                (
+                    Mode::Sticking
+                    | Mode::Stuck {
+                        shadowed: false, ..
+                    },
+                    _,
+                ) => {
                     scratch.sticking[sticking] = i;
                     sticking += 1;
+                }
+                (Mode::Sliding { direction }, InteractionLaw::Friction { kinetic_force, .. }) => {
+                    // The kinetic force against the sliding, and its loss.
+                    let hv = h_dot(&it.h[..d], v);
+                    let force = -direction * kinetic_force;
+                    for (a, p) in acc.iter_mut().zip(&it.push[..d]) {
+                        *a += p * force;
+                    }
+                    *loss = -force * hv;
                 }
                 _ => {}
             }

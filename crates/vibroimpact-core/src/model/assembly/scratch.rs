@@ -169,7 +169,7 @@ impl Scratch {
     pub fn new(assembly: &Assembly) -> Self {
         // Only rigid pairs stick: without one the constraint system is
         // never solved (and a run's set-up allocates nothing for it).
-        let m = if assembly.has_rigid() {
+        let m = if assembly.has_rigid() || assembly.has_friction() {
             assembly.interactions.len().max(1)
         } else {
             0

@@ -111,6 +111,32 @@ pub struct Collision {
     pub law: PairLaw,
 }
 
+/// Where a dry-friction element acts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FrictionSite {
+    /// Between a loose mass (an index into [`SystemSpec::dampers`]) and its
+    /// carrier point (a horizontal damper sliding on its cavity's floor).
+    Damper(usize),
+    /// Between a point of the structure (as a stop's `at`) and another
+    /// (`against`), or the base (`None`): a Den Hartog dry-friction damper.
+    Points { at: f64, against: Option<f64> },
+}
+
+/// Coulomb friction along the axis: while the two sides slide, a force
+/// `coefficient * normal_force` opposes their relative velocity; they stick
+/// when it reaches zero and the force holding them is within
+/// `static_coefficient * normal_force`, and slip again when it is not.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Friction {
+    pub site: FrictionSite,
+    /// Kinetic coefficient (>= 0).
+    pub coefficient: f64,
+    /// Static coefficient (>= `coefficient`).
+    pub static_coefficient: f64,
+    /// N (>= 0): the weight of a horizontal damper, or a preload.
+    pub normal_force: f64,
+}
+
 /// Everything a run needs to know about the system.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemSpec {
@@ -119,6 +145,8 @@ pub struct SystemSpec {
     pub stops: Vec<Stop>,
     /// Loose masses striking each other, after the stops' pairs.
     pub collisions: Vec<Collision>,
+    /// Dry-friction elements, after the collisions' pairs.
+    pub frictions: Vec<Friction>,
     /// m/s^2 (>= 0), along -x.
     pub gravity: f64,
     pub excitations: Vec<Excitation>,

@@ -24,6 +24,12 @@ impl Assembly {
             .any(|it| matches!(it.law, InteractionLaw::Rigid { .. }))
     }
 
+    /// Whether any friction element acts (stick-slip: its stuck constraint
+    /// is solved with the sticking pairs').
+    pub fn has_friction(&self) -> bool {
+        self.interactions.iter().any(|it| it.law.is_friction())
+    }
+
     /// The quantities the reductions follow: each structure coordinate, then
     /// each point of [`super::SystemSpec::points`], then each moment.
     pub fn observed(&self) -> usize {
@@ -103,7 +109,8 @@ fn state_from(assembly: &Assembly, arrays: [&[f64]; 4], resumed: bool) -> Result
     for i in 0..assembly.interactions.len() {
         let (gap, _) = assembly.gap(i, &y);
         let it = &assembly.interactions[i];
-        if resumed && matches!(it.law, InteractionLaw::Compliant { .. }) {
+        // A friction element's row is no gap: it has no wall to be inside.
+        if (resumed && matches!(it.law, InteractionLaw::Compliant { .. })) || it.law.is_friction() {
             continue;
         }
         // On the wall to round-off is at the wall.

@@ -28,6 +28,7 @@ fn beam() -> Assembly {
             damper(0.25, 1e-4, PairLaw::rigid(0.5).unwrap()),
         ],
         collisions: vec![],
+        frictions: vec![],
         stops: vec![],
         gravity: 9.81,
         excitations: vec![Excitation {

@@ -255,6 +255,7 @@ mod tests {
                 law,
             }],
             collisions: vec![],
+            frictions: vec![],
             stops: if stop { stops } else { vec![] },
             gravity: if stop { 9.81 } else { 0.0 },
             excitations: vec![Excitation {
