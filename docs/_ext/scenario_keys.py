@@ -159,6 +159,23 @@ SYSTEM = {
             '"rigid", "hertz", "hyster-hertz", "hertz-damped" or "linear"',
             "the contact law",
         ),
+        "friction": (
+            None,
+            ">= 0",
+            "Coulomb's kinetic coefficient between the mass and its carrier (a horizontal "
+            "damper sliding on its cavity's floor); needs normal_force",
+        ),
+        "static_friction": (
+            None,
+            ">= friction",
+            "the static coefficient: stuck, the mass holds while the force needed is within "
+            "static_friction * normal_force (default: friction)",
+        ),
+        "normal_force": (
+            "N",
+            ">= 0",
+            "the force pressing the mass on its floor: its weight, or a preload",
+        ),
     },
     "stop": {
         "at": (None, _POINT, "the point that hits the stop"),
@@ -179,6 +196,22 @@ SYSTEM = {
             '"rigid", "hertz", "hyster-hertz", "hertz-damped" or "linear"',
             "the contact law",
         ),
+    },
+    "friction": {
+        "at": (None, _POINT, "the point of the structure that rubs"),
+        "against": (
+            None,
+            _POINT,
+            "the point it rubs on (default: the base, or the ground)",
+        ),
+        "coefficient": (None, ">= 0", "Coulomb's kinetic coefficient"),
+        "static_coefficient": (
+            None,
+            ">= coefficient",
+            "the static coefficient: stuck while the force needed is within "
+            "static_coefficient * normal_force (default: coefficient)",
+        ),
+        "normal_force": ("N", ">= 0", "the force pressing the two sides together"),
     },
     "collision": {
         "dampers": (

@@ -55,6 +55,7 @@ def _system_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
         "damper": ("[[damper]]", schema._DAMPER),
         "stop": ("[[stop]]", schema._STOP),
         "collision": ("[[collision]]", schema._COLLISION),
+        "friction": ("[[friction]]", schema._FRICTION),
         "gravity": ("[gravity]", schema._GRAVITY),
         "excitation": ("[[excitation]]", schema._EXCITATION),
         "initial": ("[initial]", schema._INITIAL),

@@ -62,7 +62,7 @@ def system_rows(system: Any, natural: str = "") -> Rows:
         rows.append(("beam as simulated", _keys("structure", shown, sections)))
     if natural:
         rows.append(("natural frequencies", natural))
-    for name in ("damper", "stop", "collision", "excitation"):
+    for name in ("damper", "stop", "collision", "friction", "excitation"):
         for j, table in enumerate(sections.get(name, ())):
             label = f"{name} {j}" + (f" ({table['kind']})" if name == "excitation" else "")
             rows.append((label, _keys(f"{name}.{j}", table, sections)))

@@ -35,6 +35,10 @@ _KEY_UNITS = {
     "upper_clearance": _M,
     "gap": _M,
     "restitution": _ONE,
+    "static_friction": _ONE,
+    "coefficient": _ONE,
+    "static_coefficient": _ONE,
+    "normal_force": "N",
     "seed": _ONE,
     "damping_ratio": _ONE,
     "ground_damping": _ONE,
@@ -98,8 +102,10 @@ def parameter_units(parameter: str, data: Mapping[str, Any] | None = None) -> st
     if key == "stiffness" and section in ("damper", "stop", "collision"):
         law = entry.get("law")
         return "N m-1" if law == "linear" else "N m-1.5" if law in _HERTZ_LAWS else None
-    if (key == "at" and section in ("damper", "stop", "excitation")) or (
-        key == "against" and section == "stop"
+    if key == "friction" and section == "damper":
+        return _ONE
+    if (key == "at" and section in ("damper", "stop", "excitation", "friction")) or (
+        key == "against" and section in ("stop", "friction")
     ):
         structure = data.get("structure")
         if isinstance(structure, Mapping):

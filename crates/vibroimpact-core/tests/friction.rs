@@ -106,7 +106,11 @@ fn check_decay(solution: &SystemSolution, x0: f64, tolerance: f64) {
     // At rest at the last one, within the static band.
     let last = *expected.last().unwrap();
     let end = &solution.final_state;
-    assert!((end[0] - last).abs() <= tolerance, "{} against {last}", end[0]);
+    assert!(
+        (end[0] - last).abs() <= tolerance,
+        "{} against {last}",
+        end[0]
+    );
     assert!(end[1].abs() <= 1e-9, "still moving: {}", end[1]);
     // The ledger: the friction loss is the energy that left the spring.
     let e = &solution.energy;
@@ -196,5 +200,57 @@ fn a_block_slides_to_rest_in_the_closed_form_distance() {
         assert!((stuck[0].onset - t_stop).abs() <= 1e-9 * t_stop);
         let lost = 0.5 * m * v0 * v0;
         assert!((solution.energy.friction - lost).abs() <= 1e-8 * lost);
+    });
+}
+
+/// A horizontal impact damper with friction on a forced structure (impacts,
+/// chattering onto a wall, stick-slip, a stop that slides back within a step):
+/// the exact flow and dop853 at tight tolerances end 20 periods on the same state,
+/// with the ledger closed.
+#[test]
+fn a_horizontal_damper_with_friction_agrees_on_exact_and_dop853() {
+    common::timeout(60, || {
+        use vibroimpact_core::model::assembly::{Excitation, Load};
+        use vibroimpact_core::model::signals::{Harmonic, Signal};
+        let spec = SystemSpec {
+            structure: Structure::oscillator(1.0, 4000.0, 2.0).unwrap(),
+            dampers: vec![Damper {
+                mass: 0.1,
+                at: 0.0,
+                lower_clearance: 0.01,
+                upper_clearance: 0.01,
+                law: PairLaw::rigid(0.6).unwrap(),
+            }],
+            collisions: vec![],
+            frictions: vec![Friction {
+                site: FrictionSite::Damper(0),
+                coefficient: 0.2,
+                static_coefficient: 0.3,
+                normal_force: 0.981,
+            }],
+            stops: vec![],
+            gravity: 0.0,
+            excitations: vec![Excitation {
+                load: Load::Force { at: 0.0 },
+                signal: Signal::Harmonic(Harmonic::new(30.0, 10.0, 0.0).unwrap()),
+            }],
+            points: vec![],
+            moments: vec![],
+        };
+        let system = Assembly::new(&spec).unwrap();
+        let y = initial_state(&system, &[0.0], &[0.0], &[0.0], &[0.0]).unwrap();
+        let mut flow = ExactFlow::new(&system).unwrap();
+        let dt = flow.step();
+        let exact = run(&system, &mut flow, &y, Some(dt), 2.0);
+        let mut dop853 = ExplicitRk::dop853(system.state_len(), 1e-12, 1e-15);
+        let adaptive = run(&system, &mut dop853, &y, None, 2.0);
+        for (a, b) in exact.final_state.iter().zip(&adaptive.final_state).take(4) {
+            assert!((a - b).abs() <= 1e-6, "{a} against {b}");
+        }
+        for solution in [&exact, &adaptive] {
+            let e = &solution.energy;
+            assert!(e.friction > 0.0 && e.impact > 0.0);
+            assert!(e.residual.abs() <= 1e-8 * e.input_work, "{e:?}");
+        }
     });
 }

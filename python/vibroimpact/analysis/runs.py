@@ -53,6 +53,7 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
         damper=data.get("damper", ()),
         stop=data.get("stop", ()),
         collision=data.get("collision", ()),
+        friction=data.get("friction", ()),
         gravity=data.get("gravity"),
         excitation=data.get("excitation", ()),
         initial=data.get("initial"),
@@ -99,6 +100,13 @@ class Runner:
         arguments.instance("recorded", recorded, Mapping, "Runner.periods(..., record=True)")
         rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
         return split_observed(rms, self.n, len(self.points))
+
+    @property
+    def has_friction(self) -> bool:
+        """Whether the system has dry friction (the tangent flow does not yet pass
+        through stick-slip)."""
+        spec = self.prepared.spec
+        return bool(spec.get("friction")) or any(d.get("friction") for d in spec.get("damper", ()))
 
     def initial_state(self) -> np.ndarray:
         """The scenario's ``[initial]`` as a flat state ``(x, v)``."""

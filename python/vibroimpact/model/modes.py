@@ -65,7 +65,10 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
     attach = arguments.flag("attach_dampers", attach_dampers)
     sections = system.model_sections()
     parts = linear_parts(
-        sections["structure"], damper=sections["damper"], collision=sections["collision"]
+        sections["structure"],
+        damper=sections["damper"],
+        collision=sections["collision"],
+        friction=sections["friction"],
     )
     n = parts["n"]
     mass, stiffness = parts["mass"][:n, :n].copy(), parts["stiffness"][:n, :n]

@@ -226,7 +226,10 @@ class Damper(Part):
     ``restitution`` in [0, 1]) or a compliant law, ``"hertz"``, ``"hyster-hertz"``,
     ``"hertz-damped"`` or ``"linear"``, with ``stiffness`` (N/m^1.5; N/m for
     ``"linear"``), ``restitution`` where the law takes one and the contact damper's
-    ``damping`` (N s/m, default 0)."""
+    ``damping`` (N s/m, default 0). Coulomb friction between the mass and its carrier
+    (a horizontal damper sliding on its cavity's floor): ``friction`` (kinetic
+    coefficient), ``static_friction`` (>= ``friction``, default equal) and
+    ``normal_force`` (N: its weight, or a preload)."""
 
     mass: float
     at: float
@@ -237,6 +240,9 @@ class Damper(Part):
     stiffness: float | None = None
     restitution: float | None = None
     damping: float | None = None
+    friction: float | None = None
+    static_friction: float | None = None
+    normal_force: float | None = None
 
 
 @keywords_checked
@@ -274,6 +280,23 @@ class Collision(Part):
     stiffness: float | None = None
     restitution: float | None = None
     damping: float | None = None
+
+
+@keywords_checked
+@dataclass(frozen=True, kw_only=True, repr=False)
+class Friction(Part):
+    """A ``[[friction]]``: a dry-friction (Coulomb) element between the structure's
+    point ``at`` and ``against`` (another point; None: the base), as Den Hartog's
+    friction damper. While they slide a force ``coefficient * normal_force`` (N)
+    opposes their relative velocity; they stick when it reaches zero and the force
+    holding them is within ``static_coefficient * normal_force`` (default: the
+    kinetic coefficient), and slip again when it is not."""
+
+    at: float
+    against: float | None = None
+    coefficient: float
+    static_coefficient: float | None = None
+    normal_force: float
 
 
 # ------------------------------------------------------------------- signals

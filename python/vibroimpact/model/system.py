@@ -20,6 +20,7 @@ from vibroimpact.model.parts import (
     Collision,
     Damper,
     Force,
+    Friction,
     Gravity,
     Initial,
     Matrices,
@@ -38,6 +39,7 @@ from vibroimpact.system import (
     _INITIAL,
     _OUTPUT,
     _SOLVER,
+    RUN_SECTIONS,
     _fail,
     _table,
     _unknown_key,
@@ -59,6 +61,7 @@ class System:
     of a TOML scenario: ``structure`` (:class:`Oscillator`, :class:`Matrices` or
     :class:`Cantilever`), ``dampers`` (``[[damper]]``), ``stops`` (``[[stop]]``),
     ``collisions`` (``[[collision]]``: loose masses striking each other),
+    ``frictions`` (``[[friction]]``: dry-friction elements on the structure),
     ``excitations`` (``[[excitation]]``: :class:`Force` or :class:`Base`), ``gravity``
     and ``initial``.
 
@@ -80,6 +83,7 @@ class System:
     dampers: Sequence[Damper] = ()
     stops: Sequence[Stop] = ()
     collisions: Sequence[Collision] = ()
+    frictions: Sequence[Friction] = ()
     excitations: Sequence[Force | Base] = ()
     gravity: Gravity | None = None
     initial: Initial | None = None
@@ -90,7 +94,12 @@ class System:
 
     def __post_init__(self) -> None:
         _instance("structure", self.structure, Structure, "Oscillator, Matrices or Cantilever")
-        for name, kind in (("dampers", Damper), ("stops", Stop), ("collisions", Collision)):
+        for name, kind in (
+            ("dampers", Damper),
+            ("stops", Stop),
+            ("collisions", Collision),
+            ("frictions", Friction),
+        ):
             object.__setattr__(self, name, _parts(name, getattr(self, name), kind, kind.__name__))
         excitations = _parts("excitations", self.excitations, (Force, Base), "Force or Base")
         for j, excitation in enumerate(excitations):
@@ -160,14 +169,15 @@ class System:
 
     def model_sections(self) -> dict[str, Any]:
         """The model's sections as :func:`vibroimpact.system.prepare_system` takes them
-        (``structure``, ``damper``, ``stop``, ``collision``, ``gravity``, ``excitation``,
-        ``initial``)."""
+        (``structure``, ``damper``, ``stop``, ``collision``, ``friction``, ``gravity``,
+        ``excitation``, ``initial``)."""
         sections = self.to_dict()
         return {
             "structure": sections["structure"],
             "damper": sections.get("damper", []),
             "stop": sections.get("stop", []),
             "collision": sections.get("collision", []),
+            "friction": sections.get("friction", []),
             "gravity": sections.get("gravity"),
             "excitation": sections.get("excitation", []),
             "initial": sections.get("initial"),
@@ -175,10 +185,15 @@ class System:
 
     def to_dict(self) -> dict[str, Any]:
         """The scenario's sections as ``tomllib`` reads them: ``structure``, ``damper``,
-        ``stop``, ``collision``, ``gravity``, ``excitation`` (lists of tables),
+        ``stop``, ``collision``, ``friction``, ``gravity``, ``excitation`` (lists of tables),
         ``initial``, ``solver``, ``output`` and the analyses' tables, each where given."""
         sections: dict[str, Any] = {"structure": self.structure.to_dict()}
-        listed = (("damper", self.dampers), ("stop", self.stops), ("collision", self.collisions))
+        listed = (
+            ("damper", self.dampers),
+            ("stop", self.stops),
+            ("collision", self.collisions),
+            ("friction", self.frictions),
+        )
         for name, parts in listed:
             if parts:
                 sections[name] = [part.to_dict() for part in parts]
@@ -225,7 +240,7 @@ class System:
                 f"sections: must be a dict of tables (as tomllib reads a scenario), got "
                 f"{shown(sections)}"
             )
-        known = {"structure", "damper", "stop", "collision", "gravity", "excitation", "initial"}
+        known = {name for name in RUN_SECTIONS if name not in ("solver", "output")}
         for name in sections:
             if name not in known | {"solver", "output", *ANALYSIS_SECTIONS}:
                 raise InvalidInputError(
@@ -248,6 +263,7 @@ class System:
                 model["excitation"] or (),
                 directory("base_dir", base_dir),
                 collision=model["collision"] or (),
+                friction=model["friction"] or (),
             )
             _table("[initial] ", model["initial"] or {}, _INITIAL)
             for name, schema in (("solver", _SOLVER), ("output", _OUTPUT)):
@@ -275,6 +291,7 @@ class System:
             dampers=_tables(Damper, sections.get("damper")),
             stops=_tables(Stop, sections.get("stop")),
             collisions=_tables(Collision, sections.get("collision")),
+            frictions=_tables(Friction, sections.get("friction")),
             excitations=[_excitation(dict(e)) for e in listed_tables(sections.get("excitation"))],
             gravity=_part(Gravity, gravity),
             initial=_part(Initial, sections.get("initial")),

@@ -70,6 +70,7 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
             damper=data.get("damper", ()),
             stop=data.get("stop", ()),
             collision=data.get("collision", ()),
+            friction=data.get("friction", ()),
             gravity=data.get("gravity"),
             excitation=data.get("excitation", ()),
             initial=data.get("initial"),

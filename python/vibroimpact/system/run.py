@@ -45,6 +45,7 @@ def simulate_system(
     damper: Any = (),
     stop: Any = (),
     collision: Any = (),
+    friction: Any = (),
     gravity: Any = None,
     excitation: Any = (),
     initial: Mapping[str, Any] | None = None,
@@ -72,7 +73,8 @@ def simulate_system(
     """Integrate a 0.2 system from ``initial`` to ``t_end`` (s).
 
     The sections are those of a TOML scenario (see the module docstring), as dicts
-    (``damper``, ``stop``, ``collision`` and ``excitation`` as lists of dicts). ``initial`` holds
+    (``damper``, ``stop``, ``collision``, ``friction`` and ``excitation`` as lists of
+    dicts). ``initial`` holds
     ``structure_displacement``, ``structure_velocity``, ``damper_displacement``,
     ``damper_velocity`` (arrays, SI; zeros where left out). ``method``: ``"rk4"``
     (fixed step ``dt``), ``"dopri5"`` or ``"dop853"`` (``rtol``, ``atol``),
@@ -103,6 +105,7 @@ def simulate_system(
         damper=damper,
         stop=stop,
         collision=collision,
+        friction=friction,
         gravity=gravity,
         excitation=excitation,
         initial=initial,
@@ -218,6 +221,7 @@ def prepare_system(
     damper: Any = (),
     stop: Any = (),
     collision: Any = (),
+    friction: Any = (),
     gravity: Any = None,
     excitation: Any = (),
     initial: Any = None,
@@ -230,7 +234,14 @@ def prepare_system(
     base_dir = directory("base_dir", base_dir)
     try:
         spec = system_spec(
-            structure, damper, stop, gravity, excitation, base_dir, collision=collision
+            structure,
+            damper,
+            stop,
+            gravity,
+            excitation,
+            base_dir,
+            collision=collision,
+            friction=friction,
         )
     except RecursionError:
         # Arrays nested thousands deep: no structure has them.

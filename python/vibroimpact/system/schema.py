@@ -23,6 +23,14 @@ A system is described by the same sections as a TOML scenario (SI units):
 - ``collision`` (a list): two loose masses that strike each other, ``dampers = [i, j]``
   (damper i below damper j), touching when damper i's displacement minus damper j's
   reaches ``gap`` (m); a ``law``.
+- Dry (Coulomb) friction: a damper's ``friction`` (kinetic coefficient),
+  ``static_friction`` (>= ``friction``, default equal) and ``normal_force`` (N: the
+  weight of a horizontal damper, or a preload) between it and its carrier; and
+  ``friction`` (a list) between the structure's point ``at`` and ``against`` (another
+  point; default the base): ``coefficient``, ``static_coefficient``, ``normal_force``.
+  While sliding a force ``coefficient * normal_force`` opposes the relative velocity;
+  the sides stick when it reaches zero and the force holding them is within
+  ``static_coefficient * normal_force``, and slip again when it is not.
 - Laws: ``"rigid"`` (Newton's restitution ``restitution`` in [0, 1], located
   instantaneous impacts, chattering summed to its accumulation instant, then
   sticking) or a compliant law of :class:`vibroimpact.Contact` (``stiffness``,
@@ -75,6 +83,7 @@ RUN_SECTIONS = (
     "damper",
     "stop",
     "collision",
+    "friction",
     "gravity",
     "excitation",
     "initial",
@@ -123,6 +132,9 @@ _DAMPER = {
     "lower_clearance": (_WALL, None),
     "upper_clearance": (_WALL, None),
     **_LAW,
+    "friction": (_NUMBER, None),
+    "static_friction": (_NUMBER, None),
+    "normal_force": (_NUMBER, None),
 }
 _STOP = {
     "at": (_NUMBER, _REQ),
@@ -135,6 +147,13 @@ _COLLISION = {
     "dampers": (_NUMBERS, _REQ),
     "gap": (_NUMBER, _REQ),
     **_LAW,
+}
+_FRICTION = {
+    "at": (_NUMBER, _REQ),
+    "against": (_NUMBER, None),
+    "coefficient": (_NUMBER, _REQ),
+    "static_coefficient": (_NUMBER, None),
+    "normal_force": (_NUMBER, _REQ),
 }
 _GRAVITY = {"acceleration": (_NUMBER, 9.81)}
 _EXCITATION = {
@@ -405,6 +424,43 @@ def _collisions(tables: list[Any], dampers: int) -> list[dict[str, Any]]:
     return out
 
 
+def _check_friction(where: str, d: dict[str, Any], keys: tuple[str, str, str]) -> None:
+    """Coulomb friction's ``keys`` (kinetic coefficient, static coefficient, normal
+    force) in ``d``: the kinetic >= 0, the static (filled with the kinetic where left
+    out) >= the kinetic, the normal force >= 0 N."""
+    kinetic, held, normal = keys
+    if not d[kinetic] >= 0:
+        raise _fail(where, f"{kinetic} must be >= 0 (a coefficient), got {d[kinetic]}")
+    if d[held] is None:
+        d[held] = d[kinetic]
+    elif not d[held] >= d[kinetic]:
+        raise _fail(
+            where,
+            f"{held} must be >= {kinetic} = {d[kinetic]} (sticking holds more), got {d[held]}",
+        )
+    if d[normal] is None:
+        raise _fail(where, f"{normal} is required with {kinetic} (N: the weight, or a preload)")
+    if not (d[normal] >= 0 and math.isfinite(d[normal])):
+        raise _fail(where, f"{normal} must be a finite number >= 0 N, got {d[normal]}")
+
+
+def _frictions(tables: list[Any], structure: dict[str, Any]) -> list[dict[str, Any]]:
+    """The ``[[friction]]`` tables checked: a point ``at``, optional ``against``, and
+    Coulomb's coefficients and normal force."""
+    out = []
+    for j, table in enumerate(tables):
+        where = f"[[friction]] {j}: "
+        d = _table(where, table, _FRICTION)
+        for key in ("at", "against"):
+            if d[key] is not None:
+                _check_point(f"friction {j} {key}", table[key], d[key], structure)
+        _check_friction(where, d, ("coefficient", "static_coefficient", "normal_force"))
+        if d["against"] is None:
+            del d["against"]
+        out.append(d)
+    return out
+
+
 def _too_deep(value: Any, limit: int = 32) -> bool:
     """Whether ``value`` is arrays within arrays more than ``limit`` deep."""
     for _ in range(limit):
@@ -576,18 +632,19 @@ def system_spec(
     base_dir: Path | None = None,
     *,
     collision: Any = (),
+    friction: Any = (),
 ) -> dict[str, Any]:
     """The sections of a system, checked and with their defaults filled (see the module
     docstring); errors name the section and key."""
     spec: dict[str, Any] = {"structure": structure_spec(structure)}
     damper_tables, stop_tables = _list("damper", damper), _list("stop", stop)
-    collision_tables = _list("collision", collision)
-    pairs = len(damper_tables) + len(stop_tables) + len(collision_tables)
+    collision_tables, friction_tables = _list("collision", collision), _list("friction", friction)
+    pairs = len(damper_tables) + len(stop_tables) + len(collision_tables) + len(friction_tables)
     if pairs > MAX_PAIRS:
         # Before any is read: simultaneous impacts solve over every pair, a matrix
         # that grows as their square (70,000 stops aborted asking for 39 GB).
         raise _fail(
-            "[[damper]], [[stop]], [[collision]]: ",
+            "[[damper]], [[stop]], [[collision]], [[friction]]: ",
             f"at most {MAX_PAIRS} pairs in all, got {pairs}",
         )
     collisions = _collisions(collision_tables, len(damper_tables))
@@ -612,12 +669,23 @@ def system_spec(
                     f"[[damper]] {j}: ",
                     f"{side} must be >= 0 m, or inf for no wall on that side, got {d[side]}",
                 )
-        held = any(j in c["dampers"] for c in collisions)
+        if d["friction"] is not None:
+            _check_friction(f"[[damper]] {j}: ", d, ("friction", "static_friction", "normal_force"))
+        else:
+            for key in ("static_friction", "normal_force"):
+                if d[key] is not None:
+                    raise _fail(
+                        f"[[damper]] {j}: ", f"{key} needs friction (the kinetic coefficient)"
+                    )
+                del d[key]
+            del d["friction"]
+        rubs = bool(d.get("friction")) and bool(d.get("normal_force"))
+        held = any(j in c["dampers"] for c in collisions) or rubs
         if d["lower_clearance"] == d["upper_clearance"] == math.inf and not held:
             raise _fail(
                 f"[[damper]] {j}: ",
-                "lower_clearance and upper_clearance are both inf (no wall) and no "
-                "[[collision]] holds it: give one side a finite clearance",
+                "lower_clearance and upper_clearance are both inf (no wall) and neither a "
+                "[[collision]] nor friction holds it: give one side a finite clearance",
             )
         del d["clearance"]
         _check_point(f"damper {j} at", table["at"], d["at"], spec["structure"])
@@ -635,6 +703,7 @@ def system_spec(
         stops.append(d)
     spec["stop"] = stops
     spec["collision"] = collisions
+    spec["friction"] = _frictions(friction_tables, spec["structure"])
     if gravity is None:
         spec["gravity"] = {"acceleration": 0.0}
     else:
@@ -734,6 +803,7 @@ def linear_parts(
     gravity: Any = None,
     excitation: Any = (),
     collision: Any = (),
+    friction: Any = (),
     base_dir: Path | None = None,
 ) -> dict[str, Any]:
     """The system between contacts as a linear one over all its coordinates
@@ -744,7 +814,16 @@ def linear_parts(
     ``shape`` (the load is ``amplitude cos(omega t + phase) shape``, N). Signals
     other than harmonics are refused."""
     base_dir = directory("base_dir", base_dir)
-    spec = system_spec(structure, damper, stop, gravity, excitation, base_dir, collision=collision)
+    spec = system_spec(
+        structure,
+        damper,
+        stop,
+        gravity,
+        excitation,
+        base_dir,
+        collision=collision,
+        friction=friction,
+    )
     raw = _linear_parts({**spec, "gravity": spec["gravity"]["acceleration"]})
     dim = raw["n"] + raw["k"]
     return {

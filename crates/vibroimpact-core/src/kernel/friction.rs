@@ -38,11 +38,25 @@ impl Run<'_> {
             let at_rest = rate.abs() <= system.rate_round_off(i, &self.y);
             match self.modes[i] {
                 _ if !at_rest => self.slide(i, time, rate.signum()),
-                Mode::Stuck { shadowed, .. } => {
-                    if shadowed != self.shadowed(i) {
-                        self.stick_or_slide(i, time);
+                Mode::Stuck { shadowed, offset } => match (shadowed, self.shadowed(i)) {
+                    // The wall that held the row let go: the force holding the
+                    // pair passed the static force there, so the element slips.
+                    (true, false) => {
+                        self.modes[i] = Mode::Stuck {
+                            offset,
+                            shadowed: false,
+                        };
+                        let force = self.holding_force(i, time);
+                        self.slide(i, time, -force.signum());
                     }
-                }
+                    (false, true) => {
+                        self.modes[i] = Mode::Stuck {
+                            offset,
+                            shadowed: true,
+                        }
+                    }
+                    _ => {}
+                },
                 _ => self.stick_or_slide(i, time),
             }
         }

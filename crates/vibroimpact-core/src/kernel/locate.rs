@@ -30,7 +30,7 @@ pub(super) fn event_value(
         Mode::Compliant { .. } => -system.gap(i, y).0,
         Mode::Sticking => {
             system.rates(time, y, modes, scratch, work);
-            scratch.force_of(i).unwrap_or(0.0)
+            scratch.force_of(i).unwrap_or(0.0) + system.friction_hold[i]
         }
         Mode::Sliding { direction } => direction * system.gap(i, y).1,
         Mode::Stuck { .. } => {
@@ -148,7 +148,13 @@ pub(super) fn find_crossing(
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
             Mode::Sticking if system.locked(i) => continue,
-            Mode::Sticking | Mode::Sliding { .. } | Mode::Stuck { .. } => {
+            Mode::Sliding { direction } => {
+                if let Some(c) = sliding_crossing(i, direction, gaps.start[i], gaps.end[i], h) {
+                    consider(c);
+                }
+                continue;
+            }
+            Mode::Sticking | Mode::Stuck { .. } => {
                 let value = event_value(system, i, mode, time + h, end, modes, scratch, work);
                 if value < 0.0 {
                     consider(Crossing {
@@ -220,6 +226,69 @@ pub(super) fn find_crossing(
         }
     }
     best
+}
+
+/// A sliding friction element's stop in a step of length `h` whose ends
+/// have the row's displacement and rate `start` and `end`: the rate (the
+/// sliding velocity) is the derivative of the displacement's cubic Hermite
+/// interpolant, a quadratic, whose first root after the start is the guess
+/// (a crossing the ends show), or whose dip below zero and back (a stop
+/// and a slide on, within the step) is checked on the method's solution.
+fn sliding_crossing(
+    i: usize,
+    direction: f64,
+    (g0, r0): (f64, f64),
+    (g1, r1): (f64, f64),
+    h: f64,
+) -> Option<Crossing> {
+    // h v(theta) = a theta^2 + b theta + c, v(0) = r0, v(1) = r1 (times direction).
+    let (d0, d1, fall) = (
+        direction * r0 * h,
+        direction * r1 * h,
+        direction * (g0 - g1),
+    );
+    let (a, b, c) = (
+        6.0 * fall + 3.0 * d0 + 3.0 * d1,
+        -6.0 * fall - 4.0 * d0 - 2.0 * d1,
+        d0,
+    );
+    // The first root after the start (a start at zero speed, just set
+    // sliding, is not one).
+    let first_root = || {
+        let roots = if a == 0.0 {
+            [-c / b, f64::NAN]
+        } else {
+            let disc = (b * b - 4.0 * a * c).max(0.0).sqrt();
+            let q = -0.5 * (b + b.signum() * disc);
+            [q / a, c / q]
+        };
+        roots
+            .into_iter()
+            .filter(|t| *t > 1e-9 && *t <= 1.0)
+            .fold(f64::NAN, f64::min)
+    };
+    if d1 < 0.0 {
+        let root = first_root();
+        let guess = if root.is_nan() { 1.0 } else { root };
+        return Some(Crossing {
+            i,
+            guess,
+            interior: false,
+            before: 0.0,
+            root: guess,
+        });
+    }
+    let lowest = -b / (2.0 * a);
+    if a > 0.0 && lowest > 0.0 && lowest < 1.0 && a * lowest * lowest + b * lowest + c < 0.0 {
+        return Some(Crossing {
+            i,
+            guess: lowest,
+            interior: true,
+            before: 0.0,
+            root: first_root(),
+        });
+    }
+    None
 }
 
 /// Whether any interaction is in a compliant contact.
@@ -326,7 +395,13 @@ pub(super) fn locate<S: SystemStepper>(
     // twice that: `Assembly::release`) and moving away (a rebound): the
     // event is where it comes back, after a stretch on the old side to
     // start from.
-    let leaving = v_lo.abs() <= 4.0 * round_off && sign * system.gap(c.i, y).1 > 0.0;
+    let leaving = match mode {
+        // Just set sliding from rest (a stuck pair slipping, or one that
+        // stopped sliding back): the speed starts at zero and grows, and the
+        // event is where it comes back to zero, after a stretch sliding.
+        Mode::Sliding { .. } => v_lo <= system.rate_round_off(c.i, y),
+        _ => v_lo.abs() <= 4.0 * round_off && sign * system.gap(c.i, y).1 > 0.0,
+    };
     if c.before > 0.0 || leaving {
         let mut length = if c.before > 0.0 {
             c.before * h

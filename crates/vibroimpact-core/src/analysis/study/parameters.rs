@@ -2,7 +2,7 @@
 //! once and applied to a copy of the base system for each run.
 
 use crate::error::{Error, Result};
-use crate::model::assembly::{Load, PairLaw, SystemSpec};
+use crate::model::assembly::{FrictionSite, Load, PairLaw, SystemSpec};
 use crate::model::contact::Contact;
 use crate::model::signals::{RecipeKey, Signal};
 
@@ -29,6 +29,10 @@ pub enum Target {
     CollisionRestitution(usize),
     CollisionStiffness(usize),
     CollisionDamping(usize),
+    /// An entry of [`SystemSpec::frictions`] and its key: 0 the kinetic
+    /// coefficient (the static one follows where they were equal), 1 the
+    /// static coefficient, 2 the normal force.
+    Friction(usize, u8),
     Gravity,
     ExcitationAmplitude(usize),
     ExcitationFrequency(usize),
@@ -54,8 +58,10 @@ pub struct Parameter {
 pub const PATHS: &str = "structure.{mass, stiffness, damping} (kind \"oscillator\"), \
      structure.{length, youngs_modulus, second_moment, mass_per_length, damping_ratio} \
      (kind \"cantilever\"; none of kind \"matrices\"), damper.N.{at, mass, clearance, \
-     lower_clearance, upper_clearance, restitution, stiffness, damping}, stop.N.{at, gap, \
-     restitution, stiffness, damping}, collision.N.{gap, restitution, stiffness, damping}, \
+     lower_clearance, upper_clearance, restitution, stiffness, damping, friction, \
+     static_friction, normal_force}, stop.N.{at, \
+     gap, restitution, stiffness, damping}, collision.N.{gap, restitution, stiffness, damping}, \
+     friction.N.{coefficient, static_coefficient, normal_force}, \
      gravity.acceleration, excitation.N.at (forces), \
      excitation.N.{amplitude, frequency, phase} (harmonic signals), excitation.N.{seed, intensity, cutoff_frequency, \
      duration} (white-noise and kanai-tajimi signals; also ground_frequency, ground_damping \
@@ -112,6 +118,23 @@ impl Parameter {
                     "restitution" => Target::DamperRestitution(i),
                     "stiffness" => Target::DamperStiffness(i),
                     "damping" => Target::DamperDamping(i),
+                    "friction" | "static_friction" | "normal_force" => {
+                        let f = spec
+                            .frictions
+                            .iter()
+                            .position(|f| f.site == FrictionSite::Damper(i))
+                            .ok_or_else(|| {
+                                Error::Inconsistent(format!(
+                                    "study axis {path:?}: damper {i} has no friction (give it \
+                                     friction and normal_force)"
+                                ))
+                            })?;
+                        let key = ["friction", "static_friction", "normal_force"]
+                            .iter()
+                            .position(|k| k == key)
+                            .unwrap_or(0);
+                        Target::Friction(f, key as u8)
+                    }
                     _ => return Err(bad()),
                 }
             }
@@ -135,6 +158,19 @@ impl Parameter {
                     "damping" => Target::CollisionDamping(i),
                     _ => return Err(bad()),
                 }
+            }
+            ["friction", i, key] => {
+                let elements: Vec<usize> = (0..spec.frictions.len())
+                    .filter(|&f| matches!(spec.frictions[f].site, FrictionSite::Points { .. }))
+                    .collect();
+                let i = index(i, elements.len(), "[[friction]]")?;
+                let key = match *key {
+                    "coefficient" => 0,
+                    "static_coefficient" => 1,
+                    "normal_force" => 2,
+                    _ => return Err(bad()),
+                };
+                Target::Friction(elements[i], key)
             }
             ["gravity", "acceleration"] => Target::Gravity,
             ["structure", key] => {
@@ -280,6 +316,19 @@ impl Parameter {
             }
             Target::CollisionStiffness(i) => law(&mut spec.collisions[i].law, "stiffness")?,
             Target::CollisionDamping(i) => law(&mut spec.collisions[i].law, "damping")?,
+            Target::Friction(f, key) => {
+                let friction = &mut spec.frictions[f];
+                match key {
+                    0 => {
+                        if friction.static_coefficient == friction.coefficient {
+                            friction.static_coefficient = value;
+                        }
+                        friction.coefficient = value;
+                    }
+                    1 => friction.static_coefficient = value,
+                    _ => friction.normal_force = value,
+                }
+            }
             Target::Gravity => spec.gravity = value,
             Target::ExcitationAmplitude(i)
             | Target::ExcitationFrequency(i)

@@ -46,11 +46,13 @@ impl Assembly {
             })
             .collect();
         let point_rows = followed_rows(spec)?;
+        let friction_hold = friction_holds(&interactions);
         let mut assembly = Self {
             compact: None,
             point_rows,
             mirrors_previous,
             sticking_step: 0.1 * scales.shortest,
+            friction_hold,
             floor_mass_acceleration: scales.floor_mass_acceleration,
             time_scale: scales.time_scale,
             n,
@@ -93,6 +95,31 @@ impl Assembly {
             mirrors: &self.mirrors_previous,
         })
     }
+}
+
+/// Each rigid wall's friction hold (see [`Assembly::friction_hold`]): the
+/// static force of the friction element whose row is the wall's, either sign.
+fn friction_holds(interactions: &[Interaction]) -> Vec<f64> {
+    let parallel = |a: &[f64], b: &[f64]| {
+        let along = linalg::dot(a, b);
+        along * along >= (1.0 - 1e-12) * linalg::dot(a, a) * linalg::dot(b, b)
+    };
+    interactions
+        .iter()
+        .map(|wall| {
+            if !matches!(wall.law, InteractionLaw::Rigid { .. }) {
+                return 0.0;
+            }
+            interactions
+                .iter()
+                .filter(|f| parallel(&f.h, &wall.h))
+                .map(|f| match f.law {
+                    InteractionLaw::Friction { static_force, .. } => static_force,
+                    _ => 0.0,
+                })
+                .sum()
+        })
+        .collect()
 }
 
 /// Refuses two rigid walls with the same gap (the same points, side and

@@ -129,6 +129,11 @@ pub struct Assembly {
     /// of the shortest natural or forcing period): how long an adaptive step
     /// may be while a pair sticks, whose release nothing else foretells.
     pub sticking_step: f64,
+    /// For each rigid wall, the static force of a friction element on the
+    /// same row (N; 0 for none): sticking there, the wall and the friction
+    /// hold the pair together, so it lets go only where the wall would pull
+    /// by more than that.
+    pub(crate) friction_hold: Vec<f64>,
     /// The total mass times the square of the largest acceleration acting
     /// (gravity, base, force), kg m^2/s^4, and the system's time scale (its
     /// shortest period or signal's, infinite for none), s: see
@@ -227,8 +232,9 @@ impl Mode {
             Mode::Open => g1 < 0.0 || (r0 < 0.0 && r1 > 0.0),
             Mode::Compliant { .. } => g1 > 0.0 || (r0 > 0.0 && r1 < 0.0),
             Mode::Sticking | Mode::Stuck { .. } => true,
-            // Sliding ends where the sliding velocity reaches zero.
-            Mode::Sliding { direction } => direction * r1 <= 0.0,
+            // Sliding ends where the sliding velocity reaches zero, at a step's
+            // end or within it (`locate::sliding_crossing` looks).
+            Mode::Sliding { .. } => true,
         }
     }
 

@@ -1,0 +1,312 @@
+"""Coulomb friction (issue 27): stick-slip located as events in every event-stepped
+method, checked against closed forms (the free decay's amplitude lost per half cycle
+and its stop inside the static band, a block sliding to rest, a block bouncing between
+walls, Den Hartog's forced response sliding throughout) and scipy's event-driven
+integration of a horizontal impact damper with friction (tests/friction_reference.py)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+import vibroimpact.analysis as an
+from friction_reference import HorizontalDamper
+from friction_reference import simulate as scipy_simulate
+
+ROOT = Path(__file__).resolve().parents[1]
+G = 9.81
+FREE = {"lower_clearance": math.inf, "upper_clearance": math.inf}
+# Methods that step by events (fixed stepping refuses friction).
+METHODS = ["exact", "dop853", "dopri5", "newmark-implicit"]
+
+
+def _step(method: str) -> dict[str, Any]:
+    return {"dt": 2e-4} if method in ("newmark-implicit", "rk4") else {}
+
+
+def _decay_system(x0: float, kinetic: float, held: float, normal: float) -> vi.System:
+    return vi.System(
+        structure=vi.Oscillator(mass=2.0, stiffness=800.0, damping=0.0),
+        frictions=[
+            vi.Friction(at=0, coefficient=kinetic, static_coefficient=held, normal_force=normal)
+        ],
+        initial=vi.Initial(structure_displacement=[x0]),
+    )
+
+
+def _turning_points(x0: float, slide: float, band: float) -> list[float]:
+    """Each half cycle about the kinetic force's offset ``slide`` (m) loses ``2 slide``
+    of amplitude; the motion stops at the first turning point inside ``band``."""
+    points, x = [x0], x0
+    while abs(x) > band:
+        x = -(x - 2.0 * slide * math.copysign(1.0, x))
+        points.append(x)
+    return points
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.timeout(30)
+def test_free_decay_loses_twice_the_friction_offset_each_half_cycle(method: str) -> None:
+    x0, kinetic, held, normal, k = 0.0513, 0.3, 0.4, 10.0, 800.0
+    expected = _turning_points(x0, kinetic * normal / k, held * normal / k)
+    sol = vi.simulate(
+        _decay_system(x0, kinetic, held, normal), method=method, t_end=1.2, **_step(method)
+    )
+    x, v = sol.structure_displacement[:, 0], sol.structure_velocity[:, 0]
+    # Each stop is an event (a kept row): where the speed reaches zero or turns.
+    stops = [x[0]]
+    for i in range(1, len(v)):
+        if (v[i] == 0.0 or v[i] * v[i - 1] < 0) and abs(x[i] - stops[-1]) > 1e-9:
+            stops.append(x[i])
+    tolerance = 1e-12 if method == "exact" else 1e-7
+    assert len(stops) >= len(expected)
+    assert np.allclose(stops[: len(expected)], expected, rtol=0, atol=tolerance)
+    # At rest at the last, inside the static band, which a kinetic-only rule would
+    # have left (0.0063 m > 0.0038 m).
+    final = sol.final_state
+    assert final["structure_displacement"][0] == pytest.approx(expected[-1], abs=tolerance)
+    assert final["structure_velocity"][0] == 0.0
+    # The ledger: the spring's energy went to friction, and nothing else.
+    lost = 0.5 * k * (x0**2 - expected[-1] ** 2)
+    assert sol.energy["friction"] == pytest.approx(lost, rel=1e-6)
+    assert sol.energy["contact"] == 0.0 and sol.energy["impact"] == 0.0
+    assert abs(sol.energy["residual"]) < 1e-6
+    # The stuck interval from the last stop on is in the contact table.
+    table = sol.contacts.to_pandas()
+    assert list(table["pair"]) == ["friction 0"] and list(table["kind"]) == ["sticking"]
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.timeout(30)
+def test_a_block_slides_to_rest_in_v_squared_over_two_mu_g(method: str) -> None:
+    m, mu, v0 = 0.5, 0.25, 1.2
+    system = vi.System(
+        # A carrier held still: heavy and stiff (its reaction moves it by 1e-13 m).
+        structure=vi.Oscillator(mass=1e9, stiffness=1e15, damping=0.0),
+        dampers=[
+            vi.Damper(
+                mass=m, at=0, law="rigid", restitution=0.5, friction=mu, normal_force=m * G, **FREE
+            )
+        ],
+        initial=vi.Initial(damper_velocity=[v0]),
+    )
+    t_stop = v0 / (mu * G)
+    sol = vi.simulate(system, method=method, t_end=1.5 * t_stop, **_step(method))
+    final = sol.final_state
+    slid = final["damper_displacement"][0] - final["structure_displacement"][0]
+    # The carrier's own motion changes the slide by 1e-12 of it.
+    tolerance = 1e-10 if method == "exact" else 1e-7
+    assert slid == pytest.approx(v0**2 / (2 * mu * G), rel=tolerance)
+    (stuck,) = sol.contacts.to_pandas().itertuples()
+    assert stuck.pair == "damper 0 friction" and stuck.kind == "sticking"
+    assert stuck.onset == pytest.approx(t_stop, rel=tolerance)
+    assert sol.energy["friction"] == pytest.approx(0.5 * m * v0**2, rel=1e-6)
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.timeout(30)
+def test_a_block_bounces_off_a_wall_and_slides_to_rest(method: str) -> None:
+    # From the middle towards the upper wall 0.2 m away: it arrives at
+    # sqrt(v0^2 - 2 mu g d), leaves at e times that and slides back to rest.
+    m, mu, v0, d, e = 0.2, 0.2, 1.5, 0.2, 0.6
+    system = vi.System(
+        structure=vi.Oscillator(mass=1e9, stiffness=1e15, damping=0.0),
+        dampers=[
+            vi.Damper(
+                mass=m,
+                at=0,
+                clearance=d,
+                law="rigid",
+                restitution=e,
+                friction=mu,
+                normal_force=m * G,
+            )
+        ],
+        initial=vi.Initial(damper_velocity=[v0]),
+    )
+    sol = vi.simulate(system, method=method, t_end=2.0, **_step(method))
+    arrival = math.sqrt(v0**2 - 2 * mu * G * d)
+    back = (e * arrival) ** 2 / (2 * mu * G)
+    table = sol.contacts.to_pandas()
+    impact = table[table.kind == "impact"].iloc[0]
+    tolerance = 1e-8 if method == "exact" else 1e-6
+    assert impact.approach_speed == pytest.approx(arrival, rel=tolerance)
+    assert impact.rebound_speed == pytest.approx(e * arrival, rel=tolerance)
+    final = sol.final_state
+    rest = final["damper_displacement"][0] - final["structure_displacement"][0]
+    assert rest == pytest.approx(d - back, rel=tolerance)
+    assert list(table.kind) == ["impact", "sticking"]
+    lost = 0.5 * m * v0**2
+    energy = sol.energy
+    assert energy["friction"] + energy["impact"] == pytest.approx(lost, rel=1e-6)
+    assert energy["impact"] == pytest.approx(0.5 * m * (1 - e**2) * arrival**2, rel=1e-6)
+
+
+@pytest.mark.parametrize(("beta", "method"), [(0.8, "exact"), (1.5, "exact"), (0.8, "dop853")])
+@pytest.mark.timeout(60)
+def test_den_hartog_s_forced_response_with_dry_friction(beta: float, method: str) -> None:
+    system, amplitude = _den_hartog(beta, 0.2)
+    period = 2 * math.pi / (beta * 10.0)
+    sol = vi.simulate(
+        system, method=method, t_end=300 * period, history=False, record_from=280 * period
+    )
+    assert sol.peak[0] == pytest.approx(amplitude, rel=1e-7)
+    # It never sticks (each stop reverses at once): no stuck interval.
+    assert len(sol.contacts) == 0
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853"])
+@pytest.mark.timeout(60)
+def test_a_horizontal_damper_with_friction_follows_scipy(method: str) -> None:
+    params = HorizontalDamper()
+    t_end = 2.0  # 20 forcing periods: impacts, chattering, stick-slip
+    reference, events = scipy_simulate(params, t_end, max_step=2e-5)
+    assert events > 300
+    sections = params.toml_sections()
+    system = vi.System.from_dict(sections)
+    tight = {"rtol": 1e-12, "atol": 1e-15} if method == "dop853" else {}
+    sol = vi.simulate(system, method=method, t_end=t_end, history=False, **tight)
+    f = sol.final_state
+    ours = [
+        f["structure_displacement"][0],
+        f["damper_displacement"][0],
+        f["structure_velocity"][0],
+        f["damper_velocity"][0],
+    ]
+    assert np.allclose(ours[:2], reference[:2], rtol=0, atol=1e-6)
+    assert np.allclose(ours[2:], reference[2:], rtol=0, atol=1e-4)
+    energy = sol.energy
+    assert energy["friction"] > 0 and energy["impact"] > 0
+    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
+    table = sol.contacts.to_pandas()
+    assert set(table.pair) == {"damper 0", "damper 0 friction"}
+    stuck = table[table.pair == "damper 0 friction"]
+    assert (stuck.kind == "sticking").all() and (stuck.duration.dropna() > 0).all()
+
+
+@pytest.mark.parametrize(
+    ("damper", "message"),
+    [
+        (
+            {"friction": 0.3, "static_friction": 0.2, "normal_force": 1.0},
+            "static_friction must be >=",
+        ),
+        ({"friction": 0.3}, "normal_force is required"),
+        ({"friction": -0.1, "normal_force": 1.0}, "friction must be >= 0"),
+        ({"friction": 0.1, "normal_force": -1.0}, "normal_force must be a finite number >= 0"),
+        ({"static_friction": 0.1}, "static_friction needs friction"),
+        ({"normal_force": 1.0}, "normal_force needs friction"),
+    ],
+)
+@pytest.mark.timeout(30)
+def test_bad_friction_keys_are_refused_naming_them(damper: dict[str, Any], message: str) -> None:
+    sections = HorizontalDamper().toml_sections()
+    for key in ("friction", "static_friction", "normal_force"):
+        del sections["damper"][0][key]
+    sections["damper"][0].update(damper)
+    with pytest.raises(ValueError, match=message) as error:
+        vi.System.from_dict(sections)
+    assert "[[damper]] 0" in str(error.value) and "\n" not in str(error.value)
+
+
+@pytest.mark.timeout(30)
+def test_a_bad_friction_element_is_refused_naming_its_key() -> None:
+    base = {"structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 100.0}}
+    for element, message in [
+        ({"at": 0, "coefficient": 0.2}, "missing key 'normal_force'"),
+        ({"at": 3, "coefficient": 0.2, "normal_force": 1.0}, "friction 0 at"),
+        (
+            {"at": 0, "coefficient": 0.2, "static_coefficient": 0.1, "normal_force": 1.0},
+            "static_coefficient must be >=",
+        ),
+    ]:
+        with pytest.raises(ValueError, match=message) as error:
+            vi.System.from_dict(base | {"friction": [element]})
+        assert "\n" not in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"method": "rk4", "dt": 1e-4, "stepping": "fixed"}, "cannot locate stick-slip"),
+        ({"method": "newmark", "dt": 1e-4}, "dry friction"),
+    ],
+)
+@pytest.mark.timeout(30)
+def test_methods_that_cannot_locate_stick_slip_refuse_friction(
+    settings: dict[str, Any], message: str
+) -> None:
+    system = vi.System.from_dict(HorizontalDamper().toml_sections())
+    damper = dataclasses.replace(system.dampers[0], law="hertz", stiffness=1e8, restitution=None)
+    system = system.replace(dampers=[damper])
+    with pytest.raises(ValueError, match=message):
+        vi.simulate(system, t_end=0.01, **settings)
+
+
+def _den_hartog(beta: float, F: float) -> tuple[vi.System, float]:
+    """An undamped oscillator (1 kg, 100 N/m) with dry friction ``F`` (N) to the ground,
+    forced by 1 N at ``beta`` times its natural frequency, and Den Hartog's amplitude of
+    its steady response sliding throughout (two stops a cycle): (P / k) sqrt(V^2 - (F /
+    P)^2 U^2), V = 1 / (1 - b^2), U = sin(pi / b) / (b (1 + cos(pi / b))) (J. P. Den
+    Hartog, Trans. ASME 53, 1931)."""
+    m, k, P = 1.0, 100.0, 1.0
+    frequency = beta * math.sqrt(k / m) / (2 * math.pi)
+    system = vi.System(
+        structure=vi.Oscillator(mass=m, stiffness=k, damping=0.0),
+        frictions=[vi.Friction(at=0, coefficient=F, normal_force=1.0)],
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=P, frequency=frequency))],
+        initial=vi.Initial(structure_velocity=[1e-3]),
+    )
+    V = 1 / (1 - beta**2)
+    U = math.sin(math.pi / beta) / (beta * (1 + math.cos(math.pi / beta)))
+    return system, P / k * math.sqrt(V**2 - (F / P) ** 2 * U**2)
+
+
+@pytest.mark.timeout(60)
+def test_the_tangent_flow_refuses_friction_and_orbits_take_differences() -> None:
+    system, amplitude = _den_hartog(0.8, 0.2)
+    system = system.replace(solver=vi.Solver(t_end=1.0, method="exact"))
+    with pytest.raises(ValueError, match="stick-slip") as error:
+        an.orbit(system, jacobian="tangent")
+    assert "\n" not in str(error.value)
+    # "auto" takes finite differences: Den Hartog's orbit is found from rest.
+    found = an.orbit(system)
+    assert found.converged and found.stable
+    assert found.amplitude[0] == pytest.approx(amplitude, rel=1e-7)
+    back = an.runner(system).map(found.state, 1)
+    assert np.allclose(back, found.state, rtol=0, atol=1e-9)
+
+
+@pytest.mark.timeout(30)
+def test_a_system_with_friction_round_trips_through_toml() -> None:
+    system = vi.System.from_dict(HorizontalDamper().toml_sections())
+    system = system.replace(frictions=[vi.Friction(at=0, coefficient=0.1, normal_force=2.0)])
+    text = system.to_toml()
+    assert "[[friction]]" in text and "static_friction = 0.3" in text
+    assert vi.load(text) == system
+
+
+@pytest.mark.timeout(60)
+def test_a_study_varies_a_damper_s_friction(tmp_path: Path) -> None:
+    from vibroimpact.study import run
+
+    data = HorizontalDamper().toml_sections()
+    data["solver"] = {"t_end": 0.5, "method": "exact"}
+    data["study"] = {
+        "axes": {"damper.0.friction": [0.05, 0.25]},
+        "metrics": ["impacts"],
+    }
+    result = run(vi.study_of(data), tmp_path / "friction.nc")
+    impacts = result["impacts"].values
+    assert result["damper.0.friction"].values.tolist() == [0.05, 0.25]
+    for value, count in zip([0.05, 0.25], impacts, strict=True):
+        one = {k: v for k, v in data.items() if k != "study"}
+        one["damper"] = [one["damper"][0] | {"friction": value, "static_friction": 0.3}]
+        alone = vi.simulate(vi.System.from_dict(one))
+        assert count == int((alone.contacts.to_pandas().kind == "impact").sum())
