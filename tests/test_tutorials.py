@@ -44,6 +44,7 @@ def test_every_tutorial_is_tested_here() -> None:
         "monte_carlo_random",
         "dask_study",
         "colliding_masses",
+        "friction",
     }
     assert names == tested and (TUTORIALS / "README.rst").is_file()
 
@@ -406,3 +407,29 @@ def test_colliding_masses_obey_newton_s_law_and_a_row_is_not_a_cradle() -> None:
         assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
         losses = float(np.sum(sol.contacts.energy_dissipated))
         assert energy["contact"] == pytest.approx(losses, rel=1e-6)
+
+
+def test_friction_tutorial_decays_as_the_closed_form_and_follows_scipy() -> None:
+    from friction_reference import HorizontalDamper
+    from friction_reference import simulate as scipy_simulate
+
+    ns = tutorial("friction")
+    turning, decay = ns["turning"], ns["decay"]
+    # The closed form written afresh: each half cycle loses 2 F / k, then rest in the band.
+    slide, band, x = 0.3 * 10.0 / 800.0, 0.4 * 10.0 / 800.0, 0.0513
+    expected = [x]
+    while abs(x) > band:
+        x = -(x - 2 * slide * math.copysign(1.0, x))
+        expected.append(x)
+    assert turning == pytest.approx(expected, abs=1e-15)
+    assert decay.final_state["structure_displacement"][0] == pytest.approx(x, abs=1e-12)
+    assert decay.energy["friction"] == pytest.approx(0.5 * 800.0 * (0.0513**2 - x**2), rel=1e-9)
+    # The horizontal damper against scipy's event-driven stick-slip (the same system).
+    reference, _ = scipy_simulate(HorizontalDamper(), 2.0, max_step=2e-5)
+    f = ns["response"].final_state
+    ours = [f["structure_displacement"][0], f["damper_displacement"][0]]
+    assert ours == pytest.approx(reference[:2], abs=1e-6)
+    energy = ns["energy"]
+    assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
+    stuck = ns["table"][ns["table"].pair == "damper 0 friction"]
+    assert len(stuck) > 0 and (stuck.kind == "sticking").all()

@@ -195,7 +195,7 @@ def _frequency_response(ax: Any, parameter: str, points: list[SweepPoint], data:
         return float(shown_values(p, shown)[0][0])
 
     grid, linear = _linear_curve(parameter, points, data, shown)
-    ax.plot(grid, linear, "k--", lw=1, label="without dampers and stops (linear)")
+    ax.plot(grid, linear, "k--", lw=1, label="without dampers, stops and friction (linear)")
     for direction, marker in (("up", "^"), ("down", "v")):
         chosen = [p for p in points if p.direction == direction]
         if chosen:
