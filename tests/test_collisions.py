@@ -416,3 +416,41 @@ def test_the_column_s_natural_modes_and_notebook_view_take_its_collisions() -> N
     assert modes.frequencies[0] == pytest.approx(expected, rel=1e-12)
     html = system._repr_html_()
     assert "collision 3" in html
+
+
+@pytest.mark.timeout(120)
+def test_damped_linear_contacts_of_a_chain_on_the_exact_flow_match_dop853() -> None:
+    # Three particles whose damped linear contacts touch two at a time: the chain then
+    # moves as one body, a mode with no stiffness whose damping is round-off (it had
+    # been taken as damping, and its constant force's response F t / c lost every
+    # digit: the exact flow was 1e-2 of the input work off its ledger).
+    count = 3
+    law = {"law": "linear", "stiffness": 2e5, "damping": 5.0}
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
+        dampers=[
+            vi.Damper(
+                mass=0.01,
+                at=0,
+                lower_clearance=0.002 if j == 0 else math.inf,
+                upper_clearance=0.03 if j == count - 1 else math.inf,
+                **law,
+            )
+            for j in range(count)
+        ],
+        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(count - 1)],
+        gravity=vi.Gravity(acceleration=9.81),
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
+    )
+    exact = vi.simulate(system, method="exact", t_end=1.0, history=False)
+    reference = vi.simulate(
+        system, method="dop853", t_end=1.0, history=False, rtol=1e-13, atol=1e-16
+    )
+    energy = exact.energy
+    assert abs(energy["residual"]) < 1e-10 * energy["input_work"]
+    assert np.allclose(
+        exact.final_state["damper_displacement"],
+        reference.final_state["damper_displacement"],
+        rtol=0,
+        atol=1e-7,
+    )

@@ -310,3 +310,154 @@ def test_a_study_varies_a_damper_s_friction(tmp_path: Path) -> None:
         one["damper"] = [one["damper"][0] | {"friction": value, "static_friction": 0.3}]
         alone = vi.simulate(vi.System.from_dict(one))
         assert count == int((alone.contacts.to_pandas().kind == "impact").sum())
+
+
+def _stick_slip_reference(t_end: float) -> float:
+    """scipy's event-driven integration of ``x'' + 100 x + F sgn(x') = 1.2 sin(2 pi t)``
+    (1 kg; 0.9 N sliding, 1 N static), stuck from rest until the spring and force pass
+    1 N: the displacement at ``t_end``."""
+    from scipy.integrate import solve_ivp
+
+    k, kinetic, held, omega = 100.0, 0.9, 1.0, 2 * math.pi
+
+    def load(t: float, x: float) -> float:
+        return 1.2 * math.sin(omega * t) - k * x
+
+    def slide(t, y, s):
+        return [y[1], load(t, y[0]) - s * kinetic]
+
+    def stopped(t, y, s):
+        return y[1]
+
+    def slips(t, y):
+        return held - abs(load(t, y[0]))
+
+    stopped.terminal = slips.terminal = True
+    slips.direction = -1
+    t, y, mode = 0.0, [0.0, 0.0], ("stuck", 0.0)
+    while t < t_end:
+        kind, s = mode
+        if kind == "stuck":
+            sol = solve_ivp(
+                lambda t, y: [0.0, 0.0],
+                (t, t_end),
+                y,
+                events=slips,
+                rtol=1e-12,
+                atol=1e-15,
+                max_step=1e-3,
+            )
+        else:
+            stopped.direction = -s
+            sol = solve_ivp(
+                slide,
+                (t, t_end),
+                y,
+                args=(s,),
+                events=stopped,
+                rtol=1e-12,
+                atol=1e-15,
+                max_step=1e-3,
+            )
+        if sol.status != 1:
+            return float(sol.y[0, -1])
+        t = float(sol.t_events[0][0])
+        y = [float(sol.y_events[0][0][0]), 0.0]
+        force = load(t, y[0])
+        if kind == "slide" and abs(force) <= held:
+            mode = ("stuck", 0.0)
+        else:
+            # Slipping (or sliding back): along the net force; a few ulps of speed
+            # that way, so that solve_ivp does not find its stop at the start.
+            s = math.copysign(1.0, force)
+            y[1] = s * 1e-15
+            mode = ("slide", s)
+    return float(y[0])
+
+
+@pytest.mark.parametrize("method", METHODS + ["generalized-alpha"])
+@pytest.mark.timeout(60)
+def test_a_forced_oscillator_sticks_and_slips_as_scipy_integrates_it(method: str) -> None:
+    # Stuck from rest, it slips where the force passes the static 1 N (t = 0.157 s) and
+    # sticks again within the period: every method locates both (an adaptive step
+    # stays short while stuck, as a slip shows only at a step's end).
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=100.0, damping=0.0),
+        frictions=[vi.Friction(at=0, coefficient=0.9, static_coefficient=1.0, normal_force=1.0)],
+        excitations=[
+            vi.Force(at=0, signal=vi.Harmonic(amplitude=1.2, frequency=1.0, phase=-math.pi / 2))
+        ],
+    )
+    step = {"dt": 1e-4} if method in ("newmark-implicit", "generalized-alpha") else {}
+    sol = vi.simulate(system, method=method, t_end=3.0, history=False, **step)
+    expected = _stick_slip_reference(3.0)
+    tolerance = 1e-9 if method in ("exact", "dop853") else 1e-6
+    assert sol.final_state["structure_displacement"][0] == pytest.approx(expected, abs=tolerance)
+    stuck = sol.contacts.to_pandas()
+    assert len(stuck) >= 3 and (stuck.duration.dropna() > 1e-3).all()
+    assert sol.energy["friction"] > 0.05
+
+
+@pytest.mark.timeout(30)
+def test_two_pads_on_one_row_act_as_one_with_their_forces_summed() -> None:
+    def decay(pads: list[vi.Friction]) -> vi.SystemSolution:
+        system = vi.System(
+            structure=vi.Oscillator(mass=2.0, stiffness=800.0, damping=0.0),
+            frictions=pads,
+            initial=vi.Initial(structure_displacement=[0.0165]),
+        )
+        return vi.simulate(system, method="exact", t_end=1.0, history=False)
+
+    two = decay(
+        [
+            vi.Friction(at=0, coefficient=0.3, static_coefficient=0.4, normal_force=10.0),
+            vi.Friction(at=0, coefficient=0.1, static_coefficient=0.2, normal_force=10.0),
+        ]
+    )
+    one = decay([vi.Friction(at=0, coefficient=0.4, static_coefficient=0.6, normal_force=10.0)])
+    x = two.final_state["structure_displacement"][0]
+    assert x == pytest.approx(one.final_state["structure_displacement"][0], abs=1e-15)
+    # The closed form: one half cycle about 5 mm loses 10 mm, then 6 N holds it.
+    assert x == pytest.approx(-0.0065, abs=1e-14)
+
+
+@pytest.mark.timeout(60)
+def test_a_cantilever_rubbing_at_its_tip_on_the_exact_flow_and_dop853() -> None:
+    # A stop that is never reached must not change the exact flow's stuck
+    # configurations (each is made again where the element sticks).
+    data = {
+        "structure": {
+            "kind": "cantilever",
+            "length": 0.5,
+            "youngs_modulus": 7e10,
+            "second_moment": 1e-10,
+            "mass_per_length": 0.27,
+            "modes": 3,
+            "damping_ratio": 0.01,
+        },
+        "excitation": [
+            {"kind": "force", "at": 0.5, "signal": "harmonic", "amplitude": 2.0, "frequency": 8.0}
+        ],
+        "friction": [
+            {"at": 0.5, "coefficient": 0.3, "static_coefficient": 0.4, "normal_force": 1.0}
+        ],
+    }
+    far = data | {
+        "stop": [{"at": 0.5, "side": "lower", "gap": 1.0, "law": "rigid", "restitution": 0.5}]
+    }
+    tips = []
+    for sections, method in ((data, "exact"), (far, "exact"), (data, "dop853")):
+        tight = {"rtol": 1e-12, "atol": 1e-15} if method == "dop853" else {}
+        sol = vi.simulate(
+            vi.System.from_dict(sections),
+            method=method,
+            t_end=0.9,
+            history=False,
+            points=[0.5],
+            **tight,
+        )
+        energy = sol.energy
+        assert abs(energy["residual"]) < 1e-9 * energy["input_work"]
+        tips.append(sol.final_state["structure_displacement"])
+    assert np.allclose(tips[0], tips[1], rtol=0, atol=1e-14)
+    assert np.allclose(tips[0], tips[2], rtol=0, atol=1e-9)

@@ -442,6 +442,10 @@ def _check_friction(where: str, d: dict[str, Any], keys: tuple[str, str, str]) -
         raise _fail(where, f"{normal} is required with {kinetic} (N: the weight, or a preload)")
     if not (d[normal] >= 0 and math.isfinite(d[normal])):
         raise _fail(where, f"{normal} must be a finite number >= 0 N, got {d[normal]}")
+    if not math.isfinite(d[held] * d[normal]):
+        raise _fail(
+            where, f"{held} times {normal} must be a finite force (N), got {d[held] * d[normal]}"
+        )
 
 
 def _frictions(tables: list[Any], structure: dict[str, Any]) -> list[dict[str, Any]]:

@@ -31,7 +31,9 @@ impl Run<'_> {
     pub(super) fn settle_friction(&mut self, time: f64) {
         let system = self.system;
         for i in 0..self.modes.len() {
-            if !system.interactions[i].law.is_friction() {
+            // One switched at this event (a slip located where its holding force
+            // passes the static force) keeps what the switch chose.
+            if !system.interactions[i].law.is_friction() || self.just_switched[i] {
                 continue;
             }
             let rate = system.gap(i, &self.y).1;

@@ -191,7 +191,7 @@ impl<'a> Run<'a> {
                 }
             }
         }
-        if modes.contains(&Mode::Sticking) {
+        if modes.iter().any(Mode::is_held) {
             // A sticking pair's release shows only as its constraint force
             // at a step's end: steps short enough not to pass over it.
             length = length.min(system.sticking_step);

@@ -31,7 +31,14 @@ pub(super) fn fits(m: &Modes, modes: &[Mode]) -> bool {
         .iter()
         .zip(modes)
         .all(|(s, mode)| *s == state_of(mode))
-        && (m.offsets.is_empty() || offsets_of(modes) == m.offsets)
+        && (m.offsets.is_empty()
+            || m.offsets.iter().zip(modes).all(|(kept, mode)| match mode {
+                Mode::Stuck {
+                    offset,
+                    shadowed: false,
+                } => kept.to_bits() == offset.to_bits(),
+                _ => true,
+            }))
 }
 
 #[inline(always)]
@@ -269,6 +276,8 @@ impl ExactFlow {
                 match stale {
                     Some(index) => {
                         self.modes[index] = made;
+                        // The flow begun there was the old configuration's.
+                        self.begun = None;
                         index
                     }
                     None => {

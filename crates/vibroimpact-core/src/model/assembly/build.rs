@@ -472,8 +472,31 @@ impl Walls {
                      got {held}"
                 )));
             }
-            if kinetic * normal == 0.0 && held * normal == 0.0 {
+            let (kinetic_force, static_force) = (kinetic * normal, held * normal);
+            if !(kinetic_force.is_finite() && static_force.is_finite()) {
+                return Err(Error::Inconsistent(format!(
+                    "{name}: its friction force (coefficient times normal_force) must be \
+                     finite, got {static_force} N"
+                )));
+            }
+            if static_force == 0.0 {
                 continue; // no force: no element
+            }
+            // Pads on one row (the same points, either way round) act as one:
+            // their forces add (two constraints on one row would be one).
+            if let Some(same) = self.interactions.iter_mut().find(|it| {
+                it.law.is_friction()
+                    && (it.h == h || it.h.iter().zip(&h).all(|(a, b)| *a == -*b))
+            }) {
+                if let InteractionLaw::Friction {
+                    kinetic_force: k,
+                    static_force: s,
+                } = &mut same.law
+                {
+                    *k += kinetic_force;
+                    *s += static_force;
+                }
+                continue;
             }
             let pair = self.pair(name);
             self.wall(
@@ -481,8 +504,8 @@ impl Walls {
                 h,
                 0.0,
                 InteractionLaw::Friction {
-                    kinetic_force: kinetic * normal,
-                    static_force: held * normal,
+                    kinetic_force,
+                    static_force,
                 },
             );
         }
