@@ -264,11 +264,16 @@ def test_a_bad_collision_is_refused_naming_its_key(collision: dict[str, Any], me
 
 
 @pytest.mark.timeout(30)
-def test_a_damper_with_no_wall_needs_a_collision_to_hold_it() -> None:
+def test_a_damper_with_no_wall_needs_a_collision_or_friction_to_hold_it() -> None:
     data = vi.load(COLUMN).to_dict()
     data["collision"] = data["collision"][:1]  # particles 2 and 3 now held by nothing
-    with pytest.raises(ValueError, match=r"\[\[damper\]\] 2: .*no \[\[collision\]\] holds it"):
+    held = r"\[\[damper\]\] 2: .*neither a \[\[collision\]\] nor friction holds it"
+    with pytest.raises(ValueError, match=held):
         an.runner(data)
+    # Friction on its carrier holds it (a mass sliding on a floor with no side walls).
+    for j in (2, 3):
+        data["damper"][j] |= {"friction": 0.2, "normal_force": 0.1}
+    an.runner(data)
 
 
 def still_table(g: float) -> tuple[vi.Oscillator, float]:

@@ -535,6 +535,7 @@ class _Unchecked:
         self.dampers = tuple(parts.get("dampers", ()))
         self.stops: tuple[Any, ...] = ()
         self.collisions = tuple(parts.get("collisions", ()))
+        self.frictions = tuple(parts.get("frictions", ()))
         self.excitations = tuple(parts.get("excitations", ()))
         self.gravity = parts.get("gravity")
         self.initial = parts.get("initial")

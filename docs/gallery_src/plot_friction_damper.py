@@ -39,8 +39,11 @@ for normal in (0.0, 10.0, 20.0, 40.0):  # N
         settle_periods=spec["settle_periods"],
         record_periods=spec["record_periods"],
     )
-    line, = ax.plot([p.value for p in points], [p.amplitude[0] * 1e3 for p in points],
-                    label=f"pressed with {normal:.0f} N")
+    (line,) = ax.plot(
+        [p.value for p in points],
+        [p.amplitude[0] * 1e3 for p in points],
+        label=f"pressed with {normal:.0f} N",
+    )
     # Den Hartog: (P / k) sqrt(V^2 - (F / P)^2 U^2), beta = f / f_n.
     slide = pad.coefficient * normal
     beta = 2 * math.pi * frequencies / math.sqrt(k / m)

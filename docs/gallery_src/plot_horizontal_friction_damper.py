@@ -37,18 +37,21 @@ for label, model, marker in (("with friction", system, "o-"), ("without", fricti
         settle_periods=spec["settle_periods"],
         record_periods=spec["record_periods"],
     )
-    ax.plot([p.value for p in points], [p.amplitude[0] * 1e3 for p in points], marker,
-            ms=3, label=label)
-ax.plot(frequencies, [p.linear_amplitude[0] * 1e3 for p in points], "k:", lw=1,
-        label="structure alone")
+    ax.plot(
+        [p.value for p in points], [p.amplitude[0] * 1e3 for p in points], marker, ms=3, label=label
+    )
+ax.plot(
+    frequencies, [p.linear_amplitude[0] * 1e3 for p in points], "k:", lw=1, label="structure alone"
+)
 ax.set_xlabel("forcing frequency (Hz)")
 ax.set_ylabel("amplitude (mm)")
 ax.legend()
 
 # Where the energy goes at resonance, over 100 periods.
 at_resonance = system.replace(
-    excitations=[dataclasses.replace(system.excitations[0],
-                                     signal=vi.Harmonic(amplitude=5.0, frequency=9.6))]
+    excitations=[
+        dataclasses.replace(system.excitations[0], signal=vi.Harmonic(amplitude=5.0, frequency=9.6))
+    ]
 )
 energy = vi.simulate(at_resonance, t_end=100 / 9.6, history=False).energy
 for key in ("viscous", "impact", "friction"):

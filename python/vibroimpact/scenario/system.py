@@ -233,8 +233,13 @@ def system_lines(
         f"{name}: {sol.method}, {sol.steps} steps ({sol.rejected_steps} rejected, "
         f"{sol.rhs_evaluations} force evaluations) to t = {sol.final_time:g} s in "
         f"{cpu_time * 1e3:.3f} ms",
-        "energy (J): stored {:.6g} -> {:.6g}, input work {:.6g}, dissipated {:.6g} (viscous "
-        "{:.6g}, contact {:.6g}, impacts {:.6g}), residual {:.3g}".format(
+        (
+            "energy (J): stored {:.6g} -> {:.6g}, input work {:.6g}, dissipated {:.6g} (viscous "
+            "{:.6g}, contact {:.6g}, impacts {:.6g}"
+            # Dry friction's loss where there is one (a frictionless run's line as it was).
+            + (f", friction {e['friction']:.6g}" if e.get("friction") else "")
+            + "), residual {:.3g}"
+        ).format(
             *(
                 e[key] + 0.0
                 for key in (

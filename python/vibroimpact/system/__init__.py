@@ -4,6 +4,7 @@ a run (:mod:`.solution`) and the runs themselves (:mod:`.run`). SI units through
 the sections are described in :mod:`vibroimpact.system.schema`.
 """
 
+from vibroimpact.system.linear import linear_parts
 from vibroimpact.system.run import PreparedRun, prepare_system, simulate_system
 from vibroimpact.system.schema import (
     _DAMPER,
@@ -28,7 +29,6 @@ from vibroimpact.system.schema import (
     _table,
     _unknown_key,
     default_stepping,
-    linear_parts,
     moment_weights,
     point_weights,
     split_observed,

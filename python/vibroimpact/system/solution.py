@@ -100,7 +100,8 @@ class SystemSolution:
     History arrays have one row per kept step: ``structure_displacement`` (m, rows
     x n), ``structure_velocity``, ``damper_displacement`` (rows x k),
     ``damper_velocity``; all relative to the base. ``energy`` (J): ``input_work``,
-    ``dissipated`` (``viscous`` + ``contact`` + ``impact``), ``stored_start``,
+    ``dissipated`` (``viscous`` + ``contact`` + ``friction`` + ``impact``: dry friction's
+    sliding loss in ``friction``), ``stored_start``,
     ``stored_end`` and ``residual`` = stored_end - stored_start - input_work +
     dissipated (numerical error; checked against ``energy_tolerance``).
     """

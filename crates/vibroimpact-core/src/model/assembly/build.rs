@@ -485,8 +485,7 @@ impl Walls {
             // Pads on one row (the same points, either way round) act as one:
             // their forces add (two constraints on one row would be one).
             if let Some(same) = self.interactions.iter_mut().find(|it| {
-                it.law.is_friction()
-                    && (it.h == h || it.h.iter().zip(&h).all(|(a, b)| *a == -*b))
+                it.law.is_friction() && (it.h == h || it.h.iter().zip(&h).all(|(a, b)| *a == -*b))
             }) {
                 if let InteractionLaw::Friction {
                     kinetic_force: k,
