@@ -233,6 +233,14 @@ def test_a_study_varies_a_collision_s_gap(tmp_path: Path) -> None:
         "metrics": ["impacts"],
     }
     result = run(vi.study_of(data), tmp_path / "gap.nc")
+
+    # The scenario kept with the result is strict JSON: its infinite clearances are
+    # written as TOML writes them, not as JSON's non-standard Infinity.
+    def refuse(constant: str) -> None:
+        raise ValueError(f"not strict JSON: {constant}")
+
+    kept = json.loads(result.attrs["scenario"], parse_constant=refuse)
+    assert kept["damper"][2]["lower_clearance"] == "inf"
     impacts = result["impacts"].values
     assert result["collision.0.gap"].values.tolist() == [0.001, 0.003]
     assert impacts.shape == (2,) and impacts[0] != impacts[1]

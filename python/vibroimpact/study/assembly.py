@@ -4,6 +4,7 @@ the metrics as variables with their units, ``status`` and the reasons of failed 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -160,9 +161,24 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
         attrs={
             "title": f"vibroimpact study of {study.source}",
             "vibroimpact_version": __version__,
-            "scenario": json.dumps(_plain(study.data), sort_keys=True, default=str),
+            "scenario": json.dumps(
+                _finite(_plain(study.data)), sort_keys=True, default=str, allow_nan=False
+            ),
             "input_hash": study.fingerprint(),
             "analysis": study.settings["analysis"],
             "reasons": json.dumps(reasons),
         },
     )
+
+
+def _finite(value: Any) -> Any:
+    """``value`` with each non-finite number written as TOML writes it (``"inf"``,
+    ``"-inf"``, ``"nan"``): strict JSON has none (an infinite clearance had been written
+    ``Infinity``, which strict readers refuse)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite(v) for v in value]
+    return value
