@@ -8,8 +8,9 @@
 
 use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactKind, Open};
+use crate::kernel::locate::constraint_force;
 use crate::kernel::run::Run;
-use crate::model::assembly::{h_dot, Mode};
+use crate::model::assembly::{h_dot, same_row, Mode};
 
 impl Run<'_> {
     /// Friction element `i` at its own event at `time`: a sliding one came
@@ -69,30 +70,23 @@ impl Run<'_> {
     fn shadowed(&self, i: usize) -> bool {
         let system = self.system;
         let h = &system.interactions[i].h;
-        let own = h_dot(h, h);
         system
             .interactions
             .iter()
             .zip(&self.modes)
-            .any(|(it, mode)| {
-                let along = h_dot(h, &it.h);
-                *mode == Mode::Sticking
-                    && along * along >= (1.0 - 1e-12) * own * h_dot(&it.h, &it.h)
-            })
+            .any(|(it, mode)| *mode == Mode::Sticking && same_row(h, &it.h))
     }
 
     /// The force that holds friction element `i` stuck at `time` (N, along
     /// its row), in the modes as they are.
     fn holding_force(&mut self, i: usize, time: f64) -> f64 {
-        let system = self.system;
-        system.rates(
-            time,
-            &self.y,
-            &self.modes,
+        constraint_force(
+            self.system,
+            i,
+            (time, &self.y, &self.modes),
             &mut self.scratch,
             &mut self.buffers.work,
-        );
-        self.scratch.force_of(i).unwrap_or(0.0)
+        )
     }
 
     /// Friction element `i`, at rest to round-off: stuck at its place (its

@@ -29,16 +29,28 @@ pub(super) fn event_value(
         Mode::Open => system.gap(i, y).0,
         Mode::Compliant { .. } => -system.gap(i, y).0,
         Mode::Sticking => {
-            system.rates(time, y, modes, scratch, work);
-            scratch.force_of(i).unwrap_or(0.0) + system.friction_hold[i]
+            constraint_force(system, i, (time, y, modes), scratch, work) + system.friction_hold[i]
         }
         Mode::Sliding { direction } => direction * system.gap(i, y).1,
         Mode::Stuck { .. } => {
-            system.rates(time, y, modes, scratch, work);
-            let held = scratch.force_of(i).unwrap_or(0.0).abs();
+            let held = constraint_force(system, i, (time, y, modes), scratch, work).abs();
             system.static_force(i) - held
         }
     }
+}
+
+/// The force that holds interaction `i` (a sticking pair or a stuck friction
+/// element, along its row) at `time` and state `y` in `modes`, N; 0 where
+/// it is not held.
+pub(super) fn constraint_force(
+    system: &Assembly,
+    i: usize,
+    (time, y, modes): (f64, &[f64], &[Mode]),
+    scratch: &mut Scratch,
+    work: &mut [f64],
+) -> f64 {
+    system.rates(time, y, modes, scratch, work);
+    scratch.force_of(i).unwrap_or(0.0)
 }
 
 /// Whether interaction `i`, whose event value at state `y` is `v`, is at its

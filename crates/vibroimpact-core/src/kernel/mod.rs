@@ -1,6 +1,7 @@
 pub(crate) mod balance;
 pub(crate) mod clock;
 pub(crate) mod compact;
+mod complementarity;
 pub mod contact_balance;
 pub(crate) mod contacts;
 pub mod events;

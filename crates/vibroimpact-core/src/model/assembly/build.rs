@@ -3,7 +3,7 @@
 //! loads, the time scales and the followed points; every input checked.
 
 use super::spec::{FrictionSite, Load, PairLaw, Side, SystemSpec, MAX_PAIRS, MAX_POINTS};
-use super::{Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw};
+use super::{same_row, Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw};
 use crate::error::{non_negative, positive, Error, Result};
 use crate::kernel::compact::Compact;
 use crate::model::signals::Signal;
@@ -100,10 +100,6 @@ impl Assembly {
 /// Each rigid wall's friction hold (see [`Assembly::friction_hold`]): the
 /// static force of the friction element whose row is the wall's, either sign.
 fn friction_holds(interactions: &[Interaction]) -> Vec<f64> {
-    let parallel = |a: &[f64], b: &[f64]| {
-        let along = linalg::dot(a, b);
-        along * along >= (1.0 - 1e-12) * linalg::dot(a, a) * linalg::dot(b, b)
-    };
     interactions
         .iter()
         .map(|wall| {
@@ -112,7 +108,7 @@ fn friction_holds(interactions: &[Interaction]) -> Vec<f64> {
             }
             interactions
                 .iter()
-                .filter(|f| parallel(&f.h, &wall.h))
+                .filter(|f| same_row(&f.h, &wall.h))
                 .map(|f| match f.law {
                     InteractionLaw::Friction { static_force, .. } => static_force,
                     _ => 0.0,

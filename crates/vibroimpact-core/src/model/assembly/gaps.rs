@@ -168,6 +168,13 @@ fn dots(h: &[f64], x: &[f64], v: &[f64]) -> (f64, f64) {
 /// stage's contact force waits on it). The gaps that the events watch are
 /// summed in order ([`dots`]); the two differ in the last bits at most, and
 /// every path sums each quantity the same way (the same bits).
+/// Whether the rows `a` and `b` hold the same relative coordinate (either
+/// sign, to 1e-12): a wall and a friction element on one damper's axis.
+pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
+    let along = linalg::dot(a, b);
+    along * along >= (1.0 - 1e-12) * linalg::dot(a, a) * linalg::dot(b, b)
+}
+
 #[inline(always)]
 pub(crate) fn h_dot(h: &[f64], x: &[f64]) -> f64 {
     let n = h.len();

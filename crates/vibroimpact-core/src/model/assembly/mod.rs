@@ -21,7 +21,7 @@ mod scratch;
 mod spec;
 mod state;
 
-pub(crate) use gaps::h_dot;
+pub(crate) use gaps::{h_dot, same_row};
 pub use linear::{HarmonicLoad, LinearParts};
 pub(crate) use rates::{apart_damping, elastic};
 pub use scratch::Scratch;
