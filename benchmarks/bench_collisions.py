@@ -20,33 +20,22 @@ per second.
 from __future__ import annotations
 
 import argparse
-import math
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import vibroimpact as vi
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from test_collisions import forced_column  # noqa: E402
 
 T_END = 20.0
 
 
 def column(count: int, restitution: float) -> vi.System:
-    law = {"law": "rigid", "restitution": restitution}
-    return vi.System(
-        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
-        dampers=[
-            vi.Damper(
-                mass=0.01,
-                at=0,
-                lower_clearance=0.002 if j == 0 else math.inf,
-                upper_clearance=0.03 if j == count - 1 else math.inf,
-                **law,
-            )
-            for j in range(count)
-        ],
-        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(count - 1)],
-        gravity=vi.Gravity(acceleration=9.81),
-        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
-    )
+    """The test suite's forced column, every pair rigid at ``restitution``."""
+    return forced_column(count, {"law": "rigid", "restitution": restitution})
 
 
 def events_per_second(system: vi.System, method: str, repeats: int) -> tuple[float, int, float]:

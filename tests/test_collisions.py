@@ -23,6 +23,30 @@ COLUMN = ROOT / "examples" / "particle_column.toml"
 FREE = {"lower_clearance": math.inf, "upper_clearance": math.inf}
 
 
+def forced_column(count: int, law: dict[str, Any]) -> vi.System:
+    """``count`` 10 g particles stacked 2 mm apart in the cavity of
+    examples/particle_column.toml (a 1 kg, 15 Hz, 5 % damped structure forced with
+    30 N at 10 Hz, under gravity): the lowest 2 mm above the floor, the highest 30 mm
+    below the ceiling, each pair of neighbours a ``[[collision]]``, all of ``law``
+    (also the column of benchmarks/bench_collisions.py)."""
+    return vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
+        dampers=[
+            vi.Damper(
+                mass=0.01,
+                at=0,
+                lower_clearance=0.002 if j == 0 else math.inf,
+                upper_clearance=0.03 if j == count - 1 else math.inf,
+                **law,
+            )
+            for j in range(count)
+        ],
+        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(count - 1)],
+        gravity=vi.Gravity(acceleration=9.81),
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
+    )
+
+
 def _masses(masses: list[float], law: dict[str, Any], gaps: list[float], v0: float) -> vi.System:
     """Loose masses in a row on a still carrier (no wall within reach: the first has a
     floor 1 m below, the last a ceiling 1 m above), each striking the next across
@@ -346,22 +370,7 @@ def test_a_forced_rigid_column_of_ten_runs_with_its_ledger_closed(restitution: f
     # goes on; the impacts' losses are the ledger's.
     count = 10
     law = {"law": "rigid", "restitution": restitution}
-    system = vi.System(
-        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
-        dampers=[
-            vi.Damper(
-                mass=0.01,
-                at=0,
-                lower_clearance=0.002 if j == 0 else math.inf,
-                upper_clearance=0.03 if j == count - 1 else math.inf,
-                **law,
-            )
-            for j in range(count)
-        ],
-        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(count - 1)],
-        gravity=vi.Gravity(acceleration=9.81),
-        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
-    )
+    system = forced_column(count, law)
     for method in ("exact", "dop853"):
         sol = vi.simulate(system, method=method, t_end=5.0, history=False)
         energy = sol.energy
@@ -439,22 +448,7 @@ def test_damped_linear_contacts_of_a_chain_on_the_exact_flow_match_dop853() -> N
     # digit: the exact flow was 1e-2 of the input work off its ledger).
     count = 3
     law = {"law": "linear", "stiffness": 2e5, "damping": 5.0}
-    system = vi.System(
-        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
-        dampers=[
-            vi.Damper(
-                mass=0.01,
-                at=0,
-                lower_clearance=0.002 if j == 0 else math.inf,
-                upper_clearance=0.03 if j == count - 1 else math.inf,
-                **law,
-            )
-            for j in range(count)
-        ],
-        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(count - 1)],
-        gravity=vi.Gravity(acceleration=9.81),
-        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
-    )
+    system = forced_column(count, law)
     exact = vi.simulate(system, method="exact", t_end=1.0, history=False)
     reference = vi.simulate(
         system, method="dop853", t_end=1.0, history=False, rtol=1e-13, atol=1e-16
