@@ -295,6 +295,20 @@ def test_a_bad_collision_is_refused_naming_its_key(collision: dict[str, Any], me
     assert "[[collision]] 0" in str(error.value) and "\n" not in str(error.value)
 
 
+@pytest.mark.parametrize("clearance", [-math.inf, math.nan, "-inf"])
+@pytest.mark.timeout(30)
+def test_a_side_s_clearance_is_a_number_or_inf_only(clearance: Any) -> None:
+    """inf means no wall on that side; -inf and nan are refused saying what is allowed."""
+    data = vi.load(COLUMN).to_dict()
+    data["damper"][0]["lower_clearance"] = clearance
+    with pytest.raises(ValueError) as error:
+        an.runner(data)
+    message = str(error.value)
+    assert "[[damper]] 0" in message and "lower_clearance" in message and "\n" not in message
+    allowed = "must be a number" if isinstance(clearance, str) else ">= 0 m, or inf for no wall"
+    assert allowed in message
+
+
 @pytest.mark.timeout(30)
 def test_a_damper_with_no_wall_needs_a_collision_or_friction_to_hold_it() -> None:
     data = vi.load(COLUMN).to_dict()

@@ -268,19 +268,99 @@ def _den_hartog(beta: float, F: float) -> tuple[vi.System, float]:
     return system, P / k * math.sqrt(V**2 - (F / P) ** 2 * U**2)
 
 
+def _stick_slip_oscillator() -> vi.System:
+    """A forced oscillator (1 kg, 100 N/m, 0.5 N s/m; 4 N at 0.8 Hz) on a friction
+    element (kinetic 1 N, static 1.6 N) that sticks once a cycle and slips again."""
+    return vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=100.0, damping=0.5),
+        frictions=[vi.Friction(at=0, coefficient=1.0, static_coefficient=1.6, normal_force=1.0)],
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=4.0, frequency=0.8))],
+        initial=vi.Initial(structure_velocity=[1e-3]),
+        solver=vi.Solver(t_end=1.0, method="exact"),
+    )
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("case", ["den-hartog", "stick-slip"])
+def test_orbits_through_stick_slip_take_the_tangent_flow_as_differences_agree(case: str) -> None:
+    """The orbit's monodromy by the tangent flow (saltations at each stop, stick and
+    slip) equals central differences of whole runs; Den Hartog's orbit (sliding
+    throughout) has his amplitude; where the orbit sticks, the stick loses the
+    velocity: a Floquet multiplier is zero."""
+    if case == "den-hartog":
+        system, amplitude = _den_hartog(0.8, 0.2)
+        system = system.replace(solver=vi.Solver(t_end=1.0, method="exact"))
+    else:
+        system, amplitude = _stick_slip_oscillator(), None
+    tangent = an.orbit(system)
+    differences = an.orbit(system, tangent.state, jacobian="differences")
+    assert tangent.jacobian == "tangent" and tangent.converged and tangent.stable
+    assert differences.converged
+    assert np.allclose(differences.state, tangent.state, rtol=0, atol=1e-9)
+    # Scaled as the coordinates are (m, m/s: the velocity about 2 pi f the
+    # displacement's).
+    omega = 2 * math.pi * 0.8 if amplitude is None else 10.0
+    scale = np.diag([1.0, omega])
+    unscaled = np.linalg.inv(scale)
+    gap = scale @ (tangent.monodromy - differences.monodromy) @ unscaled
+    assert np.abs(gap).max() < 1e-6 * max(1.0, np.abs(scale @ tangent.monodromy @ unscaled).max())
+    if amplitude is not None:
+        assert tangent.amplitude[0] == pytest.approx(amplitude, rel=1e-7)
+        # Sliding throughout: no stick to lose a direction.
+        assert np.abs(tangent.floquet_multipliers).min() > 1e-3
+    else:
+        stuck = vi.simulate(system.replace(solver=vi.Solver(t_end=5.0, method="exact")))
+        assert (stuck.contacts.to_pandas()["kind"] == "sticking").sum() >= 3
+        assert np.abs(tangent.floquet_multipliers).min() < 1e-9
+
+
 @pytest.mark.timeout(60)
-def test_the_tangent_flow_refuses_friction_and_orbits_take_differences() -> None:
-    system, amplitude = _den_hartog(0.8, 0.2)
+def test_lyapunov_exponents_through_stick_slip_are_the_orbits_floquet_exponents() -> None:
+    """From a stable orbit the spectrum is its Floquet exponents, log|mu| / T: sliding
+    throughout (Den Hartog), their sum is log|det M| / T to round-off (the product of
+    whole periods' maps); sticking once a cycle, the stick loses a direction (minus
+    infinity) and the other tends to log|mu| / T (within 1/N of the N periods)."""
+    system, _ = _den_hartog(0.8, 0.2)
     system = system.replace(solver=vi.Solver(t_end=1.0, method="exact"))
-    with pytest.raises(ValueError, match="stick-slip") as error:
-        an.orbit(system, jacobian="tangent")
-    assert "\n" not in str(error.value)
-    # "auto" takes finite differences: Den Hartog's orbit is found from rest.
+    for case in (system, _stick_slip_oscillator()):
+        found = an.orbit(case)
+        period = an.runner(case).period
+        spectrum = an.lyapunov(case, found.state, settle=0, periods=500)
+        assert not spectrum.grazings
+        largest = np.log(np.abs(found.floquet_multipliers).max()) / period
+        if case is system:
+            total = np.log(abs(np.linalg.det(found.monodromy))) / period
+            assert spectrum.exponents.sum() == pytest.approx(total, rel=1e-9)
+        else:
+            assert spectrum.exponents[1] == -math.inf
+            assert spectrum.exponents[0] == pytest.approx(largest, rel=0.02)
+
+
+@pytest.mark.timeout(120)
+def test_a_stick_slip_orbit_s_derivatives_are_the_differences_of_its_neighbours() -> None:
+    """The orbit's derivatives by parameters (the tangent flow's columns through each
+    stop, stick and slip, then the implicit function theorem) against the central
+    differences of the orbits found at p +- 1e-4 p."""
+    system = _stick_slip_oscillator()
     found = an.orbit(system)
-    assert found.converged and found.stable
-    assert found.amplitude[0] == pytest.approx(amplitude, rel=1e-7)
-    back = an.runner(system).map(found.state, 1)
-    assert np.allclose(back, found.state, rtol=0, atol=1e-9)
+    assert found.converged
+    paths = {
+        "friction.0.static_coefficient": 1.6,
+        "friction.0.coefficient": 1.0,
+        "excitation.0.amplitude": 4.0,
+    }
+    derivatives = an.orbit_derivatives(system, found, list(paths))
+    data = system.to_dict()
+    for path, value in paths.items():
+        step = 1e-4 * value
+        states = []
+        for sign in (1.0, -1.0):
+            shifted = an.with_parameter(data, path, value + sign * step)
+            states.append(an.orbit(vi.System.from_dict(shifted), found.state).state)
+        difference = (states[0] - states[1]) / (2 * step)
+        # m and m/s per unit of the parameter, scaled as the orbit's own state.
+        scale = np.array([0.01, 0.05])
+        assert np.abs((derivatives[path].state - difference) / scale).max() < 1e-4, path
 
 
 @pytest.mark.timeout(30)

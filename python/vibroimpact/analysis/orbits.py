@@ -60,8 +60,8 @@ def orbit(
     matrix (exact through rigid impacts, to the method's accuracy through compliant
     contacts); ``"differences"``, central finite differences of
     whole runs (across impacts the saltation is in the differences); ``"auto"`` (the
-    default), the tangent flow where the system has it (differences with dry friction,
-    whose stick-slip the tangent flow does not yet pass through). At the orbit the Jacobian is
+    default), the tangent flow (through dry friction's stops, sticking and slips too, each
+    by its saltation). At the orbit the Jacobian is
     the monodromy matrix; its eigenvalues are the Floquet multipliers and the orbit is
     stable when all lie inside the unit circle. Newton steps that would start inside a
     wall are halved. ``run``: a :class:`Runner` or a :class:`~vibroimpact.System`."""
@@ -72,7 +72,7 @@ def orbit(
     max_iterations = whole_count("max_iterations", max_iterations, 1)
     jacobian = arguments.choice("jacobian", jacobian, ("auto", "tangent", "differences"))
     if jacobian == "auto":
-        jacobian = "differences" if run.has_friction else "tangent"
+        jacobian = "tangent"
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     shot = run.shoot(z, periods, tolerance, max_iterations, jacobian)
     size = len(z)

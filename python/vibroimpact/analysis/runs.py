@@ -101,13 +101,6 @@ class Runner:
         rms = np.sqrt(np.asarray(recorded["square_integrals"]) / recorded["recorded_time"])
         return split_observed(rms, self.n, len(self.points))
 
-    @property
-    def has_friction(self) -> bool:
-        """Whether the system has dry friction (the tangent flow does not yet pass
-        through stick-slip)."""
-        spec = self.prepared.spec
-        return bool(spec.get("friction")) or any(d.get("friction") for d in spec.get("damper", ()))
-
     def initial_state(self) -> np.ndarray:
         """The scenario's ``[initial]`` as a flat state ``(x, v)``."""
         n, k = self.n, self.k

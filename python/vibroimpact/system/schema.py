@@ -336,8 +336,12 @@ def _value(where: str, kind: str, value: Any) -> Any:
     if kind == _WHOLE and type(value) is int and 2 <= value < 2**63:  # above every low
         return value
     if kind == _WALL:
-        if real(value) == math.inf:
+        wall = real(value)
+        if wall == math.inf:
             return math.inf
+        if wall is not None and not math.isfinite(wall):
+            # inf is allowed (no wall); -inf and nan are not.
+            raise _fail(where, f"must be a number >= 0 m, or inf for no wall, got {wall}")
         kind = _NUMBER
     if kind == _NUMBER:
         number = real(value)

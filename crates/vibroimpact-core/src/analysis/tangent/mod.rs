@@ -35,6 +35,8 @@
 //! ([`saltation`]), the Lyapunov exponents ([`lyapunov`]).
 
 mod contact;
+#[cfg(test)]
+mod friction_tests;
 mod latched;
 mod lyapunov;
 #[cfg(test)]
@@ -129,10 +131,21 @@ pub struct Tangent<'s> {
     from: f64,
 }
 
-/// The key of a set of modes: the flow's matrix depends on which pairs
-/// stick, nothing else (every pair is rigid).
+/// The key of a set of modes: the flow's matrix depends on which
+/// constraints hold (pairs sticking, friction elements stuck on rows no
+/// pair holds), nothing else (every pair is rigid; a sliding element's
+/// force is a constant load).
 fn key(modes: &[Mode]) -> impl Iterator<Item = u8> + '_ {
-    modes.iter().map(|m| u8::from(*m == Mode::Sticking))
+    modes.iter().map(|m| {
+        u8::from(matches!(
+            m,
+            Mode::Sticking
+                | Mode::Stuck {
+                    shadowed: false,
+                    ..
+                }
+        ))
+    })
 }
 
 impl<'s> Tangent<'s> {
@@ -150,15 +163,6 @@ impl<'s> Tangent<'s> {
     }
 
     fn new(system: &'s Assembly, keep: Keep) -> Result<Self> {
-        if let Some(it) = system.interactions.iter().find(|it| it.law.is_friction()) {
-            // Stick-slip's saltations (a sliding pair coming to rest, a stuck
-            // one released) are not written yet.
-            return Err(crate::error::Error::Inconsistent(format!(
-                "the tangent flow does not yet pass through stick-slip, and {} has friction: \
-                 this analysis needs a system without friction",
-                system.pairs[it.pair]
-            )));
-        }
         let size = 2 * system.dim;
         let mut matrix = vec![0.0; size * size];
         for i in 0..size {

@@ -42,7 +42,7 @@ fn system(values: &Values, law: Option<LawKind>) -> Assembly {
 
 /// The end state, the columns by `shifted` and the impacts of a run by
 /// `method` to `t_end`.
-fn run(
+pub(super) fn run(
     system: &Assembly,
     y0: &[f64],
     t_end: f64,

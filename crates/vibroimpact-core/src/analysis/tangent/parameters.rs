@@ -45,10 +45,12 @@ pub(super) struct Parameters {
     minus: Vec<f64>,
 }
 
-/// Whether two laws are of one kind (rigid, or the same compliant law).
+/// Whether two laws are of one kind (rigid, friction, or the same compliant
+/// law).
 fn same_kind(a: &InteractionLaw, b: &InteractionLaw) -> bool {
     match (a, b) {
-        (InteractionLaw::Rigid { .. }, InteractionLaw::Rigid { .. }) => true,
+        (InteractionLaw::Rigid { .. }, InteractionLaw::Rigid { .. })
+        | (InteractionLaw::Friction { .. }, InteractionLaw::Friction { .. }) => true,
         (InteractionLaw::Compliant { law: x, .. }, InteractionLaw::Compliant { law: y, .. }) => {
             std::mem::discriminant(x) == std::mem::discriminant(y)
         }

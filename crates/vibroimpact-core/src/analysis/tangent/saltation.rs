@@ -1,7 +1,17 @@
 //! The saltation matrix of an event: the jump of the tangent flow where the
-//! located pair's gap `g` reaches zero, the reset map `R` acts and the
-//! rates change from `f-` to `f+`:
-//! `S = R + (f+ - R f-) grad(g)^T / (grad(g) . f-)`.
+//! located interaction's event value `g` reaches zero, the reset map `R`
+//! acts and the rates change from `f-` to `f+`:
+//! `S = R + (f+ - R f-) grad(g)^T / (dg/dt)`, `dg/dt = grad(g) . f- +
+//! dg/dt|_y` the value's rate along the flow before it.
+//!
+//! `g` is a pair's gap (no time of its own); a sliding friction element's
+//! speed along its row (it comes to rest: it sticks, or slides back); or
+//! the margin of a held one's force, the static force less the force that
+//! holds a stuck element (it slips), or a sticking pair's force plus the
+//! friction that helps to hold it (it leaves its wall). That force depends
+//! on the state and, through the loads, on time: its gradient and time
+//! rate are central differences, exact to round-off where it is affine in
+//! the state (a linear structure with rigid pairs) ([`Saltation::margin`]).
 
 use super::parameters::Parameters;
 use crate::kernel::observe::{EventView, Jump};
@@ -21,6 +31,15 @@ pub(super) struct Outcome {
     pub grazing: Option<f64>,
 }
 
+/// The located interaction's event value: a pair's gap, a sliding
+/// element's speed along its row, or a held one's force margin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Value {
+    Gap,
+    Speed,
+    Margin,
+}
+
 /// Buffers for [`Saltation::matrix`], made once per flow.
 pub(super) struct Saltation {
     scratch: Scratch,
@@ -37,6 +56,12 @@ pub(super) struct Saltation {
     /// Whether the last event was a landing at rest (its displacements
     /// projected as the velocities are).
     landed: bool,
+    /// What the last event's located value was (how a parameter moves it).
+    value: Value,
+    /// The located event value's gradient (`2 dim`), and room for the
+    /// rates of [`Self::margin`]'s probes.
+    gradient: Vec<f64>,
+    probe: Vec<f64>,
     /// Buffers of [`Self::parameter_columns`].
     velocities: Vec<f64>,
     values: Vec<f64>,
@@ -56,6 +81,9 @@ impl Saltation {
             coupling: Vec::new(),
             jump: vec![0.0; 2 * d],
             landed: false,
+            value: Value::Gap,
+            gradient: vec![0.0; 2 * d],
+            probe: vec![0.0; len],
             velocities: vec![0.0; d],
             values: Vec::new(),
             parameter: vec![0.0; 2 * d],
@@ -104,6 +132,9 @@ impl Saltation {
     /// constraints (gaps and rates held), so that the directions they lose
     /// are lost to round-off of the rows, not carried as the round-off of a
     /// difference `1 + (v+ - v-) / u` that the growth elsewhere multiplies.
+    /// Friction elements that start to stick hold their rows' rates, not
+    /// their places (a perturbed slide stops elsewhere): only the velocity
+    /// rows are projected for them.
     pub(super) fn matrix(
         &mut self,
         system: &Assembly,
@@ -112,20 +143,24 @@ impl Saltation {
     ) -> Outcome {
         let outcome = self.jump_matrix(system, view, out);
         let sticking = sticking(view);
-        if !sticking.is_empty() {
-            self.reset_map(system, &sticking);
-            let (d, size) = (system.dim, 2 * system.dim);
+        let mut held = sticking.clone();
+        held.extend(newly_stuck(view));
+        let d = system.dim;
+        for (block, list) in [(0, &sticking), (d, &held)] {
+            if list.is_empty() {
+                continue;
+            }
+            self.reset_map(system, list);
+            let size = 2 * d;
             let mut column = vec![0.0; d];
-            for block in [0, d] {
-                for c in 0..size {
-                    for (r, value) in column.iter_mut().enumerate() {
-                        *value = (0..d)
-                            .map(|k| self.reset[r * d + k] * out[(block + k) * size + c])
-                            .sum();
-                    }
-                    for (r, value) in column.iter().enumerate() {
-                        out[(block + r) * size + c] = *value;
-                    }
+            for c in 0..size {
+                for (r, value) in column.iter_mut().enumerate() {
+                    *value = (0..d)
+                        .map(|k| self.reset[r * d + k] * out[(block + k) * size + c])
+                        .sum();
+                }
+                for (r, value) in column.iter().enumerate() {
+                    out[(block + r) * size + c] = *value;
                 }
             }
         }
@@ -146,14 +181,18 @@ impl Saltation {
         let located = view.located;
         self.jump.iter_mut().for_each(|v| *v = 0.0);
         self.landed = false;
+        self.value = Value::Gap;
         let side = match view.modes_before[located] {
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
-            // A release: the constraint force is zero there, so the rates
-            // are continuous and the flow smooth (no time shift).
-            Mode::Sticking => return Outcome { grazing: None },
-            Mode::Sliding { .. } | Mode::Stuck { .. } => {
-                unreachable!("the tangent refuses friction (Tangent::new)")
+            // A release with no friction on its row: the constraint force is
+            // zero there, so the rates are continuous and the flow smooth
+            // (no time shift).
+            Mode::Sticking if system.friction_hold[located] == 0.0 => {
+                return Outcome { grazing: None }
+            }
+            Mode::Sticking | Mode::Sliding { .. } | Mode::Stuck { .. } => {
+                return self.friction_jump(system, view, out)
             }
         };
         let h = &system.interactions[located].h;
@@ -188,13 +227,7 @@ impl Saltation {
         self.rates(system, view.time, view.after, view.modes_after, true);
         // f+ - R f-: the velocities' jump, then the accelerations'.
         for r in 0..size {
-            let reset_minus = if r < d {
-                self.minus[r]
-            } else {
-                let row = &self.reset[(r - d) * d..(r - d + 1) * d];
-                linalg::dot(row, &self.minus[d..size])
-            };
-            let jump = (self.plus[r] - reset_minus) * side / closing;
+            let jump = (self.plus[r] - self.reset_minus(d, r)) * side / closing;
             self.jump[r] = jump;
             for (c, hc) in h.iter().enumerate() {
                 out[r * size + c] += jump * hc;
@@ -203,11 +236,119 @@ impl Saltation {
         Outcome { grazing: None }
     }
 
+    /// Row `r` of `R f-` (`self.minus` through the velocities' reset).
+    fn reset_minus(&self, d: usize, r: usize) -> f64 {
+        if r < d {
+            self.minus[r]
+        } else {
+            let row = &self.reset[(r - d) * d..(r - d + 1) * d];
+            linalg::dot(row, &self.minus[d..2 * d])
+        }
+    }
+
+    /// [`Self::jump_matrix`]'s time shift where the located interaction's
+    /// value is not a gap: a sliding element coming to rest (`g` its speed
+    /// along its row, `dg/dt` that speed's acceleration), or a held one's
+    /// force reaching what holds it ([`Self::margin`]). A value that only
+    /// touches zero (a slide whose acceleration along its row is of
+    /// round-off where it stops, a force that reaches its bound and turns
+    /// back) is a grazing: the flow has no derivative there.
+    fn friction_jump(
+        &mut self,
+        system: &Assembly,
+        view: &EventView<'_>,
+        out: &mut [f64],
+    ) -> Outcome {
+        let (d, size, located) = (system.dim, 2 * system.dim, view.located);
+        self.rates(system, view.time, view.before, view.modes_before, false);
+        self.rates(system, view.time, view.after, view.modes_after, true);
+        let sliding = matches!(view.modes_before[located], Mode::Sliding { .. });
+        self.value = if sliding { Value::Speed } else { Value::Margin };
+        let (closing, scale) = if sliding {
+            let h = &system.interactions[located].h;
+            self.gradient[..d].iter_mut().for_each(|v| *v = 0.0);
+            self.gradient[d..size].copy_from_slice(h);
+            let accelerations = self.minus[d..size]
+                .iter()
+                .chain(&self.plus[d..size])
+                .fold(0.0f64, |m, a| m.max(a.abs()));
+            let norm = linalg::dot(h, h).sqrt();
+            (linalg::dot(h, &self.minus[d..size]), norm * accelerations)
+        } else {
+            self.margin(system, view)
+        };
+        if closing.abs() <= GRAZING_SPEED * scale || !closing.is_finite() {
+            return Outcome {
+                grazing: Some(closing.abs()),
+            };
+        }
+        for r in 0..size {
+            let jump = (self.plus[r] - self.reset_minus(d, r)) / closing;
+            self.jump[r] = jump;
+            for (c, g) in self.gradient.iter().enumerate() {
+                out[r * size + c] += jump * g;
+            }
+        }
+        Outcome { grazing: None }
+    }
+
+    /// The held located interaction's value (the static force less the
+    /// force holding a stuck element, or a sticking pair's force plus the
+    /// friction on its row) before the event: its gradient into
+    /// `self.gradient`, and its rate along the flow before the event with
+    /// the scale below which that rate is round-off. The gradient is a
+    /// central difference in each coordinate (steps a millionth of the
+    /// state's size: the force is affine in the state for a linear structure,
+    /// where any step gives it to round-off), the time's a five-point one
+    /// over a ten-thousandth of the system's time scale.
+    fn margin(&mut self, system: &Assembly, view: &EventView<'_>) -> (f64, f64) {
+        let (d, size) = (system.dim, 2 * system.dim);
+        let y = view.before;
+        let largest = |block: &[f64]| block.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let period = system.time_scale();
+        let period = if period.is_finite() { period } else { 1.0 };
+        let length = largest(&y[..d])
+            .max(largest(&y[d..size]) * period)
+            .max(1e-9)
+            * 1e-6;
+        let mut point = y.to_vec();
+        for j in 0..size {
+            let step = if j < d { length } else { length / period };
+            point[j] = y[j] + step;
+            let up = self.held_value(system, view, view.time, &point);
+            point[j] = y[j] - step;
+            let down = self.held_value(system, view, view.time, &point);
+            point[j] = y[j];
+            self.gradient[j] = (up - down) / (2.0 * step);
+        }
+        let step = 1e-4 * period;
+        let at = |k: f64| view.time + k * step;
+        // (Without loads the values are equal, and the rate exactly zero.)
+        let values = [-2.0, -1.0, 1.0, 2.0].map(|k| self.held_value(system, view, at(k), y));
+        let by_time = (values[0] - 8.0 * values[1] + 8.0 * values[2] - values[3]) / (12.0 * step);
+        let along = linalg::dot(&self.gradient, &self.minus[..size]);
+        let scale = self
+            .gradient
+            .iter()
+            .zip(&self.minus[..size])
+            .fold(by_time.abs(), |m, (g, f)| m + (g * f).abs());
+        (along + by_time, scale)
+    }
+
+    /// The located held interaction's event value at `(time, y)` in the
+    /// modes before the event.
+    fn held_value(&mut self, system: &Assembly, view: &EventView<'_>, time: f64, y: &[f64]) -> f64 {
+        let room = (&mut self.full[..], &mut self.probe[..]);
+        held_value(system, &mut self.scratch, room, view, (time, y))
+    }
+
     /// The event's columns by the parameters into `out` (row-major `2 dim x
     /// m`), after [`Self::matrix`] of the same event: `W+ = S W- + out`.
     /// They hold the reset moved, `(dR/dp) v-`; the time shift moved by the
-    /// located gap's `dg/dp`; and where pairs land at rest or start to
-    /// stick, their gaps (and rates) held at zero from moved offsets.
+    /// located value's `dg/dp` (a gap's, a sliding speed's, a held force
+    /// margin's in the shifted systems); and where pairs land at rest or
+    /// start to stick, their gaps (and rates) held at zero from moved
+    /// offsets, as are the rates of friction elements that start to stick.
     pub(super) fn parameter_columns(
         &mut self,
         system: &Assembly,
@@ -217,6 +358,8 @@ impl Saltation {
     ) {
         let (d, size, m) = (system.dim, 2 * system.dim, parameters.count());
         let sticking = sticking(view);
+        let mut held = sticking.clone();
+        held.extend(newly_stuck(view));
         let v_minus = &view.before[d..size];
         for (j, s) in parameters.shifted.iter().enumerate() {
             let mut column = std::mem::take(&mut self.parameter);
@@ -245,7 +388,19 @@ impl Saltation {
                     column[d + r] += sign * self.velocities[r] / (2.0 * s.delta);
                 }
             }
-            let (moved, _) = parameters.gap_by(j, view.located, view.before);
+            let moved = match self.value {
+                Value::Gap => parameters.gap_by(j, view.located, view.before).0,
+                Value::Speed => parameters.gap_by(j, view.located, view.before).1,
+                Value::Margin => {
+                    let mut by = [(&s.plus, 1.0), (&s.minus, -1.0)].map(|(other, sign)| {
+                        let room = (&mut self.full[..], &mut self.probe[..]);
+                        let scratch = &mut Scratch::new(other);
+                        sign * held_value(other, scratch, room, view, (view.time, view.before))
+                    });
+                    by[0] += by[1];
+                    by[0] / (2.0 * s.delta)
+                }
+            };
             for (value, jump) in column.iter_mut().zip(&self.jump) {
                 *value += jump * moved;
             }
@@ -263,28 +418,29 @@ impl Saltation {
                     &mut self.coupling,
                 );
             }
-            if !sticking.is_empty() {
-                self.reset_map(system, &sticking);
-                for block in [0, d] {
-                    self.velocities.copy_from_slice(&column[block..block + d]);
-                    for (r, value) in column[block..block + d].iter_mut().enumerate() {
-                        *value = linalg::dot(&self.reset[r * d..(r + 1) * d], &self.velocities);
+            // Displacements held for sticking pairs; rates for them and for
+            // friction elements that start to stick.
+            for (block, list, state) in [(0, &sticking, view.before), (d, &held, view.after)] {
+                if list.is_empty() {
+                    continue;
+                }
+                self.reset_map(system, list);
+                self.velocities.copy_from_slice(&column[block..block + d]);
+                for (r, value) in column[block..block + d].iter_mut().enumerate() {
+                    *value = linalg::dot(&self.reset[r * d..(r + 1) * d], &self.velocities);
+                }
+                self.values.clear();
+                self.values.extend(list.iter().map(|jump| {
+                    let moved = parameters.gap_by(j, jump.interaction, state);
+                    if block == 0 {
+                        moved.0
+                    } else {
+                        moved.1
                     }
-                }
-                for (block, state, rate) in [(0, view.before, false), (d, view.after, true)] {
-                    self.values.clear();
-                    self.values.extend(sticking.iter().map(|jump| {
-                        let moved = parameters.gap_by(j, jump.interaction, state);
-                        if rate {
-                            moved.1
-                        } else {
-                            moved.0
-                        }
-                    }));
-                    let its = &system.interactions;
-                    let part = &mut column[block..block + d];
-                    push_back(its, &sticking, &mut self.values, part, &mut self.coupling);
-                }
+                }));
+                let its = &system.interactions;
+                let part = &mut column[block..block + d];
+                push_back(its, list, &mut self.values, part, &mut self.coupling);
             }
             for (r, value) in column.iter().enumerate() {
                 out[r * m + j] = *value;
@@ -305,6 +461,49 @@ impl Saltation {
         };
         system.rates(time, &self.full, modes, &mut self.scratch, out);
     }
+}
+
+/// The located held interaction's event value in `system` (the run's, or
+/// one a parameter shifted, with its own `scratch`) at `(time, y)` in the
+/// modes before `view`'s event: the static force less the force holding a
+/// stuck element, or a sticking pair's force plus the friction on its row.
+fn held_value(
+    system: &Assembly,
+    scratch: &mut Scratch,
+    (full, probe): (&mut [f64], &mut [f64]),
+    view: &EventView<'_>,
+    (time, y): (f64, &[f64]),
+) -> f64 {
+    let i = view.located;
+    full[..y.len()].copy_from_slice(y);
+    system.rates(time, full, view.modes_before, scratch, probe);
+    let force = scratch.force_of(i).unwrap_or(0.0);
+    match view.modes_before[i] {
+        Mode::Stuck { .. } => system.static_force(i) - force.abs(),
+        _ => force + system.friction_hold[i],
+    }
+}
+
+/// The friction elements `view`'s event left stuck, holding their rows
+/// (not shadowed by a sticking pair), that were not (as jumps of
+/// restitution 0: their rates' projection).
+fn newly_stuck(view: &EventView<'_>) -> Vec<Jump> {
+    let holds = |m: &Mode| {
+        matches!(
+            m,
+            Mode::Stuck {
+                shadowed: false,
+                ..
+            }
+        )
+    };
+    (0..view.modes_after.len())
+        .filter(|&i| holds(&view.modes_after[i]) && !holds(&view.modes_before[i]))
+        .map(|interaction| Jump {
+            interaction,
+            restitution: 0.0,
+        })
+        .collect()
 }
 
 /// The pairs of `view`'s event that start to stick (as jumps of restitution

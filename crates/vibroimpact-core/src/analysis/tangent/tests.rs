@@ -80,7 +80,12 @@ fn run(system: &Assembly, y0: &[f64], t_end: f64) -> (Vec<f64>, Vec<f64>, u64) {
 }
 
 /// [`run`] by `method` (an adaptive one at rtol 1e-12).
-fn run_with(system: &Assembly, y0: &[f64], t_end: f64, method: &str) -> (Vec<f64>, Vec<f64>, u64) {
+pub(super) fn run_with(
+    system: &Assembly,
+    y0: &[f64],
+    t_end: f64,
+    method: &str,
+) -> (Vec<f64>, Vec<f64>, u64) {
     let tight = Options {
         rtol: 1e-12,
         atol: 1e-15,
@@ -131,7 +136,7 @@ fn start(system: &Assembly) -> Vec<f64> {
     initial_state(system, &[0.004], &[-0.2], &[0.002], &[0.3]).unwrap()
 }
 
-fn determinant(a: &[f64], n: usize) -> f64 {
+pub(super) fn determinant(a: &[f64], n: usize) -> f64 {
     let mut a = a.to_vec();
     let mut det = 1.0;
     for c in 0..n {
@@ -182,30 +187,38 @@ fn central_differences_of(method: &str) {
 /// `method` to `t_end` and the central differences of its end states (steps
 /// of `step` times each coordinate's scale), scaled as the coordinates are.
 fn worst_difference(system: &Assembly, t_end: f64, method: &str, step: f64) -> f64 {
-    {
-        let y0 = start(system);
-        let (_, tangent, _) = run_with(system, &y0, t_end, method);
-        let size = 2 * system.dim;
-        let scales = [1e-3, 1e-3, 0.1, 0.1];
-        let mut worst = 0.0f64;
-        for c in 0..size {
-            let h = step * scales[c];
-            let mut plus = y0.clone();
-            plus[c] += h;
-            let mut minus = y0.clone();
-            minus[c] -= h;
-            let (p, _, _) = run_with(system, &plus, t_end, method);
-            let (m, _, _) = run_with(system, &minus, t_end, method);
-            for r in 0..size {
-                let difference = (p[r] - m[r]) / (2.0 * h);
-                let exact = tangent[r * size + c];
-                // Scaled as the state's coordinates are.
-                let error = (difference - exact).abs() * scales[c] / scales[r];
-                worst = worst.max(error / (1.0 + exact.abs() * scales[c] / scales[r]));
-            }
+    let scales = [1e-3, 1e-3, 0.1, 0.1];
+    worst_difference_from(system, (&start(system), &scales), t_end, method, step)
+}
+
+/// [`worst_difference`] from `y0`, with each coordinate's scale.
+pub(super) fn worst_difference_from(
+    system: &Assembly,
+    (y0, scales): (&[f64], &[f64]),
+    t_end: f64,
+    method: &str,
+    step: f64,
+) -> f64 {
+    let (_, tangent, _) = run_with(system, y0, t_end, method);
+    let size = 2 * system.dim;
+    let mut worst = 0.0f64;
+    for c in 0..size {
+        let h = step * scales[c];
+        let mut plus = y0.to_vec();
+        plus[c] += h;
+        let mut minus = y0.to_vec();
+        minus[c] -= h;
+        let (p, _, _) = run_with(system, &plus, t_end, method);
+        let (m, _, _) = run_with(system, &minus, t_end, method);
+        for r in 0..size {
+            let difference = (p[r] - m[r]) / (2.0 * h);
+            let exact = tangent[r * size + c];
+            // Scaled as the state's coordinates are.
+            let error = (difference - exact).abs() * scales[c] / scales[r];
+            worst = worst.max(error / (1.0 + exact.abs() * scales[c] / scales[r]));
         }
-        worst
     }
+    worst
 }
 
 /// The forced damper with a compliant pair: Hertz (its force and slope zero
