@@ -314,6 +314,83 @@ def test_orbits_through_stick_slip_take_the_tangent_flow_as_differences_agree(ca
         assert np.abs(tangent.floquet_multipliers).min() < 1e-9
 
 
+def _coupled_rubbing() -> vi.System:
+    """Two masses (1 and 0.5 kg) on springs, each rubbing (one on the ground, one on
+    the other) with kinetic 1 N and static 2 N, the second forced with 3 N at 0.7 Hz:
+    at one instant the first stops while the second is stuck, and holding both would
+    take more than the second's static force, so both slide on."""
+    return vi.System(
+        structure=vi.Matrices(
+            mass=[[1.0, 0.0], [0.0, 0.5]],
+            stiffness=[[200.0, -100.0], [-100.0, 100.0]],
+            damping=[[0.4, -0.1], [-0.1, 0.2]],
+        ),
+        frictions=[
+            vi.Friction(at=0, coefficient=1.0, static_coefficient=2.0, normal_force=1.0),
+            vi.Friction(at=0, against=1, coefficient=1.0, static_coefficient=2.0, normal_force=1.0),
+        ],
+        excitations=[vi.Force(at=1, signal=vi.Harmonic(amplitude=3.0, frequency=0.7))],
+        solver=vi.Solver(t_end=1.0, method="exact"),
+    )
+
+
+def _end_differences(
+    run: an.Runner, state: np.ndarray, t_end: float, scales: np.ndarray, step: float = 1e-7
+) -> np.ndarray:
+    """Central differences of the end state at ``t_end`` s (steps of ``step`` times
+    ``scales``)."""
+    columns = []
+    for c, scale in enumerate(scales):
+        shift = np.zeros(len(state))
+        shift[c] = step * scale
+        up, down = (np.asarray(run.tangent(state + s, t_end)["state"]) for s in (shift, -shift))
+        columns.append((up - down) / (2 * shift[c]))
+    return np.array(columns).T
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("case", ["both-slide-at-once", "starts-stuck", "slips-from-zero"])
+def test_the_tangent_map_through_stick_slip_corners_is_the_runs_differences(case: str) -> None:
+    """Where several elements switch at one instant (the run ends that event in modes
+    that hold, not a stuck interval of no length), a run that starts stuck (the flow
+    carries no velocity along the stuck row), and a slip from a state of zero (the
+    holding force's gradient taken on the force's own scale)."""
+    if case == "both-slide-at-once":
+        system, t_end = _coupled_rubbing(), 1.0
+        state = np.array([0.01, -0.02, 0.1, 0.3])
+        scales = np.array([0.01, 0.01, 0.1, 0.1])
+    else:
+        system, t_end = _stick_slip_oscillator(), 1.0
+        if case == "slips-from-zero":
+            signal = vi.Harmonic(amplitude=4.0, frequency=0.8, phase=-math.pi / 2)
+            system = system.replace(excitations=[vi.Force(at=0, signal=signal)])
+        state = np.array([0.03 if case == "starts-stuck" else 0.0, 0.0])
+        scales = np.array([0.01, 0.1])
+    run = an.runner(system)
+    tangent = run.tangent(state, t_end)
+    assert not tangent["grazings"]
+    matrix = tangent["matrix"]
+    differences = _end_differences(run, state, t_end, scales)
+    if case == "starts-stuck":
+        # Started at rest and held, a push along the row stops within its square:
+        # the map's derivative by the start's velocity is zero (its differences
+        # shrink with their step), the displacement's is the differences'.
+        assert np.abs(matrix[:, 1]).max() == 0.0
+        coarse = _end_differences(run, state, t_end, scales, step=1e-5)
+        assert np.abs(differences[:, 1]).max() < np.abs(coarse[:, 1]).max()
+        matrix, differences, scales = matrix[:, :1], differences[:, :1], scales
+    scaled = (matrix - differences) * scales[: matrix.shape[1]] / scales[:, None]
+    size = np.abs(differences * scales[: matrix.shape[1]] / scales[:, None]).max()
+    assert np.abs(scaled).max() < 1e-5 * max(1.0, size)
+    if case == "both-slide-at-once":
+        # No stuck interval of no length at that instant.
+        initial = vi.Initial(
+            structure_displacement=list(state[:2]), structure_velocity=list(state[2:])
+        )
+        stuck = vi.simulate(system.replace(initial=initial)).contacts.to_pandas()
+        assert (stuck["separation"] > stuck["onset"]).all()
+
+
 @pytest.mark.timeout(60)
 def test_lyapunov_exponents_through_stick_slip_are_the_orbits_floquet_exponents() -> None:
     """From a stable orbit the spectrum is its Floquet exponents, log|mu| / T: sliding

@@ -205,7 +205,12 @@ impl Run<'_> {
         if self.friction {
             // Impacts change the velocities, and sticking pairs shadow
             // friction elements on their rows.
-            self.settle_friction(event_time);
+            let impulses = if rigid {
+                self.impacts.speed_scale()
+            } else {
+                0.0
+            };
+            self.settle_friction(event_time, impulses);
         }
         // Impacts change the velocities.
         system.gaps(&self.y, &mut self.gaps.start);

@@ -29,7 +29,9 @@ impl Run<'_> {
     /// Every friction element's mode after an event (an impact changed the
     /// velocities, a rigid pair that shadows one began or ended sticking),
     /// and at the start.
-    pub(super) fn settle_friction(&mut self, time: f64) {
+    /// `impulses`: the largest speed before the event's impulses (m/s; 0
+    /// where none acted), whose round-off an impulse leaves in every rate.
+    pub(super) fn settle_friction(&mut self, time: f64, impulses: f64) {
         let system = self.system;
         for i in 0..self.modes.len() {
             // One switched at this event (a slip located where its holding force
@@ -38,7 +40,14 @@ impl Run<'_> {
                 continue;
             }
             let rate = system.gap(i, &self.y).1;
-            let at_rest = rate.abs() <= system.rate_round_off(i, &self.y);
+            // After an impulse a row brought to rest keeps the impulse's
+            // round-off (a plastic landing on a wall on the row): at rest
+            // within it, as the impacts judge rest (else its sign would
+            // choose a slide, and the run would not be continuous in its
+            // start).
+            let row: f64 = system.interactions[i].h.iter().map(|h| h.abs()).sum();
+            let round_off = system.rate_round_off(i, &self.y).max(1e-9 * impulses * row);
+            let at_rest = rate.abs() <= round_off;
             match self.modes[i] {
                 _ if !at_rest => self.slide(i, time, rate.signum()),
                 Mode::Stuck { shadowed, offset } => match (shadowed, self.shadowed(i)) {
@@ -62,6 +71,54 @@ impl Run<'_> {
                 },
                 _ => self.stick_or_slide(i, time),
             }
+        }
+        self.release_overloaded(time);
+    }
+
+    /// Stuck elements whose holding force passes their static force once
+    /// the event's switches are made (an element that stuck loads another
+    /// on a coupled row) slide, the most overloaded first, until the rest
+    /// hold: the event ends in modes that hold, not in a stuck interval of
+    /// no length followed by a slip at the same instant.
+    fn release_overloaded(&mut self, time: f64) {
+        let system = self.system;
+        for _ in 0..self.modes.len() {
+            if !self.modes.iter().any(|m| {
+                matches!(
+                    m,
+                    Mode::Stuck {
+                        shadowed: false,
+                        ..
+                    }
+                )
+            }) {
+                return;
+            }
+            let work = &mut self.buffers.work;
+            system.rates(time, &self.y, &self.modes, &mut self.scratch, work);
+            let mut worst: Option<(usize, f64, f64)> = None;
+            for (i, mode) in self.modes.iter().enumerate() {
+                if !matches!(
+                    mode,
+                    Mode::Stuck {
+                        shadowed: false,
+                        ..
+                    }
+                ) {
+                    continue;
+                }
+                let force = self.scratch.force_of(i).unwrap_or(0.0);
+                let held = system.static_force(i);
+                let excess = force.abs() - held;
+                if excess > 1e-12 * held && worst.is_none_or(|(_, most, _)| excess > most) {
+                    worst = Some((i, excess, force));
+                }
+            }
+            let Some((i, _, force)) = worst else {
+                return;
+            };
+            self.slide(i, time, -force.signum());
+            self.just_switched[i] = true;
         }
     }
 
@@ -134,7 +191,8 @@ impl Run<'_> {
     fn slide(&mut self, i: usize, time: f64, direction: f64) {
         let direction = if direction < 0.0 { -1.0 } else { 1.0 };
         self.modes[i] = Mode::Sliding { direction };
-        if let Some(record) = self.open[i].take() {
+        if let Some(record) = self.open[i].take().filter(|r| r.onset < time) {
+            // (One stuck at this instant and sliding again was not held.)
             let pair = self.system.interactions[i].pair;
             self.contacts.push(record.close(pair, time, 0.0, 0.0));
         }

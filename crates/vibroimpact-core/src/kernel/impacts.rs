@@ -151,6 +151,11 @@ impl Impacts {
         ) || any
     }
 
+    /// The largest speed before the last instant resolved, m/s.
+    pub(crate) fn speed_scale(&self) -> f64 {
+        self.speed_scale
+    }
+
     /// The members the last event's impulses acted on (or held as
     /// equalities), each with the restitution its rate was resolved to
     /// (`u+ = -e u-`; 0 where it stuck, was held or touched at rest): the

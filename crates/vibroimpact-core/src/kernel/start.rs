@@ -228,7 +228,7 @@ impl<'a> Run<'a> {
         let system = self.system;
         self.resume_contacts();
         if self.friction {
-            self.settle_friction(0.0);
+            self.settle_friction(0.0, 0.0);
         }
         if self.timing.is_some() {
             self.resume_fixed();

@@ -63,6 +63,12 @@ fn stick_slip(values: [f64; 4]) -> Assembly {
 /// damper of 50 g between rigid walls 4 mm away (restitution 0.7) that
 /// slides on its floor (kinetic force 0.2 N, static 0.3 N).
 fn horizontal_damper() -> Assembly {
+    horizontal_damper_with(0.7, 6.0)
+}
+
+/// [`horizontal_damper`] with its walls' `restitution`, forced at
+/// `frequency` Hz.
+fn horizontal_damper_with(restitution: f64, frequency: f64) -> Assembly {
     let spec = SystemSpec {
         structure: Structure::oscillator(MASS, 3000.0, 2.0).unwrap(),
         dampers: vec![Damper {
@@ -70,7 +76,7 @@ fn horizontal_damper() -> Assembly {
             at: 0.0,
             lower_clearance: 0.004,
             upper_clearance: 0.004,
-            law: PairLaw::rigid(0.7).unwrap(),
+            law: PairLaw::rigid(restitution).unwrap(),
         }],
         collisions: vec![],
         frictions: vec![Friction {
@@ -83,7 +89,7 @@ fn horizontal_damper() -> Assembly {
         gravity: 0.0,
         excitations: vec![Excitation {
             load: Load::Force { at: 0.0 },
-            signal: Signal::harmonic(10.0, 6.0, 0.0).unwrap(),
+            signal: Signal::harmonic(10.0, frequency, 0.0).unwrap(),
         }],
         points: vec![],
         moments: vec![],
@@ -206,6 +212,33 @@ fn through_impacts_with_friction_the_tangent_map_is_the_runs_central_differences
             // Measured: 1.1e-7 (exact), 2.8e-7 (dop853).
             let worst = worst_difference_from(&system, (&y0, &scales), t_end, method, 1e-7);
             assert!(worst < 2e-6, "{method}: worst scaled difference {worst:e}");
+        }
+    });
+}
+
+#[test]
+fn through_landings_held_by_wall_and_friction_the_tangent_map_is_the_runs_central_differences() {
+    crate::testing::timeout(120, || {
+        // Plastic walls: the damper lands at rest on a wall, held there by
+        // the wall and its friction together, and leaves where the wall
+        // would pull by more than the static friction (a release at a
+        // force, not at zero: its time moves with the state).
+        let system = horizontal_damper_with(0.0, 5.0);
+        let y0 = initial_state(&system, &[0.002], &[-0.1], &[0.001], &[0.3]).unwrap();
+        let t_end = 1.0;
+        let run_solution = solution(&system, &y0, t_end);
+        let released = run_solution
+            .contacts
+            .iter()
+            .filter(|c| c.pair == 0 && c.kind == ContactKind::Sticking && c.separation < t_end)
+            .count();
+        assert!(released >= 3, "{released} releases from a wall");
+        let scales = [1e-3, 1e-3, 0.1, 0.1];
+        for method in ["exact", "dop853"] {
+            // Measured: 2.5e-7 (exact), 1.6e-6 (dop853, which lands by its
+            // located events' accuracy).
+            let worst = worst_difference_from(&system, (&y0, &scales), t_end, method, 1e-7);
+            assert!(worst < 1e-5, "{method}: worst scaled difference {worst:e}");
         }
     });
 }

@@ -361,6 +361,10 @@ impl EventObserver for Tangent<'_> {
     fn start(&mut self, time: f64, y: &[f64], modes: &[Mode]) -> Result<()> {
         self.since = time.max(self.from);
         self.modes.copy_from_slice(modes);
+        if time >= self.from {
+            self.saltation
+                .start_in(self.system, modes, &mut self.matrix);
+        }
         if let Some(latched) = self.latched.as_mut() {
             // Carried from the start: a resumed contact's rate is the
             // state's; from later, the state there does not set it.

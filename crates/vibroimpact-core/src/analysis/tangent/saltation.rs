@@ -145,8 +145,48 @@ impl Saltation {
         let sticking = sticking(view);
         let mut held = sticking.clone();
         held.extend(newly_stuck(view));
+        self.project(system, (&sticking, &held), out);
+        outcome
+    }
+
+    /// The rows of `out` (`2 dim x 2 dim`) projected onto the constraints
+    /// of `modes` where a run starts in them: sticking pairs hold their gaps
+    /// and rates, stuck friction elements their rates (a flow that starts
+    /// stuck does not carry a velocity along the stuck row).
+    pub(super) fn start_in(&mut self, system: &Assembly, modes: &[Mode], out: &mut [f64]) {
+        let held_as = |keep: fn(&Mode) -> bool| -> Vec<Jump> {
+            (0..modes.len())
+                .filter(|&i| keep(&modes[i]))
+                .map(|interaction| Jump {
+                    interaction,
+                    restitution: 0.0,
+                })
+                .collect()
+        };
+        let sticking = held_as(|m| *m == Mode::Sticking);
+        let held = held_as(|m| {
+            matches!(
+                m,
+                Mode::Sticking
+                    | Mode::Stuck {
+                        shadowed: false,
+                        ..
+                    }
+            )
+        });
+        self.project(system, (&sticking, &held), out);
+    }
+
+    /// `out`'s displacement rows projected onto the gaps of `sticking` held,
+    /// its velocity rows onto the rates of `held` held.
+    fn project(
+        &mut self,
+        system: &Assembly,
+        (sticking, held): (&[Jump], &[Jump]),
+        out: &mut [f64],
+    ) {
         let d = system.dim;
-        for (block, list) in [(0, &sticking), (d, &held)] {
+        for (block, list) in [(0, sticking), (d, held)] {
             if list.is_empty() {
                 continue;
             }
@@ -164,7 +204,6 @@ impl Saltation {
                 }
             }
         }
-        outcome
     }
 
     /// [`Self::matrix`] before the projection.
@@ -182,6 +221,11 @@ impl Saltation {
         self.jump.iter_mut().for_each(|v| *v = 0.0);
         self.landed = false;
         self.value = Value::Gap;
+        if view.jumps.is_empty() && view.modes_before == view.modes_after {
+            // Nothing switched (a gap met while a friction element holds it
+            // on its wall): the flow goes on smooth.
+            return Outcome { grazing: None };
+        }
         let side = match view.modes_before[located] {
             Mode::Open => 1.0,
             Mode::Compliant { .. } => -1.0,
@@ -277,6 +321,17 @@ impl Saltation {
         } else {
             self.margin(system, view)
         };
+        // Rates that do not change (a sliding element that stops on a row a
+        // sticking pair holds: the pair's constraint took its force) shift
+        // nothing, whatever the time shift.
+        let (mut change, mut magnitude) = (0.0f64, 0.0f64);
+        for r in 0..size {
+            change = change.max((self.plus[r] - self.reset_minus(d, r)).abs());
+            magnitude = magnitude.max(self.plus[r].abs()).max(self.minus[r].abs());
+        }
+        if change <= 1e-12 * magnitude {
+            return Outcome { grazing: None };
+        }
         if closing.abs() <= GRAZING_SPEED * scale || !closing.is_finite() {
             return Outcome {
                 grazing: Some(closing.abs()),
@@ -298,8 +353,9 @@ impl Saltation {
     /// `self.gradient`, and its rate along the flow before the event with
     /// the scale below which that rate is round-off. The gradient is a
     /// central difference in each coordinate (steps a millionth of the
-    /// state's size: the force is affine in the state for a linear structure,
-    /// where any step gives it to round-off), the time's a five-point one
+    /// state's size, or of what the held force displaces: the force is
+    /// affine in the state for a linear structure, where any step gives it
+    /// to round-off), the time's a five-point one
     /// over a ten-thousandth of the system's time scale.
     fn margin(&mut self, system: &Assembly, view: &EventView<'_>) -> (f64, f64) {
         let (d, size) = (system.dim, 2 * system.dim);
@@ -307,13 +363,20 @@ impl Saltation {
         let largest = |block: &[f64]| block.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let period = system.time_scale();
         let period = if period.is_finite() { period } else { 1.0 };
+        // At least the displacement the held force makes over the time
+        // scale's radian (a state near zero has no size of its own).
+        let i = view.located;
+        let force = system.static_force(i).max(system.friction_hold[i]);
+        let radian = period / std::f64::consts::TAU;
+        let pressed = force * system.interactions[i].inverse_mass * radian * radian;
         let length = largest(&y[..d])
-            .max(largest(&y[d..size]) * period)
-            .max(1e-9)
+            .max(largest(&y[d..size]) * radian)
+            .max(pressed)
+            .max(1e-12)
             * 1e-6;
         let mut point = y.to_vec();
         for j in 0..size {
-            let step = if j < d { length } else { length / period };
+            let step = if j < d { length } else { length / radian };
             point[j] = y[j] + step;
             let up = self.held_value(system, view, view.time, &point);
             point[j] = y[j] - step;
