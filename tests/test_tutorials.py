@@ -433,3 +433,11 @@ def test_friction_tutorial_decays_as_the_closed_form_and_follows_scipy() -> None
     assert abs(energy["residual"]) < 1e-8 * energy["input_work"]
     stuck = ns["table"][ns["table"].pair == "damper 0 friction"]
     assert len(stuck) > 0 and (stuck.kind == "sticking").all()
+    # The stick-slip orbit: a zero multiplier (the stick forgets the velocity), the
+    # other as differences of whole runs give it, and the orbit returns on itself.
+    orbit, checked = ns["orbit"], ns["checked"]
+    assert orbit.converged and orbit.stable and orbit.jacobian == "tangent"
+    multipliers = np.sort(np.abs(orbit.floquet_multipliers))
+    assert multipliers[0] == 0.0
+    assert multipliers[1] == pytest.approx(np.abs(checked.floquet_multipliers).max(), rel=1e-6)
+    assert (ns["cycle"].contacts.to_pandas().kind == "sticking").sum() >= 2
