@@ -27,6 +27,12 @@ fn rubbing(
     [kinetic, held, amplitude, stiffness]: [f64; 4],
     frequency: f64,
 ) -> Assembly {
+    let signal = Signal::harmonic(amplitude, frequency, 0.3).unwrap();
+    driven(damping, [kinetic, held, stiffness], signal)
+}
+
+/// [`rubbing`] driven by the force `signal` (N).
+fn driven(damping: f64, [kinetic, held, stiffness]: [f64; 3], signal: Signal) -> Assembly {
     let spec = SystemSpec {
         structure: Structure::oscillator(MASS, stiffness, damping).unwrap(),
         dampers: vec![],
@@ -44,7 +50,7 @@ fn rubbing(
         gravity: 0.0,
         excitations: vec![Excitation {
             load: Load::Force { at: 0.0 },
-            signal: Signal::harmonic(amplitude, frequency, 0.3).unwrap(),
+            signal,
         }],
         points: vec![],
         moments: vec![],
@@ -239,6 +245,36 @@ fn through_landings_held_by_wall_and_friction_the_tangent_map_is_the_runs_centra
             // located events' accuracy).
             let worst = worst_difference_from(&system, (&y0, &scales), t_end, method, 1e-7);
             assert!(worst < 1e-5, "{method}: worst scaled difference {worst:e}");
+        }
+    });
+}
+
+#[test]
+fn a_slip_just_after_a_recorded_sample_takes_the_load_s_rate_on_its_stretch() {
+    crate::testing::timeout(60, || {
+        // Stuck at rest, pushed by a recorded force whose slope falls from
+        // 1.6 N/s to 1.4 N/s at 1 s, 1e-6 N short of the static force: the
+        // slip comes 7e-7 s after that sample. A start moved by dx slips
+        // k dx / (1.4 N/s) later; a rate taken across the kink would not.
+        let ramp = Signal::recorded(vec![0.0, 1.0, 2.0], vec![0.0, 1.6 - 1e-6, 3.0], 1.0).unwrap();
+        let system = driven(0.5, [KINETIC, 1.6, STIFFNESS], ramp);
+        let y0 = initial_state(&system, &[0.0], &[0.0], &[], &[]).unwrap();
+        let t_end = 1.5;
+        let (_, tangent) = run(&system, &y0, t_end, "dop853");
+        let step = 1e-9;
+        let moved = |by: f64| {
+            let mut start = y0.clone();
+            start[0] += by;
+            run(&system, &start, t_end, "dop853").0
+        };
+        let (up, down) = (moved(step), moved(-step));
+        for r in 0..2 {
+            let difference = (up[r] - down[r]) / (2.0 * step);
+            let exact = tangent[r * 2];
+            assert!(
+                (difference - exact).abs() < 1e-4 * (1.0 + exact.abs()),
+                "row {r}: {exact:e} against differences {difference:e}"
+            );
         }
     });
 }

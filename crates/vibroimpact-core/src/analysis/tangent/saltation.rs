@@ -356,7 +356,8 @@ impl Saltation {
     /// state's size, or of what the held force displaces: the force is
     /// affine in the state for a linear structure, where any step gives it
     /// to round-off), the time's a five-point one
-    /// over a ten-thousandth of the system's time scale.
+    /// over a ten-thousandth of the system's time scale (a backward one
+    /// within the last stretch of samples where a load is a record).
     fn margin(&mut self, system: &Assembly, view: &EventView<'_>) -> (f64, f64) {
         let (d, size) = (system.dim, 2 * system.dim);
         let y = view.before;
@@ -387,8 +388,23 @@ impl Saltation {
         let step = 1e-4 * period;
         let at = |k: f64| view.time + k * step;
         // (Without loads the values are equal, and the rate exactly zero.)
-        let values = [-2.0, -1.0, 1.0, 2.0].map(|k| self.held_value(system, view, at(k), y));
-        let by_time = (values[0] - 8.0 * values[1] + 8.0 * values[2] - values[3]) / (12.0 * step);
+        let by_time = if system.has_breakpoints() {
+            // Loads interpolated between samples: the rate just before the
+            // event, within the stretch of samples it ends in (a stencil
+            // across a kink would mix two slopes): a backward difference of
+            // second order, exact on a straight stretch.
+            let mut back = step;
+            let tiny = 1e-15 * period.max(view.time.abs());
+            while system.next_breakpoint(view.time - 2.0 * back) < view.time && back > tiny {
+                back *= 0.5;
+            }
+            let values =
+                [0.0, 1.0, 2.0].map(|k| self.held_value(system, view, view.time - k * back, y));
+            (3.0 * values[0] - 4.0 * values[1] + values[2]) / (2.0 * back)
+        } else {
+            let values = [-2.0, -1.0, 1.0, 2.0].map(|k| self.held_value(system, view, at(k), y));
+            (values[0] - 8.0 * values[1] + 8.0 * values[2] - values[3]) / (12.0 * step)
+        };
         let along = linalg::dot(&self.gradient, &self.minus[..size]);
         let scale = self
             .gradient
