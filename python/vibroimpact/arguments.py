@@ -50,19 +50,32 @@ def shown_range(low: int, high: int) -> str:
     return f"[{low}, {'2^63 - 1' if high == LARGEST_WHOLE else high}]"
 
 
-def _real(value: Any) -> float | None:
-    """``value`` as a float when it is a real number (an int, a float, a NumPy real
-    scalar or 0-d array; never a boolean), else None."""
+def real(value: Any) -> int | float | None:
+    """``value`` as a Python int or float when it is a real number: an int, a float, a
+    NumPy integer or floating scalar, or a 0-d array of one; None for anything else,
+    booleans (Python's or NumPy's) included."""
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
         value = value[()]
-    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+    if isinstance(value, bool | np.bool_):
         return None
-    if isinstance(value, np.complexfloating):
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    if isinstance(value, int | float):
+        return value
+    return None
+
+
+def _real(value: Any) -> float | None:
+    """:func:`real` as a float (an int beyond a float's range as an infinity)."""
+    exact = real(value)
+    if exact is None:
         return None
     try:
-        return float(value)
+        return float(exact)
     except OverflowError:
-        return math.copysign(math.inf, value)
+        return math.copysign(math.inf, exact)
 
 
 def sections(name: str, value: Any) -> Mapping[str, Any]:

@@ -5,6 +5,12 @@ the sections are described in :mod:`vibroimpact.system.schema`.
 """
 
 from vibroimpact.system.linear import linear_parts
+from vibroimpact.system.points import (
+    moment_weights,
+    point_weights,
+    split_observed,
+    structure_coordinates,
+)
 from vibroimpact.system.run import PreparedRun, prepare_system, simulate_system
 from vibroimpact.system.schema import (
     _DAMPER,
@@ -29,10 +35,6 @@ from vibroimpact.system.schema import (
     _table,
     _unknown_key,
     default_stepping,
-    moment_weights,
-    point_weights,
-    split_observed,
-    structure_coordinates,
     system_spec,
 )
 from vibroimpact.system.solution import SystemContacts, SystemSolution

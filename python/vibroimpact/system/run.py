@@ -21,6 +21,7 @@ from vibroimpact._core import _check_settings as check_settings
 from vibroimpact._core import simulate_system as _simulate_system
 from vibroimpact.arguments import directory
 from vibroimpact.messages import short_numbers, shown
+from vibroimpact.system.points import _check_bends, _check_point, split_observed
 from vibroimpact.system.schema import (
     _FIXED_STEP,
     _INITIAL,
@@ -28,12 +29,9 @@ from vibroimpact.system.schema import (
     _OUTPUT,
     _SOLVER,
     SYSTEM_SOLVER_DEFAULTS,
-    _check_bends,
-    _check_point,
     _choice,
     _fail,
     _table,
-    split_observed,
     system_spec,
 )
 from vibroimpact.system.solution import SystemContacts, SystemSolution

@@ -13,10 +13,7 @@ from vibroimpact._core import (
 )
 from vibroimpact.notebook import solution_html
 from vibroimpact.summary import contacts_frame, contacts_repr, history_dataset, solution_repr
-from vibroimpact.system.schema import (
-    moment_weights,
-    point_weights,
-)
+from vibroimpact.system.points import moment_weights, point_weights
 
 
 @dataclass(frozen=True)
