@@ -1,7 +1,10 @@
 //! The exact flow alone (no Python): the forced damper of
 //! benchmarks/bench_analyses.py part 1 over 1000 forcing periods and the ball
 //! dropped 1 m (part 4); medians of repeated runs, with the flow evaluations
-//! per impact. `exact_damper once` runs the damper once (for callgrind).
+//! per impact, and the column of ten rigid particles of
+//! benchmarks/bench_collisions.py (events per second). `exact_damper once`
+//! runs the damper once (for callgrind), `exact_damper column` the column
+//! 50 times (for perf).
 //!
 //!     cargo run --release -p vibroimpact-core --example exact_damper
 
@@ -10,7 +13,7 @@ use vibroimpact_core::kernel::events::{RunOptions, SystemSolution};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::{AnyStepper, Options};
 use vibroimpact_core::model::assembly::{
-    initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+    initial_state, Assembly, Collision, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
 use vibroimpact_core::model::signals::Signal;
 use vibroimpact_core::model::structure::Structure;
@@ -32,6 +35,43 @@ fn run(spec: &SystemSpec, t_end: f64) -> SystemSolution {
     stepper
         .integrate(&system, &y, &options, &mut || false)
         .unwrap()
+}
+
+/// Ten 10 g particles stacked 2 mm apart in a 1 kg, 15 Hz, 5 % damped
+/// cavity forced with 30 N at 10 Hz under gravity, every pair rigid at
+/// `restitution` (tests/test_collisions.py's `forced_column`).
+fn column(restitution: f64) -> SystemSpec {
+    let count = 10;
+    let k = 8883.0;
+    let law = PairLaw::rigid(restitution).unwrap();
+    SystemSpec {
+        structure: Structure::oscillator(1.0, k, 9.42).unwrap(),
+        dampers: (0..count)
+            .map(|j| Damper {
+                mass: 0.01,
+                at: 0.0,
+                lower_clearance: if j == 0 { 0.002 } else { f64::INFINITY },
+                upper_clearance: if j == count - 1 { 0.03 } else { f64::INFINITY },
+                law: law.clone(),
+            })
+            .collect(),
+        collisions: (0..count - 1)
+            .map(|j| Collision {
+                dampers: [j, j + 1],
+                gap: 0.002,
+                law: law.clone(),
+            })
+            .collect(),
+        frictions: vec![],
+        stops: vec![],
+        gravity: 9.81,
+        excitations: vec![Excitation {
+            load: Load::Force { at: 0.0 },
+            signal: Signal::harmonic(30.0, 10.0, 0.0).unwrap(),
+        }],
+        points: vec![],
+        moments: vec![],
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -83,6 +123,7 @@ fn main() {
     let one = match std::env::args().nth(1).as_deref() {
         Some("once") => Some(run(&damper, 125.0)),
         Some("ball") => Some(run(&ball, 6.0)),
+        Some("column") => (0..50).map(|_| run(&column(0.9), 20.0)).last(),
         _ => None,
     };
     if let Some(sol) = one {
@@ -98,6 +139,8 @@ fn main() {
     for (name, spec, t_end, repeats) in [
         ("damper, 1000 periods", &damper, 125.0, 41),
         ("ball", &ball, 6.0, 2001),
+        ("column, e 0.9", &column(0.9), 20.0, 21),
+        ("column, e 0.6", &column(0.6), 20.0, 21),
     ] {
         let mut last = None;
         let times = (0..repeats)
@@ -112,8 +155,10 @@ fn main() {
         let sol = last.unwrap();
         let t = median(times);
         println!(
-            "{name}: {:.1} us per run; {} steps, {} evaluations, {} contacts, final {:?}",
+            "{name}: {:.1} us per run ({:.3e} contacts/s); {} steps, {} evaluations, {} \
+             contacts, final {:?}",
             t * 1e6,
+            sol.contacts.len() as f64 / t,
             sol.steps,
             sol.rhs_evaluations,
             sol.contacts.len(),

@@ -45,10 +45,8 @@ impl Complementarity {
         self.matrix.clear();
         for &a in members {
             for &b in members {
-                self.matrix.push(linalg::dot(
-                    &system.interactions[a].h,
-                    &system.interactions[b].push,
-                ));
+                self.matrix
+                    .push(system.interactions[a].dot(&system.interactions[b].push));
             }
         }
         self.q.clear();

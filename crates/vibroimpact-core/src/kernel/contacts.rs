@@ -10,7 +10,7 @@ use crate::kernel::clock::CHATTER_EVENTS;
 use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactKind, Open};
 use crate::kernel::impacts;
-use crate::kernel::locate::{any_compliant, crossed, event_value};
+use crate::kernel::locate::{any_compliant, crossed, event_value_from};
 use crate::kernel::observe::EventView;
 use crate::kernel::run::{loss_slot, Run};
 use crate::methods::step_control::initial_step;
@@ -149,12 +149,19 @@ impl Run<'_> {
         // `mark_touching`).
         let touch = self.touch_band(instant);
         let mut near = false;
+        // The step's end, kept: its gaps are those the step found there.
+        debug_assert!({
+            let mut here = self.gaps.end.clone();
+            system.gaps(&self.y, &mut here);
+            here == self.gaps.start
+        });
         for i in 0..self.modes.len() {
             let mode = self.modes[i];
-            let v = event_value(
+            let v = event_value_from(
                 system,
                 i,
                 mode,
+                self.gaps.start[i],
                 time,
                 &self.y,
                 &self.modes,
@@ -173,6 +180,14 @@ impl Run<'_> {
             }
             let onset = self.open[i].map(|o| o.balance);
             self.switch(i, event_time, (instant, time_scale));
+            if matches!(
+                mode,
+                Mode::Sticking | Mode::Sliding { .. } | Mode::Stuck { .. }
+            ) {
+                // A release or a slip moved the state: the later pairs'
+                // values are taken at the state moved.
+                system.gaps(&self.y, &mut self.gaps.start);
+            }
             self.just_switched[i] = true;
             self.check_contact(i, mode, onset)?;
             any = true;
@@ -247,7 +262,8 @@ impl Run<'_> {
     fn mark_touching(&mut self, touch: TouchBand) {
         let system = self.system;
         for i in 0..self.modes.len() {
-            let gap = system.gap(i, &self.y).0;
+            // (`gaps.start` follows the state through the switches.)
+            let gap = self.gaps.start[i].0;
             if gap <= touch.of(&system.interactions[i]) && !system.held_by_mirror(i, &self.modes) {
                 self.impacts.mark(system, i, self.modes[i]);
             }

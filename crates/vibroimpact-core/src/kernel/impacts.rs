@@ -315,9 +315,7 @@ impl Impacts {
             for (s, &i) in self.members.iter().enumerate() {
                 let impulse = self.lcp.z[s];
                 if impulse != 0.0 {
-                    for (v, p) in y[d..2 * d].iter_mut().zip(&system.interactions[i].push) {
-                        *v += p * impulse;
-                    }
+                    system.interactions[i].add_push(impulse, &mut y[d..2 * d]);
                 }
             }
             let mut more = false;

@@ -39,6 +39,33 @@ pub(super) fn event_value(
     }
 }
 
+/// [`event_value`] where interaction `i`'s gap and rate at `y` are known,
+/// as [`Assembly::gaps`] gives them (the same bits as [`Assembly::gap`]): a
+/// gap's, an indentation's or a sliding speed's value without the products
+/// again.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn event_value_from(
+    system: &Assembly,
+    i: usize,
+    mode: Mode,
+    (gap, rate): (f64, f64),
+    time: f64,
+    y: &[f64],
+    modes: &[Mode],
+    scratch: &mut Scratch,
+    work: &mut [f64],
+) -> f64 {
+    match mode {
+        Mode::Open => gap,
+        Mode::Compliant { .. } => -gap,
+        Mode::Sliding { direction } => direction * rate,
+        Mode::Sticking | Mode::Stuck { .. } => {
+            event_value(system, i, mode, time, y, modes, scratch, work)
+        }
+    }
+}
+
 /// The force that holds interaction `i` (a sticking pair or a stuck friction
 /// element, along its row) at `time` and state `y` in `modes`, N; 0 where
 /// it is not held.
@@ -102,7 +129,8 @@ pub(super) fn past(system: &Assembly, i: usize, mode: Mode, v: f64, y: &[f64]) -
     match mode {
         Mode::Sticking => v < 0.0 && !system.locked(i),
         Mode::Sliding { .. } | Mode::Stuck { .. } => v < 0.0,
-        _ => v < -wall_round_off(system, i, y),
+        // (The round-off's products only for a value below the wall.)
+        _ => v < 0.0 && v < -wall_round_off(system, i, y),
     }
 }
 

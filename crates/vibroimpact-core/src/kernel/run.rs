@@ -12,7 +12,7 @@ use crate::kernel::events::{ContactTiming, Open, PairContact, RunOptions};
 use crate::kernel::fixed::Change;
 use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{
-    event_value, find_crossing, locate, may_cross, past, Buffers, Crossing, Gaps, Location,
+    event_value_from, find_crossing, locate, may_cross, past, Buffers, Crossing, Gaps, Location,
 };
 use crate::kernel::observe::Watch;
 use crate::kernel::reductions::{reduce_step, Reductions};
@@ -406,10 +406,12 @@ impl<'a> Run<'a> {
             if Some(j) == switched || system.held_by_mirror(j, &self.modes) {
                 continue;
             }
-            let v = event_value(
+            // `gaps.end` holds the cut end's gaps.
+            let v = event_value_from(
                 system,
                 j,
                 mode,
+                self.gaps.end[j],
                 at,
                 &self.end,
                 &self.modes,

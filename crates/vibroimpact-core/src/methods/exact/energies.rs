@@ -90,7 +90,12 @@ impl ExactFlow {
             let (eta0, rate0) = self.span_modal[j];
             let (eta1, rate1) = (self.eta[j], self.rate[j]);
             let mut work = 0.0;
-            if let Some((harmonic, u0, u1, sin_turn)) = forcing {
+            // A mode the harmonic does not force (a free mass's) does no work:
+            // its terms below are zeros, and `work` stays +0 (the same bits).
+            let forced = forcing.filter(|(harmonic, ..)| {
+                harmonic.force[j] != (0.0, 0.0) || harmonic.response[j] != (0.0, 0.0)
+            });
+            if let Some((harmonic, u0, u1, sin_turn)) = forced {
                 let w = harmonic.omega;
                 let (zr, zi) = harmonic.response[j];
                 let (pr, pi) = harmonic.force[j];

@@ -169,9 +169,10 @@ impl ExactFlow {
                 *a += pr * c - pi * s;
             }
         }
+        let eta = &self.eta[..r];
         for (i, a) in out[..dim].iter_mut().enumerate() {
-            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
-            *a = row.iter().zip(&self.eta[..r]).map(|(b, e)| b * e).sum();
+            let (columns, row) = cfg.coordinate_rows.row(i);
+            *a = columns.iter().zip(row).map(|(&c, b)| b * eta[c]).sum();
         }
     }
 
@@ -211,11 +212,11 @@ impl ExactFlow {
             *j -= o.c * a;
         }
         for i in 0..dim {
-            let row = &cfg.to_coordinates[i * r..(i + 1) * r];
+            let (columns, row) = cfg.coordinate_rows.row(i);
             let (mut x, mut y) = (0.0, 0.0);
-            for k in 0..r {
-                x += row[k] * a[k];
-                y += row[k] * j[k];
+            for (&k, b) in columns.iter().zip(row) {
+                x += b * a[k];
+                y += b * j[k];
             }
             accel[i] = x;
             jerk[i] = y;
@@ -257,12 +258,14 @@ impl ExactFlow {
         }
         let (x0, v0) = self.begun_state[..2 * dim].split_at(dim);
         let (xs, vs) = out[..2 * dim].split_at_mut(dim);
-        let rows = cfg.to_coordinates[..dim * r].chunks_exact(r);
-        for ((((row, x1), v1), x0), v0) in rows.zip(xs).zip(vs).zip(x0).zip(v0) {
+        // `B`'s non-zero entries only (a free mass's mode moves its own
+        // coordinate alone).
+        for (i, (((x1, v1), x0), v0)) in xs.iter_mut().zip(vs).zip(x0).zip(v0).enumerate() {
+            let (columns, row) = cfg.coordinate_rows.row(i);
             let (mut x, mut v) = (*x0, *v0);
-            for ((b, e), w) in row.iter().zip(eta.iter()).zip(rate.iter()) {
-                x += b * e;
-                v += b * w;
+            for (&c, b) in columns.iter().zip(row) {
+                x += b * eta[c];
+                v += b * rate[c];
             }
             *x1 = x;
             *v1 = v;

@@ -37,6 +37,11 @@ pub struct Configuration {
     pub to_coordinates: Vec<f64>,
     /// `T` (`modes x dim`): modal coordinates from coordinates.
     pub to_modal: Vec<f64>,
+    /// `B`'s and `T`'s non-zero entries by rows: the products the flow
+    /// takes at every evaluation (free masses' modes are one coordinate
+    /// each, and most of `B` zeros).
+    pub coordinate_rows: linalg::SparseRows,
+    pub modal_rows: linalg::SparseRows,
     /// Each mode's `w2` (1/s^2, >= 0) and `c` (1/s, >= 0).
     pub stiffness: Vec<f64>,
     pub damping: Vec<f64>,
@@ -56,6 +61,8 @@ impl Configuration {
             origin: Vec::new(),
             to_coordinates: Vec::new(),
             to_modal: Vec::new(),
+            coordinate_rows: linalg::SparseRows::default(),
+            modal_rows: linalg::SparseRows::default(),
             stiffness: Vec::new(),
             damping: Vec::new(),
             constant: Vec::new(),
@@ -151,6 +158,8 @@ impl Configuration {
         Ok(Some(Self {
             modes: r,
             origin: origin.clone(),
+            coordinate_rows: linalg::SparseRows::new(&to_coordinates, dim, r),
+            modal_rows: linalg::SparseRows::new(&to_modal, r, dim),
             to_coordinates,
             to_modal,
             stiffness: values,

@@ -102,12 +102,14 @@ impl Oscillator {
 /// each).
 #[inline(always)]
 pub(super) fn modal_state(cfg: &Configuration, dim: usize, j: usize, y: &[f64]) -> (f64, f64) {
-    let row = &cfg.to_modal[j * dim..(j + 1) * dim];
-    let (x, v) = (&y[..dim], &y[dim..2 * dim]);
+    // `T`'s non-zero entries of row `j` (the sums from +0 take no sign
+    // from the zeros' terms left out: the dense products' bits).
+    let (columns, row) = cfg.modal_rows.row(j);
+    let (x, v, origin) = (&y[..dim], &y[dim..2 * dim], &cfg.origin[..dim]);
     let (mut eta, mut rate) = (0.0, 0.0);
-    for i in 0..dim {
-        eta += row[i] * (x[i] - cfg.origin[i]);
-        rate += row[i] * v[i];
+    for (&i, b) in columns.iter().zip(row) {
+        eta += b * (x[i] - origin[i]);
+        rate += b * v[i];
     }
     (eta, rate)
 }

@@ -3,7 +3,9 @@
 //! loads, the time scales and the followed points; every input checked.
 
 use super::spec::{FrictionSite, Load, PairLaw, Side, SystemSpec, MAX_PAIRS, MAX_POINTS};
-use super::{same_row, Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw};
+use super::{
+    same_row, Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw, SPARSE_FROM,
+};
 use crate::error::{non_negative, positive, Error, Result};
 use crate::kernel::compact::Compact;
 use crate::model::signals::Signal;
@@ -278,6 +280,12 @@ impl Walls {
         for interaction in &mut walls.interactions {
             interaction.push = full_push(&interaction.h);
             interaction.inverse_mass = linalg::dot(&interaction.h, &interaction.push);
+            interaction.support = (0..dim)
+                .filter(|&c| interaction.h[c] != 0.0 || interaction.push[c] != 0.0)
+                .collect();
+            if dim < SPARSE_FROM || 2 * interaction.support.len() > dim {
+                interaction.support.clear();
+            }
             if interaction.inverse_mass.is_nan() || interaction.inverse_mass <= 0.0 {
                 return Err(Error::Inconsistent(format!(
                     "{} acts at a point that does not move (every mode has a node there): \
@@ -306,6 +314,7 @@ impl Walls {
             h,
             offset,
             law,
+            support: vec![],
         });
     }
 

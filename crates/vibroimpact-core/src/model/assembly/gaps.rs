@@ -2,7 +2,7 @@
 //! of one wall: when it lands, whether its mirror holds it, its scale, its
 //! release from sticking.
 
-use super::{Assembly, Interaction, InteractionLaw, Mode};
+use super::{Assembly, Interaction, InteractionLaw, Mode, SPARSE_FROM};
 use crate::kernel::sized::by_size;
 use crate::numerics::linalg;
 
@@ -17,10 +17,8 @@ impl Assembly {
     pub fn gap(&self, i: usize, y: &[f64]) -> (f64, f64) {
         let it = &self.interactions[i];
         let d = self.dim;
-        (
-            it.offset + linalg::dot(&it.h, &y[..d]),
-            linalg::dot(&it.h, &y[d..2 * d]),
-        )
+        let (hx, hv) = it.dots(&y[..d], &y[d..2 * d]);
+        (it.offset + hx, hv)
     }
 
     /// Every interaction's gap and its rate at state `y` into `out`, as
@@ -42,6 +40,9 @@ impl Assembly {
         {
             products = if *mirror {
                 (-products.0, -products.1)
+            } else if d >= SPARSE_FROM {
+                // (A branch the small sizes' constants fold away.)
+                it.dots(x, v)
             } else {
                 dots(&it.h[..d], x, v)
             };
@@ -54,7 +55,7 @@ impl Assembly {
     /// now); None where the gap's acceleration does not close it.
     pub fn landing_time(&self, i: usize, y: &[f64], acc: &[f64]) -> Option<f64> {
         let (gap, rate) = self.gap(i, y);
-        let closing = -linalg::dot(&self.interactions[i].h, &acc[..self.dim]);
+        let closing = -self.interactions[i].dot(&acc[..self.dim]);
         (closing > 0.0)
             .then(|| (rate + (rate * rate + 2.0 * closing * gap.max(0.0)).sqrt()) / closing)
     }
@@ -103,13 +104,7 @@ impl Assembly {
     /// speed this small is zero.
     pub fn rate_round_off(&self, i: usize, y: &[f64]) -> f64 {
         let d = self.dim;
-        let it = &self.interactions[i];
-        let scale: f64 =
-            it.h.iter()
-                .zip(&y[d..2 * d])
-                .map(|(h, v)| (h * v).abs())
-                .sum();
-        8.0 * f64::EPSILON * scale
+        8.0 * f64::EPSILON * self.interactions[i].magnitudes(&y[d..2 * d])
     }
 
     /// The scale of interaction `i`'s gap at state `y`, m: its offset and
@@ -117,12 +112,7 @@ impl Assembly {
     /// carries.
     pub fn gap_scale(&self, i: usize, y: &[f64]) -> f64 {
         let it = &self.interactions[i];
-        it.offset.abs()
-            + it.h
-                .iter()
-                .zip(&y[..self.dim])
-                .map(|(h, x)| (h * x).abs())
-                .sum::<f64>()
+        it.offset.abs() + it.magnitudes(&y[..self.dim])
     }
 
     /// A sticking pair `i` released: held on its wall only to round-off, it
@@ -134,15 +124,68 @@ impl Assembly {
     pub fn release(&self, i: usize, y: &mut [f64]) {
         let it = &self.interactions[i];
         let d = self.dim;
-        let (gap, rate) = (
-            it.offset + linalg::dot(&it.h, &y[..d]),
-            linalg::dot(&it.h, &y[d..2 * d]),
-        );
+        let (gap, rate) = self.gap(i, y);
         let opening = (16.0 * f64::EPSILON * self.gap_scale(i, y) - gap) / it.inverse_mass;
         let lift = -rate.min(0.0) / it.inverse_mass;
         for (k, p) in it.push.iter().enumerate() {
             y[k] += p * opening;
             y[d + k] += p * lift;
+        }
+    }
+}
+
+impl Interaction {
+    /// `(h . x, h . v)`, each summed in order as [`linalg::dot`] sums it:
+    /// over the support where the row has one (the zeros' terms left out
+    /// change a sum only where it is zero, in its sign).
+    #[inline(always)]
+    pub fn dots(&self, x: &[f64], v: &[f64]) -> (f64, f64) {
+        if self.support.is_empty() {
+            return dots(&self.h, x, v);
+        }
+        let (mut hx, mut hv) = (-0.0, -0.0);
+        for &c in &self.support {
+            hx += self.h[c] * x[c];
+            hv += self.h[c] * v[c];
+        }
+        (hx, hv)
+    }
+
+    /// `h . x` as [`linalg::dot`] sums it, over the support where the row
+    /// has one.
+    #[inline(always)]
+    pub fn dot(&self, x: &[f64]) -> f64 {
+        if self.support.is_empty() {
+            return linalg::dot(&self.h, x);
+        }
+        self.support
+            .iter()
+            .fold(-0.0, |sum, &c| sum + self.h[c] * x[c])
+    }
+
+    /// `sum |h_k x_k|`: the magnitudes a product `h . x` sums (its
+    /// round-off's scale), over the support where the row has one.
+    #[inline(always)]
+    pub fn magnitudes(&self, x: &[f64]) -> f64 {
+        if self.support.is_empty() {
+            return self.h.iter().zip(x).map(|(h, x)| (h * x).abs()).sum();
+        }
+        self.support
+            .iter()
+            .fold(-0.0, |sum, &c| sum + (self.h[c] * x[c]).abs())
+    }
+
+    /// `M^-1 h^T p`'s velocities added to `v` (an impulse `p`, N s).
+    #[inline(always)]
+    pub fn add_push(&self, p: f64, v: &mut [f64]) {
+        if self.support.is_empty() {
+            for (v, push) in v.iter_mut().zip(&self.push) {
+                *v += push * p;
+            }
+        } else {
+            for &c in &self.support {
+                v[c] += self.push[c] * p;
+            }
         }
     }
 }

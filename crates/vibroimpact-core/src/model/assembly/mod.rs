@@ -78,7 +78,18 @@ pub struct Interaction {
     /// `h M^-1 h^T`, 1/kg: the inverse of the effective mass at the gap.
     pub inverse_mass: f64,
     pub law: InteractionLaw,
+    /// The coordinates where `h` or `push` is not zero, in order, where
+    /// those are few in many (see [`SPARSE_FROM`]); empty where the
+    /// products run over every coordinate.
+    pub support: Vec<usize>,
 }
+
+/// The fewest coordinates whose interactions take their products over the
+/// non-zero entries of their rows alone (a column of ten particles: each
+/// pair's row touches two of eleven). Smaller systems take every entry, in
+/// loops of a length known at compile time, as the fixed-size paths
+/// ([`crate::kernel::compact`]) take them: the same bits.
+pub const SPARSE_FROM: usize = 7;
 
 /// A force excitation, ready for the kernel.
 #[derive(Debug, Clone, PartialEq)]

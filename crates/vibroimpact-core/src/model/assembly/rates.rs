@@ -38,7 +38,7 @@ impl Assembly {
         work: &mut [f64],
     ) -> f64 {
         self.rates(time, y, modes, scratch, work);
-        linalg::dot(&self.interactions[i].h, &work[self.dim..2 * self.dim])
+        self.interactions[i].dot(&work[self.dim..2 * self.dim])
     }
 
     /// [`Self::rates`] for `n` structure coordinates and `k` dampers: inlined

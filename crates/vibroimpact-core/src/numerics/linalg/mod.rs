@@ -10,6 +10,7 @@
 mod eigen;
 mod expm;
 mod solve;
+mod sparse;
 mod symmetric;
 #[cfg(test)]
 mod tests;
@@ -18,6 +19,7 @@ pub use eigen::eigenvalues;
 pub use expm::{expm, Expm};
 pub(crate) use solve::solve_pivoted;
 pub use solve::{solve_in_place, solve_matrix_in_place};
+pub use sparse::SparseRows;
 pub use symmetric::{symmetric_eigen, symmetric_eigenvalues};
 
 /// The largest absolute entry.
