@@ -3,8 +3,9 @@
 //! dropped 1 m (part 4); medians of repeated runs, with the flow evaluations
 //! per impact, and the column of ten rigid particles of
 //! benchmarks/bench_collisions.py (events per second). `exact_damper once`
-//! runs the damper once (for callgrind), `exact_damper column` the column
-//! 50 times (for perf).
+//! runs the damper once (for callgrind), `exact_damper balls` the ball 300
+//! times (callgrind of a run's set-up and a few events), `exact_damper
+//! column` the column 50 times (for perf).
 //!
 //!     cargo run --release -p vibroimpact-core --example exact_damper
 
@@ -52,14 +53,14 @@ fn column(restitution: f64) -> SystemSpec {
                 at: 0.0,
                 lower_clearance: if j == 0 { 0.002 } else { f64::INFINITY },
                 upper_clearance: if j == count - 1 { 0.03 } else { f64::INFINITY },
-                law: law.clone(),
+                law,
             })
             .collect(),
         collisions: (0..count - 1)
             .map(|j| Collision {
                 dampers: [j, j + 1],
                 gap: 0.002,
-                law: law.clone(),
+                law,
             })
             .collect(),
         frictions: vec![],
@@ -72,6 +73,15 @@ fn column(restitution: f64) -> SystemSpec {
         points: vec![],
         moments: vec![],
     }
+}
+
+/// `run` made `times` times (every one: a profile's runs), the last kept.
+fn repeated(times: usize, run: impl Fn() -> SystemSolution) -> Option<SystemSolution> {
+    let mut last = None;
+    for _ in 0..times {
+        last = Some(run());
+    }
+    last
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -123,7 +133,8 @@ fn main() {
     let one = match std::env::args().nth(1).as_deref() {
         Some("once") => Some(run(&damper, 125.0)),
         Some("ball") => Some(run(&ball, 6.0)),
-        Some("column") => (0..50).map(|_| run(&column(0.9), 20.0)).last(),
+        Some("balls") => repeated(300, || run(&ball, 6.0)),
+        Some("column") => repeated(50, || run(&column(0.9), 20.0)),
         _ => None,
     };
     if let Some(sol) = one {
@@ -136,12 +147,22 @@ fn main() {
         );
         return;
     }
-    for (name, spec, t_end, repeats) in [
-        ("damper, 1000 periods", &damper, 125.0, 41),
-        ("ball", &ball, 6.0, 2001),
-        ("column, e 0.9", &column(0.9), 20.0, 21),
-        ("column, e 0.6", &column(0.6), 20.0, 21),
-    ] {
+    // Each system made just before its runs (the heap the runs meet is then
+    // the same whatever follows: the ball's short runs are sensitive to it).
+    type Make<'a> = Box<dyn Fn() -> SystemSpec + 'a>;
+    let runs: [(&str, Make, f64, usize); 4] = [
+        (
+            "damper, 1000 periods",
+            Box::new(|| damper.clone()),
+            125.0,
+            41,
+        ),
+        ("ball", Box::new(|| ball.clone()), 6.0, 2001),
+        ("column, e 0.9", Box::new(|| column(0.9)), 20.0, 21),
+        ("column, e 0.6", Box::new(|| column(0.6)), 20.0, 21),
+    ];
+    for (name, make, t_end, repeats) in runs {
+        let spec = &make();
         let mut last = None;
         let times = (0..repeats)
             .map(|_| {

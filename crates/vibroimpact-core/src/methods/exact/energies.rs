@@ -92,9 +92,7 @@ impl ExactFlow {
             let mut work = 0.0;
             // A mode the harmonic does not force (a free mass's) does no work:
             // its terms below are zeros, and `work` stays +0 (the same bits).
-            let forced = forcing.filter(|(harmonic, ..)| {
-                harmonic.force[j] != (0.0, 0.0) || harmonic.response[j] != (0.0, 0.0)
-            });
+            let forced = forcing.filter(|(harmonic, ..)| harmonic.forced.contains(&j));
             if let Some((harmonic, u0, u1, sin_turn)) = forced {
                 let w = harmonic.omega;
                 let (zr, zi) = harmonic.response[j];

@@ -5,7 +5,7 @@ use super::configurations::{Modes, OPEN};
 use super::energies::{Span, NODES};
 use super::oscillator::{from_rest_part, modal_state};
 use crate::error::{Error, Result};
-use crate::model::assembly::{Assembly, InteractionLaw, LinearParts};
+use crate::model::assembly::{Assembly, InteractionLaw, LinearParts, SPARSE_FROM};
 use crate::model::contact::AnyLaw;
 use crate::numerics::series::sin_cos;
 
@@ -169,6 +169,13 @@ impl ExactFlow {
                 *a += pr * c - pi * s;
             }
         }
+        if dim < SPARSE_FROM {
+            for (i, a) in out[..dim].iter_mut().enumerate() {
+                let row = &cfg.to_coordinates[i * r..(i + 1) * r];
+                *a = row.iter().zip(&self.eta[..r]).map(|(b, e)| b * e).sum();
+            }
+            return;
+        }
         let eta = &self.eta[..r];
         for (i, a) in out[..dim].iter_mut().enumerate() {
             let (columns, row) = cfg.coordinate_rows.row(i);
@@ -212,11 +219,19 @@ impl ExactFlow {
             *j -= o.c * a;
         }
         for i in 0..dim {
-            let (columns, row) = cfg.coordinate_rows.row(i);
             let (mut x, mut y) = (0.0, 0.0);
-            for (&k, b) in columns.iter().zip(row) {
-                x += b * a[k];
-                y += b * j[k];
+            if dim < SPARSE_FROM {
+                let row = &cfg.to_coordinates[i * r..(i + 1) * r];
+                for k in 0..r {
+                    x += row[k] * a[k];
+                    y += row[k] * j[k];
+                }
+            } else {
+                let (columns, row) = cfg.coordinate_rows.row(i);
+                for (&k, b) in columns.iter().zip(row) {
+                    x += b * a[k];
+                    y += b * j[k];
+                }
             }
             accel[i] = x;
             jerk[i] = y;
@@ -258,6 +273,23 @@ impl ExactFlow {
         }
         let (x0, v0) = self.begun_state[..2 * dim].split_at(dim);
         let (xs, vs) = out[..2 * dim].split_at_mut(dim);
+        if dim < SPARSE_FROM {
+            // A small system: every entry of `B`, in rows of one length (no
+            // index to load; the same sums where the zeros' terms change
+            // nothing).
+            let rows = cfg.to_coordinates[..dim * r].chunks_exact(r);
+            for ((((row, x1), v1), x0), v0) in rows.zip(xs).zip(vs).zip(x0).zip(v0) {
+                let (mut x, mut v) = (*x0, *v0);
+                for ((b, e), w) in row.iter().zip(eta.iter()).zip(rate.iter()) {
+                    x += b * e;
+                    v += b * w;
+                }
+                *x1 = x;
+                *v1 = v;
+            }
+            self.evaluations += 1;
+            return;
+        }
         // `B`'s non-zero entries only (a free mass's mode moves its own
         // coordinate alone).
         for (i, (((x1, v1), x0), v0)) in xs.iter_mut().zip(vs).zip(x0).zip(v0).enumerate() {
@@ -299,9 +331,11 @@ impl ExactFlow {
             // The angle at the start turned by omega t.
             let (st, ct) = sin_cos(h.omega * t);
             let (s, c) = (s0 * ct + c0 * st, c0 * ct - s0 * st);
-            for ((e, v), &(zr, zi)) in eta.iter_mut().zip(rate.iter_mut()).zip(&h.response) {
-                *e += zr * c - zi * s;
-                *v -= h.omega * (zr * s + zi * c);
+            // The modes it forces (the others' terms are zeros).
+            for &j in &h.forced {
+                let (zr, zi) = h.response[j];
+                eta[j] += zr * c - zi * s;
+                rate[j] -= h.omega * (zr * s + zi * c);
             }
         }
     }

@@ -12,7 +12,7 @@
 //! `eta'' + c eta' + w2 eta = F0 + sum_k Re(P_k e^(i omega_k t))`.
 
 use crate::error::{Error, Result};
-use crate::model::assembly::{HarmonicLoad, LinearParts};
+use crate::model::assembly::{HarmonicLoad, LinearParts, SPARSE_FROM};
 use crate::numerics::linalg;
 
 /// One harmonic of the forcing, with each mode's steady (particular)
@@ -24,6 +24,18 @@ pub struct ModalHarmonic {
     pub response: Vec<(f64, f64)>,
     /// Each mode's force `Re(P e^(i omega t))` as `(Re P, Im P)`.
     pub force: Vec<(f64, f64)>,
+    /// The modes it forces (a response or a force not zero), in order: the
+    /// others' terms are zeros (a free mass's mode where the force acts on
+    /// the structure).
+    pub forced: Vec<usize>,
+}
+
+impl ModalHarmonic {
+    fn find_forced(&mut self) {
+        self.forced = (0..self.response.len())
+            .filter(|&j| self.response[j] != (0.0, 0.0) || self.force[j] != (0.0, 0.0))
+            .collect();
+    }
 }
 
 /// A linear system in the normal modes of one set of constraints.
@@ -155,11 +167,12 @@ impl Configuration {
                 None => harmonics.push(harmonic),
             }
         }
+        harmonics.iter_mut().for_each(ModalHarmonic::find_forced);
         Ok(Some(Self {
             modes: r,
             origin: origin.clone(),
-            coordinate_rows: linalg::SparseRows::new(&to_coordinates, dim, r),
-            modal_rows: linalg::SparseRows::new(&to_modal, r, dim),
+            coordinate_rows: sparse_rows(&to_coordinates, dim, r),
+            modal_rows: sparse_rows(&to_modal, r, dim),
             to_coordinates,
             to_modal,
             stiffness: values,
@@ -282,6 +295,16 @@ fn align_repeated(values: &[f64], phi: &mut [f64], cr: &[f64], r: usize, scale: 
     }
 }
 
+/// A transform's rows by their non-zero entries where the flow takes its
+/// products so (a system of [`SPARSE_FROM`] coordinates or more); none for a
+/// smaller one, whose products take every entry.
+fn sparse_rows(dense: &[f64], rows: usize, columns: usize) -> linalg::SparseRows {
+    if rows.max(columns) < SPARSE_FROM {
+        return linalg::SparseRows::default();
+    }
+    linalg::SparseRows::new(dense, rows, columns)
+}
+
 /// `B = N Phi` (`dim x r`: coordinates from modal coordinates) and `T =
 /// Phi^T Mr N^T` (`r x dim`: modal coordinates from coordinates), `null`
 /// holding `N`'s columns and `mr` the reduced mass.
@@ -355,6 +378,7 @@ fn steady_response(
         omega: load.omega,
         response,
         force,
+        forced: Vec::new(),
     })
 }
 

@@ -2,6 +2,7 @@
 
 use super::from_rest;
 use super::modal::Configuration;
+use crate::model::assembly::SPARSE_FROM;
 use crate::numerics::series::{exp, sin_cos};
 
 /// One modal oscillator `eta'' + c eta' + w2 eta = F0 + forcing`.
@@ -102,11 +103,19 @@ impl Oscillator {
 /// each).
 #[inline(always)]
 pub(super) fn modal_state(cfg: &Configuration, dim: usize, j: usize, y: &[f64]) -> (f64, f64) {
+    let (x, v, origin) = (&y[..dim], &y[dim..2 * dim], &cfg.origin[..dim]);
+    let (mut eta, mut rate) = (0.0, 0.0);
+    if dim < SPARSE_FROM {
+        let row = &cfg.to_modal[j * dim..(j + 1) * dim];
+        for i in 0..dim {
+            eta += row[i] * (x[i] - origin[i]);
+            rate += row[i] * v[i];
+        }
+        return (eta, rate);
+    }
     // `T`'s non-zero entries of row `j` (the sums from +0 take no sign
     // from the zeros' terms left out: the dense products' bits).
     let (columns, row) = cfg.modal_rows.row(j);
-    let (x, v, origin) = (&y[..dim], &y[dim..2 * dim], &cfg.origin[..dim]);
-    let (mut eta, mut rate) = (0.0, 0.0);
     for (&i, b) in columns.iter().zip(row) {
         eta += b * (x[i] - origin[i]);
         rate += b * v[i];

@@ -280,11 +280,13 @@ impl Walls {
         for interaction in &mut walls.interactions {
             interaction.push = full_push(&interaction.h);
             interaction.inverse_mass = linalg::dot(&interaction.h, &interaction.push);
-            interaction.support = (0..dim)
-                .filter(|&c| interaction.h[c] != 0.0 || interaction.push[c] != 0.0)
-                .collect();
-            if dim < SPARSE_FROM || 2 * interaction.support.len() > dim {
-                interaction.support.clear();
+            if dim >= SPARSE_FROM {
+                interaction.support = (0..dim)
+                    .filter(|&c| interaction.h[c] != 0.0 || interaction.push[c] != 0.0)
+                    .collect();
+                if 2 * interaction.support.len() > dim {
+                    interaction.support = Vec::new();
+                }
             }
             if interaction.inverse_mass.is_nan() || interaction.inverse_mass <= 0.0 {
                 return Err(Error::Inconsistent(format!(
@@ -633,22 +635,19 @@ mod tests {
     use crate::model::assembly::Damper;
 
     fn with_clearances(lower: f64, upper: f64) -> SystemSpec {
+        let damper = Damper {
+            mass: 0.05,
+            at: 0.0,
+            lower_clearance: lower,
+            upper_clearance: upper,
+            law: PairLaw::rigid(0.6).unwrap(),
+        };
         SystemSpec {
-            structure: Structure::oscillator(1.0, 400.0, 0.5).unwrap(),
-            dampers: vec![Damper {
-                mass: 0.05,
-                at: 0.0,
-                lower_clearance: lower,
-                upper_clearance: upper,
-                law: PairLaw::rigid(0.6).unwrap(),
-            }],
-            collisions: vec![],
-            frictions: vec![],
-            stops: vec![],
             gravity: 9.81,
-            excitations: vec![],
-            points: vec![],
-            moments: vec![],
+            ..SystemSpec::of(
+                Structure::oscillator(1.0, 400.0, 0.5).unwrap(),
+                vec![damper],
+            )
         }
     }
 

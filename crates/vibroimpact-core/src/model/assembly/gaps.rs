@@ -110,6 +110,7 @@ impl Assembly {
     /// The scale of interaction `i`'s gap at state `y`, m: its offset and
     /// the magnitudes of the terms `h . x` sums, whose round-off the gap
     /// carries.
+    #[inline(always)]
     pub fn gap_scale(&self, i: usize, y: &[f64]) -> f64 {
         let it = &self.interactions[i];
         it.offset.abs() + it.magnitudes(&y[..self.dim])
@@ -227,4 +228,79 @@ pub(crate) fn h_dot(h: &[f64], x: &[f64]) -> f64 {
         sum[i % 2] += h[i] * x[i];
     }
     sum[0] + sum[1]
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::model::assembly::{Assembly, Collision, Damper, PairLaw, SystemSpec};
+    use crate::model::structure::Structure;
+    use crate::numerics::linalg;
+
+    /// `count` loose masses in a row on an oscillator, neighbours colliding.
+    fn row_of(count: usize) -> Assembly {
+        let law = PairLaw::rigid(0.9).unwrap();
+        let dampers = (0..count)
+            .map(|j| Damper {
+                mass: 0.01 * (1.0 + j as f64),
+                at: 0.0,
+                lower_clearance: if j == 0 { 2e-3 } else { f64::INFINITY },
+                upper_clearance: if j == count - 1 { 3e-2 } else { f64::INFINITY },
+                law,
+            })
+            .collect();
+        let structure = Structure::oscillator(1.0, 8883.0, 9.42).unwrap();
+        Assembly::new(&SystemSpec {
+            collisions: (0..count - 1)
+                .map(|j| Collision {
+                    dampers: [j, j + 1],
+                    gap: 2e-3,
+                    law,
+                })
+                .collect(),
+            gravity: 9.81,
+            ..SystemSpec::of(structure, dampers)
+        })
+        .unwrap()
+    }
+
+    /// A large system's rows keep the coordinates where `h` or `push` is not
+    /// zero, and its products over them are the dense products: a support
+    /// missing a coordinate (or a mirror's products shared wrongly) moves a
+    /// gap, a rate, a landing or an impulse.
+    #[test]
+    fn products_over_the_support_are_the_dense_products() {
+        crate::testing::timeout(10, || {
+            let system = row_of(10);
+            let d = system.dim;
+            assert_eq!(d, 11);
+            let y: Vec<f64> = (0..2 * d)
+                .map(|k| ((k as f64) * 0.7).sin() * 1e-2 + 1e-3)
+                .collect();
+            let mut gaps = vec![(0.0, 0.0); system.interactions.len()];
+            system.gaps(&y, &mut gaps);
+            for (i, it) in system.interactions.iter().enumerate() {
+                // The floor and ceiling touch the structure and one mass, a
+                // collision two masses.
+                assert_eq!(it.support.len(), 2, "{i}");
+                let dense = (
+                    it.offset + linalg::dot(&it.h, &y[..d]),
+                    linalg::dot(&it.h, &y[d..]),
+                );
+                assert_eq!(system.gap(i, &y), dense, "{i}");
+                assert_eq!(gaps[i], dense, "{i}");
+                let magnitudes: f64 = it.h.iter().zip(&y[..d]).map(|(h, x)| (h * x).abs()).sum();
+                assert_eq!(it.magnitudes(&y[..d]), magnitudes);
+                let mut pushed = y[d..].to_vec();
+                it.add_push(0.3, &mut pushed);
+                for (k, (after, before)) in pushed.iter().zip(&y[d..]).enumerate() {
+                    assert_eq!(*after, before + it.push[k] * 0.3, "{i} {k}");
+                }
+            }
+            // A small system keeps every entry (the fixed-size paths' sums).
+            assert!(row_of(2)
+                .interactions
+                .iter()
+                .all(|it| it.support.is_empty()));
+        });
+    }
 }

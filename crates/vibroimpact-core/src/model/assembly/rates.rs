@@ -28,6 +28,7 @@ impl Assembly {
     /// The second derivative of interaction `i`'s gap at `time` and state `y`
     /// in `modes` (m/s^2, < 0 pressing it shut): `h . a` from [`Self::rates`],
     /// which `work` (the state's length) receives.
+    #[inline(always)]
     pub fn gap_acceleration(
         &self,
         i: usize,

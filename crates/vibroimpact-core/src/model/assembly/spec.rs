@@ -159,6 +159,25 @@ pub struct SystemSpec {
     pub moments: Vec<f64>,
 }
 
+impl SystemSpec {
+    /// `structure` carrying `dampers`, with no stop, collision, friction,
+    /// gravity, excitation or point followed: the other parts set by field
+    /// (`SystemSpec { gravity: 9.81, ..SystemSpec::of(structure, dampers) }`).
+    pub fn of(structure: Structure, dampers: Vec<Damper>) -> Self {
+        Self {
+            structure,
+            dampers,
+            stops: vec![],
+            collisions: vec![],
+            frictions: vec![],
+            gravity: 0.0,
+            excitations: vec![],
+            points: vec![],
+            moments: vec![],
+        }
+    }
+}
+
 /// The most points a run may follow (each is a row of the structure's
 /// coordinates, a peak and a mean square).
 pub const MAX_POINTS: usize = 10_000;
