@@ -62,12 +62,11 @@ impl SparseRows {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::timeout;
 
     /// Each row's products equal the dense ones, with the zeros left out.
     #[test]
     fn rows_hold_the_non_zero_entries_in_order() {
-        timeout(5, || {
+        crate::testing::timeout(5, || {
             let dense = [1.5, 0.0, -2.0, 0.0, 0.0, 0.0, 0.0, 3.0, 0.25];
             let sparse = SparseRows::new(&dense, 3, 3);
             assert_eq!(sparse.len(), 4);
