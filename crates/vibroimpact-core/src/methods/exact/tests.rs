@@ -265,3 +265,85 @@ fn closed_form_step_energies_are_the_gauss_legendre_quadrature_s() {
         }
     });
 }
+
+/// Ten loose masses in a row on a forced, damped oscillator under gravity,
+/// drawing apart in free flight: a flow of eleven coordinates, taken by the
+/// non-zero entries of its transforms (each free mass's mode is its own
+/// coordinate), must give each mass its parabola and every coordinate the
+/// accelerations (and their rates) the system's own rates give.
+#[test]
+fn a_large_system_s_flow_is_its_free_flights_and_its_rates() {
+    crate::testing::timeout(30, || {
+        use crate::model::assembly::Collision;
+        let law = PairLaw::rigid(0.9).unwrap();
+        let dampers = (0..10)
+            .map(|j| Damper {
+                mass: 0.01 * (1.0 + j as f64),
+                at: 0.0,
+                lower_clearance: if j == 0 { 0.05 } else { f64::INFINITY },
+                upper_clearance: if j == 9 { 0.5 } else { f64::INFINITY },
+                law,
+            })
+            .collect();
+        let spec = SystemSpec {
+            collisions: (0..9)
+                .map(|j| Collision {
+                    dampers: [j, j + 1],
+                    gap: 0.05,
+                    law,
+                })
+                .collect(),
+            gravity: 9.81,
+            excitations: vec![Excitation {
+                load: Load::Force { at: 0.0 },
+                signal: Signal::harmonic(20.0, 7.0, 0.3).unwrap(),
+            }],
+            ..SystemSpec::of(Structure::oscillator(1.0, 3000.0, 3.0).unwrap(), dampers)
+        };
+        let system = Assembly::new(&spec).unwrap();
+        let (dim, len) = (system.dim, system.state_len());
+        assert_eq!(dim, 11);
+        let speeds: Vec<f64> = (0..10).map(|j| 0.01 * j as f64).collect();
+        let y = initial_state(&system, &[0.004], &[-0.2], &[0.0; 10], &speeds).unwrap();
+        let mut flow = ExactFlow::new(&system).unwrap();
+        let modes = vec![Mode::Open; system.interactions.len()];
+        let mut scratch = Scratch::new(&system);
+        let (mut end, mut rates) = (vec![0.0; len], vec![0.0; len]);
+        let (time, h) = (0.37, 0.6 * flow.step());
+        flow.attempt(&system, time, &y, h, &modes, &mut scratch, &mut end)
+            .unwrap();
+        for k in 1..dim {
+            // x0 + v0 h - g h^2 / 2, v0 - g h.
+            let (x, v) = (
+                y[k] + y[dim + k] * h - 0.5 * 9.81 * h * h,
+                y[dim + k] - 9.81 * h,
+            );
+            assert!(
+                (end[k] - x).abs() <= 1e-15 * (1.0 + x.abs()),
+                "{k}: {} {x}",
+                end[k]
+            );
+            assert!(
+                (end[dim + k] - v).abs() <= 1e-14,
+                "{k}: {} {v}",
+                end[dim + k]
+            );
+        }
+        // The flow's accelerations at the end against the system's rates.
+        system.rates(time + h, &end, &modes, &mut scratch, &mut rates);
+        let (mut accel, mut jerk) = (vec![0.0; dim], vec![0.0; dim]);
+        assert!(flow.end_derivatives(&system, &mut accel, &mut jerk));
+        let scale = rates[dim..2 * dim]
+            .iter()
+            .fold(0.0f64, |m, a| m.max(a.abs()));
+        for i in 0..dim {
+            assert!(
+                (accel[i] - rates[dim + i]).abs() <= 1e-12 * scale,
+                "{i}: {accel:?} {rates:?}"
+            );
+        }
+        // A free mass's acceleration is gravity's alone: no jerk.
+        assert!(jerk[1..].iter().all(|j| *j == 0.0), "{jerk:?}");
+        assert!(jerk[0] != 0.0);
+    });
+}

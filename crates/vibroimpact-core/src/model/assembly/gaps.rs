@@ -263,6 +263,28 @@ mod tests {
         .unwrap()
     }
 
+    /// Five loose masses on a two-coordinate structure whose mass matrix
+    /// couples its coordinates: a wall's push (`M^-1 h^T`) moves a structure
+    /// coordinate its row does not touch.
+    fn coupled_carrier() -> Assembly {
+        let structure = Structure::matrices(
+            &[vec![2.0, 0.5], vec![0.5, 1.0]],
+            &[vec![900.0, -300.0], vec![-300.0, 600.0]],
+            &[vec![0.0, 0.0], vec![0.0, 0.0]],
+        )
+        .unwrap();
+        let dampers = (0..5)
+            .map(|j| Damper {
+                mass: 0.02,
+                at: 0.0,
+                lower_clearance: 1e-3 * (1.0 + j as f64),
+                upper_clearance: 2e-3,
+                law: PairLaw::rigid(0.5).unwrap(),
+            })
+            .collect();
+        Assembly::new(&SystemSpec::of(structure, dampers)).unwrap()
+    }
+
     /// A large system's rows keep the coordinates where `h` or `push` is not
     /// zero, and its products over them are the dense products: a support
     /// missing a coordinate (or a mirror's products shared wrongly) moves a
@@ -270,6 +292,21 @@ mod tests {
     #[test]
     fn products_over_the_support_are_the_dense_products() {
         crate::testing::timeout(10, || {
+            // The coupled carrier: each wall's row touches coordinate 0 and
+            // its mass, its push coordinate 1 as well (a support of the row
+            // alone would leave the impulse's share there out).
+            let system = coupled_carrier();
+            let d = system.dim;
+            let y: Vec<f64> = (0..2 * d).map(|k| 1e-3 * (k as f64 + 1.0)).collect();
+            for it in &system.interactions {
+                assert_eq!((it.h[1], it.support.len()), (0.0, 3));
+                assert_ne!(it.push[1], 0.0);
+                let mut pushed = y[d..].to_vec();
+                it.add_push(0.3, &mut pushed);
+                for (k, (after, before)) in pushed.iter().zip(&y[d..]).enumerate() {
+                    assert_eq!(*after, before + it.push[k] * 0.3, "{k}");
+                }
+            }
             let system = row_of(10);
             let d = system.dim;
             assert_eq!(d, 11);
