@@ -45,17 +45,16 @@ fn column(restitution: f64) -> SystemSpec {
     let count = 10;
     let k = 8883.0;
     let law = PairLaw::rigid(restitution).unwrap();
+    let dampers = (0..count)
+        .map(|j| Damper {
+            mass: 0.01,
+            at: 0.0,
+            lower_clearance: if j == 0 { 0.002 } else { f64::INFINITY },
+            upper_clearance: if j == count - 1 { 0.03 } else { f64::INFINITY },
+            law,
+        })
+        .collect();
     SystemSpec {
-        structure: Structure::oscillator(1.0, k, 9.42).unwrap(),
-        dampers: (0..count)
-            .map(|j| Damper {
-                mass: 0.01,
-                at: 0.0,
-                lower_clearance: if j == 0 { 0.002 } else { f64::INFINITY },
-                upper_clearance: if j == count - 1 { 0.03 } else { f64::INFINITY },
-                law,
-            })
-            .collect(),
         collisions: (0..count - 1)
             .map(|j| Collision {
                 dampers: [j, j + 1],
@@ -63,15 +62,12 @@ fn column(restitution: f64) -> SystemSpec {
                 law,
             })
             .collect(),
-        frictions: vec![],
-        stops: vec![],
         gravity: 9.81,
         excitations: vec![Excitation {
             load: Load::Force { at: 0.0 },
             signal: Signal::harmonic(30.0, 10.0, 0.0).unwrap(),
         }],
-        points: vec![],
-        moments: vec![],
+        ..SystemSpec::of(Structure::oscillator(1.0, k, 9.42).unwrap(), dampers)
     }
 }
 

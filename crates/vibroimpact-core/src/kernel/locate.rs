@@ -25,18 +25,12 @@ pub(super) fn event_value(
     scratch: &mut Scratch,
     work: &mut [f64],
 ) -> f64 {
-    match mode {
-        Mode::Open => system.gap(i, y).0,
-        Mode::Compliant { .. } => -system.gap(i, y).0,
-        Mode::Sticking => {
-            constraint_force(system, i, (time, y, modes), scratch, work) + system.friction_hold[i]
-        }
-        Mode::Sliding { direction } => direction * system.gap(i, y).1,
-        Mode::Stuck { .. } => {
-            let held = constraint_force(system, i, (time, y, modes), scratch, work).abs();
-            system.static_force(i) - held
-        }
-    }
+    // A held element's value is a force: its gap is not needed.
+    let gap = match mode {
+        Mode::Sticking | Mode::Stuck { .. } => (f64::NAN, f64::NAN),
+        _ => system.gap(i, y),
+    };
+    event_value_from(system, i, mode, gap, time, y, modes, scratch, work)
 }
 
 /// [`event_value`] where interaction `i`'s gap and rate at `y` are known,
@@ -60,8 +54,12 @@ pub(super) fn event_value_from(
         Mode::Open => gap,
         Mode::Compliant { .. } => -gap,
         Mode::Sliding { direction } => direction * rate,
-        Mode::Sticking | Mode::Stuck { .. } => {
-            event_value(system, i, mode, time, y, modes, scratch, work)
+        Mode::Sticking => {
+            constraint_force(system, i, (time, y, modes), scratch, work) + system.friction_hold[i]
+        }
+        Mode::Stuck { .. } => {
+            let held = constraint_force(system, i, (time, y, modes), scratch, work).abs();
+            system.static_force(i) - held
         }
     }
 }
