@@ -22,6 +22,11 @@ stay the same): fewer operations than a kernel for any system can do.
     python benchmarks/bench_numba.py
 
 Goal (issue 8): the two-mass RK4 path at least as fast as numba's.
+
+Where the time goes: the same runs of 2e5 steps (a third of them in contact) and of
+1e7 (a thirteenth) give, for each side, the cost of a step in free flight and of one
+with the pair indented (two runs, two unknowns; the steps in contact counted along
+the same trajectory).
 """
 
 from __future__ import annotations
@@ -35,9 +40,11 @@ import vibroimpact as vi
 M, K, C, m, d = 1.0, 1.0, 0.01, 0.25, 0.01
 K_HZ, C1 = 3000.0, 0.01
 DT, STEPS = 1e-4, 10_000_000
+# The short run of the decomposition (a third of its steps in contact).
+SHORT = 200_000
 
 
-def ours() -> tuple[float, tuple[float, float, float, float]]:
+def ours(steps: int = STEPS) -> tuple[float, tuple[float, float, float, float]]:
     system = vi.ImpactDamper(main_mass=M, stiffness=K, damping=C, impact_mass=m, clearance=d)
     contact = vi.Contact("hertz", stiffness=K_HZ, damping=C1)
     start = vi.InitialState(impact_displacement=d, impact_velocity=0.1)
@@ -49,9 +56,9 @@ def ours() -> tuple[float, tuple[float, float, float, float]]:
         method="rk4",
         stepping="fixed",
         dt=DT,
-        t_end=STEPS * DT,
+        t_end=steps * DT,
         history=False,
-        max_steps=STEPS,
+        max_steps=steps,
     )
     seconds = time.perf_counter() - t0
     s = sol.final_state
@@ -125,6 +132,63 @@ def kernel(frozen: bool) -> object:
     return lambda n, dt: run(params, n, dt)
 
 
+def contact_steps(steps: int) -> tuple[int, tuple[float, float, float, float]]:
+    """How many of the first ``steps`` steps start with the pair indented
+    (``|y - w| > d``), along the same trajectory (the same arithmetic: the
+    final state, returned too, is the kernels' to the bit)."""
+    from numba import njit
+
+    @njit(cache=False)
+    def count(steps: int, dt: float) -> tuple[int, float, float, float, float]:
+        w, wv, y, yv = 0.0, 0.0, d, 0.1
+        half = dt * 0.5
+        b1, b2 = dt * (1.0 / 6.0), dt * (1.0 / 3.0)
+        indented = 0
+        for _ in range(steps):
+            if abs(y - w) > d:
+                indented += 1
+            ks: list[tuple[float, float, float, float]] = []
+            point = (w, wv, y, yv)
+            for weight in (0.0, half, half, dt):
+                if ks:
+                    k = ks[-1]
+                    point = (
+                        w + weight * k[0],
+                        wv + weight * k[1],
+                        y + weight * k[2],
+                        yv + weight * k[3],
+                    )
+                main = (-(C / M)) * point[1] - (K / M) * point[0]
+                u = point[2] - point[0]
+                aw, ay = main, 0.0
+                if abs(u) > d:
+                    side = 1.0 if (u > 0.0 or (u == 0.0 and point[3] - point[1] >= 0.0)) else -1.0
+                    ind = side * u - d
+                    rate = side * (point[3] - point[1])
+                    law = K_HZ * ind * math.sqrt(ind) if ind > 0.0 else 0.0
+                    total = law + C1 * rate if ind > 0.0 else 0.0
+                    push = side * total
+                    aw, ay = main + push * (1.0 / M), -push * (1.0 / m)
+                ks.append((point[1], aw, point[3], ay))
+            k1, k2, k3, k4 = ks
+            w = w + b1 * k1[0] + b2 * k2[0] + b2 * k3[0] + b1 * k4[0]
+            wv = wv + b1 * k1[1] + b2 * k2[1] + b2 * k3[1] + b1 * k4[1]
+            y = y + b1 * k1[2] + b2 * k2[2] + b2 * k3[2] + b1 * k4[2]
+            yv = yv + b1 * k1[3] + b2 * k2[3] + b2 * k3[3] + b1 * k4[3]
+        return indented, w, wv, y, yv
+
+    indented, *state = count(steps, DT)
+    return int(indented), (state[0], state[1], state[2], state[3])
+
+
+def per_step(short: float, long: float, indented: tuple[int, int]) -> tuple[float, float]:
+    """Seconds a step in free flight and a step in contact, from the times of
+    the ``SHORT`` and ``STEPS`` runs and their steps in contact."""
+    (a, b), (c, e) = (SHORT - indented[0], indented[0]), (STEPS - indented[1], indented[1])
+    determinant = a * e - b * c
+    return (short * e - b * long) / determinant, (a * long - c * short) / determinant
+
+
 def main() -> None:
     try:
         arguments, frozen = build()
@@ -156,6 +220,35 @@ def main() -> None:
         if not same:
             print(f"    vibroimpact {states['vibroimpact']}\n    numba       {states[name]}")
     print("  goal (issue 8): ratio >= 1 against the same arithmetic (parameters as arguments)")
+    decompose(arguments, ours_s, statistics.median(times["arguments"]), states["arguments"])
+
+
+def decompose(arguments: object, ours_long: float, theirs_long: float, final: object) -> None:
+    """Each side's cost of a step in free flight and in contact (see the doc)."""
+    (short_count, _), (long_count, counted) = contact_steps(SHORT), contact_steps(STEPS)
+    if counted != final:
+        raise SystemExit(f"the counting kernel left the trajectory: {counted} != {final}")
+    indented = (short_count, long_count)
+    short: dict[str, list[float]] = {"vibroimpact": [], "numba": []}
+    for _ in range(21):
+        short["vibroimpact"].append(ours(SHORT)[0])
+        t0 = time.perf_counter()
+        arguments(SHORT, DT)  # type: ignore[operator]
+        short["numba"].append(time.perf_counter() - t0)
+    ours_free, ours_contact = per_step(statistics.median(short["vibroimpact"]), ours_long, indented)
+    free, contact = per_step(statistics.median(short["numba"]), theirs_long, indented)
+    print(
+        f"  per step (steps in contact: {indented[0]} of {SHORT:.0e}, {indented[1]} of "
+        f"{STEPS:.0e}):"
+    )
+    print(
+        f"    free flight: vibroimpact {ours_free * 1e9:.1f} ns, numba {free * 1e9:.1f} ns, "
+        f"ratio {free / ours_free:.2f}"
+    )
+    print(
+        f"    in contact:  vibroimpact {ours_contact * 1e9:.1f} ns, numba {contact * 1e9:.1f} ns, "
+        f"ratio {contact / ours_contact:.2f}"
+    )
 
 
 if __name__ == "__main__":

@@ -14,7 +14,7 @@ use vibroimpact_core::kernel::events::{RunOptions, SystemSolution};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::{AnyStepper, Options};
 use vibroimpact_core::model::assembly::{
-    initial_state, Assembly, Collision, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
+    initial_state, Assembly, Damper, Excitation, Load, PairLaw, Side, Stop, SystemSpec,
 };
 use vibroimpact_core::model::signals::Signal;
 use vibroimpact_core::model::structure::Structure;
@@ -42,32 +42,14 @@ fn run(spec: &SystemSpec, t_end: f64) -> SystemSolution {
 /// cavity forced with 30 N at 10 Hz under gravity, every pair rigid at
 /// `restitution` (tests/test_collisions.py's `forced_column`).
 fn column(restitution: f64) -> SystemSpec {
-    let count = 10;
-    let k = 8883.0;
+    let structure = Structure::oscillator(1.0, 8883.0, 9.42).unwrap();
     let law = PairLaw::rigid(restitution).unwrap();
-    let dampers = (0..count)
-        .map(|j| Damper {
-            mass: 0.01,
-            at: 0.0,
-            lower_clearance: if j == 0 { 0.002 } else { f64::INFINITY },
-            upper_clearance: if j == count - 1 { 0.03 } else { f64::INFINITY },
-            law,
-        })
-        .collect();
     SystemSpec {
-        collisions: (0..count - 1)
-            .map(|j| Collision {
-                dampers: [j, j + 1],
-                gap: 0.002,
-                law,
-            })
-            .collect(),
-        gravity: 9.81,
         excitations: vec![Excitation {
             load: Load::Force { at: 0.0 },
             signal: Signal::harmonic(30.0, 10.0, 0.0).unwrap(),
         }],
-        ..SystemSpec::of(Structure::oscillator(1.0, k, 9.42).unwrap(), dampers)
+        ..SystemSpec::column(structure, &[0.01; 10], [0.002, 0.002, 0.03], law)
     }
 }
 

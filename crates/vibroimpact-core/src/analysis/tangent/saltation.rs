@@ -269,15 +269,26 @@ impl Saltation {
         }
         self.rates(system, view.time, view.before, view.modes_before, false);
         self.rates(system, view.time, view.after, view.modes_after, true);
-        // f+ - R f-: the velocities' jump, then the accelerations'.
+        // The gap's own rate `h . v-` (`side` squared is 1: the same bits as
+        // dividing `side (f+ - R f-)` by `closing`).
+        self.shift(d, side * closing, h, out);
+        Outcome { grazing: None }
+    }
+
+    /// The time shift of the located event's value `g`, of rate `rate` along
+    /// the flow before the event and gradient `gradient` (over the first
+    /// coordinates; the rest zero): `(f+ - R f-) grad(g)^T / (dg/dt)` added
+    /// to `out` (the velocities' jump, then the accelerations'), the jump
+    /// per unit of `g` kept for the parameter columns.
+    fn shift(&mut self, d: usize, rate: f64, gradient: &[f64], out: &mut [f64]) {
+        let size = 2 * d;
         for r in 0..size {
-            let jump = (self.plus[r] - self.reset_minus(d, r)) * side / closing;
+            let jump = (self.plus[r] - self.reset_minus(d, r)) / rate;
             self.jump[r] = jump;
-            for (c, hc) in h.iter().enumerate() {
-                out[r * size + c] += jump * hc;
+            for (c, g) in gradient.iter().enumerate() {
+                out[r * size + c] += jump * g;
             }
         }
-        Outcome { grazing: None }
     }
 
     /// Row `r` of `R f-` (`self.minus` through the velocities' reset).
@@ -337,13 +348,10 @@ impl Saltation {
                 grazing: Some(closing.abs()),
             };
         }
-        for r in 0..size {
-            let jump = (self.plus[r] - self.reset_minus(d, r)) / closing;
-            self.jump[r] = jump;
-            for (c, g) in self.gradient.iter().enumerate() {
-                out[r * size + c] += jump * g;
-            }
-        }
+        // Taken out for the call (no copy: an empty vector in its place).
+        let gradient = std::mem::take(&mut self.gradient);
+        self.shift(d, closing, &gradient, out);
+        self.gradient = gradient;
         Outcome { grazing: None }
     }
 

@@ -274,31 +274,15 @@ fn closed_form_step_energies_are_the_gauss_legendre_quadrature_s() {
 #[test]
 fn a_large_system_s_flow_is_its_free_flights_and_its_rates() {
     crate::testing::timeout(30, || {
-        use crate::model::assembly::Collision;
+        let structure = Structure::oscillator(1.0, 3000.0, 3.0).unwrap();
+        let masses: Vec<f64> = (0..10).map(|j| 0.01 * (1.0 + j as f64)).collect();
         let law = PairLaw::rigid(0.9).unwrap();
-        let dampers = (0..10)
-            .map(|j| Damper {
-                mass: 0.01 * (1.0 + j as f64),
-                at: 0.0,
-                lower_clearance: if j == 0 { 0.05 } else { f64::INFINITY },
-                upper_clearance: if j == 9 { 0.5 } else { f64::INFINITY },
-                law,
-            })
-            .collect();
         let spec = SystemSpec {
-            collisions: (0..9)
-                .map(|j| Collision {
-                    dampers: [j, j + 1],
-                    gap: 0.05,
-                    law,
-                })
-                .collect(),
-            gravity: 9.81,
             excitations: vec![Excitation {
                 load: Load::Force { at: 0.0 },
                 signal: Signal::harmonic(20.0, 7.0, 0.3).unwrap(),
             }],
-            ..SystemSpec::of(Structure::oscillator(1.0, 3000.0, 3.0).unwrap(), dampers)
+            ..SystemSpec::column(structure, &masses, [0.05, 0.05, 0.5], law)
         };
         let system = Assembly::new(&spec).unwrap();
         let (dim, len) = (system.dim, system.state_len());

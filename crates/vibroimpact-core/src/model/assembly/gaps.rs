@@ -232,34 +232,21 @@ pub(crate) fn h_dot(h: &[f64], x: &[f64]) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use crate::model::assembly::{Assembly, Collision, Damper, PairLaw, SystemSpec};
+    use crate::model::assembly::{Assembly, Damper, PairLaw, SystemSpec};
     use crate::model::structure::Structure;
     use crate::numerics::linalg;
 
     /// `count` loose masses in a row on an oscillator, neighbours colliding.
     fn row_of(count: usize) -> Assembly {
-        let law = PairLaw::rigid(0.9).unwrap();
-        let dampers = (0..count)
-            .map(|j| Damper {
-                mass: 0.01 * (1.0 + j as f64),
-                at: 0.0,
-                lower_clearance: if j == 0 { 2e-3 } else { f64::INFINITY },
-                upper_clearance: if j == count - 1 { 3e-2 } else { f64::INFINITY },
-                law,
-            })
-            .collect();
         let structure = Structure::oscillator(1.0, 8883.0, 9.42).unwrap();
-        Assembly::new(&SystemSpec {
-            collisions: (0..count - 1)
-                .map(|j| Collision {
-                    dampers: [j, j + 1],
-                    gap: 2e-3,
-                    law,
-                })
-                .collect(),
-            gravity: 9.81,
-            ..SystemSpec::of(structure, dampers)
-        })
+        let masses: Vec<f64> = (0..count).map(|j| 0.01 * (1.0 + j as f64)).collect();
+        let law = PairLaw::rigid(0.9).unwrap();
+        Assembly::new(&SystemSpec::column(
+            structure,
+            &masses,
+            [2e-3, 2e-3, 3e-2],
+            law,
+        ))
         .unwrap()
     }
 

@@ -176,6 +176,47 @@ impl SystemSpec {
             moments: vec![],
         }
     }
+
+    /// A column of loose masses (`masses`, kg) on `structure`'s coordinate
+    /// 0 under gravity (9.81 m/s^2): the first `floor` (m) above its lower
+    /// wall, the last `ceiling` (m) below its upper one, neighbours
+    /// colliding across `gap` (m), every pair with `law`. A particle column
+    /// in a vibrating cavity; the other parts set by field.
+    pub fn column(
+        structure: Structure,
+        masses: &[f64],
+        [floor, gap, ceiling]: [f64; 3],
+        law: PairLaw,
+    ) -> Self {
+        let count = masses.len();
+        let dampers = masses
+            .iter()
+            .enumerate()
+            .map(|(j, &mass)| Damper {
+                mass,
+                at: 0.0,
+                lower_clearance: if j == 0 { floor } else { f64::INFINITY },
+                upper_clearance: if j + 1 == count {
+                    ceiling
+                } else {
+                    f64::INFINITY
+                },
+                law,
+            })
+            .collect();
+        let collisions = (1..count)
+            .map(|j| Collision {
+                dampers: [j - 1, j],
+                gap,
+                law,
+            })
+            .collect();
+        Self {
+            collisions,
+            gravity: 9.81,
+            ..Self::of(structure, dampers)
+        }
+    }
 }
 
 /// The most points a run may follow (each is a row of the structure's
