@@ -49,7 +49,7 @@ fn column(restitution: f64) -> SystemSpec {
             load: Load::Force { at: 0.0 },
             signal: Signal::harmonic(30.0, 10.0, 0.0).unwrap(),
         }],
-        ..SystemSpec::column(structure, &[0.01; 10], [0.002, 0.002, 0.03], law)
+        ..SystemSpec::column(structure, 0.0, &[0.01; 10], [0.002, 0.002, 0.03], law)
     }
 }
 

@@ -49,9 +49,10 @@ pub(super) struct Saltation {
     reset: Vec<f64>,
     column: Vec<f64>,
     coupling: Vec<f64>,
-    /// The last event's `(f+ - R f-) / (grad(g) . f-)`: the saltation's
-    /// column per unit of the located gap's change (zero where the event
-    /// had no time shift: a release, a grazing, a landing at rest).
+    /// The last event's `(f+ - R f-) / (dg/dt)` (see `shift`): the
+    /// saltation's column per unit of the located event value's change
+    /// (zero where the event had no time shift: a release, a grazing, a
+    /// landing at rest).
     jump: Vec<f64>,
     /// Whether the last event was a landing at rest (its displacements
     /// projected as the velocities are).

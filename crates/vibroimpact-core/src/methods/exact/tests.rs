@@ -282,7 +282,7 @@ fn a_large_system_s_flow_is_its_free_flights_and_its_rates() {
                 load: Load::Force { at: 0.0 },
                 signal: Signal::harmonic(20.0, 7.0, 0.3).unwrap(),
             }],
-            ..SystemSpec::column(structure, &masses, [0.05, 0.05, 0.5], law)
+            ..SystemSpec::column(structure, 0.0, &masses, [0.05, 0.05, 0.5], law)
         };
         let system = Assembly::new(&spec).unwrap();
         let (dim, len) = (system.dim, system.state_len());

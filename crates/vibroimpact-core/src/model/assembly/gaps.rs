@@ -243,6 +243,7 @@ mod tests {
         let law = PairLaw::rigid(0.9).unwrap();
         Assembly::new(&SystemSpec::column(
             structure,
+            0.0,
             &masses,
             [2e-3, 2e-3, 3e-2],
             law,

@@ -177,13 +177,14 @@ impl SystemSpec {
         }
     }
 
-    /// A column of loose masses (`masses`, kg) on `structure`'s coordinate
-    /// 0 under gravity (9.81 m/s^2): the first `floor` (m) above its lower
-    /// wall, the last `ceiling` (m) below its upper one, neighbours
-    /// colliding across `gap` (m), every pair with `law`. A particle column
-    /// in a vibrating cavity; the other parts set by field.
+    /// A column of loose masses (`masses`, kg) at point `at` of `structure`
+    /// (see [`Damper::at`]) under gravity (9.81 m/s^2): the first `floor`
+    /// (m) above its lower wall, the last `ceiling` (m) below its upper one,
+    /// neighbours colliding across `gap` (m), every pair with `law`. A
+    /// particle column in a vibrating cavity; the other parts set by field.
     pub fn column(
         structure: Structure,
+        at: f64,
         masses: &[f64],
         [floor, gap, ceiling]: [f64; 3],
         law: PairLaw,
@@ -194,7 +195,7 @@ impl SystemSpec {
             .enumerate()
             .map(|(j, &mass)| Damper {
                 mass,
-                at: 0.0,
+                at,
                 lower_clearance: if j == 0 { floor } else { f64::INFINITY },
                 upper_clearance: if j + 1 == count {
                     ceiling
