@@ -36,6 +36,9 @@ if TYPE_CHECKING:
 #: Newton iterations, and the parameter's tolerance relative to its size.
 ITERATIONS = 16
 PARAMETER_TOLERANCE = 1e-12
+#: The farthest a Newton iterate's touch instant may stand from the section, in the
+#: orbit's spans (beyond it Newton has left the grazing: None).
+TOUCH_SPANS = 4.0
 #: The samples of a gap over the orbit that give Newton its first instant.
 SAMPLES = 64
 
@@ -267,7 +270,9 @@ def _newton(arc: _Arc, wall: _Wall, start: np.ndarray, tau: float | None) -> Gra
     w = np.concatenate([w, [tau / t_scale]])
     for _ in range(ITERATIONS):
         z, p, tau = w[:size] * z_scale, float(w[size] * p_scale), float(w[size + 1] * t_scale)
-        if not tau > 0:
+        # The touch lies within the orbit's span; an iterate far beyond it has left
+        # the grazing (and would have the gap's run integrate for as long: once 1e8 s).
+        if not 0 < tau <= TOUCH_SPANS * t_scale:
             return None
         free, h, _ = wall.at(p)
         d = len(h)
