@@ -253,3 +253,54 @@ def test_a_curve_whose_branch_meets_no_grazing_says_which_keys_to_widen(tmp_path
     assert done.returncode == 2 and "Traceback" not in done.stderr
     (line,) = done.stderr.strip().splitlines()
     assert "no grazing" in line and "[curve] start, stop" in line and "0.6" in line
+
+
+def _grazing_arc(data: dict[str, Any]) -> tuple[Any, np.ndarray, float, float]:
+    """The frequency continuation's arc of the grazing scenario, built as a curve builds
+    it (one period, its scales), with the closed form's grazing: the scaled unknowns
+    (state, frequency) of the orbit there, the frequency and the touch's instant (s)."""
+    from vibroimpact.analysis.continuation import _Arc
+
+    m, k, c, _, gap = _oscillator(data)
+    f = _grazing_frequency(data, gap)
+    w = 2 * math.pi * f
+    theta = math.atan2(c * w, k - m * w * w)
+    arc = _Arc(data, FREQUENCY, 1, 1e-10, None, 0.45)
+    arc.size = 2
+    arc.scale = np.array([gap, w * gap, 0.45])
+    # Start off the grazing (1 % below in frequency, the orbit of the closed form).
+    state = np.array([gap * math.cos(theta), gap * w * math.sin(theta)])
+    unknowns = np.concatenate([state / arc.scale[:2], [0.99 * f / arc.scale[2]]])
+    return arc, unknowns, f, (theta / w) % (1 / f)
+
+
+@pytest.mark.timeout(60)
+def test_newton_gives_up_where_the_touch_instant_leaves_the_orbit_s_span(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # An iterate whose touch instant stands beyond TOUCH_SPANS orbit spans has left the
+    # grazing; running the gap to it would integrate for as long (once 1e8 s, 1e9
+    # steps). Newton must give up before any run reaches it, and still converge from
+    # an instant within the span. Each run of the gap's flow is recorded.
+    from vibroimpact.analysis import grazing
+
+    data = _scenario()
+    arc, unknowns, f, touch = _grazing_arc(data)
+    asked: list[float] = []
+    gap_of = grazing._Wall.gap
+
+    def recorded(self: Any, p: float, z: np.ndarray, tau: float) -> Any:
+        asked.append(tau)
+        return gap_of(self, p, z, tau)
+
+    monkeypatch.setattr(grazing._Wall, "gap", recorded)
+    # From the instant within the span: the closed form's grazing.
+    found = grazing.locate_grazing(arc, "stop 0", unknowns, tau=touch)
+    assert found is not None
+    assert found.value == pytest.approx(f, rel=1e-10)
+    assert asked and max(asked) <= grazing.TOUCH_SPANS / f
+    # From instants far beyond it, or before the section: none, and no run asked.
+    for far in (10 * grazing.TOUCH_SPANS / f, 1e8, -0.25 / f):
+        asked.clear()
+        assert grazing.locate_grazing(arc, "stop 0", unknowns, tau=far) is None
+        assert asked == []
