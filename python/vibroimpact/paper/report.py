@@ -46,7 +46,13 @@ def write_report(
 ) -> None:
     """Write the report to ``path`` (whole or not at all); ``files`` are the names of
     every file the job writes, this report included."""
-    exact, gold = found.exact, found.goldsmith
+    text = _opening(rows, blocks, found, elapsed, machine, files) + _differences(rows, found)
+    with written_whole(path) as f:
+        f.write(text)
+
+
+def _table2(rows: list[Row]) -> str:
+    """Table 2: the paper's contact durations, errors and CPU times beside ours."""
     t2 = []
     for method, dt, tc, cpu, err in PAPER_TABLE2:
         counted = _row(rows, f"{method} (step-count)", dt)
@@ -65,7 +71,7 @@ def write_report(
                 f"{located.cpu_time:.2e}" if located.cpu_time is not None else "",
             ]
         )
-    table2_md = _md(
+    return _md(
         [
             "method",
             "dt (s)",
@@ -81,6 +87,10 @@ def write_report(
         t2,
     )
 
+
+def _table3(blocks: dict[str, Block]) -> tuple[float, str, str, str]:
+    """Table 3 as the paper prints it and as Eq. 15 recomputes it (with their largest
+    difference), ours, and the most adequate run at each weight."""
     recomputed = paper_table3_recomputed()
     worst = max(
         abs(a - b)
@@ -108,58 +118,24 @@ def write_report(
             for i, w in enumerate(WEIGHTS)
         )
     )
+    return worst, t3_paper, t3_ours, best_note
 
-    nm = {dt: _row(rows, "newmark (located)", dt) for dt in STEP_SIZES}
-    rk = {dt: _row(rows, "rk4 (located)", dt) for dt in STEP_SIZES}
-    rkc = {dt: _row(rows, "rk4 (step-count)", dt) for dt in STEP_SIZES}
-    hy = {(m, t): tc for m, t, tc in found.hyster_rows}
-    agreements, misses = [], []
-    for m, dt, tc, *_ in PAPER_TABLE2:
-        ours = _row(rows, f"{m} (step-count)", dt).contact_duration
-        if abs(round(ours, 4) - tc) < 5e-9:
-            agreements.append(f"{m} at dt = {dt:g}")
-        else:
-            # The step difference from our full value: rounded to the paper's four
-            # digits first, it could be off by a step.
-            misses.append(
-                f"{m} at dt = {dt:g} ({ours:.4f} s against {tc:.4f} s, "
-                f"{(tc - ours) / dt:+.0f} steps)"
-            )
-    agree_note = f"match the paper's for {', '.join(agreements) or 'no run'}" + (
-        f" and differ for {'; '.join(misses)}" if misses else ""
-    )
-    cpu_nm = nm[2e-5].cpu_time or 0.0
-    cpu_rk = rk[2e-5].cpu_time or 0.0
 
-    rebound_md = _md(
-        ["method", "dt (s)", "rebound / approach speed", "exact model"],
-        [
-            [m, f"{dt:g}", f"{r:.5f}", f"{REFERENCE_REBOUND_RATIO}"]
-            for m, dt, r in found.rebound_rows
-        ],
-    )
-    beyond_text = _beyond_section(found, rows)
+def _opening(
+    rows: list[Row],
+    blocks: dict[str, Block],
+    found: Findings,
+    elapsed: float,
+    machine: str,
+    files: list[str],
+) -> str:
+    """The report up to its differences: the case, the reference values, Tables 2 and 3."""
+    exact, gold = found.exact, found.goldsmith
+    table2_md = _table2(rows)
+    worst, t3_paper, t3_ours, best_note = _table3(blocks)
     missing = scipy_missing()
     scipy_note = f"\n\n**Note:** {missing}." if missing is not None else ""
-    restitution_md = _md(
-        ["e asked", "e* exact relation", "e* simulated (two free bodies, RK4)"],
-        [[f"{e:g}", f"{x:.4f}", f"{s:.4f}"] for e, x, s in found.restitution_rows],
-    )
-    hyster_md = _md(
-        ["method (dt = 1e-4 s)", "paper Tc", "ours, steps counted", "ours, located", "exact model"],
-        [
-            [
-                m,
-                f"{PAPER_HYSTER[m]:.4f}",
-                f"{hy[(m, 'step-count')]:.4f}",
-                f"{hy[(m, 'located')]:.7f}",
-                f"{found.exact_hyster:.7f}",
-            ]
-            for m in ("rk4", "newmark")
-        ],
-    )
-
-    text = f"""# Reproducing Afsharfard & Farshidianfar (2012) with vibroimpact
+    return f"""# Reproducing Afsharfard & Farshidianfar (2012) with vibroimpact
 
 A. Afsharfard, A. Farshidianfar, "An efficient method to solve the strongly coupled
 nonlinear differential equations of impact dampers", Arch. Appl. Mech. 82 (2012) 977-984.
@@ -215,7 +191,64 @@ over all twelve numerical rows; `table3.csv` also has the block with errors agai
 
 Most adequate by our numbers: {best_note}.
 
-## Every difference, explained
+"""
+
+
+def _agreement(rows: list[Row]) -> str:
+    """Where our step-counted durations, rounded as the paper prints them, match its own."""
+    agreements, misses = [], []
+    for m, dt, tc, *_ in PAPER_TABLE2:
+        ours = _row(rows, f"{m} (step-count)", dt).contact_duration
+        if abs(round(ours, 4) - tc) < 5e-9:
+            agreements.append(f"{m} at dt = {dt:g}")
+        else:
+            # The step difference from our full value: rounded to the paper's four
+            # digits first, it could be off by a step.
+            misses.append(
+                f"{m} at dt = {dt:g} ({ours:.4f} s against {tc:.4f} s, "
+                f"{(tc - ours) / dt:+.0f} steps)"
+            )
+    return f"match the paper's for {', '.join(agreements) or 'no run'}" + (
+        f" and differ for {'; '.join(misses)}" if misses else ""
+    )
+
+
+def _differences(rows: list[Row], found: Findings) -> str:
+    """The report's differences from the paper, each explained, and its figures."""
+    exact = found.exact
+    nm = {dt: _row(rows, "newmark (located)", dt) for dt in STEP_SIZES}
+    rk = {dt: _row(rows, "rk4 (located)", dt) for dt in STEP_SIZES}
+    rkc = {dt: _row(rows, "rk4 (step-count)", dt) for dt in STEP_SIZES}
+    hy = {(m, t): tc for m, t, tc in found.hyster_rows}
+    agree_note = _agreement(rows)
+    cpu_nm = nm[2e-5].cpu_time or 0.0
+    cpu_rk = rk[2e-5].cpu_time or 0.0
+    rebound_md = _md(
+        ["method", "dt (s)", "rebound / approach speed", "exact model"],
+        [
+            [m, f"{dt:g}", f"{r:.5f}", f"{REFERENCE_REBOUND_RATIO}"]
+            for m, dt, r in found.rebound_rows
+        ],
+    )
+    beyond_text = _beyond_section(found, rows)
+    restitution_md = _md(
+        ["e asked", "e* exact relation", "e* simulated (two free bodies, RK4)"],
+        [[f"{e:g}", f"{x:.4f}", f"{s:.4f}"] for e, x, s in found.restitution_rows],
+    )
+    hyster_md = _md(
+        ["method (dt = 1e-4 s)", "paper Tc", "ours, steps counted", "ours, located", "exact model"],
+        [
+            [
+                m,
+                f"{PAPER_HYSTER[m]:.4f}",
+                f"{hy[(m, 'step-count')]:.4f}",
+                f"{hy[(m, 'located')]:.7f}",
+                f"{found.exact_hyster:.7f}",
+            ]
+            for m in ("rk4", "newmark")
+        ],
+    )
+    return f"""## Every difference, explained
 
 1. **Step counting quantises the duration.** The paper counts the steps spent in contact
    (touching while `|y - w| >= d`), so its durations are multiples of `dt`, and their error
@@ -306,8 +339,6 @@ Most adequate by our numbers: {best_note}.
   fixed steps straddle each onset, where the contact damper's force `c1 v` jumps from 0 to
   1e-3 N, and RK4's stages integrate a jump to O(dt); the figure's note says so (see below).
 """
-    with written_whole(path) as f:
-        f.write(text)
 
 
 def _beyond_section(found: Findings, rows: list[Row]) -> str:

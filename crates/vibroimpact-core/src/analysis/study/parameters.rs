@@ -87,157 +87,187 @@ pub(super) const INITIAL: [&str; 4] = [
     "damper_velocity",
 ];
 
+/// A study axis's path being parsed: each error names it.
+struct AxisPath<'a>(&'a str);
+
+impl AxisPath<'_> {
+    /// Not a path a study can vary.
+    fn bad(&self) -> Error {
+        Error::Inconsistent(format!(
+            "study axis {:?}: not a path a study can vary; allowed: {PATHS}",
+            self.0
+        ))
+    }
+
+    /// The index `text` of one of `count` sections named `what`.
+    fn index(&self, text: &str, count: usize, what: &str) -> Result<usize> {
+        let i: usize = text.parse().map_err(|_| self.bad())?;
+        if i < count {
+            Ok(i)
+        } else {
+            Err(Error::Inconsistent(format!(
+                "study axis {:?}: the scenario has {count} {what}",
+                self.0
+            )))
+        }
+    }
+
+    /// `damper.i.key`.
+    fn damper(&self, spec: &SystemSpec, i: usize, key: &str) -> Result<Target> {
+        Ok(match key {
+            "at" => Target::DamperAt(i),
+            "mass" => Target::DamperMass(i),
+            "clearance" => Target::DamperClearance(i),
+            "lower_clearance" => Target::DamperLowerClearance(i),
+            "upper_clearance" => Target::DamperUpperClearance(i),
+            "restitution" => Target::DamperRestitution(i),
+            "stiffness" => Target::DamperStiffness(i),
+            "damping" => Target::DamperDamping(i),
+            "friction" | "static_friction" | "normal_force" => {
+                let f = spec
+                    .frictions
+                    .iter()
+                    .position(|f| f.site == FrictionSite::Damper(i))
+                    .ok_or_else(|| {
+                        Error::Inconsistent(format!(
+                            "study axis {:?}: damper {i} has no friction (give it friction and \
+                             normal_force)",
+                            self.0
+                        ))
+                    })?;
+                let key = ["friction", "static_friction", "normal_force"]
+                    .iter()
+                    .position(|k| *k == key)
+                    .unwrap_or(0);
+                Target::Friction(f, key as u8)
+            }
+            _ => return Err(self.bad()),
+        })
+    }
+
+    /// `structure.key`: an input of the structure's kind.
+    fn structure(&self, spec: &SystemSpec, key: &str) -> Result<Target> {
+        let mut recipe = spec.structure.recipe();
+        let kind = recipe.kind();
+        if recipe.input(key).is_none() {
+            let allowed = match recipe.keys() {
+                "" => format!(
+                    "a structure of kind \"{kind}\" has no inputs a study can vary (only kinds \
+                     \"oscillator\" and \"cantilever\" do)"
+                ),
+                keys => format!("allowed for kind \"{kind}\": structure.{{{keys}}}"),
+            };
+            return Err(Error::Inconsistent(format!(
+                "study axis {:?}: not a path a study can vary; {allowed}",
+                self.0
+            )));
+        }
+        let at = STRUCTURE_KEYS.iter().position(|k| *k == key);
+        Ok(Target::Structure(at.expect("every recipe input is listed")))
+    }
+
+    /// `excitation.i.key`: a force's point, or its signal's input.
+    fn excitation(&self, spec: &SystemSpec, i: usize, key: &str) -> Result<Target> {
+        let path = self.0;
+        if key == "at" {
+            if !matches!(spec.excitations[i].load, Load::Force { .. }) {
+                return Err(Error::Inconsistent(format!(
+                    "study axis {path:?}: excitation {i} is a base excitation, which acts at no \
+                     point"
+                )));
+            }
+            return Ok(Target::ExcitationAt(i));
+        }
+        let signal = &spec.excitations[i].signal;
+        if let Some(recipe) = signal.recipe() {
+            let key = RecipeKey::parse(key, recipe).ok_or_else(|| {
+                Error::Inconsistent(format!(
+                    "study axis {path:?}: not a path a study can vary; allowed for excitation \
+                     {i} (a {} signal): excitation.{i}.{{{}}}",
+                    recipe.name(),
+                    recipe.keys()
+                ))
+            })?;
+            Ok(Target::ExcitationRecipe(i, key))
+        } else if matches!(signal, Signal::Harmonic(_)) {
+            Ok(match key {
+                "amplitude" => Target::ExcitationAmplitude(i),
+                "frequency" => Target::ExcitationFrequency(i),
+                "phase" => Target::ExcitationPhase(i),
+                _ => return Err(self.bad()),
+            })
+        } else {
+            Err(Error::Inconsistent(format!(
+                "study axis {path:?}: excitation {i} is neither a harmonic nor a random \
+                 (white-noise, kanai-tajimi) signal; allowed: {PATHS}"
+            )))
+        }
+    }
+}
+
 impl Parameter {
     /// Parse `path` against `spec` (indices must exist).
     pub fn parse(path: &str, spec: &SystemSpec) -> Result<Self> {
         let parts: Vec<&str> = path.split('.').collect();
-        let bad = || {
-            Error::Inconsistent(format!(
-                "study axis {path:?}: not a path a study can vary; allowed: {PATHS}"
-            ))
-        };
-        let index = |text: &str, count: usize, what: &str| -> Result<usize> {
-            let i: usize = text.parse().map_err(|_| bad())?;
-            if i < count {
-                Ok(i)
-            } else {
-                Err(Error::Inconsistent(format!(
-                    "study axis {path:?}: the scenario has {count} {what}"
-                )))
-            }
-        };
+        let axis = AxisPath(path);
         let target = match parts.as_slice() {
             ["damper", i, key] => {
-                let i = index(i, spec.dampers.len(), "[[damper]]")?;
-                match *key {
-                    "at" => Target::DamperAt(i),
-                    "mass" => Target::DamperMass(i),
-                    "clearance" => Target::DamperClearance(i),
-                    "lower_clearance" => Target::DamperLowerClearance(i),
-                    "upper_clearance" => Target::DamperUpperClearance(i),
-                    "restitution" => Target::DamperRestitution(i),
-                    "stiffness" => Target::DamperStiffness(i),
-                    "damping" => Target::DamperDamping(i),
-                    "friction" | "static_friction" | "normal_force" => {
-                        let f = spec
-                            .frictions
-                            .iter()
-                            .position(|f| f.site == FrictionSite::Damper(i))
-                            .ok_or_else(|| {
-                                Error::Inconsistent(format!(
-                                    "study axis {path:?}: damper {i} has no friction (give it \
-                                     friction and normal_force)"
-                                ))
-                            })?;
-                        let key = ["friction", "static_friction", "normal_force"]
-                            .iter()
-                            .position(|k| k == key)
-                            .unwrap_or(0);
-                        Target::Friction(f, key as u8)
-                    }
-                    _ => return Err(bad()),
-                }
+                let i = axis.index(i, spec.dampers.len(), "[[damper]]")?;
+                axis.damper(spec, i, key)?
             }
             ["stop", i, key] => {
-                let i = index(i, spec.stops.len(), "[[stop]]")?;
+                let i = axis.index(i, spec.stops.len(), "[[stop]]")?;
                 match *key {
                     "at" => Target::StopAt(i),
                     "gap" => Target::StopGap(i),
                     "restitution" => Target::StopRestitution(i),
                     "stiffness" => Target::StopStiffness(i),
                     "damping" => Target::StopDamping(i),
-                    _ => return Err(bad()),
+                    _ => return Err(axis.bad()),
                 }
             }
             ["collision", i, key] => {
-                let i = index(i, spec.collisions.len(), "[[collision]]")?;
+                let i = axis.index(i, spec.collisions.len(), "[[collision]]")?;
                 match *key {
                     "gap" => Target::CollisionGap(i),
                     "restitution" => Target::CollisionRestitution(i),
                     "stiffness" => Target::CollisionStiffness(i),
                     "damping" => Target::CollisionDamping(i),
-                    _ => return Err(bad()),
+                    _ => return Err(axis.bad()),
                 }
             }
             ["friction", i, key] => {
                 let elements: Vec<usize> = (0..spec.frictions.len())
                     .filter(|&f| matches!(spec.frictions[f].site, FrictionSite::Points { .. }))
                     .collect();
-                let i = index(i, elements.len(), "[[friction]]")?;
+                let i = axis.index(i, elements.len(), "[[friction]]")?;
                 let key = match *key {
                     "coefficient" => 0,
                     "static_coefficient" => 1,
                     "normal_force" => 2,
-                    _ => return Err(bad()),
+                    _ => return Err(axis.bad()),
                 };
                 Target::Friction(elements[i], key)
             }
             ["gravity", "acceleration"] => Target::Gravity,
-            ["structure", key] => {
-                let mut recipe = spec.structure.recipe();
-                let kind = recipe.kind();
-                if recipe.input(key).is_none() {
-                    let allowed = match recipe.keys() {
-                        "" => format!(
-                            "a structure of kind \"{kind}\" has no inputs a study can vary \
-                             (only kinds \"oscillator\" and \"cantilever\" do)"
-                        ),
-                        keys => format!("allowed for kind \"{kind}\": structure.{{{keys}}}"),
-                    };
-                    return Err(Error::Inconsistent(format!(
-                        "study axis {path:?}: not a path a study can vary; {allowed}"
-                    )));
-                }
-                let at = STRUCTURE_KEYS.iter().position(|k| k == key);
-                Target::Structure(at.expect("every recipe input is listed"))
-            }
-            ["excitation", i, "at"] => {
-                let i = index(i, spec.excitations.len(), "[[excitation]]")?;
-                if !matches!(spec.excitations[i].load, Load::Force { .. }) {
-                    return Err(Error::Inconsistent(format!(
-                        "study axis {path:?}: excitation {i} is a base excitation, which acts \
-                         at no point"
-                    )));
-                }
-                Target::ExcitationAt(i)
-            }
+            ["structure", key] => axis.structure(spec, key)?,
             ["excitation", i, key] => {
-                let i = index(i, spec.excitations.len(), "[[excitation]]")?;
-                let signal = &spec.excitations[i].signal;
-                if let Some(recipe) = signal.recipe() {
-                    let key = RecipeKey::parse(key, recipe).ok_or_else(|| {
-                        Error::Inconsistent(format!(
-                            "study axis {path:?}: not a path a study can vary; allowed for \
-                             excitation {i} (a {} signal): excitation.{i}.{{{}}}",
-                            recipe.name(),
-                            recipe.keys()
-                        ))
-                    })?;
-                    Target::ExcitationRecipe(i, key)
-                } else if matches!(signal, Signal::Harmonic(_)) {
-                    match *key {
-                        "amplitude" => Target::ExcitationAmplitude(i),
-                        "frequency" => Target::ExcitationFrequency(i),
-                        "phase" => Target::ExcitationPhase(i),
-                        _ => return Err(bad()),
-                    }
-                } else {
-                    return Err(Error::Inconsistent(format!(
-                        "study axis {path:?}: excitation {i} is neither a harmonic nor a random \
-                         (white-noise, kanai-tajimi) signal; allowed: {PATHS}"
-                    )));
-                }
+                let i = axis.index(i, spec.excitations.len(), "[[excitation]]")?;
+                axis.excitation(spec, i, key)?
             }
             ["initial", array, i] => {
-                let which = INITIAL.iter().position(|a| a == array).ok_or_else(bad)?;
+                let which = INITIAL
+                    .iter()
+                    .position(|a| a == array)
+                    .ok_or_else(|| axis.bad())?;
                 let size = if which < 2 {
                     spec.structure.dofs()
                 } else {
                     spec.dampers.len()
                 };
-                Target::Initial(which, index(i, size, array)?)
+                Target::Initial(which, axis.index(i, size, array)?)
             }
-            _ => return Err(bad()),
+            _ => return Err(axis.bad()),
         };
         Ok(Self {
             path: path.to_string(),
