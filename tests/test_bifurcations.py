@@ -32,9 +32,7 @@ from scipy.linalg import expm
 from scipy.optimize import brentq
 
 import vibroimpact as vi
-from study_checks import load_study
-from test_analyses import EXACT, SH, holmes_flip, shaw_holmes_orbits, shaw_holmes_scenario
-from test_maps import (
+from maps_checks import (
     BALL_TABLE,
     STATE_KEYS,
     Table,
@@ -44,6 +42,8 @@ from test_maps import (
     load,
     write,
 )
+from study_checks import load_study
+from test_analyses import EXACT, SH, holmes_flip, shaw_holmes_orbits, shaw_holmes_scenario
 from vibroimpact import analysis as an
 from vibroimpact import study as st
 

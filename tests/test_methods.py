@@ -17,9 +17,6 @@ Newmark stays first order (its force lags one step).
 from __future__ import annotations
 
 import math
-import signal
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
@@ -40,6 +37,19 @@ from conftest import (
     MAIN_MASS,
     STIFFNESS,
 )
+from method_checks import (
+    ELASTIC_CONTACT,
+    SMOOTH_C,
+    SMOOTH_CONTACT,
+    SMOOTH_K,
+    SMOOTH_M,
+    SMOOTH_START,
+    SMOOTH_SYSTEM,
+    SMOOTH_W0,
+    Rattle,
+    mode_by_mode_oracle,
+    table1_run,
+)
 
 EPS = np.finfo(float).eps
 
@@ -49,46 +59,7 @@ def log_slope(x: list[float] | np.ndarray, y: list[float] | np.ndarray) -> float
     return float(np.polyfit(np.log(x), np.log(y), 1)[0])
 
 
-@contextmanager
-def time_limit(seconds: int) -> Iterator[None]:
-    """Raise TimeoutError if the block runs longer (the kernel polls signals)."""
-
-    def expire(_signum: int, _frame: object) -> None:
-        raise TimeoutError(f"still running after {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, expire)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
-
-
-def exact_hysteresis(e: float) -> float:
-    """alpha with alpha (1 + e) = ln((1 + alpha) / (1 - alpha e)), 0 for e = 1."""
-    if e == 1.0:
-        return 0.0
-    return float(
-        brentq(
-            lambda a: a * (1 + e) - (math.log1p(a) - math.log1p(-a * e)),
-            1e-6,
-            (1 - 1e-12) / e,
-            xtol=1e-15,
-        )
-    )
-
-
 # ------------------------------------------------- a) order on a smooth problem
-
-# A damped main oscillator; the impact mass rests in the middle of a 1 m clearance
-# and is never reached (|y - w| <= 0.01 m).
-SMOOTH_M, SMOOTH_K, SMOOTH_C, SMOOTH_W0 = 1.0, 4.0, 0.2, 0.01
-SMOOTH_SYSTEM = vi.ImpactDamper(
-    main_mass=SMOOTH_M, stiffness=SMOOTH_K, damping=SMOOTH_C, impact_mass=0.25, clearance=1.0
-)
-SMOOTH_CONTACT = vi.Contact("hertz", stiffness=HERTZ_STIFFNESS)
-SMOOTH_START = vi.InitialState(main_displacement=SMOOTH_W0)
 
 
 def smooth_exact(t: np.ndarray) -> np.ndarray:
@@ -248,19 +219,6 @@ def collision_oracle(contact_damping: float = CONTACT_DAMPING) -> Collision:
     )
 
 
-def table1_run(contact_damping: float = CONTACT_DAMPING, **settings: Any) -> vi.Solution:
-    system = vi.ImpactDamper(
-        main_mass=MAIN_MASS,
-        stiffness=STIFFNESS,
-        damping=DAMPING,
-        impact_mass=IMPACT_MASS,
-        clearance=CLEARANCE,
-    )
-    contact = vi.Contact("hertz", stiffness=HERTZ_STIFFNESS, damping=contact_damping)
-    start = vi.InitialState(impact_displacement=CLEARANCE, impact_velocity=APPROACH_SPEED)
-    return vi.simulate(system, contact, start, t_end=0.15, **settings)
-
-
 def collision_errors(sol: vi.Solution, exact: Collision) -> tuple[float, float, float]:
     """Relative errors of (duration, max indentation, rebound ratio) of the one contact."""
     c = sol.contacts
@@ -385,113 +343,6 @@ RATTLE_CONTACT = vi.Contact(
 RATTLE_START = vi.InitialState(main_displacement=0.05, impact_displacement=0.05)
 
 
-@dataclass(frozen=True)
-class Rattle:
-    onsets: np.ndarray
-    separations: np.ndarray
-    # Relative normal speeds at each onset and at each separation, m/s.
-    approach_speeds: np.ndarray
-    rebound_speeds: np.ndarray
-
-
-def mode_by_mode_oracle(
-    system: vi.ImpactDamper,
-    contact: vi.Contact,
-    start: vi.InitialState,
-    t_end: float,
-    max_flight_step: float = np.inf,
-    floored: bool = True,
-) -> Rattle:
-    """A run with a hertz-damped contact, mode by mode with SciPy's DOP853 (rtol 1e-13).
-
-    Free flight until |y - w| = d (event), then the contact (hertz-damped force
-    with the approach rate latched at onset, clamped at zero, plus c1) until the
-    indentation returns to zero (event), and so on to the end. The latched rate is
-    the approach, or where that is slower, the speed ``sqrt(2 a delta_s)`` the pressing
-    ``a`` (m/s^2, the main mass's acceleration against the wall at onset) gives over
-    the static indentation ``delta_s = (m_eff a / K_hz)^(2/3)``, as the law is
-    documented (``vi.SystemContacts``): a slow landing is damped as one set down on
-    the contact (``floored``; without it, the approach alone: fixed stepping's latch, as
-    the paper's). SciPy sees an event
-    only as a sign change between its steps: flights shorter than its step need
-    `max_flight_step` (s) below them.
-    """
-    assert contact.law == "hertz-damped" and contact.restitution is not None
-    alpha = exact_hysteresis(contact.restitution)
-    k, c, m_main, m_imp, d = (
-        system.stiffness,
-        system.damping,
-        system.main_mass,
-        system.impact_mass,
-        system.clearance,
-    )
-    k_hz, c1 = contact.stiffness, contact.damping
-    options: dict[str, Any] = dict(method="DOP853", rtol=1e-13, atol=1e-16)
-    t = 0.0
-    state = np.array(
-        [
-            start.main_displacement,
-            start.main_velocity,
-            start.impact_displacement,
-            start.impact_velocity,
-        ]
-    )
-    onsets: list[float] = []
-    separations: list[float] = []
-    approaches: list[float] = []
-    rebounds: list[float] = []
-    while True:
-
-        def free(_t: float, s: np.ndarray) -> list[float]:
-            return [s[1], (-c * s[1] - k * s[0]) / m_main, s[3], 0.0]
-
-        def upper(_t: float, s: np.ndarray) -> float:
-            return (s[2] - s[0]) - d
-
-        def lower(_t: float, s: np.ndarray) -> float:
-            return -(s[2] - s[0]) - d
-
-        for event in (upper, lower):
-            event.terminal = True  # type: ignore[attr-defined]
-            event.direction = 1  # type: ignore[attr-defined]
-        sol = solve_ivp(
-            free, (t, t_end), state, events=[upper, lower], max_step=max_flight_step, **options
-        )
-        if sol.status == 0:
-            break
-        hit = 0 if len(sol.t_events[0]) else 1
-        side = 1.0 if hit == 0 else -1.0
-        t, state = float(sol.t_events[hit][0]), sol.y_events[hit][0]
-        approach = side * (state[3] - state[1])
-        onsets.append(t)
-        approaches.append(approach)
-        pressing = max(side * (c * state[1] + k * state[0]) / m_main, 0.0)
-        effective_mass = m_main * m_imp / (m_main + m_imp)
-        resting = math.sqrt(2 * pressing * (effective_mass * pressing / k_hz) ** (2 / 3))
-        resting = resting if floored else 0.0
-
-        def contact(
-            _t: float, s: np.ndarray, side: float = side, v0: float = max(approach, resting)
-        ) -> list[float]:
-            delta, rate = side * (s[2] - s[0]) - d, side * (s[3] - s[1])
-            law = k_hz * max(delta, 0.0) ** 1.5 * (1 + alpha * rate / v0)
-            push = side * (max(law, 0.0) + c1 * rate)
-            return [s[1], (push - c * s[1] - k * s[0]) / m_main, s[3], -push / m_imp]
-
-        def apart(_t: float, s: np.ndarray, side: float = side) -> float:
-            return side * (s[2] - s[0]) - d
-
-        apart.terminal = True  # type: ignore[attr-defined]
-        apart.direction = -1  # type: ignore[attr-defined]
-        sol = solve_ivp(contact, (t, t_end), state, events=apart, **options)
-        if sol.status == 0:
-            break
-        t, state = float(sol.t_events[0][0]), sol.y_events[0][0]
-        separations.append(t)
-        rebounds.append(-side * (state[3] - state[1]))
-    return Rattle(np.array(onsets), np.array(separations), np.array(approaches), np.array(rebounds))
-
-
 @cache
 def rattle_oracle(floored: bool = True) -> Rattle:
     return mode_by_mode_oracle(
@@ -600,7 +451,6 @@ def mechanical_energy(sol: vi.Solution, system: vi.ImpactDamper) -> np.ndarray:
 CONSERVATIVE_SYSTEM = vi.ImpactDamper(
     main_mass=MAIN_MASS, stiffness=RATTLE_K, impact_mass=IMPACT_MASS, clearance=CLEARANCE
 )
-ELASTIC_CONTACT = vi.Contact("hertz", stiffness=HERTZ_STIFFNESS)
 
 
 @pytest.mark.parametrize(
@@ -732,252 +582,3 @@ def test_adaptive_statistics(method: str, stages: int) -> None:
     assert collision.rejected_steps > 0
     assert collision.rhs_evaluations >= 1 + stages * (collision.steps + collision.rejected_steps)
     assert len(collision.t) == collision.steps + 1  # every = 1 keeps each accepted step
-
-
-# ------------------------------------------------- f) grazing
-
-
-GRAZE_SYSTEM = vi.ImpactDamper(
-    main_mass=1.0, stiffness=1.0, impact_mass=IMPACT_MASS, clearance=CLEARANCE
-)
-GRAZE_METHODS = [
-    {"method": "rk4", "dt": 1e-3, "stepping": "events"},
-    {"method": "rk4", "dt": 1e-4, "stepping": "events"},
-    {"method": "newmark-implicit", "dt": 1e-3},
-    {"method": "generalized-alpha", "dt": 1e-3, "spectral_radius": 1.0},
-]
-GRAZE_IDS = ["rk4-1e-3", "rk4-1e-4", "newmark-implicit", "generalized-alpha"]
-
-
-def graze_run(relative_overshoot: float, **settings: Any) -> vi.Solution:
-    """The impact mass rests at y = 0; the main mass starts at w = 0 with w' = A,
-    so y - w = -A sin t (K = M = 1, C = 0) reaches -A at t = pi/2: a peak
-    indentation of A - d = d * relative_overshoot at the wall y - w = -d."""
-    amplitude = CLEARANCE * (1 + relative_overshoot)
-    start = vi.InitialState(main_velocity=amplitude)
-    with time_limit(20):
-        return vi.simulate(GRAZE_SYSTEM, ELASTIC_CONTACT, start, t_end=3.0, **settings)
-
-
-@pytest.mark.parametrize("settings", GRAZE_METHODS, ids=GRAZE_IDS)
-def test_touching_the_wall_is_a_graze(settings: dict[str, Any]) -> None:
-    # Peak indentation 5e-15 m: half the kernel's graze tolerance (1e-12 * d).
-    sol = graze_run(5e-13, **settings)
-    assert len(sol.contacts) == 0
-    assert sol.grazing_contacts == 1
-    assert np.all(sol.contact_force == 0.0)
-
-
-@pytest.mark.parametrize("settings", GRAZE_METHODS, ids=GRAZE_IDS)
-def test_just_missing_the_wall_is_nothing(settings: dict[str, Any]) -> None:
-    sol = graze_run(-1e-6, **settings)
-    assert (len(sol.contacts), sol.grazing_contacts) == (0, 0)
-
-
-@pytest.mark.parametrize("settings", GRAZE_METHODS, ids=GRAZE_IDS)
-def test_penetrating_beyond_the_tolerance_is_a_contact(settings: dict[str, Any]) -> None:
-    overshoot = 1e-9  # 1e-11 m, a thousand times the graze tolerance
-    sol = graze_run(overshoot, **settings)
-    assert (len(sol.contacts), sol.grazing_contacts) == (1, 0)
-    c = sol.contacts
-    # The force (K_hz delta^1.5 ~ 1e-13 N) barely acts: the contact spans the
-    # arc where A sin t > d, t = pi/2 -+ acos(1 / (1 + overshoot)). The Newmark
-    # family's period error (~(w dt)^2 / 12) shifts the arc by ~1e-7 s.
-    half = math.acos(1 / (1 + overshoot))
-    assert c.duration[0] == pytest.approx(2 * half, rel=1e-3)
-    assert 0.5 * (c.onset[0] + c.separation[0]) == pytest.approx(math.pi / 2, abs=1e-6)
-    assert c.max_indentation[0] == pytest.approx(CLEARANCE * overshoot, rel=1e-3)
-
-
-@pytest.mark.parametrize("method", ["dopri5", "dop853"])
-def test_adaptive_methods_graze_and_miss(method: str) -> None:
-    # Deep contact found, a clear miss is nothing; neither hangs.
-    assert len(graze_run(1e-2, method=method).contacts) == 1
-    assert len(graze_run(1e-3, method=method).contacts) == 1
-    missed = graze_run(-1e-6, method=method)
-    assert (len(missed.contacts), missed.grazing_contacts) == (0, 0)
-
-
-def test_dop853_finds_a_shallow_contact() -> None:
-    assert len(graze_run(1e-4, method="dopri5").contacts) == 1
-    assert len(graze_run(1e-4, method="dop853").contacts) == 1
-
-
-# ------------------------------------------------- g) chattering, limits
-
-
-# The impact mass starts 0.1 mm from the trailing wall while the main mass (w = -0.05
-# m, K = 100 N/m) accelerates at +5 m/s^2 for a quarter period: a ball dropped on a
-# table. Rigid impacts with e < 1 would make infinitely many ever-shorter bounces in
-# finite time (Zeno); a compliant contact ends them in a persistent contact.
-PRESSED_SYSTEM = vi.ImpactDamper(main_mass=1.0, stiffness=100.0, impact_mass=0.25, clearance=0.01)
-PRESSED_CONTACT = vi.Contact("hertz-damped", stiffness=1e9, restitution=0.8)
-PRESSED_START = vi.InitialState(main_displacement=-0.05, impact_displacement=-0.05 - 0.01 + 1e-4)
-PRESSED_RUNS = [
-    {"method": "dop853"},
-    {"method": "dopri5"},
-    {"method": "rk4", "dt": 1e-5, "stepping": "events"},
-    {"method": "newmark-implicit", "dt": 1e-6},
-    {"method": "generalized-alpha", "dt": 1e-6},
-]
-
-
-@cache
-def pressed_reference() -> Rattle:
-    # The flights shrink to about 1 ms: ten SciPy steps at least in each.
-    return mode_by_mode_oracle(
-        PRESSED_SYSTEM, PRESSED_CONTACT, PRESSED_START, 0.3, max_flight_step=1e-4
-    )
-
-
-@pytest.mark.parametrize("settings", PRESSED_RUNS, ids=[s["method"] for s in PRESSED_RUNS])
-def test_bouncing_down_ends_in_persistent_contact_or_chattering_error(
-    settings: dict[str, Any],
-) -> None:
-    try:
-        with time_limit(30):
-            sol = vi.simulate(PRESSED_SYSTEM, PRESSED_CONTACT, PRESSED_START, t_end=0.3, **settings)
-    except vi.SimulationError as err:
-        assert "chatter" in str(err).lower(), str(err)
-        return
-    c = sol.contacts
-    assert 5 <= len(c) < 100
-    # Bounces on the trailing wall (y - w = -d), ever slower and closer together,
-    # then a contact that lasts until the main mass decelerates (a quarter period
-    # is 0.157 s).
-    assert np.all(np.diff(c.approach_speed) < 0)
-    flights = c.onset[1:] - c.separation[:-1]
-    assert np.all(flights > 0) and np.all(np.diff(flights) < 0)
-    assert c.duration[-1] > 50 * c.duration[0]
-    reference = pressed_reference()
-    assert len(c) == len(reference.onsets)
-    # Measured: onsets within 3e-6 and durations within 3e-5 (DOPRI5 at its default
-    # tolerance), the others closer.
-    np.testing.assert_allclose(c.onset, reference.onsets, rtol=1e-5)
-    closed = np.isfinite(c.separation)
-    np.testing.assert_allclose(
-        c.duration[closed], reference.separations - reference.onsets[: closed.sum()], rtol=1e-4
-    )
-
-
-def test_a_stiff_contact_may_fail_newton_but_says_so() -> None:
-    """Generalised-alpha at dt = 1e-4 on the pressed contact (K_hz = 1e9, contacts of
-    ~1 ms): either the result agrees with DOP853 or a SimulationError names Newton
-    and the remedy; never a hang."""
-    try:
-        with time_limit(30):
-            sol = vi.simulate(
-                PRESSED_SYSTEM,
-                PRESSED_CONTACT,
-                PRESSED_START,
-                t_end=0.3,
-                method="generalized-alpha",
-                dt=1e-4,
-            )
-    except vi.SimulationError as err:
-        assert isinstance(err, RuntimeError)
-        assert "Newton" in str(err) and "dt" in str(err)
-        return
-    assert len(sol.contacts) == len(pressed_reference().onsets)
-
-
-@pytest.mark.parametrize(
-    "settings",
-    [
-        {"method": "dop853"},
-        {"method": "dopri5"},
-        {"method": "rk4", "dt": 1e-4, "stepping": "events"},
-        {"method": "newmark", "dt": 1e-4, "stepping": "events"},
-        {"method": "newmark-implicit", "dt": 1e-4},
-        {"method": "generalized-alpha", "dt": 1e-4},
-    ],
-    ids=lambda s: s["method"],
-)
-def test_max_steps_bounds_a_run(settings: dict[str, Any]) -> None:
-    if "dt" in settings:
-        # A fixed step's count is known: 1500 steps are refused before the run.
-        with pytest.raises(vi.InvalidInputError, match="max_steps"):
-            table1_run(max_steps=10, **settings)
-    else:
-        with pytest.raises(vi.SimulationError, match="max_steps") as err:
-            table1_run(max_steps=10, **settings)
-        assert isinstance(err.value, RuntimeError)
-    # Enough steps: the same run completes.
-    assert table1_run(max_steps=100_000, **settings).final_time >= 0.15
-
-
-@pytest.mark.parametrize("method", ["rk4", "newmark"])
-def test_max_steps_bounds_fixed_stepping(method: str) -> None:
-    with pytest.raises(vi.InvalidInputError, match="max_steps"):
-        table1_run(method=method, dt=1e-4, max_steps=10)
-
-
-def test_a_run_of_exactly_max_steps_completes() -> None:
-    settings: dict[str, Any] = dict(method="rk4", dt=0.01, t_end=4.0, stepping="events")
-    full = vi.simulate(SMOOTH_SYSTEM, SMOOTH_CONTACT, SMOOTH_START, **settings)
-    assert full.steps == 400
-    sol = vi.simulate(SMOOTH_SYSTEM, SMOOTH_CONTACT, SMOOTH_START, max_steps=400, **settings)
-    assert sol.steps == 400
-
-
-def test_newton_is_translation_invariant() -> None:
-    """K = C = 0: shifting both bodies by 1 m to 1 km changes nothing physical. Each run
-    is ten elastic contacts, each resolved by 200+ steps."""
-    system = vi.ImpactDamper(
-        main_mass=MAIN_MASS, stiffness=0.0, impact_mass=IMPACT_MASS, clearance=CLEARANCE
-    )
-    failures = []
-    for method in ("newmark-implicit", "generalized-alpha"):
-        for offset in (0.0, 1.0, 10.0, 100.0, 1000.0):
-            start = vi.InitialState(
-                main_displacement=offset,
-                impact_displacement=offset,
-                impact_velocity=APPROACH_SPEED,
-            )
-            for dt in np.linspace(4e-4, 6e-4, 11):
-                try:
-                    sol = vi.simulate(
-                        system, ELASTIC_CONTACT, start, method=method, dt=float(dt), t_end=3.0
-                    )
-                except vi.SimulationError as err:
-                    failures.append((method, offset, float(dt), str(err)))
-                    continue
-                assert sol.contacts.onset[0] == pytest.approx(0.1, rel=1e-6)
-    assert failures == []
-
-
-@pytest.mark.parametrize(
-    "settings",
-    [{"method": "rk4", "dt": 1e-3, "stepping": "events"}, {"method": "dop853"}],
-    ids=["rk4", "dop853"],
-)
-def test_contacts_faster_than_the_time_resolution_stop_with_a_clear_error(
-    settings: dict[str, Any],
-) -> None:
-    """A 1 nm gap and an absurdly stiff contact (K_hz = 1e30 N/m^1.5): contacts and
-    flights of ~1e-13 s follow each other, below the run's time resolution. The run
-    must stop at once with a SimulationError (chattering, or a step at round-off),
-    never loop or hang."""
-    system = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=1e-9)
-    contact = vi.Contact("hertz", stiffness=1e30)
-    start = vi.InitialState(impact_velocity=0.1)
-    with time_limit(20):
-        with pytest.raises(vi.SimulationError, match="chattering|too small") as err:
-            vi.simulate(system, contact, start, t_end=1.0, max_steps=10**7, **settings)
-    assert "\n" not in str(err.value)
-
-
-def test_newton_on_free_flight_takes_one_update_on_the_general_kernel() -> None:
-    """The same smooth system as a vibroimpact.System (the general kernel): apart, one
-    Newton update solves the linear equations exactly, one residual evaluation a step,
-    and one more for the energy accumulators' rates at the step's end (the trapezoidal
-    rule), plus one at the start (1 + 3 a step before the general kernel took it)."""
-    system = vi.System(
-        structure=vi.Oscillator(mass=SMOOTH_M, stiffness=SMOOTH_K, damping=SMOOTH_C),
-        dampers=[vi.Damper(mass=0.25, at=0, clearance=1.0, law="hertz", stiffness=HERTZ_STIFFNESS)],
-        initial=vi.Initial(structure_displacement=[SMOOTH_W0]),
-    )
-    for method in ("newmark-implicit", "generalized-alpha"):
-        sol = vi.simulate(system, method=method, dt=0.01, t_end=4.0)
-        assert sol.steps == 400 and len(sol.contacts) == 0
-        assert sol.rhs_evaluations == 1 + 2 * sol.steps

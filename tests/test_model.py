@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
+from model_checks import ROOT, issue_example
 from vibroimpact import system as schema
 from vibroimpact.scenario.system import SECTIONS
 
-ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
 GENERAL = [p for p in EXAMPLES if "structure" in tomllib.loads(p.read_text())]
 TWO_MASS = [p for p in EXAMPLES if p not in GENERAL]
@@ -73,14 +73,6 @@ def aluminium_beam() -> vi.Cantilever:
         mass_per_length=0.27,
         modes=3,
         damping_ratio=0.01,
-    )
-
-
-def issue_example() -> vi.System:
-    return vi.System(
-        structure=vi.Oscillator(mass=1.0, stiffness=3947.8, damping=2.513),
-        dampers=[vi.Damper(mass=0.05, at=0, clearance=0.005, law="rigid", restitution=0.6)],
-        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=5.0, frequency=10.0))],
     )
 
 
@@ -677,103 +669,7 @@ def test_a_two_mass_file_runs_as_its_system_does(name: str, stepping: str) -> No
         assert abs(general.steps - two_mass.steps) <= 1
 
 
-# ------------------------------------------------------------- the analyses
-
-
-def ball_table() -> vi.System:
-    return vi.load(ROOT / "examples" / "bouncing_ball_table.toml")
-
-
-def test_the_periodic_analyses_take_a_system() -> None:
-    system = ball_table()
-    sections = tomllib.loads((ROOT / "examples" / "bouncing_ball_table.toml").read_text())
-    run = vi.runner(sections)
-    found, expected = vi.orbit(system), vi.orbit(run)
-    assert found.converged and found.stable
-    assert np.array_equal(found.state, expected.state)
-    # Holmes: the period-one orbit's multipliers have modulus e = 0.5.
-    assert np.allclose(np.abs(found.floquet_multipliers), 0.5, rtol=1e-6)
-    steady = vi.steady_state(system, settle_periods=20, record_periods=4)
-    again = vi.steady_state(run, settle_periods=20, record_periods=4)
-    assert np.array_equal(steady.amplitude, again.amplitude)
-    assert steady.impacts_per_period == 1.0
-    section = vi.poincare(system, settle_periods=5, periods=3)
-    same = vi.poincare(run, settle_periods=5, periods=3)
-    assert len(section.impact_speed) == 3
-    assert np.array_equal(section.impact_speed, same.impact_speed)
-    basins = vi.basins(system, (0, [0.015]), (1, [0.16]), settle_periods=50, record_periods=2)
-    assert basins.labels.shape == (1, 1) and basins.labels[0, 0] == 0
-    with pytest.raises(vi.InvalidInputError, match="run"):
-        vi.orbit(sections)  # type: ignore[arg-type]  # a dict is not a run, as before
-
-
-def test_the_parameter_analyses_and_studies_take_a_system() -> None:
-    system = ball_table()
-    sections = tomllib.loads((ROOT / "examples" / "bouncing_ball_table.toml").read_text())
-    kw: dict[str, Any] = {"settle_periods": 10, "record_periods": 2}
-    swept = vi.sweep(system, "excitation.0.amplitude", [11.772, 12.0], **kw)
-    plain = vi.sweep(sections, "excitation.0.amplitude", [11.772, 12.0], **kw)
-    assert [p.to_dict() for p in swept] == [p.to_dict() for p in plain]
-    amplitude: dict[str, Any] = {"settle_periods": 5, "sample_periods": 2}
-    bif = vi.bifurcation(system, "excitation.0.amplitude", [11.772], **amplitude)
-    same = vi.bifurcation(sections, "excitation.0.amplitude", [11.772], **amplitude)
-    assert len(bif[0].samples) == 2 and np.array_equal(bif[0].samples, same[0].samples)
-    branch = vi.continue_orbit(system, "excitation.0.amplitude", stop=12.0, max_points=2)
-    assert len(branch.points) == 2 and branch.points[0].stable
-    study = vi.load(ROOT / "examples" / "clearance_study.toml")
-    assert vi.study_of(study).runs == vi.study_of(study.to_dict()).runs == 108
-    with pytest.raises(vi.InvalidInputError, match="sections .* or a vibroimpact.System, got"):
-        vi.sweep(None, "excitation.0.amplitude", [1.0])  # type: ignore[arg-type]
-
-
-# ------------------------------------------------------------------- results
-
-
-def test_results_as_pandas_and_xarray() -> None:
-    sol = vi.simulate(vi.load(ROOT / "examples" / "beam_two_dampers.toml"), t_end=0.2)
-    frame = sol.contacts.to_pandas()
-    assert list(frame.columns) == list(sol.contacts.columns)
-    assert len(frame) == len(sol.contacts) > 0
-    assert np.array_equal(frame["onset"].to_numpy(), sol.contacts.onset)
-    assert list(frame["pair"]) == sol.contacts.pair
-    data = sol.to_xarray()
-    assert data.sizes == {"time": len(sol.t), "structure_coordinate": 3, "damper": 2}
-    assert np.array_equal(data["time"].to_numpy(), sol.t)
-    assert np.array_equal(data["damper_velocity"].to_numpy(), sol.damper_velocity)
-    assert data["structure_displacement"].dims == ("time", "structure_coordinate")
-    assert data["structure_velocity"].attrs["units"] == "m/s"
-    assert data.attrs["steps"] == sol.steps and data.attrs["contacts"] == len(sol.contacts)
-    text = repr(sol)
-    assert "steps=" in text and f"contacts={len(sol.contacts)}" in text and "\n" not in text
-
-
-def test_the_two_mass_results_as_pandas_and_xarray() -> None:
-    damper = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01)
-    start = vi.InitialState(impact_displacement=0.01, impact_velocity=0.1)
-    contact = vi.Contact("hertz", stiffness=3000.0)
-    sol = vi.simulate(damper, contact, start, method="rk4", dt=1e-4, t_end=0.3)
-    frame = vi.to_pandas(sol.contacts)
-    assert list(frame.columns) == list(vi.ContactTable.columns) and len(frame) == 1
-    assert frame["separation"][0] == sol.contacts.separation[0]
-    data = vi.to_xarray(sol)
-    assert data.sizes == {"time": len(sol.t)}
-    assert np.array_equal(data["contact_force"].to_numpy(), sol.contact_force)
-    assert data["contact_force"].attrs["units"] == "N" and data.attrs["steps"] == sol.steps
-    # The 0.2 results through the same functions, as their methods give them.
-    general = vi.simulate(issue_example(), method="exact", t_end=0.2)
-    assert vi.to_pandas(general.contacts).equals(general.contacts.to_pandas())
-    assert vi.to_xarray(general).identical(general.to_xarray())
-    with pytest.raises(vi.InvalidInputError, match="contacts: must be a contact table"):
-        vi.to_pandas(sol)
-    with pytest.raises(vi.InvalidInputError, match="sol: must be a run's solution"):
-        vi.to_xarray(sol.contacts)
-
-
-def test_to_pandas_says_when_pandas_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
-    sol = vi.simulate(issue_example(), method="exact", t_end=0.2)
-    monkeypatch.setitem(sys.modules, "pandas", None)
-    with pytest.raises(ImportError, match="to_pandas\\(\\) needs pandas"):
-        sol.contacts.to_pandas()
+# ------------------------------------------------------------- names, pickles
 
 
 def test_every_model_name_is_exported() -> None:

@@ -4,10 +4,7 @@ scenarios refused with exit status 2 naming the key."""
 
 from __future__ import annotations
 
-import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -15,21 +12,10 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
+from system_checks import BALL, FREE_PAIR
 from vibroimpact.system import simulate_system
 
-ROOT = Path(__file__).resolve().parents[1]
-BALL = {"kind": "oscillator", "mass": 0.2, "stiffness": 0.0}
 FLOOR = {"at": 0, "side": "lower", "gap": 1.0, "law": "rigid", "restitution": 0.8}
-
-
-def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "vibroimpact", *args],
-        capture_output=True,
-        text=True,
-        timeout=50,
-        cwd=cwd,
-    )
 
 
 def test_bouncing_ball_accumulates_at_the_zeno_time_and_rests() -> None:
@@ -194,9 +180,6 @@ def test_momentum_through_rigid_impacts_of_a_free_pair() -> None:
     np.testing.assert_allclose(sol.contacts.restitution, 0.6, rtol=1e-12)
 
 
-FREE_PAIR = {"kind": "matrices", "mass": [[1.0, 0.0], [0.0, 3.0]], "stiffness": [[0.0] * 2] * 2}
-
-
 @pytest.mark.parametrize("method", ["exact", "dop853", "rk4", "newmark-implicit"])
 def test_two_points_pounding_rigidly_follow_the_impact_law(method: str) -> None:
     # Masses 1 and 3 kg closing at 1.5 m/s over a 1 cm gap: the impact at 1 cm / 1.5 m/s,
@@ -329,23 +312,6 @@ def test_rk4_at_fine_steps_goes_through_a_sticking_release(dt: float) -> None:
     assert sol.energy["input_work"] == pytest.approx(exact.energy["input_work"], rel=1e-8)
 
 
-@pytest.mark.parametrize(
-    ("against", "message"),
-    [(0, "stop 0 against: 0 moves as at = 0 does"), (2, "stop 0 against must be a coordinate")],
-)
-def test_a_stop_against_no_other_point_is_refused(against: int, message: str) -> None:
-    with pytest.raises(ValueError, match=message):
-        simulate_system(
-            FREE_PAIR,
-            stop=[
-                {"at": 0, "against": against, "side": "upper", "gap": 0.01, "law": "rigid"}
-                | {"restitution": 0.5}
-            ],
-            t_end=0.05,
-            method="exact",
-        )
-
-
 def test_recorded_file_reproduces_the_harmonic_it_samples(tmp_path: Path) -> None:
     # A CSV sampling 2 cos(2 pi 3 t) every 1e-4 s: linear interpolation errs by
     # at most A (2 pi f dt)^2 / 8 = 9e-7 N, so the responses agree to ~1e-6 relative.
@@ -414,164 +380,6 @@ def test_an_overdamped_kanai_tajimi_ground_passes_the_white_noise_through() -> N
     assert a.rms[0] == pytest.approx(b.rms[0], rel=0.05)
 
 
-SCENARIO = """
-[structure]
-kind = "matrices"
-mass = [[1.0, 0.0], [0.0, 0.5]]
-stiffness = [[300.0, -100.0], [-100.0, 100.0]]
-
-[[damper]]
-mass = 0.05
-at = 1
-clearance = 0.002
-law = "rigid"
-restitution = 0.5
-
-[[stop]]
-at = 0
-side = "upper"
-gap = 0.004
-law = "hertz-damped"
-stiffness = 1e8
-restitution = 0.7
-
-[[excitation]]
-kind = "force"
-at = 0
-signal = "harmonic"
-amplitude = 1.5
-frequency = 2.5
-
-[initial]
-structure_displacement = [0.001, 0.0]
-
-[solver]
-method = "dopri5"
-t_end = 1.0
-"""
-
-
-def test_cli_json_and_out_use_the_names_of_the_issue(tmp_path: Path) -> None:
-    path = tmp_path / "run.toml"
-    path.write_text(SCENARIO)
-    done = cli("simulate", str(path), "--json", "--out", str(tmp_path / "h.csv"))
-    assert done.returncode == 0, done.stderr
-    out = json.loads(done.stdout)
-    assert set(out["final_state"]) == {
-        "structure_displacement",
-        "structure_velocity",
-        "damper_displacement",
-        "damper_velocity",
-    }
-    assert len(out["final_state"]["structure_displacement"]) == 2
-    assert len(out["final_state"]["damper_velocity"]) == 1
-    energy = out["energy"]
-    for key in ("input_work", "dissipated", "stored_start", "stored_end", "residual"):
-        assert isinstance(energy[key], float)
-    balance = (
-        energy["stored_end"] - energy["stored_start"] - energy["input_work"] + energy["dissipated"]
-    )
-    assert balance == pytest.approx(energy["residual"], abs=1e-15)
-    assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
-    pairs = {c["pair"] for c in out["contacts"]}
-    assert pairs <= {"damper 0", "stop 0"} and "damper 0" in pairs
-    for c in out["contacts"]:
-        if c["kind"] == "impact":
-            assert c["duration"] == 0.0 and c["onset"] == c["separation"]
-    header = (tmp_path / "h.csv").read_text().splitlines()[0].split(",")
-    assert header == [
-        "t",
-        "structure_displacement_0",
-        "structure_displacement_1",
-        "structure_velocity_0",
-        "structure_velocity_1",
-        "damper_displacement_0",
-        "damper_velocity_0",
-    ]
-
-
-BAD = [
-    ('kind = "matrices"', 'kind = "truss"', 'kind must be one of "oscillator"'),
-    ("[-100.0, 100.0]]", "[-90.0, 100.0]]", "structure.stiffness must be symmetric"),
-    ("[[300.0, -100.0]", "[[-300.0, -100.0]", "structure.stiffness must be positive semi-definite"),
-    (
-        "mass = [[1.0, 0.0], [0.0, 0.5]]",
-        "mass = [[1.0, 0.0], [0.0, -0.5]]",
-        "structure.mass must be positive definite",
-    ),
-    ("at = 1\n", "at = 2\n", "damper 0 at must be a coordinate index"),
-    ('side = "upper"', 'side = "above"', 'side must be one of "upper", "lower"'),
-    ('law = "rigid"', 'law = "glue"', 'law must be one of "rigid"'),
-    ("restitution = 0.5", "restitution = 1.5", "restitution in [0, 1]"),
-    ('signal = "harmonic"', 'signal = "chirp"', 'signal must be one of "harmonic"'),
-    (
-        "structure_displacement = [0.001, 0.0]",
-        "structure_displacement = [0.001]",
-        "initial.structure_displacement must have 2 values",
-    ),
-    (
-        "structure_displacement = [0.001, 0.0]",
-        "structure_displacement = [0.0, 0.01]",
-        "damper 0 starts",
-    ),
-    ("clearance = 0.002", "clearence = 0.002", "did you mean 'clearance'"),
-    ('method = "dopri5"', 'method = "newmark-beta"', 'method must be one of "'),
-]
-
-
-@pytest.mark.parametrize(("old", "new", "message"), BAD, ids=[m for _, _, m in BAD])
-def test_bad_system_scenarios_exit_2_naming_the_key(
-    tmp_path: Path, old: str, new: str, message: str
-) -> None:
-    assert old in SCENARIO
-    path = tmp_path / "bad.toml"
-    path.write_text(SCENARIO.replace(old, new, 1))
-    done = cli("simulate", str(path))
-    assert done.returncode == 2, (done.stdout, done.stderr)
-    assert message in done.stderr and "Traceback" not in done.stderr
-    assert done.stderr.count("\n") == 1
-
-
-@pytest.mark.parametrize(
-    ("rows", "message"),
-    [
-        ("0.0,1.0\n0.0,2.0\n", "increase strictly"),
-        ("0.0,1.0\n", "at least 2"),
-        ("0.0,1.0\nx,y\n", "not two numbers"),
-    ],
-)
-def test_bad_recorded_series_exit_2(tmp_path: Path, rows: str, message: str) -> None:
-    (tmp_path / "ground.csv").write_text(rows)
-    text = SCENARIO.replace(
-        'signal = "harmonic"\namplitude = 1.5\nfrequency = 2.5',
-        'signal = "recorded"\nfile = "ground.csv"',
-    )
-    (tmp_path / "run.toml").write_text(text)
-    done = cli("simulate", "run.toml", cwd=tmp_path)
-    assert done.returncode == 2, done.stderr
-    assert message in done.stderr and "Traceback" not in done.stderr
-
-
-SYSTEM_EXAMPLES = sorted(
-    p for p in (ROOT / "examples").glob("*.toml") if "[structure]" in p.read_text(encoding="utf-8")
-)
-
-
-def test_examples_of_systems_run() -> None:
-    assert len(SYSTEM_EXAMPLES) >= 2
-    for path in SYSTEM_EXAMPLES:
-        done = cli("simulate", str(path), "--json")
-        assert done.returncode == 0, done.stderr
-        out = json.loads(done.stdout)
-        assert abs(out["energy"]["residual"]) < 1e-6 * max(
-            out["energy"]["dissipated"], out["energy"]["input_work"]
-        )
-
-
-def test_simulate_system_is_exported() -> None:
-    assert vi.simulate_system is simulate_system
-
-
 def test_masri_caughey_two_impacts_per_cycle_steady_state() -> None:
     """Masri and Caughey (1966), restated in shared/reference/forced-oracles.md: the
     symmetric orbit of a harmonically forced undamped primary with a loose mass, two
@@ -632,31 +440,6 @@ def test_masri_caughey_two_impacts_per_cycle_steady_state() -> None:
     k = np.floor(scaled / (math.pi / r))
     exact = xst * np.where(k % 2 == 0, 1.0, -1.0) * primary(scaled - k * math.pi / r)
     assert np.max(np.abs(sol.structure_displacement[:, 0] - exact)) < 1e-9 * np.max(np.abs(exact))
-
-
-@pytest.mark.parametrize("method", ["newmark-implicit", "generalized-alpha"])
-def test_implicit_methods_take_systems_at_second_order(method: str) -> None:
-    # The base-excited oscillator from its steady state: the error at 0.5 s falls
-    # by 4 when the step halves.
-    m, k, c, a0, f = 0.5, 200.0, 0.4, 3.0, 2.2
-    w = 2 * math.pi * f
-    x = -m * a0 / (k - m * w * w + 1j * c * w)
-    exact = (x * np.exp(1j * w * 0.5)).real
-
-    def error(dt: float) -> float:
-        sol = simulate_system(
-            {"kind": "oscillator", "mass": m, "stiffness": k, "damping": c},
-            excitation=[{"kind": "base", "signal": "harmonic", "amplitude": a0, "frequency": f}],
-            initial={"structure_displacement": [x.real], "structure_velocity": [-w * x.imag]},
-            t_end=0.5,
-            method=method,
-            dt=dt,
-            history=False,
-        )
-        return abs(float(sol.final_state["structure_displacement"][0]) - exact)
-
-    order = math.log2(error(1e-3) / error(5e-4))
-    assert abs(order - 2) < 0.05, order
 
 
 def test_long_adaptive_runs_stop_at_the_row_cap_and_history_off_keeps_none() -> None:
@@ -751,19 +534,6 @@ def test_a_zero_clearance_rigid_damper_moves_with_its_structure(method: str) -> 
     assert abs(done.energy["residual"]) < 1e-7 * done.energy["stored_start"]
 
 
-@pytest.mark.parametrize(
-    ("change", "message"),
-    [
-        ({"stiffness": 1e6}, 'stiffness applies to compliant laws only, not to law "rigid"'),
-        ({"damping": 0.1}, 'damping applies to compliant laws only, not to law "rigid"'),
-    ],
-)
-def test_keys_a_rigid_law_does_not_use_are_refused(change: dict[str, float], message: str) -> None:
-    damper = {"mass": 0.1, "at": 0, "clearance": 0.01, "law": "rigid", "restitution": 0.5}
-    with pytest.raises(vi.InvalidInputError, match=message):
-        simulate_system(BALL, damper=[{**damper, **change}], t_end=0.1, method="rk4", dt=1e-3)
-
-
 def test_sampling_every_period_does_not_change_whether_a_chattering_run_completes() -> None:
     """A damper chattering on a 10 Hz structure (found by a user trial): with a strobe
     every forcing period, a step shortened to land on one left a rebounding pair a hair
@@ -818,23 +588,6 @@ def test_two_dampers_on_one_point_rattle_to_the_end() -> None:
     assert abs(energy["residual"]) < 1e-6 * energy["input_work"]
 
 
-def test_a_negative_clearance_is_refused_naming_the_key_given() -> None:
-    damper = {"mass": 0.1, "at": 0, "clearance": -0.005, "law": "rigid", "restitution": 0.5}
-    with pytest.raises(vi.InvalidInputError, match=r"\[\[damper\]\] 0: clearance must be >= 0"):
-        simulate_system(BALL, damper=[damper], t_end=0.1, method="rk4", dt=1e-3)
-
-
-def test_keys_an_excitation_does_not_use_are_refused() -> None:
-    force = {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": 2.0}
-    with pytest.raises(vi.InvalidInputError, match="duration not used by signal 'harmonic'"):
-        simulate_system(
-            BALL, excitation=[{**force, "duration": 1.0}], t_end=0.1, method="rk4", dt=1e-3
-        )
-    base = {**force, "kind": "base"}
-    with pytest.raises(vi.InvalidInputError, match='at applies to kind "force" only'):
-        simulate_system(BALL, excitation=[base], t_end=0.1, method="rk4", dt=1e-3)
-
-
 def test_a_start_on_the_wall_to_round_off_is_accepted() -> None:
     x0 = -1.1 * 9.81 / 1000  # the damper placed exactly on its lower wall, in floats
     sol = simulate_system(
@@ -847,202 +600,3 @@ def test_a_start_on_the_wall_to_round_off_is_accepted() -> None:
         dt=1e-3,
     )
     assert sol.final_time == pytest.approx(0.1)
-
-
-def test_values_nested_thousands_deep_are_invalid_input() -> None:
-    nested: object = [1.0]
-    for _ in range(100_000):
-        nested = [nested]
-    with pytest.raises(vi.InvalidInputError, match="nested too deeply"):
-        simulate_system(
-            {"kind": "matrices", "mass": nested, "stiffness": [[1.0]]},
-            t_end=1.0,
-            method="rk4",
-            dt=1e-3,
-        )
-
-
-# An aluminium cantilever, 0.5 m long, 2 % damping in every mode.
-BEAM = {
-    "kind": "cantilever",
-    "length": 0.5,
-    "youngs_modulus": 7e10,
-    "second_moment": 1e-10,
-    "mass_per_length": 0.27,
-    "damping_ratio": 0.02,
-}
-EVERY_KIND = {
-    "compliant damper, force": {
-        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 400.0, "damping": 0.5},
-        "damper": [
-            {
-                "mass": 0.1,
-                "at": 0,
-                "clearance": 0.002,
-                "law": "hertz-damped",
-                "stiffness": 1e6,
-                "restitution": 0.7,
-            }
-        ],
-        "excitation": [
-            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 5.0, "frequency": 3.0}
-        ],
-    },
-    "rigid damper, base motion, gravity": {
-        "structure": {"kind": "oscillator", "mass": 1.0, "stiffness": 400.0, "damping": 0.5},
-        "damper": [{"mass": 0.1, "at": 0, "clearance": 0.002, "law": "rigid", "restitution": 0.6}],
-        "gravity": {},
-        "excitation": [{"kind": "base", "signal": "harmonic", "amplitude": 20.0, "frequency": 3.0}],
-    },
-    "beam with a linear stop, two harmonics": {
-        "structure": BEAM | {"modes": 2},
-        "stop": [{"at": 0.5, "side": "upper", "gap": 5e-4, "law": "linear", "stiffness": 2e4}],
-        "excitation": [
-            {
-                "kind": "force",
-                "at": 0.5,
-                "signal": "harmonics",
-                "amplitudes": [0.5, 0.2],
-                "frequencies": [10.0, 25.0],
-            }
-        ],
-    },
-    "two structures pounding (rigid and compliant), base motion": {
-        "structure": {
-            "kind": "matrices",
-            "mass": [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 1.0]],
-            "stiffness": [[1000.0, 0.0, 0.0], [0.0, 5000.0, 0.0], [0.0, 0.0, 2000.0]],
-            "damping": [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 1.0]],
-        },
-        "stop": [
-            {
-                "at": 0,
-                "against": 1,
-                "side": "upper",
-                "gap": 1e-3,
-                "law": "rigid",
-                "restitution": 0.6,
-            },
-            {
-                "at": 2,
-                "against": 1,
-                "side": "lower",
-                "gap": 1e-3,
-                "law": "linear",
-                "stiffness": 1e5,
-            },
-        ],
-        "excitation": [{"kind": "base", "signal": "harmonic", "amplitude": 20.0, "frequency": 3.0}],
-    },
-    "beam tip pounding on mid-span (m along the beam)": {
-        "structure": BEAM | {"modes": 3},
-        "stop": [
-            {
-                "at": 0.5,
-                "against": 0.25,
-                "side": "upper",
-                "gap": 2e-4,
-                "law": "linear",
-                "stiffness": 1e4,
-            }
-        ],
-        "excitation": [
-            {"kind": "force", "at": 0.5, "signal": "harmonic", "amplitude": 0.5, "frequency": 8.0}
-        ],
-    },
-}
-# Each method at settings where it is accurate: (settings, tolerance on the end state
-# relative to its size, tolerance on the energy residual relative to the energies).
-METHODS = {
-    "rk4": ({"dt": 1e-5}, 1e-8, 1e-9),
-    "dopri5": ({"rtol": 1e-10, "atol": 1e-14}, 1e-7, 1e-8),
-    "newmark-implicit": ({"dt": 1e-5}, 1e-4, 1e-5),
-    "generalized-alpha": ({"dt": 1e-5}, 1e-4, 1e-5),
-}
-
-
-@pytest.mark.parametrize("kind", list(EVERY_KIND))
-def test_every_method_gives_the_same_run_and_closes_its_energy_balance(kind: str) -> None:
-    """Contacts one by one and the end state against DOP853 at rtol 1e-12, and the
-    energy balance of every method, for a compliant and a rigid damper, force and base
-    excitation, gravity, and a beam hitting a stop."""
-    case = EVERY_KIND[kind]
-    ref = simulate_system(**case, t_end=0.5, method="dop853", rtol=1e-12, atol=1e-15)
-    end = ref.final_state["structure_displacement"]
-    assert len(ref.contacts) > 5
-    for method, (settings, state_tolerance, energy_tolerance) in METHODS.items():
-        sol = simulate_system(**case, t_end=0.5, method=method, **settings)
-        assert sol.contacts.pair == ref.contacts.pair and sol.contacts.kind == ref.contacts.kind
-        np.testing.assert_allclose(sol.contacts.onset, ref.contacts.onset, atol=1e-4)
-        error = np.max(np.abs(sol.final_state["structure_displacement"] - end))
-        assert error < state_tolerance * np.max(np.abs(end)), (method, error)
-        e = sol.energy
-        scale = abs(e["input_work"]) + e["dissipated"] + abs(e["stored_end"])
-        assert abs(e["residual"]) < energy_tolerance * scale, (method, e)
-
-
-@pytest.mark.parametrize("method", ["exact", "dop853"])
-def test_a_constant_force_as_a_0_hz_harmonic_does_its_work(method: str) -> None:
-    # A step force F0 on a damped oscillator from rest: x = F0/k (1 - e^(-z w t) (cos wd t +
-    # z / sqrt(1 - z^2) sin wd t)), and the force's work is F0 x (the exact flow used to
-    # count a 0 Hz force as a potential, like gravity, and failed its energy balance).
-    m, k, c, force, t = 0.05, 100.0, 0.01, 0.1, 0.5
-    w = math.sqrt(k / m)
-    zeta = c / (2 * math.sqrt(k * m))
-    wd = w * math.sqrt(1 - zeta * zeta)
-    decay = math.exp(-zeta * w * t)
-    x = (
-        force
-        / k
-        * (1 - decay * (math.cos(wd * t) + zeta / math.sqrt(1 - zeta**2) * math.sin(wd * t)))
-    )
-    settings = {"rtol": 1e-12, "atol": 1e-15} if method == "dop853" else {}
-    sol = simulate_system(
-        {"kind": "oscillator", "mass": m, "stiffness": k, "damping": c},
-        excitation=[
-            {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": force, "frequency": 0.0}
-        ],
-        t_end=t,
-        method=method,
-        **settings,
-    )
-    assert sol.final_state["structure_displacement"][0] == pytest.approx(x, rel=1e-9)
-    assert sol.energy["input_work"] == pytest.approx(force * x, rel=1e-9)
-    assert abs(sol.energy["residual"]) < 1e-12 * sol.energy["input_work"]
-
-
-@pytest.mark.parametrize(("first", "second"), [(5.0, 15.0), (15.0, 5.0), (7.0, 15.0)])
-def test_the_exact_flow_takes_the_work_of_every_harmonic(first: float, second: float) -> None:
-    # Two harmonic forces at different frequencies on a damped oscillator: the exact flow's
-    # input work against DOP853 at rtol 1e-12 (its quadrature once took the first
-    # harmonic's power with the rates of the harmonics before it only, and 5 + 15 Hz
-    # failed its energy balance).
-    structure = {"kind": "oscillator", "mass": 1.0, "stiffness": 3947.8, "damping": 2.513}
-    excitation = [
-        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 5.0, "frequency": first},
-        {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0, "frequency": second},
-    ]
-    exact = simulate_system(structure, excitation=excitation, t_end=2.0, method="exact")
-    ref = simulate_system(
-        structure, excitation=excitation, t_end=2.0, method="dop853", rtol=1e-12, atol=1e-15
-    )
-    assert exact.energy["input_work"] == pytest.approx(ref.energy["input_work"], rel=1e-9)
-    assert abs(exact.energy["residual"]) < 1e-12 * exact.energy["input_work"]
-
-
-def test_the_cli_prints_a_warning_on_one_line(tmp_path: Path) -> None:
-    # The paper's law at low restitution warns; on the command line that is one line like
-    # an error's, not Python's "file:line: Category" with the source line under it.
-    scenario = tmp_path / "low_e.toml"
-    scenario.write_text(
-        '[structure]\nkind = "oscillator"\nmass = 1.0\nstiffness = 100.0\n'
-        '[[damper]]\nmass = 0.1\nat = 0\nclearance = 0.01\nlaw = "hyster-hertz"\n'
-        "stiffness = 1e6\nrestitution = 0.2\n"
-        '[solver]\nmethod = "dop853"\nt_end = 0.01\n',
-        encoding="utf-8",
-    )
-    done = cli("simulate", str(scenario))
-    assert done.returncode == 0, done.stderr
-    lines = done.stderr.strip().splitlines()
-    assert lines == [lines[0]] and lines[0].startswith("vibroimpact: warning: law")
-    assert ".py" not in done.stderr
