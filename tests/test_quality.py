@@ -54,3 +54,69 @@ def test_every_rust_test_runs_under_a_time_limit() -> None:
             )
         found += expected
     assert found >= 80
+
+
+#: The tree's limits (issue 24, and the developers' guide): split along concerns first.
+MAX_FILE_LINES, MAX_FUNCTION_LINES = 800, 150
+#: The folders whose Rust and Python sources the limits hold for.
+SOURCES = ("crates", "python", "tests", "benchmarks", "docs", "examples")
+
+
+def _sources(suffix: str) -> list[Path]:
+    return sorted(
+        p
+        for folder in SOURCES
+        for p in (ROOT / folder).glob(f"**/*{suffix}")
+        if not {"target", "_build", "build", ".ipynb_checkpoints"} & set(p.parts)
+    )
+
+
+def _rust_functions(text: str) -> list[tuple[str, int]]:
+    """Each function of rustfmt-formatted ``text``, from its ``fn`` line to the brace
+    that closes it at the same indentation, with its length in lines."""
+    import re
+
+    lines = text.split("\n")
+    found = []
+    start = re.compile(r"^(\s*)(?:pub(?:\([a-z]+\))? )?(?:const )?(?:unsafe )?fn (\w+)")
+    for i, line in enumerate(lines):
+        match = start.match(line)
+        if match is None:
+            continue
+        close = match.group(1) + "}"
+        end = next((j for j in range(i + 1, len(lines)) if lines[j] == close), i)
+        found.append((match.group(2), end - i + 1))
+    return found
+
+
+def test_no_source_file_or_function_is_over_the_tree_s_limits() -> None:
+    import ast
+
+    rust, python = _sources(".rs"), _sources(".py")
+    assert len(rust) > 50 and len(python) > 100
+    too_long = [
+        f"{p.relative_to(ROOT)}: {n} lines"
+        for p in rust + python
+        if (n := p.read_text(encoding="utf-8").count("\n")) > MAX_FILE_LINES
+    ]
+    for p in rust:
+        too_long += [
+            f"{p.relative_to(ROOT)}: fn {name}, {n} lines"
+            for name, n in _rust_functions(p.read_text(encoding="utf-8"))
+            if n > MAX_FUNCTION_LINES
+        ]
+    for p in python:
+        too_long += [
+            f"{p.relative_to(ROOT)}: def {node.name}, {n} lines"
+            for node in ast.walk(ast.parse(p.read_text(encoding="utf-8")))
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
+            and (n := (node.end_lineno or node.lineno) - node.lineno + 1) > MAX_FUNCTION_LINES
+        ]
+    assert not too_long, "split along concerns: " + "; ".join(too_long)
+
+
+def test_the_rust_functions_are_measured_to_their_closing_brace() -> None:
+    # The measure the limit relies on: a function's length runs to its own closing
+    # brace (not a nested one, not the file's end).
+    text = "impl A {\n    pub(crate) fn a() {\n        if x {\n        }\n    }\n}\nfn b() {\n}\n"
+    assert _rust_functions(text) == [("a", 4), ("b", 2)]
