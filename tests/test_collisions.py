@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 
 import vibroimpact as vi
 import vibroimpact.analysis as an
-from test_system import cli
+from system_checks import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 COLUMN = ROOT / "examples" / "particle_column.toml"

@@ -23,8 +23,8 @@ from scipy.optimize import brentq
 
 import vibroimpact as vi
 import vibroimpact.analysis as an
+from system_checks import cli
 from test_collisions import still_table
-from test_system import cli
 from vibroimpact.analysis import continue_orbit
 from vibroimpact.analysis.curves import curve
 from vibroimpact.analysis.grazing import struck

@@ -1,6 +1,6 @@
 """Continuation, bifurcation diagrams, Poincare sections and basins of attraction
-(vibroimpact.continuation, vibroimpact.maps and the commands continue, bifurcation,
-poincare and basins) against closed forms.
+(vibroimpact.continuation, vibroimpact.maps) against closed forms; the commands
+continue, bifurcation, poincare and basins are in test_maps_cli.py.
 
 Every expected value is derived here, never read from the code under test; the
 formulas are those of /work/shared/reference/forced-oracles.md:

@@ -3,8 +3,9 @@
 References, all computed here: the closed form of a damped oscillator (a run in which
 the bodies never touch), SciPy's DOP853 at rtol 1e-12 with the contact onsets and
 separations located as events (one collision, or a whole multi-contact run mode by
-mode), conservation of energy, and the geometry of a trajectory that just touches,
-just misses or just penetrates a wall.
+mode) and conservation of energy. The geometry of a trajectory that just touches,
+just misses or just penetrates a wall, and the limits of a run, are in
+test_methods_edges.py.
 
 Expected orders: RK4 4, the Newmark family 2 (the paper's lagged Newmark is plain
 average-acceleration Newmark while the bodies are apart), DOPRI5 5 and DOP853 8 in

@@ -1,5 +1,6 @@
 """The typed model (issue 24): a System built from parts named as the TOML sections and
-keys, read from any scenario file, written back, run, and taken by the analyses.
+keys, read from any scenario file, written back and run (the analyses that take it,
+and its results as pandas and xarray, are in test_model_results.py).
 
 Independent references: the scenario files as tomllib reads them, the command line's
 JSON of the same file, the dict API (simulate_system, the analyses of a scenario's

@@ -63,28 +63,50 @@ SOURCES = ("crates", "python", "tests", "benchmarks", "docs", "examples")
 
 
 def _sources(suffix: str) -> list[Path]:
+    """The repository's own files of ``suffix`` in :data:`SOURCES` (those git tracks,
+    where it can say; else every such file there, outside build folders)."""
+    done = subprocess.run(
+        ["git", "ls-files", "-z", "--", *SOURCES], cwd=ROOT, capture_output=True, timeout=60
+    )
+    if done.returncode == 0 and done.stdout:
+        names = done.stdout.decode().split("\0")
+        paths = (ROOT / name for name in names if name.endswith(suffix))
+        return sorted(p for p in paths if p.is_file())
     return sorted(
         p
         for folder in SOURCES
         for p in (ROOT / folder).glob(f"**/*{suffix}")
-        if not {"target", "_build", "build", ".ipynb_checkpoints"} & set(p.parts)
+        if not {"target", "_build", ".venv", "site-packages"} & set(p.parts)
     )
 
 
 def _rust_functions(text: str) -> list[tuple[str, int]]:
-    """Each function of rustfmt-formatted ``text``, from its ``fn`` line to the brace
-    that closes it at the same indentation, with its length in lines."""
+    """Each function with a body in rustfmt-formatted ``text``, from its ``fn`` line to
+    the brace that closes it at the same indentation, with its length in lines (a
+    trait's declarations, ending in ``;``, have none)."""
     import re
 
     lines = text.split("\n")
     found = []
-    start = re.compile(r"^(\s*)(?:pub(?:\([a-z]+\))? )?(?:const )?(?:unsafe )?fn (\w+)")
+    start = re.compile(
+        r"^(\s*)(?:pub(?:\([a-z]+\))? )?(?:const )?(?:async )?(?:unsafe )?"
+        r'(?:extern "C" )?fn (\w+)'
+    )
     for i, line in enumerate(lines):
         match = start.match(line)
         if match is None:
             continue
+        # The signature ends where the body opens (or closes on the same line).
+        for j in range(i, len(lines)):
+            tail = lines[j].rstrip()
+            if tail.endswith(("{", ";", "}")):
+                break
+        if tail.endswith(";"):
+            continue
         close = match.group(1) + "}"
-        end = next((j for j in range(i + 1, len(lines)) if lines[j] == close), i)
+        end = j
+        if tail.endswith("{"):
+            end = next((e for e in range(j + 1, len(lines)) if lines[e] == close), len(lines))
         found.append((match.group(2), end - i + 1))
     return found
 
@@ -117,6 +139,12 @@ def test_no_source_file_or_function_is_over_the_tree_s_limits() -> None:
 
 def test_the_rust_functions_are_measured_to_their_closing_brace() -> None:
     # The measure the limit relies on: a function's length runs to its own closing
-    # brace (not a nested one, not the file's end).
-    text = "impl A {\n    pub(crate) fn a() {\n        if x {\n        }\n    }\n}\nfn b() {\n}\n"
-    assert _rust_functions(text) == [("a", 4), ("b", 2)]
+    # brace (not a nested one, not a later function's, not the file's end); a trait's
+    # declaration has no body; an empty body closes on its own line.
+    text = (
+        "trait T {\n    fn d(&self) -> u8;\n    fn e(\n        &self,\n    ) -> u8 {\n"
+        "        1\n    }\n}\n"
+        "impl A {\n    pub(crate) fn a() {\n        if x {\n        }\n    }\n}\n"
+        "fn b() {\n}\nfn c() {}\nasync fn f<T>(x: T)\nwhere\n    T: Copy,\n{\n    x;\n}\n"
+    )
+    assert _rust_functions(text) == [("e", 5), ("a", 4), ("b", 2), ("c", 1), ("f", 6)]

@@ -17,7 +17,7 @@ from conftest import limit_memory
 from vibroimpact.cli import main
 
 REPO = Path(__file__).resolve().parent.parent
-# The two-mass examples ([system]); those of 0.2 systems ([structure]) run in test_system.py.
+# The two-mass examples ([system]); those of 0.2 systems ([structure]) run in test_system_inputs.py.
 EXAMPLES = sorted(
     p for p in (REPO / "examples").glob("*.toml") if "[system]" in p.read_text(encoding="utf-8")
 )

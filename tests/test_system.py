@@ -1,6 +1,7 @@
-"""0.2 systems from Python, TOML and the command line: results against closed forms
-and a SciPy oracle, the names the outside checks use (--json, --out), and bad
-scenarios refused with exit status 2 naming the key."""
+"""0.2 systems run from Python: results against closed forms and a SciPy oracle
+(Zeno and rest, base excitation, rattling, pounding, sticking, recorded and random
+signals, rows and limits). Their scenarios, the command line's names and refusals are
+in test_system_inputs.py; every method on every kind in test_system_methods.py."""
 
 from __future__ import annotations
 
