@@ -86,9 +86,14 @@ macro_rules! plain_step_with {
     };
 }
 
-/// `if keep { new } else { old }` of every lane (a select, which vectorises).
+/// `if keep { new } else { old }` of every lane (a select, which vectorises);
+/// a copy where `keep` holds every lane (`all`, the common step: no mask).
 #[inline(always)]
-fn select(keep: &[bool; LANES], new: &V, old: &mut V) {
+fn select(keep: &[bool; LANES], all: bool, new: &V, old: &mut V) {
+    if all {
+        *old = *new;
+        return;
+    }
     for l in 0..LANES {
         old[l] = if keep[l] { new[l] } else { old[l] };
     }
@@ -315,6 +320,7 @@ impl<L: LaneLaw> Group<L> {
         runs: &mut LaneRuns,
     ) {
         let d = n + k;
+        let all = plain.iter().all(|&p| p);
         let LaneRuns {
             y: start,
             peaks,
@@ -335,7 +341,7 @@ impl<L: LaneLaw> Group<L> {
             for l in 0..LANES {
                 peak[l] = peaks[j][l].max(p0[l].abs().max(p1[l].abs()));
             }
-            select(plain, &peak, &mut peaks[j]);
+            select(plain, all, &peak, &mut peaks[j]);
             if values.is_none() {
                 continue;
             }
@@ -354,13 +360,13 @@ impl<L: LaneLaw> Group<L> {
                 );
                 square[l] = squares[j][l] + h * square_integral(&a);
             }
-            select(plain, &square, &mut squares[j]);
+            select(plain, all, &square, &mut squares[j]);
         }
         let mut sum = [0.0; LANES];
         for l in 0..LANES {
             sum[l] = recorded[l] + h;
         }
-        select(plain, &sum, recorded);
+        select(plain, all, &sum, recorded);
     }
 
     /// The lanes in `plain` moved to the step's end `end` (walls' gaps
@@ -373,12 +379,13 @@ impl<L: LaneLaw> Group<L> {
         end_gaps: &LaneGaps,
         runs: &mut LaneRuns,
     ) {
+        let all = plain.iter().all(|&p| p);
         for e in 0..self.len.min(super::MAX_LEN) {
-            select(plain, &end[e], &mut runs.y[e]);
+            select(plain, all, &end[e], &mut runs.y[e]);
         }
         for w in 0..self.walls.len() {
             for g in 0..2 {
-                select(plain, &end_gaps[w][g], &mut runs.gaps[w][g]);
+                select(plain, all, &end_gaps[w][g], &mut runs.gaps[w][g]);
             }
         }
     }
