@@ -271,3 +271,100 @@ impl Schedule {
         Some((next, self.in_window(time, self.dt)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Clock, Schedule};
+
+    /// A fixed-step schedule of `dt` to `t_end`, its window from
+    /// `record_from`, strobes every `strobe_period` and rows kept where
+    /// `keep_history`.
+    fn schedule(t_end: f64, record_from: f64, strobe_period: f64, keep_history: bool) -> Schedule {
+        Schedule {
+            adaptive: false,
+            dt: 1e-3,
+            t_end,
+            keep_history,
+            every: 7,
+            record_from,
+            strobe_period,
+            mean_square: false,
+            time_scale: t_end,
+            fixed: None,
+        }
+    }
+
+    /// The clock on grid point `grid` (`until_kept` rows to go, the next
+    /// strobe at `next_strobe`).
+    fn clock(dt: f64, grid: u64, until_kept: u64, next_strobe: f64) -> Clock {
+        Clock {
+            time: grid as f64 * dt,
+            grid,
+            accepted: grid,
+            until_kept,
+            next_strobe,
+        }
+    }
+
+    /// The rule asked step by step, as the kernel asks it: the steps in a
+    /// row (at most `most`) that are `plain`, as the grid and the row's
+    /// countdown move on.
+    fn one_by_one(s: &Schedule, c: &Clock, most: u64, plain: impl Fn(&Clock) -> bool) -> u64 {
+        (0..most)
+            .find(|&i| {
+                let at = clock(
+                    s.dt,
+                    c.grid + i,
+                    c.until_kept.saturating_sub(i),
+                    c.next_strobe,
+                );
+                !plain(&at)
+            })
+            .unwrap_or(most)
+    }
+
+    #[test]
+    fn the_runs_of_plain_steps_are_those_asked_one_by_one() {
+        crate::testing::timeout(60, || {
+            // Each rule's turn inside the range: the run's end (1 s), the
+            // window's start (0.3 s, and on a grid point: 0.25 s), a strobe
+            // (at 0.6 s) and a history row (every 7 steps). The fast path
+            // (`Compact::fixed_stretch`) takes the steps the search allows
+            // in a row; a search that allowed one too many would take a step
+            // the kernel must take itself.
+            let mut cases = vec![
+                schedule(1.0, 0.3, f64::INFINITY, false),
+                schedule(1.0, 0.25, f64::INFINITY, false),
+                schedule(1.0, 0.0, 0.2, false),
+                schedule(1.0, 0.0, f64::INFINITY, true),
+                schedule(0.4005, 2.0, f64::INFINITY, false),
+            ];
+            // Mean squares summed: no step in the window is plain.
+            cases.push(Schedule {
+                mean_square: true,
+                ..schedule(1.0, 0.3, f64::INFINITY, false)
+            });
+            let mut runs = 0;
+            for s in &cases {
+                for grid in 1..1001 {
+                    for most in [1, 5, 64, 10_000] {
+                        // No strobe due where there are none (as a run's clock
+                        // starts them).
+                        let strobe = if s.strobe_period.is_finite() {
+                            0.6
+                        } else {
+                            f64::INFINITY
+                        };
+                        let c = clock(s.dt, grid, 7 + grid % 5, strobe);
+                        let plain = |at: &Clock| s.plain_fixed_step(at).is_some();
+                        let asked = one_by_one(s, &c, most, plain);
+                        assert_eq!(s.plain_fixed_run(&c, most), asked, "{grid} {most}");
+                        runs += usize::from(asked > 0 && asked < most);
+                    }
+                }
+            }
+            // The rows' turns inside the runs searched, not only full runs.
+            assert!(runs > 2000, "{runs}");
+        });
+    }
+}
