@@ -307,20 +307,17 @@ mod tests {
     }
 
     /// The rule asked step by step, as the kernel asks it: the steps in a
-    /// row (at most `most`) that are `plain`, as the grid and the row's
-    /// countdown move on.
+    /// row (at most `most`) that are `plain`, the clock moved on by each as
+    /// a stretch moves it ([`Clock::plain_step_to`] the next grid point).
     fn one_by_one(s: &Schedule, c: &Clock, most: u64, plain: impl Fn(&Clock) -> bool) -> u64 {
-        (0..most)
-            .find(|&i| {
-                let at = clock(
-                    s.dt,
-                    c.grid + i,
-                    c.until_kept.saturating_sub(i),
-                    c.next_strobe,
-                );
-                !plain(&at)
-            })
-            .unwrap_or(most)
+        let mut at = *c;
+        for i in 0..most {
+            if !plain(&at) {
+                return i;
+            }
+            at.plain_step_to((at.grid + 1) as f64 * s.dt);
+        }
+        most
     }
 
     #[test]
