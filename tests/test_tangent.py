@@ -403,7 +403,11 @@ def test_largest_exponent_of_a_ball_on_a_compliant_table_matches_two_trajectorie
     run = an.lyapunov_runner(data)
     start = run.map(np.array([0.05, 0.0]), 200)
     found = vi.lyapunov(run, start, settle=0, periods=periods)
-    assert np.all(np.isfinite(found.exponents)) and found.grazings == []
+    # A landing slower than the damped law's latched rate (a soft one) is reported as a
+    # grazing: a chaotic orbit has a few among its thousands of landings, which of them
+    # shifting with the engine's round-off; they stay rare.
+    assert np.all(np.isfinite(found.exponents))
+    assert len(found.grazings) <= found.impacts // 1000
     # Each contact counted (as its onset): a few a period (the plain kernel's run
     # parts from this one after some tens of periods, chaos amplifying round-off).
     contacts = len(run.periods(start, periods)["contacts"]["onset"])

@@ -199,7 +199,7 @@ impl Run<'_> {
                 reason: "the state is no longer finite",
             });
         }
-        let kept_attempt = !self.reduce(stepper, dt)?;
+        let kept_attempt = !self.reduce(stepper, dt, true)?;
         let first = self.fixed_changes(dt);
         if kept_attempt {
             stepper.accept();

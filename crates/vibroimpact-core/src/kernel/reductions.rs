@@ -139,14 +139,18 @@ pub fn square_integral(a: &[f64; 6]) -> f64 {
 
 /// Add the kept step `(time, y) -> end` of length `h` to the reductions.
 /// Returns whether the stepper was used (its last attempt is then not the
-/// kept step).
+/// kept step). `stages`: a fixed step's work space, through whose signal
+/// caches the step's stages went; the rates at the step's ends then take
+/// the force's values the stages took there (the start's are the method's
+/// first stage where it has one, [`SystemStepper::first_stage`]), so that
+/// a step's end rates are the next step's first stage, to the bit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn reduce_step<S: SystemStepper>(
     system: &Assembly,
     stepper: &mut S,
     (time, y, end, h): (f64, &[f64], &[f64], f64),
     modes: &[Mode],
-    scratch: &mut Scratch,
+    (scratch, stages): (&mut Scratch, Option<&Scratch>),
     (probe, start, work): (&mut [f64], &mut [f64], &mut [f64]),
     out: &mut Reductions,
     mean_square: bool,
@@ -176,7 +180,13 @@ pub(crate) fn reduce_step<S: SystemStepper>(
     // for the mean square, or where a velocity changes sign (a peak inside).
     let turning = (0..observed).any(|j| of(j, v0) * of(j, v1) < 0.0);
     if interpolated || turning {
-        system.rates(time, y, modes, scratch, start);
+        match (stages, stepper.first_stage()) {
+            (Some(_), Some(first)) => start[..first.len()].copy_from_slice(first),
+            _ => system.rates(time, y, modes, scratch, start),
+        }
+        if let Some(stages) = stages {
+            scratch.signals_from(stages);
+        }
         system.rates(time + h, end, modes, scratch, work);
     }
     for j in 0..observed {

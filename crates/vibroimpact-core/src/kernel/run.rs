@@ -60,7 +60,8 @@ pub(super) struct Run<'a> {
     /// The reductions evaluate with their own: the signals' values the
     /// steps cache (a harmonic's rotated phasor) are then the same bits
     /// whatever is reduced (a peak differed in its last bit with the RMS
-    /// kept or not).
+    /// kept or not). A fixed step's reductions copy the steps' caches into
+    /// it ([`Scratch::signals_from`]), which leaves those as they were.
     pub(super) reduce_scratch: Scratch,
     pub(super) modes: Vec<Mode>,
     /// The contact each interaction is in, if any.
@@ -255,7 +256,7 @@ impl<'a> Run<'a> {
             });
         }
         let mut probed = self.compliant && self.deepest_indentation(stepper, taken)?;
-        probed |= self.reduce(stepper, taken)?;
+        probed |= self.reduce(stepper, taken, false)?;
         if probed && kept_attempt {
             if stepper.carries_solution() {
                 // The probes replaced the stepper's pending data: the kept
@@ -481,25 +482,36 @@ impl<'a> Run<'a> {
     /// reductions where it is in the recorded window; whether the stepper
     /// was used (its last attempt is then not the step).
     #[inline(always)]
-    pub(super) fn reduce<S: SystemStepper>(&mut self, stepper: &mut S, taken: f64) -> Result<bool> {
+    /// `fixed`: a fixed step's (see [`reduce_step`]'s `stages`).
+    pub(super) fn reduce<S: SystemStepper>(
+        &mut self,
+        stepper: &mut S,
+        taken: f64,
+        fixed: bool,
+    ) -> Result<bool> {
         if !self.schedule.in_window(self.clock.time, taken) {
             return Ok(false);
         }
-        self.reduce_in_window(stepper, taken)
+        self.reduce_in_window(stepper, taken, fixed)
     }
 
     /// [`Self::reduce`] for a step in the recorded window: the window's test
     /// is inlined in the step, the reductions (a loop over the observed
     /// quantities, a peak's location) stay a call of their own.
     #[inline(never)]
-    fn reduce_in_window<S: SystemStepper>(&mut self, stepper: &mut S, taken: f64) -> Result<bool> {
+    fn reduce_in_window<S: SystemStepper>(
+        &mut self,
+        stepper: &mut S,
+        taken: f64,
+        fixed: bool,
+    ) -> Result<bool> {
         let time = self.clock.time;
         reduce_step(
             self.system,
             stepper,
             (time, &self.y, &self.end, taken),
             &self.modes,
-            &mut self.reduce_scratch,
+            (&mut self.reduce_scratch, fixed.then_some(&self.scratch)),
             (
                 &mut self.buffers.probe,
                 &mut self.buffers.start,

@@ -8,7 +8,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::lanes::{LANES, V};
-use crate::model::assembly::{rotated, same_increment, Cached, CachedParts, RESYNC};
+use crate::model::assembly::{rotated, same_increment, same_instant, Cached, CachedParts, RESYNC};
 use crate::model::signals::Signal;
 use crate::numerics::series::{
     in_quadrant, quadrant_reduce, reduces, sin_cos_series, SERIES_ANGLE,
@@ -149,7 +149,7 @@ impl LaneCaches {
 
     /// [`Cached::value`] of each lane's harmonic (`[amplitude, omega,
     /// phase]`) at `time`, kept in the lanes of `live` whose time is not
-    /// `time` already: a rotation by the cached increment, the increment's
+    /// `time` already (to its round-off, [`same_instant`]): a rotation by the cached increment, the increment's
     /// first (its rotation's series, then the rotation), or a direct
     /// evaluation (the reduced angle's series), each the cache's
     /// operations, the series made only where a lane needs them. The lanes
@@ -164,9 +164,10 @@ impl LaneCaches {
     ) -> [bool; LANES] {
         let (mut first, mut rotates, mut direct) = ([false; LANES], [false; LANES], [false; LANES]);
         let mut same = [false; LANES];
-        let (mut any_first, mut any_direct) = (false, false);
+        let (mut any_first, mut any_direct, mut any_due) = (false, false, false);
         for l in 0..LANES {
-            let due = live[l] & (self.time[l].to_bits() != time.to_bits());
+            let due = live[l] & !same_instant(time, self.time[l]);
+            any_due |= due;
             same[l] = same_increment(time - self.time[l], self.delta[l], time);
             let rotations = self.rotations[l];
             first[l] = due & same[l] & (rotations == 0);
@@ -176,6 +177,11 @@ impl LaneCaches {
             any_direct |= direct[l];
         }
         let mut cold = [false; LANES];
+        if !any_due {
+            // Every lane's value is its cached one (a step's repeated
+            // midpoint, its start at the last one's end).
+            return cold;
+        }
         if any_first {
             // The increment's rotation, where it is its first repeat.
             for l in 0..LANES {

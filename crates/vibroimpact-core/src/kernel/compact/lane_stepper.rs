@@ -128,6 +128,10 @@ impl SystemStepper for LaneStepper {
         Ok(0.0)
     }
 
+    fn first_stage(&self) -> Option<&[f64]> {
+        Some(&self.first)
+    }
+
     fn accept(&mut self) {
         // RK4's end is not the next start's first stage (as ExplicitRk).
         self.start_valid = false;

@@ -25,8 +25,9 @@ pub(crate) struct LaneRuns {
     pub(crate) peaks: [V; MAX_OBSERVED],
     pub(crate) squares: [V; MAX_OBSERVED],
     pub(crate) recorded: V,
-    /// The rates at a step's ends (the mean squares' accelerations).
-    pub(crate) rates: Box<[LaneState; 2]>,
+    /// The rates at the last step's end (the mean squares' accelerations,
+    /// and the next step's first stage).
+    pub(crate) end_rates: Box<LaneState>,
 }
 
 impl Default for LaneRuns {
@@ -37,7 +38,7 @@ impl Default for LaneRuns {
             peaks: [[0.0; LANES]; MAX_OBSERVED],
             squares: [[0.0; LANES]; MAX_OBSERVED],
             recorded: [0.0; LANES],
-            rates: Box::new([[[0.0; LANES]; super::MAX_LEN]; 2]),
+            end_rates: LaneStep::state(),
         }
     }
 }
@@ -51,13 +52,15 @@ pub(crate) struct PlainStep<'s> {
     /// The lanes with a run in progress.
     pub(crate) live: [bool; LANES],
     pub(crate) in_window: bool,
-    /// Each lane's force at the four stages' times, and (for the mean
-    /// squares) at the step's ends through the reductions' cache.
+    /// Each lane's force at the four stages' times (the last, the step's
+    /// end's: the mean squares' rates there take it, as the kernel's fixed
+    /// step takes its stages').
     pub(crate) values: &'s [V; 4],
-    pub(crate) reduce_values: Option<&'s [V; 2]>,
-    /// Whether the rates at the start with `reduce_values[0]` are those
-    /// at the last step's end (the runs' reductions' rates, to the bit).
-    pub(crate) start_rates_kept: bool,
+    /// Whether the mean squares are summed (the rates at the step's end made).
+    pub(crate) summed: bool,
+    /// Whether the runs' rates at the last step's end are this step's first
+    /// stage (every lane's state and force that end's), to the bit.
+    pub(crate) first_kept: bool,
 }
 
 /// [`Group::plain_step_in`] compiled for a processor feature (the same
@@ -138,19 +141,12 @@ impl<L: LaneLaw> Group<L> {
         out: &mut LaneStep,
         end_gaps: &mut LaneGaps,
     ) -> [bool; LANES] {
-        let (n, k) = sizes;
-        let [at_start, at_end] = &mut *runs.rates;
-        let with_first = match p.reduce_values {
-            Some(_) if p.start_rates_kept => {
-                // Only the structure's accelerations are read (`reduce`).
-                let d = n + k;
-                at_start[d..d + n].copy_from_slice(&at_end[d..d + n]);
-                None
-            }
-            Some(values) => Some((&values[0], at_start)),
-            None => None,
-        };
-        self.step_in(sizes, &runs.y, p.h, p.modes, p.values, with_first, out);
+        if p.first_kept {
+            // The buffers trade places: the end's rates are overwritten
+            // where they are made again (`reduce`).
+            std::mem::swap(&mut out.first, &mut runs.end_rates);
+        }
+        self.step_in(sizes, &runs.y, p.h, p.modes, p.values, p.first_kept, out);
         self.gaps(sizes, &out.end, end_gaps);
         let mut plain = self.plain(sizes, (&runs.y, &out.end), end_gaps, p.open, p.in_window);
         self.power(sizes, &out.end, p, &mut out.power);
@@ -158,14 +154,9 @@ impl<L: LaneLaw> Group<L> {
             plain[l] &= p.live[l];
         }
         if p.in_window {
-            self.reduce(
-                sizes,
-                (&out.end, p.h),
-                p.modes,
-                p.reduce_values,
-                &plain,
-                runs,
-            );
+            let end_value = p.summed.then_some(&p.values[3]);
+            let ends = (&*out.first, &*out.end, p.h);
+            self.reduce(sizes, ends, p.modes, end_value, &plain, runs);
         }
         plain
     }
@@ -304,18 +295,18 @@ impl<L: LaneLaw> Group<L> {
     }
 
     /// The plain fixed step of `h` from the lanes' state in `runs` to
-    /// `end` of the lanes in `plain` added to their reductions, as
-    /// `reduce_step` adds a step with no peak inside: each observed
-    /// quantity's peak, with `values` (each lane's force at the step's ends,
-    /// through the cache the run's reductions use) its mean square over the
-    /// step's quintic interpolant, and the recorded time.
+    /// `end` (its first stage `first`) of the lanes in `plain` added to
+    /// their reductions, as `reduce_step` adds a step with no peak inside:
+    /// each observed quantity's peak, with `end_value` (each lane's force
+    /// at the step's end, its last stage's) its mean square over the step's
+    /// quintic interpolant, and the recorded time.
     #[inline(always)]
     pub(crate) fn reduce(
         &self,
         (n, k): (usize, usize),
-        (end, h): (&LaneState, f64),
+        (first, end, h): (&LaneState, &LaneState, f64),
         modes: &LaneModes,
-        values: Option<&[V; 2]>,
+        end_value: Option<&V>,
         plain: &[bool; LANES],
         runs: &mut LaneRuns,
     ) {
@@ -326,14 +317,13 @@ impl<L: LaneLaw> Group<L> {
             peaks,
             squares,
             recorded,
-            rates,
+            end_rates,
             ..
         } = runs;
         let start: &LaneState = start;
-        // The rates at the start were made with the step's first stage.
-        if let Some(values) = values {
-            let factor = self.factors(modes);
-            self.rates((n, k), end, &values[1], modes, &factor, &mut rates[1]);
+        // The rates at the start are the step's first stage.
+        if let Some(value) = end_value {
+            self.rates((n, k), end, value, modes, &modes.factor, end_rates);
         }
         for j in 0..n + self.points.len() {
             let (p0, p1) = (self.observe(n, j, start, 0), self.observe(n, j, end, 0));
@@ -342,12 +332,12 @@ impl<L: LaneLaw> Group<L> {
                 peak[l] = peaks[j][l].max(p0[l].abs().max(p1[l].abs()));
             }
             select(plain, all, &peak, &mut peaks[j]);
-            if values.is_none() {
+            if end_value.is_none() {
                 continue;
             }
             let (s0, s1) = (self.observe(n, j, start, d), self.observe(n, j, end, d));
-            let c0 = self.observe(n, j, &rates[0], d);
-            let c1 = self.observe(n, j, &rates[1], d);
+            let c0 = self.observe(n, j, first, d);
+            let c1 = self.observe(n, j, end_rates, d);
             let mut square = [0.0; LANES];
             for l in 0..LANES {
                 let a = quintic(

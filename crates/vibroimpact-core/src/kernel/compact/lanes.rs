@@ -151,16 +151,16 @@ impl<L: LaneLaw> Walls<L> {
 
     /// Lane `l`'s contact force on the wall with products `(hx, hv)`, in
     /// contact with the latched `approach` rate (`factor` its law's), added
-    /// to its accelerations in each of `outs` and its loss rate into slot
-    /// `loss`: the vector's operations on that lane.
+    /// to its accelerations in `out` and its loss rate into slot `loss`:
+    /// the vector's operations on that lane.
     #[inline(always)]
-    fn push_lane<const M: usize>(
+    fn push_lane(
         &self,
         l: usize,
         (hx, hv): (f64, f64),
         (approach, factor): (f64, f64),
         d: usize,
-        outs: &mut [&mut LaneState; M],
+        out: &mut LaneState,
         loss: usize,
     ) {
         let (indentation, rate) = (-(self.offset[l] + hx), -hv);
@@ -173,14 +173,12 @@ impl<L: LaneLaw> Walls<L> {
             (0.0, 0.0, 0.0)
         };
         let total = force + damping * rate;
-        for out in outs.iter_mut() {
-            if total != 0.0 {
-                for i in 0..d {
-                    out[d + i][l] += self.push[i][l] * total;
-                }
+        if total != 0.0 {
+            for i in 0..d {
+                out[d + i][l] += self.push[i][l] * total;
             }
-            out[loss][l] = (total - elastic) * rate;
         }
+        out[loss][l] = (total - elastic) * rate;
     }
 }
 
@@ -323,6 +321,13 @@ pub(crate) struct LaneModes {
     /// 1 in contact, 0 open (numbers: what the vector selects read).
     pub(super) active: [V; MAX_WALLS],
     pub(super) approach: [V; MAX_WALLS],
+    /// What the steps read of them, made where they change
+    /// ([`Group::latch`]): each wall's lanes in contact, a bit each, and
+    /// each compliant law's `parts[1] / approach`.
+    pub(super) touching: [u32; MAX_WALLS],
+    pub(super) factor: [V; MAX_WALLS],
+    /// Whether `touching` and `factor` are those of the modes now.
+    latched: bool,
 }
 
 impl LaneModes {
@@ -330,6 +335,7 @@ impl LaneModes {
     /// fixed stepping's compliant contact, whose forces act only where the
     /// pair is indented (the lanes do not take it).
     pub(crate) fn set(&mut self, l: usize, modes: &[Mode]) -> bool {
+        self.latched = false;
         for (w, mode) in modes.iter().enumerate().take(MAX_WALLS) {
             match mode {
                 Mode::Open => self.active[w][l] = 0.0,
@@ -352,6 +358,9 @@ impl Default for LaneModes {
         Self {
             active: [[0.0; LANES]; MAX_WALLS],
             approach: [[0.0; LANES]; MAX_WALLS],
+            touching: [0; MAX_WALLS],
+            factor: [[0.0; LANES]; MAX_WALLS],
+            latched: false,
         }
     }
 }
@@ -379,7 +388,7 @@ macro_rules! step_with {
             values: &[V; 4],
             out: &mut LaneStep,
         ) {
-            self.step_in((self.n, self.k), start, h, modes, values, None, out)
+            self.step_in((self.n, self.k), start, h, modes, values, false, out)
         }
     };
 }
@@ -498,35 +507,19 @@ impl<L: LaneLaw> Group<L> {
     #[inline(always)]
     pub(super) fn rates(
         &self,
-        sizes: (usize, usize),
+        (n, k): (usize, usize),
         y: &LaneState,
         value: &V,
         modes: &LaneModes,
         factor: &[V; MAX_WALLS],
         out: &mut LaneState,
     ) {
-        self.rates_of(sizes, y, [value], modes, factor, [out]);
-    }
-
-    /// [`Self::rates`] at one state `y` for each of the force's `values`
-    /// into the matching one of `outs`: what does not depend on the force
-    /// (the modes' own terms, the contacts) made once, the same bits.
-    #[inline(always)]
-    pub(super) fn rates_of<const M: usize>(
-        &self,
-        (n, k): (usize, usize),
-        y: &LaneState,
-        values: [&V; M],
-        modes: &LaneModes,
-        factor: &[V; MAX_WALLS],
-        mut outs: [&mut LaneState; M],
-    ) {
         let d = n + k;
         let mut inertial = [0.0; LANES];
         for l in 0..LANES {
             inertial[l] = 0.0 + self.gravity[l];
         }
-        let mut input = [[0.0; LANES]; M];
+        let mut input = [0.0; LANES];
         let mut viscous = [0.0; LANES];
         if let Some((push, row, _)) = &self.force {
             let mut power = [-0.0; LANES];
@@ -535,18 +528,14 @@ impl<L: LaneLaw> Group<L> {
                 for l in 0..LANES {
                     let (x, v) = (y[i][l], y[d + i][l]);
                     let own = elastic(k[l], c[l], r[l], inertial[l], x, v);
-                    for (out, value) in outs.iter_mut().zip(values) {
-                        out[i][l] = v;
-                        out[d + i][l] = own + push[i][l] * value[l];
-                    }
+                    out[i][l] = v;
+                    out[d + i][l] = own + push[i][l] * value[l];
                     viscous[l] += damping[l] * v * v;
                     power[l] += row[i][l] * v;
                 }
             }
-            for (input, value) in input.iter_mut().zip(values) {
-                for l in 0..LANES {
-                    input[l] += value[l] * power[l];
-                }
+            for l in 0..LANES {
+                input[l] += value[l] * power[l];
             }
         } else {
             for i in 0..n {
@@ -554,20 +543,16 @@ impl<L: LaneLaw> Group<L> {
                 for l in 0..LANES {
                     let (x, v) = (y[i][l], y[d + i][l]);
                     let own = elastic(k[l], c[l], r[l], inertial[l], x, v);
-                    for out in outs.iter_mut() {
-                        out[i][l] = v;
-                        out[d + i][l] = own;
-                    }
+                    out[i][l] = v;
+                    out[d + i][l] = own;
                     viscous[l] += damping[l] * v * v;
                 }
             }
         }
-        for out in outs.iter_mut() {
-            for j in n..d {
-                for l in 0..LANES {
-                    out[j][l] = y[d + j][l];
-                    out[d + j][l] = -inertial[l];
-                }
+        for j in n..d {
+            for l in 0..LANES {
+                out[j][l] = y[d + j][l];
+                out[d + j][l] = -inertial[l];
             }
         }
         // The last wall's products where it was in contact (a mirror wall
@@ -578,18 +563,16 @@ impl<L: LaneLaw> Group<L> {
         for (w, wall) in self.walls.iter().enumerate() {
             let loss = 2 * d + CONTACT + w;
             let active = &modes.active[w];
-            let touching = lanes_where(active);
+            let touching = modes.touching[w];
             if touching.count_ones() <= LANE_BY_LANE {
                 // No lane touches, or few: those few lane by lane (the
                 // vector would evaluate the law in every lane).
-                for out in outs.iter_mut() {
-                    out[loss] = [0.0; LANES];
-                }
+                out[loss] = [0.0; LANES];
                 for l in each_lane(touching) {
                     let mirrored = wall.mirror & (previous_lanes >> l & 1 != 0);
                     (px[l], pv[l]) = wall.touch(l, y, d, mirrored.then(|| (px[l], pv[l])));
                     let latched = (modes.approach[w][l], factor[w][l]);
-                    wall.push_lane(l, (px[l], pv[l]), latched, d, &mut outs, loss);
+                    wall.push_lane(l, (px[l], pv[l]), latched, d, out, loss);
                 }
                 previous = *active;
                 previous_lanes = touching;
@@ -649,17 +632,13 @@ impl<L: LaneLaw> Group<L> {
                     0.0
                 };
             }
-            for out in outs.iter_mut() {
-                out[loss] = loss_rate;
-                for i in 0..d {
-                    out[d + i] = push_where(&out[d + i], &wall.push[i], &total, &add);
-                }
+            out[loss] = loss_rate;
+            for i in 0..d {
+                out[d + i] = push_where(&out[d + i], &wall.push[i], &total, &add);
             }
         }
-        for (out, input) in outs.iter_mut().zip(input) {
-            out[2 * d + VISCOUS] = viscous;
-            out[2 * d + INPUT] = input;
-        }
+        out[2 * d + VISCOUS] = viscous;
+        out[2 * d + INPUT] = input;
     }
 
     /// Each lane's force signal, if the lanes are forced, and their
@@ -669,20 +648,21 @@ impl<L: LaneLaw> Group<L> {
         Some((signals, self.harmonics.as_ref()))
     }
 
-    /// Each compliant law's `parts[1] / approach` in `modes`, made once a
-    /// step (as the compact step makes it).
-    #[inline(always)]
-    pub(super) fn factors(&self, modes: &LaneModes) -> [V; MAX_WALLS] {
-        let mut factor = [[0.0; LANES]; MAX_WALLS];
-        for (w, wall) in self.walls.iter().enumerate() {
-            if lanes_where(&modes.active[w]) == 0 {
-                continue;
-            }
+    /// What the steps read of `modes` made again where they changed: each
+    /// wall's lanes in contact, and each compliant law's `parts[1] /
+    /// approach` (which the compact step makes once a step: the same bits
+    /// made once a change).
+    pub(crate) fn latch(&self, modes: &mut LaneModes) {
+        if modes.latched {
+            return;
+        }
+        for (w, wall) in self.walls.iter().enumerate().take(MAX_WALLS) {
+            modes.touching[w] = lanes_where(&modes.active[w]);
             for l in 0..LANES {
-                factor[w][l] = wall.parts[1][l] / modes.approach[w][l];
+                modes.factor[w][l] = wall.parts[1][l] / modes.approach[w][l];
             }
         }
-        factor
+        modes.latched = true;
     }
 
     /// One RK4 step `h` from `start` of every lane in `modes`, as
@@ -709,14 +689,14 @@ impl<L: LaneLaw> Group<L> {
                 return unsafe { self.step_avx2(start, h, modes, values, out) };
             }
         }
-        self.step_in((self.n, self.k), start, h, modes, values, None, out)
+        self.step_in((self.n, self.k), start, h, modes, values, false, out)
     }
 
     step_with!(step_avx512, "avx512f");
     step_with!(step_avx2, "avx2");
 
-    /// `with_first`: another force value at the start and where the rates
-    /// with it go (the reductions'), made with the first stage.
+    /// `first_given`: `out.first` holds the first stage already (the rates
+    /// at `start` with `values[0]`, the same bits).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn step_in(
@@ -726,7 +706,7 @@ impl<L: LaneLaw> Group<L> {
         h: f64,
         modes: &LaneModes,
         values: &[V; 4],
-        with_first: Option<(&V, &mut LaneState)>,
+        first_given: bool,
         out: &mut LaneStep,
     ) {
         let coordinates = 2 * (n + k);
@@ -742,21 +722,18 @@ impl<L: LaneLaw> Group<L> {
         } = out;
         // Every slot of the state's length is written by each rate (the
         // compact step's fresh zeros are not needed).
-        let factor = self.factors(modes);
-        match with_first {
-            Some((value, rates)) => {
-                let values = [&values[0], value];
-                self.rates_of((n, k), start, values, modes, &factor, [first, rates]);
-            }
-            None => self.rates((n, k), start, &values[0], modes, &factor, first),
+        debug_assert!(modes.latched, "the modes' factors made (Group::latch)");
+        let factor = &modes.factor;
+        if !first_given {
+            self.rates((n, k), start, &values[0], modes, factor, first);
         }
         let [k1, k2, k3] = &mut **stages;
         stage_points(point, (start, hw[0], first), coordinates);
-        self.rates((n, k), point, &values[1], modes, &factor, k1);
+        self.rates((n, k), point, &values[1], modes, factor, k1);
         stage_points(point, (start, hw[1], k1), coordinates);
-        self.rates((n, k), point, &values[2], modes, &factor, k2);
+        self.rates((n, k), point, &values[2], modes, factor, k2);
         stage_points(point, (start, hw[2], k2), coordinates);
-        self.rates((n, k), point, &values[3], modes, &factor, k3);
+        self.rates((n, k), point, &values[3], modes, factor, k3);
         combine(end, start, &w, [first, k1, k2, k3], len);
     }
 }

@@ -66,17 +66,18 @@ struct Lockstep<'a> {
     /// Whether the lanes take lane `l`'s steps (its modes are theirs).
     fed: [bool; LANES],
     /// Whether the lanes' reductions' rates at the end of lane `l`'s last
-    /// step are those at its state now, made with its force `end_values`.
+    /// step are those at its state now, made with its force `end_values`
+    /// (the last stage's).
     end_rates: [bool; LANES],
     end_values: V,
     /// Plain steps each lane took since its run was last brought up to date.
     pending: [u64; LANES],
     /// Each run's most accepted steps before its step limit.
     max_accepted: [u64; LANES],
-    /// Each run's force caches, the stages' and the reductions' (theirs
-    /// while the lanes step them, see [`Self::store`]).
+    /// Each run's force cache (its stages', which a fixed step's
+    /// reductions take their values from; the run's while the lanes step
+    /// it, see [`Self::store`]).
     stage_caches: LaneCaches,
-    reduce_caches: LaneCaches,
     step: LaneStep,
     end_gaps: LaneGaps,
     dt: f64,
@@ -101,7 +102,6 @@ impl<'a> Lockstep<'a> {
             pending: [0; LANES],
             max_accepted: [0; LANES],
             stage_caches: LaneCaches::default(),
-            reduce_caches: LaneCaches::default(),
             step: LaneStep::default(),
             end_gaps: [[[0.0; LANES]; 2]; MAX_WALLS],
             dt: options.dt.unwrap_or(f64::NAN),
@@ -192,6 +192,7 @@ impl<'a> Lockstep<'a> {
     /// own cache, in the stages' order), and the lanes' attempt of that
     /// step, which a run taking the step itself is given.
     fn attempt<L: LaneLaw>(&mut self, group: &Group<L>, time: f64) {
+        group.latch(&mut self.modes);
         let values = self.stage_values(group, time, &self.live());
         group.step(&self.lanes.y, self.dt, &self.modes, &values, &mut self.step);
         for (l, stepper) in self.steppers.iter_mut().enumerate() {
@@ -233,47 +234,32 @@ impl<'a> Lockstep<'a> {
         let (dt, time) = (self.dt, grid as f64 * self.dt);
         let next = (grid + 1) as f64 * dt;
         let live = self.live();
+        group.latch(&mut self.modes);
         let values = self.stage_values(group, time, &live);
-        // The reductions' cache of a lane whose step is not plain is put
-        // back: its run's own step takes the values again.
-        let mut saved = None;
-        let mut reduce_values = [[0.0; LANES]; 2];
         let summed = in_window && self.mean_square;
-        if let (Some((signals, harmonics)), true) = (group.signals(), summed) {
-            saved = Some(self.reduce_caches.clone());
-            let caches = &mut self.reduce_caches;
-            reduce_values[0] = caches.values(signals, harmonics, &live, time);
-            reduce_values[1] = caches.values(signals, harmonics, &live, time + dt);
-        }
-        // The reductions' rates at the start are those at the last step's
-        // end where every lane's state and force are that end's.
-        let mut kept = summed;
+        // The first stage is the reductions' rates at the last step's end
+        // where every lane's state and force are that end's (the force's
+        // value at a grid point is one, [`same_instant`]).
+        let mut first_kept = true;
         for l in 0..LANES {
-            let same = reduce_values[0][l].to_bits() == self.end_values[l].to_bits();
-            kept &= !live[l] | (self.end_rates[l] & same);
+            let same = values[0][l].to_bits() == self.end_values[l].to_bits();
+            first_kept &= !live[l] | (self.end_rates[l] & same);
         }
         let step = PlainStep {
-            start_rates_kept: kept,
+            first_kept,
+            summed,
             h: dt,
             modes: &self.modes,
             open: &self.open,
             live,
             in_window,
             values: &values,
-            reduce_values: summed.then_some(&reduce_values),
         };
         let plain = group.plain_step(&step, &mut self.lanes, &mut self.step, &mut self.end_gaps);
-        if let Some(saved) = saved {
-            for l in 0..LANES {
-                if live[l] & !plain[l] {
-                    self.reduce_caches.set(l, &saved.get(l));
-                }
-            }
-        }
         for l in 0..LANES {
             self.end_rates[l] = summed & plain[l];
         }
-        self.end_values = reduce_values[1];
+        self.end_values = values[3];
         self.go_on(&plain);
         group.advance(&plain, &self.step.end, &self.end_gaps, &mut self.lanes);
         for l in 0..self.runs.len() {
@@ -389,9 +375,6 @@ impl<'a> Lockstep<'a> {
         if let Some(cache) = run.scratch.first_cache() {
             *cache = self.stage_caches.get(l);
         }
-        if let Some(cache) = run.reduce_scratch.first_cache() {
-            *cache = self.reduce_caches.get(l);
-        }
         let pending = std::mem::take(&mut self.pending[l]);
         if pending > 0 {
             let clock = &mut run.clock;
@@ -412,9 +395,6 @@ impl<'a> Lockstep<'a> {
         let run = &mut run.run;
         if let Some(cache) = run.scratch.first_cache() {
             self.stage_caches.set(l, cache);
-        }
-        if let Some(cache) = run.reduce_scratch.first_cache() {
-            self.reduce_caches.set(l, cache);
         }
         for (e, v) in run.y.iter().enumerate().take(MAX_LEN) {
             self.lanes.y[e][l] = *v;

@@ -127,6 +127,13 @@ pub trait SystemStepper {
     ) -> bool {
         false
     }
+    /// The state's rates at the start of the last attempt where the method
+    /// made them there (RK4's first stage, with the force's value at the
+    /// step's start as the stages took it), else None. A fixed step's
+    /// reductions take them (the same bits, one evaluation fewer).
+    fn first_stage(&self) -> Option<&[f64]> {
+        None
+    }
     /// The last attempt is the new current point.
     fn accept(&mut self);
     /// Complete the step `h` from `(time, y)` the kernel keeps, `end`, with

@@ -25,7 +25,7 @@ pub(crate) use gaps::{h_dot, same_row};
 pub use linear::{HarmonicLoad, LinearParts};
 pub(crate) use rates::{apart_damping, elastic};
 pub use scratch::Scratch;
-pub(crate) use scratch::{rotated, same_increment, Cached, CachedParts, RESYNC};
+pub(crate) use scratch::{rotated, same_increment, same_instant, Cached, CachedParts, RESYNC};
 pub use spec::{
     Collision, Damper, Excitation, Friction, FrictionSite, Load, PairLaw, Side, Stop, SystemSpec,
     MAX_PAIRS, MAX_POINTS,

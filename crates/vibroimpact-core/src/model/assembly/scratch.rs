@@ -47,6 +47,16 @@ pub(crate) fn same_increment(delta: f64, cached: f64, time: f64) -> bool {
     (delta - cached).abs() <= 8.0 * f64::EPSILON * time.abs()
 }
 
+/// Whether `time` is the `cached` instant, up to a time's round-off: a
+/// fixed step's last stage `time + dt` and the next grid point
+/// `(grid + 1) dt` differ in their last bits, and the signal's value there
+/// is one value (the next step's first stage then takes the last one's,
+/// and its increments stay the steps' own).
+#[inline(always)]
+pub(crate) fn same_instant(time: f64, cached: f64) -> bool {
+    (time - cached).abs() <= 4.0 * f64::EPSILON * time.abs()
+}
+
 /// A [`Cached`]'s fields, for the lockstep lanes' copy of it.
 pub(crate) struct CachedParts {
     /// `[time, value, cos, sin, delta, delta_cos, delta_sin]`.
@@ -131,7 +141,7 @@ impl Cached {
 
     #[inline(always)]
     pub(crate) fn value(&mut self, signal: &Signal, time: f64) -> f64 {
-        if time.to_bits() == self.time.to_bits() {
+        if same_instant(time, self.time) {
             return self.value;
         }
         match signal {
@@ -183,6 +193,13 @@ impl Scratch {
             forces: vec![0.0; m],
             count: 0,
         }
+    }
+
+    /// The signals' caches of `stages` (the same system's): the values at
+    /// the instants its stages last took, to the bit.
+    pub(crate) fn signals_from(&mut self, stages: &Scratch) {
+        self.force_values.copy_from_slice(&stages.force_values);
+        self.base_values.copy_from_slice(&stages.base_values);
     }
 
     /// The first force's signal cache, which a step that is taken back
@@ -252,6 +269,53 @@ mod tests {
             // The angle's own round-off at t ~ 5 s is ~1e-13 rad; rotations
             // by increments equal to a few ulps of t add ~1e-11.
             assert!(time > 4.0 && worst < 1e-10, "{time} {worst}");
+        });
+    }
+
+    #[test]
+    fn fixed_steps_take_a_harmonic_s_values_by_rotation_and_share_the_grid_points() {
+        crate::testing::timeout(30, || {
+            let signal = Signal::harmonic(0.5, 8.0, 0.3).unwrap();
+            let exact = |t: f64| 0.5 * (std::f64::consts::TAU * 8.0 * t + 0.3).cos();
+            let (dt, steps) = (1e-5, 100_000u64);
+            let mut cache = Cached::EMPTY;
+            let (mut direct, mut worst, mut last) = (0u64, 0.0f64, f64::NAN);
+            for grid in 0..steps {
+                // RK4's stage times of the fixed step from grid point
+                // `grid`, as the kernel makes them.
+                let time = grid as f64 * dt;
+                for (stage, t) in [time, time + 0.5 * dt, time + 0.5 * dt, time + dt]
+                    .into_iter()
+                    .enumerate()
+                {
+                    let (before, was) = (cache.parts().rotations, cache.parts().values[0]);
+                    let value = cache.value(&signal, t);
+                    let (after, at) = (cache.parts().rotations, cache.parts().values[0]);
+                    // A new time not reached by one rotation: evaluated directly.
+                    let moved = at.to_bits() != was.to_bits();
+                    direct += u64::from(moved && after != before + 1);
+                    worst = worst.max((value - exact(t)).abs());
+                    if stage == 0 && grid > 0 {
+                        // The grid point is the last step's end, whose
+                        // value it takes (`time + dt` and `(grid + 1) dt`
+                        // differ in their last bits).
+                        assert_eq!(value.to_bits(), last.to_bits(), "grid {grid}");
+                    }
+                    if stage == 3 {
+                        last = value;
+                    }
+                }
+                // The next step's start: the last stage's value.
+                let next = (grid + 1) as f64 * dt;
+                let value = cache.value(&signal, next);
+                assert_eq!(value.to_bits(), last.to_bits(), "grid {grid}");
+            }
+            // Two rotations a step and a direct evaluation every RESYNC of
+            // them (about one in 31 steps): not one or two each step, as
+            // where a grid point missed the cache by its last bits.
+            let most = steps / 16;
+            assert!(direct <= most, "{direct} direct evaluations > {most}");
+            assert!(worst < 1e-10, "{worst}");
         });
     }
 }

@@ -487,6 +487,11 @@ impl SystemStepper for ExplicitRk {
         })
     }
 
+    fn first_stage(&self) -> Option<&[f64]> {
+        // RK4's first stage is `k[0]` on either path (the compact one too).
+        self.rk4.then_some(&self.k[0][..])
+    }
+
     fn accept(&mut self) {
         match self.end_slot {
             Some(slot) => {
