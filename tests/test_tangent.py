@@ -404,10 +404,12 @@ def test_largest_exponent_of_a_ball_on_a_compliant_table_matches_two_trajectorie
     start = run.map(np.array([0.05, 0.0]), 200)
     found = vi.lyapunov(run, start, settle=0, periods=periods)
     # A landing slower than the damped law's latched rate (a soft one) is reported as a
-    # grazing: a chaotic orbit has a few among its thousands of landings, which of them
-    # shifting with the engine's round-off; they stay rare.
+    # grazing: a chaotic orbit has a few among its thousands of landings (2 of 3343 at
+    # the nineteenth stop, none before), which of them shifting with the engine's
+    # round-off; they stay rare (an onset the tangent flow failed to take every time
+    # would be one in each landing).
     assert np.all(np.isfinite(found.exponents))
-    assert len(found.grazings) <= found.impacts // 1000
+    assert len(found.grazings) <= found.impacts // 100
     # Each contact counted (as its onset): a few a period (the plain kernel's run
     # parts from this one after some tens of periods, chaos amplifying round-off).
     contacts = len(run.periods(start, periods)["contacts"]["onset"])

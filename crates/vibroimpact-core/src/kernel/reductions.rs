@@ -140,10 +140,11 @@ pub fn square_integral(a: &[f64; 6]) -> f64 {
 /// Add the kept step `(time, y) -> end` of length `h` to the reductions.
 /// Returns whether the stepper was used (its last attempt is then not the
 /// kept step). `stages`: a fixed step's work space, through whose signal
-/// caches the step's stages went; the rates at the step's ends then take
-/// the force's values the stages took there (the start's are the method's
-/// first stage where it has one, [`SystemStepper::first_stage`]), so that
-/// a step's end rates are the next step's first stage, to the bit.
+/// caches the step's stages went. The rates at the step's start are then
+/// the method's first stage where it has one ([`SystemStepper::first_stage`];
+/// else made with the reductions' own caches), and those at its end take
+/// the force's values the stages took there: with RK4, a step's end rates
+/// are the next step's first stage, to the bit.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn reduce_step<S: SystemStepper>(
     system: &Assembly,

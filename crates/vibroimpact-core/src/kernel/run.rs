@@ -480,9 +480,9 @@ impl<'a> Run<'a> {
 
     /// The step of `taken` s from the state now to `end` added to the
     /// reductions where it is in the recorded window; whether the stepper
-    /// was used (its last attempt is then not the step).
+    /// was used (its last attempt is then not the step). `fixed`: a fixed
+    /// step's (see [`reduce_step`]'s `stages`).
     #[inline(always)]
-    /// `fixed`: a fixed step's (see [`reduce_step`]'s `stages`).
     pub(super) fn reduce<S: SystemStepper>(
         &mut self,
         stepper: &mut S,

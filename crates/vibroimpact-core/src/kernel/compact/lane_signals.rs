@@ -149,8 +149,9 @@ impl LaneCaches {
 
     /// [`Cached::value`] of each lane's harmonic (`[amplitude, omega,
     /// phase]`) at `time`, kept in the lanes of `live` whose time is not
-    /// `time` already (to its round-off, [`same_instant`]): a rotation by the cached increment, the increment's
-    /// first (its rotation's series, then the rotation), or a direct
+    /// `time` already (to its round-off, [`same_instant`]): a rotation by
+    /// the cached increment, the increment's first (its rotation's series,
+    /// then the rotation), or a direct
     /// evaluation (the reduced angle's series), each the cache's
     /// operations, the series made only where a lane needs them. The lanes
     /// of `live` it could not take (angles beyond the series', not

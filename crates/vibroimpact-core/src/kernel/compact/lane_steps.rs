@@ -26,7 +26,8 @@ pub(crate) struct LaneRuns {
     pub(crate) squares: [V; MAX_OBSERVED],
     pub(crate) recorded: V,
     /// The rates at the last step's end (the mean squares' accelerations,
-    /// and the next step's first stage).
+    /// and the next step's first stage), for the lanes whose last step made
+    /// them (the lockstep's `end_rates`; a first stage swapped in otherwise).
     pub(crate) end_rates: Box<LaneState>,
 }
 

@@ -49,7 +49,8 @@ pub(crate) trait LaneLaw: ContactLaw + Copy {
     fn parts(&self) -> [f64; 2];
     /// [`ContactLaw::force_and_elastic`] of the law with `parts`, at the
     /// latched `approach` rate, `factor` its `parts[1] / approach` (the
-    /// division, made once a step: the same bits).
+    /// division, made once a step in the compact step and once a mode
+    /// change here, [`Group::latch`]: the same bits).
     fn force_of(
         parts: [f64; 2],
         indentation: f64,

@@ -51,7 +51,8 @@ pub(crate) fn same_increment(delta: f64, cached: f64, time: f64) -> bool {
 /// fixed step's last stage `time + dt` and the next grid point
 /// `(grid + 1) dt` differ in their last bits, and the signal's value there
 /// is one value (the next step's first stage then takes the last one's,
-/// and its increments stay the steps' own).
+/// and its increments stay the steps' own). Every path's caches take it
+/// (an event's located instant, a step's end a few ulps from it too).
 #[inline(always)]
 pub(crate) fn same_instant(time: f64, cached: f64) -> bool {
     (time - cached).abs() <= 4.0 * f64::EPSILON * time.abs()
