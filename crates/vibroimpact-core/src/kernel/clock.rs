@@ -165,6 +165,17 @@ impl Schedule {
     /// must follow, for the reason it will give ([`Stop`]).
     #[inline(always)]
     pub(crate) fn plain_step(&self, clock: &Clock) -> Option<(f64, bool)> {
+        let (length, in_window) = self.plain_summed_step(clock)?;
+        if in_window && self.mean_square {
+            return None;
+        }
+        Some((length, in_window))
+    }
+
+    /// [`Self::plain_step`] where the mean squares are summed in the step
+    /// (the compact RK4 stretch sums them).
+    #[inline(always)]
+    pub(crate) fn plain_summed_step(&self, clock: &Clock) -> Option<(f64, bool)> {
         let time = clock.time;
         if self.at_end(time) {
             return None;
@@ -181,11 +192,7 @@ impl Schedule {
         {
             return None;
         }
-        let in_window = self.in_window(time, length);
-        if in_window && self.mean_square {
-            return None;
-        }
-        Some((length, in_window))
+        Some((length, self.in_window(time, length)))
     }
 
     /// The end of the next fixed step (`dt` from `clock.time`, on the grid)

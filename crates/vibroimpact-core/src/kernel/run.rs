@@ -545,6 +545,8 @@ impl<'a> Run<'a> {
             end_gaps: &mut self.gaps.end[..],
             open: &mut self.open[..],
             peaks: &mut self.reductions.peaks[..],
+            squares: &mut self.reductions.square_integrals[..],
+            reduce_scratch: &mut self.reduce_scratch,
             recorded_time: &mut self.reductions.recorded_time,
             energy: &mut self.energy,
             // Up to the next interrupt poll, made here after it.

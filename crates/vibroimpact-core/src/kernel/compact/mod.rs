@@ -21,12 +21,12 @@ mod lane_steps;
 mod lanes;
 mod lockstep;
 mod stretch;
+mod stretch_reductions;
 pub(crate) use lanes::LaneLaw;
 pub(crate) use lanes::LANES;
 pub(crate) use lockstep::run_group;
-pub(crate) use stretch::{
-    passed_over, peak_inside, shows_no_event, widen_peaks, ArraySteps, Stretch,
-};
+pub(crate) use stretch::{passed_over, shows_no_event, ArraySteps, Stretch};
+pub(crate) use stretch_reductions::{peak_inside, widen_peaks};
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};
 use crate::model::assembly::{
@@ -743,6 +743,8 @@ mod tests {
                 end_gaps: &mut [],
                 open: &mut open,
                 peaks: &mut peaks,
+                squares: &mut [],
+                reduce_scratch: &mut Scratch::new(&system),
                 recorded_time: &mut recorded,
                 energy: &mut energy,
                 max_accepted: 20,

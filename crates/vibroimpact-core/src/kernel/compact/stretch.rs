@@ -4,7 +4,8 @@
 
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
-use super::{Compact, Factors, MAX_LEN, MAX_MODES, MAX_WALLS};
+use super::stretch_reductions::{peak_inside, widen_peaks};
+use super::{Compact, Factors, MAX_LEN, MAX_WALLS};
 use crate::error::Error;
 use crate::kernel::balance::EnergyWatch;
 use crate::kernel::clock::{Clock, Schedule};
@@ -33,6 +34,14 @@ impl Compact {
         // (sharing one, free flight's loop measured slower).
         let fixed = f.schedule.fixed.is_some();
         let free = fixed && self.free(modes) && f.open.iter().all(Option::is_none);
+        // The events' stretches that sum the mean squares, in a function of
+        // their own, from the recorded window on: one that starts before it
+        // stops at it (`Schedule::plain_step`). The summing stretch taking
+        // the steps before the window measured 4 % slower there.
+        let (schedule, clock) = (f.schedule, &*f.clock);
+        let summed = schedule.mean_square
+            && schedule.in_window(clock.time, schedule.grid_length(clock))
+            && !modes.contains(&Mode::Sticking);
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has the feature the functions are built for.
@@ -41,12 +50,16 @@ impl Compact {
                     // Out of the events' stretches, which they would grow.
                     (true, true) => fixed_free_avx2(self, system, f, modes, scratch),
                     (true, false) => fixed_contact_avx2(self, system, f, modes, scratch),
+                    (false, _) if summed => stretch_summed_avx2(self, system, f, modes, scratch),
                     (false, _) => stretch_avx2(self, system, f, modes, scratch),
                 }
             };
         }
         if fixed {
             return fixed_baseline(self, system, f, modes, scratch, free);
+        }
+        if summed {
+            return stretch_summed_sized(self, system, f, modes, scratch);
         }
         stretch_sized(self, system, f, modes, scratch)
     }
@@ -73,8 +86,11 @@ impl Compact {
     /// be plain (a gap that may cross, a compliant contact at its deepest, a
     /// peak inside the step, a state no longer finite) is taken back, for
     /// the kernel to take.
-    #[inline(always)]
-    pub(crate) fn stretch<const STICKING: bool, const FREE: bool>(
+    // Out of line in debug builds: every size's and variant's copy in one
+    // frame outgrew a thread's stack there.
+    #[cfg_attr(debug_assertions, inline(never))]
+    #[cfg_attr(not(debug_assertions), inline(always))]
+    pub(crate) fn stretch<const STICKING: bool, const FREE: bool, const SUMMED: bool>(
         &self,
         system: &Assembly,
         n: usize,
@@ -106,6 +122,14 @@ impl Compact {
         // Whether `stages[0]` holds the rates at the step's start (the last
         // step's release test evaluated them there).
         let mut start_valid = false;
+        // The mean squares' rates at the step's start and end (the
+        // reductions' own, as `reduce_step` makes them): the last summed
+        // step's end rates are the next one's start rates, to the bit.
+        // `SUMMED`: the mean squares are summed (a compile-time constant:
+        // the stretches that sum none measured 4 % slower carrying it).
+        debug_assert!(!SUMMED || (f.schedule.mean_square && !STICKING));
+        let mut reduce_rates = [[0.0; MAX_LEN]; 2];
+        let mut reduce_valid = false;
         // In registers through the loop, written back after it.
         let mut energy = *f.energy;
         let schedule = *f.schedule;
@@ -115,7 +139,12 @@ impl Compact {
                 f.limited = true;
                 break;
             }
-            let Some((length, in_window)) = schedule.plain_step(&clock) else {
+            let plain_step = if SUMMED {
+                schedule.plain_summed_step(&clock)
+            } else {
+                schedule.plain_step(&clock)
+            };
+            let Some((length, in_window)) = plain_step else {
                 break;
             };
             let time = clock.time;
@@ -174,6 +203,19 @@ impl Compact {
                 widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
                 *f.recorded_time += length;
             }
+            if SUMMED && in_window {
+                let kept = observed.min(f.squares.len());
+                self.sum_squares::<STICKING, FREE>(
+                    system,
+                    (n, k),
+                    ((time, &y), (length, &end)),
+                    (modes, &factors),
+                    (&mut reduce_rates, reduce_valid),
+                    f.reduce_scratch,
+                    &mut f.squares[..kept],
+                );
+            }
+            reduce_valid = SUMMED && in_window;
             clock.plain_step_to(next);
             f.evaluations += 4;
             f.steps += 1;
@@ -490,13 +532,32 @@ fn stretch_sized(
     // flight, no wall's force and no gravity.
     if modes.contains(&Mode::Sticking) {
         by_size!(system, |n, k| compact
-            .stretch::<true, false>(system, n, k, f, modes, scratch))
+            .stretch::<true, false, false>(system, n, k, f, modes, scratch))
     } else if compact.free(modes) {
         by_size!(system, |n, k| compact
-            .stretch::<false, true>(system, n, k, f, modes, scratch))
+            .stretch::<false, true, false>(system, n, k, f, modes, scratch))
     } else {
         by_size!(system, |n, k| compact
-            .stretch::<false, false>(system, n, k, f, modes, scratch))
+            .stretch::<false, false, false>(system, n, k, f, modes, scratch))
+    }
+}
+
+/// [`stretch_sized`] summing the mean squares (no pair sticks: the kernel
+/// sums them where one does).
+#[inline(always)]
+fn stretch_summed_sized(
+    compact: &Compact,
+    system: &Assembly,
+    f: &mut Stretch<'_>,
+    modes: &[Mode],
+    scratch: &mut Scratch,
+) {
+    if compact.free(modes) {
+        by_size!(system, |n, k| compact
+            .stretch::<false, true, true>(system, n, k, f, modes, scratch))
+    } else {
+        by_size!(system, |n, k| compact
+            .stretch::<false, false, true>(system, n, k, f, modes, scratch))
     }
 }
 
@@ -628,60 +689,9 @@ macro_rules! stretch_with {
     };
 }
 stretch_with!(stretch_avx2, stretch_sized, "avx2");
+stretch_with!(stretch_summed_avx2, stretch_summed_sized, "avx2");
 stretch_with!(fixed_free_avx2, fixed_free_sized, "avx2");
 stretch_with!(fixed_contact_avx2, fixed_contact_sized, "avx2");
-
-/// `n` values of `y` from `from`, copied: a runtime index into the state
-/// itself would keep the compact path's state in memory rather than in
-/// registers.
-#[inline(always)]
-fn block(y: &[f64], from: usize, n: usize) -> [f64; MAX_MODES] {
-    let mut out = [0.0; MAX_MODES];
-    for i in 0..n.min(MAX_MODES) {
-        out[i] = y[from + i];
-    }
-    out
-}
-
-/// Whether an observed velocity changes sign in the step from `y` to `end`
-/// (`d` coordinates, `n` of the structure, at most [`MAX_MODES`]): a peak
-/// inside it, for the kernel to find.
-#[inline(always)]
-pub(crate) fn peak_inside(
-    system: &Assembly,
-    observed: usize,
-    (y, end): (&[f64], &[f64]),
-    d: usize,
-    n: usize,
-) -> bool {
-    if n > MAX_MODES {
-        let of = |j, block: &[f64]| system.observe(j, &block[d..d + n]);
-        return (0..observed).any(|j| of(j, y) * of(j, end) < 0.0);
-    }
-    let (v0, v1) = (block(y, d, n), block(end, d, n));
-    (0..observed).any(|j| system.observe(j, &v0[..n]) * system.observe(j, &v1[..n]) < 0.0)
-}
-
-/// The observed displacements' peaks widened to the step's ends.
-#[inline(always)]
-pub(crate) fn widen_peaks(
-    system: &Assembly,
-    peaks: &mut [f64],
-    (y, end): (&[f64], &[f64]),
-    n: usize,
-) {
-    let widen = |peaks: &mut [f64], x0: &[f64], x1: &[f64]| {
-        for (j, peak) in peaks.iter_mut().enumerate() {
-            let (p0, p1) = (system.observe(j, x0), system.observe(j, x1));
-            *peak = peak.max(p0.abs().max(p1.abs()));
-        }
-    };
-    if n > MAX_MODES {
-        return widen(peaks, &y[..n], &end[..n]);
-    }
-    let (x0, x1) = (block(y, 0, n), block(end, 0, n));
-    widen(peaks, &x0[..n], &x1[..n]);
-}
 
 /// What the fast path advances, lent by the kernel ([`crate::kernel::run`]):
 /// its clock, state, gaps, open contacts (their deepest indentation), peaks
@@ -702,8 +712,12 @@ pub struct Stretch<'a> {
     pub(crate) end: &'a mut [f64],
     pub(crate) end_gaps: &'a mut [(f64, f64)],
     pub(crate) open: &'a mut [Option<Open>],
-    /// The reductions' peaks and recorded time (used in the window).
+    /// The reductions' peaks, mean squares' integrals and recorded time
+    /// (used in the window), and their rates' work space (its signal
+    /// caches: the reductions' own, [`crate::kernel::reductions::reduce_step`]).
     pub(crate) peaks: &'a mut [f64],
+    pub(crate) squares: &'a mut [f64],
+    pub(crate) reduce_scratch: &'a mut Scratch,
     pub(crate) recorded_time: &'a mut f64,
     pub(crate) energy: &'a mut EnergyWatch,
     /// The most accepted steps the stretch may reach, and whether it did.
