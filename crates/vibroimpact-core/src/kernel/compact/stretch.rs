@@ -125,8 +125,8 @@ impl Compact {
         // The mean squares' rates at the step's start and end (the
         // reductions' own, as `reduce_step` makes them): the last summed
         // step's end rates are the next one's start rates, to the bit.
-        // `SUMMED`: the mean squares are summed (a compile-time constant:
-        // the stretches that sum none measured 4 % slower carrying it).
+        // `SUMMED`: the mean squares are summed, in the recorded window (the
+        // caller, `run_stretch`, picks it from there on).
         debug_assert!(!SUMMED || (f.schedule.mean_square && !STICKING));
         let mut reduce_rates = [[0.0; MAX_LEN]; 2];
         let mut reduce_valid = false;
