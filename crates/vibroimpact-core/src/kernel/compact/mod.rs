@@ -20,6 +20,7 @@ mod lane_stepper;
 mod lane_steps;
 mod lanes;
 mod lockstep;
+mod press;
 mod stretch;
 mod stretch_reductions;
 pub(crate) use lanes::LaneLaw;

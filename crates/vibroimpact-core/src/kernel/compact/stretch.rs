@@ -406,6 +406,10 @@ impl Compact {
         // few steps, is made between runs of steps, and a step into the
         // window is left to the kernel.
         let mut due = None;
+        // In contact, the last step's dissipated power at its end is taken
+        // from the next step's first stage (the rates at that state and
+        // time): a force evaluated once, not again beside the stages.
+        let mut pressing = false;
         'steps: loop {
             if let Some(check) = due.take() {
                 let copy = y;
@@ -445,6 +449,10 @@ impl Compact {
                     false,
                     &mut end,
                 );
+                if !FREE && pressing {
+                    pressing = false;
+                    self.press(system, d, f, (&y, len, modes), Some(&stages[0]), dt);
+                }
                 let mut plain = end[..2 * d].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
                 if FREE {
                     // No contact: none may begin (the gaps themselves are
@@ -472,9 +480,7 @@ impl Compact {
                     if let Some(oc) = f.open[w].as_mut() {
                         let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
                         fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
-                        // A copy: the state's address stays untaken (in registers).
-                        let at = end;
-                        fixed::press(system, w, oc, &at[..len], modes[w], dt);
+                        pressing = true;
                     }
                 }
                 if in_window {
@@ -506,6 +512,10 @@ impl Compact {
                 }
             }
             break;
+        }
+        if !FREE && pressing {
+            // The last step's power where no next step was made here.
+            self.press(system, d, f, (&y, len, modes), None, dt);
         }
         f.steps += taken;
         f.evaluations += 4 * taken;

@@ -1,0 +1,67 @@
+//! A fixed stretch's contacts pressed on (the trapezoidal sum of each open
+//! contact's dissipated power, [`crate::kernel::fixed::press`]), with the
+//! power read from the rates the next step makes at the same state where
+//! they hold it: the force evaluated once, not again beside the stages.
+
+use super::{Compact, Stretch, CONTACT, MAX_LEN, MAX_WALLS};
+use crate::kernel::fixed;
+use crate::model::assembly::{Assembly, Mode};
+
+impl Compact {
+    /// The open contacts' last step of `dt` ended at `y` (`first`: the
+    /// rates there, where made): each contact's dissipated power at that
+    /// end, as [`fixed::press`] takes it, added to its record.
+    #[inline(always)]
+    pub(super) fn press(
+        &self,
+        system: &Assembly,
+        d: usize,
+        f: &mut Stretch<'_>,
+        (y, len, modes): (&[f64; MAX_LEN], usize, &[Mode]),
+        first: Option<&[f64; MAX_LEN]>,
+        dt: f64,
+    ) {
+        for w in 0..self.count.min(MAX_WALLS) {
+            if let Some(oc) = f.open[w].as_mut() {
+                match first.and_then(|first| self.dissipation(d, w, y, modes[w], first)) {
+                    Some(power) => fixed::pressed(oc, power, dt),
+                    None => {
+                        // A copy: the state's address stays untaken (in registers).
+                        let at = *y;
+                        fixed::press(system, w, oc, &at[..len], modes[w], dt)
+                    }
+                }
+            }
+        }
+    }
+
+    /// Wall `w`'s dissipated power at `y`, as [`fixed::press`] evaluates
+    /// it, read from the rates `first` made at `y` in `mode` (their loss
+    /// room: the same law and sums); None where those rates make no loss of
+    /// the wall's (not in compliant contact) or their products may differ
+    /// from `press`'s in the last bit: `press` sums a gap's terms in order
+    /// (`Assembly::gap`), the rates in two halves (`h_dot`), which is the
+    /// same sum for two coordinates or fewer (the two-mass damper).
+    #[inline(always)]
+    fn dissipation(
+        &self,
+        d: usize,
+        w: usize,
+        y: &[f64; MAX_LEN],
+        mode: Mode,
+        first: &[f64; MAX_LEN],
+    ) -> Option<f64> {
+        let wall = &self.walls[w];
+        if d > 2 || !matches!(mode, Mode::Compliant { .. }) || wall.law.is_none() {
+            return None;
+        }
+        // The loss the rates make where apart (a contact damper's) is not
+        // the ledger's: nothing is dissipated there.
+        let indentation = -(wall.offset + wall.products(d, y).0);
+        Some(if indentation > 0.0 {
+            first[2 * d + CONTACT + w]
+        } else {
+            0.0
+        })
+    }
+}
