@@ -216,11 +216,12 @@ impl Schedule {
     /// down by one a step). Its terms only grow with the grid (the time, the
     /// steps taken towards a row), so no step after one that is not plain
     /// is: the first found by doubling and bisection, a few rules asked
-    /// instead of one a step.
-    pub(crate) fn plain_fixed_run(&self, clock: &Clock, most: u64) -> u64 {
+    /// instead of one a step. `summed`: the steps sum the mean squares
+    /// themselves ([`Self::plain_fixed_summed_step`]).
+    pub(crate) fn plain_fixed_run(&self, clock: &Clock, most: u64, summed: bool) -> u64 {
         let plain = |i: u64| {
             if i == 0 {
-                return self.plain_fixed_step(clock).is_some();
+                return self.plain_fixed_step_of(clock, summed).is_some();
             }
             let grid = clock.grid + i;
             let at = Clock {
@@ -230,7 +231,7 @@ impl Schedule {
                 until_kept: clock.until_kept.saturating_sub(i),
                 next_strobe: clock.next_strobe,
             };
-            self.plain_fixed_step(&at).is_some()
+            self.plain_fixed_step_of(&at, summed).is_some()
         };
         if most == 0 || !plain(0) {
             return 0;
@@ -259,8 +260,19 @@ impl Schedule {
         hi
     }
 
+    /// [`Self::plain_fixed_summed_step`] where the step sums the mean
+    /// squares (`summed`), else [`Self::plain_fixed_step`].
+    #[inline(always)]
+    pub(crate) fn plain_fixed_step_of(&self, clock: &Clock, summed: bool) -> Option<(f64, bool)> {
+        if summed {
+            self.plain_fixed_summed_step(clock)
+        } else {
+            self.plain_fixed_step(clock)
+        }
+    }
+
     /// [`Self::plain_fixed_step`] where the mean squares are summed in the
-    /// step (the lockstep lanes sum them).
+    /// step (the lockstep lanes and the compact fixed stretch sum them).
     #[inline(always)]
     pub(crate) fn plain_fixed_summed_step(&self, clock: &Clock) -> Option<(f64, bool)> {
         let time = clock.time;
@@ -360,10 +372,15 @@ mod tests {
                             f64::INFINITY
                         };
                         let c = clock(s.dt, grid, 7 + grid % 5, strobe);
-                        let plain = |at: &Clock| s.plain_fixed_step(at).is_some();
-                        let asked = one_by_one(s, &c, most, plain);
-                        assert_eq!(s.plain_fixed_run(&c, most), asked, "{grid} {most}");
-                        runs += usize::from(asked > 0 && asked < most);
+                        for summed in [false, true] {
+                            let plain = |at: &Clock| s.plain_fixed_step_of(at, summed).is_some();
+                            let asked = one_by_one(s, &c, most, plain);
+                            let run = s.plain_fixed_run(&c, most, summed);
+                            assert_eq!(run, asked, "{grid} {most} {summed}");
+                            if !summed {
+                                runs += usize::from(asked > 0 && asked < most);
+                            }
+                        }
                     }
                 }
             }

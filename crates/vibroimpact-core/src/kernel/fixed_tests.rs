@@ -529,14 +529,18 @@ fn fixed_rk4_s_fast_path_is_its_general_path_to_the_bit() {
             hertz(),
             Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap(),
         ];
-        // Unforced too: the free flights' stretch without a force.
+        // Unforced too: the free flights' stretch without a force. With
+        // mean squares too: the stretch sums them in the window.
         let cases = laws.iter().flat_map(|c| {
             [
-                (c, ContactTiming::Located, true),
-                (c, ContactTiming::StepCount, true),
+                (c, ContactTiming::Located, true, false),
+                (c, ContactTiming::StepCount, true, false),
+                (c, ContactTiming::Located, true, true),
             ]
         });
-        for (contact, timing, forced) in cases.chain([(&laws[0], ContactTiming::Located, false)]) {
+        let unforced =
+            [false, true].map(|mean_square| (&laws[0], ContactTiming::Located, false, mean_square));
+        for (contact, timing, forced, mean_square) in cases.chain(unforced) {
             let mut spec = spec(&system, contact);
             spec.excitations = vec![crate::model::assembly::Excitation {
                 load: crate::model::assembly::Load::Force { at: 0.0 },
@@ -551,7 +555,7 @@ fn fixed_rk4_s_fast_path_is_its_general_path_to_the_bit() {
             o.reduce = ReduceOptions {
                 record_from: 0.1,
                 strobe_period: 1.0 / 9.0,
-                mean_square: false,
+                mean_square,
                 ..ReduceOptions::default()
             };
             let stepping = Stepping::Fixed {

@@ -21,12 +21,14 @@ mod lane_steps;
 mod lanes;
 mod lockstep;
 mod press;
+mod stop_rules;
 mod stretch;
 mod stretch_reductions;
 pub(crate) use lanes::LaneLaw;
 pub(crate) use lanes::LANES;
 pub(crate) use lockstep::run_group;
-pub(crate) use stretch::{passed_over, shows_no_event, ArraySteps, Stretch};
+pub(crate) use stop_rules::{passed_over, shows_no_event};
+pub(crate) use stretch::{ArraySteps, Stretch};
 pub(crate) use stretch_reductions::{peak_inside, widen_peaks};
 
 use crate::methods::tableau::{RK4_A, RK4_B, RK4_C};

@@ -3,7 +3,9 @@
 //! power read from the rates the next step makes at the same state where
 //! they hold it: the force evaluated once, not again beside the stages.
 
+use super::stop_rules::WallGaps;
 use super::{Compact, Stretch, CONTACT, MAX_LEN, MAX_WALLS};
+use crate::kernel::events::Open;
 use crate::kernel::fixed;
 use crate::model::assembly::{Assembly, Mode};
 
@@ -64,4 +66,24 @@ impl Compact {
             0.0
         })
     }
+}
+
+/// The open contacts' deepest indentations with a plain fixed step of `dt`
+/// (the walls' gaps at its start and end); whether any contact is open.
+#[inline(always)]
+pub(super) fn deepen(
+    open: &mut [Option<Open>],
+    (start, end): (&WallGaps, &WallGaps),
+    dt: f64,
+    located: bool,
+) -> bool {
+    let mut any = false;
+    for (w, contact) in open.iter_mut().enumerate() {
+        if let Some(oc) = contact.as_mut() {
+            let ((g0, r0), (g1, r1)) = (start[w], end[w]);
+            fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+            any = true;
+        }
+    }
+    any
 }

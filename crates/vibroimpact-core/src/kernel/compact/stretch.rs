@@ -4,13 +4,14 @@
 
 #![allow(clippy::needless_range_loop, clippy::manual_memcpy)]
 
-use super::stretch_reductions::{peak_inside, widen_peaks};
+use super::press::deepen;
+use super::stop_rules::{passed_over, shows_no_event};
+use super::stretch_reductions::{peak_inside, widen_peaks, Sums};
 use super::{Compact, Factors, MAX_LEN, MAX_WALLS};
 use crate::error::Error;
 use crate::kernel::balance::EnergyWatch;
 use crate::kernel::clock::{Clock, Schedule};
 use crate::kernel::events::{ContactTiming, Open};
-use crate::kernel::fixed;
 use crate::kernel::sized::by_size;
 use crate::model::assembly::CONTACT;
 use crate::model::assembly::{Assembly, Mode, Scratch};
@@ -199,20 +200,13 @@ impl Compact {
                 }
             }
             if in_window {
-                let kept = observed.min(f.peaks.len());
-                widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
-                *f.recorded_time += length;
-            }
-            if SUMMED && in_window {
-                let kept = observed.min(f.squares.len());
-                self.sum_squares::<STICKING, FREE>(
+                self.reduce_plain::<STICKING, FREE>(
                     system,
                     (n, k),
                     ((time, &y), (length, &end)),
                     (modes, &factors),
-                    (&mut reduce_rates, reduce_valid),
-                    f.reduce_scratch,
-                    &mut f.squares[..kept],
+                    (&mut reduce_rates, reduce_valid, SUMMED),
+                    f.sums(),
                 );
             }
             reduce_valid = SUMMED && in_window;
@@ -229,10 +223,7 @@ impl Compact {
                 break;
             }
         }
-        *f.energy = energy;
-        *f.clock = clock;
-        f.y[..len].copy_from_slice(&y[..len]);
-        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+        f.keep(energy, clock, &y[..len], &start_gaps[..count]);
     }
 
     /// [`Self::stretch`]'s loop for another method's steps ([`ArraySteps`]):
@@ -354,10 +345,7 @@ impl Compact {
                 break;
             }
         }
-        *f.energy = energy;
-        *f.clock = clock;
-        f.y[..len].copy_from_slice(&y[..len]);
-        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+        f.keep(energy, clock, &y[..len], &start_gaps[..count]);
     }
 
     /// Plain fixed steps of `dt` on the grid (`stepping = "fixed"`), as the
@@ -380,7 +368,6 @@ impl Compact {
     ) {
         let (d, count) = (n + k, self.count.min(MAX_WALLS));
         let len = f.y.len().min(MAX_LEN);
-        let observed = system.observed();
         let modes = &modes[..count];
         let mut y = [0.0; MAX_LEN];
         y[..len].copy_from_slice(&f.y[..len]);
@@ -394,7 +381,12 @@ impl Compact {
         // The stop rules asked once for the steps they allow in a row (the
         // most the stretch may take: it is then limited, if all were plain).
         let most = f.max_accepted.saturating_sub(clock.accepted);
-        let allowed = schedule.plain_fixed_run(&clock, most);
+        // In the window, the mean squares summed here as the kernel's fixed
+        // step sums them (`reduce_step` with the stages' signal caches):
+        // from the step's first stage and the rates at its end.
+        let summed = !OUTSIDE && schedule.mean_square;
+        let mut reduce_rates = [[0.0; MAX_LEN]; 2];
+        let allowed = schedule.plain_fixed_run(&clock, most, summed);
         f.limited = allowed == most;
         // The steps taken (counted into `f` after the loop).
         let mut taken = 0;
@@ -421,7 +413,7 @@ impl Compact {
                 }
             }
             while taken < allowed {
-                debug_assert!(schedule.plain_fixed_step(&clock).is_some());
+                debug_assert!(schedule.plain_fixed_step_of(&clock, summed).is_some());
                 let time = clock.time;
                 let next = (clock.grid + 1) as f64 * dt;
                 let in_window = schedule.in_window(time, dt);
@@ -453,40 +445,30 @@ impl Compact {
                     pressing = false;
                     self.press(system, d, f, (&y, len, modes), Some(&stages[0]), dt);
                 }
-                let mut plain = end[..2 * d].iter().fold(0.0, |sum, v| sum + v * 0.0) == 0.0;
-                if FREE {
-                    // No contact: none may begin (the gaps themselves are
-                    // needed only where the stretch ends).
-                    plain &= !self.indented(d, &end);
-                } else {
-                    self.gaps(d, &end, &mut end_gaps);
-                    for w in 0..count {
-                        // Indented at the end exactly where in contact: no onset
-                        // or separation in the step.
-                        plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
-                    }
-                }
-                if in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n) {
-                    plain = false;
-                }
-                if !plain {
+                let ends = (&y, &end);
+                if !self.fixed_plain::<FREE>(system, (n, k), ends, &mut end_gaps, f, in_window) {
                     if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
                         *cache = saved;
                     }
                     f.limited = false;
                     break 'steps;
                 }
-                for w in 0..if FREE { 0 } else { count } {
-                    if let Some(oc) = f.open[w].as_mut() {
-                        let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
-                        fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
-                        pressing = true;
-                    }
+                if !FREE {
+                    pressing = deepen(&mut f.open[..count], (&start_gaps, &end_gaps), dt, located);
                 }
                 if in_window {
-                    let kept = observed.min(f.peaks.len());
-                    widen_peaks(system, &mut f.peaks[..kept], (&y[..], &end[..]), n);
-                    *f.recorded_time += dt;
+                    if summed {
+                        f.reduce_scratch.signals_from(scratch);
+                        reduce_rates[0] = stages[0];
+                    }
+                    self.reduce_plain::<false, FREE>(
+                        system,
+                        (n, k),
+                        ((time, &y), (dt, &end)),
+                        (modes, &factors),
+                        (&mut reduce_rates, true, summed),
+                        f.sums(),
+                    );
                 }
                 clock.plain_step_to(next);
                 taken += 1;
@@ -522,10 +504,7 @@ impl Compact {
         if FREE && taken > 0 {
             self.gaps(d, &y, &mut start_gaps);
         }
-        *f.energy = energy;
-        *f.clock = clock;
-        f.y[..len].copy_from_slice(&y[..len]);
-        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+        f.keep(energy, clock, &y[..len], &start_gaps[..count]);
     }
 }
 
@@ -740,53 +719,31 @@ pub struct Stretch<'a> {
     pub(crate) unbalanced: Option<Error>,
 }
 
-/// Per wall, whether the event search passes over it and whether it is
-/// locked; whether a sticking pair may release.
-type PassedOver = ([bool; MAX_WALLS], [bool; MAX_WALLS], bool);
-
-/// Each wall's gap and rate.
-type WallGaps = [(f64, f64); MAX_WALLS];
-
-/// The walls the event search passes over in `modes` (the open wall of a
-/// sticking damper), the sticking walls of a damper without clearance
-/// (locked), and whether a sticking pair may release.
-#[inline(always)]
-pub(crate) fn passed_over(system: &Assembly, modes: &[Mode]) -> PassedOver {
-    let mut held = [false; MAX_WALLS];
-    let mut locked = [false; MAX_WALLS];
-    let mut releasable = false;
-    for w in 0..modes.len().min(MAX_WALLS) {
-        held[w] = modes[w] == Mode::Open && system.held_by_mirror(w, modes);
-        locked[w] = system.locked(w);
-        releasable |= modes[w] == Mode::Sticking && !locked[w];
+impl Stretch<'_> {
+    /// The stretch's end written back to the kernel: its energy watch and
+    /// clock, the state `y` and the walls' `gaps` there.
+    #[inline(always)]
+    pub(crate) fn keep(
+        &mut self,
+        energy: EnergyWatch,
+        clock: Clock,
+        y: &[f64],
+        gaps: &[(f64, f64)],
+    ) {
+        *self.energy = energy;
+        *self.clock = clock;
+        self.y[..y.len()].copy_from_slice(y);
+        self.gaps[..gaps.len()].copy_from_slice(gaps);
     }
-    (held, locked, releasable)
-}
 
-/// Whether the step of `length` whose walls' gaps and rates are `gaps` at
-/// its start and end shows no event the kernel would search for, and no
-/// compliant contact at its deepest.
-#[inline(always)]
-pub(crate) fn shows_no_event(
-    modes: &[Mode],
-    held: &[bool; MAX_WALLS],
-    (start, end): (&WallGaps, &WallGaps),
-    length: f64,
-) -> bool {
-    let mut plain = true;
-    for w in 0..modes.len().min(MAX_WALLS) {
-        match modes[w] {
-            // The event search passes over these (see `find_crossing`).
-            Mode::Sticking => {}
-            Mode::Open if held[w] => {}
-            mode => {
-                plain &= !mode.may_cross(start[w], end[w]);
-                if let Mode::Compliant { .. } = mode {
-                    let (m0, m1) = (start[w].1 * length, end[w].1 * length);
-                    plain &= !(m0 < 0.0 && m1 > 0.0);
-                }
-            }
-        }
+    /// The reductions a plain step in the recorded window adds to.
+    #[inline(always)]
+    fn sums(&mut self) -> Sums<'_> {
+        (
+            self.peaks,
+            self.squares,
+            self.recorded_time,
+            self.reduce_scratch,
+        )
     }
-    plain
 }

@@ -9,24 +9,31 @@ use crate::kernel::reductions::{quintic, square_integral};
 use crate::model::assembly::{Assembly, Mode, Scratch};
 
 impl Compact {
-    /// A plain step of `length` from `(time, y)` to `end` of [`Self::stretch`] added to
-    /// the observed quantities' mean squares `squares` as
-    /// [`crate::kernel::reductions::reduce_step`] adds it, with the rates at
-    /// its ends made as it makes them (through the reductions' own `scratch`):
-    /// `rates` holds those at its start where `valid` (the last summed
-    /// step's end), and receives those at its end in their place.
+    /// A plain step of `length` from `(time, y)` to `end` in the recorded
+    /// window added to the stretch's reductions `sums` as
+    /// [`crate::kernel::reductions::reduce_step`] adds it: the observed
+    /// quantities' peaks at its ends, the recorded time and, where `summed`,
+    /// the mean squares, with the rates at its ends made as it makes them
+    /// (through the reductions' own scratch): `rates` holds those at its
+    /// start where `valid`, and receives those at its end in their place.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(super) fn sum_squares<const STICKING: bool, const FREE: bool>(
+    pub(super) fn reduce_plain<const STICKING: bool, const FREE: bool>(
         &self,
         system: &Assembly,
         (n, k): (usize, usize),
         ((time, y), (length, end)): (Timed<'_>, Timed<'_>),
         at: (&[Mode], &Factors),
-        (rates, valid): (&mut [[f64; MAX_LEN]; 2], bool),
-        scratch: &mut Scratch,
-        squares: &mut [f64],
+        (rates, valid, summed): (&mut [[f64; MAX_LEN]; 2], bool, bool),
+        (peaks, squares, recorded_time, scratch): Sums<'_>,
     ) {
+        let observed = system.observed();
+        let kept = observed.min(peaks.len());
+        widen_peaks(system, &mut peaks[..kept], (&y[..], &end[..]), n);
+        *recorded_time += length;
+        if !summed {
+            return;
+        }
         let [start_rates, end_rates] = rates;
         if !valid {
             self.rates::<STICKING, FREE>(system, n, k, time, y, at, scratch, start_rates);
@@ -35,10 +42,15 @@ impl Compact {
         let next = time + length;
         self.rates::<STICKING, FREE>(system, n, k, next, end, at, scratch, end_rates);
         let ends = ((y, end), (&*start_rates, &*end_rates));
-        add_mean_squares(system, squares, ends, (n + k, n), length);
+        let kept = observed.min(squares.len());
+        add_mean_squares(system, &mut squares[..kept], ends, (n + k, n), length);
         *start_rates = *end_rates;
     }
 }
+
+/// A stretch's reductions: the observed quantities' peaks and mean-square
+/// integrals, the recorded time (s), and the reductions' own scratch.
+pub(super) type Sums<'s> = (&'s mut [f64], &'s mut [f64], &'s mut f64, &'s mut Scratch);
 
 /// `n` values of `y` from `from`, copied: a runtime index into the state
 /// itself would keep the compact path's state in memory rather than in

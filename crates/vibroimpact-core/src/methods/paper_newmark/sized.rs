@@ -282,7 +282,7 @@ impl PaperNewmark {
         // most the stretch may take: it is then limited, if all were plain),
         // as the compact path's fixed stretch asks them.
         let most = f.max_accepted.saturating_sub(clock.accepted);
-        let allowed = schedule.plain_fixed_run(&clock, most);
+        let allowed = schedule.plain_fixed_run(&clock, most, false);
         f.limited = allowed == most;
         while f.steps < allowed {
             debug_assert!(schedule.plain_fixed_step(&clock).is_some());

@@ -193,9 +193,6 @@ impl PaperNewmark {
         self.evaluations += f.steps;
         self.accel[..d].copy_from_slice(&carried.accel[..d]);
         self.powers.start_rates()[..rate_count].copy_from_slice(&carried.rates[..rate_count]);
-        *f.energy = energy;
-        *f.clock = clock;
-        f.y[..len].copy_from_slice(&y[..len]);
-        f.gaps[..count].copy_from_slice(&start_gaps[..count]);
+        f.keep(energy, clock, &y[..len], &start_gaps[..count]);
     }
 }
