@@ -210,8 +210,8 @@ impl Schedule {
         Some((next, in_window))
     }
 
-    /// How many plain fixed steps ([`Self::plain_fixed_step`]) follow in a
-    /// row from `clock`, at most `most`: the rule asked of each step's clock
+    /// How many plain fixed steps ([`Self::plain_fixed_step_of`]) follow in
+    /// a row from `clock`, at most `most`: the rule asked of each step's clock
     /// as the steps before it leave it (on the grid, the row's countdown
     /// down by one a step). Its terms only grow with the grid (the time, the
     /// steps taken towards a row), so no step after one that is not plain
@@ -355,7 +355,8 @@ mod tests {
                 schedule(1.0, 0.0, f64::INFINITY, true),
                 schedule(0.4005, 2.0, f64::INFINITY, false),
             ];
-            // Mean squares summed: no step in the window is plain.
+            // Mean squares summed: no step in the window is plain, unless
+            // the steps sum them themselves (`summed`).
             cases.push(Schedule {
                 mean_square: true,
                 ..schedule(1.0, 0.3, f64::INFINITY, false)

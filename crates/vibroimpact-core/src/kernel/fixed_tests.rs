@@ -525,9 +525,13 @@ fn fixed_rk4_s_fast_path_is_its_general_path_to_the_bit() {
         // Forced and damped (a contact damper on one law), kept every 7th
         // step, a recorded window and strobes: every field of the solution.
         let system = ImpactDamper::new(1.0, 3947.8, 2.5, 0.05, 1e-3).unwrap();
+        // The Hyster-Hertz law too: its rates (`force_of`, the factor made
+        // once a stretch) and `fixed::press` (`force_and_elastic`) are two
+        // codes for one force.
         let laws = [
             hertz(),
             Contact::new(LawKind::Linear, 2e6, None, 20.0).unwrap(),
+            Contact::new(LawKind::HysterHertz, 1e9, Some(0.6), 0.0).unwrap(),
         ];
         // Unforced too: the free flights' stretch without a force. With
         // mean squares too: the stretch sums them in the window.

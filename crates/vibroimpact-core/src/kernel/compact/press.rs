@@ -1,16 +1,18 @@
-//! A fixed stretch's contacts pressed on (the trapezoidal sum of each open
-//! contact's dissipated power, [`crate::kernel::fixed::press`]), with the
-//! power read from the rates the next step makes at the same state where
-//! they hold it: the force evaluated once, not again beside the stages.
+//! A fixed stretch's open contacts carried through its plain steps: their
+//! deepest indentation ([`crate::kernel::fixed::deepest`]) and the
+//! trapezoidal sum of their dissipated power ([`crate::kernel::fixed::press`]),
+//! the power read from the rates the next step makes at the same state
+//! where they hold it to the bit: the force evaluated once, not again
+//! beside the stages.
 
 use super::stop_rules::WallGaps;
-use super::{Compact, Stretch, CONTACT, MAX_LEN, MAX_WALLS};
+use super::{Compact, CONTACT, MAX_LEN, MAX_WALLS};
 use crate::kernel::events::Open;
 use crate::kernel::fixed;
 use crate::model::assembly::{Assembly, Mode};
 
 impl Compact {
-    /// The open contacts' last step of `dt` ended at `y` (`first`: the
+    /// The `open` contacts' last step of `dt` ended at `y` (`first`: the
     /// rates there, where made): each contact's dissipated power at that
     /// end, as [`fixed::press`] takes it, added to its record.
     #[inline(always)]
@@ -18,13 +20,13 @@ impl Compact {
         &self,
         system: &Assembly,
         d: usize,
-        f: &mut Stretch<'_>,
+        open: &mut [Option<Open>],
         (y, len, modes): (&[f64; MAX_LEN], usize, &[Mode]),
         first: Option<&[f64; MAX_LEN]>,
         dt: f64,
     ) {
         for w in 0..self.count.min(MAX_WALLS) {
-            if let Some(oc) = f.open[w].as_mut() {
+            if let Some(oc) = open[w].as_mut() {
                 match first.and_then(|first| self.dissipation(d, w, y, modes[w], first)) {
                     Some(power) => fixed::pressed(oc, power, dt),
                     None => {

@@ -4,7 +4,8 @@
 //! fixed steps a contact begun or ended.
 
 use super::stretch_reductions::peak_inside;
-use super::{Compact, Stretch, MAX_LEN, MAX_WALLS};
+use super::{Compact, MAX_LEN, MAX_WALLS};
+use crate::kernel::events::Open;
 use crate::model::assembly::{Assembly, Mode};
 
 /// Per wall, whether the event search passes over it and whether it is
@@ -71,7 +72,7 @@ impl Compact {
         (n, k): (usize, usize),
         (y, end): (&[f64; MAX_LEN], &[f64; MAX_LEN]),
         end_gaps: &mut WallGaps,
-        f: &Stretch<'_>,
+        open: &[Option<Open>],
         in_window: bool,
     ) -> bool {
         let d = n + k;
@@ -83,10 +84,9 @@ impl Compact {
         } else {
             self.gaps(d, end, end_gaps);
             for w in 0..self.count.min(MAX_WALLS) {
-                plain &= (end_gaps[w].0 < 0.0) == f.open[w].is_some();
+                plain &= (end_gaps[w].0 < 0.0) == open[w].is_some();
             }
         }
-        let observed = system.observed();
-        plain && !(in_window && peak_inside(system, observed, (&y[..], &end[..]), d, n))
+        plain && !(in_window && peak_inside(system, system.observed(), (&y[..], &end[..]), d, n))
     }
 }

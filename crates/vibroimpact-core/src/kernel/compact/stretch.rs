@@ -350,9 +350,10 @@ impl Compact {
 
     /// Plain fixed steps of `dt` on the grid (`stepping = "fixed"`), as the
     /// kernel's fixed step takes them ([`crate::kernel::fixed`]), for as
-    /// long as nothing but the step and the contacts that go on are due (the
-    /// kernel's rule, [`Schedule::plain_fixed_step`]): each the kernel's to
-    /// the bit. One that turns out not to be plain (a contact begins or ends
+    /// long as nothing but the step, the contacts that go on and its
+    /// reductions are due (the kernel's rule, [`Schedule::plain_fixed_step_of`]:
+    /// the stretch sums the mean squares in the window): each the kernel's
+    /// to the bit. One that turns out not to be plain (a contact begins or ends
     /// in it, a peak inside it, a state no longer finite) is taken back, for
     /// the kernel to take. No pair sticks in fixed stepping (no rigid pair).
     /// `FREE`: free flight ([`Compact::free`]).
@@ -400,7 +401,7 @@ impl Compact {
         let mut due = None;
         // In contact, the last step's dissipated power at its end is taken
         // from the next step's first stage (the rates at that state and
-        // time): a force evaluated once, not again beside the stages.
+        // time) where it is the same bits (see `Compact::press`).
         let mut pressing = false;
         'steps: loop {
             if let Some(check) = due.take() {
@@ -443,10 +444,11 @@ impl Compact {
                 );
                 if !FREE && pressing {
                     pressing = false;
-                    self.press(system, d, f, (&y, len, modes), Some(&stages[0]), dt);
+                    self.press(system, d, f.open, (&y, len, modes), Some(&stages[0]), dt);
                 }
                 let ends = (&y, &end);
-                if !self.fixed_plain::<FREE>(system, (n, k), ends, &mut end_gaps, f, in_window) {
+                if !self.fixed_plain::<FREE>(system, (n, k), ends, &mut end_gaps, f.open, in_window)
+                {
                     if let (Some(saved), Some(cache)) = (cache, scratch.first_cache()) {
                         *cache = saved;
                     }
@@ -497,7 +499,7 @@ impl Compact {
         }
         if !FREE && pressing {
             // The last step's power where no next step was made here.
-            self.press(system, d, f, (&y, len, modes), None, dt);
+            self.press(system, d, f.open, (&y, len, modes), None, dt);
         }
         f.steps += taken;
         f.evaluations += 4 * taken;
