@@ -39,13 +39,17 @@ impl Compact {
         }
     }
 
-    /// Wall `w`'s dissipated power at `y`, as [`fixed::press`] evaluates
-    /// it, read from the rates `first` made at `y` in `mode` (their loss
-    /// room: the same law and sums); None where those rates make no loss of
-    /// the wall's (not in compliant contact) or their products may differ
-    /// from `press`'s in the last bit: `press` sums a gap's terms in order
-    /// (`Assembly::gap`), the rates in two halves (`h_dot`), which is the
-    /// same sum for two coordinates or fewer (the two-mass damper).
+    /// Wall `w`'s dissipated power at `y`, the end of a plain step with its
+    /// contact open, as [`fixed::press`] evaluates it, read from the rates
+    /// `first` made at `y` in `mode` (their loss room: the same law and
+    /// sums); None where those rates make no loss of the wall's (not in
+    /// compliant contact) or their products may differ from `press`'s in
+    /// the last bit: `press` sums a gap's terms in order (`Assembly::gap`),
+    /// the rates in two halves (`h_dot`), which is the same sum for two
+    /// coordinates or fewer (the two-mass damper). The wall is indented at
+    /// `y` (a plain step ends indented exactly where in contact, by the
+    /// same sums), so the rates' loss is the law's, not a contact damper's
+    /// apart, where `press` would give none.
     #[inline(always)]
     fn dissipation(
         &self,
@@ -59,14 +63,8 @@ impl Compact {
         if d > 2 || !matches!(mode, Mode::Compliant { .. }) || wall.law.is_none() {
             return None;
         }
-        // The loss the rates make where apart (a contact damper's) is not
-        // the ledger's: nothing is dissipated there.
-        let indentation = -(wall.offset + wall.products(d, y).0);
-        Some(if indentation > 0.0 {
-            first[2 * d + CONTACT + w]
-        } else {
-            0.0
-        })
+        debug_assert!(-(wall.offset + wall.products(d, y).0) > 0.0);
+        Some(first[2 * d + CONTACT + w])
     }
 }
 
