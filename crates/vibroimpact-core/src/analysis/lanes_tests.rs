@@ -112,6 +112,16 @@ fn lanes_are_single_fixed_runs_to_the_bit() {
         let mut o = options(0.02);
         o.reduce.mean_square = false;
         check(&specs[..5], &o);
+        // History rows every 37 steps and strobes every 12.3 ms: the runs'
+        // rows of plain steps end where the schedule's rule says, found once
+        // a row and counted down (the lockstep's `plain_window`).
+        let mut o = options(0.02);
+        (o.keep_history, o.every) = (true, 37);
+        o.reduce.strobe_period = 0.0123;
+        let lanes = check(&specs[..5], &o);
+        let first = lanes[0].as_ref().unwrap();
+        let (rows, strobes) = (first.time.len(), first.reductions.strobe_time.len());
+        assert!(rows > 100 && strobes >= 4, "{rows} rows, {strobes} strobes");
         // A stop under the tip (the dampers' law) and gravity: the beam
         // rests on it in every lane (the lanes' contact force in vector
         // form) while the dampers rattle in a few (lane by lane).

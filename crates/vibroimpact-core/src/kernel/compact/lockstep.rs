@@ -20,6 +20,7 @@ use super::lanes::{each_lane, lanes_where, stage_times, Group, LaneLaw, LaneMode
 use super::lanes::{LANES, V};
 use super::{MAX_LEN, MAX_WALLS};
 use crate::error::{Error, Result};
+use crate::kernel::clock::Schedule;
 use crate::kernel::events::{ContactTiming, RunOptions, SystemSolution};
 use crate::kernel::fixed;
 use crate::kernel::stepwise::FixedRun;
@@ -72,6 +73,13 @@ struct Lockstep<'a> {
     end_values: V,
     /// Plain steps each lane took since its run was last brought up to date.
     pending: [u64; LANES],
+    /// The grid point before which each run's steps are plain by its
+    /// schedule, as last found ([`Self::plain_window`]; 0 not known), and
+    /// the least of them over the runs in progress (0 not known).
+    plain_until: [u64; LANES],
+    rows_until: u64,
+    /// A run's schedule: the group's recorded window.
+    window: Option<Schedule>,
     /// Each run's most accepted steps before its step limit.
     max_accepted: [u64; LANES],
     /// Each run's force cache (its stages', which a fixed step's
@@ -100,6 +108,9 @@ impl<'a> Lockstep<'a> {
             end_rates: [false; LANES],
             end_values: [0.0; LANES],
             pending: [0; LANES],
+            plain_until: [0; LANES],
+            rows_until: 0,
+            window: None,
             max_accepted: [0; LANES],
             stage_caches: LaneCaches::default(),
             step: LaneStep::default(),
@@ -116,6 +127,7 @@ impl<'a> Lockstep<'a> {
             );
             match run {
                 Ok(run) => {
+                    me.window = Some(run.run.schedule);
                     me.max_accepted[l] = options
                         .max_steps
                         .saturating_sub(run.run.control.rejected + 1);
@@ -166,26 +178,49 @@ impl<'a> Lockstep<'a> {
 
     /// Whether every run's next step from grid point `grid` may be plain
     /// (the kernel's rule, after its first step, within the step limit),
-    /// and if so whether it is in the recorded window.
-    fn plain_window(&self, grid: u64) -> Option<bool> {
+    /// and if so whether it is in the recorded window. Each run's row of
+    /// such steps is found once ([`Schedule::plain_fixed_run`], the rule
+    /// asked of each step's clock as its plain steps leave it) and counted
+    /// down, not asked again each step: only the run's own step changes
+    /// its clock otherwise ([`Self::kernel_step`] forgets the rows).
+    fn plain_window(&mut self, grid: u64) -> Option<bool> {
         if grid == 0 {
             return None;
         }
-        let mut in_window = false;
+        if grid >= self.rows_until {
+            self.rows_until = self.rows(grid)?;
+        }
+        // Every run's window is the group's options' (one schedule's rule).
+        let schedule = self.window.as_ref()?;
+        Some(schedule.in_window(grid as f64 * self.dt, schedule.dt))
+    }
+
+    /// The grid point before which every run's steps from `grid` are plain
+    /// by its schedule (each run's row found where not known), None where
+    /// one's next step is not.
+    fn rows(&mut self, grid: u64) -> Option<u64> {
+        let mut until = u64::MAX;
         for (l, run) in self.runs.iter().enumerate() {
             let Some(run) = run else { continue };
             if !self.fed[l] || grid >= self.max_accepted[l] {
                 return None;
             }
             let run = &run.run;
-            let mut clock = run.clock;
-            let pending = self.pending[l];
-            clock.until_kept = clock.until_kept.saturating_sub(pending);
-            (clock.grid, clock.accepted) = (grid, grid);
-            clock.time = grid as f64 * self.dt;
-            in_window = run.schedule.plain_fixed_summed_step(&clock)?.1;
+            if grid >= self.plain_until[l] {
+                let mut clock = run.clock;
+                clock.until_kept = clock.until_kept.saturating_sub(self.pending[l]);
+                (clock.grid, clock.accepted) = (grid, grid);
+                clock.time = grid as f64 * self.dt;
+                let most = self.max_accepted[l] - grid;
+                let row = run.schedule.plain_fixed_run(&clock, most, true);
+                self.plain_until[l] = grid + row;
+                if row == 0 {
+                    return None;
+                }
+            }
+            until = until.min(self.plain_until[l]);
         }
-        Some(in_window)
+        Some(until)
     }
 
     /// Each run's force at the stages of the step from `time` (through its
@@ -332,6 +367,7 @@ impl<'a> Lockstep<'a> {
             return;
         }
         self.store(l);
+        (self.plain_until[l], self.rows_until) = (0, 0);
         let (Some(run), stepper) = (self.runs[l].as_mut(), &mut self.steppers[l]) else {
             return;
         };
