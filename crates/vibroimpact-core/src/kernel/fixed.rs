@@ -103,8 +103,20 @@ pub(super) fn contact_force(system: &Assembly, i: usize, y: &[f64], mode: Mode) 
     }
 }
 
+/// A step's indentation data `(i0, i1, m0, m1)` from a pair's gap and rate
+/// `(gap, rate)` at its start and end, `dt` long: the indentation (m) at
+/// its ends and its rate times the step (0.1's data).
+#[inline(always)]
+pub(crate) fn indentation_data(
+    (g0, r0): (f64, f64),
+    (g1, r1): (f64, f64),
+    dt: f64,
+) -> (f64, f64, f64, f64) {
+    (-g0, -g1, -r0 * dt, -r1 * dt)
+}
+
 /// A contact's deepest indentation with the step's indentation data `(i0,
-/// i1, m0, m1)` (see [`Run::fixed_step`]): its end, and where located, the
+/// i1, m0, m1)` ([`indentation_data`]): its end, and where located, the
 /// interpolant's peak when the step passes one.
 #[inline(always)]
 pub(crate) fn deepest(oc: &mut Open, (i0, i1, m0, m1): (f64, f64, f64, f64), located: bool) {
@@ -280,9 +292,8 @@ impl Run<'_> {
         let located = self.timing == Some(ContactTiming::Located);
         let mut first = None;
         for i in 0..self.modes.len() {
-            let ((g0, r0), (g1, r1)) = (self.gaps.start[i], self.gaps.end[i]);
-            // The indentation and its rate times the step (0.1's data).
-            let (i0, i1, m0, m1) = (-g0, -g1, -r0 * dt, -r1 * dt);
+            let ends = (self.gaps.start[i], self.gaps.end[i]);
+            let (i0, i1, m0, m1) = indentation_data(ends.0, ends.1, dt);
             self.changes[i] = None;
             match self.open[i].as_mut() {
                 None if i1 > 0.0 => {

@@ -78,8 +78,8 @@ pub(crate) fn plain_fixed_steps<S: SystemStepper + ?Sized>(
         }
         for (w, open) in f.open.iter_mut().enumerate() {
             if let Some(oc) = open.as_mut() {
-                let ((g0, r0), (g1, r1)) = (f.gaps[w], f.end_gaps[w]);
-                fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+                let ends = fixed::indentation_data(f.gaps[w], f.end_gaps[w], dt);
+                fixed::deepest(oc, ends, located);
                 fixed::press(system, w, oc, f.end, modes[w], dt);
             }
         }

@@ -326,9 +326,9 @@ impl<'a> Lockstep<'a> {
                 let Some(Some(oc)) = run.run.open.get_mut(w) else {
                     continue;
                 };
-                let (g0, r0) = (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]);
-                let (g1, r1) = (self.end_gaps[w][0][l], self.end_gaps[w][1][l]);
-                fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+                let start = (self.lanes.gaps[w][0][l], self.lanes.gaps[w][1][l]);
+                let end = (self.end_gaps[w][0][l], self.end_gaps[w][1][l]);
+                fixed::deepest(oc, fixed::indentation_data(start, end, dt), located);
                 // `fixed::press`, with the power the lanes made.
                 fixed::pressed(oc, self.step.power[w][l], dt);
             }

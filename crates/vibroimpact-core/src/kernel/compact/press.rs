@@ -80,8 +80,7 @@ pub(super) fn deepen(
     let mut any = false;
     for (w, contact) in open.iter_mut().enumerate() {
         if let Some(oc) = contact.as_mut() {
-            let ((g0, r0), (g1, r1)) = (start[w], end[w]);
-            fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+            fixed::deepest(oc, fixed::indentation_data(start[w], end[w], dt), located);
             any = true;
         }
     }

@@ -327,8 +327,8 @@ impl PaperNewmark {
             }
             for w in 0..if FREE { 0 } else { count } {
                 if let Some(oc) = f.open[w].as_mut() {
-                    let ((g0, r0), (g1, r1)) = (start_gaps[w], end_gaps[w]);
-                    fixed::deepest(oc, (-g0, -g1, -r0 * dt, -r1 * dt), located);
+                    let ends = fixed::indentation_data(start_gaps[w], end_gaps[w], dt);
+                    fixed::deepest(oc, ends, located);
                     // The power press takes, where its numbers are the
                     // accumulator's.
                     match sized.pressed_power(w, d, &end, modes[w], (&step, &*next_carried)) {
