@@ -506,6 +506,11 @@ def test_bad_values_elsewhere_are_named_as_the_file_names_them(tmp_path: Path) -
         ),
         (
             vi.Oscillator(mass=1.0, stiffness=1.0),
+            {"solver": vi.Solver(method="rk4", dt=0.02, t_end=0.01)},
+            "[solver] dt: must be at most t_end (0.01 s) for the fixed-step method 'rk4'",
+        ),
+        (
+            vi.Oscillator(mass=1.0, stiffness=1.0),
             {"initial": vi.Initial(structure_velocity=["fast"])},  # type: ignore[list-item]
             "[initial] structure_velocity[0]: must be a number",
         ),

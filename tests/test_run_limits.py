@@ -109,6 +109,23 @@ def test_a_fixed_step_count_beyond_max_steps_is_refused_and_one_within_runs(
     check_solver(**settings, max_steps=100)  # exactly 100 steps
 
 
+@pytest.mark.parametrize(("method", "stepping"), FIXED_STEP)
+def test_a_fixed_step_longer_than_the_run_is_refused_and_one_of_the_whole_run_is_not(
+    method: str, stepping: str | None
+) -> None:
+    # Taken, one step of 0.5 s would end the run past t_end (or, for the paper's
+    # stepping, fail its energy balance at 0.5 s: an error that does not name dt).
+    settings: dict[str, Any] = dict(method=method, stepping=stepping, dt=0.5, t_end=0.3)
+    said = f"dt must be at most t_end (0.3 s) for the fixed-step method '{method}', got 0.5"
+    with time_limit(10):
+        with pytest.raises(vi.InvalidInputError) as err:
+            vi.simulate(table1(), HERTZ, ONSET, **settings)
+    assert one_line(err) == said
+    with pytest.raises(vi.InvalidInputError, match=re.escape(said)):
+        check_solver(**settings)
+    check_solver(**{**settings, "dt": 0.3})  # one step, the whole run
+
+
 @pytest.mark.parametrize(("method", "stepping"), ADAPTIVE)
 def test_adaptive_methods_take_a_tiny_first_step_and_stop_clearly_at_a_huge_t_end(
     method: str, stepping: str | None
@@ -131,6 +148,7 @@ def test_adaptive_methods_take_a_tiny_first_step_and_stop_clearly_at_a_huge_t_en
         ('method = "rk4"\ndt = 1e-4\nt_end = 1e20', 2, "t_end / dt"),
         ('method = "generalized-alpha"\ndt = 1e-4\nt_end = 1e20', 2, "t_end / dt"),
         ('method = "dop853"\ndt = 1e-4\nt_end = 1e20', 1, "t_end"),
+        ('method = "rk4"\ndt = 1.0\nt_end = 0.3', 2, "dt must be at most t_end (0.3 s)"),
     ],
 )
 def test_the_command_line_says_so_in_one_line(

@@ -73,6 +73,21 @@ pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
     check_scales(&RunScales::of(system), plan)
 }
 
+/// Refuse a fixed step `dt` (s) longer than the run, `t_end` (s): its one
+/// step would end past `t_end` (or be cut to it), a run no fixed-step
+/// method is meant for. `field` names the step in the message (the
+/// scenario's `[solver] dt:`, or `dt`), `method` the method.
+pub fn check_step_within(dt: f64, t_end: f64, method: &str, field: &str) -> Result<()> {
+    if dt > t_end {
+        return Err(Error::Inconsistent(format!(
+            "{field} must be at most t_end ({} s) for the fixed-step method '{method}', got {}",
+            python_repr(t_end),
+            python_repr(dt)
+        )));
+    }
+    Ok(())
+}
+
 /// [`check_run`] on what it reads of the system.
 pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
     let spec = method(plan.method)?;
@@ -92,6 +107,9 @@ pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
             "[solver] dt: is required for method '{}' (a step in s > 0)",
             spec.name
         )));
+    }
+    if let Some(dt) = plan.dt.filter(|_| fixed) {
+        check_step_within(dt, plan.t_end, spec.name, "[solver] dt:")?;
     }
     // The exact flow steps at most dt where one is given: as many steps.
     let step = plan.dt.filter(|_| fixed || spec.kind == Kind::Exact);

@@ -236,6 +236,9 @@ impl Settings {
                 method.name()
             )));
         }
+        if let Some(dt) = dt.filter(|_| !method.is_adaptive()) {
+            registry::check_step_within(dt, t_end, method.name(), "dt")?;
+        }
         let stepping = match stepping {
             Some(stepping) => stepping,
             None => Stepping::parse(registry::TWO_MASS.stepping(method.name())?)?,
@@ -444,6 +447,44 @@ mod tests {
                     "{bad}: {text}"
                 );
             }
+        });
+    }
+
+    /// A fixed step longer than the run is refused, naming dt, t_end and
+    /// the method; a step of the whole run is not, nor an adaptive method's
+    /// first step longer than the run (it is cut to the run).
+    #[test]
+    fn a_fixed_step_longer_than_the_run_is_refused() {
+        crate::testing::timeout(10, || {
+            let settings = |method: Method, dt: f64, t_end: f64| {
+                let timing = ContactTiming::Located;
+                Settings::new(method, Some(dt), t_end, 1, timing, None, 1_000_000)
+            };
+            for method in [
+                Method::Rk4,
+                Method::Newmark {
+                    beta: 0.25,
+                    gamma: 0.5,
+                },
+            ] {
+                let name = method.name();
+                let text = settings(method, 0.5, 0.3).unwrap_err().to_string();
+                let said = format!(
+                    "dt must be at most t_end (0.3 s) for the fixed-step method '{name}', got 0.5"
+                );
+                assert_eq!(text, said);
+                let above = f64::from_bits(0.3f64.to_bits() + 1);
+                assert!(
+                    settings(method, above, 0.3).is_err(),
+                    "{name}: one ulp above"
+                );
+                assert!(settings(method, 0.3, 0.3).is_ok(), "{name}: the whole run");
+            }
+            let tolerances = Tolerances {
+                rtol: 1e-8,
+                atol: 1e-12,
+            };
+            assert!(settings(Method::Dop853(tolerances), 0.5, 0.3).is_ok());
         });
     }
 }
