@@ -193,6 +193,17 @@ def test_missing_required_section(table1_toml: str, section: str) -> None:
     assert f"missing section [{section}]" in message
 
 
+@pytest.mark.parametrize("example", ["frf_impact_damper.toml", "particle_column.toml"])
+def test_a_structure_s_file_without_its_structure_says_so(example: str) -> None:
+    # Without [structure] the file was read as a two-mass one, whose error named the
+    # first section it does not know ([damper]) as an unknown key.
+    text = (Path(__file__).resolve().parents[1] / "examples" / example).read_text()
+    start = text.index("[structure]")
+    end = text.find("\n[", start + 1)
+    message = scenario_error(text[:start] + text[end + 1 :])
+    assert "missing section [structure]: [" in message and "unknown key" not in message, message
+
+
 def test_optional_sections_may_be_left_out(table1_toml: str) -> None:
     for section in ("initial", "output"):
         start = table1_toml.index(f"[{section}]")

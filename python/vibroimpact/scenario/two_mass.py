@@ -29,7 +29,7 @@ from vibroimpact._core import (
     check_solver,
     simulate,
 )
-from vibroimpact.scenario.system import SystemScenario, system_scenario
+from vibroimpact.scenario.system import SECTIONS, SystemScenario, system_scenario
 
 
 class ScenarioError(InvalidInputError):
@@ -274,6 +274,15 @@ def parse_scenario(
             return system_scenario(data, source, base_dir)
         except InvalidInputError as err:
             raise ScenarioError(str(err)) from None
+    # A section only a structure's file has, and no [system]: [structure] left out
+    # (not a two-mass file with an unknown section).
+    theirs = [name for name in data if name in SECTIONS and name not in _SCHEMA]
+    if theirs and "system" not in data:
+        raise ScenarioError(
+            f"{source}: missing section [structure]: [{theirs[0]}] belongs to a system on a "
+            "structure, which [structure] describes (a two-mass damper's file has [system] "
+            "and [contact] instead)"
+        )
     return two_mass_scenario(data, source)
 
 
