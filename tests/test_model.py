@@ -708,3 +708,15 @@ def test_a_system_pickles_and_hashes() -> None:
         again = pickle.loads(pickle.dumps(system))
         assert again == system and hash(again) == hash(system)
     assert len({issue_example(), issue_example()}) == 1
+
+
+def test_an_unknown_keyword_of_simulate_names_simulate_and_the_close_one() -> None:
+    # Python's own error named the private function it calls, with no hint.
+    system = vi.System(structure=vi.Oscillator(mass=1.0, stiffness=100.0))
+    with pytest.raises(TypeError) as err:
+        vi.simulate(system, tend=1.0)  # type: ignore[call-arg]
+    assert str(err.value) == (
+        "simulate() got an unexpected keyword argument 'tend' (did you mean 't_end'?)"
+    )
+    with pytest.raises(TypeError, match=r"^simulate\(\) got an unexpected keyword argument 'zzz'$"):
+        vi.simulate(system, zzz=1.0)  # type: ignore[call-arg]

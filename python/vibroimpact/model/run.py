@@ -3,6 +3,7 @@ or the two-mass impact damper (``ImpactDamper``, ``Contact``, ``InitialState``).
 
 from __future__ import annotations
 
+import difflib
 import inspect
 from collections.abc import Callable
 from typing import Any, overload
@@ -197,8 +198,19 @@ def simulate(
         and not settings.keys() & _SYSTEM_ONLY
     ):
         return two_mass(system, contact, initial, **settings)
+    unknown = sorted(settings.keys() - _KEYWORDS)
+    if unknown:
+        # Python's own error would name the private function, with no hint.
+        close = difflib.get_close_matches(unknown[0], sorted(_KEYWORDS), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise TypeError(f"simulate() got an unexpected keyword argument {unknown[0]!r}{hint}")
     return _simulate(system, contact, initial, **settings)
 
 
 simulate.__doc__ = _simulate.__doc__
 simulate.__signature__ = inspect.signature(_simulate)  # type: ignore[attr-defined]
+_KEYWORDS = frozenset(
+    name
+    for name, parameter in inspect.signature(_simulate).parameters.items()
+    if parameter.kind is inspect.Parameter.KEYWORD_ONLY
+)
