@@ -597,3 +597,34 @@ def test_a_poincare_section_too_long_to_keep_is_refused_early(
     # One that fits runs.
     section = run_json(run_cli, "poincare", str(scenario), "--settle", "0", "--periods", "10000")
     assert len(section["strobe"]) == 10000
+
+
+@pytest.mark.parametrize(
+    ("command", "extra"),
+    [
+        ("orbit", []),
+        ("sweep", []),
+        ("bifurcation", []),
+        ("poincare", []),
+        ("basins", []),
+        ("continue", []),
+        ("lyapunov", []),
+        ("curve", []),
+        ("study", ["--out", "result.nc"]),
+    ],
+)
+def test_a_two_mass_file_is_refused_naming_the_command_and_structure(
+    table1_toml: str,
+    write_scenario: Callable[[str, str], Path],
+    run_cli: Callable[..., subprocess.CompletedProcess[str]],
+    command: str,
+    extra: list[str],
+) -> None:
+    # The message said "orbit and sweep take a 0.2 scenario" whatever the command, in a
+    # version's jargon the README never uses.
+    path = write_scenario(table1_toml, "two_mass.toml")
+    proc = run_cli(command, str(path), *extra)
+    assert proc.returncode == 2, proc.stderr
+    said = f"{command} takes a scenario with a [structure] section (a system on a structure)"
+    assert said in proc.stderr and "0.2" not in proc.stderr, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr

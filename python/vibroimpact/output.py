@@ -61,6 +61,15 @@ class UsageError(ValueError):
     in Python)."""
 
 
+def structure_needed(path: Path, command: str) -> str:
+    """The error of ``command`` given a two-mass scenario at ``path``: it takes a system
+    on a structure."""
+    return (
+        f"{path}: {command} takes a scenario with a [structure] section (a system on a "
+        "structure); this one is a two-mass damper's ([system] and [contact])"
+    )
+
+
 def _regular_or_absent(path: Path) -> os.stat_result | None:
     """The status of what ``path`` names (links followed), None when nothing does;
     :class:`UsageError` when it is not a regular file (a device, a FIFO, a folder),

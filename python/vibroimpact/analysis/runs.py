@@ -34,8 +34,8 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
     # Refused here, naming the section (a KeyError or a TypeError had named nothing).
     if "structure" not in data:
         raise InvalidInputError(
-            "[structure] is required: the analyses take a 0.2 scenario (a [structure] "
-            "section, its dampers, stops and excitations)"
+            "[structure] is required: the analyses take a system on a structure (a "
+            "[structure] section, its dampers, stops and excitations)"
         )
     if not isinstance(data.get("solver", {}), Mapping):
         raise InvalidInputError(f"[solver] must be a table, got {shown(data['solver'])}")

@@ -37,21 +37,21 @@ from vibroimpact.analysis import (
     sweep_values,
 )
 from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
-from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text
+from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
 from vibroimpact.units import derivative_units
 
 
-def _system(path: Path) -> SystemScenario:
+def _system(path: Path, command: str) -> SystemScenario:
     scenario = load_scenario(path)
     if not isinstance(scenario, SystemScenario):
-        raise UsageError(f"{path}: orbit and sweep take a 0.2 scenario (a [structure] section)")
+        raise UsageError(structure_needed(path, command))
     return scenario
 
 
 def run_orbit(args: argparse.Namespace) -> int:
-    scenario = _system(args.scenario)
+    scenario = _system(args.scenario, args.command)
     check_periods("", "--periods", args.periods, 1)
     if not args.tolerance > 0:
         raise UsageError(f"--tolerance must be > 0, got {args.tolerance}")
@@ -149,7 +149,7 @@ def run_orbit(args: argparse.Namespace) -> int:
 
 
 def run_sweep(args: argparse.Namespace) -> int:
-    scenario = _system(args.scenario)
+    scenario = _system(args.scenario, args.command)
     settings = scenario.data.get("sweep")
     if settings is None:
         raise UsageError(
@@ -259,7 +259,7 @@ def _section(scenario: SystemScenario, name: str, path: Path) -> dict[str, Any]:
 
 
 def run_bifurcation(args: argparse.Namespace) -> int:
-    scenario = _system(args.scenario)
+    scenario = _system(args.scenario, args.command)
     settings = _section(scenario, "sweep", args.scenario)
     sample = args.sample or settings["sample"]
     pair = args.pair if args.pair is not None else settings["pair"]
@@ -356,7 +356,7 @@ def _named_as(argument: str, key: str) -> Iterator[None]:
 
 
 def run_poincare(args: argparse.Namespace) -> int:
-    scenario = _system(args.scenario)
+    scenario = _system(args.scenario, args.command)
     check_periods("", "--settle", args.settle, 0)
     check_periods("", "--periods", args.periods, 1)
     check_total(("--settle", args.settle), ("--periods", args.periods))
@@ -392,7 +392,7 @@ def run_poincare(args: argparse.Namespace) -> int:
 
 
 def run_basins(args: argparse.Namespace) -> int:
-    scenario = _system(args.scenario)
+    scenario = _system(args.scenario, args.command)
     settings = _section(scenario, "basins", args.scenario)
     run = runner(scenario.data, scenario.base_dir)
     axes = []
@@ -451,7 +451,7 @@ def run_basins(args: argparse.Namespace) -> int:
 
 
 def run_continue(args: argparse.Namespace) -> int:
-    scenario = _system(args.scenario)
+    scenario = _system(args.scenario, args.command)
     settings = _section(scenario, "continuation", args.scenario)
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()

@@ -16,7 +16,7 @@ def add_commands(sub: Any) -> None:
     """Register ``orbit`` and ``sweep`` on the command line's subparsers."""
     orbit_parser = sub.add_parser(
         "orbit",
-        help="shoot for a periodic orbit of a forced 0.2 scenario, with its stability",
+        help="shoot for a periodic orbit of a forced scenario with [structure], with its stability",
         description=(
             "Newton's method on the stroboscopic map over K forcing periods (the common "
             "period of the harmonic excitations), from the scenario's [initial] state: "

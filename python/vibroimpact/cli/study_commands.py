@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.output import UsageError, check_output, check_plot, json_text
+from vibroimpact.output import UsageError, check_output, check_plot, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
 from vibroimpact.study import (
@@ -35,8 +35,9 @@ def add_command(sub: Any) -> None:
         "study",
         help="a grid of runs varying [study.axes], metrics into a NetCDF 4 file or Zarr store",
         description=(
-            "Run every combination of the [study.axes] values of a 0.2 scenario on all "
-            "cores (or --workers N), each run reduced to the [study] metrics, and write "
+            "Run every combination of the [study.axes] values of a scenario with "
+            "[structure] on all cores (or --workers N), each run reduced to the [study] "
+            "metrics, and write "
             "them as an xarray Dataset (one dimension per axis, a status variable, the "
             "reasons of failed runs in its attributes) in NetCDF 4 (--out RESULT.nc: HDF5 "
             "by h5netcdf, 64-bit integers, strings, compressed; xr.open_dataset reads it) "
@@ -89,7 +90,7 @@ def run_study_command(args: argparse.Namespace) -> int:
         check_plot(args.plot, [args.scenario])
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
-        raise UsageError(f"{args.scenario}: study takes a 0.2 scenario (a [structure] section)")
+        raise UsageError(structure_needed(args.scenario, "study"))
     try:
         study = study_of(scenario.data, str(args.scenario), scenario.base_dir)
     except InvalidInputError as err:

@@ -16,7 +16,7 @@ from vibroimpact.analysis import (
     lyapunov_runner,
     plots,
 )
-from vibroimpact.output import UsageError, json_text
+from vibroimpact.output import UsageError, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
 
@@ -25,7 +25,7 @@ def add_tangent_parsers(sub: Any) -> None:
     """Register ``lyapunov`` and ``curve`` on the command line's subparsers."""
     parser = sub.add_parser(
         "lyapunov",
-        help="the Lyapunov spectrum of a 0.2 scenario through its impacts (exact)",
+        help="the Lyapunov spectrum of a scenario with [structure] through its impacts (exact)",
         description=(
             "Settle --settle forcing periods from the scenario's [initial] state, then "
             "carry the tangent flow over --periods periods through every impact by its "
@@ -77,7 +77,7 @@ def add_tangent_parsers(sub: Any) -> None:
 def run_lyapunov(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
-        raise UsageError(f"{args.scenario}: lyapunov takes a 0.2 scenario (a [structure] section)")
+        raise UsageError(structure_needed(args.scenario, "lyapunov"))
     if args.settle is not None:
         check_periods("", "--settle", args.settle, 0)
     if args.periods is not None:
@@ -135,7 +135,7 @@ def run_lyapunov(args: argparse.Namespace) -> int:
 def run_curve(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
-        raise UsageError(f"{args.scenario}: curve takes a 0.2 scenario (a [structure] section)")
+        raise UsageError(structure_needed(args.scenario, "curve"))
     if "curve" not in scenario.data:
         raise UsageError(f"{args.scenario}: curve needs a [curve] section")
     start = time.perf_counter()
