@@ -34,7 +34,7 @@ from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.crossings import _CLASSES, _flags, _kind, _largest
 from vibroimpact.analysis.grazing import grazing_ahead, grazings_between
-from vibroimpact.analysis.limits import AnalysisError, whole_count
+from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError, relative_tolerance, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import shifted, with_parameter
@@ -127,14 +127,14 @@ def continue_orbit(
     arguments.text("parameter", parameter)
     stop = arguments.number("stop", stop)
     periods = whole_count("periods", periods, 1)
-    arguments.positive("tolerance", tolerance)
+    tolerance = relative_tolerance("tolerance", tolerance)
     base_dir = arguments.directory("base_dir", base_dir)
     arguments.callback("progress", progress)
     switch = arguments.flag("switch", switch)
     start_value = _value_of(data, parameter)
     if stop == start_value:
         raise AnalysisError(f"stop: must be a finite value other than the start {start_value:g}")
-    max_points = whole_count("max_points", max_points, 2)
+    max_points = whole_count("max_points", max_points, 2, MAX_POINTS)
     span = stop - start_value
     ds = abs(span) / 50 if step is None else arguments.positive("step", step)
     if not STEP_RANGE[0] * abs(span) <= ds <= STEP_RANGE[1] * abs(span):

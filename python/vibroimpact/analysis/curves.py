@@ -20,7 +20,7 @@ import numpy as np
 from vibroimpact import arguments
 from vibroimpact.analysis.continuation import _Arc, _value_of, continue_orbit
 from vibroimpact.analysis.grazing import away_from_zero, locate_grazing, struck
-from vibroimpact.analysis.limits import AnalysisError, whole_count
+from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError, relative_tolerance, whole_count
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner, state_arrays
@@ -100,8 +100,13 @@ def curve(
     second_stop = arguments.number("second_stop", second_stop)
     step = arguments.positive("step", step)
     periods = whole_count("periods", periods, 1)
-    max_points = whole_count("max_points", max_points, 2)
-    arguments.positive("tolerance", tolerance)
+    max_points = whole_count("max_points", max_points, 2, MAX_POINTS)
+    tolerance = relative_tolerance("tolerance", tolerance)
+    arguments.text("second", second)
+    if second == parameter:
+        # Followed in itself, the located point only moves along its own branch: no
+        # curve, but the search reported one.
+        raise AnalysisError(f"second: must be another parameter than {parameter!r}")
     s0 = _value_of(data, second)
     at_start = with_parameter(data, parameter, start)
     branch = continue_orbit(

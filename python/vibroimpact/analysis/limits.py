@@ -37,14 +37,34 @@ arguments.WHOLE_RANGES.update(
 arguments.WHOLE_RANGES["[sweep] count"] = (1, MAX_POINTS)
 
 
-def whole_count(name: str, value: Any, low: int) -> int:
-    """``value`` as a Python int when it is a whole number >= ``low`` (an int or a
-    NumPy integer, never a boolean); else :class:`AnalysisError` naming ``name``."""
+#: The most Newton iterations of a shooting (``max_iterations``): it converges in a few,
+#: or not at all; each is a run of the orbit's periods, so 1e9 was hours of computing.
+MAX_ITERATIONS = 10_000
+
+
+def whole_count(name: str, value: Any, low: int, high: int | None = None) -> int:
+    """``value`` as a Python int when it is a whole number >= ``low`` (and at most
+    ``high`` where given: an int or a NumPy integer, never a boolean); else
+    :class:`AnalysisError` naming ``name``."""
     if isinstance(value, np.integer):
         value = int(value)
     if not isinstance(value, int) or isinstance(value, bool) or value < low:
         raise AnalysisError(f"{name}: must be a whole number >= {low}, got {shown(value)}")
+    if high is not None and value > high:
+        raise AnalysisError(f"{name}: must be a whole number in [{low}, {high}], got {value}")
     return value
+
+
+def relative_tolerance(name: str, value: Any) -> float:
+    """A Newton solve's relative tolerance, in (0, 1): at 1 or more any state passes
+    (an orbit reported converged that is none); else :class:`AnalysisError`."""
+    checked = float(arguments.positive(name, value))
+    if not checked < 1.0:
+        raise AnalysisError(
+            f"{name}: must be in (0, 1) (relative: 1 or more takes any state for an orbit), "
+            f"got {shown(checked)}"
+        )
+    return checked
 
 
 def check_total(settle: tuple[str, int], record: tuple[str, int]) -> None:

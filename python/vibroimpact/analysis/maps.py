@@ -16,7 +16,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, SimulationError
-from vibroimpact.analysis.limits import AnalysisError, check_total, whole_count
+from vibroimpact.analysis.limits import MAX_STARTS, AnalysisError, check_total, whole_count
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import Runner, as_runner, check_kept, checked_run, runner
 from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
@@ -280,6 +280,20 @@ def basins(
     for name, (index, _) in (("first", first), ("second", second)):
         if not 0 <= index < len(base):
             raise AnalysisError(f"{name}: a state index in [0, {len(base)}), got {index}")
+    if first[0] == second[0]:
+        # The second would overwrite the first at every start: a grid over one entry.
+        raise AnalysisError(
+            f"second[0] (the state index): must differ from first's, both {first[0]}: the "
+            "grid is over two entries of the state"
+        )
+    for name, (_, values) in (("first", first), ("second", second)):
+        if len(values) == 0:
+            raise AnalysisError(f"{name}[1] (the values): must hold at least one value, got none")
+    if len(first[1]) * len(second[1]) > MAX_STARTS:
+        raise AnalysisError(
+            f"first, second: {len(first[1])} x {len(second[1])} starts, more than "
+            f"{MAX_STARTS}; give fewer values"
+        )
     a_values, b_values = np.asarray(first[1], float), np.asarray(second[1], float)
     labels = np.full((len(a_values), len(b_values)), -2, dtype=int)
     attractors: list[dict[str, Any]] = []

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact.analysis.limits import whole_count
+from vibroimpact.analysis.limits import MAX_ITERATIONS, relative_tolerance, whole_count
 from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run, state_arrays
 from vibroimpact.model.system import System
 from vibroimpact.summary import summarised
@@ -68,8 +68,8 @@ def orbit(
     run = as_runner(run)
     state = checked_run(run, state)
     periods = whole_count("periods", periods, 1)
-    arguments.positive("tolerance", tolerance)
-    max_iterations = whole_count("max_iterations", max_iterations, 1)
+    tolerance = relative_tolerance("tolerance", tolerance)
+    max_iterations = whole_count("max_iterations", max_iterations, 1, MAX_ITERATIONS)
     jacobian = arguments.choice("jacobian", jacobian, ("auto", "tangent", "differences"))
     if jacobian == "auto":
         jacobian = "tangent"

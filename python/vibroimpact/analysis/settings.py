@@ -13,6 +13,7 @@ from vibroimpact.analysis.limits import (
     AnalysisError,
     check_periods,
     check_total,
+    relative_tolerance,
 )
 from vibroimpact.analysis.parameters import with_parameter_path_check
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
@@ -108,6 +109,7 @@ def continuation_settings(table: Any) -> dict[str, Any]:
     for key in ("step", "tolerance"):
         if out[key] is not None and not out[key] > 0:
             raise AnalysisError(f"[continuation] {key}: must be > 0, got {out[key]}")
+    relative_tolerance("[continuation] tolerance", out["tolerance"])
     return out
 
 
@@ -215,6 +217,7 @@ def curve_settings(table: Any) -> dict[str, Any]:
     for key in ("step", "tolerance"):
         if not out[key] > 0:
             raise AnalysisError(f"[curve] {key}: must be > 0, got {out[key]}")
+    relative_tolerance("[curve] tolerance", out["tolerance"])
     if not 2 <= out["max_points"] <= MAX_POINTS:
         raise AnalysisError(
             f"[curve] max_points: must be in [2, {MAX_POINTS}], got {out['max_points']}"

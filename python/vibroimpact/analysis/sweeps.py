@@ -15,7 +15,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
-from vibroimpact.analysis.limits import AnalysisError
+from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner
 from vibroimpact.analysis.sensitivities import Derivative, derivative_paths, settled_derivatives
@@ -217,6 +217,9 @@ def sweep(
     arguments.text("parameter", parameter)
     paths = derivative_paths(data, derivatives)
     values = sorted(arguments.numbers("values", values).tolist())
+    if not 1 <= len(values) <= MAX_POINTS:
+        # As a [sweep]'s count: each point is hundreds of forcing periods and a result.
+        raise AnalysisError(f"values: must be 1 to {MAX_POINTS} values, got {len(values)}")
     _choice("", "direction", direction, _DIRECTIONS)
     base_dir = arguments.directory("base_dir", base_dir)
     arguments.callback("progress", progress)

@@ -53,8 +53,11 @@ def _system(path: Path, command: str) -> SystemScenario:
 def run_orbit(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario, args.command)
     check_periods("", "--periods", args.periods, 1)
-    if not args.tolerance > 0:
-        raise UsageError(f"--tolerance must be > 0, got {args.tolerance}")
+    if not 0 < args.tolerance < 1:
+        raise UsageError(
+            f"--tolerance must be in (0, 1) (relative: 1 or more takes any state), got "
+            f"{args.tolerance}"
+        )
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
     found = orbit(run, periods=args.periods, tolerance=args.tolerance)
