@@ -283,6 +283,9 @@ def test_sweep_plot_is_a_png_that_replaces_an_existing_file_whole(
     done = run_cli("sweep", str(path), "--plot", str(plot))
     assert done.returncode == 0, done.stderr
     assert f"plot written to {plot}" in done.stdout
+    # The table's units, above it (its columns had none).
+    units = "(value: excitation.0.frequency, Hz; amplitude, linear and rms: m)"
+    assert done.stdout.splitlines()[1] == units, done.stdout
     data = plot.read_bytes()
     assert data.startswith(PNG_SIGNATURE) and data.endswith(PNG_END)
     assert b"old plot" not in data
@@ -628,3 +631,21 @@ def test_a_two_mass_file_is_refused_naming_the_command_and_structure(
     said = f"{command} takes a scenario with a [structure] section (a system on a structure)"
     assert said in proc.stderr and "0.2" not in proc.stderr, proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize(
+    ("command", "example", "said"),
+    [
+        ("continue", "ball_table_continuation", "along excitation.0.amplitude (m s-2) in"),
+        ("bifurcation", "ball_table_bifurcation", "values of excitation.0.amplitude (m s-2) in"),
+        ("curve", "ball_table_flip_curve", "stop.0.restitution  excitation.0.amplitude (m s-2)"),
+    ],
+)
+def test_the_parameters_printed_state_their_units(
+    run_cli: RunCli, command: str, example: str, said: str
+) -> None:
+    # The text outputs named the parameter without its unit (a restitution's, 1, is
+    # not written).
+    done = run_cli(command, str(ROOT / "examples" / f"{example}.toml"))
+    assert done.returncode == 0, done.stderr
+    assert said in done.stdout, done.stdout

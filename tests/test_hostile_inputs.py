@@ -20,6 +20,7 @@ import docs_blocks
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER
 from vibroimpact.analysis import AnalysisError, curve, with_parameter
+from vibroimpact.analysis.settings import sweep_settings
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import ScenarioError, parse_scenario
@@ -359,6 +360,17 @@ def test_basins_over_the_same_entry_twice_are_refused() -> None:
     for y in ("structure_displacement.0", "structure_displacement.00"):
         text = BASINS.format(x="structure_displacement.0", y=y, count=2)
         assert "must differ from x.state" in parse_error(text)
+
+
+def test_a_sweep_of_one_point_to_another_stop_is_refused(tmp_path: Path, run_cli: Cli) -> None:
+    # count = 1 swept start alone, dropping stop without a word.
+    text = BASE + '[sweep]\nparameter = "excitation.0.frequency"\nstart = 7.0\nstop = 13.0\n'
+    said = "[sweep] count: must be >= 2 to reach stop (13) from start (7), got 1"
+    refused(run_cli("sweep", str(write(tmp_path, text + "count = 1\n"))), said)
+    table = {"parameter": "excitation.0.frequency", "start": 7.0, "stop": 7.0, "count": 1}
+    assert sweep_settings(table)["count"] == 1  # one point, start = stop: taken
+    with pytest.raises(AnalysisError, match="must be >= 2 to reach stop"):
+        sweep_settings({**table, "stop": 13.0})
 
 
 def test_the_analyses_python_calls_refuse_what_their_sections_refuse() -> None:

@@ -323,6 +323,21 @@ def test_simulate_text_output_through_main(
     check_csv(out, direct_table1(every=1), 2001)
 
 
+def test_both_formats_tables_of_contacts_state_their_units(
+    capsys: pytest.CaptureFixture[str], table1_toml: str, write_scenario: WriteScenario
+) -> None:
+    # A [structure] system's table had bare column names (approach_speed, ...).
+    system = REPO / "examples" / "frf_impact_damper.toml"
+    for path in (write_scenario(table1_toml), system):
+        assert main(["simulate", str(path)]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        at = next(i for i, line in enumerate(lines) if line.endswith("contact(s)"))
+        header = lines[at + 1]
+        for cell in ("onset (s)", "duration (s)", "approach (m/s)", "dissipated (J)"):
+            assert cell in header, header
+        assert not {"approach_speed", "energy_dissipated"} & set(header.split()), header
+
+
 def test_simulate_json_through_main(
     capsys: pytest.CaptureFixture[str], table1_toml: str, write_scenario: WriteScenario
 ) -> None:
@@ -398,12 +413,24 @@ def test_blow_up_exits_1(run_cli: RunCli, table1_toml: str, write_scenario: Writ
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
-def test_bad_arguments_exit_2(run_cli: RunCli) -> None:
-    for args in (("simulate", "--no-such-option"), ("no-such-command",), ()):
+def test_bad_arguments_exit_2_in_one_line(run_cli: RunCli) -> None:
+    # argparse printed its usage lines before the error; every other error is one line.
+    cases = [
+        (("simulate", "--no-such-option"), "vibroimpact: error: unrecognized arguments"),
+        (("no-such-command",), "vibroimpact: error: argument COMMAND: invalid choice"),
+        ((), "vibroimpact: error: the following arguments are required: COMMAND"),
+        (
+            ("orbit", "x.toml", "--periods", "1.5"),
+            "vibroimpact orbit: error: argument --periods: invalid int value: '1.5'",
+        ),
+    ]
+    for args, said in cases:
         proc = run_cli(*args)
         assert proc.returncode == 2, args
-        assert "Traceback" not in proc.stderr
-        assert "usage:" in proc.stderr
+        assert "Traceback" not in proc.stderr and "usage:" not in proc.stderr, proc.stderr
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith(said), proc.stderr
+        assert lines[0].endswith("--help)"), proc.stderr
 
 
 @pytest.mark.parametrize("args", [[], ["simulate"], ["paper"]])

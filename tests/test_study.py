@@ -440,6 +440,14 @@ def test_the_study_command_plots_a_heat_map(tmp_path: Path) -> None:
         "study", str(path), "--out", str(tmp_path / "s.nc"), "--plot", str(png), "--metric", "speed"
     )
     assert bad.returncode == 2 and "--metric" in bad.stderr and "amplitude" in bad.stderr
+    # Without --plot they choose nothing: refused before any run (no output written).
+    for flag, value in (("--metric", "amplitude"), ("--x", "damper.0.clearance")):
+        out = tmp_path / "unused.nc"
+        bare = cli("study", str(path), "--out", str(out), flag, value)
+        assert bare.returncode == 2 and not out.exists(), bare.stderr
+        assert bare.stderr.strip() == (
+            f"vibroimpact: error: {flag} chooses what --plot draws: give --plot FILE.png too"
+        )
 
 
 MONTE_CARLO = """

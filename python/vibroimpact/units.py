@@ -155,3 +155,26 @@ def _state_unit(name: str) -> str | None:
     if "displacement" in name:
         return _M
     return None
+
+
+#: Headers of the printed tables of contacts, by column of a contact table: SI units in
+#: brackets, as the command line prints them.
+CONTACT_HEADERS = {
+    "onset": "onset (s)",
+    "separation": "separation (s)",
+    "duration": "duration (s)",
+    "max_indentation": "max indent. (m)",
+    "approach_speed": "approach (m/s)",
+    "rebound_speed": "rebound (m/s)",
+    "restitution": "restitution",
+    "energy_dissipated": "dissipated (J)",
+    "energy_change": "net change (J)",
+}
+
+
+def with_units(parameter: str, data: Mapping[str, Any] | None = None) -> str:
+    """``parameter`` (a dotted path) with its SI unit in brackets, as the printed
+    tables head a parameter's column (``"excitation.0.frequency (Hz)"``); alone where
+    the unit is 1 or cannot be told."""
+    unit = parameter_units(parameter, data)
+    return parameter if unit in (None, _ONE) else f"{parameter} ({unit})"

@@ -58,6 +58,12 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     _choice("[sweep] ", "spacing", out["spacing"], _SPACINGS)
     if out["count"] < 1:
         raise AnalysisError(f"[sweep] count: must be >= 1, got {out['count']}")
+    if out["count"] == 1 and out["start"] != out["stop"]:
+        # One value is start alone: stop would be dropped without a word.
+        raise AnalysisError(
+            f"[sweep] count: must be >= 2 to reach stop ({out['stop']:g}) from start "
+            f"({out['start']:g}), got 1 (one point: set stop = start)"
+        )
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
         check_periods("[sweep] ", key, out[key], low)
     check_total(

@@ -40,7 +40,7 @@ from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
-from vibroimpact.units import derivative_units
+from vibroimpact.units import derivative_units, parameter_units, with_units
 
 
 def _system(path: Path, command: str) -> SystemScenario:
@@ -221,6 +221,8 @@ def run_sweep(args: argparse.Namespace) -> int:
     ]
     if shown != "coordinate":
         print(f"({shown_label(points[0], shown)}, {unit})")
+    value_unit = parameter_units(settings["parameter"], scenario.data) or "its own unit"
+    print(f"(value: {settings['parameter']}, {value_unit}; amplitude, linear and rms: {unit})")
     for path in derivatives:
         print(f"(d amplitude{name} / d {path}: {derivative_units(unit, path, scenario.data)})")
     widths = [max(14, len(h)) for h in head]
@@ -323,7 +325,8 @@ def run_bifurcation(args: argparse.Namespace) -> int:
             )
         )
         return 0
-    print(f"{args.scenario}: {len(points)} values of {settings['parameter']} in {cpu_time:.3f} s")
+    parameter = with_units(settings["parameter"], scenario.data)
+    print(f"{args.scenario}: {len(points)} values of {parameter} in {cpu_time:.3f} s")
     what = {
         "displacement": "stroboscopic displacement(s)",
         "impact-velocity": "impact velocities",
@@ -481,7 +484,8 @@ def run_continue(args: argparse.Namespace) -> int:
         return 0
     print(
         f"{args.scenario}: {len(branch.points)} orbits of {branch.periods} period(s) along "
-        f"{branch.parameter} in {cpu_time:.3f} s; stopped: {branch.stopped}"
+        f"{with_units(branch.parameter, scenario.data)} in {cpu_time:.3f} s; stopped: "
+        f"{branch.stopped}"
     )
     for p in branch.points:
         flags = ", ".join(

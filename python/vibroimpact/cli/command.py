@@ -19,7 +19,7 @@ import time
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from vibroimpact._core import (
     InvalidInputError,
@@ -51,6 +51,7 @@ from vibroimpact.scenario.system import (
     write_system_history,
 )
 from vibroimpact.scenario.two_mass import Scenario, ScenarioError, load_scenario, paper_collision
+from vibroimpact.units import CONTACT_HEADERS
 
 HISTORY_COLUMNS = (
     ("t", "time, s"),
@@ -62,18 +63,6 @@ HISTORY_COLUMNS = (
 )
 
 
-# Headers of the text table of contacts, by column of `ContactTable.columns`.
-CONTACT_HEADERS = {
-    "onset": "onset (s)",
-    "separation": "separation (s)",
-    "duration": "duration (s)",
-    "max_indentation": "max indent. (m)",
-    "approach_speed": "approach (m/s)",
-    "rebound_speed": "rebound (m/s)",
-    "restitution": "restitution",
-    "energy_dissipated": "dissipated (J)",
-    "energy_change": "net change (J)",
-}
 # What the energy columns are: printed under the table, the same words as in the help.
 ENERGY_DISSIPATED_TEXT = (
     "dissipated (J) is the work of the contact's dissipative forces (the law's hysteresis "
@@ -87,8 +76,17 @@ ENERGY_CHANGE_TEXT = (
 ENERGY_NOTE = 0.01
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser whose usage errors are one line, as every other error is (not
+    the usage lines first), pointing to the command's help; exit status 2. The
+    commands' parsers are of this class too (``add_subparsers`` makes its own kind)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="vibroimpact",
         description="Simulate impact dampers and vibro-impact systems (SI units).",
     )

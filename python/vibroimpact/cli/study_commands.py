@@ -88,6 +88,10 @@ def run_study_command(args: argparse.Namespace) -> int:
         check_output(args.out, "--out", [args.scenario])
     if args.plot:
         check_plot(args.plot, [args.scenario])
+    for flag, value in (("--metric", args.metric), ("--x", args.x), ("--y", args.y)):
+        if value is not None and not args.plot:
+            # They choose the map's metric and axes only: without a map they did nothing.
+            raise UsageError(f"{flag} chooses what --plot draws: give --plot FILE.png too")
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
         raise UsageError(structure_needed(args.scenario, "study"))

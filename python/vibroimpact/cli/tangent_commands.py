@@ -19,6 +19,7 @@ from vibroimpact.analysis import (
 from vibroimpact.output import UsageError, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
+from vibroimpact.units import with_units
 
 
 def add_tangent_parsers(sub: Any) -> None:
@@ -162,7 +163,8 @@ def run_curve(args: argparse.Namespace) -> int:
     lines = [
         f"{args.scenario}: {len(found.points)} points of the {found.kind} curve of "
         f"{found.periods}-period orbits in {cpu_time:.3f} s; stopped: {found.stopped}",
-        f"{found.second:>24}  {found.parameter}",
+        f"{with_units(found.second, scenario.data):>24}  "
+        f"{with_units(found.parameter, scenario.data)}",
         *(
             f"{p.values[found.second]:>24.10g}  {p.values[found.parameter]:.12g}"
             for p in found.points

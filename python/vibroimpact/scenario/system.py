@@ -27,6 +27,7 @@ from vibroimpact.system import (
     prepare_system,
     structure_coordinates,
 )
+from vibroimpact.units import CONTACT_HEADERS
 
 SECTIONS = (*RUN_SECTIONS, *ANALYSIS_SECTIONS)
 
@@ -283,7 +284,7 @@ def system_lines(
             "restitution",
             "energy_dissipated",
         ]
-        lines.append("  ".join(f"{h:>17}" for h in head))
+        lines.append("  ".join(f"{CONTACT_HEADERS.get(h, h):>17}" for h in head))
         for row in sol.contacts.to_dicts():
             cells = []
             for h in head:
