@@ -19,8 +19,7 @@ import pytest
 import docs_blocks
 import vibroimpact as vi
 from study_checks import FORCED_DAMPER
-from vibroimpact.analysis import AnalysisError, curve, with_parameter
-from vibroimpact.analysis.settings import sweep_settings
+from vibroimpact.analysis import AnalysisError, with_parameter
 from vibroimpact.output import UsageError, written_whole
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import ScenarioError, parse_scenario
@@ -360,84 +359,6 @@ def test_basins_over_the_same_entry_twice_are_refused() -> None:
     for y in ("structure_displacement.0", "structure_displacement.00"):
         text = BASINS.format(x="structure_displacement.0", y=y, count=2)
         assert "must differ from x.state" in parse_error(text)
-
-
-def test_a_sweep_of_one_point_to_another_stop_is_refused(tmp_path: Path, run_cli: Cli) -> None:
-    # count = 1 swept start alone, dropping stop without a word.
-    text = BASE + '[sweep]\nparameter = "excitation.0.frequency"\nstart = 7.0\nstop = 13.0\n'
-    said = "[sweep] count: must be >= 2 to reach stop (13) from start (7), got 1"
-    refused(run_cli("sweep", str(write(tmp_path, text + "count = 1\n"))), said)
-    table = {"parameter": "excitation.0.frequency", "start": 7.0, "stop": 7.0, "count": 1}
-    assert sweep_settings(table)["count"] == 1  # one point, start = stop: taken
-    with pytest.raises(AnalysisError, match="must be >= 2 to reach stop"):
-        sweep_settings({**table, "stop": 13.0})
-
-
-def test_the_analyses_python_calls_refuse_what_their_sections_refuse() -> None:
-    # Each was taken from Python and ran: a curve followed in its own parameter (84
-    # "flip" points, none a flip), a basins grid over one entry or of no start, and
-    # counts and tolerances without a bound (a shooting of 1e9 iterations, hours; a
-    # tolerance of 1e300 reported any state as a converged orbit).
-    system = vi.load(ROOT / "examples" / "frf_impact_damper.toml")
-    ball = vi.load(ROOT / "examples" / "ball_table_continuation.toml")
-    frequency = "excitation.0.frequency"
-    cases: list[tuple[Callable[[], object], str]] = [
-        (
-            lambda: vi.orbit(system, max_iterations=10**9),
-            "max_iterations: must be a whole number in [1, 10000], got 1000000000",
-        ),
-        (lambda: vi.orbit(system, tolerance=1.0), "tolerance: must be in (0, 1)"),
-        (lambda: vi.orbit(system, tolerance=1e300), "tolerance: must be in (0, 1)"),
-        (
-            lambda: vi.sweep(system, frequency, np.linspace(9.0, 11.0, 100_001)),
-            "values: must be 1 to 100000 values, got 100001",
-        ),
-        (
-            lambda: vi.continue_orbit(system, frequency, stop=11.0, max_points=100_001),
-            "max_points: must be a whole number in [2, 100000], got 100001",
-        ),
-        (
-            lambda: vi.continue_orbit(system, frequency, stop=11.0, tolerance=2.0),
-            "tolerance: must be in (0, 1)",
-        ),
-        (
-            lambda: vi.basins(system, (0, [0.01, 0.02]), (0, [0.005])),
-            "second[0] (the state index): must differ from first's, both 0",
-        ),
-        (
-            lambda: vi.basins(system, (0, np.array([])), (1, [0.1])),
-            "first[1] (the values): must hold at least one value",
-        ),
-        (
-            lambda: curve(
-                ball,
-                "flip",
-                "excitation.0.amplitude",
-                start=11.772,
-                stop=17.0,
-                second="excitation.0.amplitude",
-                second_stop=20.0,
-                step=0.1,
-            ),
-            "second: must be another parameter than 'excitation.0.amplitude'",
-        ),
-    ]
-    for call, said in cases:
-        with pytest.raises(AnalysisError) as err:
-            call()
-        assert isinstance(err.value, ValueError) and said in str(err.value), str(err.value)
-    # Within the bounds the shooting runs (a loose tolerance still converges to an orbit).
-    assert vi.orbit(system, tolerance=0.5, max_iterations=10_000).residual < 0.5
-
-
-def test_the_command_line_refuses_a_tolerance_that_takes_any_state(
-    tmp_path: Path, run_cli: Cli
-) -> None:
-    # It printed "converged to a 1-period orbit ... (residual 1.00e+00)" and exit 0.
-    path = ROOT / "examples" / "frf_impact_damper.toml"
-    refused(run_cli("orbit", str(path), "--tolerance", "1e300"), "--tolerance", "(0, 1)")
-    text = BASE + '[continuation]\nparameter = "excitation.0.amplitude"\nstop = 9.0\n'
-    assert "[continuation] tolerance: must be in (0, 1)" in parse_error(text + "tolerance = 1.0\n")
 
 
 # 4. Enumerated keys of the wrong type, or missing, are named.
