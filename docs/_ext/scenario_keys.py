@@ -341,7 +341,11 @@ ANALYSES = {
     "sweep": {
         **_VALUES_AXIS,
         "parameter": (None, _PARAMETER, "the parameter swept"),
-        "count": ("1", "[1, 100000]", "how many values, start and stop among them"),
+        "count": (
+            "1",
+            "[1, 100000]; >= 2 where stop differs from start",
+            "how many values, start and stop among them",
+        ),
         "direction": (
             None,
             '"up", "down" or "both"',
