@@ -36,6 +36,7 @@ from vibroimpact.analysis import (
     sweep,
     sweep_values,
 )
+from vibroimpact.analysis.limits import relative_tolerance
 from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
@@ -53,11 +54,7 @@ def _system(path: Path, command: str) -> SystemScenario:
 def run_orbit(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario, args.command)
     check_periods("", "--periods", args.periods, 1)
-    if not 0 < args.tolerance < 1:
-        raise UsageError(
-            f"--tolerance must be in (0, 1) (relative: 1 or more takes any state), got "
-            f"{args.tolerance}"
-        )
+    relative_tolerance("--tolerance", args.tolerance)
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
     found = orbit(run, periods=args.periods, tolerance=args.tolerance)
