@@ -5,7 +5,7 @@
 //! benchmarks/bench_collisions.py (events per second). `exact_damper once`
 //! runs the damper once (for callgrind), `exact_damper balls` the ball 300
 //! times (callgrind of a run's set-up and a few events), `exact_damper
-//! column` the column 50 times (for perf).
+//! column` the column 50 times (for perf; `column-0.6` at restitution 0.6).
 //!
 //!     cargo run --release -p vibroimpact-core --example exact_damper
 
@@ -113,6 +113,7 @@ fn main() {
         Some("ball") => Some(run(&ball, 6.0)),
         Some("balls") => repeated(300, || run(&ball, 6.0)),
         Some("column") => repeated(50, || run(&column(0.9), 20.0)),
+        Some("column-0.6") => repeated(50, || run(&column(0.6), 20.0)),
         _ => None,
     };
     if let Some(sol) = one {

@@ -33,6 +33,13 @@ impl Run<'_> {
     /// where none acted), whose round-off an impulse leaves in every rate.
     pub(super) fn settle_friction(&mut self, time: f64, impulses: f64) {
         let system = self.system;
+        let d = system.dim;
+        // The speeds in play (the state's, and its displacements' over the
+        // system's time scale): a rate this far below them is at rest, though
+        // a state come to rest holds round-off far below its own magnitudes.
+        let speeds = self.y[d..2 * d].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let reach = self.y[..d].iter().fold(0.0f64, |m, x| m.max(x.abs())) / system.time_scale();
+        let in_play = 64.0 * f64::EPSILON * (speeds + reach);
         for i in 0..self.modes.len() {
             // One switched at this event (a slip located where its holding force
             // passes the static force) keeps what the switch chose.
@@ -46,8 +53,15 @@ impl Run<'_> {
             // choose a slide, and the run would not be continuous in its
             // start).
             let row: f64 = system.interactions[i].h.iter().map(|h| h.abs()).sum();
-            let round_off = system.rate_round_off(i, &self.y).max(1e-9 * impulses * row);
-            let at_rest = rate.abs() <= round_off;
+            let round_off = system
+                .rate_round_off(i, &self.y)
+                .max(1e-9 * impulses * row)
+                .max(in_play * row);
+            // A stuck element's constraint holds its rate at zero: without an
+            // impulse its rate is the integration's drift, not a slide (its
+            // slip is its holding force passing the static force).
+            let held = impulses == 0.0 && matches!(self.modes[i], Mode::Stuck { .. });
+            let at_rest = held || rate.abs() <= round_off;
             match self.modes[i] {
                 _ if !at_rest => self.slide(i, time, rate.signum()),
                 Mode::Stuck { shadowed, offset } => match (shadowed, self.shadowed(i)) {

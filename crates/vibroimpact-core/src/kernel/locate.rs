@@ -163,13 +163,13 @@ pub(super) fn find_crossing(
     system: &Assembly,
     time: f64,
     gaps: &Gaps,
-    end: &[f64],
+    (start, end): (&[f64], &[f64]),
     h: f64,
     modes: &[Mode],
     graze: f64,
     grazes: &mut u64,
     scratch: &mut Scratch,
-    work: &mut [f64],
+    (work, mut probe): (&mut [f64], Probe<'_>),
     skip: &[bool],
 ) -> Option<Crossing> {
     let mut best: Option<Crossing> = None;
@@ -193,15 +193,16 @@ pub(super) fn find_crossing(
                 continue;
             }
             Mode::Sticking | Mode::Stuck { .. } => {
-                let value = event_value(system, i, mode, time + h, end, modes, scratch, work);
-                if value < 0.0 {
-                    consider(Crossing {
-                        i,
-                        guess: 1.0,
-                        interior: false,
-                        before: 0.0,
-                        root: f64::NAN,
-                    });
+                let held = Held {
+                    system,
+                    i,
+                    mode,
+                    modes,
+                };
+                if let Some(c) =
+                    held.crossing((time, h), (start, end), (scratch, work), probe.reborrow())
+                {
+                    consider(c);
                 }
                 continue;
             }
@@ -264,6 +265,117 @@ pub(super) fn find_crossing(
         }
     }
     best
+}
+
+/// What the held interactions' rates are found with: a state a little along
+/// its rates, a buffer of rates, and a work space of their own (the run's
+/// caches its signals' last values: evaluations at other times would change
+/// the bits of its next ones).
+pub(super) struct Probe<'a> {
+    pub(super) shifted: &'a mut [f64],
+    pub(super) rates: &'a mut [f64],
+    pub(super) scratch: &'a mut Scratch,
+}
+
+impl Probe<'_> {
+    fn reborrow(&mut self) -> Probe<'_> {
+        Probe {
+            shifted: self.shifted,
+            rates: self.rates,
+            scratch: self.scratch,
+        }
+    }
+}
+
+/// A held interaction (a sticking pair, a stuck friction element), whose
+/// event value is a force.
+struct Held<'a> {
+    system: &'a Assembly,
+    i: usize,
+    mode: Mode,
+    modes: &'a [Mode],
+}
+
+impl Held<'_> {
+    /// Its event in the step `start -> end` of length `h` from `time`: at
+    /// the end where the force there has passed its limit; inside, where
+    /// the force's cubic Hermite interpolant (from its values and rates at
+    /// the ends) dips past the limit and back within the step, as a gap's
+    /// does (a force that peaks past the static force between two steps'
+    /// ends is a slip, not a stuck interval).
+    fn crossing(
+        &self,
+        (time, h): (f64, f64),
+        (start, end): (&[f64], &[f64]),
+        (scratch, work): (&mut Scratch, &mut [f64]),
+        mut probe: Probe<'_>,
+    ) -> Option<Crossing> {
+        let (system, i, mode, modes) = (self.system, self.i, self.mode, self.modes);
+        let v1 = event_value(system, i, mode, time + h, end, modes, scratch, work);
+        if v1 < 0.0 {
+            return Some(Crossing {
+                i: self.i,
+                guess: 1.0,
+                interior: false,
+                before: 0.0,
+                root: f64::NAN,
+            });
+        }
+        // A dip needs the value rising at the end and falling at the start.
+        let (_, r1) = self.value_and_rate(time + h, end, h, probe.reborrow());
+        // (NaN, a force not finite, is no dip.)
+        if r1.is_nan() || r1 <= 0.0 {
+            return None;
+        }
+        let (v0, r0) = self.value_and_rate(time, start, h, probe);
+        if v0.is_nan() || v0 <= 0.0 || r0.is_nan() || r0 >= 0.0 {
+            return None;
+        }
+        let (m0, m1) = (r0 * h, r1 * h);
+        let theta = hermite::peak(-v0, -v1, -m0, -m1);
+        let low = hermite::eval(v0, v1, m0, m1, theta).0;
+        // As a gap's dip: one the interpolant takes down to half of the
+        // ends' lower value is checked on the method's own solution.
+        (low < 0.5 * v0.min(v1)).then(|| Crossing {
+            i: self.i,
+            guess: theta,
+            interior: true,
+            before: 0.0,
+            root: hermite::root_within(v0, v1, m0, m1, 0.0, theta),
+        })
+    }
+
+    /// The event value at `(time, y)` and its rate (per s): the difference
+    /// along the state's own rates over a millionth of the step `h` (the
+    /// force is affine in the state for a linear system, so the difference
+    /// is its derivative but for the forcing's curvature and round-off).
+    fn value_and_rate(&self, time: f64, y: &[f64], h: f64, probe: Probe<'_>) -> (f64, f64) {
+        let (system, i, mode, modes) = (self.system, self.i, self.mode, self.modes);
+        let Probe {
+            shifted,
+            rates,
+            scratch,
+        } = probe;
+        // `event_value` leaves the rates at `y` in `rates`.
+        let value = event_value(system, i, mode, time, y, modes, scratch, rates);
+        let row = 2 * system.dim;
+        let delta = 1e-6 * h;
+        for ((s, v), r) in shifted[..row].iter_mut().zip(&y[..row]).zip(&rates[..row]) {
+            *s = v + delta * r;
+        }
+        shifted[row..].copy_from_slice(&y[row..]);
+        let later = event_value(
+            system,
+            i,
+            mode,
+            time + delta,
+            shifted,
+            modes,
+            scratch,
+            rates,
+        );
+        (value, (later - value) / delta)
+    }
 }
 
 /// A sliding friction element's stop in a step of length `h` whose ends
@@ -403,6 +515,11 @@ pub(super) struct Buffers {
     /// the stepper gives them.
     pub(super) accel: Vec<f64>,
     pub(super) jerk: Vec<f64>,
+    /// A state a little along its rates, the rates, and a work space of
+    /// their own (a held force's rate: see [`Probe`]).
+    pub(super) shifted: Vec<f64>,
+    pub(super) rates: Vec<f64>,
+    pub(super) held: Scratch,
 }
 
 /// Locates interaction `c.i`'s event in the step of length `h` whose end is

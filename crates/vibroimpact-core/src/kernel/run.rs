@@ -13,6 +13,7 @@ use crate::kernel::fixed::Change;
 use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{
     event_value_from, find_crossing, locate, may_cross, past, Buffers, Crossing, Gaps, Location,
+    Probe,
 };
 use crate::kernel::observe::Watch;
 use crate::kernel::reductions::{reduce_step, Reductions};
@@ -386,13 +387,20 @@ impl<'a> Run<'a> {
             self.system,
             self.clock.time,
             &self.gaps,
-            &self.end,
+            (&self.y, &self.end),
             h,
             &self.modes,
             self.graze,
             grazes,
             &mut self.scratch,
-            &mut self.buffers.work,
+            (
+                &mut self.buffers.work,
+                Probe {
+                    shifted: &mut self.buffers.shifted,
+                    rates: &mut self.buffers.rates,
+                    scratch: &mut self.buffers.held,
+                },
+            ),
             &self.unconfirmed,
         )
     }

@@ -98,7 +98,9 @@ pub(super) fn forcing_period(spec: &SystemSpec) -> Result<f64> {
 pub(super) fn failed_run(spec: &SystemSpec, reason: String) -> RunMetrics {
     // Each structure coordinate, then each followed point and moment.
     let n = spec.structure.dofs() + spec.points.len() + spec.moments.len();
-    let pairs = spec.dampers.len() + spec.stops.len() + spec.collisions.len();
+    // As the system names its pairs (a friction element is one whatever its force).
+    let pairs =
+        spec.dampers.len() + spec.stops.len() + spec.collisions.len() + spec.frictions.len();
     RunMetrics {
         status: 1,
         reason,

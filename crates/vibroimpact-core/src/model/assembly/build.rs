@@ -432,7 +432,10 @@ impl Walls {
     fn add_frictions(&mut self, spec: &SystemSpec, n: usize, dim: usize) -> Result<()> {
         let s = &spec.structure;
         let k = spec.dampers.len();
-        for (f, friction) in spec.frictions.iter().enumerate() {
+        // A [[friction]] element is named by its place among the elements, not
+        // among every friction (a damper's own is named by its damper).
+        let mut elements = 0;
+        for friction in &spec.frictions {
             let (name, h) = match friction.site {
                 FrictionSite::Damper(j) => {
                     let name = format!("damper {j} friction");
@@ -450,7 +453,8 @@ impl Walls {
                     (name, h)
                 }
                 FrictionSite::Points { at, against } => {
-                    let name = format!("friction {f}");
+                    let name = format!("friction {elements}");
+                    elements += 1;
                     let mut point = s.point(&format!("{name} at"), at)?;
                     if let Some(against) = against {
                         let other = s.point(&format!("{name} against"), against)?;
@@ -486,6 +490,9 @@ impl Walls {
                      finite, got {static_force} N"
                 )));
             }
+            // Every element is a pair, one of no force or merged with another too:
+            // a study's runs then have the same pairs whatever their values.
+            let pair = self.pair(name);
             if static_force == 0.0 {
                 continue; // no force: no element
             }
@@ -504,7 +511,6 @@ impl Walls {
                 }
                 continue;
             }
-            let pair = self.pair(name);
             self.wall(
                 pair,
                 h,
