@@ -70,7 +70,12 @@ def test_results_as_pandas_and_xarray() -> None:
     assert np.array_equal(frame["onset"].to_numpy(), sol.contacts.onset)
     assert list(frame["pair"]) == sol.contacts.pair
     data = sol.to_xarray()
-    assert data.sizes == {"time": len(sol.t), "structure_coordinate": 3, "damper": 2}
+    assert data.sizes == {
+        "time": len(sol.t),
+        "structure_coordinate": 3,
+        "damper": 2,
+        "contact_pair": len(sol.contact_force_pairs),
+    }
     assert np.array_equal(data["time"].to_numpy(), sol.t)
     assert np.array_equal(data["damper_velocity"].to_numpy(), sol.damper_velocity)
     assert data["structure_displacement"].dims == ("time", "structure_coordinate")

@@ -125,7 +125,7 @@ BAD = [
     (
         "structure_displacement = [0.001, 0.0]",
         "structure_displacement = [0.001]",
-        "initial.structure_displacement must have 2 values",
+        "[initial] structure_displacement: must have 2 values",
     ),
     (
         "structure_displacement = [0.001, 0.0]",

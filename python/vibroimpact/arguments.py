@@ -220,6 +220,12 @@ def instance(name: str, value: Any, kind: type, made_by: str) -> Any:
     return value
 
 
+class KeywordError(InvalidInputError, TypeError):
+    """A call given a keyword it does not take, a positional value where only keywords
+    go, or missing one it needs: a ``ValueError`` as every bad input is here, and the
+    ``TypeError`` Python raises for it."""
+
+
 def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
     """A core function whose arguments of the wrong type (PyO3 raises a TypeError
     naming the argument only in a note) are refused naming it: on a TypeError the
@@ -237,8 +243,9 @@ def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
             except TypeError as err:
                 try:
                     bound = signature.bind(*args, **kwargs)
-                except TypeError:
-                    raise  # a missing or unknown argument: Python's own error says which
+                except TypeError as wrong:
+                    # A missing or unknown argument: Python's own words say which.
+                    raise KeywordError(f"{function.__name__}() {wrong}") from None
                 for key, allowed in kinds.items():
                     if key in bound.arguments and not isinstance(bound.arguments[key], allowed):
                         names = allowed if isinstance(allowed, tuple) else (allowed,)

@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
+from vibroimpact.units import CONTACT_UNITS
 
 _T = TypeVar("_T", bound=type)
 
@@ -93,8 +94,9 @@ def contacts_repr(contacts: Any) -> str:
     """A contact table in one line: how many contacts, of which kinds, and the pairs."""
     kinds = {kind: list(contacts.kind).count(kind) for kind in sorted(set(contacts.kind))}
     pairs = sorted(set(contacts.pair))
+    count = len(contacts)
     return (
-        f"{type(contacts).__name__}({len(contacts)} contacts"
+        f"{type(contacts).__name__}({count} contact{'' if count == 1 else 's'}"
         + "".join(f", {count} {kind}" for kind, count in kinds.items())
         + (f"; pairs: {', '.join(pairs[:_SHOWN])}" if pairs else "")
         + (", ..." if len(pairs) > _SHOWN else "")
@@ -119,7 +121,21 @@ def contacts_frame(contacts: Any) -> Any:
     ``pandas.DataFrame``: a 0.2 run's ``SystemContacts`` or the two-mass run's
     ``ContactTable``; pandas is imported here, and its absence said."""
     pandas = _pandas()
-    return pandas.DataFrame({name: getattr(contacts, name) for name in contacts.columns})
+    frame = pandas.DataFrame(
+        {
+            # Text columns stay text when empty (pandas would make them float64).
+            name: np.asarray(getattr(contacts, name), dtype=object)
+            if name in _TEXT_COLUMNS
+            else getattr(contacts, name)
+            for name in contacts.columns
+        }
+    )
+    frame.attrs["units"] = {name: CONTACT_UNITS[name] for name in contacts.columns}
+    return frame
+
+
+#: The contact tables' columns of text.
+_TEXT_COLUMNS = ("pair", "kind")
 
 
 #: The units of a history's arrays (attributes of :func:`history_dataset`'s variables).
@@ -174,9 +190,44 @@ def history_dataset(sol: Any) -> Any:
     coordinates = {"structure_coordinate": np.arange(n), "damper": np.arange(k)}
     energy = {f"energy_{key}": value for key, value in sol.energy.items()}
     followed, followed_at = _followed(sol)
+    results, results_at = _results(sol, n, k)
     return xr.Dataset(
-        arrays | followed, coords=time | coordinates | followed_at, attrs=attrs | energy
+        arrays | followed | results,
+        coords=time | coordinates | followed_at | results_at,
+        attrs=attrs | energy | {"recorded_time": sol.recorded_time},
     )
+
+
+def _results(sol: Any, n: int, k: int) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A run's results beside its history: the compliant pairs' forces over time (N,
+    over ``contact_pair``), each structure coordinate's recorded peak and RMS (m), and
+    the strobed states over ``strobe_time`` (s), each state entry named as the history's
+    columns are (``structure_displacement_0``, ...)."""
+    arrays: dict[str, Any] = {}
+    coordinates: dict[str, Any] = {}
+    force = np.asarray(sol.contact_force)
+    if force.ndim == 2 and force.size and force.shape[0] == len(sol.t):
+        coordinates["contact_pair"] = ("contact_pair", list(sol.contact_force_pairs))
+        arrays["contact_force"] = (
+            ("time", "contact_pair"),
+            force,
+            {"units": "N", "long_name": "compliant pair's force, > 0 pushing it apart"},
+        )
+    for statistic in ("peak", "rms"):
+        values = np.asarray(getattr(sol, statistic))
+        if values.shape == (n,):
+            arrays[statistic] = ("structure_coordinate", values, {"units": "m"})
+    strobe = np.asarray(sol.strobe)
+    if strobe.ndim == 2 and strobe.size:
+        names = [
+            f"{name}_{i}"
+            for name, count in zip(_UNITS, (n, n, k, k), strict=True)
+            for i in range(count)
+        ]
+        coordinates["strobe_time"] = ("strobe_time", sol.strobe_time, {"units": "s"})
+        coordinates["state"] = ("state", names)
+        arrays["strobe"] = (("strobe_time", "state"), strobe, {"long_name": "strobed state"})
+    return arrays, coordinates
 
 
 def _followed(sol: Any) -> tuple[dict[str, Any], dict[str, Any]]:

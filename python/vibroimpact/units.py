@@ -172,6 +172,23 @@ CONTACT_HEADERS = {
 }
 
 
+#: The SI unit of each column of a contact table (``to_pandas().attrs["units"]``; "1"
+#: where it has none, "" for text).
+CONTACT_UNITS = {
+    "pair": "",
+    "kind": "",
+    "onset": "s",
+    "separation": "s",
+    "duration": "s",
+    "max_indentation": _M,
+    "approach_speed": _M_S,
+    "rebound_speed": _M_S,
+    "restitution": _ONE,
+    "energy_dissipated": "J",
+    "energy_change": "J",
+}
+
+
 def with_units(parameter: str, data: Mapping[str, Any] | None = None) -> str:
     """``parameter`` (a dotted path) with its SI unit in brackets, as the printed
     tables head a parameter's column (``"excitation.0.frequency (Hz)"``); alone where

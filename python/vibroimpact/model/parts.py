@@ -19,7 +19,7 @@ from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError
+from vibroimpact.arguments import KeywordError
 from vibroimpact.system import _GRAVITY, _STRUCTURE, _unknown_key, system_spec
 
 _Numbers = tuple[float, ...]
@@ -39,6 +39,21 @@ def _as_tuple(value: Any, depth: int) -> Any:
     return tuple(_as_tuple(row, depth - 1) for row in value)
 
 
+#: Values of an array a repr shows before it summarises the rest.
+_SHOWN_VALUES = 4
+
+
+def _shown(value: Any) -> str:
+    """A field in a part's repr: a long array (a record's samples, a large matrix) as its
+    first values and its length, so that a repr stays a line."""
+    if isinstance(value, tuple) and len(value) > _SHOWN_VALUES:
+        head = ", ".join(_shown(v) for v in value[:_SHOWN_VALUES])
+        return f"({head}, ... {len(value)} in all)"
+    if isinstance(value, tuple) and value and isinstance(value[0], tuple):
+        return f"({', '.join(_shown(v) for v in value)})"
+    return repr(value)
+
+
 def _plain(value: Any) -> Any:
     """A tuple as the list TOML reads (rows as lists of lists)."""
     if isinstance(value, tuple):
@@ -46,7 +61,7 @@ def _plain(value: Any) -> Any:
     return value
 
 
-class PartKeywordError(InvalidInputError):
+class PartKeywordError(KeywordError):
     """A part given a keyword it does not take, or not given one it needs (a
     ``ValueError``): the message names the part and the key, with the closest allowed key
     as a suggestion, as a scenario file's error does."""
@@ -104,7 +119,7 @@ class Part:
     def __repr__(self) -> str:
         # The keys given only, as the part would be written (None: left to the format).
         given = ", ".join(
-            f"{f.name}={getattr(self, f.name)!r}"
+            f"{f.name}={_shown(getattr(self, f.name))}"
             for f in dataclasses.fields(self)  # type: ignore[arg-type]
             if getattr(self, f.name) is not None
         )

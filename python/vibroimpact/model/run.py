@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import difflib
 import inspect
-from collections.abc import Callable
+import os
+from collections.abc import Callable, Mapping
 from typing import Any, overload
 
 from vibroimpact._core import (
@@ -16,9 +17,9 @@ from vibroimpact._core import (
     Solution,
 )
 from vibroimpact._core import simulate as _two_mass
-from vibroimpact.arguments import typed
+from vibroimpact.arguments import KeywordError, typed
 from vibroimpact.messages import shown
-from vibroimpact.model.parts import Output, Solver
+from vibroimpact.model.parts import Output, Part, Solver
 from vibroimpact.model.system import System
 from vibroimpact.system import SystemSolution, prepare_system
 
@@ -53,7 +54,7 @@ def simulate_model(system: System, **settings: Any) -> SystemSolution:
     scenario file does (the same checks and the same bits)."""
     unknown = [key for key in settings if key not in _SOLVER_KEYS + _OUTPUT_KEYS]
     if unknown:
-        raise TypeError(
+        raise KeywordError(
             f"simulate() of a System got an unexpected keyword argument {unknown[0]!r} "
             f"(it takes {', '.join(_SOLVER_KEYS + _OUTPUT_KEYS)})"
         )
@@ -119,6 +120,13 @@ def _simulate(
     """
     given = {key: value for key, value in locals().items() if value is not _UNSET}
     del given["system"]
+    if not isinstance(system, System | ImpactDamper):
+        raise InvalidInputError(_not_a_system(system))
+    if isinstance(system, ImpactDamper) and (contact is _UNSET or initial is _UNSET):
+        raise KeywordError(
+            "simulate() of the two-mass ImpactDamper needs its Contact and InitialState: "
+            "simulate(ImpactDamper, Contact, InitialState, t_end=...)"
+        )
     if isinstance(system, System):
         for name in ("contact", "initial"):
             if name in given:
@@ -136,6 +144,22 @@ def _simulate(
             )
     # Forwarded as given (None included): the two-mass run's checks name what is wrong.
     return two_mass(system, **given)
+
+
+def _not_a_system(value: Any) -> str:
+    """The error of ``simulate`` given something other than a system, with the call
+    that makes one of it."""
+    hint = ""
+    if isinstance(value, str | os.PathLike):
+        hint = "; a scenario file is read by vibroimpact.load(path) first"
+    elif isinstance(value, Mapping):
+        hint = "; a scenario's tables make one by vibroimpact.System.from_dict(tables)"
+    elif isinstance(value, Part):
+        hint = f"; a {type(value).__name__} is one part of vibroimpact.System(...)"
+    return (
+        "system: must be a vibroimpact.System (or the two-mass vibroimpact.ImpactDamper, "
+        f"with a Contact and an InitialState), got {shown(value)}{hint}"
+    )
 
 
 @overload
@@ -203,7 +227,7 @@ def simulate(
         # Python's own error would name the private function, with no hint.
         close = difflib.get_close_matches(unknown[0], sorted(_KEYWORDS), n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise TypeError(f"simulate() got an unexpected keyword argument {unknown[0]!r}{hint}")
+        raise KeywordError(f"simulate() got an unexpected keyword argument {unknown[0]!r}{hint}")
     return _simulate(system, contact, initial, **settings)
 
 

@@ -4,6 +4,7 @@ initial state, checked by the scenario format's one schema (:mod:`vibroimpact.sy
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -28,21 +29,22 @@ from vibroimpact.model.parts import (
     Output,
     Part,
     PartKeywordError,
+    Recorded,
     Signal,
     Solver,
     Stop,
     Structure,
+    keywords_checked,
 )
 from vibroimpact.model.toml_text import toml_text
 from vibroimpact.notebook import system_html
 from vibroimpact.system import (
-    _INITIAL,
     _OUTPUT,
     _SOLVER,
     RUN_SECTIONS,
     _fail,
-    _table,
     _unknown_key,
+    initial_table,
     prepare_system,
     system_spec,
 )
@@ -55,6 +57,7 @@ _STRUCTURES: dict[str, type[Structure]] = {c.kind: c for c in (Oscillator, Matri
 _SIGNAL_OF: dict[str, type[Signal]] = {c.kind: c for c in SIGNALS}
 
 
+@keywords_checked
 @dataclass(frozen=True, kw_only=True, repr=False)
 class System:
     """A vibro-impact system (SI units), built from typed parts named as the sections
@@ -125,9 +128,30 @@ class System:
                     f"System analyses: unknown section {shown(name)} (allowed: "
                     f"{', '.join(ANALYSIS_SECTIONS)})"
                 )
-        object.__setattr__(self, "analyses", dict(self.analyses))
+        # The System's own copy: a caller's dict changed later does not change it.
+        object.__setattr__(self, "analyses", copy.deepcopy(dict(self.analyses)))
         object.__setattr__(self, "base_dir", directory("base_dir", self.base_dir))
         self._check()
+
+    def __eq__(self, other: object) -> bool:
+        """Systems are equal where their parts, settings and analyses are; and, where a
+        recorded signal reads a relative ``file``, their ``base_dir`` too (the same text
+        read from two folders reads two records)."""
+        if type(other) is not System:
+            return NotImplemented
+        compared = [f.name for f in fields(self) if f.compare]
+        if any(getattr(self, name) != getattr(other, name) for name in compared):
+            return False
+        return not self._reads_relative_file() or self.base_dir == other.base_dir
+
+    def _reads_relative_file(self) -> bool:
+        """Whether a recorded signal reads a ``file`` by a relative path."""
+        return any(
+            isinstance(e.signal, Recorded)
+            and e.signal.file is not None
+            and not Path(e.signal.file).is_absolute()
+            for e in self.excitations
+        )
 
     def __repr__(self) -> str:
         given = ", ".join(
@@ -164,7 +188,7 @@ class System:
             spec = system_spec(**model, base_dir=self.base_dir)
         except RecursionError:
             raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
-        _table("[initial] ", {} if initial is None else initial, _INITIAL)
+        initial_table(initial, spec)
         _core_check(spec)
 
     def model_sections(self) -> dict[str, Any]:
@@ -205,11 +229,13 @@ class System:
             part = getattr(self, name)
             if part is not None:
                 sections[name] = part.to_dict()
-        return sections | {name: self.analyses[name] for name in self.analyses}
+        return sections | copy.deepcopy(dict(self.analyses))
 
     def to_toml(self, *, solver: Solver | None = None, output: Output | None = None) -> str:
         """The system as a 0.2 scenario (TOML text, SI units) that
-        :func:`vibroimpact.load` reads back into an equal System; ``solver`` and
+        :func:`vibroimpact.load` reads back into an equal System (a recorded signal's
+        relative ``file`` is written as given: the text read from ``base_dir``, or saved
+        there, reads the same record); ``solver`` and
         ``output`` in place of the system's own (a scenario run from the command line
         needs a ``[solver]`` with ``t_end``)."""
         system = self
@@ -265,7 +291,7 @@ class System:
                 collision=model["collision"] or (),
                 friction=model["friction"] or (),
             )
-            _table("[initial] ", model["initial"] or {}, _INITIAL)
+            initial_table(model["initial"], spec)
             for name, schema in (("solver", _SOLVER), ("output", _OUTPUT)):
                 table = sections.get(name)
                 if table is None:

@@ -35,6 +35,7 @@ from vibroimpact.system.schema import (
     _table,
     _unknown_key,
     default_stepping,
+    initial_table,
     system_spec,
 )
 from vibroimpact.system.solution import SystemContacts, SystemSolution
@@ -72,5 +73,6 @@ __all__ = [
     "_choice",
     "_fail",
     "_table",
+    "initial_table",
     "_unknown_key",
 ]

@@ -32,6 +32,7 @@ from vibroimpact.system.schema import (
     _choice,
     _fail,
     _table,
+    initial_table,
     system_spec,
 )
 from vibroimpact.system.solution import SystemContacts, SystemSolution
@@ -245,7 +246,7 @@ def prepare_system(
         # Arrays nested thousands deep: no structure has them.
         raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
     # "is None", not "or": an array given for a table has no truth value.
-    init = _table("[initial] ", {} if initial is None else initial, _INITIAL)
+    init = initial_table(initial, spec)
     solver = _table("[solver] ", solver, _SOLVER)
     output = _table("[output] ", {} if output is None else output, _OUTPUT)
     _choice("[solver] ", "method", solver["method"], _METHODS)

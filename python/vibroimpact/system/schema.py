@@ -73,7 +73,7 @@ from vibroimpact._core import (
 from vibroimpact.arguments import real, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.system.beam import DIMENSIONS, resolve_cantilever
-from vibroimpact.system.points import _check_point
+from vibroimpact.system.points import _check_point, structure_coordinates
 from vibroimpact.system.record_file import check_record, read_record
 
 #: A 0.2 scenario's sections of the system and its run, in the order they are written.
@@ -449,6 +449,24 @@ def _frictions(tables: list[Any], structure: dict[str, Any]) -> list[dict[str, A
             del d["against"]
         out.append(d)
     return out
+
+
+def initial_table(initial: Any, spec: Mapping[str, Any]) -> dict[str, Any]:
+    """The ``[initial]`` table checked against the system ``spec`` (as
+    :func:`system_spec` gives it): its arrays of numbers, each of the structure's
+    coordinates or the dampers' count of values, or none (zeros)."""
+    table = _table("[initial] ", {} if initial is None else initial, _INITIAL)
+    n, k = structure_coordinates(spec["structure"]), len(spec["damper"])
+    for key, size in zip(_INITIAL, (n, n, k, k), strict=True):
+        got = len(table[key])
+        if got and got != size:
+            whose = "structure coordinate" if key.startswith("structure") else "[[damper]]"
+            raise _fail(
+                f"[initial] {key}: ",
+                f"must have {size} value{'' if size == 1 else 's'} (one a {whose}), or none, "
+                f"got {got}",
+            )
+    return table
 
 
 def _too_deep(value: Any, limit: int = 32) -> bool:

@@ -16,9 +16,10 @@ from vibroimpact.summary import contacts_frame, contacts_repr, history_dataset, 
 from vibroimpact.system.points import moment_weights, point_weights
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SystemContacts:
     """The contacts of a 0.2 run, one entry per contact, as NumPy arrays (SI units).
+    Tables compare by identity (compare their columns' arrays for values).
 
     ``pair`` names the pair ("damper 0", "stop 1"); ``kind`` is "compliant",
     "impact" (a rigid impact: zero duration) or "sticking" (a rigid pair moving
@@ -90,9 +91,10 @@ def _plain(x: Any) -> Any:
     return x if isinstance(x, str) else float(x)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SystemSolution:
-    """What :func:`simulate_system` returns.
+    """What :func:`simulate_system` returns (solutions compare by identity: compare
+    their arrays for values).
 
     History arrays have one row per kept step: ``structure_displacement`` (m, rows
     x n), ``structure_velocity``, ``damper_displacement`` (rows x k),
@@ -189,6 +191,9 @@ class SystemSolution:
 
     def to_xarray(self) -> Any:
         """The history as an ``xarray.Dataset`` over ``time`` (s), with named
-        coordinates and units, the statistics and energy as attributes (contacts:
-        ``contacts.to_pandas()``)."""
+        coordinates and units: the structure's and dampers' arrays, the followed points,
+        the compliant pairs' ``contact_force`` (N, over ``contact_pair``), the recorded
+        ``peak`` and ``rms`` (m, per structure coordinate) and the ``strobe`` (over
+        ``strobe_time``, s); the statistics, ``recorded_time`` and energy (J) as
+        attributes (contacts: ``contacts.to_pandas()``)."""
         return history_dataset(self)

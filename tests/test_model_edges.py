@@ -1,0 +1,188 @@
+"""The typed model and its results at the edges a new user's probe found (issue 24):
+results compared and hashed, a System's analyses its own, the folder of a record read
+by a relative path counted in a System's equality, a short repr of a long record, the
+contact table's units, the history's whole results in xarray, what ``simulate`` and
+``System`` say to a wrong argument, and an initial state of the wrong length refused
+when the System is built."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from model_checks import ROOT
+
+
+def _oscillator(**keys: object) -> vi.System:
+    return vi.System(structure=vi.Oscillator(mass=1.0, stiffness=3947.8, damping=2.513), **keys)
+
+
+def _rattling() -> vi.System:
+    return vi.load(ROOT / "examples" / "frf_impact_damper.toml")
+
+
+@pytest.mark.timeout(60)
+def test_results_compare_by_identity_and_hash() -> None:
+    """``==`` of two solutions raised numpy's 'truth value of an array is ambiguous',
+    and ``hash`` a TypeError: results are compared by identity, as the two-mass run's
+    are."""
+    system = _rattling()
+    first, second = vi.simulate(system, t_end=0.05), vi.simulate(system, t_end=0.05)
+    assert first == first and first != second
+    assert first.contacts == first.contacts and first.contacts != second.contacts
+    assert len({first, second, first.contacts}) == 3
+    # Their values are the same: the arrays say so.
+    assert np.array_equal(first.structure_displacement, second.structure_displacement)
+
+
+@pytest.mark.timeout(60)
+def test_a_systems_analyses_are_its_own() -> None:
+    """``to_dict()`` and the dict a System was given shared the analyses' tables: a
+    change to either changed the System (and ``load(to_toml())`` then failed)."""
+    given = {"sweep": {"parameter": "excitation.0.frequency", "values": [8.0, 9.0]}}
+    system = _oscillator(analyses=given)
+    given["sweep"]["values"] = [-1.0]
+    sections = system.to_dict()
+    sections["sweep"]["values"].append(7.0)
+    assert system.analyses == {
+        "sweep": {"parameter": "excitation.0.frequency", "values": [8.0, 9.0]}
+    }
+    assert vi.load(system.to_toml()) == system
+
+
+def _recorded(base_dir: Path | None) -> vi.System:
+    return _oscillator(excitations=[vi.Base(signal=vi.Recorded(file="acc.csv"))], base_dir=base_dir)
+
+
+@pytest.mark.timeout(60)
+def test_systems_reading_one_relative_record_name_in_two_folders_differ(
+    tmp_path: Path,
+) -> None:
+    """Two Systems of the same text read from two folders compared equal (and hashed
+    the same) while they ran two records."""
+    here, there = tmp_path / "here", tmp_path / "there"
+    for folder, scale in ((here, 1.0), (there, 2.0)):
+        folder.mkdir()
+        times = np.linspace(0.0, 0.2, 201)
+        rows = "\n".join(f"{float(t)!r},{scale * math.sin(60.0 * t)!r}" for t in times)
+        (folder / "acc.csv").write_text(f"time,acceleration\n{rows}\n", encoding="utf-8")
+    system, elsewhere = _recorded(here), _recorded(there)
+    a = vi.simulate(system, method="dop853", t_end=0.2)
+    b = vi.simulate(elsewhere, method="dop853", t_end=0.2)
+    assert not np.array_equal(a.structure_displacement, b.structure_displacement)
+    assert elsewhere != system
+    assert system == _recorded(here) and hash(system) == hash(_recorded(here))
+    # Saved beside its record, the text reads it again: an equal System, the same run.
+    (here / "shaken.toml").write_text(system.to_toml(), encoding="utf-8")
+    again = vi.load(here / "shaken.toml")
+    assert again == system
+    c = vi.simulate(again, method="dop853", t_end=0.2)
+    assert np.array_equal(a.structure_displacement, c.structure_displacement)
+    # Where no file is read, the folder does not matter.
+    assert _oscillator(base_dir=here) == _oscillator(base_dir=there)
+
+
+@pytest.mark.timeout(30)
+def test_a_long_record_has_a_short_repr() -> None:
+    """A record of 10,000 samples gave a repr of 414,347 characters."""
+    times = np.linspace(0.0, 1.0, 10_000)
+    signal = vi.Recorded(time=times, value=np.sin(times))
+    system = _oscillator(excitations=[vi.Base(signal=signal)])
+    assert len(repr(signal)) < 300 and "10000 in all" in repr(signal)
+    assert len(repr(system)) < 600 and "\n" not in repr(system)
+    # Short arrays are shown whole.
+    assert repr(vi.Harmonics(amplitudes=[1.0, 2.0], frequencies=[3.0, 4.0])) == (
+        "Harmonics(amplitudes=(1.0, 2.0), frequencies=(3.0, 4.0))"
+    )
+
+
+@pytest.mark.timeout(60)
+def test_the_contact_table_states_its_units_and_keeps_its_text() -> None:
+    sol = vi.simulate(_rattling(), t_end=0.2)
+    frame = sol.contacts.to_pandas()
+    units = frame.attrs["units"]
+    assert units["onset"] == "s" and units["approach_speed"] == "m s-1"
+    assert units["energy_dissipated"] == "J" and units["max_indentation"] == "m"
+    assert set(units) == set(frame.columns)
+    empty = vi.simulate(_oscillator(), method="dop853", t_end=0.05).contacts
+    assert len(empty) == 0 and repr(empty).startswith("SystemContacts(0 contacts")
+    # Text columns stay text (pandas made the empty ones float64).
+    assert empty.to_pandas()["pair"].dtype == object
+    one = vi.simulate(_rattling(), t_end=0.2).contacts
+    first = vi.SystemContacts(**{name: getattr(one, name)[:1] for name in one.columns})
+    assert repr(first).startswith("SystemContacts(1 contact,")
+
+
+@pytest.mark.timeout(60)
+def test_the_history_in_xarray_holds_the_runs_results() -> None:
+    """``to_xarray()`` left out the contact force, the recorded peak and RMS, the
+    recorded time and the strobe."""
+    system = vi.load(ROOT / "examples" / "hyster_hertz.toml")
+    sol = vi.simulate(system, t_end=0.3, record_from=0.1, strobe_period=0.05)
+    data = sol.to_xarray()
+    assert np.array_equal(data["contact_force"].to_numpy(), sol.contact_force)
+    assert list(data["contact_pair"].values) == sol.contact_force_pairs
+    assert data["contact_force"].attrs["units"] == "N"
+    assert np.array_equal(data["peak"].to_numpy(), sol.peak)
+    assert np.array_equal(data["rms"].to_numpy(), sol.rms)
+    assert data.attrs["recorded_time"] == sol.recorded_time > 0
+    assert np.array_equal(data["strobe"].to_numpy(), sol.strobe)
+    assert np.array_equal(data["strobe_time"].to_numpy(), sol.strobe_time)
+    assert data["state"].values[0] == "structure_displacement_0"
+
+
+@pytest.mark.parametrize(
+    ("value", "words"),
+    [
+        (None, "got None"),
+        ("examples/x.toml", "vibroimpact.load(path) first"),
+        ({"structure": {}}, "System.from_dict"),
+        (vi.Oscillator(mass=1.0, stiffness=1.0), "one part of vibroimpact.System"),
+    ],
+)
+@pytest.mark.timeout(30)
+def test_simulate_of_something_else_says_what_a_system_is(value: object, words: str) -> None:
+    """Each said "missing a required argument: 'contact'" (the two-mass run's)."""
+    with pytest.raises(vi.InvalidInputError, match="system: must be a vibroimpact.System") as err:
+        vi.simulate(value, t_end=1.0)  # type: ignore[call-overload]
+    assert words in str(err.value)
+
+
+@pytest.mark.timeout(30)
+def test_wrong_keywords_are_value_errors_that_are_type_errors() -> None:
+    """Each raised a bare TypeError; the standard is a ValueError naming the argument
+    (Python's own TypeError kept for code that catches it)."""
+    system = _oscillator()
+    damper = vi.ImpactDamper(main_mass=1.0, stiffness=1.0, impact_mass=0.25, clearance=0.01)
+    calls = [
+        (lambda: vi.System(vi.Oscillator(mass=1.0, stiffness=1.0)), "keywords only"),  # type: ignore[misc]
+        (lambda: _oscillator(foo=1), "unknown key 'foo'"),
+        (lambda: vi.simulate(system, foo=1), "unexpected keyword argument 'foo'"),  # type: ignore[call-overload]
+        (lambda: vi.check_solver(method="rk4", dt=1e-3, t_end=1.0, foo=1), "'foo'"),
+        (lambda: vi.simulate(damper, t_end=1.0), "needs its Contact and InitialState"),  # type: ignore[call-overload]
+    ]
+    for call, words in calls:
+        with pytest.raises(ValueError, match=words) as err:
+            call()
+        assert isinstance(err.value, TypeError | vi.InvalidInputError)
+
+
+@pytest.mark.timeout(30)
+def test_an_initial_state_of_the_wrong_length_is_refused_when_the_system_is_built() -> None:
+    """Built and loaded, refused only when simulated ('must have 1 value')."""
+    with pytest.raises(
+        vi.InvalidInputError,
+        match=r"\[initial\] structure_displacement: must have 1 value .* got 2",
+    ):
+        _oscillator(initial=vi.Initial(structure_displacement=[0.001, 1.0]))
+    with pytest.raises(vi.InvalidInputError, match=r"damper_velocity: must have 0 values"):
+        _oscillator(initial=vi.Initial(damper_velocity=[1.0]))
+    text = _oscillator().to_toml() + "\n[initial]\nstructure_velocity = [0.0, 0.0]\n"
+    with pytest.raises(vi.InvalidInputError, match="structure_velocity: must have 1 value"):
+        vi.load(text)
+    # The right lengths (or none) are taken.
+    _oscillator(initial=vi.Initial(structure_displacement=[0.001], structure_velocity=[]))
