@@ -295,6 +295,17 @@ def test_a_bad_collision_is_refused_naming_its_key(collision: dict[str, Any], me
     assert "[[collision]] 0" in str(error.value) and "\n" not in str(error.value)
 
 
+@pytest.mark.parametrize("dampers", [0, 1])
+@pytest.mark.timeout(30)
+def test_a_collision_without_two_dampers_says_so(dampers: int) -> None:
+    """With no damper it said "indices (0 to -1)"."""
+    data = vi.load(COLUMN).to_dict()
+    data["damper"] = data["damper"][:dampers]
+    data["collision"] = data["collision"][:1]
+    with pytest.raises(ValueError, match=f"between two \\[\\[damper\\]\\] .* has {dampers}:"):
+        an.runner(data)
+
+
 @pytest.mark.parametrize("clearance", [-math.inf, math.nan, "-inf"])
 @pytest.mark.timeout(30)
 def test_a_side_s_clearance_is_a_number_or_inf_only(clearance: Any) -> None:

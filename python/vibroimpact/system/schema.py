@@ -391,6 +391,12 @@ def _collisions(tables: list[Any], dampers: int) -> list[dict[str, Any]]:
     for j, table in enumerate(tables):
         where = f"[[collision]] {j}: "
         d = _table(where, table, _COLLISION)
+        if dampers < 2:
+            raise _fail(
+                where,
+                f"a collision is between two [[damper]] (loose masses), and the system has "
+                f"{dampers}: add the dampers, or strike a wall with a [[stop]]",
+            )
         pair = d["dampers"]
         if (
             len(pair) != 2
