@@ -399,6 +399,8 @@ impl<'a> Run<'a> {
                     shifted: &mut self.buffers.shifted,
                     rates: &mut self.buffers.rates,
                     scratch: &mut self.buffers.held,
+                    forces: &mut self.buffers.forces,
+                    last: &mut self.buffers.last,
                 },
             ),
             &self.unconfirmed,

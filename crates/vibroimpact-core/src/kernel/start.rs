@@ -9,7 +9,7 @@ use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactKind, Open, RunOptions, Stepping};
 use crate::kernel::fixed;
 use crate::kernel::impacts::Impacts;
-use crate::kernel::locate::{any_compliant, wall_round_off, Buffers, Gaps};
+use crate::kernel::locate::{any_compliant, wall_round_off, Buffers, Gaps, LastEnd};
 use crate::kernel::memory::FIRST_ROWS;
 use crate::kernel::reductions::Reductions;
 use crate::kernel::run::{loss_slot, Run};
@@ -167,6 +167,8 @@ impl<'a> Run<'a> {
                 shifted: vec![0.0; len],
                 rates: vec![0.0; len],
                 held: Scratch::new(system),
+                forces: vec![0.0; 4 * count],
+                last: LastEnd::default(),
             },
             scratch: Scratch::new(system),
             reduce_scratch: Scratch::new(system),
