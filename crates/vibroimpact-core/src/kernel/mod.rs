@@ -7,6 +7,7 @@ pub(crate) mod contacts;
 pub mod events;
 pub mod fixed;
 mod friction;
+mod held;
 pub(crate) mod impacts;
 pub(crate) mod locate;
 pub mod memory;

@@ -10,10 +10,10 @@ use crate::kernel::compact::Stretch;
 use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactTiming, Open, PairContact, RunOptions};
 use crate::kernel::fixed::Change;
+use crate::kernel::held::Probe;
 use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{
     event_value_from, find_crossing, locate, may_cross, past, Buffers, Crossing, Gaps, Location,
-    Probe,
 };
 use crate::kernel::observe::Watch;
 use crate::kernel::reductions::{reduce_step, Reductions};
