@@ -85,6 +85,12 @@ def test_systems_reading_one_relative_record_name_in_two_folders_differ(
     # Where no file is read, the folder does not matter.
     assert _oscillator(base_dir=here) == _oscillator(base_dir=there)
 
+    class Named(vi.System):
+        """A System of a user's own kind: its equal instances are equal."""
+
+    made = {"structure": vi.Oscillator(mass=1.0, stiffness=1.0)}
+    assert Named(**made) == Named(**made) and Named(**made) != vi.System(**made)
+
 
 @pytest.mark.timeout(30)
 def test_a_long_record_has_a_short_repr() -> None:
@@ -94,7 +100,9 @@ def test_a_long_record_has_a_short_repr() -> None:
     system = _oscillator(excitations=[vi.Base(signal=signal)])
     assert len(repr(signal)) < 300 and "10000 in all" in repr(signal)
     assert len(repr(system)) < 600 and "\n" not in repr(system)
-    # Short arrays are shown whole.
+    # Short arrays are shown whole, a matrix of one row as the tuple it is.
+    one_row = repr(vi.Matrices(mass=[[1.0]], stiffness=[[4.0]]))
+    assert "mass=((1.0,),)" in one_row and "stiffness=((4.0,),)" in one_row
     assert repr(vi.Harmonics(amplitudes=[1.0, 2.0], frequencies=[3.0, 4.0])) == (
         "Harmonics(amplitudes=(1.0, 2.0), frequencies=(3.0, 4.0))"
     )
@@ -132,7 +140,17 @@ def test_the_history_in_xarray_holds_the_runs_results() -> None:
     assert data.attrs["recorded_time"] == sol.recorded_time > 0
     assert np.array_equal(data["strobe"].to_numpy(), sol.strobe)
     assert np.array_equal(data["strobe_time"].to_numpy(), sol.strobe_time)
-    assert data["state"].values[0] == "structure_displacement_0"
+    # A strobe row is every displacement, then every velocity; the last is at t_end.
+    assert list(data["state"].values) == [
+        "structure_displacement_0",
+        "damper_displacement_0",
+        "structure_velocity_0",
+        "damper_velocity_0",
+    ]
+    last = data["strobe"].isel(strobe_time=-1)
+    assert float(data["strobe_time"][-1]) == pytest.approx(0.3)
+    for name in ("structure_displacement", "damper_displacement", "damper_velocity"):
+        assert float(last.sel(state=f"{name}_0")) == sol.final_state[name][0]
 
 
 @pytest.mark.parametrize(

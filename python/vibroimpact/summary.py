@@ -219,11 +219,15 @@ def _results(sol: Any, n: int, k: int) -> tuple[dict[str, Any], dict[str, Any]]:
             arrays[statistic] = ("structure_coordinate", values, {"units": "m"})
     strobe = np.asarray(sol.strobe)
     if strobe.ndim == 2 and strobe.size:
-        names = [
-            f"{name}_{i}"
-            for name, count in zip(_UNITS, (n, n, k, k), strict=True)
-            for i in range(count)
-        ]
+        # A strobe row is the state as the run keeps it: every displacement (the
+        # structure's, then the dampers'), then every velocity.
+        order = (
+            ("structure_displacement", n),
+            ("damper_displacement", k),
+            ("structure_velocity", n),
+            ("damper_velocity", k),
+        )
+        names = [f"{name}_{i}" for name, count in order for i in range(count)]
         coordinates["strobe_time"] = ("strobe_time", sol.strobe_time, {"units": "s"})
         coordinates["state"] = ("state", names)
         arrays["strobe"] = (("strobe_time", "state"), strobe, {"long_name": "strobed state"})

@@ -50,7 +50,8 @@ def _shown(value: Any) -> str:
         head = ", ".join(_shown(v) for v in value[:_SHOWN_VALUES])
         return f"({head}, ... {len(value)} in all)"
     if isinstance(value, tuple) and value and isinstance(value[0], tuple):
-        return f"({', '.join(_shown(v) for v in value)})"
+        inner = ", ".join(_shown(v) for v in value)
+        return f"({inner},)" if len(value) == 1 else f"({inner})"
     return repr(value)
 
 

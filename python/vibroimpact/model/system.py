@@ -137,7 +137,7 @@ class System:
         """Systems are equal where their parts, settings and analyses are; and, where a
         recorded signal reads a relative ``file``, their ``base_dir`` too (the same text
         read from two folders reads two records)."""
-        if type(other) is not System:
+        if other.__class__ is not self.__class__:
             return NotImplemented
         compared = [f.name for f in fields(self) if f.compare]
         if any(getattr(self, name) != getattr(other, name) for name in compared):

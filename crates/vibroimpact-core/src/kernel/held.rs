@@ -12,25 +12,12 @@ use crate::numerics::hermite;
 /// signals' last values: evaluations at other times would change the bits of
 /// its next ones), and each interaction's holding force at the step's end,
 /// a little after it, at its start and a little after that (`4 count`, N),
-/// made once a step for all of them, where first needed; the last end's
-/// (`last`) serve as the next step's start.
+/// made once a step for all of them, where first needed.
 pub(super) struct Probe<'a> {
     pub(super) shifted: &'a mut [f64],
     pub(super) rates: &'a mut [f64],
     pub(super) scratch: &'a mut Scratch,
     pub(super) forces: &'a mut [f64],
-    pub(super) last: &'a mut LastEnd,
-}
-
-/// The state, time, modes and difference step of the holding forces last
-/// found at a step's end, and those forces (`2 count`: at it and after).
-#[derive(Debug, Clone, Default)]
-pub(super) struct LastEnd {
-    pub(super) time: f64,
-    pub(super) delta: f64,
-    pub(super) state: Vec<f64>,
-    pub(super) modes: Vec<Mode>,
-    pub(super) forces: Vec<f64>,
 }
 
 impl Probe<'_> {
@@ -73,9 +60,9 @@ impl Probe<'_> {
         holding_forces(self.scratch, &mut self.forces[at + count..at + 2 * count]);
     }
 
-    /// The forces at the step's end (`forces[..2 count]`), kept as `last`:
-    /// at the end, those of the run's own evaluation there (`scratch`, its
-    /// rates in `rates`), which the end's values were found with.
+    /// The forces at the step's end (`forces[..2 count]`): at the end, those
+    /// of the run's own evaluation there (`scratch`, its rates in `rates`),
+    /// which the end's values were found with.
     fn forces_at_end(
         &mut self,
         (system, modes): (&Assembly, &[Mode]),
@@ -87,35 +74,6 @@ impl Probe<'_> {
         holding_forces(scratch, &mut self.forces[..count]);
         self.rates.copy_from_slice(rates);
         self.forces_later(system, modes, end, 0, delta);
-        let last = &mut *self.last;
-        (last.time, last.delta) = (end.0, delta);
-        last.state.clear();
-        last.state.extend_from_slice(end.1);
-        last.modes.clear();
-        last.modes.extend_from_slice(modes);
-        last.forces.clear();
-        last.forces.extend_from_slice(&self.forces[..2 * count]);
-    }
-
-    /// The forces at the step's start (`forces[2 count..]`): the last end's
-    /// where the step starts there in the same modes, else found; the
-    /// difference step they were found with.
-    fn forces_at_start(
-        &mut self,
-        system: &Assembly,
-        modes: &[Mode],
-        start: (f64, &[f64]),
-        delta: f64,
-    ) -> f64 {
-        let count = modes.len();
-        let last = &*self.last;
-        if last.time.to_bits() == start.0.to_bits() && last.modes == modes && last.state == start.1
-        {
-            self.forces[2 * count..4 * count].copy_from_slice(&last.forces);
-            return last.delta;
-        }
-        self.forces_at(system, modes, start, 2 * count, delta);
-        delta
     }
 }
 
@@ -126,10 +84,9 @@ type Ends<'a> = (&'a [f64], &'a [f64]);
 /// values are made of, found once for all of them.
 pub(super) struct Held<'p> {
     pub(super) probe: Probe<'p>,
-    /// Whether the forces at the step's end are found, and the difference
-    /// step of those at its start (NaN: not found).
+    /// Whether the forces at the step's end and at its start are found.
     pub(super) end: bool,
-    pub(super) start: f64,
+    pub(super) start: bool,
 }
 
 impl Held<'_> {
@@ -165,14 +122,13 @@ impl Held<'_> {
         if r1.is_nan() || r1 <= 0.0 {
             return None;
         }
-        if self.start.is_nan() {
-            self.start = self
-                .probe
-                .forces_at_start(system, modes, (time, start), delta);
+        if !std::mem::replace(&mut self.start, true) {
+            self.probe
+                .forces_at(system, modes, (time, start), 2 * count, delta);
         }
         let forces = &self.probe.forces;
         let v0 = value(forces[2 * count + i]);
-        let r0 = (value(forces[3 * count + i]) - v0) / self.start;
+        let r0 = (value(forces[3 * count + i]) - v0) / delta;
         if v0.is_nan() || v0 <= 0.0 || r0.is_nan() || r0 >= 0.0 {
             return None;
         }

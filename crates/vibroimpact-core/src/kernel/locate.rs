@@ -5,7 +5,7 @@
 //! the method's own solution ([`locate`]: the step length that ends on it).
 
 use crate::error::Result;
-use crate::kernel::held::{Held, LastEnd, Probe};
+use crate::kernel::held::{Held, Probe};
 use crate::methods::step_control::rejects;
 use crate::methods::steppers::SystemStepper;
 use crate::model::assembly::{Assembly, Mode, Scratch};
@@ -176,7 +176,7 @@ pub(super) fn find_crossing(
     let mut held = Held {
         probe,
         end: false,
-        start: f64::NAN,
+        start: false,
     };
     let mut best: Option<Crossing> = None;
     let mut consider = |c: Crossing| {
@@ -428,7 +428,6 @@ pub(super) struct Buffers {
     pub(super) rates: Vec<f64>,
     pub(super) held: Scratch,
     pub(super) forces: Vec<f64>,
-    pub(super) last: LastEnd,
 }
 
 /// Locates interaction `c.i`'s event in the step of length `h` whose end is

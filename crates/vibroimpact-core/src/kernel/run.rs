@@ -400,7 +400,6 @@ impl<'a> Run<'a> {
                     rates: &mut self.buffers.rates,
                     scratch: &mut self.buffers.held,
                     forces: &mut self.buffers.forces,
-                    last: &mut self.buffers.last,
                 },
             ),
             &self.unconfirmed,

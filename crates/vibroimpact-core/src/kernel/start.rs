@@ -8,7 +8,6 @@ use crate::kernel::clock::{Clock, Schedule};
 use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactKind, Open, RunOptions, Stepping};
 use crate::kernel::fixed;
-use crate::kernel::held::LastEnd;
 use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{any_compliant, wall_round_off, Buffers, Gaps};
 use crate::kernel::memory::FIRST_ROWS;
@@ -169,7 +168,6 @@ impl<'a> Run<'a> {
                 rates: vec![0.0; len],
                 held: Scratch::new(system),
                 forces: vec![0.0; 4 * count],
-                last: LastEnd::default(),
             },
             scratch: Scratch::new(system),
             reduce_scratch: Scratch::new(system),
