@@ -149,9 +149,10 @@ fn holding_forces(scratch: &Scratch, out: &mut [f64]) {
     }
 }
 
-/// The event value of interaction `i`, held in `mode`, whose holding force
-/// is `force` (N): as [`event_value_from`] makes it.
-fn held_value(system: &Assembly, i: usize, mode: Mode, force: f64) -> f64 {
+/// The event value of interaction `i`, held in `mode` (sticking or stuck),
+/// whose holding force is `force` (N): a stuck element's static force left,
+/// a sticking pair's force with its row's friction added.
+pub(super) fn held_value(system: &Assembly, i: usize, mode: Mode, force: f64) -> f64 {
     match mode {
         Mode::Stuck { .. } => system.static_force(i) - force.abs(),
         _ => force + system.friction_hold[i],

@@ -5,7 +5,7 @@
 //! the method's own solution ([`locate`]: the step length that ends on it).
 
 use crate::error::Result;
-use crate::kernel::held::{Held, Probe};
+use crate::kernel::held::{held_value, Held, Probe};
 use crate::methods::step_control::rejects;
 use crate::methods::steppers::SystemStepper;
 use crate::model::assembly::{Assembly, Mode, Scratch};
@@ -55,12 +55,9 @@ pub(super) fn event_value_from(
         Mode::Open => gap,
         Mode::Compliant { .. } => -gap,
         Mode::Sliding { direction } => direction * rate,
-        Mode::Sticking => {
-            constraint_force(system, i, (time, y, modes), scratch, work) + system.friction_hold[i]
-        }
-        Mode::Stuck { .. } => {
-            let held = constraint_force(system, i, (time, y, modes), scratch, work).abs();
-            system.static_force(i) - held
+        Mode::Sticking | Mode::Stuck { .. } => {
+            let force = constraint_force(system, i, (time, y, modes), scratch, work);
+            held_value(system, i, mode, force)
         }
     }
 }
