@@ -515,3 +515,45 @@ def test_orbit_json_says_how_its_jacobian_was_made(run_cli: RunCli) -> None:
     assert out["jacobian"] == "tangent" and out["grazings"] == []
     multipliers = [complex(re, im) for re, im in out["floquet_multipliers"]]
     assert spectrum_distance(np.array(multipliers), holmes_multipliers(0.5, 1.2)) < 1e-6
+
+
+LINEAR_PAIR = """
+[structure]
+kind = "matrices"
+mass = [[1.0, 0.0], [0.0, 0.5]]
+stiffness = [[300.0, -100.0], [-100.0, 100.0]]
+damping = [[30.0, 0.0], [0.0, 0.1]]
+
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = 1.0
+frequency = 1.0
+
+[solver]
+method = "exact"
+t_end = 1.0
+"""
+
+
+LIGHTER_PAIR = LINEAR_PAIR.replace("[0.0, 0.5]]", "[0.0, 1.0]]").replace("30.0, 0.0", "8.0, 0.0")
+
+
+@pytest.mark.parametrize("source", [LINEAR_PAIR, LIGHTER_PAIR])
+def test_lyapunov_of_a_linear_structure_without_contact(
+    run_cli: RunCli, tmp_path: Path, source: str
+) -> None:
+    # Nothing touches, so the exponents are the real parts of the state matrix's
+    # eigenvalues (numpy's), and their sum its trace. Every block of 100 s is one
+    # smooth stretch: carried as one factor, its fast directions were lost (-2.4/s
+    # for -13.1/s here), or their squared norms underflowed to minus infinity.
+    out = lyapunov_json(run_cli, str(write(tmp_path, "pair.toml", source)))
+    data = vi.load(tmp_path / "pair.toml").to_dict()["structure"]
+    m, k, c = (np.array(data[key], dtype=float) for key in ("mass", "stiffness", "damping"))
+    a = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(m, k), -np.linalg.solve(m, c)]])
+    expected = np.sort(np.linalg.eigvals(a).real)[::-1]
+    assert out["impacts"] == 0
+    got = np.array(out["exponents"], dtype=float)
+    assert np.abs(got - expected).max() < 0.01, (got, expected)
+    assert got.sum() == pytest.approx(np.trace(a), rel=1e-9)

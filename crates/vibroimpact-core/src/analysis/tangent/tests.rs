@@ -401,3 +401,62 @@ fn orthonormalising_keeps_the_stretches_logarithms() {
         }
     });
 }
+
+/// The Lyapunov exponents of damped oscillators driven by a force and never
+/// touching anything: each pair of exponents is its oscillator's `-c / (2 m)`
+/// (closed form; 1 kg: -4/s at 8 N s/m beside 100 N/m, -15/s at 30 N s/m
+/// beside 400 N/m), over 1000 s of one smooth stretch (no event to
+/// re-orthonormalise at); within the finite time's `ln(cond) / T` (the
+/// eigenvectors' condition, about 100), and their sum `trace(A)` (Liouville)
+/// to round-off.
+#[test]
+fn a_long_stretch_without_events_keeps_every_exponent() {
+    crate::testing::timeout(20, || {
+        let rows = |a: f64, b: f64| vec![vec![a, 0.0], vec![0.0, b]];
+        let pair = Structure::matrices(&rows(1.0, 1.0), &rows(100.0, 400.0), &rows(8.0, 30.0));
+        for (structure, expected) in [
+            (
+                Structure::oscillator(1.0, 100.0, 8.0).unwrap(),
+                vec![-4.0; 2],
+            ),
+            (pair.unwrap(), vec![-4.0, -4.0, -15.0, -15.0]),
+        ] {
+            let spec = SystemSpec {
+                structure,
+                dampers: vec![],
+                collisions: vec![],
+                frictions: vec![],
+                stops: vec![],
+                gravity: 0.0,
+                excitations: vec![Excitation {
+                    load: Load::Force { at: 0.0 },
+                    signal: Signal::harmonic(1.0, 1.0, 0.0).unwrap(),
+                }],
+                points: vec![],
+                moments: vec![],
+            };
+            let system = Assembly::new(&spec).unwrap();
+            let y0 = initial_state(&system, &[], &[], &[], &[]).unwrap();
+            let t_end = 1000.0;
+            let mut stepper = AnyStepper::new(&system, "exact", &Options::default()).unwrap();
+            let dt = stepper.step(None, t_end, f64::INFINITY);
+            let mut flow = Tangent::orthonormal(&system).unwrap();
+            stepper
+                .integrate_observed(&system, &y0, &options(t_end, dt), &mut || false, &mut flow)
+                .unwrap();
+            let mut exponents: Vec<f64> = flow.logs().iter().map(|l| l / t_end).collect();
+            exponents.sort_by(|a, b| b.total_cmp(a));
+            for (got, want) in exponents.iter().zip(&expected) {
+                assert!(
+                    (got - want).abs() < 0.01,
+                    "{exponents:?} against {expected:?}"
+                );
+            }
+            let (sum, trace) = (exponents.iter().sum::<f64>(), expected.iter().sum::<f64>());
+            assert!(
+                (sum - trace).abs() < 1e-9 * trace.abs(),
+                "{sum} against {trace}"
+            );
+        }
+    });
+}
