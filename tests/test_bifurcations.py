@@ -324,6 +324,31 @@ def test_derivatives_of_the_ball_on_the_table_are_those_of_holmes_orbit() -> Non
         an.orbit_derivatives(data, found, ["stop.0.law"])
 
 
+def test_derivatives_of_an_orbit_of_two_periods_are_those_of_its_one_period_orbit() -> None:
+    # Holmes's orbit closes after one period, so after two as well: its derivatives
+    # are the same either way (the monodromy and the map's derivative both over the
+    # orbit's own periods; pairing one period's with two periods' gave a wrong answer).
+    data = load(BALL_TABLE)
+    once = an.orbit(an.runner(data))
+    twice = an.orbit(an.runner(data), once.state, periods=2)
+    assert once.converged and twice.converged and twice.periods == 2
+    expected = ball_derivatives(data)[AMPLITUDE][0]
+    derivative = an.orbit_derivatives(data, twice, [AMPLITUDE])[AMPLITUDE]
+    assert relative_error(derivative.state, expected) < 1e-6
+    with pytest.raises(ValueError, match=r"^periods: the orbit found closes after 1 "):
+        an.orbit_derivatives(data, once, [AMPLITUDE], periods=2)
+
+
+def test_a_derivative_at_a_parameters_bound_is_one_sided() -> None:
+    # The table's gap is 0, the least it may be: the orbit moves with the table's top,
+    # d(x, v)/d gap = (-1, 0) exactly (the ball is on no spring); the difference was
+    # taken at -1e-6 m and refused as a gap the scenario never had.
+    data = load(BALL_TABLE)
+    found = an.orbit(an.runner(data))
+    derivative = an.orbit_derivatives(data, found, ["stop.0.gap"])["stop.0.gap"]
+    assert np.abs(derivative.state - [-1.0, 0.0]).max() < 1e-6
+
+
 def test_orbit_command_prints_the_derivatives(run_cli: RunCli) -> None:
     done = run_cli(
         "orbit", str(BALL_TABLE), "--derivative", AMPLITUDE, "--derivative", RESTITUTION, "--json"

@@ -38,6 +38,8 @@ class Orbit:
     #: ``|bending moment|`` (N m) at each of ``[output] moments``.
     point_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
     moment_amplitude: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: The forcing periods the orbit takes to close (``monodromy`` is over these).
+    periods: int = 1
 
     def arrays(self, n: int, k: int) -> dict[str, list[float]]:
         """The state as the four arrays of ``[initial]``."""
@@ -100,4 +102,5 @@ def orbit(
         grazings=grazings,
         point_amplitude=point_amplitude,
         moment_amplitude=moment_amplitude,
+        periods=periods,
     )

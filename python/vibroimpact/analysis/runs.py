@@ -204,7 +204,8 @@ class Runner:
         state), ``impacts`` and ``grazings`` (the compiled core's ``tangent_map``); and
         ``parameters``, the derivatives of the end state by each parameter of
         ``parameters`` (one column each, at fixed ``t_end``), each given as the
-        runners of the system made at ``p + delta`` and ``p - delta``, and ``delta``:
+        runners of the system made at ``p + delta`` and ``p - delta`` (or at ``p`` and
+        ``p +- 2 delta``, one-sided at a parameter's bound), and ``delta``:
         carried by the tangent flow beside the map (the forward sensitivity
         equations, the rates' and gaps' own quotients between the two systems, see
         ``core::analysis::tangent::parameters``)."""

@@ -27,6 +27,7 @@ from vibroimpact.analysis.orbits import Orbit, orbit
 from vibroimpact.analysis.parameters import with_parameter, with_parameter_path_check
 from vibroimpact.analysis.runs import Runner, runner
 from vibroimpact.analysis.steady import SteadyState
+from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 
 #: The parameter's step in the differences, relative to its value (absolute where the
@@ -91,15 +92,24 @@ def orbit_derivatives(
     found: Orbit,
     paths: Sequence[str],
     *,
-    periods: int = 1,
+    periods: int | None = None,
     base_dir: Path | None = None,
 ) -> dict[str, Derivative]:
-    """The derivatives of the ``periods``-period orbit ``found`` (of the scenario
-    ``data``) in each parameter of ``paths`` (dotted paths such as
-    ``"damper.0.clearance"``), by the implicit function theorem on the shooting
-    equations (see the module). The orbit must have converged."""
+    """The derivatives of the orbit ``found`` (of the scenario ``data``; its
+    ``periods``, which ``periods`` must equal where given) in each parameter of ``paths``
+    (dotted paths such as ``"damper.0.clearance"``), by the implicit function theorem on
+    the shooting equations (see the module). The orbit must have converged. At a
+    parameter's bound (a gap of 0, a restitution of 1) the differences are one-sided."""
     data, base_dir = sections_of(data, base_dir)
     arguments.instance("found", found, Orbit, "vibroimpact.analysis.orbit(...)")
+    if periods is not None and periods != found.periods:
+        # The monodromy is over the orbit's own periods: a map over others would pair
+        # with it into a wrong answer.
+        raise AnalysisError(
+            f"periods: the orbit found closes after {found.periods} forcing period(s) "
+            f"(its monodromy is over those), got {shown(periods)}: leave periods out"
+        )
+    periods = found.periods
     if not found.converged:
         raise UndefinedDerivativeError(
             "found: the orbit did not converge; its derivatives are not defined"
@@ -108,25 +118,44 @@ def orbit_derivatives(
     out: dict[str, Derivative] = {}
     size = len(found.state)
     base = runner(data, base_dir)
-    shifted: list[tuple[Runner, Runner, float]] = []
-    for path in paths:
-        value = _value_of(data, path)
-        h = RELATIVE_STEP * (abs(value) if value else 1.0)
-        up, down = (runner(with_parameter(data, path, value + s * h), base_dir) for s in (1, -1))
-        shifted.append((up, down, h))
+    sides = [_sides(data, path, base, base_dir) for path in paths]
+    shifted = [(up, down, (s_up - s_down) / 2) for (up, s_up), (down, s_down) in sides]
     map_by = map_derivatives(base, found.state, periods, shifted)
     n, d = base.n, base.n + base.k
     structure = [*range(n), *range(d, d + n)]
-    for column, (path, (*runs, h)) in enumerate(zip(paths, shifted, strict=True)):
+    for column, (path, ends) in enumerate(zip(paths, sides, strict=True)):
         state = _orbit_shift(np.eye(size) - found.monodromy, map_by[:, column], structure)
         amplitudes = []
-        for sign, run in zip((1.0, -1.0), runs, strict=True):
-            recorded = run.periods(found.state + sign * h * state, periods, record=True)
+        for run, shift in ends:
+            recorded = run.periods(found.state + shift * state, periods, record=True)
             amplitudes.append(run.amplitudes(recorded))
+        width = ends[0][1] - ends[1][1]
         out[path] = Derivative(
-            state, *((up - down) / (2 * h) for up, down in zip(*amplitudes, strict=True))
+            state, *((up - down) / width for up, down in zip(*amplitudes, strict=True))
         )
     return out
+
+
+def _sides(
+    data: Mapping[str, Any], path: str, base: Runner, base_dir: Path | None
+) -> list[tuple[Runner, float]]:
+    """The runners of the differences in ``path``, above and below its value, each with
+    its shift from the value: ``+-h``, or 0 (the value's own runner, ``base``) on a side
+    where the parameter's range ends at its value (a one-sided difference)."""
+    value = _value_of(data, path)
+    h = RELATIVE_STEP * (abs(value) if value else 1.0)
+    sides: list[tuple[Runner, float]] = []
+    for shift in (h, -h):
+        try:
+            sides.append((runner(with_parameter(data, path, value + shift), base_dir), shift))
+        except ValueError:
+            sides.append((base, 0.0))
+    if sides[0][1] == sides[1][1]:
+        raise AnalysisError(
+            f"derivative {path}: the scenario takes no value beside {value!r} on either "
+            "side, so there is no derivative in it"
+        )
+    return sides
 
 
 def map_derivatives(
@@ -136,8 +165,8 @@ def map_derivatives(
     shifted: Sequence[tuple[Runner, Runner, float]],
 ) -> np.ndarray:
     """The derivatives of the stroboscopic map over ``periods`` forcing periods from
-    ``state`` by each parameter of ``shifted`` (its runners at ``p +- delta`` and
-    ``delta``), one column each: the tangent flow's columns at the fixed end, plus the
+    ``state`` by each parameter of ``shifted`` (its runners at two values ``2 delta``
+    apart and ``delta``), one column each: the tangent flow's columns at the fixed end, plus the
     end's rate times the move of the end where the parameter moves the period."""
     raw = run.tangent(state, periods * run.period, shifted)
     moved = np.array(
