@@ -79,6 +79,29 @@ def test_the_analyses_python_calls_refuse_what_their_sections_refuse() -> None:
             ),
             "second: must be another parameter than 'excitation.0.amplitude'",
         ),
+        # Targets the scenario cannot take ran to a corrector's or Newton's failure,
+        # which hid why (one took 9 s).
+        (
+            lambda: vi.continue_orbit(ball, "stop.0.restitution", stop=1.5),
+            "stop: must be a value the scenario takes (stop.0.restitution = 1.5: ",
+        ),
+        (
+            lambda: vi.continue_orbit(system, frequency, stop=-1.0),
+            "stop: must be a value the scenario takes (excitation.0.frequency = -1: ",
+        ),
+        (
+            lambda: curve(
+                ball,
+                "flip",
+                "excitation.0.amplitude",
+                start=11.772,
+                stop=17.0,
+                second="stop.0.restitution",
+                second_stop=1.5,
+                step=0.1,
+            ),
+            "second_stop: must be a value the scenario takes (",
+        ),
     ]
     for call, said in cases:
         with pytest.raises(AnalysisError) as err:

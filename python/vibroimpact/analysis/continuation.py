@@ -153,6 +153,12 @@ def continue_orbit(
     )
     arc = _Arc(data, parameter, periods, tolerance, base_dir, span, shiftable=shiftable)
     first_run = arc.run_at(start_value)
+    try:
+        # A target the scenario cannot take is refused, not followed until a corrector
+        # fails there with a message that hides why.
+        arc.run_at(stop)
+    except AnalysisError as err:
+        raise AnalysisError(f"stop: must be a value the scenario takes ({err})") from None
     first = orbit(first_run, periods=periods, tolerance=tolerance)
     if not first.converged:
         raise AnalysisError(
