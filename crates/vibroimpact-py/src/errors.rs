@@ -63,7 +63,8 @@ pub(crate) fn to_py(err: core::Error) -> PyErr {
 
 /// Runs `work` with the GIL released, giving it a question to ask now and
 /// then: has Ctrl-C been pressed? An interruption becomes the Python
-/// exception (KeyboardInterrupt) that caused it; other errors map by kind.
+/// exception (KeyboardInterrupt) that caused it, even where the work ended
+/// all the same; other errors map by kind.
 pub(crate) fn released<T, F>(py: Python<'_>, work: F) -> PyResult<T>
 where
     T: Send,
@@ -79,12 +80,14 @@ where
             }
         })
     });
-    match result {
-        Ok(value) => Ok(value),
-        Err(core::Error::Interrupted { .. }) if signal.is_some() => {
-            Err(signal.take().expect("checked"))
-        }
-        Err(e) => Err(to_py(e)),
+    // A signal seen is the caller's stop whatever the work's end: checking
+    // ran its handler, so Python will not see it again (a study's watcher may
+    // see it after the last run has finished; taken as a result, the study
+    // had gone on to write over the earlier output).
+    match (signal, result) {
+        (Some(stop), _) => Err(stop),
+        (None, Ok(value)) => Ok(value),
+        (None, Err(e)) => Err(to_py(e)),
     }
 }
 

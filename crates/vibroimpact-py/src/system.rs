@@ -4,6 +4,7 @@
 //! results returned as flat NumPy arrays for the Python side to shape.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::RecvTimeoutError;
 use std::time::Duration;
 
 use numpy::IntoPyArray;
@@ -655,10 +656,15 @@ pub fn run_study<'py>(
         // The runs go on the study's threads, where Python's signals cannot be
         // seen: this thread watches them and raises a flag every run checks
         // (between its steps), so Ctrl-C stops the chunk within moments.
+        // The worker says when it ends, so that a short chunk is not held for
+        // the rest of the watcher's 20 ms.
         let stop = AtomicBool::new(false);
+        let (ended, end) = std::sync::mpsc::channel::<()>();
         std::thread::scope(|scope| {
             let worker = scope.spawn(|| {
-                study(
+                // Moved in: dropped if the study panics, which ends the wait too.
+                let ended = ended;
+                let result = study(
                     &system_spec,
                     &initial,
                     &parameters,
@@ -666,10 +672,12 @@ pub fn run_study<'py>(
                     &settings,
                     threads,
                     &|| stop.load(Ordering::Relaxed),
-                )
+                );
+                // The watcher may have left already (a receiver gone): nothing to tell.
+                let _ = ended.send(());
+                result
             });
-            while !worker.is_finished() {
-                std::thread::sleep(Duration::from_millis(20));
+            while let Err(RecvTimeoutError::Timeout) = end.recv_timeout(Duration::from_millis(20)) {
                 if !stop.load(Ordering::Relaxed) && interrupt() {
                     stop.store(true, Ordering::Relaxed);
                 }

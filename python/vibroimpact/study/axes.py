@@ -24,16 +24,27 @@ _AXIS = {
 
 def _check_path(where: str, path: str) -> None:
     """Refuse a dotted path whose index is not a whole number from 0 (``-1``, ``+1``):
-    Python would read a negative one from the end."""
+    Python would read a negative one from the end; or is written with leading zeros
+    (``00``): a second spelling of a path would make a second axis of one parameter."""
     for part in path.split(".")[1:]:
-        if part.lstrip("+-").isdigit() and not (part.isascii() and part.isdigit()):
-            raise StudyError(f"{where}{part!r}: an index is a whole number from 0")
+        if part.lstrip("+-").isdigit() and not (
+            part.isascii() and part.isdigit() and str(int(part)) == part
+        ):
+            raise StudyError(
+                f"{where}{part!r}: an index is a whole number from 0, without leading zeros"
+            )
+
+
+def _listed(spec: Any) -> Any:
+    """An axis given as a numpy array (from Python) as the list a file gives."""
+    return spec.tolist() if isinstance(spec, np.ndarray) and spec.ndim == 1 else spec
 
 
 def _axis_count(path: str, spec: Any) -> int:
     """The number of values of an axis, checked (and a seed axis's values) without
     making them."""
     where = f"[study.axes] {path!r}: "
+    spec = _listed(spec)
     if not isinstance(spec, Mapping):
         return len(_axis_values(path, spec))
     axis = _table(where, spec, _AXIS)
@@ -138,6 +149,7 @@ def _tidy(values: np.ndarray) -> np.ndarray:
 
 def _axis_values(path: str, spec: Any) -> np.ndarray:
     where = f"[study.axes] {path!r}: "
+    spec = _listed(spec)
     if isinstance(spec, Mapping):
         _axis_count(path, spec)
         axis = _table(where, spec, _AXIS)

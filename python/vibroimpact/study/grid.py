@@ -19,7 +19,7 @@ from vibroimpact.analysis.parameters import forcing_period, with_parameter
 from vibroimpact.analysis.runs import _prepare
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.study.beam_axes import beam_corners, resolve_beam_axes
-from vibroimpact.study.limits import StudyError, check_threads
+from vibroimpact.study.limits import StudyError, check_study_memory, check_threads
 from vibroimpact.study.settings import base_metrics, study_settings
 
 
@@ -152,15 +152,9 @@ def study_of(
     base_dir = arguments.directory("base_dir", base_dir)
     if "study" not in data:
         raise StudyError(f"{source}: a study needs a [study] section with [study.axes]")
-    settings = data["study"]
-    if (
-        "axes" in settings
-        and isinstance(settings["axes"], Mapping)
-        and all(isinstance(v, np.ndarray) for v in settings["axes"].values())
-    ):
-        checked = dict(settings)
-    else:
-        checked = study_settings(settings)
+    # Always checked: axes given as arrays (from Python) were once taken as checked,
+    # and a chunk size of 0 or an unknown metric failed after the runs.
+    checked = study_settings(data["study"])
     output = data.get("output")
     output = output if isinstance(output, Mapping) else {}
     for name in checked["metrics"]:
@@ -176,7 +170,18 @@ def study_of(
         checked["record_from"] = 0.0 if window is None else float(window)
     study = Study(dict(data), checked, source, base_dir)
     # The base scenario and every axis path are checked by a run of none.
-    study.run_chunk(range(0, 0))
+    shape = study.run_chunk(range(0, 0))
+    # Each structure coordinate, then each followed point and moment.
+    followed = sum(len(output.get(kind) or ()) for kind in ("points", "moments"))
+    check_study_memory(study.runs, int(shape["n"]) + followed, len(shape["pairs"]), source)
+    if checked["analysis"] == "run":
+        t_end = _prepare({k: v for k, v in data.items() if k != "study"}, base_dir).solver["t_end"]
+        if not checked["record_from"] < t_end:
+            # As a single run refuses it: every run would record nothing.
+            raise StudyError(
+                f"{source}: [study] record_from: must be before [solver] t_end "
+                f"({t_end!r} s), got {checked['record_from']!r}"
+            )
     if checked["analysis"] != "run":  # whole forcing periods
         try:
             check_axis_frequencies(data, checked["axes"], base_dir)

@@ -35,3 +35,36 @@ def check_threads(threads: Any, name: str) -> None:
 #: its metrics and their reasons are gathered in memory at the end (about 100 bytes a
 #: run and metric), and ten million runs are hours of computing already.
 MAX_STUDY_RUNS = 10_000_000
+
+
+def machine_memory() -> int | None:
+    """This machine's physical memory, bytes (None where the system does not say)."""
+    try:
+        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, OSError, ValueError):
+        return None
+
+
+#: The memory a study may plan for where the machine's is not known, bytes.
+UNKNOWN_MEMORY_LIMIT = 8 * 2**30
+
+
+def check_study_memory(runs: int, observed: int, pairs: int, where: str) -> None:
+    """Refuse a study whose results could not be held in memory: each run's metrics are
+    ``2 observed + pairs + 8`` numbers (peaks and mean squares of every observed
+    quantity, the pairs' energies, the scalars) and its status, held twice (the chunks'
+    parts and the Dataset made of them), against half of the machine's memory. The
+    count of runs alone (:data:`MAX_STUDY_RUNS`) let a study of 10 million runs, each
+    following 2,000 points and moments, start towards 650 GB."""
+    per_run = 8 * (2 * observed + pairs + 8) + 64
+    need = 2 * runs * per_run
+    memory = machine_memory()
+    limit = memory // 2 if memory else UNKNOWN_MEMORY_LIMIT
+    if need > limit:
+        of = f"half of this machine's {memory / 1e9:.3g} GB" if memory else f"{limit / 1e9:.3g} GB"
+        raise StudyError(
+            f"{where}: the study's results would take about {need / 1e9:.3g} GB of memory "
+            f"({runs:,} runs, each of {observed} observed quantities and {pairs} pair(s)), more "
+            f"than {of}; lower the axes' counts or the [output] points and moments, or split "
+            "the study"
+        )
