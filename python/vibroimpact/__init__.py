@@ -87,6 +87,7 @@ from vibroimpact.analysis import (
     steady_state,
     sweep,
 )
+from vibroimpact.arguments import KeywordError
 from vibroimpact.arguments import typed as _typed
 from vibroimpact.model import *  # noqa: F403  (the parts and System: model.__all__)
 from vibroimpact.model.load import load, loads
@@ -160,6 +161,7 @@ __all__ = [
     "ImpactDamper",
     "InitialState",
     "InvalidInputError",
+    "KeywordError",
     "NumericalBlowUpError",
     "RestitutionWarning",
     "Scenario",
