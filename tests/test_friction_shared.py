@@ -234,11 +234,63 @@ def test_a_study_whose_runs_drop_a_friction_element_keeps_every_pair(tmp_path: P
     ok = data["status"] == 0
     # damper.0.friction 0.5 is refused (static_friction 0.3 below it): those runs fail.
     assert int(ok.sum()) == 4
-    # The metric is the contacts' and impacts' losses: the walls' impacts take
-    # energy in every completed run, a friction element's stuck intervals none.
+    # The metric is the contacts' and impacts' losses and the friction elements'
+    # sliding: the walls' impacts take energy in every completed run, a friction
+    # element some where it has a force, and none where it has none.
     done = dissipated.where(ok)
     assert np.all(done.sel({"pair": "damper 0"}).values[ok.values] > 0.0)
-    for pair in ("damper 0 friction", "friction 0"):
-        assert np.all(done.sel({"pair": pair}).values[ok.values] == 0.0)
+    damper_friction = done.sel({"pair": "damper 0 friction", "damper.0.friction": 0.2})
+    assert np.all(damper_friction.values > 0.0)
+    assert np.all(done.sel({"pair": "damper 0 friction", "damper.0.friction": 0.0}).values == 0)
+    element = done.sel({"pair": "friction 0", "damper.0.friction": [0.0, 0.2]})
+    assert np.all(element.sel({"friction.0.normal_force": 0.0}).values == 0.0)
+    assert np.all(element.sel({"friction.0.normal_force": 2.0}).values > 0.0)
     failed = dissipated.sel({"damper.0.friction": 0.5})
     assert np.all(np.isnan(failed.values))
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("record_from", [0.0, 0.2])
+def test_a_studys_friction_energy_is_the_sliding_blocks_kinetic_energy(
+    tmp_path: Path, record_from: float
+) -> None:
+    """A 0.1 kg damper thrown at 1 m/s on a carrier too heavy to move (1e9 kg), in a
+    study over its friction coefficient: its element's energy_dissipated over the
+    recorded window is the block's kinetic energy lost while sliding, m (v(t0)^2 -
+    v(t1)^2) / 2, v falling at mu N / m to rest (closed form). It read 0 J: a stuck
+    interval, the element's only record, loses nothing, and the slides are in none."""
+    text = _THROWN + (
+        f'[study]\nanalysis = "run"\nrecord_from = {record_from}\n'
+        'metrics = ["energy_dissipated"]\n[study.axes]\n"damper.0.friction" = [0.1, 0.2]\n'
+    )
+    data = st.run(load_study(tmp_path / "study.toml", text), tmp_path / "out.nc", threads=1)
+    assert np.all(data["status"] == 0)
+    for mu in (0.1, 0.2):
+        speed = 1.0 - mu * 0.981 / 0.1 * record_from
+        lost = data["energy_dissipated"].sel({"pair": "damper 0 friction", "damper.0.friction": mu})
+        assert float(lost) == pytest.approx(0.5 * 0.1 * speed**2, rel=1e-7)
+
+
+_THROWN = """
+[structure]
+kind = "oscillator"
+mass = 1e9
+stiffness = 1e11
+damping = 0.0
+
+[[damper]]
+mass = 0.1
+at = 0
+clearance = 5.0
+law = "rigid"
+restitution = 0.5
+friction = 0.2
+normal_force = 0.981
+
+[initial]
+damper_velocity = [1.0]
+
+[solver]
+method = "exact"
+t_end = 2.0
+"""

@@ -24,7 +24,11 @@ _DESCRIPTIONS = {
     "peak": ("largest |displacement| of each structure coordinate, recorded", "m"),
     "rms": ("RMS displacement of each structure coordinate, recorded", "m"),
     "impacts": ("impacts and compliant contacts recorded (sticking not counted)", "1"),
-    "energy_dissipated": ("energy taken by each pair's contacts and impacts, recorded", "J"),
+    "energy_dissipated": (
+        "energy taken by each pair's contacts and impacts (a friction element's: its "
+        "sliding), recorded",
+        "J",
+    ),
     "amplitude": (
         "largest |displacement| of each structure coordinate over the recorded periods",
         "m",

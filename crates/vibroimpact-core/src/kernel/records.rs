@@ -9,7 +9,7 @@ use crate::kernel::clock::{Stop, STALLED_STEPS};
 use crate::kernel::events::SystemSolution;
 use crate::kernel::fixed;
 use crate::kernel::memory::{self, NoRoom, FIRST_ROWS};
-use crate::kernel::run::{poll_due, Run};
+use crate::kernel::run::{loss_slot, poll_due, Run};
 use crate::methods::steppers::SystemStepper;
 
 /// The longest a large system goes without asking whether to stop, s.
@@ -229,6 +229,12 @@ impl Run<'_> {
             self.energy.impact_loss,
         );
         let row = 2 * system.dim;
+        // The friction elements' losses over the window: at the end less at
+        // its start.
+        let at = loss_slot(system, 0);
+        for (loss, end) in self.reductions.window_losses.iter_mut().zip(&self.y[at..]) {
+            *loss = end - *loss;
+        }
         SystemSolution {
             time: self.time_rows,
             states: self.states,

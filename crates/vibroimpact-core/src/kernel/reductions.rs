@@ -58,6 +58,12 @@ pub struct Reductions {
     pub strobe: Vec<f64>,
     /// Times of the strobe rows (s).
     pub strobe_time: Vec<f64>,
+    /// Where the system has friction elements: each interaction's loss over
+    /// the recorded window (J, its contact-loss accumulator at the run's end
+    /// less that at the window's start, which a run holds here until its
+    /// end): a friction element's sliding loss, which no contact record
+    /// holds. Empty otherwise, or where the window did not start.
+    pub window_losses: Vec<f64>,
 }
 
 /// Monomial coefficients (in `theta` in [0, 1]) of the quintic Hermite

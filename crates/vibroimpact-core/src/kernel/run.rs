@@ -515,6 +515,16 @@ impl<'a> Run<'a> {
         fixed: bool,
     ) -> Result<bool> {
         let time = self.clock.time;
+        if self.reductions.recorded_time == 0.0
+            && self.reductions.window_losses.is_empty()
+            && self.system.has_friction()
+        {
+            // The window's first step: the friction elements' losses so far
+            // (sliding loses energy outside any contact's record).
+            let at = loss_slot(self.system, 0);
+            let count = self.modes.len();
+            self.reductions.window_losses = self.y[at..at + count].to_vec();
+        }
         reduce_step(
             self.system,
             stepper,

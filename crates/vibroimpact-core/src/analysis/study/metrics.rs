@@ -200,6 +200,7 @@ pub(super) fn metrics_of(
             energy[c.pair] += c.energy_dissipated;
         }
     }
+    add_friction_losses(system, sol, &mut energy);
     let (impacts_per_period, settled) = match settings.analysis {
         Analysis::SteadyState {
             settle,
@@ -239,5 +240,21 @@ pub(super) fn metrics_of(
         stable: f64::NAN,
         largest_multiplier: f64::NAN,
         largest_lyapunov: f64::NAN,
+    }
+}
+
+/// Each friction element's sliding loss over the recorded window (J) added to
+/// its pair's (a stuck interval, its contact record, loses nothing; the
+/// slides between are in no record). NaN where the window's start was not
+/// seen.
+fn add_friction_losses(system: &Assembly, sol: &SystemSolution, energy: &mut [f64]) {
+    if !system.has_friction() {
+        return;
+    }
+    let losses = &sol.reductions.window_losses;
+    for (i, it) in system.interactions.iter().enumerate() {
+        if it.law.is_friction() {
+            energy[it.pair] += losses.get(i).copied().unwrap_or(f64::NAN);
+        }
     }
 }
