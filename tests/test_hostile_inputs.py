@@ -63,7 +63,7 @@ def parse_error(text: str, base_dir: Path | None = None) -> str:
 
 
 def test_out_refuses_a_fifo_and_leaves_it_a_fifo(tmp_path: Path, run_cli: Cli) -> None:
-    fifo = tmp_path / "pipe"
+    fifo = tmp_path / "pipe.csv"
     os.mkfifo(fifo)
     done = run_cli("simulate", str(write(tmp_path, BASE)), "--out", str(fifo))
     refused(done, "--out", "not a regular file")

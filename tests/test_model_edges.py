@@ -82,6 +82,15 @@ def test_systems_reading_one_relative_record_name_in_two_folders_differ(
     assert again == system
     c = vi.simulate(again, method="dop853", t_end=0.2)
     assert np.array_equal(a.structure_displacement, c.structure_displacement)
+    # Loaded by a relative path, it reads its own record after a change of folder (it
+    # read the other folder's, no error), and two spellings of the path are one System.
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(tmp_path)
+        relative = vi.load(Path("here") / "shaken.toml")
+        assert relative == system == vi.load(Path("there/../here/shaken.toml"))
+        patch.chdir(there)
+        d = vi.simulate(relative, method="dop853", t_end=0.2)
+    assert np.array_equal(a.structure_displacement, d.structure_displacement)
     # Where no file is read, the folder does not matter.
     assert _oscillator(base_dir=here) == _oscillator(base_dir=there)
 
@@ -204,3 +213,16 @@ def test_an_initial_state_of_the_wrong_length_is_refused_when_the_system_is_buil
         vi.load(text)
     # The right lengths (or none) are taken.
     _oscillator(initial=vi.Initial(structure_displacement=[0.001], structure_velocity=[]))
+
+
+@pytest.mark.timeout(60)
+def test_a_text_longer_than_a_scenario_file_may_be_is_refused() -> None:
+    """A record of 300,000 samples gave 12 MB of text, which load() refuses (a scenario
+    file is at most 4 MiB): to_toml says so instead of writing what does not read back."""
+    times = np.linspace(0.0, 10.0, 300_000)
+    signal = vi.Recorded(time=times, value=np.sin(times))
+    system = _oscillator(excitations=[vi.Force(at=0, signal=signal)])
+    with pytest.raises(vi.InvalidInputError, match=r"^System.to_toml: the scenario would be 1"):
+        system.to_toml()
+    short = _oscillator(excitations=[vi.Force(at=0, signal=vi.Recorded(time=[0, 1], value=[0, 1]))])
+    assert vi.load(short.to_toml()) == short

@@ -552,7 +552,7 @@ def test_study_mistakes_found_by_a_new_user_exit_2(
 def test_a_study_into_a_missing_folder_is_refused(tmp_path: Path) -> None:
     out = tmp_path / "missing" / "r.nc"
     done = cli("study", str(scenario(tmp_path, BASE + STEADY)), "--out", str(out))
-    assert done.returncode == 2 and "cannot write" in done.stderr, done.stderr
+    assert done.returncode == 2 and "does not exist" in done.stderr, done.stderr
     assert not (tmp_path / "missing").exists()
 
 

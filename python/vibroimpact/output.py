@@ -6,6 +6,7 @@ neither imports the other.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import errno
 import json
@@ -88,11 +89,26 @@ def _regular_or_absent(path: Path) -> os.stat_result | None:
     return status
 
 
+def path_argument(text: str) -> Path:
+    """A command line's path (argparse's ``type``): an empty one is refused (an unset
+    shell variable: ``--out ""`` was the current folder, and ``paper`` wrote there)."""
+    if not text:
+        raise argparse.ArgumentTypeError("an empty path (give a file or folder name)")
+    return Path(text)
+
+
 def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
     """Refuse, before anything runs, an output ``path`` given as ``flag`` (such as
-    ``--out``) that exists and is not a regular file, or that is one of the ``inputs``
-    (the scenario file, a recorded signal's file: writing the output there would
-    replace it)."""
+    ``--out``) whose folder does not exist, that exists and is not a regular file, or
+    that is one of the ``inputs`` (the scenario file, a recorded signal's file: writing
+    the output there would replace it)."""
+    folder = path.parent
+    if not folder.is_dir():
+        # Said before the run, not after it (a long run was lost to a missing folder).
+        raise UsageError(
+            f"{flag} {path}: the folder {str(folder)!r} does not exist; create it or give "
+            "another path"
+        )
     try:
         status = _regular_or_absent(path)
     except UsageError:
@@ -121,6 +137,18 @@ def check_plot(path: Path, inputs: Sequence[Path] = ()) -> None:
     if path.suffix.lower() != ".png":
         raise UsageError(f"--plot {path}: plots are PNG images; give a file name ending in .png")
     check_output(path, "--plot", inputs)
+
+
+def check_csv(path: Path, inputs: Sequence[Path] = ()) -> None:
+    """Refuse, before anything runs, a ``--out`` history path that :func:`check_output`
+    refuses or that does not name a CSV file (the history's only format: ``r.nc`` was
+    written as CSV, which xarray could not open)."""
+    if path.suffix.lower() != ".csv":
+        raise UsageError(
+            f"--out {path}: the history is written as CSV; give a file name ending in .csv "
+            "(vibroimpact.simulate(...).to_xarray() gives a Dataset to write as NetCDF)"
+        )
+    check_output(path, "--out", inputs)
 
 
 # A temporary file or folder of ours beside TARGET: ".TARGET.PID-TOKEN.tmp" (being

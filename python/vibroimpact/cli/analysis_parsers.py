@@ -5,11 +5,11 @@ each runs is in :mod:`vibroimpact.cli.analysis_commands`."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 from vibroimpact.analysis import BIFURCATION_SAMPLES
 from vibroimpact.cli.tangent_commands import add_tangent_parsers
+from vibroimpact.output import path_argument
 
 
 def add_commands(sub: Any) -> None:
@@ -28,7 +28,9 @@ def add_commands(sub: Any) -> None:
             "displacement| over the orbit, m, per coordinate)."
         ),
     )
-    orbit_parser.add_argument("scenario", type=Path, help="scenario file (.toml, [structure])")
+    orbit_parser.add_argument(
+        "scenario", type=path_argument, help="scenario file (.toml, [structure])"
+    )
     orbit_parser.add_argument(
         "--periods", type=int, default=1, metavar="K", help="forcing periods of the orbit (1)"
     )
@@ -51,7 +53,7 @@ def add_commands(sub: Any) -> None:
     orbit_parser.add_argument("--json", action="store_true", help="print one JSON object")
     orbit_parser.add_argument(
         "--plot",
-        type=Path,
+        type=path_argument,
         metavar="FILE.png",
         help="plot the orbit's time history and phase portrait with its impacts marked",
     )
@@ -70,7 +72,9 @@ def add_commands(sub: Any) -> None:
             "structure's linear response without dampers and stops."
         ),
     )
-    sweep_parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [sweep]")
+    sweep_parser.add_argument(
+        "scenario", type=path_argument, help="scenario file (.toml) with [sweep]"
+    )
     sweep_parser.add_argument(
         "--derivative",
         action="append",
@@ -85,7 +89,7 @@ def add_commands(sub: Any) -> None:
     sweep_parser.add_argument("--json", action="store_true", help="print one JSON object")
     sweep_parser.add_argument(
         "--plot",
-        type=Path,
+        type=path_argument,
         metavar="FILE.png",
         help="plot the response against the parameter, with and without the dampers "
         "(with derivatives, d amplitude / d PATH beside it)",
@@ -126,11 +130,11 @@ def add_commands(sub: Any) -> None:
             "each impact's phase in the forcing period (rad) and speed (m/s)."
         ),
     )
-    sec.add_argument("scenario", type=Path, help="scenario file (.toml, [structure])")
+    sec.add_argument("scenario", type=path_argument, help="scenario file (.toml, [structure])")
     sec.add_argument("--settle", type=int, default=200, help="forcing periods to settle (200)")
     sec.add_argument("--periods", type=int, default=500, help="forcing periods sampled (500)")
     sec.add_argument("--json", action="store_true", help="print one JSON object")
-    sec.add_argument("--plot", type=Path, metavar="FILE.png", help="plot both sections")
+    sec.add_argument("--plot", type=path_argument, metavar="FILE.png", help="plot both sections")
 
     bas = sub.add_parser(
         "basins",
@@ -161,6 +165,6 @@ def add_commands(sub: Any) -> None:
 
 def _outputs(parser: argparse.ArgumentParser, scenario: str, plot: str) -> None:
     """The scenario argument, --json and --plot of an analysis command."""
-    parser.add_argument("scenario", type=Path, help=scenario)
+    parser.add_argument("scenario", type=path_argument, help=scenario)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--plot", type=Path, metavar="FILE.png", help=plot)
+    parser.add_argument("--plot", type=path_argument, metavar="FILE.png", help=plot)

@@ -9,6 +9,7 @@ interrupted. Errors are one line on stderr, never a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import math
 import os
@@ -35,9 +36,10 @@ from vibroimpact.cli.study_commands import run_study_command
 from vibroimpact.messages import short_numbers
 from vibroimpact.output import (
     UsageError,
-    check_output,
+    check_csv,
     finite_or_none,
     json_text,
+    path_argument,
     written_whole,
 )
 from vibroimpact.paper import run_paper
@@ -105,7 +107,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     paper.add_argument(
         "--out",
-        type=Path,
+        type=path_argument,
         default=Path("paper-results"),
         metavar="DIR",
         help="output folder (default: paper-results/)",
@@ -123,10 +125,10 @@ def _parser() -> argparse.ArgumentParser:
             "--json)."
         ),
     )
-    simulate.add_argument("scenario", nargs="?", type=Path, help="scenario file (.toml)")
+    simulate.add_argument("scenario", nargs="?", type=path_argument, help="scenario file (.toml)")
     simulate.add_argument(
         "--out",
-        type=Path,
+        type=path_argument,
         metavar="FILE.csv",
         help="write the time history to a CSV file (whole or not at all: a run that fails "
         "leaves an existing file as it was)",
@@ -196,7 +198,7 @@ def contact_lines(sol: Solution) -> list[str]:
 def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
     if args.out:
         # Nor the records it reads (user trial: --out replaced the accelerogram).
-        check_output(args.out, "--out", [args.scenario, *record_files(scenario)])
+        check_csv(args.out, [args.scenario, *record_files(scenario)])
         # Known before the run where its steps are fixed: refused before it starts.
         check_history_file(scenario.prepared, expected_rows(scenario.prepared))
     start = time.perf_counter()
@@ -218,7 +220,7 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
 
 def _simulate(args: argparse.Namespace) -> int:
     if args.out:
-        check_output(args.out, "--out", [args.scenario] if args.scenario else [])
+        check_csv(args.out, [args.scenario] if args.scenario else [])
     scenario = load_scenario(args.scenario) if args.scenario else paper_collision()
     keeps = (
         scenario.prepared.output["history"]
@@ -353,6 +355,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         # stdout at devnull so that Python's exit flush does not fail again.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as err:
+        # What the system refused (the output full: `--json > /dev/full`, a file size
+        # limit), said in one line as every error is; the run itself did not fail.
+        print(f"vibroimpact: error: {err.strerror or err}", file=sys.stderr)
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     finally:
         warnings.showwarning = shown
         for signum, handler in previous.items():

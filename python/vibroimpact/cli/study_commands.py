@@ -8,13 +8,19 @@ import shlex
 import sys
 import time
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from vibroimpact._core import InvalidInputError
-from vibroimpact.output import UsageError, check_output, check_plot, json_text, structure_needed
+from vibroimpact.output import (
+    UsageError,
+    check_output,
+    check_plot,
+    json_text,
+    path_argument,
+    structure_needed,
+)
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
 from vibroimpact.study import (
@@ -46,10 +52,10 @@ def add_command(sub: Any) -> None:
             "it stopped when run again, and gives the same file or store."
         ),
     )
-    parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [study]")
+    parser.add_argument("scenario", type=path_argument, help="scenario file (.toml) with [study]")
     parser.add_argument(
         "--out",
-        type=Path,
+        type=path_argument,
         required=True,
         metavar="RESULT.nc|RESULT.zarr",
         help="NetCDF 4 file (.nc) or Zarr store (.zarr; needs vibroimpact[zarr]) to write",
@@ -71,7 +77,7 @@ def add_command(sub: Any) -> None:
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
     parser.add_argument(
         "--plot",
-        type=Path,
+        type=path_argument,
         metavar="FILE.png",
         help="heat map of --metric over the axes --x and --y (the others reduced to their "
         "worst, the largest value), the optimum (smallest) marked",

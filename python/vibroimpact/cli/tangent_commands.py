@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 from typing import Any
 
 from vibroimpact.analysis import (
@@ -16,7 +15,7 @@ from vibroimpact.analysis import (
     lyapunov_runner,
     plots,
 )
-from vibroimpact.output import UsageError, json_text, structure_needed
+from vibroimpact.output import UsageError, json_text, path_argument, structure_needed
 from vibroimpact.scenario.system import SystemScenario
 from vibroimpact.scenario.two_mass import load_scenario
 from vibroimpact.units import with_units
@@ -37,7 +36,7 @@ def add_tangent_parsers(sub: Any) -> None:
             "averaged over [solver] t_end from [initial]."
         ),
     )
-    parser.add_argument("scenario", type=Path, help="scenario file (.toml, [structure])")
+    parser.add_argument("scenario", type=path_argument, help="scenario file (.toml, [structure])")
     parser.add_argument(
         "--settle", type=int, metavar="N", help="forcing periods settled first (100)"
     )
@@ -47,7 +46,7 @@ def add_tangent_parsers(sub: Any) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument(
         "--plot",
-        type=Path,
+        type=path_argument,
         metavar="FILE.png",
         help="plot each exponent's estimate against the time averaged over",
     )
@@ -65,11 +64,13 @@ def add_tangent_parsers(sub: Any) -> None:
             "[{values, state, floquet_multipliers}]."
         ),
     )
-    curve_parser.add_argument("scenario", type=Path, help="scenario file (.toml) with [curve]")
+    curve_parser.add_argument(
+        "scenario", type=path_argument, help="scenario file (.toml) with [curve]"
+    )
     curve_parser.add_argument("--json", action="store_true", help="print one JSON object")
     curve_parser.add_argument(
         "--plot",
-        type=Path,
+        type=path_argument,
         metavar="FILE.png",
         help="plot the curve in its plane, with the regions it bounds labelled",
     )

@@ -50,10 +50,15 @@ def load(source: str | os.PathLike[str]) -> System:
 
 def loads(text: str, source: str = "<scenario>", base_dir: Path | None = None) -> System:
     """The :class:`~vibroimpact.System` of a scenario's TOML text (see :func:`load`);
-    ``source`` names it in errors, ``base_dir`` is the folder of its recorded files."""
+    ``source`` names it in errors, ``base_dir`` is the folder of its recorded files
+    (kept absolute: a relative one would be read from wherever the run is made)."""
     arguments.text("text", text)
     arguments.text("source", source)
     base_dir = arguments.directory("base_dir", base_dir)
+    if base_dir is not None:
+        # Made absolute now: after a chdir, a relative folder read another folder's
+        # record (no contact, no error), and two spellings of one path compared unequal.
+        base_dir = Path(os.path.abspath(base_dir))
     data = read_toml(text, source)
     if "structure" not in data:
         return _two_mass(two_mass_scenario(data, source), data)

@@ -48,6 +48,7 @@ from vibroimpact.system import (
     prepare_system,
     system_spec,
 )
+from vibroimpact.system.schema import MAX_SCENARIO_BYTES
 
 _P = TypeVar("_P", bound=Part)
 
@@ -244,7 +245,16 @@ class System:
                 solver=self.solver if solver is None else solver,
                 output=self.output if output is None else output,
             )
-        return toml_text(system.to_dict())
+        text = toml_text(system.to_dict())
+        size = len(text.encode("utf-8"))
+        if size > MAX_SCENARIO_BYTES:
+            # load() refuses a file this large: the text would not read back.
+            raise InvalidInputError(
+                f"System.to_toml: the scenario would be {size / 2**20:.1f} MiB, more than "
+                f"the {MAX_SCENARIO_BYTES // 2**20} MiB a scenario file may be; keep a long "
+                "record in a CSV file (Recorded(file=...)) and name it"
+            )
+        return text
 
     def replace(self, **changes: Any) -> System:
         """A copy with ``changes`` (fields by name), checked as a new System."""

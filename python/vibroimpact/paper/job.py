@@ -293,6 +293,8 @@ def run_paper(out: Path) -> int:
     from vibroimpact.paper.plots import fig1, fig3, fig4, work_precision
 
     started = time.perf_counter()
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {out}: is a file; --out is the folder the results go into")
     try:
         out.mkdir(parents=True, exist_ok=True)
         probe = out / ".write-test"

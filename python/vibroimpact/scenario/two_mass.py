@@ -30,6 +30,7 @@ from vibroimpact._core import (
     simulate,
 )
 from vibroimpact.scenario.system import SECTIONS, SystemScenario, system_scenario
+from vibroimpact.system.schema import MAX_SCENARIO_BYTES
 
 
 class ScenarioError(InvalidInputError):
@@ -43,9 +44,6 @@ _BOOLEAN = "boolean"
 # TOML integers are 64-bit: "If an integer cannot be represented losslessly, an
 # error must be thrown" (TOML 1.0). Python's parser reads any size, so we check.
 _TOML_INTEGERS = range(-(2**63), 2**63)
-# A scenario is a few kB; a cap keeps a wrong path (a disk image, /dev/zero) from
-# filling the memory, and bounds the parse (tomllib reads about 1 MiB/s).
-MAX_SCENARIO_BYTES = 4 * 2**20
 # Values quoted in error messages are cut short: an error is one line.
 _SHORT = reprlib.Repr()
 _SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxdict = 2, 4, 4

@@ -27,6 +27,9 @@ def output_kind(out: Path) -> str:
     kind = out.suffix.lower()
     if kind not in OUTPUTS:
         allowed = " or ".join(f"{suffix} ({what})" for suffix, what in OUTPUTS.items())
+        if out.name.lower() in OUTPUTS:
+            # ".nc" alone is a hidden file's name, with no suffix.
+            raise UsageError(f"--out {out}: needs a name before its suffix (such as study.nc)")
         raise UsageError(f"--out {out}: must end in {allowed}")
     if kind == ".nc" and (missing := netcdf4_missing()) is not None:
         raise UsageError(f"--out {out}: {missing}")

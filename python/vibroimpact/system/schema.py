@@ -76,6 +76,11 @@ from vibroimpact.system.beam import DIMENSIONS, resolve_cantilever
 from vibroimpact.system.points import _check_point, structure_coordinates
 from vibroimpact.system.record_file import check_record, read_record
 
+#: The largest scenario file read, bytes. A scenario is a few kB; a cap keeps a wrong
+#: path (a disk image, /dev/zero) from filling the memory, and bounds the parse
+#: (tomllib reads about 1 MiB/s).
+MAX_SCENARIO_BYTES = 4 * 2**20
+
 #: A 0.2 scenario's sections of the system and its run, in the order they are written.
 RUN_SECTIONS = (
     "structure",

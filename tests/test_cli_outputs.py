@@ -1,0 +1,79 @@
+"""The command line's outputs at their edges (a new user's trial): a history is CSV and
+its name says so, a missing folder is said before the run, an empty path is no path,
+``paper --out`` is a folder, a study's ``.nc`` alone is a name, and a write the system
+refuses (a full device) is one line, not a traceback."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from test_hostile_inputs import BASE, Cli, refused, write
+
+
+def test_a_history_is_csv_and_its_name_must_say_so(tmp_path: Path, run_cli: Cli) -> None:
+    # r.nc and r.zarr were written as CSV, which xarray could not open.
+    scenario = write(tmp_path, BASE)
+    for name in ("r.nc", "r.zarr", "r"):
+        refused(run_cli("simulate", str(scenario), "--out", name), f"--out {name}", "CSV", ".csv")
+        assert not (tmp_path / name).exists()
+    done = run_cli("simulate", str(scenario), "--out", "r.csv")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "r.csv").read_text().startswith("t,")
+
+
+def test_a_missing_folder_is_said_before_the_run(tmp_path: Path, run_cli: Cli) -> None:
+    # It was said after the whole run, which a long run lost.
+    scenario = write(tmp_path, BASE.replace("t_end = 0.2", "t_end = 1e6"))
+    done = run_cli("simulate", str(scenario), "--out", "nodir/x.csv", timeout=20)
+    refused(done, "--out nodir/x.csv: the folder 'nodir' does not exist")
+    sweep = BASE + '[sweep]\nparameter = "excitation.0.frequency"\nstart = 9.0\nstop = 11.0\n'
+    done = run_cli("sweep", str(write(tmp_path, sweep, "w.toml")), "--plot", "nodir/w.png")
+    refused(done, "--plot nodir/w.png: the folder 'nodir' does not exist")
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("paper", "--out", ""),
+        ("simulate", "", "--json"),
+        ("simulate", "s.toml", "--out", ""),
+        ("study", "s.toml", "--out", ""),
+    ],
+)
+def test_an_empty_path_is_refused(tmp_path: Path, run_cli: Cli, args: tuple[str, ...]) -> None:
+    # An unset shell variable: paper --out "" wrote its seven files into the current
+    # folder, replacing a report.md there.
+    write(tmp_path, BASE)
+    (tmp_path / "report.md").write_text("mine")
+    refused(run_cli(*args), "an empty path")
+    assert (tmp_path / "report.md").read_text() == "mine"
+
+
+def test_paper_out_is_a_folder_and_a_studys_out_a_name(tmp_path: Path, run_cli: Cli) -> None:
+    (tmp_path / "afile").write_text("mine")
+    refused(run_cli("paper", "--out", "afile"), "--out afile: is a file; --out is the folder")
+    assert (tmp_path / "afile").read_text() == "mine"
+    study = write(tmp_path, BASE + '[study]\n[study.axes]\n"damper.0.clearance" = [0.005]\n')
+    refused(run_cli("study", str(study), "--out", ".nc"), "--out .nc: needs a name before")
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
+def test_a_full_output_is_one_line(tmp_path: Path) -> None:
+    # --json > /dev/full ended in a traceback (OSError: No space left on device).
+    scenario = write(tmp_path, BASE)
+    with open("/dev/full", "w") as full:
+        done = subprocess.run(
+            [sys.executable, "-m", "vibroimpact", "simulate", str(scenario), "--json"],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=50,
+            check=False,
+        )
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert done.stderr.strip() == "vibroimpact: error: No space left on device"
