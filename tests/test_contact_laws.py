@@ -142,6 +142,18 @@ def test_hertz_damped_force_rebounds_two_bodies_at_e(e: float) -> None:
     assert contact.law_force(-1e-3, 0.05, 0.1) == 0.0
 
 
+@pytest.mark.parametrize("gap", [1e-6, 1e-9])
+def test_hertz_damped_rebounds_at_e_within_a_billionth_of_elastic(gap: float) -> None:
+    """Its hysteresis was the root of a relation summed in closed form, whose sign near
+    e = 1 was round-off: e = 1 - 1e-9 rebounded at 1 - 2.8e-13, losing nothing. The
+    rebound of the law's force (SciPy, 1e-12) loses 1 - e of the speed."""
+    e = 1.0 - gap
+    contact = vi.Contact("hertz-damped", stiffness=1e6, restitution=e)
+    rebound = rebound_of_law_force(contact, 0.2, 1.0)
+    assert (1.0 - rebound) == pytest.approx(1.0 - e, rel=1e-2)
+    assert 1.0 - contact.effective_restitution == pytest.approx(1.0 - e, rel=1e-6)
+
+
 @pytest.mark.parametrize("e", [0.1, 0.5, 0.9])
 def test_hyster_hertz_force_rebounds_two_bodies_above_e(e: float) -> None:
     """The paper's law rebounds at the relation's root for alpha = 3/4 (1 - e^2)."""

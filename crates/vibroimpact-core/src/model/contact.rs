@@ -156,16 +156,55 @@ fn hysteresis_for(restitution: f64) -> f64 {
     if e >= 1.0 {
         return 0.0;
     }
+    if e > NEAR_ELASTIC {
+        // The root is below 0.2: the relation's series, divided by alpha^2.
+        return bisect(0.0, 0.5, |a| relation_series(a, e) > 0.0);
+    }
     // f > 0 on (0, root) (f ~ alpha^2 (1 - e^2)/2 near 0) and f -> -inf at 1/e;
     // log1p keeps f's sign right for small alpha.
     let f = |a: f64| a * (1.0 + e) - ((a).ln_1p() - (-a * e).ln_1p());
-    let (mut lo, mut hi) = (0.0_f64, 1.0 / e);
+    bisect(0.0, 1.0 / e, |a| f(a) > 0.0)
+}
+
+/// Above this restitution the relation is summed as its series
+/// ([`relation_series`]): its closed form is a difference of terms of order
+/// `alpha` whose value is of order `alpha^3 (1 - e)`, and near e = 1 its sign
+/// was round-off (a hertz-damped law at e = 1 - 1e-9 rebounded at 1 - 3e-13).
+const NEAR_ELASTIC: f64 = 0.9;
+
+/// The relation `alpha (1 + e) - ln((1 + alpha)/(1 - alpha e))` over
+/// `alpha^2`, as its series `sum over n >= 2 of alpha^(n-2) ((-1)^n - e^n) / n`
+/// (for `alpha` in [0, 1/2] and `e` in [1/2, 1): each term below `2^-(n-2)`),
+/// with `1 - e^n` summed as `(1 - e)(1 + e + ... + e^(n-1))`, free of
+/// cancellation near `e = 1`.
+fn relation_series(alpha: f64, e: f64) -> f64 {
+    let delta = 1.0 - e; // exact for e in [1/2, 1]
+    let (mut sum, mut power) = (0.0, 1.0);
+    // 1 + e + ... + e^(n-1) and e^n, for n = 2.
+    let (mut geometric, mut e_n) = (1.0 + e, e * e);
+    for n in 2..64 {
+        let c = if n % 2 == 0 {
+            delta * geometric
+        } else {
+            -(1.0 + e_n)
+        };
+        sum += power * c / f64::from(n);
+        power *= alpha;
+        geometric += e_n;
+        e_n *= e;
+    }
+    sum
+}
+
+/// The point of `(lo, hi)` where `above` turns from true to false, to the
+/// last bit.
+fn bisect(mut lo: f64, mut hi: f64, above: impl Fn(f64) -> bool) -> f64 {
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             break;
         }
-        if f(mid) > 0.0 {
+        if above(mid) {
             lo = mid;
         } else {
             hi = mid;
@@ -186,21 +225,18 @@ fn ratio_for(hysteresis: f64) -> f64 {
     if a <= 0.0 {
         return 1.0;
     }
-    let f = |e: f64| a * (1.0 + e) - (a.ln_1p() - (-a * e).ln_1p());
-    let (mut lo, mut hi) = (0.0_f64, (1.0_f64).min(1.0 / a));
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if f(mid) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
+    if a < NEAR_ELASTIC_HYSTERESIS {
+        // The ratio is above 0.9: the relation's series (see hysteresis_for).
+        return bisect(0.5, 1.0, |e| relation_series(a, e) > 0.0);
     }
-    0.5 * (lo + hi)
+    let f = |e: f64| a * (1.0 + e) - (a.ln_1p() - (-a * e).ln_1p());
+    bisect(0.0, (1.0_f64).min(1.0 / a), |e| f(e) > 0.0)
 }
+
+/// Below this hysteresis the rebound ratio is above 0.9 (the hysteresis of
+/// [`NEAR_ELASTIC`] is about 0.15), where the relation is summed as its
+/// series.
+const NEAR_ELASTIC_HYSTERESIS: f64 = 0.1;
 
 /// Below this approach rate (m/s) a contact is a graze and the damping term,
 /// which divides by the approach rate, is left out.
@@ -597,6 +633,41 @@ pub(crate) mod tests {
             Err(Error::InvalidParameter { field, .. }) => field,
             other => panic!("expected an invalid parameter, got {other:?}"),
         }
+    }
+
+    /// Near e = 1 the hysteresis follows the relation's expansion,
+    /// `alpha = 3 (1 - e^2) / (2 (1 + e^3))` to first order in `1 - e` (from
+    /// `alpha^2 (1 - e^2)/2 - alpha^3 (1 + e^3)/3 + O(alpha^4) = 0`), and the
+    /// rebound ratio of that hysteresis is e again. Summed in closed form, the
+    /// relation's sign was round-off there: e = 1 - 1e-9 gave a law that
+    /// rebounded at 1 - 3e-13.
+    #[test]
+    fn near_elastic_hysteresis_follows_the_relations_expansion() {
+        crate::testing::timeout(10, || {
+            for gap in [1e-4, 1e-6, 1e-8, 1e-9, 1e-12, 1e-15] {
+                let e = 1.0 - gap;
+                let delta = 1.0 - e; // (exact)
+                let alpha = exact_hysteresis(e).unwrap();
+                let first = 3.0 * (1.0 - e * e) / (2.0 * (1.0 + e * e * e));
+                // The next order is alpha's own size (about 1.5 delta) relative.
+                assert!(
+                    (alpha / first - 1.0).abs() < 3.0 * delta,
+                    "{delta}: {alpha} vs {first}"
+                );
+                let back = rebound_ratio(alpha).unwrap();
+                // To the doubles' spacing near 1.
+                assert!(
+                    ((1.0 - back) - delta).abs() < 4.0 * f64::EPSILON,
+                    "{delta}: {back}"
+                );
+            }
+            // Either side of the switch to the series, one relation.
+            let (below, above) = (
+                exact_hysteresis(0.9).unwrap(),
+                exact_hysteresis(0.9 + 1e-12),
+            );
+            assert!((below - above.unwrap()).abs() < 1e-10);
+        });
     }
 
     #[test]
