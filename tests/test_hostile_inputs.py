@@ -71,8 +71,11 @@ def test_out_refuses_a_fifo_and_leaves_it_a_fifo(tmp_path: Path, run_cli: Cli) -
 
 
 def test_out_refuses_a_folder(tmp_path: Path, run_cli: Cli) -> None:
-    refused(run_cli("simulate", str(write(tmp_path, BASE)), "--out", str(tmp_path)), "--out")
-    assert tmp_path.is_dir()
+    folder = tmp_path / "x.csv"
+    folder.mkdir()
+    done = run_cli("simulate", str(write(tmp_path, BASE)), "--out", str(folder))
+    refused(done, "--out", "not a regular file")
+    assert folder.is_dir()
 
 
 def test_out_refuses_the_scenario_file_itself(tmp_path: Path, run_cli: Cli) -> None:

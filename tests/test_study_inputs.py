@@ -150,7 +150,26 @@ def test_a_study_whose_results_would_not_fit_in_memory_is_refused(tmp_path: Path
     said = str(err.value)
     assert "the study's results would take about 291 GB of memory (9,000,000 runs" in said
     assert "1002 observed quantities and 1 pair(s)" in said and "split the study" in said
-    # A tenth of the points in a hundredth of the runs is a study.
+    # A tenth of the points in a ten-thousandth of the runs is a study.
     few = ", ".join(f"{0.5 * i / 99:.6f}" for i in range(100))
-    small = text.replace(f"[{points}]", f"[{few}]").replace("count = 3000", "count = 300")
-    assert load_study(tmp_path / "small.toml", small).runs == 90_000
+    small = text.replace(f"[{points}]", f"[{few}]").replace("count = 3000", "count = 30")
+    assert load_study(tmp_path / "small.toml", small).runs == 900
+
+
+def test_points_given_as_an_array_count_in_the_memory_bound(tmp_path: Path) -> None:
+    # Sections built in Python may hold [output] points as a numpy array, which the
+    # bound's count took for a truth value (numpy's 'ambiguous' error).
+    from test_study_beam_axes import BEAM, RECTANGLE
+
+    data = vi.load(write_text(tmp_path, BEAM.format(section=RECTANGLE))).to_dict()
+    data["output"] = {"points": np.array([0.25, 0.5]), "record_from": 0.0}
+    data["study"] = {"axes": {"damper.0.clearance": [4e-4, 5e-4]}, "metrics": ["point_peak"]}
+    study = st.study_of(data)
+    assert study.runs == 2
+    assert st.chunk_part(study, 0, 2, threads=1)["peak"].shape == (2 * (2 + 2),)
+
+
+def write_text(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "beam.toml"
+    path.write_text(text)
+    return path

@@ -108,12 +108,12 @@ def curve(
         # curve, but the search reported one.
         raise AnalysisError(f"second: must be another parameter than {parameter!r}")
     s0 = _value_of(data, second)
+    at_start = with_parameter(data, parameter, start)
     try:
         # As continue_orbit's stop: a target the scenario cannot take is refused.
-        runner(with_parameter(data, second, second_stop), base_dir)
+        runner(with_parameter(at_start, second, second_stop), base_dir)
     except ValueError as err:
         raise AnalysisError(f"second_stop: must be a value the scenario takes ({err})") from None
-    at_start = with_parameter(data, parameter, start)
     branch = continue_orbit(
         at_start,
         parameter,

@@ -358,7 +358,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as err:
         # What the system refused (the output full: `--json > /dev/full`, a file size
         # limit), said in one line as every error is; the run itself did not fail.
-        print(f"vibroimpact: error: {err.strerror or err}", file=sys.stderr)
+        where = f"{err.filename}: " if err.filename else ""
+        print(f"vibroimpact: error: {where}{err.strerror or err}", file=sys.stderr)
+        _print_notes(err)
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1

@@ -58,7 +58,7 @@ def loads(text: str, source: str = "<scenario>", base_dir: Path | None = None) -
     if base_dir is not None:
         # Made absolute now: after a chdir, a relative folder read another folder's
         # record (no contact, no error), and two spellings of one path compared unequal.
-        base_dir = Path(os.path.abspath(base_dir))
+        base_dir = base_dir.resolve()
     data = read_toml(text, source)
     if "structure" not in data:
         return _two_mass(two_mass_scenario(data, source), data)

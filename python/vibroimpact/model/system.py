@@ -5,6 +5,7 @@ initial state, checked by the scenario format's one schema (:mod:`vibroimpact.sy
 from __future__ import annotations
 
 import copy
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -248,11 +249,13 @@ class System:
         text = toml_text(system.to_dict())
         size = len(text.encode("utf-8"))
         if size > MAX_SCENARIO_BYTES:
-            # load() refuses a file this large: the text would not read back.
-            raise InvalidInputError(
-                f"System.to_toml: the scenario would be {size / 2**20:.1f} MiB, more than "
-                f"the {MAX_SCENARIO_BYTES // 2**20} MiB a scenario file may be; keep a long "
-                "record in a CSV file (Recorded(file=...)) and name it"
+            # loads() reads it; load() of a file refuses one this large.
+            warnings.warn(
+                f"System.to_toml: the scenario is {size / 2**20:.1f} MiB, more than the "
+                f"{MAX_SCENARIO_BYTES // 2**20} MiB a scenario file may be: vibroimpact.load "
+                "refuses it saved as a file (loads reads the text); keep a long record in a "
+                "CSV file (Recorded(file=...))",
+                stacklevel=2,
             )
         return text
 

@@ -159,7 +159,7 @@ def study_of(
     output = output if isinstance(output, Mapping) else {}
     for name in checked["metrics"]:
         for kind in ("point", "moment"):
-            if name.startswith(f"{kind}_") and not output.get(f"{kind}s"):
+            if name.startswith(f"{kind}_") and not _count(output, f"{kind}s"):
                 raise StudyError(
                     f"[study] metrics: {name} needs [output] {kind}s (where to follow it)"
                 )
@@ -172,7 +172,7 @@ def study_of(
     # The base scenario and every axis path are checked by a run of none.
     shape = study.run_chunk(range(0, 0))
     # Each structure coordinate, then each followed point and moment.
-    followed = sum(len(output.get(kind) or ()) for kind in ("points", "moments"))
+    followed = _count(output, "points") + _count(output, "moments")
     check_study_memory(study.runs, int(shape["n"]) + followed, len(shape["pairs"]), source)
     if checked["analysis"] == "run":
         t_end = _prepare({k: v for k, v in data.items() if k != "study"}, base_dir).solver["t_end"]
@@ -188,6 +188,13 @@ def study_of(
         except InvalidInputError as err:
             raise StudyError(f"{source}: {err}") from None
     return study
+
+
+def _count(output: Mapping[str, Any], key: str) -> int:
+    """How many ``[output]`` ``key`` (points, moments) holds: a list, a tuple or a numpy
+    array (sections built in Python), or none."""
+    value = output.get(key)
+    return 0 if value is None else len(value)
 
 
 def check_axis_frequencies(

@@ -177,14 +177,12 @@ class _Rows:
 
 
 def _names_columns(line: str) -> bool:
-    """Whether the first line names the columns: a cell that is not a number and not
-    meant as one (``time``, ``El Centro 1940 NS``; ``0,1_0`` is a mistyped sample), and
-    a first cell that is not meant as one either (``0,100 # start`` is a sample with a
-    comment after it, which a header's rule had dropped without a word)."""
-    cells = _SEPARATOR.split(line)
-    return not _MEANT_AS_NUMBER.match(cells[0]) and any(
-        not _NUMBER.fullmatch(c) and not _MEANT_AS_NUMBER.match(c) for c in cells
-    )
+    """Whether the first line names the columns: a cell before any comment that is not
+    a number and not meant as one (``time``, ``El Centro 1940 NS``; ``0,1_0`` is a
+    mistyped sample, ``0,100 # start`` a sample with a comment after it, which the rule
+    had read as a header and dropped without a word)."""
+    cells = _SEPARATOR.split(line.split("#", 1)[0].strip())
+    return any(not _NUMBER.fullmatch(c) and not _MEANT_AS_NUMBER.match(c) for c in cells)
 
 
 def check_record(

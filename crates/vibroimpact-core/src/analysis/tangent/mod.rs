@@ -339,8 +339,9 @@ impl<'s> Tangent<'s> {
             return;
         }
         // At most the stretch's time over the fastest decay's, which the
-        // run's steps are already shorter than (bounded all the same).
-        let pieces = pieces.min(1e7);
+        // run's steps are already shorter than; bounded all the same (each
+        // piece is a product and a QR, with no poll for an interrupt here).
+        let pieces = pieces.min(1e6);
         let piece = tau / pieces;
         self.expm
             .compute(&self.flows[slot].1, piece, &mut self.factor);
