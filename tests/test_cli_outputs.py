@@ -77,3 +77,18 @@ def test_a_full_output_is_one_line(tmp_path: Path) -> None:
         )
     assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
     assert done.stderr.strip() == "vibroimpact: error: No space left on device"
+
+
+def test_a_start_inside_a_wall_names_the_file(tmp_path: Path, run_cli: Cli) -> None:
+    # Found when the run begins, the refusal named neither the file nor the keys' section.
+    root = Path(__file__).resolve().parents[1]
+    two_mass = (root / "examples" / "paper_collision.toml").read_text()
+    assert "impact_displacement = 0.01" in two_mass
+    path = write(
+        tmp_path, two_mass.replace("impact_displacement = 0.01", "impact_displacement = 0.5")
+    )
+    said = refused(run_cli("simulate", str(path)), f"{path}: the initial state", "inside the wall")
+    assert "impact_displacement" in said
+    inside = BASE + "[initial]\ndamper_displacement = [0.01]\n"
+    path = write(tmp_path, inside, "inside.toml")
+    refused(run_cli("simulate", str(path)), f"{path}: initial state: damper 0 starts", "wall")

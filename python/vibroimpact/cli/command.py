@@ -195,6 +195,15 @@ def contact_lines(sol: Solution) -> list[str]:
     return [*lines, f"  {ENERGY_DISSIPATED_TEXT}", f"  {ENERGY_CHANGE_TEXT}"]
 
 
+def _named(err: InvalidInputError, path: Path | None) -> ScenarioError:
+    """A run's refusal of its input (a start inside a wall, found when the run begins)
+    as the scenario's error, naming the file as a refusal when it is read does."""
+    text = str(err)
+    if path is None or text.startswith(f"{path}:"):
+        return ScenarioError(text)
+    return ScenarioError(f"{path}: {text}")
+
+
 def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
     if args.out:
         # Nor the records it reads (user trial: --out replaced the accelerogram).
@@ -205,7 +214,7 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
     try:
         sol = scenario.run()
     except InvalidInputError as err:
-        raise ScenarioError(str(err)) from None
+        raise _named(err, args.scenario) from None
     cpu_time = time.perf_counter() - start
     if args.out:
         write_system_history(args.out, sol, scenario.prepared)
@@ -235,7 +244,10 @@ def _simulate(args: argparse.Namespace) -> int:
     if isinstance(scenario, SystemScenario):
         return _simulate_system(args, scenario)
     start = time.perf_counter()
-    sol = scenario.run()
+    try:
+        sol = scenario.run()
+    except InvalidInputError as err:
+        raise _named(err, args.scenario) from None
     cpu_time = time.perf_counter() - start
     if args.out:
         write_history(args.out, sol)
