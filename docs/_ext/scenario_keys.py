@@ -269,7 +269,7 @@ SYSTEM = {
         ),
         "sweep": (None, '"linear" or "logarithmic"', '"sweep"\'s law of frequency'),
         "amplitudes": ("N (force) or m s-2 (base)", None, '"harmonics": one per term'),
-        "frequencies": ("Hz", "> 0", '"harmonics": one per amplitude'),
+        "frequencies": ("Hz", ">= 0", '"harmonics": one per amplitude (0: a constant term)'),
         "phases": ("rad", None, '"harmonics": one per amplitude (default 0)'),
         "file": (
             None,
@@ -381,7 +381,7 @@ ANALYSES = {
         "periods": ("1", "[1, 10000000]", "K: the orbit's period in forcing periods"),
         "step": ("the parameter's", "> 0", "the step along the branch, about (default chosen)"),
         "max_points": ("1", "[2, 100000]", "the most points the branch may have"),
-        "tolerance": ("1", "> 0", "the shooting's Newton tolerance on the orbit"),
+        "tolerance": ("1", "(0, 1)", "the shooting's Newton tolerance on the orbit"),
         "switch": (
             None,
             "true or false",
@@ -411,7 +411,7 @@ ANALYSES = {
         "step": ("the second's", "> 0", "the step in the second parameter (halved where needed)"),
         "periods": ("1", "[1, 10000000]", "K: the orbit's period in forcing periods"),
         "max_points": ("1", "[2, 100000]", "the most points the curve may have"),
-        "tolerance": ("1", "> 0", "the Newton tolerance on the orbit"),
+        "tolerance": ("1", "(0, 1)", "the Newton tolerance on the orbit"),
     },
     "basins": {
         "x": (None, "a table: state, start, stop, count", "the grid's first axis"),

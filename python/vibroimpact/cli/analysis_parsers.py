@@ -23,7 +23,8 @@ def add_commands(sub: Any) -> None:
             "prints whether it converged, "
             "the state on the orbit at t = 0 (the four arrays of [initial], SI), the Floquet "
             "multipliers (eigenvalues of the monodromy matrix: the tangent flow through the "
-            "impacts and contacts, or finite differences), stability, "
+            "impacts and contacts; finite differences from Python, "
+            'vibroimpact.orbit(..., jacobian="differences")), stability, '
             "impacts per forcing period and the amplitude (largest |structure "
             "displacement| over the orbit, m, per coordinate)."
         ),
