@@ -656,15 +656,16 @@ pub fn run_study<'py>(
         // The runs go on the study's threads, where Python's signals cannot be
         // seen: this thread watches them and raises a flag every run checks
         // (between its steps), so Ctrl-C stops the chunk within moments.
-        // The worker says when it ends, so that a short chunk is not held for
-        // the rest of the watcher's 20 ms.
+        // The worker's end closes a channel, so that a short chunk is not held
+        // for the rest of the watcher's 20 ms.
         let stop = AtomicBool::new(false);
         let (ended, end) = std::sync::mpsc::channel::<()>();
         std::thread::scope(|scope| {
             let worker = scope.spawn(|| {
-                // Moved in: dropped if the study panics, which ends the wait too.
-                let ended = ended;
-                let result = study(
+                // Moved in and dropped when the study returns (or panics), which
+                // ends the watcher's wait.
+                let _ended = ended;
+                study(
                     &system_spec,
                     &initial,
                     &parameters,
@@ -672,10 +673,7 @@ pub fn run_study<'py>(
                     &settings,
                     threads,
                     &|| stop.load(Ordering::Relaxed),
-                );
-                // The watcher may have left already (a receiver gone): nothing to tell.
-                let _ = ended.send(());
-                result
+                )
             });
             while let Err(RecvTimeoutError::Timeout) = end.recv_timeout(Duration::from_millis(20)) {
                 if !stop.load(Ordering::Relaxed) && interrupt() {

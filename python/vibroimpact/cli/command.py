@@ -195,13 +195,17 @@ def contact_lines(sol: Solution) -> list[str]:
     return [*lines, f"  {ENERGY_DISSIPATED_TEXT}", f"  {ENERGY_CHANGE_TEXT}"]
 
 
-def _named(err: InvalidInputError, path: Path | None) -> ScenarioError:
-    """A run's refusal of its input (a start inside a wall, found when the run begins)
-    as the scenario's error, naming the file as a refusal when it is read does."""
-    text = str(err)
-    if path is None or text.startswith(f"{path}:"):
-        return ScenarioError(text)
-    return ScenarioError(f"{path}: {text}")
+def _run(scenario: Scenario | SystemScenario, path: Path | None) -> Any:
+    """The scenario's run; its refusal of the input (a start inside a wall, found when
+    the run begins) as the scenario's error, naming the file as a refusal when it is
+    read does."""
+    try:
+        return scenario.run()
+    except InvalidInputError as err:
+        text = str(err)
+        if path is None or text.startswith(f"{path}:"):
+            raise ScenarioError(text) from None
+        raise ScenarioError(f"{path}: {text}") from None
 
 
 def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
@@ -211,10 +215,7 @@ def _simulate_system(args: argparse.Namespace, scenario: SystemScenario) -> int:
         # Known before the run where its steps are fixed: refused before it starts.
         check_history_file(scenario.prepared, expected_rows(scenario.prepared))
     start = time.perf_counter()
-    try:
-        sol = scenario.run()
-    except InvalidInputError as err:
-        raise _named(err, args.scenario) from None
+    sol = _run(scenario, args.scenario)
     cpu_time = time.perf_counter() - start
     if args.out:
         write_system_history(args.out, sol, scenario.prepared)
@@ -244,10 +245,7 @@ def _simulate(args: argparse.Namespace) -> int:
     if isinstance(scenario, SystemScenario):
         return _simulate_system(args, scenario)
     start = time.perf_counter()
-    try:
-        sol = scenario.run()
-    except InvalidInputError as err:
-        raise _named(err, args.scenario) from None
+    sol = _run(scenario, args.scenario)
     cpu_time = time.perf_counter() - start
     if args.out:
         write_history(args.out, sol)

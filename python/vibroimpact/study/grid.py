@@ -72,9 +72,13 @@ class Study:
         size = self.settings["chunk_size"]
         return [range(i, min(i + size, self.runs)) for i in range(0, self.runs, size)]
 
+    def prepared(self) -> Any:
+        """The base scenario prepared as a run of it is (its sections but ``[study]``)."""
+        return _prepare({k: v for k, v in self.data.items() if k != "study"}, self.base_dir)
+
     def run_chunk(self, runs: range, threads: int = 0) -> dict[str, Any]:
         """The raw metrics of the runs ``runs`` (flat indices into the grid)."""
-        prepared = _prepare({k: v for k, v in self.data.items() if k != "study"}, self.base_dir)
+        prepared = self.prepared()
         axes = list(self.settings["axes"].values())
         random = self.settings.get("random", {})
         index = np.unravel_index(np.arange(runs.start, runs.stop), self.shape)
@@ -175,7 +179,7 @@ def study_of(
     followed = _count(output, "points") + _count(output, "moments")
     check_study_memory(study.runs, int(shape["n"]) + followed, len(shape["pairs"]), source)
     if checked["analysis"] == "run":
-        t_end = _prepare({k: v for k, v in data.items() if k != "study"}, base_dir).solver["t_end"]
+        t_end = study.prepared().solver["t_end"]
         if not checked["record_from"] < t_end:
             # As a single run refuses it: every run would record nothing.
             raise StudyError(

@@ -248,9 +248,6 @@ pub(super) fn metrics_of(
 /// slides between are in no record). NaN where the window's start was not
 /// seen.
 fn add_friction_losses(system: &Assembly, sol: &SystemSolution, energy: &mut [f64]) {
-    if !system.has_friction() {
-        return;
-    }
     let losses = &sol.reductions.window_losses;
     for (i, it) in system.interactions.iter().enumerate() {
         if it.law.is_friction() {

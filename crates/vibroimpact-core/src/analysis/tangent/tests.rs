@@ -422,18 +422,11 @@ fn a_long_stretch_without_events_keeps_every_exponent() {
             (pair.unwrap(), vec![-4.0, -4.0, -15.0, -15.0]),
         ] {
             let spec = SystemSpec {
-                structure,
-                dampers: vec![],
-                collisions: vec![],
-                frictions: vec![],
-                stops: vec![],
-                gravity: 0.0,
                 excitations: vec![Excitation {
                     load: Load::Force { at: 0.0 },
                     signal: Signal::harmonic(1.0, 1.0, 0.0).unwrap(),
                 }],
-                points: vec![],
-                moments: vec![],
+                ..SystemSpec::of(structure, vec![])
             };
             let system = Assembly::new(&spec).unwrap();
             let y0 = initial_state(&system, &[], &[], &[], &[]).unwrap();
