@@ -9,6 +9,7 @@ __all__ = [
     "DEFAULT_ENERGY_TOLERANCE",
     "DEFAULT_MAX_ROWS",
     "MAX_PAIRS",
+    "MAX_PERIODS",
     "MAX_POINTS",
     "MAX_RECORD_BYTES",
     "MAX_SIGNAL_SAMPLES",
@@ -79,6 +80,8 @@ METHOD_OPTIONS: dict[str, dict[str, Any]]
 #: Each model kind's ("two-mass", "system") defaults: {"method", "fixed_by_default",
 #: "contact_timing"}.
 RUN_DEFAULTS: dict[str, dict[str, Any]]
+#: The most forcing periods one run of an analysis may settle and record in all.
+MAX_PERIODS: int
 
 _FloatArray = npt.NDArray[np.float64]
 

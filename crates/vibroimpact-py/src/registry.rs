@@ -59,6 +59,7 @@ pub(crate) fn add_registry(m: &Bound<'_, PyModule>) -> PyResult<()> {
         defaults.set_item(kind.name, entry)?;
     }
     m.add("RUN_DEFAULTS", defaults)?;
+    m.add("MAX_PERIODS", registry::MAX_PERIODS)?;
     // Internal (not in __all__): vibroimpact.system's checks call them.
     m.setattr("_check_run", wrap_pyfunction!(check_run, m)?)?;
     m.setattr("_check_settings", wrap_pyfunction!(check_settings, m)?)?;

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact import arguments
+from vibroimpact import _core, arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact.messages import shown
 
@@ -23,10 +23,11 @@ class AnalysisError(InvalidInputError):
 MAX_POINTS = 100_000
 #: The most starts of ``[basins]`` (``x.count`` times ``y.count``).
 MAX_STARTS = 1_000_000
-#: The most forcing periods one run of an analysis may settle or record: with a few
-#: impacts and tens of steps a period that is already minutes of computing, and every
-#: kept impact is memory; a longer run is a typo (1e12 for 1e2), refused before it starts.
-MAX_PERIODS = 10_000_000
+#: The most forcing periods one run of an analysis may settle or record (the core's
+#: registry): with a few impacts and tens of steps a period that is already minutes of
+#: computing, and every kept impact is memory; a longer run is a typo (1e12 for 1e2),
+#: refused before it starts.
+MAX_PERIODS: int = _core.MAX_PERIODS
 arguments.WHOLE_RANGES.update(
     settle_periods=(0, MAX_PERIODS),
     record_periods=(1, MAX_PERIODS),

@@ -173,11 +173,6 @@ def study_of(
         window = output.get("record_from")
         checked["record_from"] = 0.0 if window is None else float(window)
     study = Study(dict(data), checked, source, base_dir)
-    # The base scenario and every axis path are checked by a run of none.
-    shape = study.run_chunk(range(0, 0))
-    # Each structure coordinate, then each followed point and moment.
-    followed = _count(output, "points") + _count(output, "moments")
-    check_study_memory(study.runs, int(shape["n"]) + followed, len(shape["pairs"]), source)
     if checked["analysis"] == "run":
         t_end = study.prepared().solver["t_end"]
         if not checked["record_from"] < t_end:
@@ -186,6 +181,11 @@ def study_of(
                 f"{source}: [study] record_from: must be before [solver] t_end "
                 f"({t_end!r} s), got {checked['record_from']!r}"
             )
+    # The base scenario and every axis path are checked by a run of none.
+    shape = study.run_chunk(range(0, 0))
+    # Each structure coordinate, then each followed point and moment.
+    followed = _count(output, "points") + _count(output, "moments")
+    check_study_memory(study.runs, int(shape["n"]) + followed, len(shape["pairs"]), source)
     if checked["analysis"] != "run":  # whole forcing periods
         try:
             check_axis_frequencies(data, checked["axes"], base_dir)

@@ -2,7 +2,7 @@
 //! which its stroboscopic state repeats. The one criterion of the steady-state
 //! analyses (through the binding) and of steady-state studies.
 
-use crate::error::{positive, Result};
+use crate::error::{positive, Error, Result};
 
 /// The most forcing periods a settled response may take to repeat.
 pub const MAX_PERIOD: usize = 8;
@@ -34,6 +34,13 @@ pub fn checked_strobe_period(
 ) -> Result<Option<usize>> {
     positive("forcing_period", forcing_period)?;
     positive("tolerance", tolerance)?;
+    if width == 0 || width % 2 != 0 || strobe.len() % width != 0 {
+        return Err(Error::Inconsistent(format!(
+            "stroboscopic rows of {width} values (displacements then velocities, an even \
+             number >= 2) must divide the {} values given",
+            strobe.len()
+        )));
+    }
     Ok(strobe_period(
         strobe,
         width,

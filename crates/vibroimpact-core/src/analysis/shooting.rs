@@ -65,7 +65,10 @@ pub fn shoot(
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<Shot> {
-    let mut by = Differences { map };
+    check_shooting(z0, forcing_period, tolerance)?;
+    let size = z0.len();
+    let mut checked = |z: &[f64]| sized("the map's image", map(z)?, size);
+    let mut by = Differences { map: &mut checked };
     newton(&mut by, z0, forcing_period, tolerance, max_iterations)
 }
 
@@ -79,8 +82,55 @@ pub fn shoot_by_tangent(
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<Shot> {
-    let mut by = ByTangent { run, last: None };
+    check_shooting(z0, forcing_period, tolerance)?;
+    let size = z0.len();
+    let mut checked = |z: &[f64]| {
+        let (image, matrix) = run(z)?;
+        Ok((
+            sized("the map's image", image, size)?,
+            sized("the map's Jacobian", matrix, size * size)?,
+        ))
+    };
+    let mut by = ByTangent {
+        run: &mut checked,
+        last: None,
+    };
     newton(&mut by, z0, forcing_period, tolerance, max_iterations)
+}
+
+/// Refuses a shooting no map can serve: a start `z0` of displacements then
+/// velocities (an even number of values, at least 2, finite), a forcing
+/// period and a tolerance in the registry's ranges.
+fn check_shooting(z0: &[f64], forcing_period: f64, tolerance: f64) -> Result<()> {
+    use crate::methods::registry::{FORCING_PERIOD, TOLERANCE};
+    FORCING_PERIOD.check(forcing_period)?;
+    TOLERANCE.check(tolerance)?;
+    if z0.is_empty() || z0.len() % 2 != 0 {
+        return Err(Error::Inconsistent(format!(
+            "a shooting starts from displacements then velocities (an even number of values, \
+             at least 2), got {}",
+            z0.len()
+        )));
+    }
+    match z0.iter().position(|v| !v.is_finite()) {
+        Some(at) => Err(Error::Inconsistent(format!(
+            "a shooting's start must be finite: value {at} is {}",
+            z0[at]
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// `values`, where there are `len` of them: what a map must return.
+fn sized(what: &str, values: Vec<f64>, len: usize) -> Result<Vec<f64>> {
+    if values.len() == len {
+        Ok(values)
+    } else {
+        Err(Error::Inconsistent(format!(
+            "{what} must have {len} values, got {}",
+            values.len()
+        )))
+    }
 }
 
 /// A map that returns its image with its Jacobian (row-major).

@@ -50,6 +50,61 @@ pub struct RunOptions {
     pub reduce: ReduceOptions,
 }
 
+impl RunOptions {
+    /// Refuses options no run can take, naming the field (the registry's
+    /// ranges: [`crate::methods::registry`]): `t_end` finite and > 0, `dt`
+    /// (where given) finite and > 0, `every` and `max_steps` at least 1,
+    /// `energy_tolerance` in (0, 1]; `record_from` and `contacts_from` not
+    /// NaN, `strobe_period` > 0 (infinite: none).
+    pub fn check(&self) -> Result<()> {
+        use crate::methods::registry::{DT, ENERGY_TOLERANCE, T_END};
+        T_END.check(self.t_end)?;
+        if let Some(dt) = self.dt {
+            DT.check(dt)?;
+        }
+        ENERGY_TOLERANCE.check(self.energy_tolerance)?;
+        for (field, value) in [("every", self.every), ("max_steps", self.max_steps)] {
+            if value == 0 {
+                return Err(Error::InvalidParameter {
+                    field,
+                    allowed: "a whole number >= 1",
+                    value: 0.0,
+                });
+            }
+        }
+        let reduce = &self.reduce;
+        let refused = |field, allowed, value| {
+            Err(Error::InvalidParameter {
+                field,
+                allowed,
+                value,
+            })
+        };
+        if reduce.record_from.is_nan() || reduce.record_from < 0.0 {
+            return refused(
+                "record_from",
+                "a time >= 0 s (infinite: none)",
+                reduce.record_from,
+            );
+        }
+        if reduce.contacts_from.is_nan() {
+            return refused(
+                "contacts_from",
+                "a time in s, not NaN",
+                reduce.contacts_from,
+            );
+        }
+        if reduce.strobe_period.is_nan() || reduce.strobe_period <= 0.0 {
+            return refused(
+                "strobe_period",
+                "> 0 s (infinite: none)",
+                reduce.strobe_period,
+            );
+        }
+        Ok(())
+    }
+}
+
 /// How a run steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Stepping {

@@ -111,6 +111,14 @@ impl<'a> Run<'a> {
                 initial.len()
             )));
         }
+        options.check()?;
+        if let Some(at) = initial.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Inconsistent(format!(
+                "the initial state must be finite: value {at} (of x, v and the energy \
+                 accumulators) is {}",
+                initial[at]
+            )));
+        }
         let adaptive = stepper.is_adaptive();
         let timing = Self::timing(stepping);
         if timing.is_some() {

@@ -434,6 +434,14 @@ impl Contact {
         })
     }
 
+    /// The same law through [`Contact::new`]'s checks: a literal's fields
+    /// (they are public) in their ranges, a restitution only where the law
+    /// takes one.
+    pub fn checked(&self) -> Result<Self> {
+        let restitution = self.law.uses_restitution().then_some(self.restitution);
+        Self::new(self.law, self.stiffness, restitution, self.damping)
+    }
+
     /// The rebound/approach speed ratio two bodies alone get from the law
     /// (without the contact damper): `e` for "hertz-damped", more than `e`
     /// for "hyster-hertz" and never below 0.66296.

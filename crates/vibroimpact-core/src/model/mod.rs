@@ -4,5 +4,6 @@ pub mod closed_forms;
 pub mod contact;
 pub mod impact_damper;
 pub mod materials;
+pub mod noise;
 pub mod signals;
 pub mod structure;

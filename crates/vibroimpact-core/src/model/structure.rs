@@ -61,7 +61,7 @@ impl Recipe {
         }
     }
 
-    /// The keys a study can set (see [`Recipe::set`]), for error messages.
+    /// The keys a study can set (see [`Recipe::input`]), for error messages.
     pub fn keys(&self) -> &'static str {
         match self {
             Self::Oscillator { .. } => "mass, stiffness, damping",

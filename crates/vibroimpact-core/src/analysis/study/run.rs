@@ -27,6 +27,14 @@ pub fn run_study(
     threads: usize,
     interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<RunMetrics>> {
+    settings.check()?;
+    let width = parameters.len().max(1);
+    if !parameters.is_empty() && values.len() % width != 0 {
+        return Err(Error::Inconsistent(format!(
+            "a study of {width} parameters takes {width} values a row, got {} values in all",
+            values.len()
+        )));
+    }
     if !matches!(settings.analysis, Analysis::Run { .. }) {
         // Refused up front on the base scenario; an axis may still make a
         // point aperiodic, which then fails alone.
@@ -40,7 +48,6 @@ pub fn run_study(
             ExactFlow::takes(&system)?;
         }
     }
-    let width = parameters.len().max(1);
     let rows = if parameters.is_empty() {
         1
     } else {

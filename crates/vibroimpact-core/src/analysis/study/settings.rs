@@ -1,6 +1,7 @@
 //! Study settings: the method and limits of each run, and the analysis it makes.
 
-use crate::methods::registry::Options;
+use crate::error::{Error, Result};
+use crate::methods::registry::{Options, DT, ENERGY_TOLERANCE, MAX_PERIODS, T_END};
 
 /// How each run of a study is made and what it keeps.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,4 +44,78 @@ pub enum Analysis {
     /// `periods` periods from there (see [`crate::analysis::shooting`]): its Floquet
     /// multipliers, amplitude and impacts.
     Orbit { settle: u64, periods: u64 },
+}
+
+impl StudySettings {
+    /// Refuses settings no run can take, naming the field: the registry's
+    /// ranges for `t_end`, `dt` and `energy_tolerance`, `max_steps` at least
+    /// 1, `record_from` in [0, t_end), a steady state's or orbit's periods
+    /// whole numbers in their ranges and at most [`MAX_PERIODS`] in all, a
+    /// steady state's `tolerance` > 0. (The method's options are checked
+    /// when its stepper is made.)
+    pub fn check(&self) -> Result<()> {
+        if let Some(dt) = self.dt {
+            DT.check(dt)?;
+        }
+        ENERGY_TOLERANCE.check(self.energy_tolerance)?;
+        if self.max_steps == 0 {
+            return Err(whole("max_steps", 1, 0));
+        }
+        let (settle, record) = match self.analysis {
+            Analysis::Run { t_end, record_from } => {
+                T_END.check(t_end)?;
+                if !(record_from >= 0.0 && record_from < t_end) {
+                    return Err(Error::InvalidParameter {
+                        field: "record_from",
+                        allowed: "a time >= 0 s before t_end",
+                        value: record_from,
+                    });
+                }
+                return Ok(());
+            }
+            Analysis::SteadyState {
+                settle,
+                record,
+                tolerance,
+            } => {
+                if !(tolerance > 0.0 && tolerance.is_finite()) {
+                    return Err(Error::InvalidParameter {
+                        field: "tolerance",
+                        allowed: "a finite number > 0",
+                        value: tolerance,
+                    });
+                }
+                if record == 0 {
+                    return Err(whole("record_periods", 1, 0));
+                }
+                (settle, record)
+            }
+            Analysis::Orbit { settle, periods } => {
+                if periods == 0 {
+                    return Err(whole("orbit_periods", 1, 0));
+                }
+                (settle, periods)
+            }
+        };
+        match settle.checked_add(record) {
+            Some(total) if total <= MAX_PERIODS => Ok(()),
+            _ => Err(Error::Inconsistent(format!(
+                "settle_periods {settle} and {record} periods to record or shoot: a run settles \
+                 and records at most {MAX_PERIODS} forcing periods in all"
+            ))),
+        }
+    }
+}
+
+/// A whole number below its least, `low`.
+fn whole(field: &'static str, low: u64, value: u64) -> Error {
+    Error::InvalidParameter {
+        field,
+        allowed: if low == 1 {
+            "a whole number >= 1"
+        } else {
+            "a whole number >= 0"
+        },
+        value: value as f64,
+    }
 }

@@ -126,7 +126,7 @@ fn fixed_runs_are_those_of_the_general_steps_to_the_bit() {
         options.keep_history = false;
         options.max_steps = 7000;
         // (The lagged contact force creates energy at a contact.)
-        options.energy_tolerance = 10.0;
+        options.energy_tolerance = 1.0;
         let y0 = initial_state(&system, &[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0], &[], &[]).unwrap();
         let runs = [true, false].map(|sized| {
             let mut stepper = PaperNewmark::new(&system, 0.25, 0.5).unwrap();
@@ -182,7 +182,7 @@ fn event_runs_are_those_of_the_general_steps_to_the_bit() {
         let start = crate::State::new(0.0, 0.0, 0.01, 0.1).unwrap();
         let y = start.vector(&system).unwrap();
         (options.dt, options.t_end, options.keep_history) = (Some(1e-4), 30.0, false);
-        options.energy_tolerance = 10.0;
+        options.energy_tolerance = 1.0;
         let [sized, general] = both_from(&system, &y, &options, Stepping::Events);
         assert!(sized.matches("onset").count() > 20, "{sized:.3000}");
         same(&sized, &general);

@@ -11,6 +11,12 @@ use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::model::assembly::SystemSpec;
 use crate::model::structure::Structure;
 
+/// The most forcing periods one run of an analysis may settle and record in
+/// all: with a few impacts and tens of steps a period is already minutes of
+/// computing, and every kept impact is memory; more is a typo (1e12 for
+/// 1e2), refused before it starts.
+pub const MAX_PERIODS: u64 = 10_000_000;
+
 /// What a run is asked to do, as far as its limits go.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunPlan<'a> {

@@ -37,6 +37,22 @@ pub fn simulate(
     settings: &Settings,
     interrupt: &mut dyn FnMut() -> bool,
 ) -> Result<SystemSolution> {
+    // Literals (the fields are public) through their constructors' checks,
+    // named as the two-mass model names them.
+    let system = &ImpactDamper::new(
+        system.main_mass,
+        system.stiffness,
+        system.damping,
+        system.impact_mass,
+        system.clearance,
+    )?;
+    let start = &State::new(
+        start.main_displacement,
+        start.main_velocity,
+        start.impact_displacement,
+        start.impact_velocity,
+    )?;
+    let settings = &settings.checked()?;
     start.check_apart(system.clearance)?;
     let assembly = system.assembly(contact)?;
     let y0 = start.vector(&assembly)?;

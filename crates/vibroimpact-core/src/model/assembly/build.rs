@@ -151,10 +151,16 @@ fn duplicate_walls(interactions: &[Interaction], pairs: &[String]) -> Result<()>
 
 fn interaction_law(name: &str, law: &PairLaw) -> Result<InteractionLaw> {
     Ok(match *law {
-        PairLaw::Compliant(contact) => InteractionLaw::Compliant {
-            law: contact.any_law(),
-            damping: contact.damping,
-        },
+        PairLaw::Compliant(contact) => {
+            // A law written as a literal has skipped `Contact::new`'s checks.
+            let contact = contact
+                .checked()
+                .map_err(|e| Error::Inconsistent(format!("{name} {e}")))?;
+            InteractionLaw::Compliant {
+                law: contact.any_law(),
+                damping: contact.damping,
+            }
+        }
         PairLaw::Rigid { restitution } => {
             if !(0.0..=1.0).contains(&restitution) {
                 return Err(Error::Inconsistent(format!(
@@ -533,6 +539,11 @@ fn excitation_loads(spec: &SystemSpec, minv: &[f64]) -> Result<(Vec<ForceLoad>, 
     let mut forces = Vec::new();
     let mut base = Vec::new();
     for (j, excitation) in spec.excitations.iter().enumerate() {
+        // A signal written as a literal has skipped its constructor's checks.
+        excitation
+            .signal
+            .check()
+            .map_err(|e| Error::Inconsistent(format!("excitation {j} signal: {e}")))?;
         match excitation.load {
             Load::Force { at } => {
                 let row = s.point(&format!("excitation {j} at"), at)?;

@@ -193,7 +193,7 @@ pub struct Settings {
     pub history: bool,
     /// Most history rows plus contacts a run may keep.
     pub max_rows: u64,
-    /// Relative tolerance of the energy-balance checks (see [`simulate`]).
+    /// Relative tolerance of the energy-balance checks (see [`super::simulate`]).
     pub energy_tolerance: f64,
 }
 
@@ -302,6 +302,26 @@ impl Settings {
         };
         settings.check_memory()?;
         Ok(settings)
+    }
+
+    /// The same settings through [`Settings::new`] and
+    /// [`Settings::with_limits`]: a literal's fields (they are public) in
+    /// their ranges, and a history that fits in memory.
+    pub fn checked(&self) -> Result<Self> {
+        Self::new(
+            self.method,
+            self.dt,
+            self.t_end,
+            self.every,
+            self.timing,
+            Some(self.stepping),
+            self.max_steps,
+        )?
+        .with_limits(
+            self.history,
+            Some(self.max_rows),
+            Some(self.energy_tolerance),
+        )
     }
 
     /// The most energy a contact may create, relative to the energy in play:
