@@ -218,6 +218,18 @@ def test_the_fold_of_the_impact_oscillator_is_located_exactly() -> None:
 # ---------------------------------------------------- the period-doubled branch (Holmes)
 
 
+def assert_period_two(data: dict[str, Any], key: str, point: Any) -> None:
+    """``point`` (of a branch in excitation 0's ``key``) is a genuine period-two orbit:
+    the map of two periods returns its state, that of one does not."""
+    moved = copy.deepcopy(data)
+    moved["excitation"][0][key] = point.value
+    run = an.runner(moved)
+    once, twice = run.map(point.state, 1), run.map(point.state, 2)
+    size = float(np.max(np.abs(point.state)))
+    assert np.max(np.abs(twice - point.state)) < 1e-8 * size, point.value  # P(P(z)) = z
+    assert np.max(np.abs(once - point.state)) > 1e-4 * size, point.value  # P(z) != z
+
+
 @pytest.mark.timeout(90)
 def test_switching_at_the_flip_follows_genuine_period_two_orbits() -> None:
     data = load(FLIP_CURVE)
@@ -232,13 +244,7 @@ def test_switching_at_the_flip_follows_genuine_period_two_orbits() -> None:
     # Born at the flip: shot a thousandth of the remaining range beyond it.
     assert 0 < doubled.points[0].value - flip <= 1.001e-3 * (stop - flip)
     for p in doubled.points:
-        moved = copy.deepcopy(data)
-        moved["excitation"][0]["amplitude"] = p.value
-        run = an.runner(moved)
-        once, twice = run.map(p.state, 1), run.map(p.state, 2)
-        size = float(np.max(np.abs(p.state)))
-        assert np.max(np.abs(twice - p.state)) < 1e-8 * size, p.value  # P(P(z)) = z
-        assert np.max(np.abs(once - p.state)) > 1e-4 * size, p.value  # P(z) != z
+        assert_period_two(data, "amplitude", p)
         # Two impacts over the orbit, each taking e^2 of the phase-space volume.
         assert np.prod(p.floquet_multipliers).real == pytest.approx(table.e**4, rel=1e-9)
         assert p.impacts_per_period == 1
@@ -248,6 +254,89 @@ def test_switching_at_the_flip_follows_genuine_period_two_orbits() -> None:
     assert np.min(second.floquet_multipliers.real) == pytest.approx(-1, abs=1e-9)
     before = [p for p in doubled.points if p.value < second.value]
     assert before and all(p.stable for p in before)
+
+
+FRF_DAMPER = ROOT / "examples" / "frf_impact_damper.toml"
+
+
+def frf_damper(frequency: float, orbit: list[float]) -> dict[str, Any]:
+    """The FRF example's damper forced at ``frequency`` by the exact flow, from a state
+    on its orbit there (``x_structure, x_damper, v_structure, v_damper``)."""
+    data = load(FRF_DAMPER)
+    data["solver"] = {"method": "exact", "t_end": 1.0}
+    data["excitation"][0]["frequency"] = frequency
+    keys = ("structure_displacement", "damper_displacement")
+    keys += ("structure_velocity", "damper_velocity")
+    data["initial"] = {key: [value] for key, value in zip(keys, orbit, strict=True)}
+    data.pop("sweep", None)
+    return data
+
+
+@pytest.mark.timeout(90)
+def test_switching_at_a_flip_of_a_structure_with_a_damper_follows_period_two_orbits() -> None:
+    """The switch's first period-two orbit was written into ``[initial]`` with every
+    coordinate taken for the structure's: any system with a damper failed there
+    ('[initial] structure_displacement: must have 1 value ..., got 2') and lost the
+    branch already found. The FRF damper's period-one orbit at 10 Hz, continued down
+    through its flip near 9.993 Hz."""
+    data = frf_damper(
+        10.0, [-0.012337650541489631, -0.014639868045576737, 0.6871410089900853, 0.5027180992484881]
+    )
+    frequency = "excitation.0.frequency"
+    branch = an.continue_orbit(data, frequency, stop=9.95, step=0.01, max_points=8, switch=True)
+    (flip,) = [b for b in branch.bifurcations if b.kind == "flip"]
+    assert 9.95 < flip.value < 10.0
+    assert np.min(flip.floquet_multipliers.real) == pytest.approx(-1, abs=1e-9)
+    doubled = branch.switched
+    assert doubled is not None and doubled.periods == 2 and len(doubled.points) >= 5
+    for p in doubled.points[:5]:
+        assert_period_two(data, "frequency", p)
+        # Two coordinates: the structure's and the damper's, as the run's own start.
+        assert len(p.state) == 4
+
+
+@pytest.mark.timeout(120)
+def test_a_branch_point_flagged_on_a_branch_is_located() -> None:
+    """A real multiplier crossing +1 on the FRF damper's two-impact orbit (a branch
+    point, where Newton's extended system is singular) was flagged 'branch at 11.2365'
+    and never located: its crossing 2e-4 Hz off, ``bifurcations`` empty. Its value is
+    checked here by a second route: the shot orbit's multiplier nearest +1, at fixed
+    frequencies, its root by the secant method."""
+    data = frf_damper(
+        11.5,
+        [-0.0026161903683378073, -0.006289810675844254, 0.05974307148717366, -0.33831703831643123],
+    )
+    frequency = "excitation.0.frequency"
+    branch = an.continue_orbit(data, frequency, stop=11.2, step=0.05)
+    (found,) = [b for b in branch.bifurcations if b.kind == "branch"]
+    assert np.min(np.abs(found.floquet_multipliers - 1.0)) < 1e-6
+
+    # (x_structure, x_damper, v_structure, v_damper), as [initial] lists them.
+    state = np.array([v[0] for v in data["initial"].values()])
+
+    def distance_from_one(f: float) -> float:
+        nonlocal state
+        moved = copy.deepcopy(data)
+        moved["excitation"][0]["frequency"] = f
+        shot = an.orbit(an.runner(moved), state, periods=1, tolerance=1e-12)
+        state = np.asarray(shot.state)
+        m = np.asarray(shot.floquet_multipliers)
+        real = m[np.abs(m.imag) < 1e-9].real
+        return float(real[np.argmin(np.abs(real - 1))] - 1)
+
+    low, high = 11.2153, 11.27825
+    g_low, g_high = distance_from_one(low), distance_from_one(high)
+    assert g_low * g_high < 0
+    for _ in range(40):
+        mid = (low * g_high - high * g_low) / (g_high - g_low)
+        g_mid = distance_from_one(mid)
+        if abs(g_mid) < 1e-12 or abs(high - low) < 1e-12:
+            break
+        if (g_mid > 0) == (g_low > 0):
+            low, g_low = mid, g_mid
+        else:
+            high, g_high = mid, g_mid
+    assert found.value == pytest.approx(mid, abs=1e-7)
 
 
 # ------------------------------------------------------------------- sensitivities

@@ -148,6 +148,25 @@ def test_a_bifurcation_whose_every_run_fails_is_an_error() -> None:
         bifurcation(data, "excitation.0.frequency", [10.0, 11.0], settle_periods=1)
 
 
+def test_a_sweep_command_whose_every_run_fails_exits_1_without_a_plot(
+    run_cli: Any, tmp_path: Path
+) -> None:
+    # It had exited 0 and written its plot of nothing, where bifurcation exits 1.
+    text = (EXAMPLES / "bouncing_ball_table.toml").read_text(encoding="utf-8")
+    assert "[sweep]" not in text and "max_steps" not in text
+    sweep = '[sweep]\nparameter = "excitation.0.frequency"\nstart = 10.0\nstop = 11.0\ncount = 2\n'
+    scenario = tmp_path / "ball.toml"
+    text = text.replace('method = "exact"', 'method = "dop853"')
+    scenario.write_text(text + "max_steps = 10\n\n" + sweep, encoding="utf-8")
+    assert tomllib.loads(scenario.read_text())["solver"]["max_steps"] == 10
+    done = run_cli("sweep", str(scenario), "--plot", "sweep.png")
+    assert done.returncode == 1, done.stdout + done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert "sweep: the run failed at every value of excitation.0.frequency (2)" in line
+    assert "max_steps" in line
+    assert not (tmp_path / "sweep.png").exists()
+
+
 @pytest.mark.parametrize("method", ["rk4", "newmark-implicit", "generalized-alpha", "exact"])
 def test_simulate_refuses_a_forcing_its_steps_cannot_follow(method: str) -> None:
     # The 5 Hz oscillator forced at 1e9 Hz: rk4 at dt = 1e-3 s had reported 1.1e-4 J stored

@@ -35,7 +35,13 @@ from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.crossings import _CLASSES, _flags, _kind, _largest
 from vibroimpact.analysis.grazing import grazing_ahead, grazings_between
 from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError, relative_tolerance, whole_count
-from vibroimpact.analysis.located import Bifurcation, refine
+from vibroimpact.analysis.located import (
+    ITERATIONS,
+    PARAMETER_TOLERANCE,
+    Bifurcation,
+    refine,
+    test_value,
+)
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import shifted, with_parameter
 from vibroimpact.analysis.runs import Runner, runner, state_arrays
@@ -228,7 +234,7 @@ def _doubled(
             distinct = float(np.max(np.abs(half - found.state)[:n])) > 1e-6 * size
             if not (found.converged and distinct):
                 continue
-            seeded = _seeded(changed, found.state, n)
+            seeded = _seeded(changed, found.state, run.n)
             return continue_orbit(
                 seeded,
                 parameter,
@@ -248,6 +254,13 @@ def _seeded(data: Mapping[str, Any], state: np.ndarray, n: int) -> dict[str, Any
     out = copy.deepcopy(dict(data))
     out["initial"] = state_arrays(state, n, len(state) // 2 - n)
     return out
+
+
+#: The test function (a multiplier's distance from +1 or -1) within which
+#: :meth:`_Arc.along` takes an orbit for the bifurcation: where two branches cross,
+#: the corrector converges no closer (the FRF damper's branch point at 11.2367 Hz:
+#: 2.6e-8, about 1e-8 Hz from it).
+BRANCH_TOLERANCE = 1e-6
 
 
 @dataclass(eq=False)
@@ -463,6 +476,55 @@ class _Arc:
                 hi, above, high = mid, value, multipliers
         return 0.5 * (below + above), (high if last > 0 else low), last_trial
 
+    def along(
+        self,
+        kind: str,
+        u: np.ndarray,
+        t: np.ndarray,
+        h: float,
+        ends: tuple[BranchPoint, BranchPoint],
+    ) -> tuple[BranchPoint, np.ndarray] | None:
+        """Where the test function of ``kind`` vanishes on the arc between ``u`` (the
+        point ``ends[0]``) and the point ``h`` along ``t`` (``ends[1]``): the Illinois
+        method on the fraction of the arc, each trial an orbit corrected on the plane
+        normal to ``t``, until the orbits either side are within
+        :data:`PARAMETER_TOLERANCE` of the parameter. Beside a branch point another
+        branch crosses the plane and the corrector stops converging short of that: the
+        trial nearest zero is kept where its test function is within
+        :data:`BRANCH_TOLERANCE`. Its branch point and scaled unknowns; None where the
+        test function does not change sign there or no trial comes that close."""
+        g_lo, g_hi = (test_value(kind, p.floquet_multipliers) for p in ends)
+        if not (np.isfinite(g_lo) and np.isfinite(g_hi)) or (g_lo > 0) == (g_hi > 0):
+            return None
+        p_lo, p_hi = (p.value for p in ends)
+        lo, hi, kept = 0.0, 1.0, 0
+        best: tuple[float, np.ndarray, np.ndarray] | None = None
+        for _ in range(ITERATIONS * 5):
+            s = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+            if not lo < s < hi:
+                s = 0.5 * (lo + hi)
+            found = self.correct(u + s * h * t, t)
+            jac = None if found is None else self.jacobian(*found)
+            g = float("nan") if jac is None else test_value(kind, self.multipliers_of(jac))
+            if found is None or jac is None or not np.isfinite(g):
+                break
+            value = float(found[0][self.size] * self.scale[self.size])
+            if best is None or abs(g) < best[0]:
+                best = (abs(g), found[0], jac)
+            if (g > 0) == (g_lo > 0):
+                lo, g_lo, p_lo = s, g, value
+                g_hi *= 0.5 if kept == -1 else 1.0
+                kept = -1
+            else:
+                hi, g_hi, p_hi = s, g, value
+                g_lo *= 0.5 if kept == 1 else 1.0
+                kept = 1
+            if g == 0.0 or abs(p_hi - p_lo) <= PARAMETER_TOLERANCE * max(abs(value), 1.0):
+                break
+        if best is None or best[0] > BRANCH_TOLERANCE:
+            return None
+        return self.point(best[1], best[2]), best[1]
+
     def ended(self, points: list[BranchPoint], u: np.ndarray) -> str:
         """Why the corrector failed beyond the last point: at a grazing (located, and
         kept among the bifurcations), or not known."""
@@ -559,6 +621,10 @@ class _Arc:
                 reach = max(abs(candidate.value - points[-1].value), chord)
                 low = min(candidate.value, points[-1].value) - reach
                 refined = refine(self, name, start, (low, low + 3 * reach))
+                if refined is None:
+                    # Newton on the extended system is singular at a branch point (the
+                    # parameter's column lies in the state's range there): along the arc.
+                    refined = self.along(name, u, t, h, ends)
                 if refined is not None:
                     crossings[name] = refined[0].value
                     self.bifurcations.append(

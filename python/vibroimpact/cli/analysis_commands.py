@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError
+from vibroimpact._core import InvalidInputError, SimulationError
 from vibroimpact.analysis import (
     BIFURCATION_SAMPLES,
     AnalysisError,
@@ -181,6 +181,13 @@ def run_sweep(args: argparse.Namespace) -> int:
         if show:
             print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
+    failed = [p for p in points if p.error]
+    if points and len(failed) == len(points):
+        # No point of the response: an error (exit 1, no plot), as bifurcation says it.
+        raise SimulationError(
+            f"sweep: the run failed at every value of {settings['parameter']} "
+            f"({len(points)}); at {failed[0].value:g}: {failed[0].error}"
+        )
     if args.plot:
         plots.plot_sweep(
             args.plot, settings["parameter"], points, scenario.data, derivatives=derivatives
@@ -484,10 +491,18 @@ def run_continue(args: argparse.Namespace) -> int:
         f"{with_units(branch.parameter, scenario.data)} in {cpu_time:.3f} s; stopped: "
         f"{branch.stopped}"
     )
+    located = {(b.kind, b.value) for b in branch.bifurcations}
+
+    def flagged(p: Any, f: str) -> str:
+        if f not in p.crossings:
+            return f
+        if (f, p.crossings[f]) in located:
+            return f"{f} at {p.crossings[f]:.6g}"
+        # An estimate between the two orbits, not a located bifurcation.
+        return f"{f} near {p.crossings[f]:.6g} (not located)"
+
     for p in branch.points:
-        flags = ", ".join(
-            f"{f} at {p.crossings[f]:.6g}" if f in p.crossings else f for f in p.flags
-        )
+        flags = ", ".join(flagged(p, f) for f in p.flags)
         largest = float(np.max(np.abs(p.floquet_multipliers)))
         print(
             f"{p.value:>12.6g}  amplitude {p.amplitude[0]:.6g} m  max|multiplier| "

@@ -128,7 +128,9 @@ def add_commands(sub: Any) -> None:
         description=(
             "From the scenario's [initial] state, settle --settle forcing periods, then "
             "sample --periods more: the state at each period (stroboscopic section) and "
-            "each impact's phase in the forcing period (rad) and speed (m/s)."
+            "each rigid impact's phase in the forcing period (rad) and speed (m/s) (a "
+            "compliant contact has no impact instant: bifurcation --sample impact-velocity "
+            "samples its onsets)."
         ),
     )
     sec.add_argument("scenario", type=path_argument, help="scenario file (.toml, [structure])")
