@@ -351,7 +351,9 @@ record_periods = 5
         encoding="utf-8",
     )
     done = run_cli("sweep", str(scenario), "--json")
-    assert done.returncode == 0, done.stderr
+    # Every point failed: exit 1 (as bifurcation's), the JSON of each point's error first.
+    assert done.returncode == 1, done.stderr
+    assert "sweep: the run failed at every value" in done.stderr
 
     def refuse(constant: str) -> None:
         raise AssertionError(f"{constant} is no JSON")

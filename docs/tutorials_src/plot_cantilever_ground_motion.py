@@ -80,8 +80,9 @@ print(
 # With an impact damper at the tip
 # --------------------------------
 # A damped Hertz law (``"hertz-damped"``) rebounds at exactly its restitution and, unlike
-# a rigid impact, converges as modes are added. The damper's displacement is its own
-# (absolute), not relative to the beam.
+# a rigid impact, converges as modes are added. The damper's displacement, like the beam's,
+# is relative to the moving ground (every coordinate is, under base excitation), not to the
+# beam: its gap is its displacement less the tip's.
 damper = vi.Damper(
     mass=0.05, at=LENGTH, clearance=0.002, law="hertz-damped", stiffness=1e8, restitution=0.6
 )

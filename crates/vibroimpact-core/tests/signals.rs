@@ -286,3 +286,78 @@ fn kanai_tajimi_variance_matches_its_spectral_density() {
         assert_eq!(x[0], 0.0);
     });
 }
+
+/// A 1 Hz oscillator (1 kg, 2 % damped) struck at 5 s by a recorded 1 ms
+/// triangular pulse of 0.05 N s, by rk4 at `dt`: its displacement at 6 s.
+fn struck_by_a_pulse(dt: f64) -> Result<f64, Error> {
+    use vibroimpact_core::kernel::events::RunOptions;
+    use vibroimpact_core::methods::registry::{AnyStepper, Options};
+    use vibroimpact_core::model::assembly::{
+        initial_state, Assembly, Excitation, Load, SystemSpec,
+    };
+    use vibroimpact_core::model::structure::Structure;
+    let w = TAU;
+    let mut spec = SystemSpec::of(Structure::oscillator(1.0, w * w, 2.0 * 0.02 * w)?, vec![]);
+    let pulse = Signal::recorded(vec![5.0, 5.0005, 5.001], vec![0.0, 100.0, 0.0], 1.0)?;
+    spec.excitations = vec![Excitation {
+        load: Load::Force { at: 0.0 },
+        signal: pulse,
+    }];
+    let system = Assembly::new(&spec)?;
+    let y0 = initial_state(&system, &[0.0], &[0.0], &[], &[])?;
+    let mut method = AnyStepper::new(&system, "rk4", &Options::default())?;
+    let options = RunOptions {
+        dt: Some(dt),
+        t_end: 6.0,
+        every: 1,
+        keep_history: false,
+        max_steps: 100_000_000,
+        max_rows: 1_000_000,
+        energy_tolerance: 1e-2,
+        reduce: Default::default(),
+    };
+    let run = method.integrate(&system, &y0, &options, &mut || false)?;
+    Ok(run.final_state[0])
+}
+
+#[test]
+fn a_fixed_step_longer_than_a_records_samples_is_refused_not_a_pulse_lost() {
+    common::timeout(60, || {
+        // The impulse response I / (m w_d) e^(-zeta w t) sin(w_d t), 1 s after the
+        // pulse's centre (its 1 ms width shifts it by far less than the tolerance).
+        let (zeta, w) = (0.02, TAU);
+        let wd = w * (1.0f64 - zeta * zeta).sqrt();
+        let t = 1.0 - 0.0005;
+        let expected = 0.05 / wd * (-zeta * w * t).exp() * (wd * t).sin();
+        let found = struck_by_a_pulse(1e-4).unwrap();
+        assert!(
+            (found - expected).abs() < 1e-3 * expected.abs(),
+            "{found} {expected}"
+        );
+        // At dt = 3e-3 s the pulse fell between two steps' stages: x(6) = 0 and no
+        // input work, without a word.
+        let refused = struck_by_a_pulse(3e-3).unwrap_err().to_string();
+        assert!(
+            refused.contains("\"recorded\" excitation changes every 5.000e-4 s")
+                && refused.contains("dt = 3e-3 s"),
+            "{refused}"
+        );
+    });
+}
+
+#[test]
+fn a_ground_filter_too_stiff_over_the_whole_record_is_refused_at_once() {
+    common::timeout(10, || {
+        // 1.3e6 filter steps a sample over 50,001 samples: it had been accepted
+        // (each sample's steps within bounds) and ran for minutes past Ctrl-C.
+        let error = Signal::kanai_tajimi(1.0, 2.5, 1e5, 25.0, 1000.0, 7).unwrap_err();
+        assert!(
+            error
+                .to_string()
+                .contains("too stiff to integrate over 1000 s"),
+            "{error}"
+        );
+        // A soil's damping over the same record is generated.
+        assert!(Signal::kanai_tajimi(1.0, 2.5, 0.6, 25.0, 1000.0, 7).is_ok());
+    });
+}

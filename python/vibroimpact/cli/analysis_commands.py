@@ -182,12 +182,17 @@ def run_sweep(args: argparse.Namespace) -> int:
             print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
     failed = [p for p in points if p.error]
-    if points and len(failed) == len(points):
-        # No point of the response: an error (exit 1, no plot), as bifurcation says it.
-        raise SimulationError(
-            f"sweep: the run failed at every value of {settings['parameter']} "
-            f"({len(points)}); at {failed[0].value:g}: {failed[0].error}"
-        )
+    # No point of the response: an error (exit 1, no plot), as bifurcation says it; --json
+    # still prints each point's error first.
+    nothing = points and len(failed) == len(points)
+    refusal = SimulationError(
+        f"sweep: the run failed at every value of {settings['parameter']} "
+        f"({len(points)}); at {failed[0].value:g}: {failed[0].error}"
+        if nothing
+        else ""
+    )
+    if nothing and not args.json:
+        raise refusal
     if args.plot:
         plots.plot_sweep(
             args.plot, settings["parameter"], points, scenario.data, derivatives=derivatives
@@ -202,6 +207,8 @@ def run_sweep(args: argparse.Namespace) -> int:
                 }
             )
         )
+        if nothing:
+            raise refusal
         return 0
     print(
         f"{args.scenario}: {len(points)} points of {settings['parameter']} in "

@@ -127,10 +127,8 @@ def add_commands(sub: Any) -> None:
         help="Poincare sections: stroboscopic and at impacts",
         description=(
             "From the scenario's [initial] state, settle --settle forcing periods, then "
-            "sample --periods more: the state at each period (stroboscopic section) and "
-            "each rigid impact's phase in the forcing period (rad) and speed (m/s) (a "
-            "compliant contact has no impact instant: bifurcation --sample impact-velocity "
-            "samples its onsets)."
+            "sample --periods more: the state at each period (stroboscopic section) and each "
+            "rigid impact's phase (rad) and speed (m/s) (compliant onsets: bifurcation --sample)."
         ),
     )
     sec.add_argument("scenario", type=path_argument, help="scenario file (.toml, [structure])")

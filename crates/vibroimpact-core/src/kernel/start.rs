@@ -45,6 +45,25 @@ fn first_rows(schedule: &Schedule) -> usize {
     (steps as usize / schedule.every.max(1) as usize + 2).min(FIRST_ROWS)
 }
 
+/// Refuses a fixed step `dt` (s) longer than the finest interval over which
+/// an excitation's signal changes: a recorded pulse shorter than a step fell
+/// between two steps' stages and was lost whole (input work 0, without a
+/// word), where a harmonic that fast is refused up front
+/// ([`crate::methods::registry::check_run`]).
+fn check_signal_steps(system: &Assembly, dt: f64) -> Result<()> {
+    match system.finest_signal_interval() {
+        Some((interval, name)) if dt > interval * (1.0 + 1e-9) => {
+            Err(Error::Inconsistent(format!(
+                "a \"{name}\" excitation changes every {interval:.3e} s (its samples, or a sweep's \
+                 half period at its highest frequency), less than the fixed step dt = {dt:e} s, \
+                 which would pass over it: reduce dt to at most {interval:.3e} s, or choose an \
+                 adaptive method (\"dop853\")"
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Every compliant interaction in contact (see [`Run::all_compliant`]).
 fn all_compliant(system: &Assembly) -> Vec<Mode> {
     let mode = |it: &crate::model::assembly::Interaction| match it.law {
@@ -132,6 +151,9 @@ impl<'a> Run<'a> {
                 "dt is required for method {:?} (a step in s > 0)",
                 stepper.name()
             )));
+        }
+        if !adaptive && !stepper.is_exact() {
+            check_signal_steps(system, dt)?;
         }
         let graze = graze_tolerance(system);
         let resolution = if adaptive || stepper.is_exact() {

@@ -74,10 +74,15 @@ impl Signal {
             ground
         };
         let substeps = (20.0 * fastest * interval).ceil().max(1.0);
-        if substeps > MAX_SIGNAL_SAMPLES as f64 {
+        // Bounded in all, not only per sample: the filter's steps over the whole
+        // record are one loop without an interrupt (ground_damping 1e5 over 1000 s
+        // had run past Ctrl-C and SIGTERM for minutes).
+        let total = substeps * value.len().saturating_sub(1) as f64;
+        if total > MAX_SIGNAL_SAMPLES as f64 {
             return Err(Error::Inconsistent(format!(
                 "ground_damping {ground_damping} makes the ground filter too stiff to integrate \
-                 ({substeps:.3e} steps per sample); a soil's damping ratio is below 1 or 2"
+                 over {duration} s ({substeps:.3e} steps per sample, {total:.3e} in all, more \
+                 than {MAX_SIGNAL_SAMPLES}); a soil's damping ratio is below 1 or 2"
             )));
         }
         let substeps = substeps as usize;

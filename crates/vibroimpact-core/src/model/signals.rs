@@ -376,6 +376,9 @@ impl Signal {
     pub fn check(&self) -> Result<()> {
         match self {
             Self::Harmonic(h) => Harmonic::new(h.amplitude, h.frequency, h.phase).map(|_| ()),
+            Self::Harmonics(list) if list.is_empty() => Err(Error::Inconsistent(
+                "a harmonics signal needs at least one term (amplitudes and frequencies)".into(),
+            )),
             Self::Harmonics(list) => list.iter().try_for_each(|h| Self::Harmonic(*h).check()),
             Self::Sweep {
                 amplitude,

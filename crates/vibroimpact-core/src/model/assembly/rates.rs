@@ -243,6 +243,18 @@ impl Assembly {
         self.signals().any(Signal::has_breakpoints)
     }
 
+    /// The finest time over which an excitation that is not a sum of
+    /// harmonics changes (s), with its signal's name: a record's or a random
+    /// signal's shortest sample interval, a sweep's half period at its
+    /// highest frequency ([`Signal::extent`]); None without one. A fixed
+    /// step longer than this passes over what the signal does in between.
+    pub fn finest_signal_interval(&self) -> Option<(f64, &'static str)> {
+        self.signals()
+            .filter(|signal| signal.has_breakpoints())
+            .map(|signal| (0.5 * signal.extent().1, signal.harmonic_frequencies().0))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
     /// The first kink of any excitation's signal after `time` (s; see
     /// [`Signal::next_breakpoint`]), or infinity.
     pub fn next_breakpoint(&self, time: f64) -> f64 {
