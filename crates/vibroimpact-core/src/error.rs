@@ -176,6 +176,19 @@ pub(crate) fn non_negative(field: &'static str, value: f64) -> Result<f64> {
     }
 }
 
+/// A count (`every`, `max_steps`, a number of periods) must be at least 1.
+pub(crate) fn at_least_one(field: &'static str, value: u64) -> Result<u64> {
+    if value >= 1 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            field,
+            allowed: "a whole number >= 1",
+            value: value as f64,
+        })
+    }
+}
+
 /// `value` must be finite (any sign).
 pub(crate) fn finite(field: &'static str, value: f64) -> Result<f64> {
     if value.is_finite() {

@@ -15,10 +15,17 @@ from typing import Any
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError, SimulationError
+from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
 from vibroimpact.analysis.limits import MAX_STARTS, AnalysisError, check_total, whole_count
 from vibroimpact.analysis.parameters import with_parameter
-from vibroimpact.analysis.runs import Runner, as_runner, check_kept, checked_run, runner
+from vibroimpact.analysis.runs import (
+    Runner,
+    as_runner,
+    check_kept,
+    checked_run,
+    failed_everywhere,
+    runner,
+)
 from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
 from vibroimpact.analysis.steady import steady_state
 from vibroimpact.analysis.sweeps import from_carried
@@ -210,14 +217,10 @@ def bifurcation(
                 points.append(BifurcationPoint(value, leg, strobe, samples=samples))
             if progress is not None:
                 progress(len(points), total)
-    failed = [point for point in points if point.error is not None]
-    if points and len(failed) == len(points):
-        # No point of the diagram: an error, not a diagram of nothing (the command had
-        # printed "0 distinct ... of 0" for each).
-        raise SimulationError(
-            f"bifurcation: the run failed at every value of {parameter} ({len(points)}); "
-            f"at {failed[0].value:g}: {failed[0].error}"
-        )
+    # No point of the diagram: the command had printed "0 distinct ... of 0" for each.
+    refusal = failed_everywhere("bifurcation", parameter, points)
+    if refusal is not None:
+        raise refusal
     return points
 
 

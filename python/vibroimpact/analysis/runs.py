@@ -259,6 +259,21 @@ def state_arrays(state: np.ndarray, n: int, k: int) -> dict[str, list[float]]:
     }
 
 
+def failed_everywhere(
+    command: str, parameter: str, points: Sequence[Any]
+) -> SimulationError | None:
+    """The error of ``command``'s map of ``parameter`` whose run failed at every one of
+    its ``points`` (each with ``value`` and ``error``): nothing to show, an error rather
+    than a map of nothing. None where any point ran."""
+    failed = [point for point in points if point.error is not None]
+    if not points or len(failed) < len(points):
+        return None
+    return SimulationError(
+        f"{command}: the run failed at every value of {parameter} ({len(points)}); "
+        f"at {failed[0].value:g}: {failed[0].error}"
+    )
+
+
 def as_runner(run: Runner | System) -> Runner:
     """The analyses' entry: a :class:`~vibroimpact.System` as its :class:`Runner`
     (anything else as it is, for :func:`checked_run` to check)."""

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError, SimulationError
+from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis import (
     BIFURCATION_SAMPLES,
     AnalysisError,
@@ -37,6 +37,7 @@ from vibroimpact.analysis import (
     sweep_values,
 )
 from vibroimpact.analysis.limits import relative_tolerance
+from vibroimpact.analysis.runs import failed_everywhere
 from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
@@ -181,17 +182,10 @@ def run_sweep(args: argparse.Namespace) -> int:
         if show:
             print(file=sys.stderr)
     cpu_time = time.perf_counter() - start
-    failed = [p for p in points if p.error]
-    # No point of the response: an error (exit 1, no plot), as bifurcation says it; --json
-    # still prints each point's error first.
-    nothing = points and len(failed) == len(points)
-    refusal = SimulationError(
-        f"sweep: the run failed at every value of {settings['parameter']} "
-        f"({len(points)}); at {failed[0].value:g}: {failed[0].error}"
-        if nothing
-        else ""
-    )
-    if nothing and not args.json:
+    # No point of the response: an error (exit 1, no plot), as bifurcation's; --json still
+    # prints each point's error first.
+    refusal = failed_everywhere("sweep", settings["parameter"], points)
+    if refusal is not None and not args.json:
         raise refusal
     if args.plot:
         plots.plot_sweep(
@@ -207,7 +201,7 @@ def run_sweep(args: argparse.Namespace) -> int:
                 }
             )
         )
-        if nothing:
+        if refusal is not None:
             raise refusal
         return 0
     print(

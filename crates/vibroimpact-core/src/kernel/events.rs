@@ -18,7 +18,7 @@
 //! ([`crate::kernel::contacts`]); records and checks after each step
 //! ([`crate::kernel::records`]).
 
-use crate::error::{Error, Result};
+use crate::error::{at_least_one, Error, Result};
 pub use crate::kernel::balance::EnergyBalance;
 use crate::kernel::clock::Stop;
 use crate::kernel::contact_balance::OnsetBalance;
@@ -54,52 +54,31 @@ impl RunOptions {
     /// Refuses options no run can take, naming the field (the registry's
     /// ranges: [`crate::methods::registry`]): `t_end` finite and > 0, `dt`
     /// (where given) finite and > 0, `every` and `max_steps` at least 1,
-    /// `energy_tolerance` in (0, 1]; `record_from` and `contacts_from` not
-    /// NaN, `strobe_period` > 0 (infinite: none).
+    /// `energy_tolerance` in (0, 1]; `record_from` >= 0 and `strobe_period`
+    /// > 0 (each infinite: none), `contacts_from` not NaN.
     pub fn check(&self) -> Result<()> {
-        use crate::methods::registry::{DT, ENERGY_TOLERANCE, T_END};
+        use crate::methods::registry::{DT, ENERGY_TOLERANCE, RECORD_FROM, STROBE_PERIOD, T_END};
         T_END.check(self.t_end)?;
         if let Some(dt) = self.dt {
             DT.check(dt)?;
         }
         ENERGY_TOLERANCE.check(self.energy_tolerance)?;
-        for (field, value) in [("every", self.every), ("max_steps", self.max_steps)] {
-            if value == 0 {
-                return Err(Error::InvalidParameter {
-                    field,
-                    allowed: "a whole number >= 1",
-                    value: 0.0,
-                });
-            }
-        }
+        at_least_one("every", self.every)?;
+        at_least_one("max_steps", self.max_steps)?;
+        // Infinite: no record window, no strobe; any other value in the registry's range.
         let reduce = &self.reduce;
-        let refused = |field, allowed, value| {
-            Err(Error::InvalidParameter {
-                field,
-                allowed,
-                value,
-            })
-        };
-        if reduce.record_from.is_nan() || reduce.record_from < 0.0 {
-            return refused(
-                "record_from",
-                "a time >= 0 s (infinite: none)",
-                reduce.record_from,
-            );
+        if reduce.record_from != f64::INFINITY {
+            RECORD_FROM.check(reduce.record_from)?;
+        }
+        if reduce.strobe_period != f64::INFINITY {
+            STROBE_PERIOD.check(reduce.strobe_period)?;
         }
         if reduce.contacts_from.is_nan() {
-            return refused(
-                "contacts_from",
-                "a time in s, not NaN",
-                reduce.contacts_from,
-            );
-        }
-        if reduce.strobe_period.is_nan() || reduce.strobe_period <= 0.0 {
-            return refused(
-                "strobe_period",
-                "> 0 s (infinite: none)",
-                reduce.strobe_period,
-            );
+            return Err(Error::InvalidParameter {
+                field: "contacts_from",
+                allowed: "a time in s, not NaN",
+                value: reduce.contacts_from,
+            });
         }
         Ok(())
     }

@@ -10,7 +10,7 @@
 //! in a form whose terms are all of order one, so that every mode is right to
 //! round-off, and no mode number overflows.
 
-use crate::error::{positive, within, Error, Result};
+use crate::error::{at_least_one, positive, within, Error, Result};
 use crate::model::closed_forms::representable;
 
 /// `1 / cosh(x)` and `tanh(x)` for `x >= 0`, from `e^-x` so that neither
@@ -27,13 +27,7 @@ fn sech_tanh(x: f64) -> (f64, f64) {
 /// Newton's method on `cos(x) + 1/cosh(x) = 0` (the same roots; the form never
 /// overflows and its slope stays near 1), from the asymptote `(2i - 1) pi / 2`.
 pub fn cantilever_root(mode: u32) -> Result<f64> {
-    if mode == 0 {
-        return Err(Error::InvalidParameter {
-            field: "mode",
-            allowed: "a whole number >= 1",
-            value: 0.0,
-        });
-    }
+    at_least_one("mode", u64::from(mode))?;
     let mut x = (2.0 * f64::from(mode) - 1.0) * std::f64::consts::FRAC_PI_2;
     // Converges in at most 6 steps (mode 1, 0.3 from its start); the cap only
     // guards against a cycle at round-off.

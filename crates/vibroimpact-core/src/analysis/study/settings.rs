@@ -1,7 +1,7 @@
 //! Study settings: the method and limits of each run, and the analysis it makes.
 
-use crate::error::{Error, Result};
-use crate::methods::registry::{Options, DT, ENERGY_TOLERANCE, MAX_PERIODS, T_END};
+use crate::error::{at_least_one, Error, Result};
+use crate::methods::registry::{Options, DT, ENERGY_TOLERANCE, MAX_PERIODS, TOLERANCE, T_END};
 
 /// How each run of a study is made and what it keeps.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,9 +58,7 @@ impl StudySettings {
             DT.check(dt)?;
         }
         ENERGY_TOLERANCE.check(self.energy_tolerance)?;
-        if self.max_steps == 0 {
-            return Err(whole("max_steps", 1, 0));
-        }
+        at_least_one("max_steps", self.max_steps)?;
         let (settle, record) = match self.analysis {
             Analysis::Run { t_end, record_from } => {
                 T_END.check(t_end)?;
@@ -78,23 +76,11 @@ impl StudySettings {
                 record,
                 tolerance,
             } => {
-                if !(tolerance > 0.0 && tolerance.is_finite()) {
-                    return Err(Error::InvalidParameter {
-                        field: "tolerance",
-                        allowed: "a finite number > 0",
-                        value: tolerance,
-                    });
-                }
-                if record == 0 {
-                    return Err(whole("record_periods", 1, 0));
-                }
-                (settle, record)
+                TOLERANCE.check(tolerance)?;
+                (settle, at_least_one("record_periods", record)?)
             }
             Analysis::Orbit { settle, periods } => {
-                if periods == 0 {
-                    return Err(whole("orbit_periods", 1, 0));
-                }
-                (settle, periods)
+                (settle, at_least_one("orbit_periods", periods)?)
             }
         };
         match settle.checked_add(record) {
@@ -104,18 +90,5 @@ impl StudySettings {
                  and records at most {MAX_PERIODS} forcing periods in all"
             ))),
         }
-    }
-}
-
-/// A whole number below its least, `low`.
-fn whole(field: &'static str, low: u64, value: u64) -> Error {
-    Error::InvalidParameter {
-        field,
-        allowed: if low == 1 {
-            "a whole number >= 1"
-        } else {
-            "a whole number >= 0"
-        },
-        value: value as f64,
     }
 }

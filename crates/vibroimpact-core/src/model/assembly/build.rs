@@ -57,6 +57,7 @@ impl Assembly {
             friction_hold,
             floor_mass_acceleration: scales.floor_mass_acceleration,
             time_scale: scales.time_scale,
+            finest_signal: scales.finest_signal,
             n,
             k,
             dim,
@@ -569,6 +570,9 @@ struct TimeScales {
     longest_period: f64,
     time_scale: f64,
     floor_mass_acceleration: f64,
+    /// The finest interval over which a signal that is not a sum of
+    /// harmonics changes (s), with its signal's name.
+    finest_signal: Option<(f64, &'static str)>,
 }
 
 impl TimeScales {
@@ -590,9 +594,18 @@ impl TimeScales {
         let total_mass: f64 =
             linalg::dot(mass_influence, s.influence()) + damper_mass.iter().sum::<f64>();
         let mut acceleration = gravity;
+        let mut finest_signal: Option<(f64, &'static str)> = None;
         for excitation in &spec.excitations {
             let (largest, period) = excitation.signal.extent();
             shortest = shortest.min(period);
+            // A record's or random signal's shortest sample interval (half its
+            // extent's period), a sweep's half period at its highest frequency.
+            let interval = 0.5 * period;
+            if excitation.signal.has_breakpoints()
+                && finest_signal.is_none_or(|(f, _)| interval < f)
+            {
+                finest_signal = Some((interval, excitation.signal.harmonic_frequencies().0));
+            }
             acceleration += match excitation.load {
                 Load::Base => largest,
                 Load::Force { .. } => largest / total_mass,
@@ -622,6 +635,7 @@ impl TimeScales {
             longest_period,
             time_scale,
             floor_mass_acceleration: total_mass * acceleration * acceleration,
+            finest_signal,
         }
     }
 }

@@ -151,6 +151,8 @@ pub struct Assembly {
     /// [`Assembly::energy_floor`].
     floor_mass_acceleration: f64,
     time_scale: f64,
+    /// See [`Assembly::finest_signal_interval`] (found once, when assembled).
+    finest_signal: Option<(f64, &'static str)>,
     /// Pair names, as the contact table gives them ("damper 0", "stop 1").
     pub pairs: Vec<String>,
     /// The rows (over the structure coordinates, `n` each) of the points

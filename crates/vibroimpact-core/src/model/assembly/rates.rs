@@ -249,10 +249,7 @@ impl Assembly {
     /// highest frequency ([`Signal::extent`]); None without one. A fixed
     /// step longer than this passes over what the signal does in between.
     pub fn finest_signal_interval(&self) -> Option<(f64, &'static str)> {
-        self.signals()
-            .filter(|signal| signal.has_breakpoints())
-            .map(|signal| (0.5 * signal.extent().1, signal.harmonic_frequencies().0))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
+        self.finest_signal
     }
 
     /// The first kink of any excitation's signal after `time` (s; see

@@ -2,7 +2,7 @@
 //! stepping, the step and end time, what to keep, and the run's limits (steps,
 //! rows, energy balance), checked before it starts.
 
-use crate::error::{Error, Result};
+use crate::error::{at_least_one, Error, Result};
 use crate::kernel::contact_balance::CONTACT_CREATION_LIMIT;
 use crate::kernel::events::{self, RunOptions};
 use crate::methods::registry::{self, ATOL, RTOL};
@@ -216,20 +216,8 @@ impl Settings {
         // The registry's ranges and messages, as every other path's.
         let dt = dt.map(|dt| registry::DT.check(dt)).transpose()?;
         let t_end = registry::T_END.check(t_end)?;
-        if every == 0 {
-            return Err(Error::InvalidParameter {
-                field: "every",
-                allowed: "a whole number >= 1",
-                value: 0.0,
-            });
-        }
-        if max_steps == 0 {
-            return Err(Error::InvalidParameter {
-                field: "max_steps",
-                allowed: "a whole number >= 1",
-                value: 0.0,
-            });
-        }
+        at_least_one("every", every)?;
+        at_least_one("max_steps", max_steps)?;
         if dt.is_none() && !method.is_adaptive() {
             return Err(Error::Inconsistent(format!(
                 "dt is required for method {:?} (a step in s > 0)",
@@ -282,14 +270,7 @@ impl Settings {
         max_rows: Option<u64>,
         energy_tolerance: Option<f64>,
     ) -> Result<Self> {
-        let max_rows = max_rows.unwrap_or(DEFAULT_MAX_ROWS);
-        if max_rows == 0 {
-            return Err(Error::InvalidParameter {
-                field: "max_rows",
-                allowed: "a whole number >= 1",
-                value: 0.0,
-            });
-        }
+        let max_rows = at_least_one("max_rows", max_rows.unwrap_or(DEFAULT_MAX_ROWS))?;
         let energy_tolerance = match energy_tolerance {
             Some(tolerance) => checked_energy_tolerance(tolerance)?,
             None => DEFAULT_ENERGY_TOLERANCE,
