@@ -14,6 +14,7 @@ motion, independent of the engine (also the benchmark's peer).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -205,3 +206,10 @@ def simulate(
         else:
             mode = ("slide", math.copysign(1.0, u))
     return y, events
+
+
+@functools.cache
+def horizontal_damper_at(t_end: float) -> tuple[np.ndarray, int]:
+    """``simulate(HorizontalDamper(), t_end, max_step=2e-5)``, run once per process: the
+    event-driven scipy run takes some 20 s and several tests compare against it."""
+    return simulate(HorizontalDamper(), t_end, max_step=2e-5)
