@@ -65,6 +65,8 @@ cluster = LocalCluster(
     threads_per_worker=2,
     processes=False,
     dashboard_address=None,
+    # The scheduler's HTTP server on a free port, not 8787 (a cluster already running).
+    scheduler_kwargs={"dashboard_address": ":0"},
     silence_logs=logging.ERROR,
 )
 

@@ -37,6 +37,10 @@ def _run_on_dask(
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=None,
+                # No dashboard, but the scheduler still serves HTTP (health, metrics),
+                # by default on 8787: a free port, so a cluster already running (a
+                # notebook's) neither clashes nor is warned about.
+                scheduler_kwargs={"dashboard_address": ":0"},
                 # Its workers' own messages (an interrupt stops them too) are noise.
                 silence_logs=logging.CRITICAL,
             )
