@@ -11,6 +11,7 @@ from __future__ import annotations
 import inspect
 import os
 import resource
+import signal
 import subprocess
 import sys
 from collections.abc import Callable
@@ -122,6 +123,16 @@ def write_scenario(tmp_path: Path) -> Callable[[str, str], Path]:
 # Address space of a command run by a test, bytes: a run whose history grows without
 # bound fails there with an allocation error instead of taking the machine's memory.
 SUBPROCESS_MEMORY = 2 << 30
+
+
+def shell_signals() -> None:
+    """For subprocess.Popen(preexec_fn=...): the child takes Ctrl-C (SIGINT), SIGHUP and
+    SIGQUIT as a shell's child does. pytest-xdist's workers ignore them (so that Ctrl-C
+    reaches its controller alone), a child inherits an ignored signal, and Python then
+    installs no KeyboardInterrupt: a test interrupting its child waited for ever."""
+    for name in ("SIGINT", "SIGHUP", "SIGQUIT"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_DFL)
 
 
 def limit_memory() -> None:

@@ -20,6 +20,7 @@ from typing import Any
 import pytest
 
 import docs_blocks
+import vibroimpact as vi
 
 ROOT = Path(__file__).resolve().parents[1]
 BALL_TABLE = ROOT / "examples" / "bouncing_ball_table.toml"
@@ -358,6 +359,37 @@ def test_bad_sweep_sections_exit_2_naming_the_key(
 ) -> None:
     path = small_frf(tmp_path, change)
     assert_one_line_error(run_cli("sweep", str(path)), str(path), *fragments)
+
+
+@pytest.mark.parametrize(
+    ("change", "fragments"),
+    [
+        (
+            ('parameter = "excitation.0.frequency"', 'parameter = "excitation.0.freq"'),
+            ["[sweep] parameter", "[excitation] has no key 'freq'", "did you mean 'frequency'"],
+        ),
+        (
+            (
+                "[sweep]",
+                '[study]\nanalysis = "run"\n[study.axes]\n"damper.0.mas" = [0.1, 0.2]\n[sweep]',
+            ),
+            ["[study.axes]", "[damper] has no key 'mas'", "did you mean 'mass'"],
+        ),
+        (
+            ("[sweep]", '[continuation]\nparameter = "structure.stifness"\nstop = 1.0\n[sweep]'),
+            ["[continuation] parameter", "[structure] has no key 'stifness'"],
+        ),
+    ],
+    ids=["sweep", "study axis", "continuation"],
+)
+def test_a_misspelt_parameter_key_is_refused_when_the_file_is_read(
+    run_cli: RunCli, tmp_path: Path, change: tuple[str, str], fragments: list[str]
+) -> None:
+    # A plain run of the file had taken it; only the analysis refused it, later.
+    path = small_frf(tmp_path, change)
+    assert_one_line_error(run_cli("simulate", str(path)), str(path), *fragments)
+    with pytest.raises(ValueError, match=re.escape(fragments[1])):
+        vi.load(path)
 
 
 def test_sweep_without_a_sweep_section_exits_2(run_cli: RunCli, tmp_path: Path) -> None:

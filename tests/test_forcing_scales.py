@@ -4,6 +4,7 @@ blow-up advising a smaller dt; a free body had no bound at all)."""
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 import tomllib
@@ -121,12 +122,37 @@ def test_a_natural_period_the_run_cannot_resolve_is_refused(
     data = _oscillator(5.0, method)
     data["structure"].update(change)
     key = r"\[solver\] dt: the fastest mode" if method == "rk4" else r"\[solver\] t_end = 2\.0 s"
-    with pytest.raises(InvalidInputError, match=key + r".*max_steps|" + key + r".*below dt"):
+    with pytest.raises(
+        InvalidInputError, match=key + r".*max_steps|" + key + r".*below 2\.22 steps"
+    ):
         prepare_system(
             data["structure"],
             excitation=data["excitation"],
             solver={**data["solver"], "method": method},
         )
+
+
+@pytest.mark.parametrize("fixed", [False, True])
+def test_rk4_is_refused_where_it_is_unstable_and_runs_where_it_is_stable(fixed: bool) -> None:
+    # RK4 is stable on an undamped mode while omega dt <= 2 sqrt(2): a period of at least
+    # pi / sqrt(2) = 2.221 steps. A period of 1.5 steps had run, grown by 1e63 and stopped
+    # on the energy check ("energy balance violated", exit 1).
+    dt = 1e-3
+    stepping = {"stepping": "fixed"} if fixed else {}
+    for steps, stable in [(1.5, False), (2.2, False), (2.25, True), (3.0, True)]:
+        stiffness = (2 * math.pi / (steps * dt)) ** 2  # 1 kg, undamped
+        structure = {"kind": "oscillator", "mass": 1.0, "stiffness": stiffness}
+        initial = {"structure_displacement": [1e-3]}
+        # RK4 damps so coarse a mode (by 99 % in 0.03 s, which the energy check would
+        # call impossible): the tolerance admits it, to see it bounded.
+        solver = {"method": "rk4", "t_end": 0.2, "dt": dt, "energy_tolerance": 1.0, **stepping}
+        if not stable:
+            with pytest.raises(InvalidInputError, match=r"below 2\.22 steps of dt = 0\.001 s"):
+                prepare_system(structure, initial=initial, solver=solver)
+            continue
+        sol = prepare_system(structure, initial=initial, solver=solver).run()
+        # Stable: RK4 damps such a coarse mode, never grows it.
+        assert 0 < abs(sol.final_state["structure_displacement"][0]) <= 1e-3
 
 
 def test_a_resolvable_natural_period_runs() -> None:

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -467,6 +469,20 @@ def test_a_study_varies_a_damper_s_friction(tmp_path: Path) -> None:
         assert count == int((alone.contacts.to_pandas().kind == "impact").sum())
 
 
+def test_a_study_s_friction_above_the_static_names_the_damper_s_keys(tmp_path: Path) -> None:
+    import json
+
+    from vibroimpact.study import run
+
+    data = HorizontalDamper().toml_sections()
+    data["solver"] = {"t_end": 0.1, "method": "exact"}
+    data["study"] = {"axes": {"damper.0.friction": [0.5]}, "metrics": ["impacts"]}
+    result = run(vi.study_of(data), tmp_path / "friction.nc")
+    # It had named the friction element's keys, which a damper does not have.
+    (reason,) = json.loads(result.attrs["reasons"])
+    assert "damper 0 static_friction: must be >= friction 0.5" in reason, reason
+
+
 def _stick_slip_reference(t_end: float) -> float:
     """scipy's event-driven integration of ``x'' + 100 x + F sgn(x') = 1.2 sin(2 pi t)``
     (1 kg; 0.9 N sliding, 1 N static), stuck from rest until the spring and force pass
@@ -616,3 +632,96 @@ def test_a_cantilever_rubbing_at_its_tip_on_the_exact_flow_and_dop853() -> None:
         tips.append(sol.final_state["structure_displacement"])
     assert np.allclose(tips[0], tips[1], rtol=0, atol=1e-14)
     assert np.allclose(tips[0], tips[2], rtol=0, atol=1e-9)
+
+
+@pytest.mark.timeout(60)
+def test_masses_held_together_by_friction_move_as_one_body_by_the_exact_flow() -> None:
+    # Two masses on a spring, held by a [[friction]] element that never slips (0.16 N of
+    # spring force, 0.4 N held), under a constant load: one 1.6 kg body. With both
+    # masses stuck the only mode left is rigid, whose stiffness came out as round-off
+    # (1e-29, with no stiffer mode to judge it by): its static response F / w2 swamped the
+    # motion. The exact flow returned the start's positions at every t (input work 0,
+    # missed by the 5 % ledger), or an energy error under gravity.
+    structure = {
+        "kind": "matrices",
+        "mass": [[1.0, 0.0], [0.0, 0.6]],
+        "stiffness": [[400.0, -400.0], [-400.0, 400.0]],
+    }
+    held = [{"at": 1, "against": 0, "coefficient": 0.3, "static_coefficient": 0.4}]
+    held[0]["normal_force"] = 1.0
+    x0, v0, t_end = np.array([0.0, 4e-4]), 1.0, 0.5
+    force = [{"kind": "force", "at": 1, "signal": "harmonics"}]
+    force[0].update(amplitudes=[0.03], frequencies=[0.0])  # a constant 0.03 N
+    loads = {"excitation": force}, {"gravity": {"acceleration": 9.81}}
+    accelerations = 0.03 / 1.6, -9.81
+    for load, a in zip(loads, accelerations, strict=True):
+        sol = vi.simulate_system(
+            structure,
+            method="exact",
+            friction=held,
+            initial={"structure_displacement": x0.tolist(), "structure_velocity": [v0, v0]},
+            t_end=t_end,
+            **load,
+        )
+        f = sol.final_state
+        expected = x0 + v0 * t_end + 0.5 * a * t_end**2
+        assert np.allclose(f["structure_displacement"], expected, rtol=0, atol=1e-12), load
+        assert np.allclose(f["structure_velocity"], v0 + a * t_end, rtol=0, atol=1e-12)
+        assert abs(sol.energy["residual"]) < 1e-12
+
+
+@pytest.mark.timeout(60)
+def test_a_continuation_ending_on_a_damper_with_friction_ends_without_a_traceback(
+    tmp_path: Path,
+) -> None:
+    # Where the corrector failed, the grazings ahead were sought on every pair named
+    # "damper ...": the damper's friction, "damper 0 friction", was taken for a damper's
+    # wall ("damper 0 friction upper"), a KeyError and a traceback (exit 1).
+    from vibroimpact.analysis.grazing import walls
+
+    names = ["damper 0", "damper 0 friction", "stop 1", "friction 0", "collision 0"]
+    assert walls(names) == ["damper 0 upper", "damper 0 lower", "stop 1"]
+    text = """
+[structure]
+kind = "oscillator"
+mass = 1.0
+stiffness = 4000.0
+damping = 2.0
+[[damper]]
+mass = 0.1
+at = 0
+clearance = 0.01
+law = "rigid"
+restitution = 0.6
+friction = 0.2
+static_friction = 0.3
+normal_force = 0.981
+[[excitation]]
+kind = "force"
+at = 0
+signal = "harmonic"
+amplitude = 50.0
+frequency = 4.0
+[solver]
+method = "exact"
+t_end = 1.0
+[initial]
+structure_displacement = [0.01521499070420853]
+damper_displacement = [0.01600750284188991]
+structure_velocity = [-0.0335928489612893]
+damper_velocity = [0.29798609918843927]
+[continuation]
+parameter = "excitation.0.frequency"
+stop = 9.0
+step = 0.1
+"""
+    path = tmp_path / "continue.toml"
+    path.write_text(text)
+    done = subprocess.run(
+        [sys.executable, "-m", "vibroimpact", "continue", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=50,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr and "orbits of 1 period" in done.stdout

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import shell_signals
 from study_checks import FORCED_DAMPER  # noqa: E402
 
 LONG_RUN = """
@@ -31,6 +32,7 @@ def test_sigint_interrupts_a_long_run_with_keyboard_interrupt() -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=shell_signals,
     )
     assert proc.stdout is not None and proc.stdout.readline().strip() == "started"
     time.sleep(0.3)
@@ -61,6 +63,7 @@ def test_sigint_stops_a_study_within_its_chunk(tmp_path: Path) -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=shell_signals,
     )
     # Once the study has started its chunks (its parts folder made), not while Python
     # is still starting.

@@ -17,6 +17,7 @@ from typing import Any
 
 import pytest
 
+from conftest import shell_signals
 from vibroimpact import output
 from vibroimpact.output import beside, written_whole
 
@@ -53,6 +54,7 @@ def long_writer(tmp_path: Path, out: Path) -> subprocess.Popen[str]:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=shell_signals,
     )
 
 

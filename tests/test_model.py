@@ -694,11 +694,20 @@ def test_from_dict_names_what_its_parts_cannot_take() -> None:
         ({"structure": {"mass": 1.0}}, "[structure] missing key 'kind'"),
         ({"structure": oscillator, "solver": 5}, "[solver] must be a table, got 5"),
         ({"structure": oscillator, "extra": {}}, "unknown section [extra]"),
+        # A key above the first section is no section (it had read "unknown section [title]").
+        ({"structure": oscillator, "title": "x"}, "unknown key 'title' above the first section"),
     ]  # fmt: skip
     for sections, expected in cases:
         with pytest.raises(vi.InvalidInputError) as caught:
             vi.System.from_dict(sections)
         assert str(caught.value).startswith(expected), caught.value
+    # The same in a file, with and without [solver].
+    for solver in ('[solver]\nmethod = "rk4"\nt_end = 0.1\n', ""):
+        text = (
+            f'title = "x"\n[structure]\nkind = "oscillator"\nmass = 1.0\nstiffness = 1.0\n{solver}'
+        )
+        with pytest.raises(ValueError, match=r"unknown key 'title' above the first section"):
+            vi.loads(text)
 
 
 def test_a_system_pickles_and_hashes() -> None:

@@ -685,3 +685,82 @@ def test_the_heat_map_of_a_study_whose_every_run_failed(tmp_path: Path) -> None:
     png = tmp_path / "heat.png"
     plot_study(png, dataset, "peak", "damper.0.mass", "damper.0.clearance")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_an_output_that_is_a_folder_is_refused_before_any_run(tmp_path: Path) -> None:
+    # The command refused it up front; the Python call ran every run first, then failed,
+    # and its note's way to resume failed the same way.
+    study = load(scenario(tmp_path, BASE + STEADY))
+    folder = tmp_path / "result.nc"
+    folder.mkdir()
+    progressed: list[int] = []
+    with pytest.raises(ValueError, match="not a regular file"):
+        st.run(study, folder, progress=lambda done, total, rate: progressed.append(done))
+    assert progressed == [] and list(folder.iterdir()) == []
+
+
+def test_a_scenario_read_by_a_relative_path_keeps_its_folder_wherever_the_runs_are(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A recorded signal's relative file is read from the scenario's folder: that folder
+    # had been kept as "." when the scenario was named relative to the current folder, so
+    # a Dask worker started elsewhere did not find the file.
+    folder = tmp_path / "case"
+    folder.mkdir()
+    (folder / "force.csv").write_text("time,value\n0,0\n0.1,5\n0.5,0\n")
+    text = BASE.replace(
+        'signal = "harmonic"\namplitude = 5.0\nfrequency = 10.0',
+        'signal = "recorded"\nfile = "force.csv"',
+    )
+    text = text.replace('method = "exact"', 'method = "dop853"')
+    text += '\n[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+    text += '[study.axes]\n"damper.0.clearance" = [0.002, 0.004]\n'
+    (folder / "study.toml").write_text(text)
+    monkeypatch.chdir(folder)
+    study = load(Path("study.toml"))
+    monkeypatch.chdir(tmp_path)  # where a worker might run
+    done = st.run(study, tmp_path / "out.nc")
+    assert (done["status"].values == 0).all(), done.attrs.get("reasons")
+    assert (done["peak"].values > 0).all()
+
+
+# The forced damper's oscillator and force without the damper, by RK4 at dt = 1 ms.
+LINEAR = (
+    BASE.replace(BASE[BASE.index("[[damper]]") : BASE.index("[[excitation]]")], "")
+    .replace('method = "exact"', 'method = "rk4"\ndt = 0.001')
+    .replace("t_end = 0.5", "t_end = 0.2")
+)
+
+
+@pytest.mark.parametrize("stepping", ["events", "fixed"])
+def test_a_point_whose_forcing_its_step_cannot_sample_fails_as_its_run_is_refused(
+    tmp_path: Path, stepping: str
+) -> None:
+    # 2 kHz sampled by dt = 1e-3 s falls at one phase at every stage: a constant load. A
+    # single run of the point is refused; the study had run it (status 0, a "settled"
+    # amplitude of 126 m where the closed form gives micrometres).
+    text = LINEAR + f'[study]\nanalysis = "run"\nstepping = "{stepping}"\nmetrics = ["peak"]\n'
+    text += '[study.axes]\n"excitation.0.frequency" = [10.0, 2000.0]\n'
+    done = st.run(load(scenario(tmp_path, text)), tmp_path / "out.nc")
+    assert done["status"].values.tolist() == [0, 1]
+    reasons = json.loads(done.attrs["reasons"])
+    assert len(reasons) == 1 and "sampled below two steps of dt" in reasons[0], reasons
+    alone = vi.simulate(vi.loads(LINEAR), stepping=stepping, history=False, record_from=0.0)
+    assert done["peak"].values[0][0] == alone.peak[0]
+
+
+@pytest.mark.parametrize("where", ["output", "study"])
+def test_a_record_window_shorter_than_a_fixed_step_is_refused(tmp_path: Path, where: str) -> None:
+    # No fixed step ends in it: the run recorded nothing, a peak of NaN (a study's lanes:
+    # 0.0) with status 0.
+    window = "record_from = 0.1995\n"
+    if where == "output":
+        text = LINEAR.replace("t_end = 0.2\n", 't_end = 0.2\nstepping = "fixed"\n')
+        text += f"[output]\n{window}"
+        with pytest.raises(ValueError, match=r"record_from: must leave at least one step"):
+            vi.loads(text)
+        return
+    text = LINEAR + f'[study]\nanalysis = "run"\nstepping = "fixed"\n{window}metrics = ["peak"]\n'
+    text += '[study.axes]\n"excitation.0.frequency" = [10.0]\n'
+    with pytest.raises(ValueError, match=r"\[study\] record_from: must leave at least one step"):
+        load(scenario(tmp_path, text))

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import vibroimpact as vi
+from conftest import shell_signals
 from study_checks import FORCED_DAMPER, load_study
 from vibroimpact import study as st
 
@@ -124,7 +125,11 @@ RACE = textwrap.dedent(
 def test_ctrl_c_between_a_chunks_last_step_and_its_end_stops_the_study(fraction: float) -> None:
     script = RACE.format(tests=str(Path(__file__).parent), fraction=fraction)
     done = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, timeout=100
+        [sys.executable, "-c", script],
+        capture_output=True,
+        text=True,
+        timeout=100,
+        preexec_fn=shell_signals,
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "interrupted"

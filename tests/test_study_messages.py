@@ -11,16 +11,26 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 import xarray as xr
 
+from conftest import shell_signals
 from study_checks import FORCED_DAMPER  # noqa: E402
 from test_study import BASE, STEADY, Stop, cli, load, scenario
 from test_study_orbit import LINEAR
 from vibroimpact import study as st
 from vibroimpact.analysis import runner, steady_state, with_parameter
+
+# A child that takes Ctrl-C, its output read as text.
+INTERRUPTIBLE: dict[str, Any] = {
+    "stdout": subprocess.PIPE,
+    "stderr": subprocess.PIPE,
+    "text": True,
+    "preexec_fn": shell_signals,
+}
 
 # Four runs of a chunk each: the first two fail at once (a clearance below zero fails
 # its run alone), the other two run for 1e6 s, so the interrupt finds two chunks kept.
@@ -48,7 +58,7 @@ def test_an_interrupted_study_names_the_chunks_kept_and_the_resume_command(
     path = scenario(tmp_path, SLOW)
     out = tmp_path / "out.nc"
     command = [sys.executable, "-m", "vibroimpact", "study", str(path), "--out", str(out)]
-    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(command, **INTERRUPTIBLE)
     parts = tmp_path / "out.nc.parts"
     started(proc, parts / "chunk-000001.npz")
     time.sleep(0.3)
@@ -62,7 +72,7 @@ def test_an_interrupted_study_names_the_chunks_kept_and_the_resume_command(
         f"again: vibroimpact study {path} --out {out}"
     )
     # The command it gives resumes, and says so.
-    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(command, **INTERRUPTIBLE)
     assert proc.stderr is not None
     first = proc.stderr.readline()
     proc.send_signal(signal.SIGINT)

@@ -89,7 +89,14 @@ def _analysis_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
 
 
 def _two_mass_sections() -> dict[str, tuple[str, dict[str, tuple[str, Any]]]]:
-    return {name: (f"[{name}]", keys) for name, keys in two_mass._SCHEMA.items()}
+    sections = {name: (f"[{name}]", dict(keys)) for name, keys in two_mass._SCHEMA.items()}
+    # The run bounds the two-mass schema leaves to the core (None) take the same defaults
+    # as a system's (the core registry's), which its schema writes out.
+    solver = sections["solver"][1]
+    for key in ("energy_tolerance", "max_rows"):
+        if solver[key][1] is None:
+            solver[key] = (solver[key][0], schema._SOLVER[key][1])
+    return sections
 
 
 def _two_mass_methods() -> list[str]:

@@ -46,3 +46,17 @@ def short_numbers(text: str) -> str:
     """``text`` with every number written in full (21 digits or more, or 6 leading zeros
     after the point) rewritten as the ``repr`` of its float, exact and short."""
     return _LONG.sub(lambda m: repr(float(m.group())), text)
+
+
+def unknown_section(name: str, value: Any, allowed: str) -> str:
+    """The message for a name at a scenario's top level that is none of its sections:
+    a table (``[title]``), or a key written above the first section (``title = "x"``),
+    which is no section at all. ``allowed`` is the note in parentheses."""
+    table = isinstance(value, dict) or (
+        isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)
+    )
+    if table:
+        return f"unknown section [{name}] ({allowed})"
+    return (
+        f"unknown key {name!r} above the first section: a scenario holds sections only ({allowed})"
+    )

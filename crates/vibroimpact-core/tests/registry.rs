@@ -99,7 +99,19 @@ fn an_explicit_step_over_the_fastest_period_is_refused() {
         refused(
             &stiff,
             &plan("rk4", Some(1e-5), 1e-3),
-            &["[solver] dt: the fastest mode's period, 6.28e-06 s (1.59e+05 Hz), is below dt = 1e-05 s"],
+            &["[solver] dt: the fastest mode's period, 6.28e-06 s (1.59e+05 Hz), is below 2.22 steps of dt = 1e-05 s"],
+        );
+        // RK4 is stable while omega dt <= 2 sqrt(2): a period of pi / sqrt(2) steps.
+        let period = std::f64::consts::TAU / 1e6;
+        let limit = period * std::f64::consts::SQRT_2 / std::f64::consts::PI;
+        refused(
+            &stiff,
+            &plan("rk4", Some(1.01 * limit), 1e-3),
+            &["is below 2.22 steps"],
+        );
+        assert_eq!(
+            check_run(&stiff, &plan("rk4", Some(0.99 * limit), 1e-3)),
+            Ok(())
         );
         // Implicit methods are stable on it.
         assert_eq!(

@@ -71,15 +71,23 @@ class Grazing:
 SIDES = {"upper": -1.0, "lower": 1.0}
 
 
+def _kind(pair: str) -> str:
+    """``"damper"`` or ``"stop"`` for a damper's walls or a stop (``"damper 0"``,
+    ``"stop 1"``), else ``""``: a damper's friction (``"damper 0 friction"``), a friction
+    element or a collision has no wall."""
+    words = pair.split()
+    return words[0] if len(words) == 2 and words[0] in ("damper", "stop") else ""
+
+
 def walls(pairs: list[str]) -> list[str]:
     """The walls of the pairs named ``pairs`` whose grazing is located: a stop is its
     own wall (``"stop 0"``), a damper has two (``"damper 0 upper"``, ``"damper 0
-    lower"``); collisions between loose masses are not located."""
+    lower"``); collisions between loose masses and friction are not located."""
     out: list[str] = []
     for pair in pairs:
-        if pair.startswith("damper "):
+        if _kind(pair) == "damper":
             out.extend(f"{pair} {side}" for side in SIDES)
-        elif pair.startswith("stop "):
+        elif _kind(pair) == "stop":
             out.append(pair)
     return out
 
@@ -193,7 +201,7 @@ def struck(run: Runner, state: np.ndarray, periods: int) -> set[str]:
         name = names[p]
         if kind not in ("impact", "compliant"):
             continue
-        if not name.startswith("damper "):
+        if _kind(name) != "damper":
             hit.add(name)
         elif not {f"{name} {side}" for side in SIDES} <= hit:
             hit.add(_side_struck(run, state, name, float(onset)))

@@ -8,6 +8,7 @@ import os
 from pathlib import Path
 
 from vibroimpact import arguments
+from vibroimpact.messages import unknown_section
 from vibroimpact.model.parts import Damper, Initial, Oscillator, Output, Solver
 from vibroimpact.model.system import System
 from vibroimpact.scenario.system import SECTIONS, system_scenario
@@ -70,10 +71,8 @@ def loads(text: str, source: str = "<scenario>", base_dir: Path | None = None) -
             # A system written without [solver] (System.to_toml of a bare System).
             for name in data:
                 if name not in SECTIONS:
-                    raise ScenarioError(
-                        f"{source}: unknown section [{name}] (allowed with [structure]: "
-                        f"{', '.join(SECTIONS)})"
-                    )
+                    allowed = f"allowed with [structure]: {', '.join(SECTIONS)}"
+                    raise ScenarioError(f"{source}: {unknown_section(name, data[name], allowed)}")
     except ValueError as err:
         raise ScenarioError(str(err)) from None
     try:

@@ -13,7 +13,7 @@ from typing import Any, TypeVar
 
 from vibroimpact._core import InvalidInputError, PreparedSystem
 from vibroimpact.arguments import directory
-from vibroimpact.messages import shown
+from vibroimpact.messages import shown, unknown_section
 from vibroimpact.model.modes import frequencies_summary
 from vibroimpact.model.parts import (
     SIGNALS,
@@ -174,7 +174,10 @@ class System:
         through the core, which holds the model's ranges (a damper's mass > 0, a
         frequency >= 0, ...): a System that is built is one that runs, and a bad value is
         refused where it is written, not when it is first simulated."""
+        from vibroimpact.analysis.parameters import check_parameter_keys
+
         sections = self.to_dict()
+        check_parameter_keys(sections)
         model = self.model_sections()
         if self.solver is not None and self.solver.t_end is not None:
             run = prepare_system(
@@ -282,10 +285,11 @@ class System:
         known = {name for name in RUN_SECTIONS if name not in ("solver", "output")}
         for name in sections:
             if name not in known | {"solver", "output", *ANALYSIS_SECTIONS}:
-                raise InvalidInputError(
-                    f"unknown section [{name}] (allowed: {', '.join(sorted(known))}, solver, "
-                    f"output, {', '.join(ANALYSIS_SECTIONS)})"
+                allowed = (
+                    f"allowed: {', '.join(sorted(known))}, solver, output, "
+                    f"{', '.join(ANALYSIS_SECTIONS)}"
                 )
+                raise InvalidInputError(unknown_section(name, sections[name], allowed))
         if "structure" not in sections:
             raise InvalidInputError("missing section [structure]")
         try:

@@ -165,7 +165,8 @@ the paper's matrix equations (this is also the convention of the independent ref
 Our exact value differs from the independent one by {abs(exact / REFERENCE_ELASTIC - 1):.1e}
 (relative; the reference is printed to 7 digits). Goldsmith's formula treats two free
 bodies: it omits `K`, `C` and `c1`, so the model's own duration is
-{(exact / gold - 1) * 100:.3f} % longer. Errors below are therefore given against both:
+{(exact / found.goldsmith_exact_constant - 1) * 100:.3f} % longer than Goldsmith's with the
+exact constant ({(exact / gold - 1) * 100:.3f} % longer than with the printed 2.9432). Errors below are therefore given against both:
 "vs Goldsmith" (the paper's choice) and "vs exact model" (what measures a numerical method).
 
 ## Table 2: contact duration, ours beside the paper's
@@ -337,7 +338,7 @@ def _differences(rows: list[Row], found: Findings) -> str:
   generalized-alpha (dashed, open circles) err alike to a few per cent and lie on each other.
   RK4 with the paper's stepping levels off near 1e-6 and then falls only as `dt` (order 1): its
   fixed steps straddle each onset, where the contact damper's force `c1 v` jumps from 0 to
-  1e-3 N, and RK4's stages integrate a jump to O(dt); the figure's note says so (see below).
+  1e-3 N, and RK4's stages integrate a jump to O(dt); the note in `work_precision.png` says so.
 """
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
+from vibroimpact.messages import unknown_section
 from vibroimpact.model.system import ANALYSIS_SECTIONS
 from vibroimpact.output import finite_or_none, written_whole
 from vibroimpact.system import (
@@ -59,10 +60,8 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
     the section and the key."""
     for name in data:
         if name not in SECTIONS:
-            raise InvalidInputError(
-                f"{source}: unknown section [{name}] (allowed with [structure]: "
-                f"{', '.join(SECTIONS)})"
-            )
+            allowed = f"allowed with [structure]: {', '.join(SECTIONS)}"
+            raise InvalidInputError(f"{source}: {unknown_section(name, data[name], allowed)}")
     if "solver" not in data:
         raise InvalidInputError(f"{source}: missing section [solver]")
     try:
@@ -83,6 +82,7 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
         raise InvalidInputError(f"{source}: {err}") from None
     data = dict(data)
     from vibroimpact.analysis import SETTINGS
+    from vibroimpact.analysis.parameters import check_parameter_keys
     from vibroimpact.study import checked_study_settings
 
     # [study] is checked, its axes and draws left unmade (a study makes them).
@@ -92,6 +92,10 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
                 data[section] = check(data[section])
             except InvalidInputError as err:
                 raise InvalidInputError(f"{source}: {err}") from None
+    try:
+        check_parameter_keys(data)
+    except InvalidInputError as err:
+        raise InvalidInputError(f"{source}: {err}") from None
     return SystemScenario(source, prepared, data, base_dir)
 
 

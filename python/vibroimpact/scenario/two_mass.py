@@ -330,7 +330,9 @@ def _validate_solver(scenario: Scenario, source: str) -> None:
 def load_scenario(path: str | Path) -> Scenario | SystemScenario:
     """Read and validate a TOML scenario file (UTF-8, at most ``MAX_SCENARIO_BYTES``)."""
     path = arguments.path("path", path)
-    return parse_scenario(read_scenario_text(path), str(path), path.parent)
+    # The folder made absolute: a study's Dask workers, started elsewhere, read a
+    # recorded signal's relative file from it (".", theirs, had not found it).
+    return parse_scenario(read_scenario_text(path), str(path), path.parent.resolve())
 
 
 def read_scenario_text(path: Path) -> str:

@@ -18,7 +18,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact.netcdf import write_netcdf
-from vibroimpact.output import UsageError, remove_stale, written_whole
+from vibroimpact.output import UsageError, check_output, remove_stale, written_whole
 from vibroimpact.study.assembly import assemble
 from vibroimpact.study.grid import Study, chunk_part
 from vibroimpact.study.limits import check_threads
@@ -76,6 +76,10 @@ def run(
     arguments.text("resume", resume)
     check_threads(threads, "threads:")
     kind = output_kind(out)
+    if kind != ".zarr":
+        # Refused before any run, as the command refuses it (a folder was found only
+        # once every run was done, and resuming failed the same way).
+        check_output(out, "out:")
     # What a killed write left: an earlier store moved aside is back before any run.
     remove_stale(out.resolve() if out.is_symlink() else out)
     parts_dir = out.with_name(out.name + ".parts")

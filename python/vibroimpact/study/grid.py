@@ -21,6 +21,7 @@ from vibroimpact.model.system import System, sections_of
 from vibroimpact.study.beam_axes import beam_corners, resolve_beam_axes
 from vibroimpact.study.limits import StudyError, check_study_memory, check_threads
 from vibroimpact.study.settings import base_metrics, study_settings
+from vibroimpact.system.run import check_fixed_window
 
 
 @dataclass
@@ -181,6 +182,14 @@ def study_of(
                 f"{source}: [study] record_from: must be before [solver] t_end "
                 f"({t_end!r} s), got {checked['record_from']!r}"
             )
+        # The study's stepping, not the scenario's, says whether its steps are fixed.
+        stepped = {**study.prepared().solver, "stepping": checked["stepping"]}
+        try:
+            check_fixed_window(
+                "[study] record_from: ", checked["record_from"], t_end, stepped, "stepping"
+            )
+        except InvalidInputError as err:
+            raise StudyError(f"{source}: {err}") from None
     # The base scenario and every axis path are checked by a run of none.
     shape = study.run_chunk(range(0, 0))
     # Each structure coordinate, then each followed point and moment.

@@ -285,6 +285,9 @@ def prepare_system(
             "[output] record_from: ",
             f"must be before [solver] t_end ({solver['t_end']!r} s), got {output['record_from']!r}",
         )
+    check_fixed_window(
+        "[output] record_from: ", output["record_from"], solver["t_end"], solver, "stepping"
+    )
     followed = len(output["points"]) + len(output["moments"])
     if followed > MAX_POINTS:
         raise _fail(
@@ -398,3 +401,21 @@ _CHECKED = (
     *(key for key in METHOD_OPTIONS if key != "max_steps"),
     "energy_tolerance",
 )
+
+
+def check_fixed_window(
+    where: str, record_from: float | None, t_end: float, solver: Mapping[str, Any], stepping: str
+) -> None:
+    """Refuse a record window (from ``record_from`` to ``t_end``, s) shorter than one step
+    of ``solver``'s ``dt`` when its ``stepping`` (the key that says it) is fixed: no step
+    ends in it, and the run recorded nothing (a peak of NaN, or 0 in a study's lanes)
+    without a word. With events, the run steps to the window's start."""
+    dt = solver.get("dt")
+    if record_from is None or solver.get(stepping) != "fixed" or dt is None:
+        return
+    if t_end - record_from < dt:
+        raise _fail(
+            where,
+            f"must leave at least one step of dt = {dt!r} s before [solver] t_end "
+            f"({t_end!r} s) with fixed steps, got {record_from!r} (nothing would be recorded)",
+        )

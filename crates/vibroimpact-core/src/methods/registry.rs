@@ -15,7 +15,10 @@ pub mod two_mass;
 
 pub use defaults::{ModelKind, RunDefaults, RUN_DEFAULTS, SYSTEM, TWO_MASS};
 pub use forcing::{check_forcing_period, ForcingPlan};
-pub use limits::{check_run, check_scales, check_step_within, RunPlan, RunScales, MAX_PERIODS};
+pub use limits::{
+    check_run, check_scales, check_step_within, check_steps_resolve, RunPlan, RunScales,
+    MAX_PERIODS,
+};
 pub use table::{
     check_settings, method, Kind, MethodSpec, OptionSpec, Options, ATOL, BETA, DEFAULT_MAX_ROWS,
     DEFAULT_MAX_STEPS, DT, ENERGY_TOLERANCE, FORCING_PERIOD, GAMMA, MAX_STEPS, METHOD_OPTIONS,

@@ -4,7 +4,7 @@
 //! run is reduced to ([`metrics_of`]).
 
 use super::metrics::{metrics_of, RunMetrics};
-use super::parameters::Parameter;
+use super::parameters::{row_system, Parameter};
 use super::run::{failed_run, run_options};
 use super::settings::StudySettings;
 
@@ -62,14 +62,9 @@ pub(super) fn run_compact_lanes(
     // Each row's system and start, or why it has none.
     let members: Vec<Member> = (0..rows)
         .map(|row| {
-            let mut spec = spec.clone();
-            let mut initial = initial.clone();
             let row_values = &values[(row * width).min(values.len())..][..parameters.len()];
-            for (p, v) in parameters.iter().zip(row_values) {
-                if let Err(e) = p.apply(&mut spec, &mut initial, *v) {
-                    return Err(e.to_string());
-                }
-            }
+            let (spec, initial) = row_system(spec, initial, parameters, row_values, settings)
+                .map_err(|e| e.to_string())?;
             if let Some(unfit) = unfit_for_lanes(&spec) {
                 return Err(unfit.to_string());
             }

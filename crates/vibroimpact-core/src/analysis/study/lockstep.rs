@@ -1,7 +1,7 @@
 //! Fixed-step studies: the runs as a lockstep ensemble of RK4 steps.
 
 use super::metrics::RunMetrics;
-use super::parameters::Parameter;
+use super::parameters::{row_system, Parameter};
 use super::settings::{Analysis, StudySettings};
 
 use crate::analysis::ensemble::{run_ensemble, EnsembleOptions, Member};
@@ -69,13 +69,9 @@ pub(super) fn run_lockstep(
     let width = parameters.len().max(1);
     let members: Vec<std::result::Result<Member, String>> = (0..rows)
         .map(|row| {
-            let mut spec = spec.clone();
-            let mut initial = initial.clone();
             let row_values = &values[(row * width).min(values.len())..][..parameters.len()];
-            for (p, v) in parameters.iter().zip(row_values) {
-                p.apply(&mut spec, &mut initial, *v)
-                    .map_err(|e| e.to_string())?;
-            }
+            let (spec, initial) = row_system(spec, initial, parameters, row_values, settings)
+                .map_err(|e| e.to_string())?;
             member_of(&spec, &initial).map_err(|e| e.to_string())
         })
         .collect();

@@ -1,7 +1,9 @@
 //! The parameters a study varies: dotted paths into the scenario, parsed
 //! once and applied to a copy of the base system for each run.
 
+use super::settings::StudySettings;
 use crate::error::{Error, Result};
+use crate::methods::registry::check_steps_resolve;
 use crate::model::assembly::{FrictionSite, Load, PairLaw, SystemSpec};
 use crate::model::contact::Contact;
 use crate::model::signals::{RecipeKey, Signal};
@@ -419,6 +421,27 @@ impl Parameter {
 }
 
 /// A core error about an input of `section` (a dotted path), named by it.
+/// The study's system and start at one row's `values`: the parameters
+/// applied, then the checks a single run of that point makes before its
+/// first step and the values can change ([`check_steps_resolve`]). A study
+/// had run such points: a 2 kHz force sampled at one phase by dt = 1e-3 s
+/// was a constant load, and 126 m a "settled" amplitude.
+pub(super) fn row_system(
+    spec: &SystemSpec,
+    initial: &[Vec<f64>; 4],
+    parameters: &[Parameter],
+    values: &[f64],
+    settings: &StudySettings,
+) -> Result<(SystemSpec, [Vec<f64>; 4])> {
+    let mut spec = spec.clone();
+    let mut initial = initial.clone();
+    for (p, v) in parameters.iter().zip(values) {
+        p.apply(&mut spec, &mut initial, *v)?;
+    }
+    check_steps_resolve(&spec, &settings.method, settings.dt)?;
+    Ok((spec, initial))
+}
+
 pub(super) fn in_section(section: &str, e: Error) -> Error {
     match e {
         Error::InvalidParameter { .. } | Error::UnknownChoice { .. } => {

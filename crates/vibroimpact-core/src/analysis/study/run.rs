@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::lockstep::run_lockstep;
 use super::metrics::{metrics_of, orbit_metrics, recorded_periods, RunMetrics};
-use super::parameters::{Parameter, Target};
+use super::parameters::{row_system, Parameter, Target};
 use super::settings::{Analysis, StudySettings};
 use crate::analysis::tangent::Tangent;
 use crate::error::{Error, Result};
@@ -186,13 +186,10 @@ pub(super) fn one_run(
     settings: &StudySettings,
     interrupt: &(dyn Fn() -> bool + Sync),
 ) -> Result<RunMetrics> {
-    let mut spec = spec.clone();
-    let mut initial = initial.clone();
-    for (p, v) in parameters.iter().zip(values) {
-        if let Err(e) = p.apply(&mut spec, &mut initial, *v) {
-            return Ok(failed_run(&spec, e.to_string()));
-        }
-    }
+    let (spec, initial) = match row_system(spec, initial, parameters, values, settings) {
+        Ok(row) => row,
+        Err(e) => return Ok(failed_run(spec, e.to_string())),
+    };
     match measured(&spec, &initial, settings, interrupt) {
         Ok(metrics) => Ok(metrics),
         Err(e @ Error::Interrupted { .. }) => Err(e),

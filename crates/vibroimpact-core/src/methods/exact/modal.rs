@@ -128,7 +128,10 @@ impl Configuration {
         // constant force's particular response `F t / c` would be huge, and
         // the start's correction cancelling it would lose every digit (the
         // exact flow had drifted 1e-2 of the input work off the ledger).
-        let largest = cm.iter().step_by(r + 1).fold(0.0f64, |m, c| m.max(c.abs()));
+        let largest = cm
+            .iter()
+            .step_by(r + 1)
+            .fold(reduced.damping_scale, |m, c| m.max(c.abs()));
         let damping: Vec<f64> = (0..r)
             .map(|i| {
                 let c = cm[i * r + i].max(0.0);
@@ -229,7 +232,7 @@ fn normal_modes(reduced: &Reduced, what: &str) -> Result<Option<NormalModes>> {
     let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     align_repeated(&values, &mut phi, cr, r, scale);
     let cm = modal_damping(cr, &phi, r);
-    let largest = (0..r).fold(0.0f64, |m, i| m.max(cm[i * r + i].abs()));
+    let largest = (0..r).fold(reduced.damping_scale, |m, i| m.max(cm[i * r + i].abs()));
     for p in 0..r {
         for q in p + 1..r {
             if cm[p * r + q].abs() > 1e-9 * largest {
@@ -237,9 +240,14 @@ fn normal_modes(reduced: &Reduced, what: &str) -> Result<Option<NormalModes>> {
             }
         }
     }
+    // Rigid-body modes: round-off of zero, against the unconstrained
+    // system's scale too (at least its modes' largest value, by Rayleigh's
+    // quotient, so it changes only systems whose constraints took the stiff
+    // directions: there a rigid mode's 1e-29 had been taken for a stiffness,
+    // its constant load's static response `F / w2` for 1e27 m).
+    let rigid = scale.max(reduced.stiffness_scale);
     for v in values.iter_mut() {
-        // Rigid-body modes: round-off of zero.
-        if v.abs() <= 1e-12 * scale {
+        if v.abs() <= 1e-12 * rigid {
             *v = 0.0;
         }
     }
@@ -393,6 +401,13 @@ pub struct Reduced {
     pub mass: Vec<f64>,
     pub stiffness: Vec<f64>,
     pub damping: Vec<f64>,
+    /// The unconstrained system's largest `K_ii / M_ii` (1/s^2) and `C_ii /
+    /// M_ii` (1/s): the scales of the reduced matrices' round-off. Where the
+    /// constraints take every stiff direction (a spring between two masses
+    /// stuck together) the reduced system's own values are all round-off, and
+    /// no scale of their own tells it.
+    pub stiffness_scale: f64,
+    pub damping_scale: f64,
 }
 
 /// `A B` of two `r x r` row-major matrices, the zeros of `A` skipped (the
@@ -472,8 +487,15 @@ impl Reduced {
             }
             out
         };
+        let diagonal_scale = |a: &[f64]| {
+            (0..dim).fold(0.0f64, |m, i| {
+                m.max(a[i * dim + i].abs() / parts.mass[i * dim + i])
+            })
+        };
         Self {
             size: r,
+            stiffness_scale: diagonal_scale(&parts.stiffness),
+            damping_scale: diagonal_scale(&parts.damping),
             mass: reduce(&parts.mass),
             stiffness: reduce(&parts.stiffness),
             damping: reduce(&parts.damping),

@@ -79,6 +79,28 @@ pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
     check_scales(&RunScales::of(system), plan)
 }
 
+/// The checks of [`check_run`] that a study's point can fail where its
+/// base system passed, its values changing the system but not the run's
+/// settings: an explicit step over the fastest mode, a harmonic sampled
+/// below two steps a period by the `method`'s fixed step `dt` (s).
+pub fn check_steps_resolve(system: &SystemSpec, method_name: &str, dt: Option<f64>) -> Result<()> {
+    let spec = method(method_name)?;
+    // No end, no rows: the run's settings, the study's own, were checked once.
+    let plan = RunPlan {
+        method: method_name,
+        dt,
+        t_end: 0.0,
+        max_steps: u64::MAX,
+        max_rows: u64::MAX,
+        every: 1,
+        history: false,
+        strobe_period: None,
+    };
+    let scales = RunScales::of(system);
+    check_natural_period(spec, &plan, scales.structure)?;
+    check_forcing_steps(spec, &plan, &scales.forcing)
+}
+
 /// Refuse a fixed step `dt` (s) longer than the run, `t_end` (s): its one
 /// step would end past `t_end` (or be cut to it), a run no fixed-step
 /// method is meant for. `field` names the step in the message (the
@@ -217,10 +239,16 @@ pub(super) fn highest_frequency(structure: &Structure) -> f64 {
     }
 }
 
+/// The fewest steps of an explicit method (RK4) in an undamped mode's period
+/// where it is stable: `omega dt <= 2 sqrt(2)`, RK4's reach along the
+/// imaginary axis, is a period of `pi / sqrt(2)` (2.22) steps. (A period of
+/// 1.5 steps had run, grown by 1e63 and stopped on the energy check.)
+const EXPLICIT_STEPS_PER_PERIOD: f64 = std::f64::consts::PI / std::f64::consts::SQRT_2;
+
 /// Whether a run of `spec` and `plan` resolves a fastest mode of `frequency`.
 fn resolves(spec: &MethodSpec, plan: &RunPlan, frequency: f64) -> bool {
     let explicit = spec.kind == Kind::Explicit;
-    if explicit && frequency * plan.dt.unwrap_or(0.0) > 1.0 {
+    if explicit && frequency * EXPLICIT_STEPS_PER_PERIOD * plan.dt.unwrap_or(0.0) > 1.0 {
         return false;
     }
     !(spec.kind.is_mode_stepped() && plan.t_end * frequency > plan.max_steps as f64)
@@ -228,7 +256,7 @@ fn resolves(spec: &MethodSpec, plan: &RunPlan, frequency: f64) -> bool {
 
 /// Refuse a run that cannot resolve the structure's fastest mode: an
 /// explicit fixed step is unstable on a mode whose period is shorter than
-/// it; an adaptive method or the exact flow steps at least once in each
+/// [`EXPLICIT_STEPS_PER_PERIOD`] of it; an adaptive method or the exact flow steps at least once in each
 /// period of that mode. The eigenvalues only where the bound does not
 /// settle it (they had cost a dropped ball's run a quarter of its time).
 fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure) -> Result<()> {
@@ -244,11 +272,14 @@ fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure
         return Ok(());
     }
     let period = 1.0 / frequency;
-    if let Some(dt) = plan.dt.filter(|dt| explicit && period < *dt) {
+    if let Some(dt) = plan
+        .dt
+        .filter(|dt| explicit && period < EXPLICIT_STEPS_PER_PERIOD * dt)
+    {
         return Err(Error::Inconsistent(format!(
-            "[solver] dt: the fastest mode's period, {} s ({} Hz), is below dt = {} s, where {} \
-             is unstable: reduce dt below {} s, use an implicit method (newmark-implicit, \
-             generalized-alpha), or check mass and stiffness",
+            "[solver] dt: the fastest mode's period, {} s ({} Hz), is below 2.22 steps of dt = \
+             {} s (pi / sqrt(2)), where {} is unstable: reduce dt below {} s, use an implicit \
+             method (newmark-implicit, generalized-alpha), or check mass and stiffness",
             python_g3(period),
             python_g3(frequency),
             python_repr(dt),

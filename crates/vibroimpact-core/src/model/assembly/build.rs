@@ -480,14 +480,17 @@ impl Walls {
                     (name, h)
                 }
             };
-            let kinetic = non_negative_named(&name, "coefficient", friction.coefficient)?;
-            let normal = non_negative_named(&name, "normal_force", friction.normal_force)?;
-            let held =
-                non_negative_named(&name, "static_coefficient", friction.static_coefficient)?;
+            // A damper's friction is written with the damper's keys.
+            let (label, kinetic_key, static_key) = match friction.site {
+                FrictionSite::Damper(j) => (format!("damper {j}"), "friction", "static_friction"),
+                FrictionSite::Points { .. } => (name.clone(), "coefficient", "static_coefficient"),
+            };
+            let kinetic = non_negative_named(&label, kinetic_key, friction.coefficient)?;
+            let normal = non_negative_named(&label, "normal_force", friction.normal_force)?;
+            let held = non_negative_named(&label, static_key, friction.static_coefficient)?;
             if held < kinetic {
                 return Err(Error::Inconsistent(format!(
-                    "{name} static_coefficient: must be >= the kinetic coefficient {kinetic}, \
-                     got {held}"
+                    "{label} {static_key}: must be >= {kinetic_key} {kinetic}, got {held}"
                 )));
             }
             let (kinetic_force, static_force) = (kinetic * normal, held * normal);
