@@ -369,18 +369,11 @@ def test_bad_sweep_sections_exit_2_naming_the_key(
             ["[sweep] parameter", "[excitation] has no key 'freq'", "did you mean 'frequency'"],
         ),
         (
-            (
-                "[sweep]",
-                '[study]\nanalysis = "run"\n[study.axes]\n"damper.0.mas" = [0.1, 0.2]\n[sweep]',
-            ),
-            ["[study.axes]", "[damper] has no key 'mas'", "did you mean 'mass'"],
-        ),
-        (
             ("[sweep]", '[continuation]\nparameter = "structure.stifness"\nstop = 1.0\n[sweep]'),
             ["[continuation] parameter", "[structure] has no key 'stifness'"],
         ),
     ],
-    ids=["sweep", "study axis", "continuation"],
+    ids=["sweep", "continuation"],
 )
 def test_a_misspelt_parameter_key_is_refused_when_the_file_is_read(
     run_cli: RunCli, tmp_path: Path, change: tuple[str, str], fragments: list[str]

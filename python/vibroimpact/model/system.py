@@ -49,6 +49,7 @@ from vibroimpact.system import (
     prepare_system,
     system_spec,
 )
+from vibroimpact.system.parameter_keys import check_parameter_keys
 from vibroimpact.system.schema import MAX_SCENARIO_BYTES
 
 _P = TypeVar("_P", bound=Part)
@@ -174,8 +175,6 @@ class System:
         through the core, which holds the model's ranges (a damper's mass > 0, a
         frequency >= 0, ...): a System that is built is one that runs, and a bad value is
         refused where it is written, not when it is first simulated."""
-        from vibroimpact.analysis.parameters import check_parameter_keys
-
         sections = self.to_dict()
         check_parameter_keys(sections)
         model = self.model_sections()

@@ -28,6 +28,7 @@ from vibroimpact.system import (
     prepare_system,
     structure_coordinates,
 )
+from vibroimpact.system.parameter_keys import check_parameter_keys
 from vibroimpact.units import CONTACT_HEADERS
 
 SECTIONS = (*RUN_SECTIONS, *ANALYSIS_SECTIONS)
@@ -82,7 +83,6 @@ def system_scenario(data: dict[str, Any], source: str, base_dir: Path | None) ->
         raise InvalidInputError(f"{source}: {err}") from None
     data = dict(data)
     from vibroimpact.analysis import SETTINGS
-    from vibroimpact.analysis.parameters import check_parameter_keys
     from vibroimpact.study import checked_study_settings
 
     # [study] is checked, its axes and draws left unmade (a study makes them).

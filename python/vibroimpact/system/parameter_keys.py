@@ -1,0 +1,66 @@
+"""A scenario's analyses' parameter paths checked against its sections' keys as the
+scenario is read (``excitation.0.freq`` had been taken by a run, and refused only when its
+analysis ran)."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from vibroimpact._core import InvalidInputError
+from vibroimpact.system import schema
+
+
+def _known_keys(data: Mapping[str, Any], section: str) -> Sequence[str] | None:
+    """The keys a section of ``data`` may have (a structure's, its kind's), or None
+    where that is not known here."""
+    if section == "structure":
+        structure = data.get("structure")
+        kind = structure.get("kind") if isinstance(structure, Mapping) else None
+        kinds = [kind] if kind in schema._STRUCTURE else list(schema._STRUCTURE)
+        return sorted({key for k in kinds for key in schema._STRUCTURE[k]})
+    tables: dict[str, Mapping[str, Any]] = {
+        "damper": schema._DAMPER,
+        "stop": schema._STOP,
+        "collision": schema._COLLISION,
+        "friction": schema._FRICTION,
+        "gravity": schema._GRAVITY,
+        "excitation": schema._EXCITATION,
+        "initial": schema._INITIAL,
+        "solver": schema._SOLVER,
+    }
+    return list(tables[section]) if section in tables else None
+
+
+def parameter_paths(analyses: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """``(where, path)`` of every parameter path the analyses' sections name: the
+    sweep's parameter and derivatives, the continuation's and the curve's parameters (a
+    study's axes and draws have their own check, which names what a study may vary)."""
+    found: list[tuple[str, str]] = []
+
+    def table(name: str) -> Mapping[str, Any]:
+        value = analyses.get(name)
+        return value if isinstance(value, Mapping) else {}
+
+    named = [("sweep", "parameter"), ("continuation", "parameter")]
+    named += [("curve", "parameter"), ("curve", "second")]
+    found += [(f"[{name}] {k}", table(name)[k]) for name, k in named if k in table(name)]
+    derivatives = table("sweep").get("derivatives", [])
+    found += [("[sweep] derivatives", p) for p in derivatives if isinstance(p, str)]
+    return [(where, path) for where, path in found if isinstance(path, str)]
+
+
+def check_parameter_keys(data: Mapping[str, Any]) -> None:
+    """Refuse, as a scenario is read, a parameter path whose key its section does not
+    have (``excitation.0.freq``): it had been refused only when its analysis ran, after a
+    plain run of the same file had taken it."""
+    for where, path in parameter_paths(data):
+        parts = path.split(".")
+        known = _known_keys(data, parts[0])
+        key = next((p for p in parts[1:] if not p.isdigit()), None)
+        if known is None or key is None or key in known:
+            continue
+        close = difflib.get_close_matches(key, known, 1)
+        hint = f"; did you mean {close[0]!r}?" if close else f" (allowed: {', '.join(known)})"
+        raise InvalidInputError(f"{where}: {path!r}: [{parts[0]}] has no key {key!r}{hint}")
