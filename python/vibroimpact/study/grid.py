@@ -21,7 +21,7 @@ from vibroimpact.model.system import System, sections_of
 from vibroimpact.study.beam_axes import beam_corners, resolve_beam_axes
 from vibroimpact.study.limits import StudyError, check_study_memory, check_threads
 from vibroimpact.study.settings import base_metrics, study_settings
-from vibroimpact.system.run import check_fixed_window
+from vibroimpact.system.run import check_record_window
 
 
 @dataclass
@@ -175,19 +175,11 @@ def study_of(
         checked["record_from"] = 0.0 if window is None else float(window)
     study = Study(dict(data), checked, source, base_dir)
     if checked["analysis"] == "run":
-        t_end = study.prepared().solver["t_end"]
-        if not checked["record_from"] < t_end:
-            # As a single run refuses it: every run would record nothing.
-            raise StudyError(
-                f"{source}: [study] record_from: must be before [solver] t_end "
-                f"({t_end!r} s), got {checked['record_from']!r}"
-            )
-        # The study's stepping, not the scenario's, says whether its steps are fixed.
+        # As a single run refuses it (every run would record nothing); the study's
+        # stepping, not the scenario's, says whether its steps are fixed.
         stepped = {**study.prepared().solver, "stepping": checked["stepping"]}
         try:
-            check_fixed_window(
-                "[study] record_from: ", checked["record_from"], t_end, stepped, "stepping"
-            )
+            check_record_window("[study] record_from: ", checked["record_from"], stepped)
         except InvalidInputError as err:
             raise StudyError(f"{source}: {err}") from None
     # The base scenario and every axis path are checked by a run of none.

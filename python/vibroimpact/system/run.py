@@ -280,14 +280,7 @@ def prepare_system(
         raise _fail("", short_numbers(str(err))) from None
     if output["record_from"] is not None and not output["record_from"] >= 0:
         raise _fail("[output] record_from: ", f"must be >= 0 s, got {output['record_from']}")
-    if output["record_from"] is not None and not output["record_from"] < solver["t_end"]:
-        raise _fail(
-            "[output] record_from: ",
-            f"must be before [solver] t_end ({solver['t_end']!r} s), got {output['record_from']!r}",
-        )
-    check_fixed_window(
-        "[output] record_from: ", output["record_from"], solver["t_end"], solver, "stepping"
-    )
+    check_record_window("[output] record_from: ", output["record_from"], solver)
     followed = len(output["points"]) + len(output["moments"])
     if followed > MAX_POINTS:
         raise _fail(
@@ -403,17 +396,18 @@ _CHECKED = (
 )
 
 
-def check_fixed_window(
-    where: str, record_from: float | None, t_end: float, solver: Mapping[str, Any], stepping: str
-) -> None:
-    """Refuse a record window (from ``record_from`` to ``t_end``, s) shorter than one step
-    of ``solver``'s ``dt`` when its ``stepping`` (the key that says it) is fixed: no step
-    ends in it, and the run recorded nothing (a peak of NaN, or 0 in a study's lanes)
-    without a word. With events, the run steps to the window's start."""
-    dt = solver.get("dt")
-    if record_from is None or solver.get(stepping) != "fixed" or dt is None:
+def check_record_window(where: str, record_from: float | None, solver: Mapping[str, Any]) -> None:
+    """Refuse a record window, from ``record_from`` to ``solver``'s ``t_end`` (s), that
+    holds nothing: one that starts at or after the end, or, where ``solver``'s
+    ``stepping`` is fixed, one shorter than a step of its ``dt`` (no step ends in it: the
+    run recorded nothing, a peak of NaN or 0 in a study's lanes, without a word). With
+    events, the run steps to the window's start."""
+    if record_from is None:
         return
-    if t_end - record_from < dt:
+    t_end, dt = solver["t_end"], solver.get("dt")
+    if not record_from < t_end:
+        raise _fail(where, f"must be before [solver] t_end ({t_end!r} s), got {record_from!r}")
+    if solver.get("stepping") == "fixed" and dt is not None and t_end - record_from < dt:
         raise _fail(
             where,
             f"must leave at least one step of dt = {dt!r} s before [solver] t_end "
