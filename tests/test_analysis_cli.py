@@ -372,8 +372,12 @@ def test_bad_sweep_sections_exit_2_naming_the_key(
             ("[sweep]", '[continuation]\nparameter = "structure.stifness"\nstop = 1.0\n[sweep]'),
             ["[continuation] parameter", "[structure] has no key 'stifness'"],
         ),
+        (
+            ("[sweep]", '[study.axes]\n"damper.0.mas" = [0.05]\n[sweep]'),
+            ["[study.axes]", "[damper] has no key 'mas'", "did you mean 'mass'"],
+        ),
     ],
-    ids=["sweep", "continuation"],
+    ids=["sweep", "continuation", "study axis"],
 )
 def test_a_misspelt_parameter_key_is_refused_when_the_file_is_read(
     run_cli: RunCli, tmp_path: Path, change: tuple[str, str], fragments: list[str]
@@ -383,6 +387,15 @@ def test_a_misspelt_parameter_key_is_refused_when_the_file_is_read(
     assert_one_line_error(run_cli("simulate", str(path)), str(path), *fragments)
     with pytest.raises(ValueError, match=re.escape(fragments[1])):
         vi.load(path)
+
+
+def test_a_misspelt_derivative_key_is_told_the_closest(run_cli: RunCli, tmp_path: Path) -> None:
+    # `--derivative damper.0.clearence` said only "not set in the scenario".
+    path = small_frf(tmp_path, ("count = 5", "count = 5"))
+    done = run_cli("orbit", str(path), "--derivative", "damper.0.clearence")
+    assert_one_line_error(done, "[damper] has no key 'clearence'", "did you mean 'clearance'")
+    done = run_cli("orbit", str(path), "--derivative", "damper.3.clearance")
+    assert_one_line_error(done, "'damper.3.clearance': not set in the scenario")
 
 
 def test_sweep_without_a_sweep_section_exits_2(run_cli: RunCli, tmp_path: Path) -> None:

@@ -529,8 +529,8 @@ def test_moment_trial_fixes(tmp_path: Path, run_cli: Any) -> None:
     assert np.isnan(sweep_dataset([found], "f")["moment_reduction"].values[0, 1])
     # A study asks for the moments by name; without [output] moments it is told why.
     text = beam_toml(9.0) + (
-        '[solver]\nmethod = "exact"\nt_end = 1.0\n[output]\nmoments = [0.0]\n'
-        '[study]\nanalysis = "run"\nmetrics = ["moment_rms"]\n'
+        '[solver]\nmethod = "exact"\nt_end = 1.0\n[output]\nmoments = [0.0]\npoints = [0.25]\n'
+        '[study]\nanalysis = "run"\nmetrics = ["moment_rms", "point_rms"]\n'
         '[study.axes]\n"excitation.0.frequency" = [9.0, 10.0]\n'
     )
     scenario.write_text(text, encoding="utf-8")
@@ -538,6 +538,10 @@ def test_moment_trial_fixes(tmp_path: Path, run_cli: Any) -> None:
     assert done.returncode == 0, done.stderr
     with xr.open_dataset(tmp_path / "m.nc") as ds:
         assert ds["moment_rms"].dims == ("excitation.0.frequency", "moment_at")
+        # A cantilever's points are positions along it, in metres (the coordinate had
+        # no units).
+        assert ds["at"].attrs["units"] == ds["moment_at"].attrs["units"] == "m"
+        assert ds["point_rms"].attrs["units"] == "m"
     scenario.write_text(text.replace("moments = [0.0]\n", ""), encoding="utf-8")
     done = run_cli("study", str(scenario), "--out", "n.nc")
     assert done.returncode == 2

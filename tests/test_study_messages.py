@@ -6,6 +6,7 @@ draws them."""
 
 from __future__ import annotations
 
+import json
 import signal
 import subprocess
 import sys
@@ -216,3 +217,24 @@ def test_the_heat_map_of_settled_draws_1_and_0_and_failed_runs_blank(
     plot_study(png, dataset, "settled", *dims)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     np.testing.assert_array_equal(drawn[0], [[1.0, 1.0], [0.0, 1.0], [np.nan, np.nan]])
+
+
+def test_a_large_failed_region_lists_a_few_reasons_and_counts_the_rest(tmp_path: Path) -> None:
+    # One line per distinct reason had printed one per refused value: a thousand lines
+    # for a wide invalid region. The file keeps every reason.
+    text = FORCED_DAMPER + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        '[study.axes]\n"damper.0.restitution" = { start = 1.1, stop = 2.0, count = 10 }\n'
+        '"damper.0.mass" = [0.05]\n'
+    )
+    out = tmp_path / "r.nc"
+    done = cli("study", str(scenario(tmp_path, text)), "--out", str(out))
+    assert done.returncode == 1, done.stdout + done.stderr  # every run failed
+    listed = [line for line in done.stdout.splitlines() if line.startswith("  failed: ")]
+    assert len(listed) == 5 and "restitution must be in [0, 1], got 1.1" in listed[0]
+    assert "... and 5 more reasons" in done.stdout
+    with xr.open_dataset(out) as ds:
+        reasons = json.loads(ds.attrs["reasons"])
+        assert len(reasons) == 10 and sorted(np.unique(ds["status"].values)) == list(range(1, 11))
+    done = cli("study", str(scenario(tmp_path, text)), "--out", str(out), "--json")
+    assert len(json.loads(done.stdout)["reasons"]) == 10

@@ -388,7 +388,7 @@ MATRICES = NOISY.replace(
 @pytest.mark.parametrize(
     ("text", "axis", "words"),
     [
-        (NOISY, '"structure.mas" = [1.0]', ["structure.mas", "oscillator", "stiffness"]),
+        (NOISY, '"structure.mas" = [1.0]', ["structure.mas", "did you mean 'mass'"]),
         (NOISY, '"structure.length" = [1.0]', ["structure.length", "allowed", "mass"]),
         (BEAM, '"structure.modes" = [3]', ["structure.modes", "cantilever", "mass_per_length"]),
         (MATRICES, '"structure.mass" = [1.0]', ["structure.mass", "matrices"]),

@@ -48,6 +48,7 @@ from vibroimpact.analysis.runs import Runner, runner, state_arrays
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
+from vibroimpact.system.parameter_keys import check_parameter_key
 
 
 @summarised
@@ -681,6 +682,8 @@ def _value_of(
         try:
             node = node[int(key)] if isinstance(node, list) else node[key]
         except (KeyError, IndexError, ValueError, TypeError):
+            # A misspelt key is told so, with the closest (else: a key left unset).
+            check_parameter_key(data, name, parameter)
             raise AnalysisError(f"{name} {parameter!r}: not set in the scenario ({why})") from None
     if isinstance(node, bool) or not isinstance(node, int | float):
         raise AnalysisError(f"{name} {parameter!r}: must be a number, got {node!r}")

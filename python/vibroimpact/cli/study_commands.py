@@ -181,11 +181,22 @@ def run_study_command(args: argparse.Namespace) -> int:
         )
         if args.plot:
             print(f"plot written to {args.plot}")
-        for reason in summary["reasons"]:
+        # A few reasons; a large failed region has one per value (the file has all).
+        reasons = summary["reasons"]
+        for reason in reasons[:_REASONS_SHOWN]:
             print(f"  failed: {reason}")
+        if len(reasons) > _REASONS_SHOWN:
+            print(
+                f"  ... and {len(reasons) - _REASONS_SHOWN} more reasons (every one in the "
+                "file's attrs['reasons'], numbered by its status)"
+            )
     if status:
         print(f"vibroimpact: error: every one of the {study.runs} runs failed", file=sys.stderr)
     return status
+
+
+#: The failure reasons the text summary lists.
+_REASONS_SHOWN = 5
 
 
 def _command(args: argparse.Namespace) -> str:

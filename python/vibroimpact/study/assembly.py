@@ -151,7 +151,13 @@ def assemble(study: Study, parts: list[dict[str, Any]]) -> Any:
             )
     coords["coordinate"] = ("coordinate", np.arange(n))
     if len(at):
-        coords["at"] = ("at", at, {"long_name": "point of the structure ([output] points)"})
+        # A cantilever's point is a position along it; another structure's, a coordinate.
+        point_units = {"units": "m"} if study.data["structure"].get("kind") == "cantilever" else {}
+        coords["at"] = (
+            "at",
+            at,
+            {"long_name": "point of the structure ([output] points)", **point_units},
+        )
     if len(moment_at):
         coords["moment_at"] = (
             "moment_at",

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact.arguments import real
 from vibroimpact.study.limits import MAX_STUDY_RUNS, StudyError
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
 
@@ -160,7 +161,9 @@ def _axis_values(path: str, spec: Any) -> np.ndarray:
         raise StudyError(f"{where}must be a list of numbers or {{start, stop, count}}")
     values = []
     for v in spec:
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+        # NumPy's scalars too (a list of np.float32 values), as an array's are.
+        number = real(v)
+        if number is None or not math.isfinite(number):
             raise StudyError(f"{where}must hold finite numbers, got {v!r:.40}")
-        values.append(float(v))
+        values.append(float(number))
     return np.asarray(values)

@@ -240,7 +240,9 @@ def chunk_part(study: Study, start: int, stop: int, threads: int = 0) -> dict[st
     """The metrics of runs ``start`` to ``stop`` as arrays (what a chunk file holds and
     a Dask task returns)."""
     arguments.instance("study", study, Study, "vibroimpact.study.study_of(sections)")
-    start, stop = whole_count("start", start, 0), whole_count("stop", stop, 0)
+    # Flat indices into the grid (a stop past it was numpy's bare IndexError).
+    stop = whole_count("stop", stop, 0, study.runs)
+    start = whole_count("start", start, 0, stop)
     check_threads(threads, "threads:")
     raw = study.run_chunk(range(start, stop), threads)
     return {

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact import arguments
 from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_total
 from vibroimpact.study.axes import (
     _axis_count,
@@ -30,6 +31,9 @@ from vibroimpact.system import (
     _choice,
     _table,
 )
+
+# A chunk holds at least one run (its range stated by the whole-number check itself).
+arguments.WHOLE_RANGES["[study] chunk_size"] = (1, arguments.LARGEST_WHOLE)
 
 # What each analysis keeps; every metric.
 _RUN_METRICS = ("peak", "rms", "impacts", "energy_dissipated", "largest_lyapunov")
@@ -144,11 +148,10 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
         ("settle_periods", 0),
         ("record_periods", 1),
         ("orbit_periods", 1),
-        ("chunk_size", 1),
     ):
         if out[key] < low:
             raise StudyError(f"[study] {key}: must be >= {low}, got {out[key]}")
-        if key != "chunk_size" and out[key] > MAX_PERIODS:
+        if out[key] > MAX_PERIODS:
             # As the analyses' own settings: 1e11 periods ran for half a minute into
             # gigabytes of contacts before failing (user trial).
             raise StudyError(

@@ -35,8 +35,8 @@ def _known_keys(data: Mapping[str, Any], section: str) -> Sequence[str] | None:
 
 def parameter_paths(analyses: Mapping[str, Any]) -> list[tuple[str, str]]:
     """``(where, path)`` of every parameter path the analyses' sections name: the
-    sweep's parameter and derivatives, the continuation's and the curve's parameters (a
-    study's axes and draws have their own check, which names what a study may vary)."""
+    sweep's parameter and derivatives, the continuation's and the curve's parameters, a
+    study's axes and draws."""
     found: list[tuple[str, str]] = []
 
     def table(name: str) -> Mapping[str, Any]:
@@ -48,6 +48,13 @@ def parameter_paths(analyses: Mapping[str, Any]) -> list[tuple[str, str]]:
     found += [(f"[{name}] {k}", table(name)[k]) for name, k in named if k in table(name)]
     derivatives = table("sweep").get("derivatives", [])
     found += [("[sweep] derivatives", p) for p in derivatives if isinstance(p, str)]
+    # A study's axes and draws: what a study may vary is checked when it is made; the
+    # key's spelling here, so that a plain run of the file does not take a misspelt one.
+    study = table("study")
+    for name in ("axes", "random"):
+        paths = study.get(name)
+        if isinstance(paths, Mapping):
+            found += [(f"[study.{name}]", p) for p in paths if isinstance(p, str)]
     return [(where, path) for where, path in found if isinstance(path, str)]
 
 
@@ -56,11 +63,24 @@ def check_parameter_keys(data: Mapping[str, Any]) -> None:
     have (``excitation.0.freq``): it had been refused only when its analysis ran, after a
     plain run of the same file had taken it."""
     for where, path in parameter_paths(data):
-        parts = path.split(".")
-        known = _known_keys(data, parts[0])
-        key = next((p for p in parts[1:] if not p.isdigit()), None)
-        if known is None or key is None or key in known:
-            continue
-        close = difflib.get_close_matches(key, known, 1)
-        hint = f"; did you mean {close[0]!r}?" if close else f" (allowed: {', '.join(known)})"
-        raise InvalidInputError(f"{where}: {path!r}: [{parts[0]}] has no key {key!r}{hint}")
+        # A study's axis that is no misspelling (a section's height on an oscillator)
+        # is left to the study's own check, which says what a study of it may vary.
+        check_parameter_key(data, where, path, typos_only=where.startswith("[study."))
+
+
+def check_parameter_key(
+    data: Mapping[str, Any], where: str, path: str, typos_only: bool = False
+) -> None:
+    """Refuse the parameter path ``path`` (named ``where`` in the message) where its
+    section's key is not one that section has, with the closest one (``typos_only``:
+    only where one is close)."""
+    parts = path.split(".")
+    known = _known_keys(data, parts[0])
+    key = next((p for p in parts[1:] if not p.isdigit()), None)
+    if known is None or key is None or key in known:
+        return
+    close = difflib.get_close_matches(key, known, 1)
+    if typos_only and not close:
+        return
+    hint = f"; did you mean {close[0]!r}?" if close else f" (allowed: {', '.join(known)})"
+    raise InvalidInputError(f"{where}: {path!r}: [{parts[0]}] has no key {key!r}{hint}")
