@@ -178,3 +178,22 @@ def write_text(tmp_path: Path, text: str) -> Path:
     path = tmp_path / "beam.toml"
     path.write_text(text)
     return path
+
+
+def test_python_callers_are_told_their_own_argument_names(tmp_path: Path) -> None:
+    # A Python call was told "--out x.csv: ...", a flag it has not got; a chunk past the
+    # grid raised numpy's bare "index 5 is out of bounds", and NumPy scalars in an axis's
+    # list were refused as not numbers.
+    study = st.study_of(with_study({"axes": {"damper.0.clearance": [np.float32(0.005), 0.006]}}))
+    single = float(np.float32(0.005))
+    assert study.settings["axes"]["damper.0.clearance"].tolist() == [single, 0.006]
+    with pytest.raises(ValueError, match=r"^out: \S*x\.csv: must end in \.nc"):
+        st.run(study, tmp_path / "x.csv")
+    with pytest.raises(ValueError, match=r"^stop: must be a whole number in \[0, 2\], got 9"):
+        st.chunk_part(study, 5, 9)
+    with pytest.raises(ValueError, match=r"^start: must be a whole number in \[0, 1\], got 2"):
+        st.chunk_part(study, 2, 1)
+    assert (
+        st.chunk_part(study, 1, 2, threads=1)["peak"].shape
+        == st.chunk_part(study, 0, 1, threads=1)["peak"].shape
+    )

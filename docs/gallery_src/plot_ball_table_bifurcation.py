@@ -15,8 +15,12 @@ import numpy as np
 
 import vibroimpact as vi
 
-# The gallery runs from docs/gallery_src; the scenarios are in the repository's examples/.
-EXAMPLES = Path.cwd().parents[1] / "examples"
+# The clone's examples/ folder: the nearest at or above the working folder (the build runs
+# this from docs/gallery_src; a downloaded copy runs from anywhere in the clone).
+EXAMPLES = next(
+    (p / "examples" for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples").is_dir()),
+    Path("examples"),
+)
 system = vi.load(EXAMPLES / "ball_table_bifurcation.toml")
 spec = system.analyses["sweep"]
 points = vi.bifurcation(

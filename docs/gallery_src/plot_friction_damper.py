@@ -20,7 +20,12 @@ import numpy as np
 
 import vibroimpact as vi
 
-EXAMPLES = Path.cwd().parents[1] / "examples"
+# The clone's examples/ folder: the nearest at or above the working folder (the build runs
+# this from docs/gallery_src; a downloaded copy runs from anywhere in the clone).
+EXAMPLES = next(
+    (p / "examples" for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples").is_dir()),
+    Path("examples"),
+)
 system = vi.load(EXAMPLES / "friction_damper.toml")
 spec = system.analyses["sweep"]
 frequencies = np.linspace(spec["start"], spec["stop"], spec["count"])  # Hz

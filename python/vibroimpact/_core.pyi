@@ -67,7 +67,7 @@ RTOL_RANGE: tuple[float, float]
 ATOL_MAX: float
 #: The largest ``energy_tolerance``: a residual as large as all the energy in play.
 MAX_ENERGY_TOLERANCE: float
-#: The most dampers and stops a system may have in all.
+#: The most dampers, stops, collisions and friction elements a system may have in all.
 MAX_PAIRS: int
 #: The most ``[output]`` points and moments a run may follow.
 MAX_POINTS: int

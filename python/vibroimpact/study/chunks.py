@@ -75,7 +75,7 @@ def run(
         arguments.text("dask", dask)
     arguments.text("resume", resume)
     check_threads(threads, "threads:")
-    kind = output_kind(out)
+    kind = output_kind(out, "out:")
     if kind != ".zarr":
         # Refused before any run, as the command refuses it (a folder was found only
         # once every run was done, and resuming failed the same way).

@@ -17,34 +17,34 @@ from vibroimpact.output import UsageError, claim_beside, remove_stale, swap_in
 OUTPUTS = {".nc": "a NetCDF 4 file", ".zarr": "a Zarr store"}
 
 
-def output_kind(out: Path) -> str:
+def output_kind(out: Path, flag: str = "--out") -> str:
     """The suffix of ``out`` that decides its format (``.nc`` or ``.zarr``), checked
     before a study runs: another suffix, a NetCDF file without h5netcdf and h5py (see
     ``vibroimpact.netcdf.netcdf4_missing``), a Zarr store without the zarr package,
     or a ``.zarr`` path that holds something other than a Zarr store (which the store
-    would replace) raise :class:`UsageError`."""
+    would replace) raise :class:`UsageError`, naming ``out`` as ``flag``."""
     out = arguments.path("out", out)
     kind = out.suffix.lower()
     if kind not in OUTPUTS:
         allowed = " or ".join(f"{suffix} ({what})" for suffix, what in OUTPUTS.items())
         if out.name.lower() in OUTPUTS:
             # ".nc" alone is a hidden file's name, with no suffix.
-            raise UsageError(f"--out {out}: needs a name before its suffix (such as study.nc)")
-        raise UsageError(f"--out {out}: must end in {allowed}")
+            raise UsageError(f"{flag} {out}: needs a name before its suffix (such as study.nc)")
+        raise UsageError(f"{flag} {out}: must end in {allowed}")
     if kind == ".nc" and (missing := netcdf4_missing()) is not None:
-        raise UsageError(f"--out {out}: {missing}")
+        raise UsageError(f"{flag} {out}: {missing}")
     if kind == ".zarr":
         try:
             importlib.import_module("zarr")
         except ImportError:
             raise UsageError(
-                f'--out {out}: a Zarr store needs zarr: pip install "vibroimpact[zarr]"'
+                f'{flag} {out}: a Zarr store needs zarr: pip install "vibroimpact[zarr]"'
             ) from None
-        _replaceable_store(out)
+        _replaceable_store(out, flag)
     return kind
 
 
-def _replaceable_store(out: Path) -> None:
+def _replaceable_store(out: Path, flag: str) -> None:
     """Refuse a ``.zarr`` path that holds a file, or a folder that is neither empty nor
     a Zarr store: writing the study there would replace what is not a result."""
     if out.is_symlink():
@@ -56,7 +56,7 @@ def _replaceable_store(out: Path) -> None:
     ):
         return
     raise UsageError(
-        f"--out {out}: exists and is not a Zarr store; remove it or choose another name"
+        f"{flag} {out}: exists and is not a Zarr store; remove it or choose another name"
     )
 
 
@@ -80,7 +80,7 @@ def _write_zarr(dataset: Any, out: Path) -> None:
         # Replace the store the link points to, and keep the link.
         out = out.resolve()
     remove_stale(out)
-    _replaceable_store(out)
+    _replaceable_store(out, "out:")
     # The new store's folder until it is swapped in, then the earlier store's.
     held: list[Path] = []
     lock: int | None = None
