@@ -687,3 +687,31 @@ def test_the_parameters_printed_state_their_units(
     done = run_cli(command, str(ROOT / "examples" / f"{example}.toml"))
     assert done.returncode == 0, done.stderr
     assert said in done.stdout, done.stdout
+
+
+def test_an_output_that_cannot_be_written_is_refused_before_the_run(
+    run_cli: RunCli, tmp_path: Path
+) -> None:
+    # A legal 246-character name whose temporary file's name is too long was refused only
+    # when written, after the whole analysis (basins: 2.7 s; an unwritable folder too).
+    path = small_frf(tmp_path, ("count = 5", "count = 5"))
+    long = tmp_path / ("a" * 246 + ".png")
+    done = run_cli("sweep", str(path), "--plot", str(long))
+    assert_one_line_error(done, "--plot", "cannot be written there", "shorter name")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+    done = run_cli("simulate", str(path), "--out", str(tmp_path / ("b" * 250 + ".csv")))
+    assert_one_line_error(done, "--out", "cannot be written there")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+def test_a_whole_number_written_as_a_float_is_told_how_to_write_it(
+    run_cli: RunCli, tmp_path: Path
+) -> None:
+    # "count: must be a whole number, got 5.0" read as a contradiction (5.0 is whole); a
+    # file written from JSON or pandas has them. TOML tells an integer by its decimal point.
+    path = small_frf(tmp_path, ("count = 5", "count = 5.0"))
+    done = run_cli("sweep", str(path))
+    assert_one_line_error(done, "[sweep] count", "written as an integer (5, not 5.0)")
+    path = small_frf(tmp_path, ("count = 5", "count = 5.5"))
+    done = run_cli("sweep", str(path))
+    assert_one_line_error(done, "[sweep] count: must be a whole number, got 5.5")

@@ -774,3 +774,18 @@ def test_a_fifo_given_as_the_scenario_is_refused_without_waiting(
     fifo = tmp_path / "fifo.toml"
     os.mkfifo(fifo)
     refused(run_cli("simulate", str(fifo)), "not a regular file", str(fifo))
+
+
+def test_a_scenario_with_a_byte_order_mark_reads_as_without(tmp_path: Path, run_cli: Cli) -> None:
+    # Notepad and PowerShell 5 write one: "invalid TOML: Invalid statement (at line 1,
+    # column 1)" for a file that looks right. (The CSV reader already took it.)
+    plain = write(tmp_path, BASE)
+    marked = tmp_path / "marked.toml"
+    marked.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    assert vi.load(marked) == vi.load(plain)
+    done = run_cli("simulate", str(marked), "--json")
+    assert done.returncode == 0, done.stderr
+    assert (
+        json.loads(done.stdout)["steps"]
+        == json.loads(run_cli("simulate", str(plain), "--json").stdout)["steps"]
+    )

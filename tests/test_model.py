@@ -731,3 +731,30 @@ def test_an_unknown_keyword_of_simulate_names_simulate_and_the_close_one() -> No
     )
     with pytest.raises(TypeError, match=r"^simulate\(\) got an unexpected keyword argument 'zzz'$"):
         vi.simulate(system, zzz=1.0)  # type: ignore[call-arg]
+
+
+def test_a_relative_record_keeps_the_folder_it_was_given_in(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A System with base_dir="." (or none) read its record from wherever it was run: after
+    # a chdir the same System read another folder's file, with no error.
+    (tmp_path / "rec.csv").write_text("time,value\n0,0\n0.1,5\n0.5,0\n", encoding="utf-8")
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "rec.csv").write_text("time,value\n0,0\n0.1,0\n0.5,0\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+
+    def system(**base: Any) -> vi.System:
+        signal = vi.Recorded(file="rec.csv")
+        structure = vi.Oscillator(mass=1.0, stiffness=100.0)
+        return vi.System(structure=structure, excitations=[vi.Force(at=0, signal=signal)], **base)
+
+    given, default = system(base_dir="."), system()
+    assert given.base_dir == default.base_dir == tmp_path.resolve() and given == default
+    before = vi.simulate(given, method="dopri5", t_end=1.0).final_state
+    assert abs(before["structure_displacement"][0]) > 1e-3  # the 5 N pulse moved it
+    monkeypatch.chdir(other)
+    for system_made_there in (given, default):
+        after = vi.simulate(system_made_there, method="dopri5", t_end=1.0).final_state
+        assert np.array_equal(after["structure_displacement"], before["structure_displacement"])
+    assert system(base_dir=".") != given  # made here, it reads here

@@ -229,3 +229,21 @@ def test_a_text_longer_than_a_scenario_file_may_be_says_so() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert vi.load(short.to_toml()) == short
+
+
+def test_a_strobe_row_is_the_flat_state_as_documented() -> None:
+    # The docs said "the history's columns" (structure displacements, then velocities,
+    # then the dampers'); a row is the flat state: every displacement, then every velocity.
+    system = vi.System(
+        structure=vi.Matrices(mass=[[1.0, 0.0], [0.0, 2.0]], stiffness=[[300, -100], [-100, 200]]),
+        dampers=[vi.Damper(mass=0.1, at=0, clearance=0.01, law="rigid", restitution=0.5)],
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=2.0, frequency=3.0))],
+    )
+    sol = vi.simulate(system, method="dopri5", t_end=1.0, strobe_period=0.5)
+    assert sol.strobe_time[-1] == 1.0 and sol.final_time == 1.0
+    s = sol.final_state
+    flat = np.concatenate(
+        [s["structure_displacement"], s["damper_displacement"]]
+        + [s["structure_velocity"], s["damper_velocity"]]
+    )
+    assert np.array_equal(sol.strobe[-1], flat)

@@ -124,3 +124,34 @@ def test_parts_still_copy_pickle_and_replace() -> None:
     assert dataclasses.replace(harmonic, frequency=6.0).frequency == 6.0
     with pytest.raises(vi.InvalidInputError, match="did you mean 'frequency'"):
         dataclasses.replace(harmonic, frequncy=6.0)
+
+
+def test_numpy_numbers_are_held_as_the_python_numbers_they_are() -> None:
+    # A value taken from a study's Dataset (`ds["damper.0.mass"][1].values`, a 0-d
+    # array) ran, but the System could not be hashed, written as TOML (a bare TypeError)
+    # or given to an analysis ("frequencies must be numbers, got [array(10.)]").
+    import json
+
+    import numpy as np
+
+    def system(mass: object, frequency: object, at: object) -> vi.System:
+        return vi.System(
+            structure=vi.Oscillator(mass=1.0, stiffness=3947.8, damping=2.513),
+            dampers=[vi.Damper(mass=mass, at=at, clearance=0.005, law="rigid", restitution=0.6)],
+            excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=5.0, frequency=frequency))],
+            solver=vi.Solver(method="exact", t_end=1.0),
+        )
+
+    given = system(np.array(0.05), np.float64(10.0), np.int64(0))
+    plain = system(0.05, 10.0, 0)
+    assert given == plain and hash(given) == hash(plain)
+    assert type(given.dampers[0].mass) is float and type(given.dampers[0].at) is int
+    assert vi.loads(given.to_toml()) == plain
+    assert json.loads(json.dumps(given.to_dict())) == plain.to_dict()
+    amplitude = vi.steady_state(given).amplitude
+    assert np.array_equal(amplitude, vi.steady_state(plain).amplitude)
+    # Elements of an array too; an array where a number belongs is still refused by name.
+    recorded = vi.Recorded(time=[np.float32(0.0), np.float64(1.0)], value=[0.0, 1.0])
+    assert recorded.time == (0.0, 1.0) and type(recorded.time[0]) is float
+    with pytest.raises(vi.InvalidInputError, match=r"mass: must be a number, got array"):
+        system(np.array([0.05, 0.06]), 10.0, 0)

@@ -45,6 +45,14 @@ def whole_range(where: str) -> tuple[int, int]:
     return WHOLE_RANGES.get(place.rsplit(" ", 1)[-1], (0, LARGEST_WHOLE))
 
 
+def integer_hint(value: Any) -> str:
+    """For a whole number written as a float (61.0, as JSON, MATLAB or pandas write it),
+    how to write it: TOML and Python tell an integer from a float by its decimal point."""
+    if isinstance(value, float) and value.is_integer():
+        return f" written as an integer ({int(value)}, not {value})"
+    return ""
+
+
 def shown_range(low: int, high: int) -> str:
     """``[low, high]`` as a message writes it (2^63 - 1 by name)."""
     return f"[{low}, {'2^63 - 1' if high == LARGEST_WHOLE else high}]"

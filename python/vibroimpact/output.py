@@ -116,6 +116,7 @@ def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
             f"{flag} {path}: exists and is not a regular file (a folder, a device or a "
             "FIFO); give the path of a file to write"
         ) from None
+    _check_writable(path, flag)
     if status is None:
         return
     for source in inputs:
@@ -128,6 +129,25 @@ def check_output(path: Path, flag: str, inputs: Sequence[Path] = ()) -> None:
                 f"{flag} {path}: is the input file {str(source)!r} itself (the scenario, "
                 "or a record it reads), which the output would replace; choose another name"
             )
+
+
+def _check_writable(path: Path, flag: str) -> None:
+    """Refuse ``path`` where the temporary file it is written through (see
+    :func:`claim_beside`) cannot be made: a folder without write permission, a
+    read-only file system, a name that its temporary file's makes too long. Said before
+    the run: every analysis had run to its end first."""
+    held: list[Path] = []
+    try:
+        os.close(claim_beside(path, held))
+    except OSError as err:
+        raise UsageError(
+            f"{flag} {path}: cannot be written there ({err.strerror or err}); give another "
+            "folder or a shorter name"
+        ) from None
+    finally:
+        for name in held:
+            with contextlib.suppress(OSError):
+                name.unlink()
 
 
 def check_plot(path: Path, inputs: Sequence[Path] = ()) -> None:

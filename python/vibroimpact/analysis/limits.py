@@ -50,7 +50,8 @@ def whole_count(name: str, value: Any, low: int, high: int | None = None) -> int
     if isinstance(value, np.integer):
         value = int(value)
     if not isinstance(value, int) or isinstance(value, bool) or value < low:
-        raise AnalysisError(f"{name}: must be a whole number >= {low}, got {shown(value)}")
+        hint = arguments.integer_hint(arguments.real(value))
+        raise AnalysisError(f"{name}: must be a whole number >= {low}{hint}, got {shown(value)}")
     if high is not None and value > high:
         raise AnalysisError(f"{name}: must be a whole number in [{low}, {high}], got {value}")
     return value

@@ -19,23 +19,33 @@ from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
-from vibroimpact.arguments import KeywordError
+from vibroimpact.arguments import KeywordError, real
 from vibroimpact.system import _GRAVITY, _STRUCTURE, _unknown_key, system_spec
 
 _Numbers = tuple[float, ...]
 _Rows = tuple[tuple[float, ...], ...]
 
 
+def _scalar(value: Any) -> Any:
+    """A NumPy number (``np.float32(0.5)``, or the 0-d array ``ds["x"][1].values`` gives)
+    as the Python int or float it holds, so that a part holding it hashes and is written
+    as TOML; anything else (a boolean too) as given, for the schema to refuse by name."""
+    if isinstance(value, np.generic | np.ndarray) and np.ndim(value) == 0:
+        number = real(value)
+        return value if number is None else number
+    return value
+
+
 def _as_tuple(value: Any, depth: int) -> Any:
     """Arrays given as lists or NumPy arrays held as tuples (``depth`` 1 for values, 2
     for rows), so that parts compare and hash by value; anything else is kept as
     given, for the schema to refuse by name."""
-    if isinstance(value, np.ndarray):
+    if isinstance(value, np.ndarray) and value.ndim:
         value = value.tolist()
     if isinstance(value, str | bytes) or not isinstance(value, Sequence):
         return value
     if depth == 1:
-        return tuple(value)
+        return tuple(_scalar(v) for v in value)
     return tuple(_as_tuple(row, depth - 1) for row in value)
 
 
@@ -114,8 +124,12 @@ class Part:
     _arrays: ClassVar[dict[str, int]] = {}
 
     def __post_init__(self) -> None:
-        for name, depth in self._arrays.items():
-            object.__setattr__(self, name, _as_tuple(getattr(self, name), depth))
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            depth = self._arrays.get(f.name)
+            held = _scalar(value) if depth is None else _as_tuple(value, depth)
+            if held is not value:
+                object.__setattr__(self, f.name, held)
 
     def __repr__(self) -> str:
         # The keys given only, as the part would be written (None: left to the format).

@@ -77,7 +77,8 @@ class System:
     them), ``analyses`` the ``[sweep]``, ``[continuation]``, ``[basins]`` and
     ``[study]`` tables as written (checked when read from a file, and by the analysis
     that uses them). ``base_dir`` is the folder a recorded signal's relative ``file`` is
-    read from (the scenario's, for a loaded system; None: the working directory).
+    read from (the scenario's, for a loaded system; by default the working directory
+    when the System is made), kept absolute.
 
     Every value is checked on construction by the scenario's schema, with the error a
     file gets (``[[damper]] 0: law "rigid" needs restitution in [0, 1], got 1.5``); the
@@ -133,7 +134,13 @@ class System:
                 )
         # The System's own copy: a caller's dict changed later does not change it.
         object.__setattr__(self, "analyses", copy.deepcopy(dict(self.analyses)))
-        object.__setattr__(self, "base_dir", directory("base_dir", self.base_dir))
+        base_dir = directory("base_dir", self.base_dir)
+        if base_dir is None and self._reads_relative_file():
+            # The folder such a file is read from now, kept: after a chdir the same
+            # System read another folder's record, with no error.
+            base_dir = Path.cwd()
+        # Absolute, as vi.loads keeps it (two spellings of one folder compare equal).
+        object.__setattr__(self, "base_dir", None if base_dir is None else base_dir.resolve())
         self._check()
 
     def __eq__(self, other: object) -> bool:

@@ -108,7 +108,8 @@ def system_summary(
     structure coordinate (m) over ``recorded_time`` (s), and ``point_peak`` and
     ``point_rms`` (m) at each of ``points`` (``[output] points``) and ``moment_peak`` and
     ``moment_rms`` (N m) at each of ``moments``, every ``strobe_period`` the
-    ``strobe`` states (rows of the history's columns but ``t``) at ``strobe_time``."""
+    ``strobe`` states (rows of the flat state: the structure's then the dampers'
+    displacements, then their velocities) at ``strobe_time``."""
     solver = scenario.solver
     output = scenario.prepared.output
     reductions: dict[str, Any] = {}

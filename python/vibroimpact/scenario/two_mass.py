@@ -286,9 +286,10 @@ def parse_scenario(
 
 def read_toml(text: str, source: str) -> dict[str, Any]:
     """The tables of a scenario's TOML text; invalid TOML is a :class:`ScenarioError`
-    naming ``source``."""
+    naming ``source``. A byte-order mark before it (Notepad's, PowerShell's) is no part of
+    the text: TOML's parser had refused the file at its first character."""
     try:
-        return tomllib.loads(text)
+        return tomllib.loads(text.removeprefix("\ufeff"))
     except RecursionError:
         # The parser recurses once per level of nested arrays or inline tables.
         raise ScenarioError(f"{source}: invalid TOML: values nested too deeply") from None

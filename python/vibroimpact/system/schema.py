@@ -70,7 +70,7 @@ from vibroimpact._core import (
     Contact,
     InvalidInputError,
 )
-from vibroimpact.arguments import real, shown_range, whole_range
+from vibroimpact.arguments import integer_hint, real, shown_range, whole_range
 from vibroimpact.messages import short_numbers, shown
 from vibroimpact.system.beam import DIMENSIONS, resolve_cantilever
 from vibroimpact.system.points import _check_point, structure_coordinates
@@ -348,7 +348,7 @@ def _value(where: str, kind: str, value: Any) -> Any:
         whole = real(value)
         if not isinstance(whole, int):
             # The key's own range, if any, is checked after (modes: [1, 200]).
-            raise _fail(where, f"must be a whole number, got {shown(value)}")
+            raise _fail(where, f"must be a whole number{integer_hint(whole)}, got {shown(value)}")
         low, high = whole_range(where)
         if not low <= whole < 2**63:  # above high and below 2^63: the key's own check
             raise _fail(

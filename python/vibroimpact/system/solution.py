@@ -126,8 +126,9 @@ class SystemSolution:
     peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rms: np.ndarray = field(default_factory=lambda: np.zeros(0))
     recorded_time: float = 0.0
-    #: The state at each multiple of ``strobe_period`` (rows of the four arrays of
-    #: ``[initial]``, concatenated as the history's columns) and its times (s).
+    #: The state at each multiple of ``strobe_period`` (rows of the flat state: the
+    #: structure's then the dampers' displacements, then their velocities; not the
+    #: history's column order) and its times (s).
     strobe: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     strobe_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: The checked ``[structure]`` the run integrated.
