@@ -721,3 +721,14 @@ def test_run_study_names_an_argument_of_the_wrong_type(name: str, bad: Any) -> N
     # PyO3's TypeError named the argument only in a note.
     with pytest.raises(vi.InvalidInputError, match=rf"^{name} has the wrong type"):
         vi.run_study(**{**kwargs, name: bad})
+
+
+@pytest.mark.parametrize("name", ["orbit", "lyapunov", "poincare"])
+def test_too_many_periods_are_refused_naming_periods(name: str) -> None:
+    # vi.orbit(s, periods=10**12) was told "count: must be >= 1 and at most ...", a
+    # name from inside the runner it never gave.
+    import vibroimpact as vi
+
+    system = vi.load(Path(__file__).resolve().parents[1] / "examples" / "frf_impact_damper.toml")
+    with pytest.raises(ValueError, match=r"^periods: must be a whole number in \[1, 10000000\]"):
+        getattr(vi, name)(system, periods=10**12)

@@ -155,3 +155,36 @@ def test_numpy_numbers_are_held_as_the_python_numbers_they_are() -> None:
     assert recorded.time == (0.0, 1.0) and type(recorded.time[0]) is float
     with pytest.raises(vi.InvalidInputError, match=r"mass: must be a number, got array"):
         system(np.array([0.05, 0.06]), 10.0, 0)
+
+
+@pytest.mark.parametrize(
+    ("name", "typo", "meant"),
+    [
+        ("orbit", "period", "periods"),
+        ("sweep", "valuez", "values"),
+        ("steady_state", "settle_period", "settle_periods"),
+        ("lyapunov", "period", "periods"),
+        ("poincare", "settle_period", "settle_periods"),
+        ("bifurcation", "valuez", "values"),
+        ("basins", "x_start", None),
+        ("continue_orbit", "stpo", "stop"),
+        ("runner", "base_dr", "base_dir"),
+        ("study_of", "sorce", "source"),
+        ("natural_modes", "attach", "attach_dampers"),
+        ("load", "sourc", "source"),
+        ("loads", "sourse", "source"),
+    ],
+)
+def test_a_misspelt_keyword_of_a_public_function_is_a_value_error_with_the_closest(
+    name: str, typo: str, meant: str | None
+) -> None:
+    # These raised Python's bare TypeError, with no suggestion (the parts and simulate()
+    # already said "did you mean").
+    function = getattr(vi, name)
+    with pytest.raises(vi.KeywordError) as err:
+        function(vi.System(structure=vi.Oscillator(mass=1.0, stiffness=1.0)), **{typo: 1})
+    said = str(err.value)
+    assert said.startswith(f"{name}() got an unexpected keyword argument {typo!r}")
+    assert isinstance(err.value, ValueError)
+    if meant is not None:
+        assert said.endswith(f"(did you mean {meant!r}?)")

@@ -6,6 +6,7 @@ a list of values would otherwise fail deep inside as an AttributeError or a Type
 
 from __future__ import annotations
 
+import difflib
 import functools
 import inspect
 import math
@@ -234,6 +235,26 @@ class KeywordError(InvalidInputError, TypeError):
     ``TypeError`` Python raises for it."""
 
 
+def _unknown_keyword(keywords: Mapping[str, Any], signature: inspect.Signature) -> str:
+    """Python's words for the first of ``keywords`` that ``signature`` does not take
+    (none where it takes any), else an empty string."""
+    parameters = signature.parameters.values()
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters):
+        return ""
+    unknown = [key for key in keywords if key not in signature.parameters]
+    return f"got an unexpected keyword argument {unknown[0]!r}" if unknown else ""
+
+
+def _closest_keyword(words: str, signature: inspect.Signature) -> str:
+    """`` (did you mean 'periods'?)`` for Python's "unexpected keyword argument
+    'period'" where ``signature`` has a keyword that close; else nothing."""
+    unknown = re.search(r"unexpected keyword argument '(\w+)'", words)
+    if unknown is None:
+        return ""
+    close = difflib.get_close_matches(unknown[1], list(signature.parameters), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
     """A core function whose arguments of the wrong type (PyO3 raises a TypeError
     naming the argument only in a note) are refused naming it: on a TypeError the
@@ -252,8 +273,12 @@ def typed(**kinds: tuple[type, ...] | type) -> Callable[[_F], _F]:
                 try:
                     bound = signature.bind(*args, **kwargs)
                 except TypeError as wrong:
-                    # A missing or unknown argument: Python's own words say which.
-                    raise KeywordError(f"{function.__name__}() {wrong}") from None
+                    # A missing or unknown argument: Python's own words say which (an
+                    # unknown keyword first: a misspelt one is also a missing one), and
+                    # the closest keyword the function takes.
+                    words = _unknown_keyword(kwargs, signature) or str(wrong)
+                    hint = _closest_keyword(words, signature)
+                    raise KeywordError(f"{function.__name__}() {words}{hint}") from None
                 for key, allowed in kinds.items():
                     if key in bound.arguments and not isinstance(bound.arguments[key], allowed):
                         names = allowed if isinstance(allowed, tuple) else (allowed,)

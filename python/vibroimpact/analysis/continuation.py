@@ -34,7 +34,13 @@ from vibroimpact import arguments
 from vibroimpact._core import InvalidInputError
 from vibroimpact.analysis.crossings import _CLASSES, _flags, _kind, _largest
 from vibroimpact.analysis.grazing import grazing_ahead, grazings_between
-from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError, relative_tolerance, whole_count
+from vibroimpact.analysis.limits import (
+    MAX_PERIODS,
+    MAX_POINTS,
+    AnalysisError,
+    relative_tolerance,
+    whole_count,
+)
 from vibroimpact.analysis.located import (
     ITERATIONS,
     PARAMETER_TOLERANCE,
@@ -109,6 +115,7 @@ class Branch:
 STEP_RANGE = (1e-9, 1.0)
 
 
+@arguments.typed()
 def continue_orbit(
     data: Mapping[str, Any] | System,
     parameter: str,
@@ -133,7 +140,7 @@ def continue_orbit(
     data, base_dir = sections_of(data, base_dir)
     arguments.text("parameter", parameter)
     stop = arguments.number("stop", stop)
-    periods = whole_count("periods", periods, 1)
+    periods = whole_count("periods", periods, 1, MAX_PERIODS)
     tolerance = relative_tolerance("tolerance", tolerance)
     base_dir = arguments.directory("base_dir", base_dir)
     arguments.callback("progress", progress)

@@ -20,7 +20,13 @@ import numpy as np
 from vibroimpact import arguments
 from vibroimpact.analysis.continuation import _Arc, _value_of, continue_orbit
 from vibroimpact.analysis.grazing import away_from_zero, locate_grazing, struck
-from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError, relative_tolerance, whole_count
+from vibroimpact.analysis.limits import (
+    MAX_PERIODS,
+    MAX_POINTS,
+    AnalysisError,
+    relative_tolerance,
+    whole_count,
+)
 from vibroimpact.analysis.located import Bifurcation, refine
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner, state_arrays
@@ -99,7 +105,7 @@ def curve(
     start, stop = arguments.number("start", start), arguments.number("stop", stop)
     second_stop = arguments.number("second_stop", second_stop)
     step = arguments.positive("step", step)
-    periods = whole_count("periods", periods, 1)
+    periods = whole_count("periods", periods, 1, MAX_PERIODS)
     max_points = whole_count("max_points", max_points, 2, MAX_POINTS)
     tolerance = relative_tolerance("tolerance", tolerance)
     arguments.text("second", second)
@@ -206,6 +212,7 @@ def _locate(
     return point.value, point.state, point.floquet_multipliers, w
 
 
+@arguments.typed()
 def curve_of(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Curve:
     """The curve a scenario's ``[curve]`` section asks for (see :func:`curve`)."""
     from vibroimpact.analysis.settings import curve_settings

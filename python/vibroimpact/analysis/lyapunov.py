@@ -11,8 +11,9 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact import arguments
 from vibroimpact._core import lyapunov_spectrum
-from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
+from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
 from vibroimpact.analysis.runs import Runner, _prepare, as_runner, checked_run
 from vibroimpact.model.system import System, sections_of
@@ -67,6 +68,7 @@ def lyapunov_runner(data: Mapping[str, Any] | System, base_dir: Path | None = No
     return Runner(prepared, float(prepared.solver["t_end"]))
 
 
+@arguments.typed()
 def lyapunov(
     run: Runner | System,
     state: np.ndarray | None = None,
@@ -89,7 +91,7 @@ def lyapunov(
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     if forced:
         settle = 100 if settle is None else whole_count("settle", settle, 0)
-        periods = 1000 if periods is None else whole_count("periods", periods, 1)
+        periods = 1000 if periods is None else whole_count("periods", periods, 1, MAX_PERIODS)
         check_periods("", "settle", settle, 0)
         check_periods("", "periods", periods, 1)
         if settle:

@@ -16,7 +16,13 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import MAX_RECORD_BYTES, InvalidInputError
-from vibroimpact.analysis.limits import MAX_STARTS, AnalysisError, check_total, whole_count
+from vibroimpact.analysis.limits import (
+    MAX_PERIODS,
+    MAX_STARTS,
+    AnalysisError,
+    check_total,
+    whole_count,
+)
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import (
     Runner,
@@ -48,6 +54,7 @@ class Section:
     impact_pair: list[str]
 
 
+@arguments.typed()
 def poincare(
     run: Runner | System,
     state: np.ndarray | None = None,
@@ -61,7 +68,7 @@ def poincare(
     run = as_runner(run)
     state = checked_run(run, state)
     settle_periods = whole_count("settle_periods", settle_periods, 0)
-    periods = whole_count("periods", periods, 1)
+    periods = whole_count("periods", periods, 1, MAX_PERIODS)
     check_total(("settle_periods", settle_periods), ("periods", periods))
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
     if settle_periods:
@@ -144,6 +151,7 @@ def _sampled(
     return run.periods(z, sample_periods, strobe=True)
 
 
+@arguments.typed()
 def bifurcation(
     data: Mapping[str, Any] | System,
     parameter: str,
@@ -253,6 +261,7 @@ def _axis(name: str, value: Any) -> tuple[int, np.ndarray]:
     return index, arguments.numbers(f"{name}[1] (the values)", value[1])
 
 
+@arguments.typed()
 def basins(
     run: Runner | System,
     first: tuple[int, np.ndarray],

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact.analysis.limits import MAX_ITERATIONS, relative_tolerance, whole_count
+from vibroimpact.analysis.limits import MAX_ITERATIONS, MAX_PERIODS, relative_tolerance, whole_count
 from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run, state_arrays
 from vibroimpact.model.system import System
 from vibroimpact.summary import summarised
@@ -46,6 +46,7 @@ class Orbit:
         return state_arrays(self.state, n, k)
 
 
+@arguments.typed()
 def orbit(
     run: Runner | System,
     state: np.ndarray | None = None,
@@ -69,7 +70,7 @@ def orbit(
     wall are halved. ``run``: a :class:`Runner` or a :class:`~vibroimpact.System`."""
     run = as_runner(run)
     state = checked_run(run, state)
-    periods = whole_count("periods", periods, 1)
+    periods = whole_count("periods", periods, 1, MAX_PERIODS)
     tolerance = relative_tolerance("tolerance", tolerance)
     max_iterations = whole_count("max_iterations", max_iterations, 1, MAX_ITERATIONS)
     jacobian = arguments.choice("jacobian", jacobian, ("auto", "tangent", "differences"))

@@ -287,6 +287,7 @@ def checked_run(run: Any, state: Any) -> np.ndarray | None:
     return arguments.state("state", state, 2 * (run.n + run.k))
 
 
+@arguments.typed()
 def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Runner:
     """A :class:`Runner` of a :class:`~vibroimpact.System` or of a scenario's sections
     (as parsed from TOML)."""

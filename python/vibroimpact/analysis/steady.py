@@ -84,6 +84,7 @@ class SteadyState:
     least_period_peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
+@arguments.typed()
 def steady_state(
     run: Runner | System,
     state: np.ndarray | None = None,

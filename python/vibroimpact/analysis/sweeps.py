@@ -189,6 +189,7 @@ class _PointFailure(Exception):
     """A sweep point the method cannot take: recorded with its reason."""
 
 
+@arguments.typed()
 def sweep(
     data: Mapping[str, Any] | System,
     parameter: str,

@@ -22,6 +22,7 @@ from vibroimpact.scenario.two_mass import (
 from vibroimpact.system import default_stepping
 
 
+@arguments.typed()
 def load(source: str | os.PathLike[str]) -> System:
     """The :class:`~vibroimpact.System` of a scenario: a path to a TOML file, or the
     TOML text itself (a str holding a line break, as :meth:`System.to_toml` writes it).
@@ -49,6 +50,7 @@ def load(source: str | os.PathLike[str]) -> System:
     return loads(read_scenario_text(path), str(path), path.parent)
 
 
+@arguments.typed()
 def loads(text: str, source: str = "<scenario>", base_dir: Path | None = None) -> System:
     """The :class:`~vibroimpact.System` of a scenario's TOML text (see :func:`load`);
     ``source`` names it in errors, ``base_dir`` is the folder of its recorded files

@@ -45,6 +45,7 @@ class NaturalModes:
         return shapes
 
 
+@arguments.typed()
 def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalModes:
     """The undamped natural frequencies (Hz) and mode shapes of ``system`` between
     contacts, from its linear parts (:func:`vibroimpact.linear_parts`): the generalized

@@ -147,6 +147,7 @@ def _plain(value: Any) -> Any:
     return value
 
 
+@arguments.typed()
 def study_of(
     data: Mapping[str, Any] | System, source: str = "<study>", base_dir: Path | None = None
 ) -> Study:
