@@ -49,7 +49,9 @@ impl Assembly {
             .collect();
         let point_rows = followed_rows(spec)?;
         let friction_hold = friction_holds(&interactions);
+        let gap_floor = gap_floor(&interactions);
         let mut assembly = Self {
+            gap_floor,
             compact: None,
             point_rows,
             mirrors_previous,
@@ -97,6 +99,21 @@ impl Assembly {
             gravity: self.gravity,
             mirrors: &self.mirrors_previous,
         })
+    }
+}
+
+/// The system's `Assembly::gap_floor`, m.
+fn gap_floor(interactions: &[Interaction]) -> f64 {
+    let smallest = interactions
+        .iter()
+        .filter(|it| !it.law.is_friction())
+        .map(|it| it.offset.abs())
+        .filter(|o| *o > 0.0 && o.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    if smallest.is_finite() {
+        1e-3 * smallest
+    } else {
+        0.0
     }
 }
 

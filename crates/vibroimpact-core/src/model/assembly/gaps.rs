@@ -109,11 +109,17 @@ impl Assembly {
 
     /// The scale of interaction `i`'s gap at state `y`, m: its offset and
     /// the magnitudes of the terms `h . x` sums, whose round-off the gap
-    /// carries.
+    /// carries; for a rigid pair, at least the system's floor
+    /// (`gap_floor`).
     #[inline(always)]
     pub fn gap_scale(&self, i: usize, y: &[f64]) -> f64 {
         let it = &self.interactions[i];
-        it.offset.abs() + it.magnitudes(&y[..self.dim])
+        let scale = it.offset.abs() + it.magnitudes(&y[..self.dim]);
+        if matches!(it.law, InteractionLaw::Rigid { .. }) {
+            scale.max(self.gap_floor)
+        } else {
+            scale
+        }
     }
 
     /// A sticking pair `i` released: held on its wall only to round-off, it
