@@ -30,6 +30,7 @@ PAGES = ["index", "getting_started", "model", "methods", "api", "scenario_format
 PAGES += ["development"]
 PACKAGES = ["vibroimpact", *(f"vibroimpact.{p}" for p in ("analysis", "study", "system"))]
 PACKAGES += [f"vibroimpact.{p}" for p in ("model", "scenario", "cli", "paper")]
+PACKAGES += ["vibroimpact.analysis.datasets"]
 
 
 def text_of(page: Path) -> str:

@@ -758,3 +758,25 @@ def test_a_relative_record_keeps_the_folder_it_was_given_in(
         after = vi.simulate(system_made_there, method="dopri5", t_end=1.0).final_state
         assert np.array_equal(after["structure_displacement"], before["structure_displacement"])
     assert system(base_dir=".") != given  # made here, it reads here
+
+
+def test_a_system_whose_study_axis_is_an_array_compares_and_round_trips() -> None:
+    # Studies take axes as arrays, but comparing such a System (==, after pickle or
+    # deepcopy, or against its own TOML read back) raised numpy's "truth value of an
+    # array is ambiguous".
+    import copy
+    import pickle
+
+    base = vi.load(Path(__file__).resolve().parents[1] / "examples" / "frf_impact_damper.toml")
+    axes = {"damper.0.clearance": np.array([0.002, 0.005]), "damper.0.mass": [np.float64(0.05)]}
+    system = vi.System(
+        structure=base.structure,
+        dampers=base.dampers,
+        excitations=base.excitations,
+        solver=base.solver,
+        analyses={"study": {"axes": axes, "metrics": ["peak"]}},
+    )
+    assert system == copy.deepcopy(system) == pickle.loads(pickle.dumps(system))
+    assert vi.loads(system.to_toml()) == system
+    assert system.analyses["study"]["axes"]["damper.0.clearance"] == [0.002, 0.005]
+    assert axes["damper.0.clearance"].shape == (2,)  # the caller's own left as given

@@ -150,7 +150,7 @@ def _names(**given: Any) -> None:
 def sweep_dataset(
     points: list[SweepPoint], parameter: str, *, units: str | None = None
 ) -> xr.Dataset:
-    """A sweep's points (:func:`vibroimpact.analysis.sweep`) as a Dataset.
+    """A sweep's points (:func:`vibroimpact.sweep`) as a Dataset.
 
     Dimensions ``point`` (in the sweep's order, up then down) and ``coordinate``
     (the structure's coordinates, with an integer coordinate 0, 1, ...).
@@ -293,7 +293,7 @@ def bifurcation_dataset(
     k: int | None = None,
     units: str | None = None,
 ) -> xr.Dataset:
-    """A bifurcation diagram (:func:`vibroimpact.analysis.bifurcation`) as a Dataset.
+    """A bifurcation diagram (:func:`vibroimpact.bifurcation`) as a Dataset.
 
     Dimensions ``point``, ``sample`` (the stroboscopic samples, with the coordinate
     ``sample`` = forcing periods after settling: 1, 2, ...) and ``state`` (the flat
@@ -369,7 +369,7 @@ def bifurcation_dataset(
 
 
 def section_dataset(section: Section, n: int, k: int) -> xr.Dataset:
-    """A Poincare section (:func:`vibroimpact.analysis.poincare`) of a system of ``n``
+    """A Poincare section (:func:`vibroimpact.poincare`) of a system of ``n``
     structure coordinates and ``k`` dampers as a Dataset.
 
     Dimensions ``sample`` (coordinate: forcing periods after settling, 1, 2, ...)
@@ -436,7 +436,7 @@ _LABELS = (
 
 
 def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
-    """Basins of attraction (:func:`vibroimpact.analysis.basins`) as a Dataset.
+    """Basins of attraction (:func:`vibroimpact.basins`) as a Dataset.
 
     Dimensions ``x`` and ``y``, with coordinates the two initial values varied
     (``result.first`` and ``result.second``), each with the attribute ``name``
@@ -488,7 +488,7 @@ def basins_dataset(result: Basins, x_name: str, y_name: str) -> xr.Dataset:
 
 
 def branch_dataset(branch: Branch, *, units: str | None = None) -> xr.Dataset:
-    """A continued branch (:func:`vibroimpact.analysis.continue_orbit`) as a
+    """A continued branch (:func:`vibroimpact.continue_orbit`) as a
     Dataset.
 
     Dimensions ``point`` (along the branch), ``state`` (coordinates ``state``, as

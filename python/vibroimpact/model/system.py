@@ -11,6 +11,8 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
+
 from vibroimpact._core import InvalidInputError, PreparedSystem
 from vibroimpact.arguments import directory
 from vibroimpact.messages import shown, unknown_section
@@ -132,8 +134,10 @@ class System:
                     f"System analyses: unknown section {shown(name)} (allowed: "
                     f"{', '.join(ANALYSIS_SECTIONS)})"
                 )
-        # The System's own copy: a caller's dict changed later does not change it.
-        object.__setattr__(self, "analyses", copy.deepcopy(dict(self.analyses)))
+        # The System's own copy: a caller's dict changed later does not change it. NumPy
+        # arrays and numbers in it as the lists and numbers TOML writes (an axis given as
+        # an array made two equal Systems' comparison raise numpy's "ambiguous").
+        object.__setattr__(self, "analyses", _plain_values(dict(self.analyses)))
         base_dir = directory("base_dir", self.base_dir)
         if base_dir is None and self._reads_relative_file():
             # The folder such a file is read from now, kept: after a chdir the same
@@ -417,6 +421,18 @@ def sections_of(data: Any, base_dir: Path | None = None) -> tuple[Mapping[str, A
             f"scenario) or a vibroimpact.System, got {shown(data)}"
         )
     return data, base_dir
+
+
+def _plain_values(value: Any) -> Any:
+    """A copy of ``value`` (an analysis's tables) with NumPy arrays as lists and NumPy
+    numbers as Python's, dicts and lists copied all the way down."""
+    if isinstance(value, Mapping):
+        return {key: _plain_values(v) for key, v in value.items()}
+    if isinstance(value, np.ndarray | np.generic):
+        return value.tolist()
+    if isinstance(value, list | tuple):
+        return [_plain_values(v) for v in value]
+    return copy.deepcopy(value)
 
 
 def _core_check(spec: dict[str, Any]) -> None:
