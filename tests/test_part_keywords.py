@@ -9,6 +9,7 @@ error the same typo gets in a TOML scenario."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 
 import pytest
@@ -188,3 +189,37 @@ def test_a_misspelt_keyword_of_a_public_function_is_a_value_error_with_the_close
     assert isinstance(err.value, ValueError)
     if meant is not None:
         assert said.endswith(f"(did you mean {meant!r}?)")
+
+
+def test_a_record_given_as_a_pandas_column_is_its_values() -> None:
+    # `Recorded(time=df.time, value=df.force)` was refused: "time: must be an array of
+    # numbers, got 0 0.000 ... dtype: float64".
+    import numpy as np
+    import pandas as pd
+
+    frame = pd.DataFrame({"time": [0.0, 0.1, 0.5], "force": [0.0, 5.0, 0.0]})
+    given = vi.Recorded(time=frame.time, value=frame.force)
+    assert given == vi.Recorded(time=[0.0, 0.1, 0.5], value=[0.0, 5.0, 0.0])
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=100.0),
+        excitations=[vi.Force(at=0, signal=given)],
+    )
+    listed = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=100.0),
+        excitations=[
+            vi.Force(
+                at=0, signal=vi.Recorded(time=np.array([0.0, 0.1, 0.5]), value=[0.0, 5.0, 0.0])
+            )
+        ],
+    )
+    first = vi.simulate(system, method="dopri5", t_end=1.0).final_state
+    second = vi.simulate(listed, method="dopri5", t_end=1.0).final_state
+    assert np.array_equal(first["structure_displacement"], second["structure_displacement"])
+    # A non-finite sample in a list is still named by its index (the check made at once).
+    with pytest.raises(vi.InvalidInputError, match=r"time\[2\]: must be a finite number, got nan"):
+        vi.System(
+            structure=vi.Oscillator(mass=1.0, stiffness=100.0),
+            excitations=[
+                vi.Force(at=0, signal=vi.Recorded(time=[0.0, 1.0, math.nan], value=[0.0] * 3))
+            ],
+        )

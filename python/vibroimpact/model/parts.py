@@ -40,8 +40,13 @@ def _as_tuple(value: Any, depth: int) -> Any:
     """Arrays given as lists or NumPy arrays held as tuples (``depth`` 1 for values, 2
     for rows), so that parts compare and hash by value; anything else is kept as
     given, for the schema to refuse by name."""
+    if not isinstance(value, np.ndarray | str | bytes | Sequence) and hasattr(value, "__array__"):
+        # A pandas Series or an xarray DataArray (a record's column) as its values.
+        value = np.asarray(value)
     if isinstance(value, np.ndarray) and value.ndim:
-        value = value.tolist()
+        value = value.tolist()  # Python numbers already, all the way down
+        if depth == 1:
+            return tuple(value)
     if isinstance(value, str | bytes) or not isinstance(value, Sequence):
         return value
     if depth == 1:
@@ -68,6 +73,8 @@ def _shown(value: Any) -> str:
 def _plain(value: Any) -> Any:
     """A tuple as the list TOML reads (rows as lists of lists)."""
     if isinstance(value, tuple):
+        if not any(isinstance(v, tuple) for v in value[:1]):
+            return list(value)  # an array of values (a record's samples: one copy in C)
         return [_plain(v) for v in value]
     return value
 

@@ -378,6 +378,12 @@ def _value(where: str, kind: str, value: Any) -> Any:
                 i = int(bad[0])
                 raise _fail(f"{where[:-2]}[{i}]: ", f"must be a finite number, got {value[i]}")
             return list(value.tolist())
+        if isinstance(value, list | tuple) and set(map(type, value)) == {float}:
+            # Python floats only (a part's record, a file's array): checked at once, in
+            # C (one by one, a 1e7-sample record took seconds at each of four checks).
+            finite = np.isfinite(np.fromiter(value, float, len(value)))
+            if finite.all():
+                return list(value)
         return [_value(f"{where[:-2]}[{i}]: ", _NUMBER, v) for i, v in enumerate(value)]
     if kind == _TEXTS:
         if isinstance(value, str | bytes) or not _is_array(value, 1):
