@@ -597,3 +597,24 @@ def test_a_study_of_largest_lyapunov_takes_a_compliant_law(tmp_path: Path) -> No
     data["solver"]["method"] = "dop853"
     expected = vi.lyapunov(an.lyapunov_runner(data), settle=5, periods=8).largest
     assert math.isfinite(found) and abs(found / expected - 1) < 1e-6
+
+
+@pytest.mark.timeout(60)
+def test_a_bifurcation_leg_up_goes_up_whatever_the_order_of_the_values() -> None:
+    # bifurcation() ran values [12, 11, 11.5] in that order and labelled the leg "up"
+    # (a sweep sorts them): a descending leg read as an ascending one misreports hysteresis.
+    system = vi.load(ROOT / "examples" / "frf_impact_damper.toml")
+    given = [12.0, 11.0, 11.5]
+    kept = {"settle_periods": 5, "sample_periods": 2}
+    up = vi.bifurcation(system, "excitation.0.frequency", given, direction="up", **kept)
+    assert [p.value for p in up] == [11.0, 11.5, 12.0]
+    both = vi.bifurcation(system, "excitation.0.frequency", given, direction="both", **kept)
+    assert [(p.direction, p.value) for p in both] == [
+        ("up", 11.0),
+        ("up", 11.5),
+        ("up", 12.0),
+        ("down", 12.0),
+        ("down", 11.5),
+        ("down", 11.0),
+    ]
+    assert [p.samples.tolist() for p in up] == [p.samples.tolist() for p in both[:3]]

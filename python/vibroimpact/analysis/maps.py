@@ -166,7 +166,8 @@ def bifurcation(
     progress: Callable[[int, int], None] | None = None,
 ) -> list[BifurcationPoint]:
     """A bifurcation diagram: for each value of ``parameter`` (a dotted path), in
-    the order given (``"up"``), reversed (``"down"``) or both, settle from the last
+    increasing order (``"up"``; the values sorted, as :func:`~vibroimpact.sweep` sorts
+    them), decreasing (``"down"``) or both, settle from the last
     point's state (see :func:`~vibroimpact.analysis.from_carried`), keep
     ``sample_periods`` stroboscopic states and sample ``sample`` over those periods:
     ``"displacement"`` (structure coordinate 0's stroboscopic displacement, m),
@@ -368,6 +369,9 @@ def _runner_at(
 def _legs(direction: str, values: list[float]) -> list[tuple[str, list[float]]]:
     if direction not in ("up", "down", "both"):
         raise AnalysisError(f'direction must be one of "up", "down", "both", got "{direction}"')
+    # Sorted, as a sweep sorts them: "up" is towards larger values whatever the order
+    # given (a leg given 12, 11, 11.5 ran in that order and was labelled "up").
+    values = sorted(values)
     legs: list[tuple[str, list[float]]] = []
     if direction in ("up", "both"):
         legs.append(("up", values))
