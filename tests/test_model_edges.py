@@ -247,3 +247,13 @@ def test_a_strobe_row_is_the_flat_state_as_documented() -> None:
         + [s["structure_velocity"], s["damper_velocity"]]
     )
     assert np.array_equal(sol.strobe[-1], flat)
+
+
+def test_the_exact_flow_ends_at_t_end_itself() -> None:
+    # Its last step ended on t_end to the grid's round-off, and the run reported that:
+    # 0.9999999999999982 (the history's last time too) where every other method ends on 1.
+    root = Path(__file__).resolve().parents[1] / "examples"
+    for name in ("bouncing_ball_table", "ball_table_basins", "frf_impact_damper"):
+        system = vi.load(root / f"{name}.toml")
+        sol = vi.simulate(system, method="exact", t_end=1.0, every=1)
+        assert sol.final_time == 1.0 and sol.to_xarray()["time"].values[-1] == 1.0, name

@@ -51,9 +51,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tangent::interactions, m)?)?;
     m.add_function(wrap_pyfunction!(check_solver, m)?)?;
     m.add_function(wrap_pyfunction!(hertz_stiffness, m)?)?;
-    // Internal (not in __all__): vibroimpact.analyses.forcing_period wraps it.
+    // Internal (not in __all__): vibroimpact.analysis.forcing_period wraps it.
     m.setattr("_forcing_period", wrap_pyfunction!(forcing_period, m)?)?;
-    // Internal: vibroimpact.analyses.steady_state's criterion, the studies' own.
+    // Internal: vibroimpact.analysis.steady_state's criterion, the studies' own.
     m.setattr("_strobe_period", wrap_pyfunction!(strobe_period, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_mode, m)?)?;
     m.add_function(wrap_pyfunction!(cantilever_root, m)?)?;

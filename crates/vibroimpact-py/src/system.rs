@@ -218,7 +218,7 @@ pub(crate) fn full_state(system: &Assembly, z: &[f64]) -> core::Result<Vec<f64>>
 }
 
 /// A 0.2 system checked once, with its method, to run many times from any
-/// state (the analyses' stroboscopic maps): see `vibroimpact.analyses`.
+/// state (the analyses' stroboscopic maps): see `vibroimpact.analysis`.
 #[pyclass(frozen, module = "vibroimpact._core")]
 pub struct PreparedSystem {
     /// A run at a time: the method's buffers are the system's.
@@ -324,7 +324,7 @@ impl PreparedSystem {
     }
 
     /// Shoot for a periodic orbit over `t_end` s (whole forcing periods) from
-    /// the flat state `state` (see `vibroimpact.analyses.orbit`): Newton's
+    /// the flat state `state` (see `vibroimpact.analysis.orbit`): Newton's
     /// method with a central-difference Jacobian, all in the core with the GIL
     /// released. `forcing_period` (s, default `t_end`) sets the scale of the
     /// motion (see `core::analysis::shooting::shoot`). Returns `state`, `monodromy`
@@ -571,7 +571,9 @@ pub fn linear_parts<'py>(
 /// forcing periods (its multipliers, amplitude and impacts). `lyapunov`
 /// carries the tangent flow for the largest Lyapunov exponent (1/s).
 /// `stepping = "fixed"` runs them as a lockstep ensemble of fixed RK4 steps
-/// (one mass, one compliant damper, unforced; see `core::analysis::ensemble`).
+/// (any system the compact path takes: a small modal structure, a few dampers
+/// and stops, compliant laws, one harmonic force; each run as its single
+/// fixed-step run, bit for bit).
 #[pyfunction]
 #[pyo3(signature = (spec, initial, *, paths, values, analysis, t_end, record_from, settle_periods, record_periods, tolerance, threads, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, energy_tolerance=None, mean_square=true, stepping=None, orbit_periods=1, lyapunov=false))]
 #[allow(clippy::too_many_arguments)]

@@ -474,6 +474,12 @@ impl<'a> Run<'a> {
             settle,
         )?;
         self.clock.time += taken;
+        if schedule.at_end(self.clock.time) {
+            // On t_end to the grid's round-off: the run ends there, at t_end itself
+            // (the exact flow's last step had ended 2e-15 s short of it, the time a
+            // run and its history reported).
+            self.clock.time = schedule.t_end;
+        }
         if !schedule.adaptive
             && (!event || (self.clock.grid + 1) as f64 * schedule.dt - self.clock.time <= 0.0)
         {

@@ -14,7 +14,7 @@ use crate::model::assembly::{resumed_state, Assembly};
 use crate::{analysis::shooting, numerics::linalg};
 
 /// Newton's tolerance and iterations for an orbit study's shooting (as
-/// `vibroimpact.analyses.orbit`'s defaults).
+/// `vibroimpact.analysis.orbit`'s defaults).
 pub(super) const ORBIT_TOLERANCE: f64 = 1e-10;
 pub(super) const ORBIT_ITERATIONS: usize = 40;
 

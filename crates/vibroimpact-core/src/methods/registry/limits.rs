@@ -278,13 +278,14 @@ fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure
     {
         return Err(Error::Inconsistent(format!(
             "[solver] dt: the fastest mode's period, {} s ({} Hz), is below 2.22 steps of dt = \
-             {} s (pi / sqrt(2)), where {} is unstable: reduce dt below {} s, use an implicit \
-             method (newmark-implicit, generalized-alpha), or check mass and stiffness",
+             {} s (pi / sqrt(2)), where {} is unstable: reduce dt to about {} s (20 steps a \
+             period; at the stability limit itself the run is stable but not accurate), use an \
+             implicit method (newmark-implicit, generalized-alpha), or check mass and stiffness",
             python_g3(period),
             python_g3(frequency),
             python_repr(dt),
             spec.name,
-            python_g3(period / 4.0)
+            python_g3(period / 20.0)
         )));
     }
     let steps = plan.t_end * frequency;
