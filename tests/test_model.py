@@ -556,6 +556,16 @@ def test_a_part_of_the_wrong_kind_is_named() -> None:
         ),
         ({"structure": oscillator, "gravity": 9.81}, "System gravity: must be a vibroimpact.Grav"),
         ({"structure": oscillator, "analyses": {"sweeps": {}}}, "System analyses: unknown section"),
+        # The kinds' shared classes themselves (an AttributeError had followed).
+        (
+            {"structure": vi.Structure()},
+            "System structure: must be a vibroimpact.Oscillator, vibroimpact.Matrices or "
+            "vibroimpact.Cantilever, got",
+        ),
+        (
+            {"structure": oscillator, "excitations": [vi.Force(at=0, signal=vi.Signal())]},
+            "System excitations[0].signal: must be a vibroimpact.Harmonic",
+        ),
     ]
     for arguments, expected in cases:
         with pytest.raises(vi.InvalidInputError) as caught:
@@ -780,3 +790,11 @@ def test_a_system_whose_study_axis_is_an_array_compares_and_round_trips() -> Non
     assert vi.loads(system.to_toml()) == system
     assert system.analyses["study"]["axes"]["damper.0.clearance"] == [0.002, 0.005]
     assert axes["damper.0.clearance"].shape == (2,)  # the caller's own left as given
+
+
+def test_an_empty_path_is_refused_as_such() -> None:
+    # Path("") is the working folder: the error read "cannot read scenario '.': Is a
+    # directory".
+    for empty in ("", "  "):
+        with pytest.raises(vi.InvalidInputError, match=r"^source: an empty path"):
+            vi.load(empty)

@@ -138,21 +138,26 @@ def contacts_frame(contacts: Any) -> Any:
 _TEXT_COLUMNS = ("pair", "kind")
 
 
-#: The units of a history's arrays (attributes of :func:`history_dataset`'s variables).
+#: The units of a history's arrays (attributes of :func:`history_dataset`'s variables),
+#: written as in UDUNITS, as the contact tables and the analyses' Datasets write them.
 _UNITS = {
     "structure_displacement": "m",
-    "structure_velocity": "m/s",
+    "structure_velocity": "m s-1",
     "damper_displacement": "m",
-    "damper_velocity": "m/s",
+    "damper_velocity": "m s-1",
 }
 #: The two-mass run's history (``vibroimpact.Solution``), each over time.
 _TWO_MASS_UNITS = {
     "main_displacement": "m",
-    "main_velocity": "m/s",
+    "main_velocity": "m s-1",
     "impact_displacement": "m",
-    "impact_velocity": "m/s",
+    "impact_velocity": "m s-1",
     "contact_force": "N",
 }
+
+
+#: The units of the ``energy_*`` attributes (an attribute has none of its own).
+_ENERGY_UNITS = {"energy_units": "J"}
 
 
 def history_dataset(sol: Any) -> Any:
@@ -177,7 +182,7 @@ def history_dataset(sol: Any) -> Any:
             for name, unit in _TWO_MASS_UNITS.items()
         }
         energy = {"energy_growth": sol.energy_growth, "energy_residual": sol.energy_residual}
-        return xr.Dataset(two_mass, coords=time, attrs=attrs | energy)
+        return xr.Dataset(two_mass, coords=time, attrs=attrs | energy | _ENERGY_UNITS)
     arrays = {
         name: (
             ("time", "structure_coordinate" if name.startswith("structure") else "damper"),
@@ -194,7 +199,7 @@ def history_dataset(sol: Any) -> Any:
     return xr.Dataset(
         arrays | followed | results,
         coords=time | coordinates | followed_at | results_at,
-        attrs=attrs | energy | {"recorded_time": sol.recorded_time},
+        attrs=attrs | energy | _ENERGY_UNITS | {"recorded_time": sol.recorded_time},
     )
 
 

@@ -8,6 +8,7 @@ import os
 from pathlib import Path
 
 from vibroimpact import arguments
+from vibroimpact._core import InvalidInputError
 from vibroimpact.messages import unknown_section
 from vibroimpact.model.parts import Damper, Initial, Oscillator, Output, Solver
 from vibroimpact.model.system import System
@@ -46,6 +47,9 @@ def load(source: str | os.PathLike[str]) -> System:
     """
     if isinstance(source, str) and "\n" in source:
         return loads(source)
+    if isinstance(source, str) and not source.strip():
+        # Path("") is the working folder: "cannot read scenario '.': Is a directory".
+        raise InvalidInputError("source: an empty path; give a scenario file")
     path = arguments.path("path", source)
     return loads(read_scenario_text(path), str(path), path.parent)
 

@@ -5,6 +5,7 @@ initial state, checked by the scenario format's one schema (:mod:`vibroimpact.sy
 from __future__ import annotations
 
 import copy
+import re
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
@@ -355,7 +356,7 @@ class System:
         )
 
 
-_SIGNAL_NAMES = ", ".join(c.__name__ for c in SIGNALS)
+_SIGNAL_NAMES = ", ".join(c.__name__ for c in SIGNALS[:-1]) + f" or {SIGNALS[-1].__name__}"
 
 
 def _shown_field(value: Any) -> str:
@@ -364,11 +365,15 @@ def _shown_field(value: Any) -> str:
 
 
 def _instance(name: str, value: Any, kind: type | tuple[type, ...], wanted: str) -> None:
-    if not isinstance(value, kind):
-        raise InvalidInputError(
-            f"System {name}: must be a vibroimpact.{wanted.replace(', ', ', vibroimpact.')}, "
-            f"got {shown(value)}"
-        )
+    # A Structure or a Signal itself is none of its kinds (it has no `kind`: an
+    # AttributeError had followed).
+    if not isinstance(value, kind) or not hasattr(type(value), "kind") and kind in _KINDED:
+        named = re.sub(r"\b([A-Z]\w+)", r"vibroimpact.\1", wanted)
+        raise InvalidInputError(f"System {name}: must be a {named}, got {shown(value)}")
+
+
+#: The parts whose concrete kinds each name a TOML ``kind`` or ``signal``.
+_KINDED = (Structure, Signal)
 
 
 def _parts(name: str, value: Any, kind: type | tuple[type, ...], wanted: str) -> tuple[Any, ...]:
