@@ -257,3 +257,19 @@ def test_the_exact_flow_ends_at_t_end_itself() -> None:
         system = vi.load(root / f"{name}.toml")
         sol = vi.simulate(system, method="exact", t_end=1.0, every=1)
         assert sol.final_time == 1.0 and sol.to_xarray()["time"].values[-1] == 1.0, name
+
+
+def test_masses_beyond_the_exact_flow_s_resolution_are_told_so() -> None:
+    # A 1e-15 kg damper on a 1 kg structure read "the mass matrix is not positive
+    # definite", naming no key, for a diagonal, positive matrix (the factor's resolution
+    # is 1e-14 of its largest entry); dop853 runs the same system.
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=100.0),
+        dampers=[vi.Damper(mass=1e-15, at=0, clearance=0.01, law="rigid", restitution=0.5)],
+        initial=vi.Initial(structure_velocity=[0.1]),
+    )
+    with pytest.raises(vi.InvalidInputError) as err:
+        vi.simulate(system, method="exact", t_end=0.1)
+    said = str(err.value)
+    assert "masses span 1.000e-15 kg to 1.000e0 kg" in said and '"dop853"' in said
+    assert vi.simulate(system, method="dop853", t_end=0.1).final_time == 0.1

@@ -381,3 +381,15 @@ def test_non_finite_scenario_number_is_refused_by_name(section: str, key: str, b
         vi.parse_scenario(text)
     message = str(err.value)
     assert names(message, key) and f"[{section}]" in message, message
+
+
+def test_the_two_mass_damper_takes_its_values_by_name_only() -> None:
+    # Its positional order (main_mass, stiffness, impact_mass, clearance, damping) is not
+    # the README's (damping third): ImpactDamper(1.0, 1.0, 0.01, 0.25, 0.01) made a 0.01 kg
+    # impact mass with 0.25 m clearances, unnoticed.
+    with pytest.raises(TypeError):
+        vi.ImpactDamper(1.0, 1.0, 0.01, 0.25, 0.01)  # type: ignore[misc]
+    damper = vi.ImpactDamper(
+        main_mass=1.0, stiffness=1.0, damping=0.01, impact_mass=0.25, clearance=0.01
+    )
+    assert (damper.impact_mass, damper.clearance, damper.damping) == (0.25, 0.01, 0.01)

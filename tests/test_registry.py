@@ -278,7 +278,9 @@ def test_a_setting_s_range_is_checked_once_with_one_text(
     messages = []
     calls = [
         lambda: vi.simulate(
-            vi.ImpactDamper(1.0, 1.0, 0.01, 0.25, 0.01),
+            vi.ImpactDamper(
+                main_mass=1.0, stiffness=1.0, impact_mass=0.01, clearance=0.25, damping=0.01
+            ),
             vi.Contact("hertz", stiffness=3000.0),
             vi.InitialState(),
             method="rk4",

@@ -95,6 +95,7 @@ class RestitutionWarning(UserWarning): ...
 class ImpactDamper:
     def __new__(
         cls,
+        *,
         main_mass: float,
         stiffness: float,
         impact_mass: float,

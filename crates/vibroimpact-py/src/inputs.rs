@@ -17,7 +17,9 @@ pub(crate) struct ImpactDamper(pub(crate) core::ImpactDamper);
 #[pymethods]
 impl ImpactDamper {
     #[new]
-    #[pyo3(signature = (main_mass, stiffness, impact_mass, clearance, damping = 0.0))]
+    // Keywords only: the order of the values is not the README's or the scenario's (a
+    // positional call put 0.01 into impact_mass and 0.25 into clearance unnoticed).
+    #[pyo3(signature = (*, main_mass, stiffness, impact_mass, clearance, damping = 0.0))]
     fn new(
         #[pyo3(from_py_with = arg::main_mass)] main_mass: f64,
         #[pyo3(from_py_with = arg::stiffness)] stiffness: f64,

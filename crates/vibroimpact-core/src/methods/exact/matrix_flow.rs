@@ -11,7 +11,7 @@
 //! (a fixed step and its Gauss nodes).
 
 use super::modal::Reduced;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::assembly::LinearParts;
 use crate::numerics::linalg;
 
@@ -45,9 +45,8 @@ impl MatrixFlow {
         let dim = parts.constant.len();
         let reduced = Reduced::new(parts, constraints);
         let r = reduced.size;
-        let l = linalg::cholesky(&reduced.mass, r).ok_or_else(|| {
-            Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
-        })?;
+        let l = linalg::cholesky(&reduced.mass, r)
+            .ok_or_else(|| super::modal::mass_error(what, &reduced.mass, r))?;
         let minv = linalg::inverse_from_cholesky(&l, r);
         let times = |a: &[f64]| {
             let mut out = vec![0.0; r * r];

@@ -187,6 +187,25 @@ impl Configuration {
     }
 }
 
+/// The error of a mass matrix `mass` (`r x r`) whose Cholesky factor
+/// failed: where its diagonal spans more than the factor's resolution (a
+/// damper of 1e-14 kg on a 1 kg structure), that, and what to do; else not
+/// positive definite.
+pub(super) fn mass_error(what: &str, mass: &[f64], r: usize) -> Error {
+    let diagonal = (0..r).map(|i| mass[i * r + i]);
+    let (least, most) = diagonal.fold((f64::INFINITY, 0.0_f64), |(lo, hi), m| {
+        (lo.min(m), hi.max(m))
+    });
+    if least > 0.0 && least <= 1e-14 * most {
+        return Error::Inconsistent(format!(
+            "{what}: its masses span {least:.3e} kg to {most:.3e} kg, a ratio below the \
+             exact flow's resolution (1e-14): make the smallest larger or the largest \
+             smaller, or use another method (\"dop853\")"
+        ));
+    }
+    Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
+}
+
 /// A reduced system's mass-normalised modes.
 struct NormalModes {
     /// Each mode's `w2` (1/s^2; rigid-body modes' round-off set to zero).
@@ -203,9 +222,7 @@ struct NormalModes {
 fn normal_modes(reduced: &Reduced, what: &str) -> Result<Option<NormalModes>> {
     let r = reduced.size;
     let (mr, kr, cr) = (&reduced.mass, &reduced.stiffness, &reduced.damping);
-    let l = linalg::cholesky(mr, r).ok_or_else(|| {
-        Error::Inconsistent(format!("{what}: the mass matrix is not positive definite"))
-    })?;
+    let l = linalg::cholesky(mr, r).ok_or_else(|| mass_error(what, mr, r))?;
     let linv = linalg::inverse_lower(&l, r);
     // A = L^-1 K L^-T; Phi = L^-T V.
     // As two products (`r^3` each, where the sum over both indices at
