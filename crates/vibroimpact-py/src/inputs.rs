@@ -1,6 +1,7 @@
 //! The two-mass system, its contact law and its initial state as Python classes.
 
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
 use vibroimpact_core as core;
 
 use crate::convert::*;
@@ -61,15 +62,23 @@ impl ImpactDamper {
     fn effective_mass(&self) -> f64 {
         self.0.effective_mass()
     }
-    fn __getnewargs__(&self) -> (f64, f64, f64, f64, f64) {
+    /// Pickled by name, as it is made (keywords only).
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
         let s = &self.0;
-        (
-            s.main_mass,
-            s.stiffness,
-            s.impact_mass,
-            s.clearance,
-            s.damping,
-        )
+        let keywords = PyDict::new(py);
+        for (name, value) in [
+            ("main_mass", s.main_mass),
+            ("stiffness", s.stiffness),
+            ("impact_mass", s.impact_mass),
+            ("clearance", s.clearance),
+            ("damping", s.damping),
+        ] {
+            keywords.set_item(name, value)?;
+        }
+        Ok((PyTuple::empty(py), keywords))
     }
     fn __repr__(&self) -> String {
         let s = &self.0;

@@ -243,11 +243,14 @@ impl SystemStepper for NewmarkFamily {
                     let (by_x, by_v) = (self.dadx[i * d + j], self.dadv[i * d + j]);
                     terms += (by_x * self.point[j]).abs() + (by_v * self.point[d + j]).abs();
                 }
+                // A pair held on its wall: the accelerations and the Jacobian's
+                // terms there are round-off, of the forces its constraint cancels.
                 size = size
                     .max(self.a1[i].abs())
                     .max(accel.abs())
                     .max(self.accel[i].abs())
-                    .max(terms);
+                    .max(terms)
+                    .max(system.held_acceleration(scratch, i));
             }
             linalg::solve_in_place(&mut self.jacobian, &mut self.step, d);
             let mut largest = 0.0f64;

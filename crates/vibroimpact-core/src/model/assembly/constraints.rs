@@ -41,6 +41,20 @@ impl Assembly {
         }
     }
 
+    /// The largest part of coordinate `i`'s acceleration that the pairs held
+    /// in `scratch` (as the last rates solved them) contribute, m/s^2 (0 for
+    /// none): a held pair's force cancels the others there, so it is the
+    /// scale of their round-off, which bounds how far Newton's method can
+    /// go where the acceleration itself is round-off.
+    pub(crate) fn held_acceleration(&self, scratch: &Scratch, i: usize) -> f64 {
+        let mut most = 0.0f64;
+        for s in 0..scratch.count {
+            let push = &self.interactions[scratch.sticking[s]].push;
+            most = most.max((scratch.forces[s] * push[i]).abs());
+        }
+        most
+    }
+
     /// The Jacobians of the accelerations (the middle `dim` rates) with
     /// respect to the coordinates `x` and the velocities `v` at state `y`, as
     /// row-major `dim x dim` matrices, for Newton's method: the structure's

@@ -124,7 +124,8 @@ impl ArraySteps for Steps {
                     .max(a1[i].abs())
                     .max(accel.abs())
                     .max(self.accel[i].abs())
-                    .max(terms);
+                    .max(terms)
+                    .max(system.held_acceleration(scratch, i));
             }
             linalg::solve_pivoted::<MAX_DIM>(&mut jacobian[..d * d], &mut step[..d], d);
             let mut largest = 0.0f64;
