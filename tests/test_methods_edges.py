@@ -284,34 +284,6 @@ def test_newton_on_free_flight_takes_one_update_on_the_general_kernel() -> None:
         assert sol.rhs_evaluations == 1 + 2 * sol.steps
 
 
-NEWTON_HELD = """
-[structure]
-kind = "oscillator"
-mass = {mass}
-stiffness = {stiffness}
-damping = {damping}
-
-[[stop]]
-at = 0
-side = "upper"
-gap = 0.01
-law = "rigid"
-restitution = 0.7
-
-[[excitation]]
-kind = "force"
-at = 0
-signal = "harmonic"
-amplitude = {force}
-frequency = 10.0
-
-[solver]
-method = "{method}"
-dt = {dt}
-t_end = 0.3
-"""
-
-
 @pytest.mark.parametrize("method", ["newmark-implicit", "generalized-alpha"])
 @pytest.mark.timeout(60)
 def test_an_implicit_method_holds_a_body_on_its_stop_whatever_its_mass(method: str) -> None:
@@ -321,15 +293,16 @@ def test_an_implicit_method_holds_a_body_on_its_stop_whatever_its_mass(method: s
     # with "Newton iterations did not converge ... reduce dt" (finer steps failed
     # sooner). The same system in units ten times larger (1 kg) had run.
     def run(scale: float, name: str, dt: float) -> Any:
-        text = NEWTON_HELD.format(
-            mass=0.1 * scale,
-            stiffness=39478.4 * scale,
-            damping=125.66 * scale,
-            force=2368.7 * scale,
-            method=name,
-            dt=dt,
+        system = vi.System(
+            structure=vi.Oscillator(
+                mass=0.1 * scale, stiffness=39478.4 * scale, damping=125.66 * scale
+            ),
+            stops=[vi.Stop(at=0, side="upper", gap=0.01, law="rigid", restitution=0.7)],
+            excitations=[
+                vi.Force(at=0, signal=vi.Harmonic(amplitude=2368.7 * scale, frequency=10.0))
+            ],
         )
-        return vi.simulate(vi.loads(text), history=False)
+        return vi.simulate(system, method=name, dt=dt, t_end=0.3, history=False)
 
     reference = run(1.0, "rk4", 1e-5)
     assert any(c.kind == "sticking" for c in reference.contacts.to_pandas().itertuples())
