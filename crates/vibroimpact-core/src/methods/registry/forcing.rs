@@ -83,9 +83,11 @@ pub fn check_forcing_period(system: &SystemSpec, plan: &ForcingPlan, period: f64
         python_g(lowest, 3)
     );
     // Only a method that takes atol resolves the motion to it: the exact flow's
-    // response to a fast forcing is its closed form however small (a MEMS sweep was
-    // refused for an atol it does not use).
-    let resolves_to_atol = spec.options.iter().any(|option| option.name == ATOL.name);
+    // response of a structure on springs to a fast forcing is its closed form however
+    // small (a MEMS sweep was refused for an atol it does not use). A free body's
+    // scale is atol for every method (its events are found to it).
+    let resolves_to_atol =
+        highest == 0.0 || spec.options.iter().any(|option| option.name == ATOL.name);
     if forcing > 0.0 && resolves_to_atol {
         let top = (forcing / atol).sqrt() / std::f64::consts::TAU;
         works += &format!(" and at most {} Hz", python_g(top, 3));
