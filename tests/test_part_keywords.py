@@ -197,29 +197,19 @@ def test_a_record_given_as_a_pandas_column_is_its_values() -> None:
     import numpy as np
     import pandas as pd
 
+    def forced_by(record: vi.Recorded) -> vi.System:
+        return vi.System(
+            structure=vi.Oscillator(mass=1.0, stiffness=100.0),
+            excitations=[vi.Force(at=0, signal=record)],
+        )
+
     frame = pd.DataFrame({"time": [0.0, 0.1, 0.5], "force": [0.0, 5.0, 0.0]})
     given = vi.Recorded(time=frame.time, value=frame.force)
     assert given == vi.Recorded(time=[0.0, 0.1, 0.5], value=[0.0, 5.0, 0.0])
-    system = vi.System(
-        structure=vi.Oscillator(mass=1.0, stiffness=100.0),
-        excitations=[vi.Force(at=0, signal=given)],
-    )
-    listed = vi.System(
-        structure=vi.Oscillator(mass=1.0, stiffness=100.0),
-        excitations=[
-            vi.Force(
-                at=0, signal=vi.Recorded(time=np.array([0.0, 0.1, 0.5]), value=[0.0, 5.0, 0.0])
-            )
-        ],
-    )
-    first = vi.simulate(system, method="dopri5", t_end=1.0).final_state
-    second = vi.simulate(listed, method="dopri5", t_end=1.0).final_state
+    listed = vi.Recorded(time=np.array([0.0, 0.1, 0.5]), value=[0.0, 5.0, 0.0])
+    first = vi.simulate(forced_by(given), method="dopri5", t_end=1.0).final_state
+    second = vi.simulate(forced_by(listed), method="dopri5", t_end=1.0).final_state
     assert np.array_equal(first["structure_displacement"], second["structure_displacement"])
     # A non-finite sample in a list is still named by its index (the check made at once).
     with pytest.raises(vi.InvalidInputError, match=r"time\[2\]: must be a finite number, got nan"):
-        vi.System(
-            structure=vi.Oscillator(mass=1.0, stiffness=100.0),
-            excitations=[
-                vi.Force(at=0, signal=vi.Recorded(time=[0.0, 1.0, math.nan], value=[0.0] * 3))
-            ],
-        )
+        forced_by(vi.Recorded(time=[0.0, 1.0, math.nan], value=[0.0] * 3))

@@ -1,7 +1,7 @@
 //! The two-mass system, its contact law and its initial state as Python classes.
 
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{IntoPyDict, PyDict, PyTuple};
 use vibroimpact_core as core;
 
 use crate::convert::*;
@@ -68,16 +68,14 @@ impl ImpactDamper {
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyTuple>, Bound<'py, PyDict>)> {
         let s = &self.0;
-        let keywords = PyDict::new(py);
-        for (name, value) in [
+        let keywords = [
             ("main_mass", s.main_mass),
             ("stiffness", s.stiffness),
             ("impact_mass", s.impact_mass),
             ("clearance", s.clearance),
             ("damping", s.damping),
-        ] {
-            keywords.set_item(name, value)?;
-        }
+        ]
+        .into_py_dict(py)?;
         Ok((PyTuple::empty(py), keywords))
     }
     fn __repr__(&self) -> String {

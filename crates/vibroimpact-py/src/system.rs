@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{IntoPyDict, PyDict, PyList};
 use vibroimpact_core as core;
 use vibroimpact_core::kernel::events::{integrate_system_stepped, RunOptions, Stepping};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
@@ -501,8 +501,7 @@ fn solution_dict<'py>(
     out.set_item("contact_force_pairs", sol.contact_force_pairs)?;
     out.set_item("contact_forces", sol.contact_forces.into_pyarray(py))?;
     let e = sol.energy;
-    let energy = PyDict::new(py);
-    for (key, value) in [
+    let energy = [
         ("input_work", e.input_work),
         ("dissipated", e.dissipated),
         ("viscous", e.viscous),
@@ -512,9 +511,8 @@ fn solution_dict<'py>(
         ("stored_start", e.stored_start),
         ("stored_end", e.stored_end),
         ("residual", e.residual),
-    ] {
-        energy.set_item(key, value)?;
-    }
+    ]
+    .into_py_dict(py)?;
     out.set_item("energy", energy)?;
     out.set_item("steps", sol.steps)?;
     out.set_item("rejected_steps", sol.rejected_steps)?;

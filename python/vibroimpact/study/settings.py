@@ -144,13 +144,9 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
         )
     # As asked (point_peak... among them: see base_metrics).
     out["metrics"] = list(dict.fromkeys(asked))
-    for key, low in (
-        ("settle_periods", 0),
-        ("record_periods", 1),
-        ("orbit_periods", 1),
-    ):
-        if out[key] < low:
-            raise StudyError(f"[study] {key}: must be >= {low}, got {out[key]}")
+    # Their lower bounds are the whole-number check's (WHOLE_RANGES, the analyses'
+    # settings'); its upper bound is each key's own.
+    for key in ("settle_periods", "record_periods", "orbit_periods"):
         if out[key] > MAX_PERIODS:
             # As the analyses' own settings: 1e11 periods ran for half a minute into
             # gigabytes of contacts before failing (user trial).

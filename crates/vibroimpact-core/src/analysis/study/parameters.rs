@@ -420,7 +420,6 @@ impl Parameter {
     }
 }
 
-/// A core error about an input of `section` (a dotted path), named by it.
 /// The study's system and start at one row's `values`: the parameters
 /// applied, then the checks a single run of that point makes before its
 /// first step and the values can change ([`check_steps_resolve`]). A study
@@ -442,6 +441,7 @@ pub(super) fn row_system(
     Ok((spec, initial))
 }
 
+/// A core error about an input of `section` (a dotted path), named by it.
 pub(super) fn in_section(section: &str, e: Error) -> Error {
     match e {
         Error::InvalidParameter { .. } | Error::UnknownChoice { .. } => {
