@@ -105,14 +105,16 @@ RACE = textwrap.dedent(
     start = time.perf_counter()
     vi.study.chunk_part(study, 0, 1, threads=1)
     each = time.perf_counter() - start
-    threading.Timer(
-        {fraction} * 60 * each, lambda: os.kill(os.getpid(), signal.SIGINT)
-    ).start()
+    delay = {fraction} * 60 * each
+    threading.Timer(delay, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    # Chunks run on until well after the signal (not a count of them, which a loaded
+    # machine's slower chunks can outlast): a signal that was lost ends the loop here.
+    until = time.perf_counter() + delay + 3.0
     try:
-        for i in range(60):
-            vi.study.chunk_part(study, i, i + 1, threads=1)
-        time.sleep(0.1)
-        print("all 60 chunks ran")
+        while time.perf_counter() < until:
+            for i in range(60):
+                vi.study.chunk_part(study, i, i + 1, threads=1)
+        print("the chunks ran on, 3 s past the signal")
     except KeyboardInterrupt:
         print("interrupted")
     """
