@@ -7,6 +7,10 @@ harmonic excitation)."""
 
 from __future__ import annotations
 
+import copy
+import math
+import pickle
+
 import pytest
 
 import vibroimpact as vi
@@ -71,3 +75,113 @@ def test_an_orbit_of_an_unforced_system_names_the_missing_excitation() -> None:
     # With the excitation, the missing dt is what is left to name.
     with pytest.raises(vi.InvalidInputError, match=r"\[solver\] dt: is required"):
         vi.orbit(unforced.replace(excitations=[FORCE]))
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    "solver", [vi.Solver(method="rk4", dt=1e-4, t_end=0.05), vi.Solver(dt=1e-4), None]
+)
+def test_a_start_inside_a_wall_is_refused_where_the_system_is_built(
+    solver: vi.Solver | None,
+) -> None:
+    # It was built (and loaded) and refused only by simulate: the run's own message now,
+    # at once, whether or not the solver has a t_end.
+    inside = vi.Initial(damper_displacement=[0.008])  # 3 mm past the 5 mm clearance
+    bare = vi.System(structure=OSCILLATOR, dampers=[RIGID_DAMPER])
+    sections = bare.model_sections() | {"initial": inside.to_dict()}
+    with pytest.raises(vi.InvalidInputError) as run:
+        prepare_system(**sections, solver={"t_end": 0.05, "dt": 1e-4}).run()
+    assert "damper 0 starts 3.000000e-3 m inside its wall" in str(run.value)
+    with pytest.raises(vi.InvalidInputError) as built:
+        bare.replace(initial=inside, solver=solver)
+    assert str(built.value) == str(run.value)
+    # Touching its wall is a start, and runs.
+    touching = bare.replace(initial=vi.Initial(damper_displacement=[0.005]), solver=solver)
+    assert vi.simulate(touching, t_end=0.01, dt=1e-4).final_time == 0.01
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    ("solver", "message"),
+    [
+        (vi.Solver(method="exakt"), r'^\[solver\] method must be one of .*got "exakt"'),
+        (vi.Solver(rtol=-1.0), r"^\[solver\] rtol: must be in \[1e-15, 0.1\], got -1.0"),
+        (vi.Solver(method="dop853", stepping="fixed"), r'^\[solver\] stepping: "fixed" takes'),
+    ],
+)
+def test_a_solver_without_t_end_is_checked_where_the_system_is_built(
+    solver: vi.Solver, message: str
+) -> None:
+    # Built, and refused only when run (a misspelt method too).
+    with pytest.raises(vi.InvalidInputError, match=message):
+        vi.System(structure=OSCILLATOR, solver=solver)
+    # The same message as a solver with its t_end gets.
+    with pytest.raises(vi.InvalidInputError, match=message):
+        vi.System(structure=OSCILLATOR, solver=vi.Solver(**solver.to_dict(), t_end=1.0))
+
+
+@pytest.mark.timeout(60)
+def test_a_system_whose_solver_has_no_t_end_loads_back_and_runs_as_given() -> None:
+    system = vi.System(
+        structure=OSCILLATOR,
+        dampers=[RIGID_DAMPER],
+        excitations=[FORCE],
+        solver=vi.Solver(method="dop853", rtol=1e-9),
+    )
+    text = system.to_toml()
+    assert "t_end" not in text
+    loaded = vi.load(text)  # it was refused: "[solver] missing key 't_end'"
+    assert loaded == system
+    ran, again = (vi.simulate(s, t_end=0.2) for s in (system, loaded))
+    assert ran.final_state == again.final_state and len(ran.contacts) > 0
+    # Its runs need their length; a file's misspelt method is still refused on loading.
+    with pytest.raises(vi.InvalidInputError, match="t_end"):
+        vi.simulate(loaded)
+    with pytest.raises(ValueError, match='got "dop835"'):
+        vi.load(text.replace('"dop853"', '"dop835"'))
+
+
+@pytest.mark.timeout(60)
+def test_a_systems_analyses_are_read_only() -> None:
+    # Changed in place, they passed by the checks a System makes when built (an unknown
+    # section, a misspelt key), and a hashed System's analyses changed under it.
+    system = vi.System(structure=OSCILLATOR, analyses={"sweep": {"count": 5, "values": [1, 2]}})
+    for change in (
+        lambda a: a.__setitem__("swep", {}),
+        lambda a: a.update(poincare={}),
+        lambda a: a["sweep"].__setitem__("count", 6),
+        lambda a: a["sweep"]["values"].append(3),
+        lambda a: a.pop("sweep"),
+    ):
+        with pytest.raises(TypeError, match=r"read-only: make a changed System"):
+            change(system.analyses)
+    assert system.analyses == {"sweep": {"count": 5, "values": [1, 2]}}
+    # A copy to change: to_dict's tables, and replace.
+    tables = system.to_dict()
+    tables["sweep"]["values"].append(3)
+    assert type(tables["sweep"]) is dict and system.analyses["sweep"]["values"] == [1, 2]
+    changed = system.replace(analyses={"sweep": tables["sweep"]})
+    assert changed.analyses["sweep"]["values"] == [1, 2, 3]
+    # Pickled (a Dask task) and copied, still read-only and equal.
+    for other in (pickle.loads(pickle.dumps(system)), copy.deepcopy(system)):
+        assert other == system
+        with pytest.raises(TypeError):
+            other.analyses["sweep"]["values"].append(3)
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["dop853", "exact", "rk4"])
+def test_natural_frequencies_beyond_a_double_are_refused(method: str) -> None:
+    # 1e-200 kg on 1e200 N/m (w^2 = 1e400 s^-2): dop853 stopped as a "numerical blow-up"
+    # (exit 1), the exact flow returned its start after a second (exit 0).
+    overflowing = vi.Oscillator(mass=1e-200, stiffness=1e200, damping=0.0)
+    solver = vi.Solver(method=method, t_end=1.0, dt=1e-3 if method == "rk4" else None)
+    with pytest.raises(vi.InvalidInputError, match=r"natural frequencies overflow a double"):
+        vi.System(structure=overflowing, solver=solver)
+    # The largest a double holds runs its closed form (w = 1e10 rad/s over 1e-9 s).
+    fine = vi.System(
+        structure=vi.Oscillator(mass=1e-150, stiffness=1e-130, damping=0.0),
+        initial=vi.Initial(structure_displacement=[1e-3]),
+    )
+    end = vi.simulate(fine, method="exact", t_end=1e-9).final_state["structure_displacement"][0]
+    assert abs(end - 1e-3 * math.cos(1e10 * 1e-9)) < 1e-15

@@ -316,6 +316,7 @@ class PreparedSystem:
         energy_tolerance: float | None = None,
         stepping: str | None = None,
         contact_timing: str | None = None,
+        initial: list[list[float]] | None = None,
     ) -> PreparedSystem: ...
     def run(
         self,

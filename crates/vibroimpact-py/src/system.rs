@@ -250,9 +250,10 @@ impl PreparedSystem {
 impl PreparedSystem {
     /// Check `spec` (the sections, as `simulate_system` takes them) and make
     /// its method; the settings as for `simulate_system` (`t_end`, s, sets the
-    /// default duration of swept signals).
+    /// default duration of swept signals); `initial`, where given, the four
+    /// arrays of `[initial]`, checked as a run from them checks them.
     #[new]
-    #[pyo3(signature = (spec, *, t_end, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, max_rows=None, energy_tolerance=None, stepping=None, contact_timing=None))]
+    #[pyo3(signature = (spec, *, t_end, method=None, dt=None, rtol=None, atol=None, beta=None, gamma=None, spectral_radius=None, max_steps=None, max_rows=None, energy_tolerance=None, stepping=None, contact_timing=None, initial=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         spec: &Bound<'_, PyDict>,
@@ -273,6 +274,7 @@ impl PreparedSystem {
         >,
         stepping: Option<&str>,
         contact_timing: Option<&str>,
+        initial: Option<[Vec<f64>; 4]>,
     ) -> PyResult<Self> {
         let options = Options::or_defaults(rtol, atol, beta, gamma, spectral_radius);
         let method = method.unwrap_or(SYSTEM.method);
@@ -285,6 +287,10 @@ impl PreparedSystem {
             (stepping, contact_timing),
         )?;
         let ready = Ready::new(spec, method, t_end, &options, limits)?;
+        if let Some(initial) = initial {
+            // `[initial]` as a run takes it: every pair apart or touching.
+            start_of(&ready.system, &initial)?;
+        }
         Ok(Self {
             ready: std::sync::Mutex::new(ready),
         })
@@ -450,16 +456,16 @@ pub fn simulate_system<'py>(
         (stepping, contact_timing),
     )?;
     let mut ready = Ready::new(spec, method, t_end, &options, limits)?;
-    let y0 = initial_state(
-        &ready.system,
-        &initial[0],
-        &initial[1],
-        &initial[2],
-        &initial[3],
-    )
-    .map_err(to_py)?;
+    let y0 = start_of(&ready.system, &initial)?;
     let sol = ready.run(py, &y0, t_end, (history, every), record_from, strobe_period)?;
     solution_dict(py, &ready.system, sol)
+}
+
+/// The state of `[initial]`'s four arrays (the structure's displacements
+/// and velocities, the dampers'), checked as a run from it checks it.
+fn start_of(system: &Assembly, initial: &[Vec<f64>; 4]) -> PyResult<Vec<f64>> {
+    let [x, v, z, w] = initial;
+    initial_state(system, x, v, z, w).map_err(to_py)
 }
 
 /// The kernel's stepping from `[solver] stepping` and `contact_timing`.
@@ -618,7 +624,7 @@ pub fn run_study<'py>(
     let system_spec = system_spec(spec, t_end)?;
     // The base system and start must be valid on their own.
     let base = Assembly::new(&system_spec).map_err(to_py)?;
-    initial_state(&base, &initial[0], &initial[1], &initial[2], &initial[3]).map_err(to_py)?;
+    start_of(&base, &initial)?;
     let parameters = paths
         .iter()
         .map(|p| Parameter::parse(p, &system_spec))

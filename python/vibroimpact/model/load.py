@@ -33,7 +33,9 @@ def load(source: str | os.PathLike[str]) -> System:
     key). A 0.2 scenario keeps its ``[solver]``, ``[output]`` and analyses' tables
     (``system.solver``, ``system.output``, ``system.analyses``), so that
     ``vi.simulate(vi.load(path))`` runs what the command line runs; a recorded signal's
-    relative ``file`` is read from the scenario's folder (``system.base_dir``).
+    relative ``file`` is read from the scenario's folder (``system.base_dir``). A
+    ``[solver]`` without ``t_end`` (as a System whose Solver has none writes it) is
+    read with its other keys checked; its runs are then given ``t_end``.
 
     A 0.1 two-mass scenario becomes its System: an :class:`Oscillator` (``main_mass``,
     ``stiffness``, ``damping``) with one :class:`Damper` at point 0 (``impact_mass``,
@@ -69,12 +71,15 @@ def loads(text: str, source: str = "<scenario>", base_dir: Path | None = None) -
     data = read_toml(text, source)
     if "structure" not in data:
         return _two_mass(two_mass_scenario(data, source), data)
+    solver = data.get("solver")
     try:
-        if "solver" in data:
+        if solver is not None and not (isinstance(solver, dict) and "t_end" not in solver):
             # Every section checked as a run of the file checks it (errors name the file).
             system_scenario(data, source, base_dir)
         else:
-            # A system written without [solver] (System.to_toml of a bare System).
+            # A system written without [solver] (System.to_toml of a bare System), or
+            # with one whose runs are given their length (its Solver has no t_end):
+            # the System checks its parts.
             for name in data:
                 if name not in SECTIONS:
                     allowed = f"allowed with [structure]: {', '.join(SECTIONS)}"

@@ -43,6 +43,7 @@ from vibroimpact.model.parts import (
 from vibroimpact.model.toml_text import toml_text
 from vibroimpact.notebook import system_html
 from vibroimpact.system import (
+    _INITIAL,
     _OUTPUT,
     _SOLVER,
     RUN_SECTIONS,
@@ -50,6 +51,7 @@ from vibroimpact.system import (
     _unknown_key,
     initial_table,
     prepare_system,
+    solver_table,
     system_spec,
 )
 from vibroimpact.system.parameter_keys import check_parameter_keys
@@ -79,14 +81,17 @@ class System:
     ``[output]`` a plain :func:`vibroimpact.simulate` of it uses (its keywords override
     them), ``analyses`` the ``[sweep]``, ``[continuation]``, ``[basins]`` and
     ``[study]`` tables as written (checked when read from a file, and by the analysis
-    that uses them). ``base_dir`` is the folder a recorded signal's relative ``file`` is
+    that uses them; read-only: ``replace(analyses=...)`` makes a changed System).
+    ``base_dir`` is the folder a recorded signal's relative ``file`` is
     read from (the scenario's, for a loaded system; by default the working directory
     when the System is made), kept absolute.
 
     Every value is checked on construction by the scenario's schema, with the error a
-    file gets (``[[damper]] 0: law "rigid" needs restitution in [0, 1], got 1.5``); the
-    solver and output as well when ``solver`` has a ``t_end``. ``to_dict()`` gives the
-    TOML sections, ``to_toml()`` the scenario text.
+    file gets (``[[damper]] 0: law "rigid" needs restitution in [0, 1], got 1.5``), and
+    the ``initial`` state as a run checks it (every pair apart or touching); the
+    solver's keys, method and ranges, and with its ``t_end`` the whole run (steps, rows,
+    memory) and its output. ``to_dict()`` gives the TOML sections, ``to_toml()`` the
+    scenario text.
     """
 
     structure: Structure
@@ -138,7 +143,8 @@ class System:
         # The System's own copy: a caller's dict changed later does not change it. NumPy
         # arrays and numbers in it as the lists and numbers TOML writes (an axis given as
         # an array made two equal Systems' comparison raise numpy's "ambiguous").
-        object.__setattr__(self, "analyses", _plain_values(dict(self.analyses)))
+        # Read-only: a table changed in place would pass by the checks below.
+        object.__setattr__(self, "analyses", _plain_values(self.analyses, read_only=True))
         base_dir = directory("base_dir", self.base_dir)
         if base_dir is None and self._reads_relative_file():
             # The folder such a file is read from now, kept: after a chdir the same
@@ -197,15 +203,20 @@ class System:
                 output=sections.get("output"),
                 base_dir=self.base_dir,
             )
-            PreparedSystem(run.binding_spec(), **run.method_arguments())
+            start = [run.initial[key] for key in _INITIAL]
+            PreparedSystem(run.binding_spec(), **run.method_arguments(), initial=start)
             return
         initial = model.pop("initial")
         try:
             spec = system_spec(**model, base_dir=self.base_dir)
         except RecursionError:
             raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
-        initial_table(initial, spec)
-        _core_check(spec)
+        table = initial_table(initial, spec)
+        _core_check(spec, [table[key] for key in _INITIAL])
+        if self.solver is not None:
+            # Its runs are given their length: the rest is checked now (a misspelt
+            # method built, and was refused only when run).
+            solver_table(sections["solver"], length_given=False)
 
     def model_sections(self) -> dict[str, Any]:
         """The model's sections as :func:`vibroimpact.system.prepare_system` takes them
@@ -245,7 +256,8 @@ class System:
             part = getattr(self, name)
             if part is not None:
                 sections[name] = part.to_dict()
-        return sections | copy.deepcopy(dict(self.analyses))
+        analyses: dict[str, Any] = _plain_values(self.analyses)
+        return sections | analyses
 
     def to_toml(self, *, solver: Solver | None = None, output: Output | None = None) -> str:
         """The system as a 0.2 scenario (TOML text, SI units) that
@@ -319,7 +331,7 @@ class System:
                 collision=model["collision"] or (),
                 friction=model["friction"] or (),
             )
-            initial_table(model["initial"], spec)
+            start = initial_table(model["initial"], spec)
             for name, schema in (("solver", _SOLVER), ("output", _OUTPUT)):
                 table = sections.get(name)
                 if table is None:
@@ -330,7 +342,7 @@ class System:
                     if key not in schema:
                         raise _unknown_key(f"[{name}] ", key, list(schema), "allowed:") from None
             # A key the core requires (a random signal's seed): its error names it.
-            _core_check(spec)
+            _core_check(spec, [start[key] for key in _INITIAL])
             raise
 
     @classmethod
@@ -428,21 +440,55 @@ def sections_of(data: Any, base_dir: Path | None = None) -> tuple[Mapping[str, A
     return data, base_dir
 
 
-def _plain_values(value: Any) -> Any:
+class ReadOnlyTable(dict):  # type: ignore[type-arg]
+    """An analysis's table in a :class:`System`: a dict that is not changed in place (a
+    change would pass by the checks a System makes when it is built); make a changed
+    System with ``System.replace(analyses=...)``."""
+
+    def _refuse(self, *args: Any, **kwargs: Any) -> None:
+        raise TypeError(
+            "System.analyses is read-only: make a changed System with "
+            "system.replace(analyses={...})"
+        )
+
+    __setitem__ = __delitem__ = __ior__ = _refuse  # type: ignore[assignment]
+    clear = pop = popitem = setdefault = update = _refuse  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Pickled and copied as the dict it holds (dict's own way sets items one by one).
+        return (ReadOnlyTable, (dict(self),))
+
+
+class ReadOnlyList(list):  # type: ignore[type-arg]
+    """An array in a :class:`System`'s analyses (see :class:`ReadOnlyTable`)."""
+
+    _refuse = ReadOnlyTable._refuse
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = _refuse  # type: ignore[assignment]
+    append = extend = insert = pop = remove = clear = sort = reverse = _refuse
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (ReadOnlyList, (list(self),))
+
+
+def _plain_values(value: Any, read_only: bool = False) -> Any:
     """A copy of ``value`` (an analysis's tables) with NumPy arrays as lists and NumPy
-    numbers as Python's, dicts and lists copied all the way down."""
+    numbers as Python's, dicts and lists copied all the way down (``read_only``: as
+    :class:`ReadOnlyTable` and :class:`ReadOnlyList`)."""
+    table, array = (ReadOnlyTable, ReadOnlyList) if read_only else (dict, list)
     if isinstance(value, Mapping):
-        return {key: _plain_values(v) for key, v in value.items()}
+        return table({key: _plain_values(v, read_only) for key, v in value.items()})
     if isinstance(value, np.ndarray | np.generic):
-        return value.tolist()
+        value = value.tolist()
+        return _plain_values(value, read_only) if isinstance(value, list) else value
     if isinstance(value, list | tuple):
-        return [_plain_values(v) for v in value]
+        return array([_plain_values(v, read_only) for v in value])
     return copy.deepcopy(value)
 
 
-def _core_check(spec: dict[str, Any]) -> None:
+def _core_check(spec: dict[str, Any], initial: list[list[float]]) -> None:
     """The model's ranges and required keys, which the core holds (a damper's mass > 0, a
-    frequency >= 0, a random signal's seed), checked on the schema's ``spec`` as a run
-    checks them: its error names the key. Any run length: these checks do not depend on it."""
+    frequency >= 0, a random signal's seed), and the ``initial`` state's arrays (every pair
+    apart or touching), checked on the schema's ``spec`` as a run checks them: its error
+    names the key. Any run length: these checks do not depend on it."""
     binding = {**spec, "gravity": spec["gravity"]["acceleration"], "points": [], "moments": []}
-    PreparedSystem(binding, t_end=1.0)
+    PreparedSystem(binding, t_end=1.0, initial=initial)

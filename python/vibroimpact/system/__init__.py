@@ -11,7 +11,7 @@ from vibroimpact.system.points import (
     split_observed,
     structure_coordinates,
 )
-from vibroimpact.system.run import PreparedRun, prepare_system, simulate_system
+from vibroimpact.system.run import PreparedRun, prepare_system, simulate_system, solver_table
 from vibroimpact.system.schema import (
     _DAMPER,
     _FIXED_STEP,
@@ -46,6 +46,7 @@ __all__ = [
     "SystemContacts",
     "SystemSolution",
     "prepare_system",
+    "solver_table",
     "simulate_system",
     "SYSTEM_SOLVER_DEFAULTS",
     "default_stepping",

@@ -247,23 +247,8 @@ def prepare_system(
         raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
     # "is None", not "or": an array given for a table has no truth value.
     init = initial_table(initial, spec)
-    solver = _table("[solver] ", solver, _SOLVER)
+    solver = solver_table(solver)
     output = _table("[output] ", {} if output is None else output, _OUTPUT)
-    _choice("[solver] ", "method", solver["method"], _METHODS)
-    _choice("[solver] ", "stepping", solver["stepping"], ("events", "fixed"))
-    _choice("[solver] ", "contact_timing", solver["contact_timing"], ("located", "step-count"))
-    if solver["stepping"] == "events" and solver["contact_timing"] != "located":
-        raise _fail(
-            "[solver] contact_timing: ",
-            '"step-count" needs stepping = "fixed" (with events the instants are located)',
-        )
-    if solver["stepping"] == "fixed" and solver["method"] not in _FIXED_STEP:
-        raise _fail(
-            "[solver] stepping: ",
-            f'"fixed" takes a fixed-step method ({", ".join(_FIXED_STEP)}), '
-            f"not {solver['method']!r}",
-        )
-    _check_settings(solver)
     # every, max_steps and max_rows are whole numbers >= 1 (the schema's WHOLE_RANGES).
     # The up-front limits (strobe_period > 0, steps, the fastest mode and forcing against
     # the step, rows, memory) are the core's (its registry's check_run), with their
@@ -369,6 +354,31 @@ def _solution(
         ),
         contact_force_pairs=[pairs[p] for p in raw["contact_force_pairs"]],
     )
+
+
+def solver_table(solver: Any, *, length_given: bool = True) -> dict[str, Any]:
+    """The ``[solver]`` table checked (its keys, method, stepping and the registry's
+    ranges) with its defaults filled; without ``length_given``, ``t_end`` (s) may be
+    left out (None): a System's solver whose runs are given their length."""
+    schema = _SOLVER if length_given else {**_SOLVER, "t_end": (_SOLVER["t_end"][0], None)}
+    checked: dict[str, Any] = _table("[solver] ", solver, schema)
+    _choice("[solver] ", "method", checked["method"], _METHODS)
+    _choice("[solver] ", "stepping", checked["stepping"], ("events", "fixed"))
+    _choice("[solver] ", "contact_timing", checked["contact_timing"], ("located", "step-count"))
+    if checked["stepping"] == "events" and checked["contact_timing"] != "located":
+        raise _fail(
+            "[solver] contact_timing: ",
+            '"step-count" needs stepping = "fixed" (with events the instants are located)',
+        )
+    if checked["stepping"] == "fixed" and checked["method"] not in _FIXED_STEP:
+        raise _fail(
+            "[solver] stepping: ",
+            f'"fixed" takes a fixed-step method ({", ".join(_FIXED_STEP)}), '
+            f"not {checked['method']!r}",
+        )
+    # No length yet: the other settings' ranges do not depend on it (1 s is in range).
+    _check_settings(checked if checked["t_end"] is not None else {**checked, "t_end": 1.0})
+    return checked
 
 
 def _check_settings(solver: Mapping[str, Any]) -> None:

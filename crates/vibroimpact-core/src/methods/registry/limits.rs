@@ -152,6 +152,7 @@ pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
             )));
         }
     }
+    check_finite_modes(system.structure)?;
     check_natural_period(spec, plan, system.structure)?;
     check_forcing_steps(spec, plan, &system.forcing)?;
     let width = 1 + 2 * system.coordinates;
@@ -224,6 +225,29 @@ fn frequency_bound(structure: &Structure) -> f64 {
     } else {
         f64::INFINITY
     }
+}
+
+/// Refuse a structure whose natural frequencies overflow a double (its
+/// stiffness over its mass beyond 1.8e308 s^-2): every method's run of it is
+/// meaningless (the exact flow's phase, an adaptive step of no length), and
+/// the checks against its fastest mode would read it as a free body. The
+/// eigenvalues only where the bound is not finite.
+fn check_finite_modes(structure: &Structure) -> Result<()> {
+    if frequency_bound(structure).is_finite() {
+        return Ok(());
+    }
+    let top = structure
+        .natural_frequencies()
+        .into_iter()
+        .fold(0.0f64, f64::max);
+    if top.is_finite() {
+        return Ok(());
+    }
+    Err(Error::Inconsistent(
+        "[structure]: its natural frequencies overflow a double (stiffness / mass beyond \
+         1.8e308 s^-2); check mass and stiffness, or write them in other units"
+            .into(),
+    ))
 }
 
 /// The structure's highest natural frequency (Hz; 0 for none).
@@ -463,6 +487,29 @@ mod tests {
             assert!((frequency_bound(&one) - expected).abs() <= 1e-15 * expected);
             let free = Structure::oscillator(2.0, 0.0, 0.0).unwrap();
             assert_eq!(frequency_bound(&free), 0.0);
+        });
+    }
+
+    /// An oscillator of 1e-200 kg on 1e200 N/m (w^2 = 1e400 s^-2, past a
+    /// double) ran: dop853 stopped as a "numerical blow-up" (exit 1), the
+    /// exact flow returned its start after a second (exit 0).
+    #[test]
+    fn natural_frequencies_beyond_a_double_are_refused() {
+        crate::testing::timeout(10, || {
+            let overflowing = Structure::oscillator(1e-200, 1e200, 0.0).unwrap();
+            let error = check_finite_modes(&overflowing).unwrap_err().to_string();
+            assert!(error.contains("overflow a double"), "{error}");
+            // Two coordinates, the overflow in the second mode only.
+            let mass = [vec![1e-160, 0.0], vec![0.0, 1e-160]];
+            let stiffness = [vec![1e-160, 0.0], vec![0.0, 1e160]];
+            let damping = [vec![0.0; 2], vec![0.0; 2]];
+            let matrices = Structure::matrices(&mass, &stiffness, &damping).unwrap();
+            assert!(check_finite_modes(&matrices).is_err());
+            // As large as a double holds: w = 1e150 rad/s, and a free body.
+            for (m, k) in [(1e-150, 1e150), (1.0, 0.0), (1e-300, 1.0)] {
+                let fine = Structure::oscillator(m, k, 0.0).unwrap();
+                assert!(check_finite_modes(&fine).is_ok(), "{m} {k}");
+            }
         });
     }
 
