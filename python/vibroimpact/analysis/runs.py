@@ -18,7 +18,7 @@ from vibroimpact._core import (
     SimulationError,
     tangent_map,
 )
-from vibroimpact.analysis.limits import AnalysisError, check_periods, whole_count
+from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
@@ -211,6 +211,14 @@ class Runner:
         ``core::analysis::tangent::parameters``)."""
         z = arguments.state("state", state, 2 * (self.n + self.k))
         assert z is not None
+        t_end = arguments.positive("t_end", t_end)
+        if t_end > MAX_PERIODS * self.period:
+            # As the analyses' periods are bounded (1e9 s of a bouncing ball ran for hours;
+            # 1e12 s stopped as a chattering no run of it has).
+            raise AnalysisError(
+                f"t_end: {t_end:.6g} s is {t_end / self.period:.3g} forcing periods, more "
+                f"than the {MAX_PERIODS} a run of an analysis may take"
+            )
         shifted = [(up.system(), down.system(), float(delta)) for up, down, delta in parameters]
         raw = tangent_map(self.system(), [float(v) for v in z], float(t_end), shifted)
         size = len(z)

@@ -264,13 +264,13 @@ impl Open {
         dissipated: f64,
     ) -> PairContact {
         let restitution = match self.kind {
-            // A sticking pair does not rebound.
-            ContactKind::Sticking if separation.is_finite() => 0.0,
             // A contact that started at rest was never an impact: its
-            // rebound over a round-off approach would be any number (1e58).
-            _ if self.resting => f64::NAN,
-            _ if self.approach_speed > 0.0 => rebound / self.approach_speed,
-            _ => f64::NAN,
+            // rebound over a round-off approach would be any number (1e58),
+            // and a friction stick (its approach 0, the slip ended) none.
+            _ if self.resting || self.approach_speed <= 0.0 => f64::NAN,
+            // A sticking pair that arrived does not rebound.
+            ContactKind::Sticking if separation.is_finite() => 0.0,
+            _ => rebound / self.approach_speed,
         };
         // A summed sequence's accumulation instant lies up to the resolution
         // after the impact where it was summed: a release before it ends

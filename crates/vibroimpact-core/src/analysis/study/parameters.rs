@@ -207,6 +207,34 @@ impl AxisPath<'_> {
     }
 }
 
+/// Whether a study may set `key` of `law` (what [`Parameter::apply`] sets).
+fn law_takes(law: &PairLaw, key: &str) -> bool {
+    match (law, key) {
+        (PairLaw::Rigid { .. }, "restitution") => true,
+        (PairLaw::Compliant(_), "stiffness" | "damping") => true,
+        (PairLaw::Compliant(c), "restitution") => c.law.uses_restitution(),
+        _ => false,
+    }
+}
+
+impl Target {
+    /// The pair's law and its key, for a target that sets a law's value.
+    fn law_key<'a>(&self, spec: &'a SystemSpec) -> Option<(&'a PairLaw, &'static str)> {
+        Some(match *self {
+            Target::DamperRestitution(i) => (&spec.dampers[i].law, "restitution"),
+            Target::DamperStiffness(i) => (&spec.dampers[i].law, "stiffness"),
+            Target::DamperDamping(i) => (&spec.dampers[i].law, "damping"),
+            Target::StopRestitution(i) => (&spec.stops[i].law, "restitution"),
+            Target::StopStiffness(i) => (&spec.stops[i].law, "stiffness"),
+            Target::StopDamping(i) => (&spec.stops[i].law, "damping"),
+            Target::CollisionRestitution(i) => (&spec.collisions[i].law, "restitution"),
+            Target::CollisionStiffness(i) => (&spec.collisions[i].law, "stiffness"),
+            Target::CollisionDamping(i) => (&spec.collisions[i].law, "damping"),
+            _ => return None,
+        })
+    }
+}
+
 impl Parameter {
     /// Parse `path` against `spec` (indices must exist).
     pub fn parse(path: &str, spec: &SystemSpec) -> Result<Self> {
@@ -271,6 +299,21 @@ impl Parameter {
             }
             _ => return Err(axis.bad()),
         };
+        // A key the pair's law lacks is refused here, not by every run.
+        if let Some((law, key)) = target.law_key(spec) {
+            if !law_takes(law, key) {
+                let takes = match law {
+                    PairLaw::Rigid { .. } => "a rigid pair's takes restitution",
+                    PairLaw::Compliant(c) if c.law.uses_restitution() => {
+                        "it takes stiffness, damping and restitution"
+                    }
+                    PairLaw::Compliant(_) => "it takes stiffness and damping",
+                };
+                return Err(Error::Inconsistent(format!(
+                    "study axis {path:?}: the pair's law has no {key} ({takes})"
+                )));
+            }
+        }
         Ok(Self {
             path: path.to_string(),
             target,
@@ -288,6 +331,7 @@ impl Parameter {
         value: f64,
     ) -> Result<()> {
         let law = |law: &mut PairLaw, key: &str| -> Result<()> {
+            // The arms `law_takes` accepts.
             match (law, key) {
                 (PairLaw::Rigid { restitution }, "restitution") => {
                     *restitution = value;

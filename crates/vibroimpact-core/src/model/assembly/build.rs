@@ -523,6 +523,16 @@ impl Walls {
             if static_force == 0.0 {
                 continue; // no force: no element
             }
+            if let FrictionSite::Damper(j) = friction.site {
+                // Held by rigid walls at no clearance, it never slides: its
+                // friction would be a second constraint on the walls' row
+                // (runs stopped as chattering), and does no work.
+                let d = &spec.dampers[j];
+                let rigid = matches!(d.law, PairLaw::Rigid { .. });
+                if rigid && d.lower_clearance == 0.0 && d.upper_clearance == 0.0 {
+                    continue;
+                }
+            }
             // Pads on one row (the same points, either way round) act as one:
             // their forces add (two constraints on one row would be one).
             if let Some(same) = self.interactions.iter_mut().find(|it| {

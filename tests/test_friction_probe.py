@@ -1,0 +1,128 @@
+"""A friction and collision probe's findings (a new user's trial): a damper held at no
+clearance between rigid walls keeps its friction and runs, a friction stick's row has
+no restitution (it never arrived), and a study axis on a key the pair's law lacks is
+refused before any run. Independent values: the same system without friction (a damper
+held by its walls never slides, so friction does no work) and the closed form of a
+block sliding to rest."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import vibroimpact as vi
+from vibroimpact import study as st
+
+
+def _held(restitution: float, **friction: float) -> vi.System:
+    """A damper at no clearance between rigid walls, on a forced oscillator."""
+    damper = vi.Damper(
+        mass=0.15, at=0, clearance=0.0, law="rigid", restitution=restitution, **friction
+    )
+    return vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=4000.0, damping=0.0),
+        dampers=[damper],
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=5.0, frequency=6.0))],
+    )
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk4"])
+@pytest.mark.parametrize("restitution", [0.0, 0.5, 1.0])
+def test_a_damper_held_at_no_clearance_with_friction_runs_as_without(
+    method: str, restitution: float
+) -> None:
+    # It stopped as "chattering at t = 2.5e-3 s": its friction was a second constraint
+    # on the row its two walls hold.
+    settings: dict[str, float | str] = {"method": method, "t_end": 0.5}
+    if method == "rk4":
+        settings["dt"] = 1e-4
+    plain = vi.simulate(_held(restitution), **settings)  # type: ignore[arg-type]
+    rubbing = _held(restitution, friction=0.4, static_friction=0.7, normal_force=2.8)
+    ran = vi.simulate(rubbing, **settings)  # type: ignore[arg-type]
+    for name in ("structure_displacement", "damper_displacement"):
+        np.testing.assert_allclose(
+            ran.final_state[name], plain.final_state[name], rtol=1e-9, atol=1e-12
+        )
+    assert ran.energy["friction"] == 0.0
+    assert abs(ran.energy["residual"]) <= 1e-6 * abs(ran.energy["input_work"]) + 1e-12
+    assert "damper 0 friction" in ran.pairs
+
+
+@pytest.mark.timeout(60)
+def test_a_friction_sticks_row_has_no_restitution() -> None:
+    # A block thrown at 1 m/s on its carrier slides v^2 / (2 mu g) and sticks: that
+    # row's approach is 0, and its restitution read 0.0 where the table's rule (a contact
+    # that started at rest was never an impact) says NaN.
+    mu, g, v = 0.3, 9.81, 1.0
+    system = vi.System(
+        structure=vi.Oscillator(mass=1e10, stiffness=1e10, damping=0.0),
+        dampers=[
+            vi.Damper(
+                mass=1.0,
+                at=0,
+                lower_clearance=math.inf,
+                upper_clearance=math.inf,
+                law="rigid",
+                restitution=0.5,
+                friction=mu,
+                normal_force=g,
+            )
+        ],
+        initial=vi.Initial(damper_velocity=[v]),
+    )
+    run = vi.simulate(system, method="exact", t_end=1.0)
+    assert math.isclose(
+        run.final_state["damper_displacement"][0], v**2 / (2 * mu * g), rel_tol=1e-6
+    )
+    sticks = [i for i, kind in enumerate(run.contacts.kind) if kind == "sticking"]
+    assert sticks, run.contacts
+    for i in sticks:
+        assert run.contacts.approach_speed[i] == 0.0
+        assert math.isnan(run.contacts.restitution[i])
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    ("law", "axis", "takes"),
+    [
+        ({"law": "rigid", "restitution": 0.3}, "collision.0.stiffness", "takes restitution"),
+        ({"law": "hertz", "stiffness": 1e8}, "collision.0.restitution", "stiffness and damping"),
+    ],
+)
+def test_a_study_axis_the_pairs_law_lacks_is_refused_before_any_run(
+    law: dict[str, object], axis: str, takes: str
+) -> None:
+    # Every run failed alone ("the pair's law has no stiffness"): a bad axis, refused
+    # as a misspelt one is.
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=4000.0, damping=1.0),
+        dampers=[
+            vi.Damper(
+                mass=0.05,
+                at=0,
+                lower_clearance=0.01,
+                upper_clearance=math.inf,
+                law="rigid",
+                restitution=0.5,
+            ),
+            vi.Damper(
+                mass=0.05,
+                at=0,
+                lower_clearance=math.inf,
+                upper_clearance=0.01,
+                law="rigid",
+                restitution=0.5,
+            ),
+        ],
+        collisions=[vi.Collision(dampers=[0, 1], gap=0.001, **law)],  # type: ignore[arg-type]
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=5.0, frequency=6.0))],
+        solver=vi.Solver(method="dop853", t_end=0.1),
+        analyses={"study": {"analysis": "run", "axes": {axis: [0.5, 1e6]}}},
+    )
+    with pytest.raises(
+        ValueError, match=rf"study axis .{axis}.: the pair's law has no \w+ \(.*{takes}\)"
+    ):
+        st.study_of(system)
