@@ -24,7 +24,7 @@ cannot: the distribution of the response with impacts.
 # noise is made of independent samples every :math:`1/(2 f_c)` s interpolated linearly,
 # so its density rolls off as :math:`\mathrm{sinc}^4(\omega\pi/(2\omega_c))` within the
 # band: with :math:`f_c = 50` Hz, far above the oscillator, the theory above holds to
-# 0.2 %. Each run lasts 45 s; the first 5 s (the start from rest, about three time
+# 0.3 %. Each run lasts 45 s; the first 5 s (the start from rest, about three time
 # constants :math:`1/(\zeta\omega_n)` of 1.6 s) are left out of the metrics.
 import tempfile
 from pathlib import Path
