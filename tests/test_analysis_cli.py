@@ -11,7 +11,6 @@ import shlex
 import shutil
 import subprocess
 import sys
-import time
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
@@ -631,9 +630,8 @@ def test_a_poincare_section_too_long_to_keep_is_refused_early(
     # row limit stopped it; the first thousand periods foretell it.
     text = (ROOT / "examples" / "ball_table_basins.toml").read_text()
     scenario = write(tmp_path, "g17.toml", text.replace("amplitude = 11.772", "amplitude = 16.677"))
-    start = time.perf_counter()
+    # Within 10 s (the whole run took 15.5 s): the run's timeout is the bound.
     done = run_cli("poincare", str(scenario), "--settle", "0", "--periods", "10000000", timeout=10)
-    assert time.perf_counter() - start < 8
     assert_one_line_error(done, "--periods 10000000", "max_rows (20000000)", "4.3")
     # One that fits runs.
     section = run_json(run_cli, "poincare", str(scenario), "--settle", "0", "--periods", "10000")

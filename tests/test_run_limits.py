@@ -15,7 +15,6 @@ import inspect
 import math
 import re
 import signal
-import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -182,13 +181,12 @@ def test_the_default_row_cap_and_tolerance_are_the_cores_and_the_docs() -> None:
 def test_a_fixed_step_history_beyond_max_rows_is_refused_before_running() -> None:
     # 1e6 steps would keep 1e6 rows; 2e5 are allowed.
     settings: dict[str, Any] = dict(method="rk4", dt=1e-4, t_end=100.0, max_rows=200_000)
-    started = time.perf_counter()
     with pytest.raises(vi.InvalidInputError) as err:
         vi.simulate(UNDAMPED, ELASTIC, RATTLE, **settings)
-    assert time.perf_counter() - started < 0.5  # refused, not run
     message = one_line(err)
     for key in ("every", "history", "max_rows", "t_end"):
         assert key in message
+    # Refused before the run (no clock in a unit test): by the up-front check itself.
     with pytest.raises(vi.InvalidInputError, match="max_rows"):
         check_solver(**settings)
     # Thinned or without a history, the same run fits.
