@@ -135,7 +135,7 @@ def test_a_system_whose_solver_has_no_t_end_loads_back_and_runs_as_given() -> No
     ran, again = (vi.simulate(s, t_end=0.2) for s in (system, loaded))
     assert ran.final_state == again.final_state and len(ran.contacts) > 0
     # Its runs need their length; a file's misspelt method is still refused on loading.
-    with pytest.raises(vi.InvalidInputError, match="t_end"):
+    with pytest.raises(vi.InvalidInputError, match=r"missing key 't_end' \(the run's length"):
         vi.simulate(loaded)
     with pytest.raises(ValueError, match='got "dop835"'):
         vi.load(text.replace('"dop853"', '"dop835"'))

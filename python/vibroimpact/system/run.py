@@ -360,8 +360,14 @@ def solver_table(solver: Any, *, length_given: bool = True) -> dict[str, Any]:
     """The ``[solver]`` table checked (its keys, method, stepping and the registry's
     ranges) with its defaults filled; without ``length_given``, ``t_end`` (s) may be
     left out (None): a System's solver whose runs are given their length."""
-    schema = _SOLVER if length_given else {**_SOLVER, "t_end": (_SOLVER["t_end"][0], None)}
+    schema = {**_SOLVER, "t_end": (_SOLVER["t_end"][0], None)}
     checked: dict[str, Any] = _table("[solver] ", solver, schema)
+    if length_given and checked["t_end"] is None:
+        # A System's solver may leave it out (its runs are given it); a run may not.
+        raise _fail(
+            "[solver] ",
+            "missing key 't_end' (the run's length in s; from Python, simulate(..., t_end=...))",
+        )
     _choice("[solver] ", "method", checked["method"], _METHODS)
     _choice("[solver] ", "stepping", checked["stepping"], ("events", "fixed"))
     _choice("[solver] ", "contact_timing", checked["contact_timing"], ("located", "step-count"))
