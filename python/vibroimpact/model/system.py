@@ -43,12 +43,12 @@ from vibroimpact.model.parts import (
 from vibroimpact.model.toml_text import toml_text
 from vibroimpact.notebook import system_html
 from vibroimpact.system import (
-    _INITIAL,
     _OUTPUT,
     _SOLVER,
     RUN_SECTIONS,
     _fail,
     _unknown_key,
+    initial_arrays,
     initial_table,
     prepare_system,
     solver_table,
@@ -203,7 +203,7 @@ class System:
                 output=sections.get("output"),
                 base_dir=self.base_dir,
             )
-            start = [run.initial[key] for key in _INITIAL]
+            start = initial_arrays(run.initial)
             PreparedSystem(run.binding_spec(), **run.method_arguments(), initial=start)
             return
         initial = model.pop("initial")
@@ -212,7 +212,7 @@ class System:
         except RecursionError:
             raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
         table = initial_table(initial, spec)
-        _core_check(spec, [table[key] for key in _INITIAL])
+        _core_check(spec, initial_arrays(table))
         if self.solver is not None:
             # Its runs are given their length: the rest is checked now (a misspelt
             # method built, and was refused only when run).
@@ -342,7 +342,7 @@ class System:
                     if key not in schema:
                         raise _unknown_key(f"[{name}] ", key, list(schema), "allowed:") from None
             # A key the core requires (a random signal's seed): its error names it.
-            _core_check(spec, [start[key] for key in _INITIAL])
+            _core_check(spec, initial_arrays(start))
             raise
 
     @classmethod

@@ -35,6 +35,7 @@ from vibroimpact.system.schema import (
     _table,
     _unknown_key,
     default_stepping,
+    initial_arrays,
     initial_table,
     system_spec,
 )
@@ -74,6 +75,7 @@ __all__ = [
     "_choice",
     "_fail",
     "_table",
+    "initial_arrays",
     "initial_table",
     "_unknown_key",
 ]

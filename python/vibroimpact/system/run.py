@@ -24,7 +24,6 @@ from vibroimpact.messages import short_numbers, shown
 from vibroimpact.system.points import _check_bends, _check_point, split_observed
 from vibroimpact.system.schema import (
     _FIXED_STEP,
-    _INITIAL,
     _METHODS,
     _OUTPUT,
     _SOLVER,
@@ -32,6 +31,7 @@ from vibroimpact.system.schema import (
     _choice,
     _fail,
     _table,
+    initial_arrays,
     initial_table,
     system_spec,
 )
@@ -199,7 +199,7 @@ class PreparedRun:
         try:
             raw = _simulate_system(
                 self.binding_spec(),
-                [init[k] for k in _INITIAL],
+                initial_arrays(init),
                 **self.method_arguments(),
                 every=output["every"],
                 history=output["history"],
@@ -356,12 +356,15 @@ def _solution(
     )
 
 
+#: ``[solver]``'s schema with ``t_end`` left out allowed (checked where a run needs it).
+_SOLVER_LENGTH_LEFT_OUT = {**_SOLVER, "t_end": (_SOLVER["t_end"][0], None)}
+
+
 def solver_table(solver: Any, *, length_given: bool = True) -> dict[str, Any]:
     """The ``[solver]`` table checked (its keys, method, stepping and the registry's
     ranges) with its defaults filled; without ``length_given``, ``t_end`` (s) may be
     left out (None): a System's solver whose runs are given their length."""
-    schema = {**_SOLVER, "t_end": (_SOLVER["t_end"][0], None)}
-    checked: dict[str, Any] = _table("[solver] ", solver, schema)
+    checked: dict[str, Any] = _table("[solver] ", solver, _SOLVER_LENGTH_LEFT_OUT)
     if length_given and checked["t_end"] is None:
         # A System's solver may leave it out (its runs are given it); a run may not.
         raise _fail(

@@ -486,6 +486,13 @@ def initial_table(initial: Any, spec: Mapping[str, Any]) -> dict[str, Any]:
     return table
 
 
+def initial_arrays(table: Mapping[str, Any]) -> list[Any]:
+    """The four arrays of a checked ``[initial]`` table (:func:`initial_table`) in the
+    order the core takes them: the structure's displacements and velocities, then the
+    dampers'."""
+    return [table[key] for key in _INITIAL]
+
+
 def _too_deep(value: Any, limit: int = 32) -> bool:
     """Whether ``value`` is arrays within arrays more than ``limit`` deep."""
     for _ in range(limit):
