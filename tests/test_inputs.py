@@ -373,6 +373,55 @@ def test_pickle_round_trip(obj: Any) -> None:
         assert repr(copy) == repr(obj)
 
 
+def test_equal_parameters_hash_equal_and_key_a_dict() -> None:
+    # Unhashable, they could not key a dict of results nor sit in a set (the typed
+    # System's parts can); equal objects must hash equal, -0.0 as 0.0.
+    pairs = [
+        (vi.ImpactDamper(**SYSTEM), vi.ImpactDamper(**SYSTEM)),
+        (vi.Contact("hertz", stiffness=1.0), vi.Contact("hertz", stiffness=1.0, damping=-0.0)),
+        (vi.InitialState(**STATE), vi.InitialState(main_velocity=-0.0, **STATE)),
+    ]
+    for first, second in pairs:
+        assert first == second and hash(first) == hash(second)
+    others = [
+        vi.ImpactDamper(**{**SYSTEM, "clearance": 0.02}),
+        vi.Contact("linear", stiffness=1.0),
+        vi.InitialState(impact_velocity=0.1),
+    ]
+    keyed = {first: k for k, (first, _) in enumerate(pairs)}
+    assert [keyed[second] for _, second in pairs] == [0, 1, 2]
+    assert len({*(p for pair in pairs for p in pair), *others}) == 6
+
+
+def test_a_two_mass_solution_pickles_whole() -> None:
+    # A pool of processes returns results by pickling them: the two-mass run's
+    # could not be (its arrays live in Rust). Every column, contact and figure comes
+    # back, and so does a table's own pickle.
+    sol = vi.simulate(
+        vi.ImpactDamper(**SYSTEM),
+        vi.Contact("hertz", stiffness=3000.0),
+        vi.InitialState(**STATE),
+        method="dop853",
+        t_end=2.0,
+    )
+    assert len(sol.contacts) > 2
+    for protocol in range(2, pickle.HIGHEST_PROTOCOL + 1):
+        copy = pickle.loads(pickle.dumps(sol, protocol=protocol))
+        assert type(copy) is type(sol) and repr(copy) == repr(sol)
+        for name in ("t", "main_displacement", "main_velocity", "impact_displacement"):
+            np.testing.assert_array_equal(getattr(copy, name), getattr(sol, name))
+        np.testing.assert_array_equal(copy.impact_velocity, sol.impact_velocity)
+        np.testing.assert_array_equal(copy.contact_force, sol.contact_force)
+        assert copy.contacts.to_dicts() == sol.contacts.to_dicts()
+        names = ("steps", "rejected_steps", "rhs_evaluations", "grazing_contacts")
+        for name in (*names, "final_time", "method", "stepping", "final_state"):
+            assert getattr(copy, name) == getattr(sol, name), name
+        assert copy.energy_residual == sol.energy_residual
+        table = pickle.loads(pickle.dumps(sol.contacts, protocol=protocol))
+        np.testing.assert_array_equal(table.onset, sol.contacts.onset)
+        assert repr(table) == repr(sol.contacts)
+
+
 def test_equality_is_by_value() -> None:
     assert vi.ImpactDamper(**SYSTEM) == vi.ImpactDamper(**SYSTEM)
     assert vi.ImpactDamper(**SYSTEM) != vi.ImpactDamper(**{**SYSTEM, "clearance": 0.02})

@@ -433,6 +433,46 @@ def test_a_contact_stepped_over_whole_is_an_error_not_a_rebound_of_one(
     assert "energy_tolerance" in message
 
 
+@pytest.mark.parametrize(
+    ("method", "settings", "advice", "not_advised"),
+    [
+        ("newmark-implicit", {"dt": 1e-3}, "reduce dt or choose another method", "rtol"),
+        ("dopri5", {"rtol": 0.1, "atol": 1e-3}, "tighten rtol and atol", "reduce dt"),
+    ],
+)
+def test_an_energy_error_advises_what_its_method_takes(
+    method: str, settings: dict[str, float], advice: str, not_advised: str
+) -> None:
+    # Every energy error said "reduce dt, choose another method (e.g. "dop853") or
+    # tighten rtol/atol": a dop853 run told to choose dop853, a fixed step to tighten
+    # tolerances it has not. The two-mass run and the general system's run alike.
+    system = vi.ImpactDamper(**{**TABLE1, "impact_mass": 0.25})
+    contact = vi.Contact("hertz-damped", stiffness=1e15, restitution=0.5)
+    with pytest.raises(vi.EnergyBalanceError) as err:
+        vi.simulate(system, contact, ONSET, method=method, t_end=0.3, **settings)
+    assert advice in one_line(err) and not_advised not in one_line(err)
+    general = vi.System(
+        structure=vi.Oscillator(mass=TABLE1["main_mass"], stiffness=TABLE1["stiffness"]),
+        dampers=[
+            vi.Damper(
+                mass=0.25,
+                at=0,
+                clearance=TABLE1["clearance"],
+                law="hertz-damped",
+                stiffness=1e15,
+                restitution=0.5,
+            )
+        ],
+        initial=vi.Initial(
+            damper_displacement=[ONSET.impact_displacement],
+            damper_velocity=[ONSET.impact_velocity],
+        ),
+    )
+    with pytest.raises(vi.EnergyBalanceError) as err:
+        vi.simulate(general, method=method, t_end=0.3, **settings)
+    assert advice in one_line(err) and not_advised not in one_line(err)
+
+
 def test_the_paper_method_at_a_coarse_step_creates_energy_and_is_refused() -> None:
     system, contact = table1(), HERTZ
     settings: dict[str, Any] = dict(method="newmark", dt=1e-3, t_end=0.15)

@@ -92,8 +92,7 @@ pub enum Error {
         "energy balance violated at t = {time:.6e} s: stored energy + dissipated work - external work \
          differs from the energy at the start by {residual:.3e} J, {ratio:.2e} of the energy in play \
          ({scale:.3e} J), more than energy_tolerance = {tolerance:e}; the result would be physically \
-         impossible: reduce dt, choose another method (e.g. \"dop853\") or tighten rtol/atol \
-         (raise energy_tolerance only to accept it)",
+         impossible: {advice} (raise energy_tolerance only to accept it)",
         ratio = .residual.abs() / .scale
     )]
     EnergyBalance {
@@ -101,6 +100,7 @@ pub enum Error {
         residual: f64,
         scale: f64,
         tolerance: f64,
+        advice: EnergyAdvice,
     },
     /// A contact whose energy balance does not close: over the contact the
     /// system's energy change plus the work of the contact's dissipative
@@ -117,7 +117,7 @@ pub enum Error {
          created), {limit}",
         residual = .change + .work + .dissipated,
         ratio = (.change + .work + .dissipated).abs() / .scale,
-        limit = contact_limit(*.tolerance, *.created)
+        limit = contact_limit(*.tolerance, *.created, *.advice)
     )]
     ContactEnergy {
         onset: f64,
@@ -129,23 +129,65 @@ pub enum Error {
         restitution: f64,
         tolerance: f64,
         created: bool,
+        advice: EnergyAdvice,
     },
+}
+
+/// What to change when a run's energy does not balance, as its method's kind
+/// gives it: a fixed step's is its `dt`, an adaptive method's its
+/// tolerances, the exact flow's the step that caps its search for contacts.
+/// The kernel raises [`EnergyAdvice::Any`]; the registry's runs, which know
+/// the method, make it theirs ([`Error::advised`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EnergyAdvice {
+    Any,
+    FixedStep,
+    Adaptive,
+    Exact,
+}
+
+impl std::fmt::Display for EnergyAdvice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Any => "reduce dt, choose another method (e.g. \"dop853\") or tighten rtol/atol",
+            Self::FixedStep => "reduce dt or choose another method (e.g. \"dop853\", adaptive)",
+            Self::Adaptive => {
+                "tighten rtol and atol, or choose another method (e.g. \"rk4\" with a small dt)"
+            }
+            Self::Exact => {
+                "reduce dt (it caps the exact flow's step, between which contacts are sought) or \
+                 choose another method (e.g. \"dop853\")"
+            }
+        })
+    }
+}
+
+impl Error {
+    /// This error with `advice` where it advises on a run's energy (the
+    /// method's own, in place of the kernel's [`EnergyAdvice::Any`]).
+    pub fn advised(mut self, advice: EnergyAdvice) -> Self {
+        if let Self::EnergyBalance { advice: a, .. } | Self::ContactEnergy { advice: a, .. } =
+            &mut self
+        {
+            *a = advice;
+        }
+        self
+    }
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
 
 /// The end of a contact energy error: the bound passed and what to change.
-fn contact_limit(tolerance: f64, created: bool) -> String {
+fn contact_limit(tolerance: f64, created: bool, advice: EnergyAdvice) -> String {
     if created {
         format!(
             "more than {tolerance:e}, the most a contact may create whatever energy_tolerance \
-             says (a contact can only lose energy: this is the method's error); reduce dt, choose \
-             another method (e.g. \"dop853\") or tighten rtol/atol"
+             says (a contact can only lose energy: this is the method's error); {advice}"
         )
     } else {
         format!(
-            "more than energy_tolerance = {tolerance:e}; reduce dt, choose another method (e.g. \
-             \"dop853\") or tighten rtol/atol (raise energy_tolerance only to accept it)"
+            "more than energy_tolerance = {tolerance:e}; {advice} (raise energy_tolerance only to \
+             accept it)"
         )
     }
 }

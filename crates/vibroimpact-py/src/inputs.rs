@@ -78,6 +78,19 @@ impl ImpactDamper {
         .into_py_dict(py)?;
         Ok((PyTuple::empty(py), keywords))
     }
+    /// Hashed as the tuple of its values (equal objects hash equal, as
+    /// `0.0 == -0.0` do), so it can key a dict or sit in a set.
+    fn __hash__(&self, py: Python<'_>) -> PyResult<isize> {
+        let s = &self.0;
+        let values = (
+            s.main_mass,
+            s.stiffness,
+            s.impact_mass,
+            s.clearance,
+            s.damping,
+        );
+        values.into_pyobject(py)?.hash()
+    }
     fn __repr__(&self) -> String {
         let s = &self.0;
         format!(
@@ -181,6 +194,10 @@ impl Contact {
             self.restitution(),
         )
     }
+    /// Hashed as the values it is made from (see [`ImpactDamper::__hash__`]).
+    fn __hash__(&self, py: Python<'_>) -> PyResult<isize> {
+        self.__getnewargs__().into_pyobject(py)?.hash()
+    }
     fn __repr__(&self) -> String {
         let restitution = match self.restitution() {
             Some(e) => format!(", restitution={e:?}"),
@@ -248,6 +265,10 @@ impl InitialState {
             s.impact_displacement,
             s.impact_velocity,
         )
+    }
+    /// Hashed as the values it is made from (see [`ImpactDamper::__hash__`]).
+    fn __hash__(&self, py: Python<'_>) -> PyResult<isize> {
+        self.__getnewargs__().into_pyobject(py)?.hash()
     }
     fn __repr__(&self) -> String {
         let s = &self.0;

@@ -5,7 +5,7 @@ use std::sync::{Mutex, OnceLock};
 
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyTuple};
 use vibroimpact_core as core;
 use vibroimpact_core::kernel::events::{PairContact, SystemSolution};
 use vibroimpact_core::methods::registry as core_registry;
@@ -73,14 +73,19 @@ pub(crate) fn record_values(r: &PairContact) -> [f64; 9] {
 /// ``duration``, ``rebound_speed``, ``restitution`` and ``energy_change``.
 #[pyclass(frozen, module = "vibroimpact._core")]
 pub(crate) struct ContactTable {
-    records: Vec<PairContact>,
+    /// Each contact's values, in the order of [`CONTACT_COLUMNS`].
+    rows: Vec<[f64; 9]>,
     columns: [OnceLock<Py<PyArray1<f64>>>; 9],
 }
 
 impl ContactTable {
-    fn new(records: Vec<PairContact>) -> Self {
+    fn new(records: &[PairContact]) -> Self {
+        Self::of_rows(records.iter().map(record_values).collect())
+    }
+
+    fn of_rows(rows: Vec<[f64; 9]>) -> Self {
         Self {
-            records,
+            rows,
             columns: Default::default(),
         }
     }
@@ -88,11 +93,7 @@ impl ContactTable {
     fn column(&self, py: Python<'_>, index: usize) -> Py<PyArray1<f64>> {
         self.columns[index]
             .get_or_init(|| {
-                let values: Vec<f64> = self
-                    .records
-                    .iter()
-                    .map(|r| record_values(r)[index])
-                    .collect();
+                let values: Vec<f64> = self.rows.iter().map(|r| r[index]).collect();
                 values.into_pyarray(py).unbind()
             })
             .clone_ref(py)
@@ -159,14 +160,22 @@ impl ContactTable {
         self.column(py, 8)
     }
     fn __len__(&self) -> usize {
-        self.records.len()
+        self.rows.len()
+    }
+    /// Pickled as its rows (a table made again by `_contact_table`).
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let rebuild = py.import("vibroimpact._core")?.getattr("_contact_table")?;
+        Ok((rebuild, (self.rows.clone(),).into_pyobject(py)?))
     }
     /// One dict per contact, keyed by the column names.
     fn to_dicts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let list = PyList::empty(py);
-        for r in &self.records {
+        for r in &self.rows {
             let d = PyDict::new(py);
-            for (name, value) in CONTACT_COLUMNS.iter().zip(record_values(r)) {
+            for (name, value) in CONTACT_COLUMNS.iter().zip(*r) {
                 d.set_item(name, value)?;
             }
             list.append(d)?;
@@ -174,8 +183,15 @@ impl ContactTable {
         Ok(list)
     }
     fn __repr__(&self) -> String {
-        format!("ContactTable({} contacts)", self.records.len())
+        format!("ContactTable({} contacts)", self.rows.len())
     }
+}
+
+/// A contact table from its rows (each in the order of `ContactTable.columns`):
+/// how a pickled table is made again.
+#[pyfunction]
+pub(crate) fn _contact_table(rows: Vec<[f64; 9]>) -> ContactTable {
+    ContactTable::of_rows(rows)
 }
 
 /// What ``simulate`` returns: the time history (NumPy arrays, SI units), the
@@ -205,10 +221,10 @@ pub(crate) struct Solution {
     final_time: f64,
     /// Method name.
     #[pyo3(get)]
-    method: &'static str,
+    method: String,
     /// "fixed" or "events".
     #[pyo3(get)]
-    stepping: &'static str,
+    stepping: String,
     /// Largest relative growth of the mechanical energy of the unforced system,
     /// ``max(E)/E(0) - 1`` (NaN if it starts at rest). Physically <= 0: a
     /// positive value is numerical error (above 0.5 the run is refused).
@@ -257,6 +273,33 @@ impl Solution {
     fn contact_force(&self, py: Python<'_>) -> Py<PyArray1<f64>> {
         self.history[5].get(py)
     }
+    /// Pickled as its columns, contacts and statistics (a solution made again
+    /// by `_two_mass_solution`), so a pool of processes can return it.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let rebuild = py
+            .import("vibroimpact._core")?
+            .getattr("_two_mass_solution")?;
+        let history: Vec<Py<PyArray1<f64>>> = self.history.iter().map(|c| c.get(py)).collect();
+        let counts = (
+            self.steps,
+            self.rejected_steps,
+            self.rhs_evaluations,
+            self.grazing_contacts,
+        );
+        let arguments = (
+            history,
+            self.contacts.clone_ref(py),
+            counts,
+            self.final_time,
+            (self.method.clone(), self.stepping.clone()),
+            (self.energy_growth, self.energy_residual),
+            self.final_state.clone(),
+        );
+        Ok((rebuild, arguments.into_pyobject(py)?))
+    }
     /// One line: the run (method, stepping, time reached, steps), the contacts and
     /// rows kept, and the fields (never the arrays themselves).
     fn __repr__(&self, py: Python<'_>) -> String {
@@ -274,10 +317,53 @@ impl Solution {
                 .parse::<f64>()
                 .unwrap_or(self.final_time),
             self.steps,
-            self.contacts.bind(py).get().records.len(),
+            self.contacts.bind(py).get().rows.len(),
             self.rows,
         )
     }
+}
+
+fn columns_rows(history: &[numpy::PyReadonlyArray1<'_, f64>]) -> usize {
+    history.first().map_or(0, |a| a.as_array().len())
+}
+
+/// A two-mass solution from what its `__reduce__` gives: how a pickled one is
+/// made again.
+#[pyfunction]
+pub(crate) fn _two_mass_solution(
+    history: Vec<numpy::PyReadonlyArray1<'_, f64>>,
+    contacts: Py<ContactTable>,
+    counts: (u64, u64, u64, u64),
+    final_time: f64,
+    names: (String, String),
+    energy: (f64, f64),
+    final_state: PyRef<'_, InitialState>,
+) -> PyResult<Solution> {
+    let ((method, stepping), (energy_growth, energy_residual)) = (names, energy);
+    let columns: Vec<Column> = history
+        .iter()
+        .map(|a| Column::new(a.as_array().to_vec()))
+        .collect();
+    let rows = columns_rows(&history);
+    let history: [Column; 6] = columns
+        .try_into()
+        .map_err(|_| InvalidInputError::new_err("a two-mass solution has six history columns"))?;
+    let (steps, rejected_steps, rhs_evaluations, grazing_contacts) = counts;
+    Ok(Solution {
+        history,
+        rows,
+        contacts,
+        steps,
+        rejected_steps,
+        rhs_evaluations,
+        grazing_contacts,
+        final_time,
+        method,
+        stepping,
+        energy_growth,
+        energy_residual,
+        final_state: final_state.clone(),
+    })
 }
 
 /// The two-mass run's settings from its arguments, each left out (None)
@@ -469,7 +555,7 @@ pub(crate) fn simulate(
             Column::new(yv),
             Column::new(forces),
         ],
-        contacts: Py::new(py, ContactTable::new(contacts))?,
+        contacts: Py::new(py, ContactTable::new(&contacts))?,
         steps: sol.steps,
         rejected_steps: sol.rejected_steps,
         rhs_evaluations: sol.rhs_evaluations,
@@ -478,10 +564,11 @@ pub(crate) fn simulate(
         energy_growth: sol.energy_growth,
         energy_residual: sol.energy_residual,
         final_state: InitialState(core::State::of_vector(&final_state)),
-        method: parsed.name(),
+        method: parsed.name().to_string(),
         stepping: match settings.stepping {
             core::Stepping::Fixed => "fixed",
             core::Stepping::Events => "events",
-        },
+        }
+        .to_string(),
     })
 }

@@ -11,7 +11,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::kernel::events::{integrate_system_stepped, RunOptions, Stepping};
+use vibroimpact_core::kernel::events::{RunOptions, Stepping};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::{
     check_settings, AnyStepper, Options, DEFAULT_MAX_ROWS, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE,
@@ -146,24 +146,9 @@ impl Ready {
     ) -> core::Result<core::kernel::events::SystemSolution> {
         let options = self.options(t_end, history, record_from, strobe_period);
         let (system, stepping) = (&self.system, self.limits.stepping);
-        if stepping == Stepping::Events {
-            return self.stepper.integrate(system, y0, &options, interrupt);
-        }
-        let limit = core::MAX_RECORD_BYTES;
-        match &mut self.stepper {
-            AnyStepper::Rk(s) => {
-                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
-            }
-            AnyStepper::Newmark(s) => {
-                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
-            }
-            AnyStepper::Paper(s) => {
-                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
-            }
-            AnyStepper::Exact(s) => {
-                integrate_system_stepped(system, s, y0, &options, stepping, interrupt, limit)
-            }
-        }
+        // The registry's run, which gives an energy error its method's advice.
+        self.stepper
+            .integrate_stepped(system, y0, &options, stepping, interrupt)
     }
 
     /// The full state of the flat state `z` (x then v).

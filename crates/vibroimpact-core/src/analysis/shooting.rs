@@ -421,6 +421,7 @@ mod tests {
                         residual: 1.0,
                         scale: 1.0,
                         tolerance: 1e-6,
+                        advice: crate::error::EnergyAdvice::Any,
                     });
                 }
                 Ok(vec![z[0] - (z[0].powi(3) - 1.0) / 3.0, 0.5 * z[1]])

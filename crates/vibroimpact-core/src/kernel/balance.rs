@@ -2,7 +2,7 @@
 //! that it closes, made every [`ENERGY_INTERVAL`] steps by the event kernel
 //! and by the compact path's stretches alike.
 
-use crate::error::{Error, Result};
+use crate::error::{EnergyAdvice, Error, Result};
 use crate::model::assembly::{Assembly, Mode, CONTACT, INPUT, VISCOUS};
 
 /// How often (accepted steps) the energy balance is checked.
@@ -139,6 +139,7 @@ pub(crate) fn check_balance(
             residual: b.residual,
             scale: *scale,
             tolerance,
+            advice: EnergyAdvice::Any,
         });
     }
     Ok(())

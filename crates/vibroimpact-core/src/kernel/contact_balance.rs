@@ -7,7 +7,7 @@
 //! where that is smaller) it is an error whatever `energy_tolerance` says, as
 //! in the two-mass kernels. Evaluated at contact ends only, never per step.
 
-use crate::error::{Error, Result};
+use crate::error::{EnergyAdvice, Error, Result};
 use crate::kernel::balance::balance;
 use crate::kernel::events::PairContact;
 use crate::model::assembly::{Assembly, Mode};
@@ -111,6 +111,7 @@ impl OnsetBalance {
                 restitution: record.restitution,
                 tolerance: limit,
                 created: limit < energy_tolerance,
+                advice: EnergyAdvice::Any,
             });
         }
         Ok(change)

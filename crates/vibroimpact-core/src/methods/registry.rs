@@ -25,7 +25,7 @@ pub use table::{
     METHOD_SPECS, RECORD_FROM, RTOL, SPECTRAL_RADIUS, STROBE_PERIOD, TOLERANCE, T_END,
 };
 
-use crate::error::{Error, Result};
+use crate::error::{EnergyAdvice, Error, Result};
 use crate::kernel::events::{
     integrate_system, integrate_system_observed, integrate_system_stepped, RunOptions, Stepping,
     SystemSolution,
@@ -35,7 +35,7 @@ use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::kernel::observe::EventObserver;
 use crate::methods::exact::ExactFlow;
 use crate::methods::paper_newmark::PaperNewmark;
-use crate::methods::steppers::{ExplicitRk, NewmarkFamily};
+use crate::methods::steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
 use crate::model::assembly::Assembly;
 
 /// A 0.2 method, made for one system.
@@ -131,6 +131,15 @@ impl AnyStepper {
         }
     }
 
+    /// What a run of this method changes when its energy does not balance.
+    fn energy_advice(&self) -> EnergyAdvice {
+        match self {
+            Self::Rk(s) if s.is_adaptive() => EnergyAdvice::Adaptive,
+            Self::Rk(_) | Self::Newmark(_) | Self::Paper(_) => EnergyAdvice::FixedStep,
+            Self::Exact(_) => EnergyAdvice::Exact,
+        }
+    }
+
     /// Integrate `system` from `y0` with this method.
     pub fn integrate(
         &mut self,
@@ -139,12 +148,14 @@ impl AnyStepper {
         options: &RunOptions,
         interrupt: &mut dyn FnMut() -> bool,
     ) -> Result<SystemSolution> {
+        let advice = self.energy_advice();
         match self {
             Self::Rk(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Newmark(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Paper(s) => integrate_system(system, s, y0, options, interrupt),
             Self::Exact(s) => integrate_system(system, s, y0, options, interrupt),
         }
+        .map_err(|e| e.advised(advice))
     }
 
     /// [`Self::integrate`] with `observer` told of the run's start, events
@@ -157,7 +168,7 @@ impl AnyStepper {
         interrupt: &mut dyn FnMut() -> bool,
         observer: &mut dyn EventObserver,
     ) -> Result<SystemSolution> {
-        let limit = MAX_RECORD_BYTES;
+        let (limit, advice) = (MAX_RECORD_BYTES, self.energy_advice());
         match self {
             Self::Rk(s) => {
                 integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
@@ -172,6 +183,7 @@ impl AnyStepper {
                 integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
             }
         }
+        .map_err(|e| e.advised(advice))
     }
 
     /// [`Self::integrate`] stepping as `stepping` says: cut at events, or
@@ -184,7 +196,7 @@ impl AnyStepper {
         stepping: Stepping,
         interrupt: &mut dyn FnMut() -> bool,
     ) -> Result<SystemSolution> {
-        let limit = MAX_RECORD_BYTES;
+        let (limit, advice) = (MAX_RECORD_BYTES, self.energy_advice());
         match self {
             Self::Rk(s) => {
                 integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
@@ -199,5 +211,6 @@ impl AnyStepper {
                 integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
             }
         }
+        .map_err(|e| e.advised(advice))
     }
 }

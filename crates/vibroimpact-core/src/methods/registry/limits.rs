@@ -97,7 +97,7 @@ pub fn check_steps_resolve(system: &SystemSpec, method_name: &str, dt: Option<f6
         strobe_period: None,
     };
     let scales = RunScales::of(system);
-    check_natural_period(spec, &plan, scales.structure)?;
+    check_natural_period(spec, &plan, scales.structure, None)?;
     check_forcing_steps(spec, &plan, &scales.forcing)
 }
 
@@ -152,8 +152,8 @@ pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
             )));
         }
     }
-    check_finite_modes(system.structure)?;
-    check_natural_period(spec, plan, system.structure)?;
+    let top = check_finite_modes(system.structure)?;
+    check_natural_period(spec, plan, system.structure, top)?;
     check_forcing_steps(spec, plan, &system.forcing)?;
     let width = 1 + 2 * system.coordinates;
     if let Some(dt) = step.filter(|_| plan.history) {
@@ -231,17 +231,18 @@ fn frequency_bound(structure: &Structure) -> f64 {
 /// stiffness over its mass beyond 1.8e308 s^-2): every method's run of it is
 /// meaningless (the exact flow's phase, an adaptive step of no length), and
 /// the checks against its fastest mode would read it as a free body. The
-/// eigenvalues only where the bound is not finite.
-fn check_finite_modes(structure: &Structure) -> Result<()> {
+/// eigenvalues only where the bound is not finite: then the highest natural
+/// frequency (Hz) they give, for [`check_natural_period`] to reuse.
+fn check_finite_modes(structure: &Structure) -> Result<Option<f64>> {
     if frequency_bound(structure).is_finite() {
-        return Ok(());
+        return Ok(None);
     }
     let top = structure
         .natural_frequencies()
         .into_iter()
         .fold(0.0f64, f64::max);
     if top.is_finite() {
-        return Ok(());
+        return Ok(Some(top / std::f64::consts::TAU));
     }
     Err(Error::Inconsistent(
         "[structure]: its natural frequencies overflow a double (stiffness / mass beyond \
@@ -282,8 +283,14 @@ fn resolves(spec: &MethodSpec, plan: &RunPlan, frequency: f64) -> bool {
 /// explicit fixed step is unstable on a mode whose period is shorter than
 /// [`EXPLICIT_STEPS_PER_PERIOD`] of it; an adaptive method or the exact flow steps at least once in each
 /// period of that mode. The eigenvalues only where the bound does not
-/// settle it (they had cost a dropped ball's run a quarter of its time).
-fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure) -> Result<()> {
+/// settle it (they had cost a dropped ball's run a quarter of its time), and
+/// once: `known` is the highest frequency (Hz) where already computed.
+fn check_natural_period(
+    spec: &MethodSpec,
+    plan: &RunPlan,
+    structure: &Structure,
+    known: Option<f64>,
+) -> Result<()> {
     let explicit = spec.kind == Kind::Explicit;
     if !explicit && !spec.kind.is_mode_stepped() {
         return Ok(());
@@ -291,7 +298,7 @@ fn check_natural_period(spec: &MethodSpec, plan: &RunPlan, structure: &Structure
     if resolves(spec, plan, frequency_bound(structure)) {
         return Ok(());
     }
-    let frequency = highest_frequency(structure);
+    let frequency = known.unwrap_or_else(|| highest_frequency(structure));
     if frequency.is_nan() || frequency <= 0.0 {
         return Ok(());
     }
@@ -510,6 +517,20 @@ mod tests {
                 let fine = Structure::oscillator(m, k, 0.0).unwrap();
                 assert!(check_finite_modes(&fine).is_ok(), "{m} {k}");
             }
+            // The bound settles a diagonal mass; a mass coupled past its
+            // diagonal (Gershgorin's disc reaching 0) has its eigenvalues
+            // computed, and their top frequency in Hz handed on to the
+            // period check, so it computes them no second time.
+            let diagonal = Structure::oscillator(1.0, 4.0 * std::f64::consts::PI.powi(2), 0.0);
+            assert_eq!(check_finite_modes(&diagonal.unwrap()).unwrap(), None);
+            let coupled = Structure::matrices(
+                &[vec![1.0, 2.0], vec![2.0, 5.0]],
+                &[vec![3.0, -1.0], vec![-1.0, 1.0]],
+                &[vec![0.0; 2], vec![0.0; 2]],
+            )
+            .unwrap();
+            let top = check_finite_modes(&coupled).unwrap().unwrap();
+            assert_eq!(top, highest_frequency(&coupled));
         });
     }
 
