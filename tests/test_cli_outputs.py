@@ -76,7 +76,8 @@ def test_a_full_output_is_one_line(tmp_path: Path) -> None:
             check=False,
         )
     assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
-    assert done.stderr.strip() == "vibroimpact: error: No space left on device"
+    said = "vibroimpact: error: writing the output: No space left on device"
+    assert done.stderr.strip() == said
 
 
 def test_a_start_inside_a_wall_names_the_file(tmp_path: Path, run_cli: Cli) -> None:
@@ -92,3 +93,36 @@ def test_a_start_inside_a_wall_names_the_file(tmp_path: Path, run_cli: Cli) -> N
     inside = BASE + "[initial]\ndamper_displacement = [0.01]\n"
     path = write(tmp_path, inside, "inside.toml")
     refused(run_cli("simulate", str(path)), f"{path}: initial state: damper 0 starts", "wall")
+
+
+@pytest.mark.timeout(60)
+def test_a_name_the_output_cannot_encode_is_escaped_not_a_traceback(tmp_path: Path) -> None:
+    # Under PYTHONIOENCODING=ascii the summary's "sp ace é.toml" raised UnicodeEncodeError
+    # (a traceback, exit 1) after the whole run.
+    scenario = write(tmp_path, BASE, "sp ace é.toml")
+    env = {**os.environ, "PYTHONIOENCODING": "ascii", "MPLBACKEND": "Agg"}
+    done = subprocess.run(
+        [sys.executable, "-m", "vibroimpact", "simulate", str(scenario)],
+        capture_output=True,
+        env=env,
+        timeout=50,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert b"sp ace \\xe9.toml: " in done.stdout and not done.stderr
+
+
+def test_memory_the_machine_refuses_is_one_line_not_a_traceback(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Under a process limit below the machine's memory (ulimit -v) a run's arrays raised
+    # MemoryError through to a traceback, exit 1.
+    from vibroimpact.cli import command
+
+    def refused_memory(args: object) -> int:
+        raise MemoryError
+
+    monkeypatch.setattr(command, "_simulate", refused_memory)
+    assert command.main(["simulate", str(write(tmp_path, BASE))]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("vibroimpact: error: out of memory: ") and err.count("\n") == 1

@@ -160,6 +160,63 @@ def test_poincare_periods_out_of_bounds_exit_2(
     refused(run_cli("poincare", str(path), flag, value), flag, str(MAX_PERIODS))
 
 
+@pytest.mark.timeout(30)
+def test_lyapunov_refuses_settling_and_recording_beyond_the_bound_together(
+    tmp_path: Path, run_cli: Cli
+) -> None:
+    # Each was checked alone: --settle 9999999 --periods 10 started a run of hours
+    # (poincare and the sweep refused the same sum).
+    path = tmp_path / "f.toml"
+    path.write_text(FORCED, encoding="utf-8")
+    system = vi.load(path)
+    with pytest.raises(AnalysisError, match=rf"{MAX_PERIODS} forcing periods in all"):
+        vi.lyapunov(system, settle=MAX_PERIODS - 9, periods=10)
+    done = run_cli("lyapunov", str(path), "--settle", str(MAX_PERIODS - 1), "--periods", "10")
+    refused(done, f"got {MAX_PERIODS + 9}")
+
+
+@pytest.mark.timeout(30)
+def test_lyapunov_averages_over_at_least_ten_of_the_slowest_natural_periods(
+    tmp_path: Path,
+) -> None:
+    # A 10 Hz oscillator forced at 1e8 Hz, never touching its damper, gave +77.8 and
+    # -80.4 1/s ("chaotic") over 1000 forcing periods (1e-5 s), where both are -1.26:
+    # the stretches of a transient. Refused, naming periods and what would do.
+    def forced_at(frequency: float) -> vi.System:
+        path = tmp_path / f"f{frequency:g}.toml"
+        path.write_text(FORCED.replace("frequency = 10.0", f"frequency = {frequency}", 1))
+        return vi.load(path)
+
+    with pytest.raises(AnalysisError, match=r"periods: .*too fast for its slowest mode"):
+        vi.lyapunov(forced_at(1e8))
+    with pytest.raises(
+        AnalysisError, match=r"periods: 1000 forcing periods span 0.1 s, .*>= 10001"
+    ):
+        vi.lyapunov(forced_at(1e4))
+    # Over 20 natural periods it runs: the exponents sum to the flow's trace, -C / M
+    # (Liouville), the free damper's two are 0.
+    found = vi.lyapunov(forced_at(1e4), periods=20_000)
+    assert found.impacts == 0
+    assert sorted(found.exponents)[2:] == [0.0, 0.0]
+    assert sum(found.exponents) == pytest.approx(-2.513, rel=1e-9)
+
+
+def test_sweeping_a_matrix_says_a_sweep_varies_one_number() -> None:
+    # "structure.stiffness = 1: [structure] stiffness: must be an array of rows" pointed
+    # at the value's format; a matrices structure has no one number to vary.
+    data = {
+        "structure": {
+            "kind": "matrices",
+            "mass": [[1.0]],
+            "stiffness": [[100.0]],
+            "damping": [[0.0]],
+        }
+    }
+    message = r'is an array in the scenario, not one number; .* kind "matrices"'
+    with pytest.raises(AnalysisError, match=message):
+        vi.analysis.with_parameter(data, "structure.stiffness", 1.0)
+
+
 def test_orbit_periods_out_of_bounds_exit_2(tmp_path: Path, run_cli: Cli) -> None:
     path = tmp_path / "f.toml"
     path.write_text(FORCED, encoding="utf-8")

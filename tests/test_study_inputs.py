@@ -199,3 +199,25 @@ def test_python_callers_are_told_their_own_argument_names(tmp_path: Path) -> Non
         st.chunk_part(study, 1, 2, threads=1)["peak"].shape
         == st.chunk_part(study, 0, 1, threads=1)["peak"].shape
     )
+
+
+@pytest.mark.timeout(60)
+def test_a_study_plans_on_the_memory_its_process_may_use(tmp_path: Path) -> None:
+    # Under `ulimit -v` the plan read the machine's memory alone: a study that fitted it
+    # but not the process's limit failed with a MemoryError traceback in the assembly.
+    script = (
+        "import resource\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))\n"
+        "from vibroimpact.study.limits import check_study_memory, machine_memory\n"
+        "assert machine_memory() <= 3 << 30, machine_memory()\n"
+        "try:\n"
+        "    check_study_memory(9_000_000, 2, 2, '[study]')\n"
+        "except ValueError as err:\n"
+        "    print(err)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=50, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert "the study's results would take about 3.17 GB" in done.stdout
+    assert "more than half of the 3.22 GB this process may use" in done.stdout

@@ -123,6 +123,27 @@ def test_a_stopped_study_notes_its_chunks_and_a_resumed_one_says_so(tmp_path: Pa
         f"resuming from {parts}: 1 of 3 chunks (5 of 12 runs) done by an earlier run, 2 "
         "chunks to run"
     ]
+    # A kept chunk damaged since is run again, and not counted as kept: "2 of 3
+    # chunks ... done, 2 chunks to run" had added up to more than the study.
+    with pytest.raises(Stop):
+        st.run(study, out, progress=stop_after_one)
+    kept = sorted(parts.glob("chunk-*.npz"))
+    assert len(kept) == 1
+    kept[0].write_bytes(b"damaged")
+    notices.clear()
+    st.run(study, out, notice=notices.append)
+    assert notices == []  # nothing read back: it starts afresh, silently
+    for _ in range(2):
+        with pytest.raises(Stop):
+            st.run(study, out, progress=stop_after_one)
+    kept = sorted(parts.glob("chunk-*.npz"))
+    assert len(kept) == 2
+    kept[0].write_bytes(b"damaged")
+    st.run(study, out, notice=notices.append)
+    assert notices == [
+        f"resuming from {parts}: 1 of 3 chunks (5 of 12 runs) done by an earlier run, 2 "
+        "chunks to run"
+    ]
     # The command line says it on stderr; a study that starts afresh says nothing.
     done = cli("study", str(tmp_path / "study.toml"), "--out", str(tmp_path / "again.nc"))
     assert done.returncode == 0 and done.stderr == ""

@@ -218,3 +218,33 @@ def test_a_zarr_path_holding_something_else_is_left_alone(
     assert status == 2 and "not a Zarr store" in one_line_error(err)
     assert (out.read_text() if kind == "file" else (out / "notes.txt").read_text()) == "notes"
     assert leftovers(tmp_path) == []
+
+
+@pytest.mark.timeout(30)
+def test_an_interrupted_store_s_folder_is_removed_though_writes_land_late(
+    tmp_path: Path,
+) -> None:
+    # Ctrl-C during to_zarr left a hidden ".out.zarr.PID-TOKEN.tmp/" of 50 chunks:
+    # zarr's threads wrote them after the one pass that removed the folder.
+    import threading
+    import time
+
+    from vibroimpact.study.stores import remove_folder
+
+    folder = tmp_path / ".out.zarr.1-00000000.tmp"
+
+    def late_writer() -> None:
+        for k in range(5):  # a chunk every 30 ms, for 120 ms
+            try:
+                (folder / "peak").mkdir(parents=True, exist_ok=True)
+                (folder / "peak" / f"{k}.0").write_bytes(b"chunk")
+            except FileNotFoundError:
+                pass  # removed between the two: as zarr's own writes race the removal
+            time.sleep(0.03)
+
+    writer = threading.Thread(target=late_writer)
+    writer.start()
+    time.sleep(0.005)
+    remove_folder(folder, late_writes=True)
+    writer.join()
+    assert not folder.exists()

@@ -269,6 +269,15 @@ def simulate_system(
     contact_timing: str | None = None,
 ) -> dict[str, Any]: ...
 def linear_parts(spec: dict[str, Any]) -> dict[str, Any]: ...
+def _contact_table(rows: list[tuple[float, ...]]) -> ContactTable: ...
+def _two_mass_solution(
+    history: list[_FloatArray],
+    contacts: ContactTable,
+    counts: tuple[int, int, int, int],
+    names: tuple[str, str],
+    figures: tuple[float, float, float],
+    final_state: InitialState,
+) -> Solution: ...
 def run_study(
     spec: dict[str, Any],
     initial: list[list[float]],

@@ -40,8 +40,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<InitialState>()?;
     m.add_class::<Solution>()?;
     m.add_class::<ContactTable>()?;
-    m.add_function(wrap_pyfunction!(run::_contact_table, m)?)?;
-    m.add_function(wrap_pyfunction!(run::_two_mass_solution, m)?)?;
+    // How a pickled two-mass result is made again (not in `__all__`).
+    m.setattr("_contact_table", wrap_pyfunction!(run::_contact_table, m)?)?;
+    m.setattr(
+        "_two_mass_solution",
+        wrap_pyfunction!(run::_two_mass_solution, m)?,
+    )?;
     m.add_class::<BeamMode>()?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(system::simulate_system, m)?)?;

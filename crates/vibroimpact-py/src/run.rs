@@ -293,9 +293,8 @@ impl Solution {
             history,
             self.contacts.clone_ref(py),
             counts,
-            self.final_time,
             (self.method.clone(), self.stepping.clone()),
-            (self.energy_growth, self.energy_residual),
+            (self.final_time, self.energy_growth, self.energy_residual),
             self.final_state.clone(),
         );
         Ok((rebuild, arguments.into_pyobject(py)?))
@@ -334,12 +333,11 @@ pub(crate) fn _two_mass_solution(
     history: Vec<numpy::PyReadonlyArray1<'_, f64>>,
     contacts: Py<ContactTable>,
     counts: (u64, u64, u64, u64),
-    final_time: f64,
     names: (String, String),
-    energy: (f64, f64),
+    figures: (f64, f64, f64),
     final_state: PyRef<'_, InitialState>,
 ) -> PyResult<Solution> {
-    let ((method, stepping), (energy_growth, energy_residual)) = (names, energy);
+    let ((method, stepping), (final_time, energy_growth, energy_residual)) = (names, figures);
     let columns: Vec<Column> = history
         .iter()
         .map(|a| Column::new(a.as_array().to_vec()))

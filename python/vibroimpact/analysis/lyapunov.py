@@ -13,11 +13,18 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact._core import lyapunov_spectrum
-from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_periods, whole_count
+from vibroimpact.analysis.limits import (
+    MAX_PERIODS,
+    AnalysisError,
+    check_periods,
+    check_total,
+    whole_count,
+)
 from vibroimpact.analysis.parameters import forcing_period
 from vibroimpact.analysis.runs import Runner, _prepare, as_runner, checked_run
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
+from vibroimpact.system import linear_parts
 
 #: Blocks the averaging time is cut into for the standard errors.
 BLOCKS = 10
@@ -94,6 +101,8 @@ def lyapunov(
         periods = 1000 if periods is None else whole_count("periods", periods, 1, MAX_PERIODS)
         check_periods("", "settle", settle, 0)
         check_periods("", "periods", periods, 1)
+        check_total(("settle", settle), ("periods", periods))
+        _check_window(run, periods)
         if settle:
             z = run.map(z, settle)
         blocks = _blocks(periods)
@@ -120,6 +129,44 @@ def lyapunov(
         running=np.asarray(raw["running"], dtype=float).reshape(blocks, len(exponents)),
         running_time=block_time * np.arange(1, blocks + 1),
     )
+
+
+#: The averaging time spans at least this many of the structure's longest natural period.
+MIN_NATURAL_PERIODS = 10
+
+
+def _check_window(run: Runner, periods: int) -> None:
+    """Refuse an averaging time, ``periods`` forcing periods, shorter than
+    :data:`MIN_NATURAL_PERIODS` of the structure's slowest mode (rigid modes aside):
+    its exponents would be the stretches of a transient, not rates the motion keeps (a
+    5 Hz oscillator forced at 1e8 Hz, never touching its damper: +77.8 and -80.4 1/s,
+    "chaotic", where both are -1.26)."""
+    spec = run.prepared.spec
+    parts = linear_parts(spec["structure"])
+    n = parts["n"]
+    import scipy.linalg  # here: at import time it doubled `import vibroimpact`
+
+    squares = scipy.linalg.eigh(
+        parts["stiffness"][:n, :n], parts["mass"][:n, :n], eigvals_only=True
+    )
+    tops = squares[squares > 1e-12 * max(float(squares.max()), 0.0)]
+    if not len(tops):
+        return  # no spring: no natural period to span
+    slowest = 2 * np.pi / np.sqrt(tops.min())
+    need = int(np.ceil(MIN_NATURAL_PERIODS * slowest / run.period * (1 - 1e-9)))
+    if periods >= need:
+        return
+    span = f"{periods} forcing periods span {periods * run.period:.3g} s"
+    why = (
+        f"under {MIN_NATURAL_PERIODS} of the structure's slowest natural period "
+        f"({slowest:.3g} s): the exponents would be a transient's stretches, not rates"
+    )
+    if need > MAX_PERIODS:
+        raise AnalysisError(
+            f"periods: {span}, {why}; {need:.3g} periods would be needed, beyond the "
+            f"{MAX_PERIODS} an analysis runs: the forcing is too fast for its slowest mode"
+        )
+    raise AnalysisError(f"periods: {span}, {why}; give periods >= {need}")
 
 
 def _blocks(periods: int) -> int:

@@ -87,6 +87,15 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
     if isinstance(node, list):
         raise AnalysisError(f"parameter {path!r}: ends on a list; name an entry's key")
     current = node.get(parts[-1]) if isinstance(node, Mapping) else None
+    if isinstance(current, list | tuple):
+        # A matrix or an array: a sweep sets one number, which its check then
+        # refused as the wrong shape ("must be an array of rows"), pointing at the value.
+        kind = out.get("structure", {}).get("kind") if parts[0] == "structure" else None
+        whose = f' (a structure of kind "{kind}" has no input one number sets)' if kind else ""
+        raise AnalysisError(
+            f"parameter {path!r}: is an array in the scenario, not one number; a sweep "
+            f"varies one number{whose}"
+        )
     if isinstance(current, int) and not isinstance(current, bool) and float(value).is_integer():
         # A whole-number key (a cantilever's modes, a seed) stays one: a sweep's
         # values are floats, which its check refused ("got 3.0", user trial).

@@ -325,6 +325,19 @@ def _show_warning(
     print(f"vibroimpact: warning: {message}", file=sys.stderr)
 
 
+def _escape_unencodable() -> list[tuple[Any, str]]:
+    """Standard output and error write what their encoding cannot hold as escapes
+    (``backslashreplace``); returns each stream changed with its former handler."""
+    changed = []
+    for stream in (sys.stdout, sys.stderr):
+        errors = getattr(stream, "errors", None)
+        if hasattr(stream, "reconfigure") and errors in ("strict", None):
+            with contextlib.suppress(ValueError, OSError):
+                stream.reconfigure(errors="backslashreplace")
+                changed.append((stream, errors or "strict"))
+    return changed
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     args = _parser().parse_args(argv)
@@ -335,6 +348,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     # Warnings as one line each, as errors are (not Python's file:line format).
     shown = warnings.showwarning
     warnings.showwarning = _show_warning
+    # A terminal or pipe that cannot encode a name (a path in another script under
+    # PYTHONIOENCODING=ascii) gets it escaped, not a UnicodeEncodeError.
+    encodings = _escape_unencodable()
     try:
         if args.command == "paper":
             return run_paper(args.out)
@@ -360,6 +376,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"vibroimpact: {_ENDINGS[ending.signum]}", file=sys.stderr)
         _print_notes(ending)
         return 128 + ending.signum
+    except MemoryError as err:
+        # The machine refused memory the up-front limits did not foresee (a process
+        # limit below the machine's memory, `ulimit -v`): one line, not a traceback.
+        detail = f" ({err})" if str(err) else ""
+        print(
+            f"vibroimpact: error: out of memory{detail}: shorten t_end, raise every or "
+            "set history = false (a study: fewer runs or a smaller chunk_size)",
+            file=sys.stderr,
+        )
+        return 1
     except BrokenPipeError:
         # The reader (e.g. `| head`) left early: not an error of ours. Point
         # stdout at devnull so that Python's exit flush does not fail again.
@@ -368,7 +394,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as err:
         # What the system refused (the output full: `--json > /dev/full`, a file size
         # limit), said in one line as every error is; the run itself did not fail.
-        where = f"{err.filename}: " if err.filename else ""
+        where = f"{err.filename}: " if err.filename else "writing the output: "
         print(f"vibroimpact: error: {where}{err.strerror or err}", file=sys.stderr)
         _print_notes(err)
         with contextlib.suppress(OSError):
@@ -376,5 +402,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     finally:
         warnings.showwarning = shown
+        for stream, errors in encodings:
+            stream.reconfigure(errors=errors)
         for signum, handler in previous.items():
             signal.signal(signum, handler)

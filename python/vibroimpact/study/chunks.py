@@ -10,7 +10,7 @@ import shutil
 import sys
 import time
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -130,7 +130,7 @@ def run(
         # Inside the try: an interrupt just after the notice still says what is kept.
         if parts and notice is not None:
             notice(
-                f"resuming from {parts_dir}: {_kept(study, chunks, path_of)} by an earlier "
+                f"resuming from {parts_dir}: {_kept(study, chunks, parts)} by an earlier "
                 f"run, {len(pending)} chunks to run"
             )
         if dask is None:
@@ -147,26 +147,26 @@ def run(
     except BaseException as stop:
         if any(path.exists() for path in path_of):
             stop.add_note(
-                f"{_kept(study, chunks, path_of)}, kept in {parts_dir}; to resume, {resume}"
+                f"{_kept(study, chunks, parts)}, kept in {parts_dir}; to resume, {resume}"
             )
         else:
             # Nothing finished: leave nothing behind (a resume has nothing to go on).
             shutil.rmtree(parts_dir, ignore_errors=True)
             if not isinstance(stop, Exception):  # interrupted, not an error's one line
                 stop.add_note(
-                    f"{_kept(study, chunks, path_of)}: nothing kept, run again it starts afresh"
+                    f"{_kept(study, chunks, parts)}: nothing kept, run again it starts afresh"
                 )
         raise
     shutil.rmtree(parts_dir, ignore_errors=True)
     return dataset
 
 
-def _kept(study: Study, chunks: list[range], path_of: list[Path]) -> str:
+def _kept(study: Study, chunks: list[range], parts: Mapping[int, Any]) -> str:
     """How much of the study its kept chunks hold (``2 of 4 chunks (8 of 16 runs)
-    done``)."""
-    kept = [runs for runs, path in zip(chunks, path_of, strict=True) if path.exists()]
-    done = sum(len(runs) for runs in kept)
-    return f"{len(kept)} of {len(chunks)} chunks ({done} of {study.runs} runs) done"
+    done``): those read back (``parts``), not a damaged file, which is run again (it had
+    been counted, so that kept and to run added up to more than the study)."""
+    done = sum(len(chunks[number]) for number in parts)
+    return f"{len(parts)} of {len(chunks)} chunks ({done} of {study.runs} runs) done"
 
 
 def terminal_progress(stream: Any = sys.stderr) -> Callable[[int, int, float], None]:

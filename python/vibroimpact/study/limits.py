@@ -5,6 +5,7 @@ up raises."""
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import Any
 
 from vibroimpact.analysis.limits import AnalysisError
@@ -38,11 +39,31 @@ MAX_STUDY_RUNS = 10_000_000
 
 
 def machine_memory() -> int | None:
-    """This machine's physical memory, bytes (None where the system does not say)."""
+    """The memory this process may use, bytes: the machine's physical memory, or less
+    where a limit on the process (``ulimit -v``, RLIMIT_AS) or its control group (a
+    container's ``memory.max``) allows less (None where nothing says). Planning on the
+    machine's alone, a study under ``ulimit -v`` failed with a traceback instead."""
+    known = []
     try:
-        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+        known.append(int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE")))
     except (AttributeError, OSError, ValueError):
-        return None
+        pass
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft != resource.RLIM_INFINITY and soft > 0:
+            known.append(int(soft))
+    except (ImportError, OSError, ValueError):
+        pass
+    for path in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            text = Path(path).read_text(encoding="ascii").strip()
+        except (OSError, UnicodeDecodeError):
+            continue
+        if text.isdigit() and 0 < int(text) < 2**60:  # v1 writes "no limit" as ~2**63
+            known.append(int(text))
+    return min(known) if known else None
 
 
 #: The memory a study may plan for where the machine's is not known, bytes.
@@ -61,7 +82,11 @@ def check_study_memory(runs: int, observed: int, pairs: int, where: str) -> None
     memory = machine_memory()
     limit = memory // 2 if memory else UNKNOWN_MEMORY_LIMIT
     if need > limit:
-        of = f"half of this machine's {memory / 1e9:.3g} GB" if memory else f"{limit / 1e9:.3g} GB"
+        of = (
+            f"half of the {memory / 1e9:.3g} GB this process may use"
+            if memory
+            else f"{limit / 1e9:.3g} GB"
+        )
         raise StudyError(
             f"{where}: the study's results would take about {need / 1e9:.3g} GB of memory "
             f"({runs:,} runs, each of {observed} observed quantities and {pairs} pair(s)), more "

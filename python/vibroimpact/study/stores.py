@@ -6,6 +6,7 @@ from __future__ import annotations
 import importlib
 import os
 import shutil
+import time
 from pathlib import Path
 from typing import Any
 
@@ -84,6 +85,7 @@ def _write_zarr(dataset: Any, out: Path) -> None:
     # The new store's folder until it is swapped in, then the earlier store's.
     held: list[Path] = []
     lock: int | None = None
+    swapped = False
     try:
         lock = claim_beside(out, held, folder=True)
         # Into the empty folder made (and locked) above: "w" would make it again.
@@ -91,6 +93,7 @@ def _write_zarr(dataset: Any, out: Path) -> None:
         _sync(held[0])
         earlier = swap_in(held[0], out)
         held[:] = [] if earlier is None else [earlier]
+        swapped = True
         _sync_folder(out.parent)
     except OSError as err:
         raise UsageError(f"cannot write {str(out)!r}: {err.strerror or err}") from None
@@ -98,7 +101,22 @@ def _write_zarr(dataset: Any, out: Path) -> None:
         if lock is not None:
             os.close(lock)
         for folder in held:
-            shutil.rmtree(folder, ignore_errors=True)
+            remove_folder(folder, late_writes=not swapped)
+
+
+def remove_folder(folder: Path, late_writes: bool = False, patience: float = 2.0) -> None:
+    """Remove ``folder`` and what is in it. With ``late_writes`` (an interrupted
+    ``to_zarr``, whose threads write chunks after the interrupt: one pass left 50 of them
+    in a hidden folder), again while they fill or make it again, until it stays gone for
+    50 ms, for up to ``patience`` s."""
+    deadline = time.monotonic() + patience
+    while True:
+        shutil.rmtree(folder, ignore_errors=True)
+        if not late_writes or time.monotonic() > deadline:
+            return
+        time.sleep(0.05)
+        if not os.path.lexists(folder):
+            return
 
 
 def _sync(folder: Path) -> None:

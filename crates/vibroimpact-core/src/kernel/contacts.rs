@@ -192,7 +192,12 @@ impl Run<'_> {
             self.check_contact(i, mode, onset)?;
             any = true;
         }
-        if rigid && near {
+        let collapse = rigid && self.squeeze.armed;
+        if collapse {
+            // Every open pair the speeds close within the resolution.
+            self.mark_touching(self.touch_band(resolution));
+            self.squeeze.resolved();
+        } else if rigid && near {
             self.mark_touching(touch);
         }
         if rigid {
@@ -206,6 +211,7 @@ impl Run<'_> {
                 &mut self.energy.impact_loss,
                 &mut self.grazes,
                 (resolution, instant, time_scale),
+                collapse,
                 &mut self.scratch,
                 &mut self.buffers.work,
                 &mut self.just_switched,
@@ -403,6 +409,8 @@ impl Run<'_> {
                 }
             }
         }
+        self.squeeze
+            .after(rigid, time - self.last_event, self.resolution);
         let interval = self.schedule.chatter_interval(time);
         if time - self.last_event < interval {
             self.close_events += 1;

@@ -26,12 +26,64 @@
 //! flight shorter than the resolution is held instead, as an equality (two
 //! dampers settling on one wall launch each other at every landing, the
 //! flights falling by the mass ratio: summed, both rest).
+//!
+//! A sequence no one pair's flights describe, a body squeezed between two
+//! converging walls (a light particle between its floor and a heavier one
+//! falling on it: it strikes each in turn, ever faster), is an inelastic
+//! collapse: its impacts close in on one instant, where every pair in it
+//! moves as one. [`Squeeze`] sees the events close in below the resolution;
+//! at the next, every rigid pair within the distance the speeds cover in the
+//! resolution is resolved plastically (`e = 0`) at once, and sticks.
 
 use crate::kernel::complementarity::Complementarity;
 use crate::kernel::events::{ContactKind, Open, PairContact};
 use crate::kernel::locate::wall_round_off;
 use crate::kernel::observe::Jump;
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
+
+/// Rigid events in a row, each closer to the last than the resolution and
+/// than the two before it were: an inelastic collapse (see the module's
+/// docs). Below this count such a sequence is left to run.
+const SQUEEZE_EVENTS: u32 = 8;
+
+/// Watches the rigid events for an inelastic collapse: `armed` once
+/// [`SQUEEZE_EVENTS`] in a row closed in on one instant.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Squeeze {
+    shrinking: u32,
+    /// The last two intervals between rigid events, s.
+    intervals: [f64; 2],
+    pub(crate) armed: bool,
+}
+
+impl Default for Squeeze {
+    fn default() -> Self {
+        Self {
+            shrinking: 0,
+            intervals: [f64::INFINITY; 2],
+            armed: false,
+        }
+    }
+}
+
+impl Squeeze {
+    /// After an event (`rigid`: one the rigid pairs' problem resolved)
+    /// `interval` s after the last, in a run of `resolution` s. Shorter than
+    /// the longer of the two before it by a margin (equal flights, an
+    /// elastic rattle, are no collapse), it closes in.
+    pub(crate) fn after(&mut self, rigid: bool, interval: f64, resolution: f64) {
+        let before = self.intervals[0].max(self.intervals[1]);
+        let closing = rigid && interval < resolution && interval < 0.999 * before;
+        self.shrinking = if closing { self.shrinking + 1 } else { 0 };
+        self.intervals = [self.intervals[1], interval];
+        self.armed = self.shrinking >= SQUEEZE_EVENTS;
+    }
+
+    /// The collapse resolved: watch afresh.
+    pub(crate) fn resolved(&mut self) {
+        *self = Self::default();
+    }
+}
 
 /// What a pair in the problem is doing at the instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,7 +154,9 @@ impl Impacts {
     /// Resolve the marked pairs and the sticking ones at `time`: impacts,
     /// sticking, release of sticking pairs lifted off. `resolution` (s) is the
     /// time below which a chattering sequence is summed, `instant` (s) the
-    /// round-off of the time, `time_scale` (s) the system's. Sets `just_switched` for the pairs that
+    /// round-off of the time, `time_scale` (s) the system's. `collapse`: an
+    /// inelastic collapse (see [`Squeeze`]), every member resolved
+    /// plastically and stuck. Sets `just_switched` for the pairs that
     /// changed; returns whether any did or any impulse acted.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn resolve(
@@ -116,6 +170,7 @@ impl Impacts {
         impact_loss: &mut f64,
         grazes: &mut u64,
         (resolution, instant, time_scale): (f64, f64, f64),
+        collapse: bool,
         scratch: &mut Scratch,
         work: &mut [f64],
         just_switched: &mut [bool],
@@ -130,7 +185,7 @@ impl Impacts {
             y,
             modes,
             grazes,
-            scales,
+            (scales, collapse),
             scratch,
             work,
             just_switched,
@@ -138,7 +193,15 @@ impl Impacts {
         if self.members.is_empty() {
             return any;
         }
-        self.impulses(system, time, y, modes, resolution, scratch, work);
+        self.impulses(
+            system,
+            time,
+            y,
+            modes,
+            (resolution, collapse),
+            scratch,
+            work,
+        );
         self.record(
             system,
             time,
@@ -147,7 +210,7 @@ impl Impacts {
             (open, contacts),
             impact_loss,
             grazes,
-            just_switched,
+            (just_switched, collapse),
         ) || any
     }
 
@@ -188,7 +251,7 @@ impl Impacts {
         y: &mut [f64],
         modes: &mut [Mode],
         grazes: &mut u64,
-        (instant, time_scale): (f64, f64),
+        ((instant, time_scale), collapse): ((f64, f64), bool),
         scratch: &mut Scratch,
         work: &mut [f64],
         just_switched: &mut [bool],
@@ -223,6 +286,13 @@ impl Impacts {
                     approach,
                     restitution,
                 }
+            } else if collapse {
+                // In the collapse, not arriving: held with the others (the
+                // impulses that stop them would close it next).
+                just_switched[i] = true;
+                any = true;
+                modes[i] = Mode::Sticking;
+                Role::Stick { approach: 0.0 }
             } else if -approach > 1e-9 * speed_scale && moving {
                 // Located on the wall but leaving it (the start of a step
                 // just after an impact): no event. Still past it by
@@ -272,7 +342,7 @@ impl Impacts {
         time: f64,
         y: &mut [f64],
         modes: &mut [Mode],
-        resolution: f64,
+        (resolution, collapse): (f64, bool),
         scratch: &mut Scratch,
         work: &mut [f64],
     ) {
@@ -300,6 +370,20 @@ impl Impacts {
         }
         self.stuck.clear();
         self.stuck.resize(m, None);
+        if collapse {
+            // The collapse's rest summed at once: each impact Newton's at
+            // its own restitution, then plastic, as a summed sequence's.
+            for (s, &i) in self.members.iter().enumerate() {
+                if let Role::Impact {
+                    approach,
+                    restitution,
+                } = self.roles[s]
+                {
+                    self.stuck[s] = Some((0.0, restitution * approach));
+                    modes[i] = Mode::Sticking;
+                }
+            }
+        }
         // Each round may find more pairs to stick or to hold: at most 2 m.
         for _ in 0..=2 * m {
             y[d..2 * d].copy_from_slice(&self.velocities);
@@ -372,6 +456,34 @@ impl Impacts {
         }
     }
 
+    /// Member `s`'s rate after the impulses and its share of the energy
+    /// they took, J: `-P (u- + u+) / 2` (the shares sum to the kinetic energy
+    /// lost).
+    fn share(&self, s: usize) -> (f64, f64) {
+        let after = self.before[s] + self.lcp.w_minus_q(s);
+        (after, -0.5 * self.lcp.z[s] * (self.before[s] + after))
+    }
+
+    /// In a collapse the pairs held from leaving take a share of either sign
+    /// (an impulse against a rate that was opening): the arriving pairs'
+    /// records carry the whole loss, each in proportion to its own. Their
+    /// shares' sum and the factor on each (1 outside a collapse).
+    fn collapse_shares(&self, collapse: bool) -> (f64, f64) {
+        let (mut arriving, mut held) = (0.0, 0.0);
+        for s in (0..self.members.len()).filter(|_| collapse) {
+            match self.roles[s] {
+                Role::Impact { .. } => arriving += self.share(s).1,
+                _ => held += self.share(s).1,
+            }
+        }
+        let scale = if arriving > 0.0 {
+            (arriving + held) / arriving
+        } else {
+            1.0
+        };
+        (arriving, scale)
+    }
+
     /// Each member's share of the energy the impulses took, its record and
     /// its new mode; whether any impulse acted or pair lifted off.
     #[allow(clippy::too_many_arguments)]
@@ -384,17 +496,22 @@ impl Impacts {
         (open, contacts): (&mut [Option<Open>], &mut Vec<PairContact>),
         impact_loss: &mut f64,
         grazes: &mut u64,
-        just_switched: &mut [bool],
+        (just_switched, collapse): (&mut [bool], bool),
     ) -> bool {
         let speed_scale = self.speed_scale;
         let mut any = false;
+        let (arriving, scale) = self.collapse_shares(collapse);
         // Each pair's share of the energy the impulses take, J:
         // -P (u- + u+) / 2, which sums to the kinetic energy lost.
         for (s, &i) in self.members.iter().enumerate() {
             let impulse = self.lcp.z[s];
-            let after = self.before[s] + self.lcp.w_minus_q(s);
-            let loss = -0.5 * impulse * (self.before[s] + after);
-            *impact_loss += loss;
+            let (after, own) = self.share(s);
+            *impact_loss += own;
+            let loss = match self.roles[s] {
+                Role::Impact { .. } => scale * own,
+                _ if arriving > 0.0 => 0.0,
+                _ => own,
+            };
             let pair = system.interactions[i].pair;
             any |= impulse != 0.0;
             match (self.roles[s], self.stuck[s]) {

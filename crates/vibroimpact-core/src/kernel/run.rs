@@ -11,7 +11,7 @@ use crate::kernel::contact_balance::OnsetBalance;
 use crate::kernel::events::{ContactTiming, Open, PairContact, RunOptions};
 use crate::kernel::fixed::Change;
 use crate::kernel::held::Probe;
-use crate::kernel::impacts::Impacts;
+use crate::kernel::impacts::{Impacts, Squeeze};
 use crate::kernel::locate::{
     event_value_from, find_crossing, locate, may_cross, past, Buffers, Crossing, Gaps, Location,
 };
@@ -80,6 +80,8 @@ pub(super) struct Run<'a> {
     pub(super) taken: f64,
     pub(super) last_event: f64,
     pub(super) close_events: u64,
+    /// The rigid events watched for an inelastic collapse.
+    pub(super) squeeze: Squeeze,
     pub(super) stalled: u64,
     /// Interactions whose dip in this step was checked and stays open.
     pub(super) unconfirmed: Vec<bool>,

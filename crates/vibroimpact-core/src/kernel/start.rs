@@ -229,6 +229,7 @@ impl<'a> Run<'a> {
             taken: 0.0,
             last_event: f64::NEG_INFINITY,
             close_events: 0,
+            squeeze: Default::default(),
             stalled: 0,
             unconfirmed: vec![false; count],
             any_unconfirmed: false,
