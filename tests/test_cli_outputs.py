@@ -126,3 +126,33 @@ def test_memory_the_machine_refuses_is_one_line_not_a_traceback(
     assert command.main(["simulate", str(write(tmp_path, BASE))]) == 1
     err = capsys.readouterr().err
     assert err.startswith("vibroimpact: error: out of memory: ") and err.count("\n") == 1
+
+
+@pytest.mark.timeout(120)
+def test_memory_refused_under_a_process_limit_is_never_an_abort(tmp_path: Path) -> None:
+    # Under `ulimit -v 400000` a two-mass run of 3 million rows aborted (SIGABRT, "memory
+    # allocation of 24000008 bytes failed"): its history's columns were copied with an
+    # allocation that cannot fail. Across limits either side of where the copy needs
+    # memory, a run ends normally or with one line, never an abort.
+    import resource
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "examples" / "rattling_damper.toml").read_text()
+    text = text.replace("t_end = 60.0", "t_end = 300.0").replace("every = 100", "every = 1")
+    scenario = write(tmp_path, text)
+    for megabytes in range(300, 520, 20):
+        limit = megabytes << 20
+
+        def limited(limit: int = limit) -> None:
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+
+        done = subprocess.run(
+            [sys.executable, "-m", "vibroimpact", "simulate", str(scenario)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+            preexec_fn=limited,
+        )
+        assert done.returncode not in (-6, 134), (megabytes, done.stderr[-300:])
+        assert "memory allocation of" not in done.stderr, (megabytes, done.stderr[-300:])

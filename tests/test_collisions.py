@@ -192,6 +192,55 @@ def test_a_particle_squeezed_between_its_floor_and_a_heavier_one_collapses_as_on
     assert abs(sol.energy["residual"]) < 1e-12
 
 
+def _stack_on_a_forced_floor(masses: list[float], ceiling: float) -> vi.System:
+    """Rigid particles (e = 0.3) stacked touching on the floor of the forced cavity of
+    :func:`forced_column`, 2 mm apart at rest, under gravity, the top one ``ceiling`` (m)
+    below the ceiling."""
+    law = {"law": "rigid", "restitution": 0.3}
+    last = len(masses) - 1
+    return vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=8883.0, damping=9.42),
+        dampers=[
+            vi.Damper(
+                mass=m,
+                at=0,
+                lower_clearance=0.002 if j == 0 else math.inf,
+                upper_clearance=ceiling if j == last else math.inf,
+                **law,
+            )
+            for j, m in enumerate(masses)
+        ],
+        collisions=[vi.Collision(dampers=(j, j + 1), gap=0.002, **law) for j in range(last)],
+        gravity=vi.Gravity(acceleration=9.81),
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=30.0, frequency=10.0))],
+        initial=vi.Initial(damper_displacement=[-0.002 - 0.002 * j for j in range(len(masses))]),
+    )
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853"])
+@pytest.mark.timeout(30)
+def test_a_stack_lifts_off_its_floor_as_the_one_body_it_is(method: str) -> None:
+    # A 1 g particle between two 50 g ones, all resting on a forced floor: at lift-off
+    # every pair's force reaches zero at once, and releasing each pair alone closed the
+    # light one's other gap, events 1e-17 s apart until the run stopped as chattering.
+    # Together they fly as one body: the floor's release and its next impact come when
+    # they do for one particle of the stack's mass (no collision in it at all).
+    stack = _stack_on_a_forced_floor([0.05, 0.001, 0.05], ceiling=0.03)
+    block = _stack_on_a_forced_floor([0.101], ceiling=0.034)  # the same ceiling
+    stack_run = vi.simulate(stack, method=method, t_end=0.1)
+    block_run = vi.simulate(block, method=method, t_end=0.1)
+
+    def floor(sol: Any) -> list[tuple[str, float, float]]:
+        rows = sol.contacts.to_dicts()
+        return [(r["kind"], r["onset"], r["separation"]) for r in rows if r["pair"] == "damper 0"]
+
+    ours, one = floor(stack_run)[:2], floor(block_run)[:2]
+    assert len(ours) == len(one) == 2 and [k for k, *_ in ours] == [k for k, *_ in one]
+    for (_, onset, separation), (_, onset_one, separation_one) in zip(ours, one, strict=True):
+        assert onset == pytest.approx(onset_one, rel=1e-9, abs=1e-12)
+        assert separation == pytest.approx(separation_one, rel=1e-9, abs=1e-12)
+
+
 def _hertz_chain(masses: list[float], stiffness: float, gaps: list[float], v0: float) -> Any:
     """scipy's integration of the masses' Hertz contacts (a test-only oracle): each
     pair pushes apart with ``stiffness * overlap^1.5`` while they overlap."""

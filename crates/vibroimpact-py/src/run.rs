@@ -528,20 +528,29 @@ pub(crate) fn simulate(
         contact_forces,
         ..
     } = sol;
-    let column = |k: usize| {
-        states
-            .iter()
-            .skip(k)
-            .step_by(4)
-            .copied()
-            .collect::<Vec<_>>()
+    // The columns are copies of the rows: memory the machine may refuse (under
+    // `ulimit -v`), said as Python's MemoryError, never an abort.
+    let rows = time.len();
+    let column = |values: &mut dyn Iterator<Item = f64>| -> PyResult<Vec<f64>> {
+        let mut out = Vec::new();
+        out.try_reserve_exact(rows).map_err(|_| {
+            pyo3::exceptions::PyMemoryError::new_err(format!(
+                "the run's history of {rows} rows could not be copied into arrays (the \
+                 machine refused {:.0} MB more): set history = false, raise every or shorten \
+                 t_end",
+                (rows * 8) as f64 / 1e6
+            ))
+        })?;
+        out.extend(values);
+        Ok(out)
     };
-    let history = [column(0), column(2), column(1), column(3)];
-    let [w, wv, y, yv] = history;
-    let forces = if contact_forces.len() == time.len() {
+    let of = |k: usize| states.iter().skip(k).step_by(4).copied();
+    let (w, wv) = (column(&mut of(0))?, column(&mut of(2))?);
+    let (y, yv) = (column(&mut of(1))?, column(&mut of(3))?);
+    let forces = if contact_forces.len() == rows {
         contact_forces
     } else {
-        vec![0.0; time.len()]
+        column(&mut std::iter::repeat_n(0.0, rows))?
     };
     Ok(Solution {
         rows: time.len(),

@@ -117,6 +117,10 @@ pub(crate) struct Impacts {
     /// The largest speed before the instant, m/s.
     speed_scale: f64,
     lcp: Complementarity,
+    /// The members touching at rest at this instant, and the problem that
+    /// spaces them off their walls together ([`Self::space_touched`]).
+    touched: Vec<usize>,
+    spacing: Complementarity,
 }
 
 impl Impacts {
@@ -137,6 +141,8 @@ impl Impacts {
             velocities: vec![0.0; dim],
             speed_scale: 0.0,
             lcp: Complementarity::new(count),
+            touched: Vec::with_capacity(count),
+            spacing: Complementarity::new(count),
         }
     }
 
@@ -600,9 +606,7 @@ impl Impacts {
                     // of round-off above the wall too: two loose masses
                     // touching in free fall close at a rate of exactly zero,
                     // which reads as arriving there.)
-                    if system.gap(i, y).0 <= wall_round_off(system, i, y) {
-                        system.release(i, y);
-                    }
+                    self.touched.push(i);
                 }
                 (Role::Held, _) => {
                     if impulse != 0.0 {
@@ -622,7 +626,38 @@ impl Impacts {
                 }
             }
         }
+        self.space_touched(system, y);
         any
+    }
+
+    /// The pairs touching at rest at this instant (`touched`) put a few units
+    /// of round-off off their walls, or the same touch is found again at
+    /// once, without end. One alone along its own `M^-1 h^T`
+    /// ([`Assembly::release`]); several at once together, by the positions'
+    /// complementarity problem `W z + (g - g*) >= 0`, `z >= 0` (`g*` the
+    /// spacing release gives): a light body touching two heavier ones at rest
+    /// (a stack lifting off as one block) had each release close the other
+    /// gap, events 1e-17 s apart without end.
+    fn space_touched(&mut self, system: &Assembly, y: &mut [f64]) {
+        let touched = &self.touched;
+        let below = |&i: &usize| system.gap(i, y).0 <= wall_round_off(system, i, y);
+        if touched.len() == 1 && below(&touched[0]) {
+            system.release(touched[0], y);
+        } else if touched.len() > 1 && touched.iter().any(below) {
+            self.spacing.set_matrix(system, touched);
+            for (s, &i) in touched.iter().enumerate() {
+                let spaced = 16.0 * f64::EPSILON * system.gap_scale(i, y);
+                self.spacing.q[s] = system.gap(i, y).0 - spaced;
+            }
+            self.spacing.solve();
+            let d = system.dim;
+            for (s, &i) in touched.iter().enumerate() {
+                if self.spacing.z[s] > 0.0 {
+                    system.interactions[i].add_push(self.spacing.z[s], &mut y[..d]);
+                }
+            }
+        }
+        self.touched.clear();
     }
 }
 
