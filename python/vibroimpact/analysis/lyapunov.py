@@ -22,9 +22,9 @@ from vibroimpact.analysis.limits import (
 )
 from vibroimpact.analysis.parameters import forcing_period
 from vibroimpact.analysis.runs import Runner, _prepare, as_runner, checked_run
+from vibroimpact.model.modes import structure_frequencies
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
-from vibroimpact.system import linear_parts
 
 #: Blocks the averaging time is cut into for the standard errors.
 BLOCKS = 10
@@ -141,18 +141,12 @@ def _check_window(run: Runner, periods: int) -> None:
     its exponents would be the stretches of a transient, not rates the motion keeps (a
     5 Hz oscillator forced at 1e8 Hz, never touching its damper: +77.8 and -80.4 1/s,
     "chaotic", where both are -1.26)."""
-    spec = run.prepared.spec
-    parts = linear_parts(spec["structure"])
-    n = parts["n"]
-    import scipy.linalg  # here: at import time it doubled `import vibroimpact`
-
-    squares = scipy.linalg.eigh(
-        parts["stiffness"][:n, :n], parts["mass"][:n, :n], eigvals_only=True
-    )
-    tops = squares[squares > 1e-12 * max(float(squares.max()), 0.0)]
-    if not len(tops):
+    frequencies = structure_frequencies(run.prepared.spec["structure"])
+    # Rigid modes aside (their 0 Hz to round-off).
+    springs = frequencies[frequencies > 1e-6 * frequencies.max(initial=0.0)]
+    if not len(springs):
         return  # no spring: no natural period to span
-    slowest = 2 * np.pi / np.sqrt(tops.min())
+    slowest = 1.0 / springs.min()
     need = int(np.ceil(MIN_NATURAL_PERIODS * slowest / run.period * (1 - 1e-9)))
     if periods >= need:
         return

@@ -4,6 +4,7 @@ rigidly at their points (the two limits of an impact damper: rattling free, or s
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -78,6 +79,20 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
         for j, damper in enumerate(system.dampers):
             weights = point_weights(structure, damper.at, f"dampers[{j}].at")
             mass += parts["mass"][n + j, n + j] * np.outer(weights, weights)
+    frequencies, shapes = _solved(stiffness, mass)
+    return NaturalModes(frequencies, shapes, mass, stiffness.copy(), structure)
+
+
+def structure_frequencies(structure: Mapping[str, Any]) -> np.ndarray:
+    """The undamped natural frequencies (Hz, lowest first; a rigid mode's 0 to
+    round-off) of a ``[structure]`` section alone, as :func:`natural_modes` gives them."""
+    parts = linear_parts(structure)
+    n = parts["n"]
+    return _solved(parts["stiffness"][:n, :n], parts["mass"][:n, :n])[0]
+
+
+def _solved(stiffness: np.ndarray, mass: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``K phi = (2 pi f)^2 M phi``: the frequencies (Hz) and unit-modal-mass shapes."""
     # Imported here: scipy.linalg at import time doubled `import vibroimpact` (+150 ms).
     import scipy.linalg
 
@@ -87,7 +102,7 @@ def natural_modes(system: System, *, attach_dampers: bool = False) -> NaturalMod
     shapes = shapes * np.where(largest < 0, -1.0, 1.0)
     # Round-off can leave a rigid-body mode's eigenvalue a hair below zero.
     frequencies = np.sqrt(np.clip(eigenvalues, 0.0, None)) / (2 * np.pi)
-    return NaturalModes(frequencies, shapes, mass, stiffness.copy(), structure)
+    return frequencies, shapes
 
 
 def frequencies_summary(system: System, shown_modes: int = 5) -> str:

@@ -192,7 +192,7 @@ impl Run<'_> {
             self.check_contact(i, mode, onset)?;
             any = true;
         }
-        let collapse = rigid && self.squeeze.armed;
+        let collapse = rigid && self.squeeze.armed();
         if collapse {
             // Every open pair the speeds close within the resolution.
             self.mark_touching(self.touch_band(resolution));

@@ -46,14 +46,12 @@ use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 /// docs). Below this count such a sequence is left to run.
 const SQUEEZE_EVENTS: u32 = 8;
 
-/// Watches the rigid events for an inelastic collapse: `armed` once
-/// [`SQUEEZE_EVENTS`] in a row closed in on one instant.
+/// Watches the rigid events for an inelastic collapse ([`Self::armed`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Squeeze {
     shrinking: u32,
     /// The last two intervals between rigid events, s.
     intervals: [f64; 2],
-    pub(crate) armed: bool,
 }
 
 impl Default for Squeeze {
@@ -61,7 +59,6 @@ impl Default for Squeeze {
         Self {
             shrinking: 0,
             intervals: [f64::INFINITY; 2],
-            armed: false,
         }
     }
 }
@@ -76,7 +73,11 @@ impl Squeeze {
         let closing = rigid && interval < resolution && interval < 0.999 * before;
         self.shrinking = if closing { self.shrinking + 1 } else { 0 };
         self.intervals = [self.intervals[1], interval];
-        self.armed = self.shrinking >= SQUEEZE_EVENTS;
+    }
+
+    /// Whether [`SQUEEZE_EVENTS`] in a row closed in on one instant.
+    pub(crate) fn armed(&self) -> bool {
+        self.shrinking >= SQUEEZE_EVENTS
     }
 
     /// The collapse resolved: watch afresh.
@@ -475,8 +476,11 @@ impl Impacts {
     /// records carry the whole loss, each in proportion to its own. Their
     /// shares' sum and the factor on each (1 outside a collapse).
     fn collapse_shares(&self, collapse: bool) -> (f64, f64) {
+        if !collapse {
+            return (0.0, 1.0);
+        }
         let (mut arriving, mut held) = (0.0, 0.0);
-        for s in (0..self.members.len()).filter(|_| collapse) {
+        for s in 0..self.members.len() {
             match self.roles[s] {
                 Role::Impact { .. } => arriving += self.share(s).1,
                 _ => held += self.share(s).1,
@@ -646,8 +650,7 @@ impl Impacts {
         } else if touched.len() > 1 && touched.iter().any(below) {
             self.spacing.set_matrix(system, touched);
             for (s, &i) in touched.iter().enumerate() {
-                let spaced = 16.0 * f64::EPSILON * system.gap_scale(i, y);
-                self.spacing.q[s] = system.gap(i, y).0 - spaced;
+                self.spacing.q[s] = system.gap(i, y).0 - system.released_gap(i, y);
             }
             self.spacing.solve();
             let d = system.dim;

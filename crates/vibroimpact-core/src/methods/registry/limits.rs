@@ -237,10 +237,7 @@ fn check_finite_modes(structure: &Structure) -> Result<Option<f64>> {
     if frequency_bound(structure).is_finite() {
         return Ok(None);
     }
-    let top = structure
-        .natural_frequencies()
-        .into_iter()
-        .fold(0.0f64, f64::max);
+    let top = top_angular_frequency(structure);
     if top.is_finite() {
         return Ok(Some(top / std::f64::consts::TAU));
     }
@@ -251,12 +248,18 @@ fn check_finite_modes(structure: &Structure) -> Result<Option<f64>> {
     ))
 }
 
-/// The structure's highest natural frequency (Hz; 0 for none).
-pub(super) fn highest_frequency(structure: &Structure) -> f64 {
-    let top = structure
+/// The largest of the structure's natural angular frequencies (rad/s; 0 for
+/// none; infinite or NaN where they overflow a double).
+fn top_angular_frequency(structure: &Structure) -> f64 {
+    structure
         .natural_frequencies()
         .into_iter()
-        .fold(0.0f64, f64::max);
+        .fold(0.0f64, f64::max)
+}
+
+/// The structure's highest natural frequency (Hz; 0 for none).
+pub(super) fn highest_frequency(structure: &Structure) -> f64 {
+    let top = top_angular_frequency(structure);
     if top.is_finite() {
         top / std::f64::consts::TAU
     } else {

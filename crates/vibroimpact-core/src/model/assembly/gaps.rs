@@ -122,6 +122,12 @@ impl Assembly {
         }
     }
 
+    /// The gap (m) a pair `i` released at state `y` is put at: a few units of
+    /// its round-off open ([`Self::release`]).
+    pub fn released_gap(&self, i: usize, y: &[f64]) -> f64 {
+        16.0 * f64::EPSILON * self.gap_scale(i, y)
+    }
+
     /// A sticking pair `i` released: held on its wall only to round-off, it
     /// is put at rest relative to the wall (no approach left) with its gap
     /// a few units of that round-off open, along `M^-1 h^T` (the momentum
@@ -132,7 +138,7 @@ impl Assembly {
         let it = &self.interactions[i];
         let d = self.dim;
         let (gap, rate) = self.gap(i, y);
-        let opening = (16.0 * f64::EPSILON * self.gap_scale(i, y) - gap) / it.inverse_mass;
+        let opening = (self.released_gap(i, y) - gap) / it.inverse_mass;
         let lift = -rate.min(0.0) / it.inverse_mass;
         for (k, p) in it.push.iter().enumerate() {
             y[k] += p * opening;
