@@ -119,3 +119,16 @@ def test_the_command_line_refuses_a_tolerance_that_takes_any_state(
     refused(run_cli("orbit", str(path), "--tolerance", "1e300"), "--tolerance", "(0, 1)")
     text = BASE + '[continuation]\nparameter = "excitation.0.amplitude"\nstop = 9.0\n'
     assert "[continuation] tolerance: must be in (0, 1)" in parse_error(text + "tolerance = 1.0\n")
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("periods", [997, 121])
+def test_lyapunov_periods_that_split_into_no_blocks_are_refused(periods: int) -> None:
+    # A tangent-dynamics probe: --periods 997 printed "-6.90575 +- nan" (one block, no
+    # spread to take) and drew the running plot as one point.
+    system = vi.load(ROOT / "examples" / "bouncing_ball_table.toml")
+    with pytest.raises(AnalysisError, match=rf"periods: {periods} forcing periods do not split"):
+        vi.lyapunov(system, settle=0, periods=periods)
+    found = vi.lyapunov(system, settle=0, periods=periods + 3 if periods == 997 else 120)
+    assert np.all(np.isfinite(found.standard_error))
+    assert len(found.running_time) == 10

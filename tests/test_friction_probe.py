@@ -1,16 +1,23 @@
 """A friction and collision probe's findings (a new user's trial): a damper held at no
 clearance between rigid walls keeps its friction and runs, a friction stick's row has
-no restitution (it never arrived), and a study axis on a key the pair's law lacks is
-refused before any run. Independent values: the same system without friction (a damper
-held by its walls never slides, so friction does no work) and the closed form of a
-block sliding to rest."""
+no restitution (it never arrived), a study axis on a key the pair's law lacks is
+refused before any run, a damper at rest on a carrier that slides on the ground from
+the start is judged with that sliding force, and the text table reads a closed row's
+undefined value as undefined, not open. Independent values: the same system without
+friction (a damper held by its walls never slides, so friction does no work), the
+closed form of a block sliding to rest, and scipy's integration of the carrier and
+damper moving as one body."""
 
 from __future__ import annotations
 
 import math
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 import vibroimpact as vi
 from vibroimpact import study as st
@@ -126,3 +133,82 @@ def test_a_study_axis_the_pairs_law_lacks_is_refused_before_any_run(
         ValueError, match=rf"study axis .{axis}.: the pair's law has no \w+ \(.*{takes}\)"
     ):
         st.study_of(system)
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["exact", "dop853"])
+def test_a_damper_at_rest_on_a_carrier_sliding_from_the_start_sticks_as_one_body(
+    method: str,
+) -> None:
+    # At t = 0 each element at rest was judged in the rows' order: the damper's holding
+    # force without the ground's sliding force (m A / (M + m) = 0.923 N > 0.9 N), so it
+    # slid at once. With the ground sliding, one body of M + m needs only
+    # m (A - Fg) / (M + m) = 0.808 N: it sticks until that force passes 0.9 N.
+    big, small, stiffness, damping, amplitude = 1.0, 0.3, 400.0, 0.5, 4.0
+    kinetic, static, ground = 0.6, 0.9, 0.5
+    system = vi.System(
+        structure=vi.Oscillator(mass=big, stiffness=stiffness, damping=damping),
+        dampers=[
+            vi.Damper(
+                mass=small,
+                at=0,
+                lower_clearance=math.inf,
+                upper_clearance=math.inf,
+                law="rigid",
+                restitution=0.5,
+                friction=kinetic,
+                static_friction=static,
+                normal_force=1.0,
+            )
+        ],
+        frictions=[vi.Friction(at=0, coefficient=ground, static_coefficient=0.8, normal_force=1.0)],
+        excitations=[vi.Force(at=0, signal=vi.Harmonic(amplitude=amplitude, frequency=1.0))],
+    )
+
+    # The reference: one body of M + m sliding on the ground (v > 0 from the start),
+    # until the damper's share of its acceleration needs more than the static force.
+    def acceleration(t: float, y: np.ndarray) -> float:
+        force = amplitude * math.cos(2 * math.pi * t) - ground - stiffness * y[0]
+        return float((force - damping * y[1]) / (big + small))
+
+    def rates(t: float, y: np.ndarray) -> list[float]:
+        return [y[1], acceleration(t, y)]
+
+    def slips(t: float, y: np.ndarray) -> float:
+        return small * abs(acceleration(t, y)) - static
+
+    def stops(t: float, y: np.ndarray) -> float:
+        return float(y[1]) if t > 0 else 1.0
+
+    slips.terminal = True  # type: ignore[attr-defined]
+    stops.terminal = True  # type: ignore[attr-defined]
+    reference = solve_ivp(rates, (0, 1), [0.0, 0.0], events=[slips, stops], rtol=1e-12, atol=1e-14)
+    assert reference.t_events[0].size == 1, "the damper slips before the body stops"
+    slip = float(reference.t_events[0][0])
+    run = vi.simulate(system, method=method, t_end=slip + 0.01)
+    rows = [
+        i
+        for i, (pair, kind) in enumerate(zip(run.contacts.pair, run.contacts.kind, strict=True))
+        if pair == "damper 0 friction" and kind == "sticking"
+    ]
+    assert rows, run.contacts
+    assert run.contacts.onset[rows[0]] == 0.0
+    assert math.isclose(run.contacts.separation[rows[0]], slip, rel_tol=1e-6)
+
+
+@pytest.mark.timeout(60)
+def test_the_text_table_reads_a_closed_rows_undefined_value_as_undefined(
+    run_cli: Callable[..., subprocess.CompletedProcess[str]],
+) -> None:
+    # A closed sticking interval's restitution (NaN: it never arrived) read "open",
+    # which the help keeps for a contact still open at the end of the run.
+    example = Path(__file__).resolve().parents[1] / "examples" / "horizontal_friction_damper.toml"
+    result = run_cli("simulate", str(example))
+    assert result.returncode == 0, result.stderr
+    rows = [line.split() for line in result.stdout.splitlines() if "sticking" in line]
+    assert rows, result.stdout
+    for row in rows:
+        # pair (three words), kind, onset, duration, approach, restitution, dissipated
+        duration, restitution = row[5], row[7]
+        if duration != "open":
+            assert restitution == "-", row

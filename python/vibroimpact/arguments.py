@@ -49,7 +49,9 @@ def whole_range(where: str) -> tuple[int, int]:
 def integer_hint(value: Any) -> str:
     """For a whole number written as a float (61.0, as JSON, MATLAB or pandas write it),
     how to write it: TOML and Python tell an integer from a float by its decimal point."""
-    if isinstance(value, float) and value.is_integer():
+    # (Not past the largest whole number a key takes: 1e30 would be told to be written
+    # as an integer no key takes.)
+    if isinstance(value, float) and value.is_integer() and abs(value) <= LARGEST_WHOLE:
         return f" written as an integer ({int(value)}, not {value})"
     return ""
 

@@ -5,6 +5,7 @@ tables label (here, outside the analyses, which import the model that the tables
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -170,6 +171,21 @@ CONTACT_HEADERS = {
     "energy_dissipated": "dissipated (J)",
     "energy_change": "net change (J)",
 }
+
+
+def contact_cell(value: Any, still_open: bool, width: int) -> str:
+    """One cell of a printed table of contacts, right-aligned in ``width``.
+
+    A value a contact still open at the end of the run does not have yet reads ``open``;
+    one a closed contact has none of (NaN: the restitution of a sticking interval or of
+    a contact that started at rest) reads ``-``.
+    """
+    if isinstance(value, str):
+        return f"{value:>{width}}"
+    if math.isnan(value):
+        return f"{'open' if still_open else '-':>{width}}"
+    # + 0.0 turns a negative zero into a zero.
+    return f"{value + 0.0:>{width}.7g}"
 
 
 #: The SI unit of each column of a contact table (``to_pandas().attrs["units"]``; "1"

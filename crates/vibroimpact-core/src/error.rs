@@ -26,6 +26,21 @@ pub enum Error {
         "numerical blow-up at t = {time:.6e} s ({reason}); reduce dt or choose a more stable method"
     )]
     NumericalBlowUp { time: f64, reason: &'static str },
+    /// A compliant contact a fixed step cannot resolve: its law holds the
+    /// pair for `duration` (s) at its approach speed, under two steps of `dt`.
+    #[error(
+        "a contact beginning at t = {time:.6e} s at {approach:.3e} m/s lasts about {duration:.3e} s \
+         by its law, under two steps of dt = {dt} s: a fixed step cannot resolve it (its rebound \
+         and losses would be the step's); reduce dt to about {suggested:.1e} s, or use an \
+         adaptive method (dop853)",
+        suggested = .duration / 20.0
+    )]
+    UnresolvedContact {
+        time: f64,
+        approach: f64,
+        duration: f64,
+        dt: f64,
+    },
     /// Newton's method did not converge within a step of an implicit method.
     #[error("Newton iterations did not converge in the step from t = {time:.6e} s; reduce dt")]
     NewtonFailed { time: f64 },

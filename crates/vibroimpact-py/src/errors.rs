@@ -46,7 +46,9 @@ pub(crate) fn to_py(err: core::Error) -> PyErr {
     use core::Error as E;
     let message = short_numbers(&err.to_string());
     match err {
-        E::NumericalBlowUp { .. } => NumericalBlowUpError::new_err(message),
+        E::NumericalBlowUp { .. } | E::UnresolvedContact { .. } => {
+            NumericalBlowUpError::new_err(message)
+        }
         E::EnergyBalance { .. } | E::ContactEnergy { .. } => EnergyBalanceError::new_err(message),
         E::Interrupted { .. } => PyKeyboardInterrupt::new_err(message),
         E::NewtonFailed { .. }

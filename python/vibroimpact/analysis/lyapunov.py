@@ -165,5 +165,14 @@ def _check_window(run: Runner, periods: int) -> None:
 
 def _blocks(periods: int) -> int:
     """The most blocks, up to :data:`BLOCKS`, that divide ``periods`` into whole
-    forcing periods each."""
-    return next(b for b in range(min(BLOCKS, periods), 0, -1) if periods % b == 0)
+    forcing periods each; refused where only one does beyond one period (997: the
+    standard error, over blocks, would be NaN and the running plot one point)."""
+    blocks = next(b for b in range(min(BLOCKS, periods), 0, -1) if periods % b == 0)
+    if blocks == 1 and periods > 1:
+        nearest = max(BLOCKS, round(periods / BLOCKS) * BLOCKS)
+        raise AnalysisError(
+            f"periods: {periods} forcing periods do not split into 2 to {BLOCKS} blocks of "
+            f"whole periods, over which the standard error is taken; give a multiple of "
+            f"{BLOCKS} (e.g. {nearest})"
+        )
+    return blocks

@@ -53,7 +53,7 @@ from vibroimpact.scenario.system import (
     write_system_history,
 )
 from vibroimpact.scenario.two_mass import Scenario, ScenarioError, load_scenario, paper_collision
-from vibroimpact.units import CONTACT_HEADERS
+from vibroimpact.units import CONTACT_HEADERS, contact_cell
 
 HISTORY_COLUMNS = (
     ("t", "time, s"),
@@ -122,7 +122,8 @@ def _parser() -> argparse.ArgumentParser:
             f"0.3 s). In the table of contacts: {ENERGY_DISSIPATED_TEXT}. "
             f"{ENERGY_CHANGE_TEXT}. A contact still open at the end of the run shows 'open' "
             "for its separation, duration, rebound, restitution and net change (null in "
-            "--json)."
+            "--json); a value a closed contact has none of (the restitution of a sticking "
+            "interval or of a contact that started at rest) shows '-'."
         ),
     )
     simulate.add_argument("scenario", nargs="?", type=path_argument, help="scenario file (.toml)")
@@ -180,18 +181,14 @@ def contact_lines(sol: Solution) -> list[str]:
     """The text table of contacts, then what its two energy columns mean.
 
     Columns come from ``ContactTable.columns``; a value left undefined because the
-    contact is still open at the end of the run (NaN in the table) reads ``open``.
+    contact is still open at the end of the run (NaN in the table) reads ``open``, one a
+    closed contact has none of reads ``-`` (see ``units.contact_cell``).
     """
     columns = list(sol.contacts.columns)
     lines = ["  ".join(f"{CONTACT_HEADERS.get(name, name):>15}" for name in columns)]
     for row in sol.contacts.to_dicts():
         still_open = not math.isfinite(row["separation"])
-        lines.append(
-            "  ".join(
-                f"{'open':>15}" if still_open and math.isnan(row[name]) else f"{row[name]:>15.7g}"
-                for name in columns
-            )
-        )
+        lines.append("  ".join(contact_cell(row[name], still_open, 15) for name in columns))
     return [*lines, f"  {ENERGY_DISSIPATED_TEXT}", f"  {ENERGY_CHANGE_TEXT}"]
 
 

@@ -5,6 +5,7 @@ initial state, checked by the scenario format's one schema (:mod:`vibroimpact.sy
 from __future__ import annotations
 
 import copy
+import math
 import re
 import warnings
 from collections.abc import Mapping, Sequence
@@ -489,6 +490,32 @@ def _core_check(spec: dict[str, Any], initial: list[list[float]]) -> None:
     """The model's ranges and required keys, which the core holds (a damper's mass > 0, a
     frequency >= 0, a random signal's seed), and the ``initial`` state's arrays (every pair
     apart or touching), checked on the schema's ``spec`` as a run checks them: its error
-    names the key. Any run length: these checks do not depend on it."""
-    binding = {**spec, "gravity": spec["gravity"]["acceleration"], "points": [], "moments": []}
+    names the key. Any run length: these checks do not depend on it, but for a random
+    signal that lasts the run, whose samples a run of its own length counts (here it
+    lasts two of its sample intervals: a 1e8 Hz cutoff was refused as 1 s of samples
+    before any run was asked for)."""
+    excitations = [_brief_noise(excitation) for excitation in spec["excitation"]]
+    binding = {
+        **spec,
+        "excitation": excitations,
+        "gravity": spec["gravity"]["acceleration"],
+        "points": [],
+        "moments": [],
+    }
     PreparedSystem(binding, t_end=1.0, initial=initial)
+
+
+def _brief_noise(excitation: dict[str, Any]) -> dict[str, Any]:
+    """``excitation`` with a random signal that lasts the run (no ``duration``) made to
+    last two of its sample intervals (``1 / cutoff_frequency``), where its cutoff is a
+    positive number (else left to be refused by name)."""
+    cutoff = excitation.get("cutoff_frequency")
+    if (
+        excitation.get("signal") not in ("white-noise", "kanai-tajimi")
+        or "duration" in excitation
+        or not isinstance(cutoff, int | float)
+        or isinstance(cutoff, bool)
+        or not 0 < cutoff < math.inf
+    ):
+        return excitation
+    return {**excitation, "duration": 1.0 / cutoff}

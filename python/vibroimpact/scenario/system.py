@@ -29,7 +29,7 @@ from vibroimpact.system import (
     structure_coordinates,
 )
 from vibroimpact.system.parameter_keys import check_parameter_keys
-from vibroimpact.units import CONTACT_HEADERS
+from vibroimpact.units import CONTACT_HEADERS, contact_cell
 
 SECTIONS = (*RUN_SECTIONS, *ANALYSIS_SECTIONS)
 
@@ -291,15 +291,6 @@ def system_lines(
         ]
         lines.append("  ".join(f"{CONTACT_HEADERS.get(h, h):>17}" for h in head))
         for row in sol.contacts.to_dicts():
-            cells = []
-            for h in head:
-                value = row[h]
-                if isinstance(value, str):
-                    cells.append(f"{value:>17}")
-                elif math.isnan(value):
-                    cells.append(f"{'open':>17}")
-                else:
-                    # + 0.0 turns a negative zero into a zero.
-                    cells.append(f"{value + 0.0:>17.7g}")
-            lines.append("  ".join(cells))
+            still_open = not math.isfinite(row["separation"])
+            lines.append("  ".join(contact_cell(row[h], still_open, 17) for h in head))
     return lines

@@ -346,10 +346,15 @@ def _value(where: str, kind: str, value: Any) -> Any:
         return number
     if kind == _WHOLE:
         whole = real(value)
+        low, high = whole_range(where)
+        if isinstance(whole, float) and whole.is_integer() and abs(whole) >= 2**63:
+            # A whole number no integer key takes (1e19, 1e30).
+            raise _fail(
+                where, f"must be a whole number in {shown_range(low, high)}, got {shown(value)}"
+            )
         if not isinstance(whole, int):
             # The key's own range, if any, is checked after (modes: [1, 200]).
             raise _fail(where, f"must be a whole number{integer_hint(whole)}, got {shown(value)}")
-        low, high = whole_range(where)
         if not low <= whole < 2**63:  # above high and below 2^63: the key's own check
             raise _fail(
                 where, f"must be a whole number in {shown_range(low, high)}, got {shown(value)}"

@@ -42,6 +42,7 @@ fn bad_step(e: &Error) -> bool {
         || matches!(
             e,
             Error::NumericalBlowUp { .. }
+                | Error::UnresolvedContact { .. }
                 | Error::NewtonFailed { .. }
                 | Error::Chattering { .. }
                 | Error::StepSizeTooSmall { .. }
@@ -257,6 +258,22 @@ fn newton(
             let trial: Vec<f64> = z.iter().zip(&step).map(|(z, s)| z + factor * s).collect();
             maps += 1;
             match by.map(&trial) {
+                // A step far beyond the motion whose residual grows as far is
+                // a diverging iteration (a hertz damper's iterates reached
+                // 6.6e4 m/s, each map a run of seconds, then minutes):
+                // shortened as a step a map refuses.
+                Ok(next) if diverges((&z, &trial), (&next, &scale), residual) => {
+                    if factor > 1e-6 {
+                        factor *= 0.5;
+                        continue;
+                    }
+                    refusal = Some(
+                        "every fraction of the Newton step took the state ten times beyond the \
+                         motion, its residual ten times further: the iteration diverges"
+                            .to_string(),
+                    );
+                    break true;
+                }
                 Ok(next) => {
                     z = trial;
                     image = next;
@@ -294,6 +311,26 @@ fn newton(
         maps,
         refusal,
     })
+}
+
+/// How far beyond the motion (and its residual) a Newton step diverges.
+const DIVERGING: f64 = 10.0;
+
+/// Whether the Newton step from `z` to `trial` (its image `next`) diverges:
+/// its largest coordinate beyond [`DIVERGING`] times the motion's size
+/// (`scale`, per coordinate, as the residual takes it) and its residual in
+/// that scale beyond [`DIVERGING`] times `residual`, the iterate's.
+fn diverges((z, trial): (&[f64], &[f64]), (next, scale): (&[f64], &[f64]), residual: f64) -> bool {
+    let beyond = |values: &[f64]| {
+        values
+            .iter()
+            .zip(scale)
+            .map(|(v, s)| v.abs() / s)
+            .fold(0.0f64, f64::max)
+    };
+    let far = beyond(trial) > DIVERGING * beyond(z).max(1.0);
+    let missed: Vec<f64> = next.iter().zip(trial).map(|(n, t)| n - t).collect();
+    far && beyond(&missed) > DIVERGING * residual
 }
 
 /// Relative disagreement of the one-sided differences beyond which a column's

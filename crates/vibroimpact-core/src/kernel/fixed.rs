@@ -25,6 +25,7 @@
 use crate::error::{Error, Result};
 use crate::kernel::clock::Stop;
 use crate::kernel::contact_balance::OnsetBalance;
+use crate::kernel::contacts::check_resolved;
 use crate::kernel::events::{ContactKind, ContactTiming, Open, Stepping};
 use crate::kernel::run::Run;
 use crate::methods::steppers::SystemStepper;
@@ -353,6 +354,7 @@ impl Run<'_> {
                     } else {
                         t1
                     };
+                    check_resolved(self.contact_step, system, i, (onset, rate))?;
                     let power = dissipation(system, i, &self.end, rate);
                     let p_onset = damping * rate * rate;
                     self.modes[i] = Mode::Compliant {

@@ -83,7 +83,12 @@ impl Run<'_> {
                     }
                     _ => {}
                 },
-                _ => self.stick_or_slide(i, time),
+                // Held for now: which of the elements at rest slide is
+                // decided with all of them in place (below), not one by
+                // one in the rows' order (a damper judged before the
+                // ground's element it rides on would be judged without
+                // that element's sliding force).
+                _ => self.stick(i, time),
             }
         }
         self.release_overloaded(time);
@@ -165,6 +170,17 @@ impl Run<'_> {
     /// that holds it there is within its static force, else sliding the way
     /// that force would not hold it.
     fn stick_or_slide(&mut self, i: usize, time: f64) {
+        self.stick(i, time);
+        let force = self.holding_force(i, time);
+        if force.abs() > self.system.static_force(i) {
+            self.slide(i, time, -force.signum());
+        }
+    }
+
+    /// Friction element `i`, at rest to round-off, stuck at its place (its
+    /// speed set to zero by the least change of the velocities), a stuck
+    /// interval begun where it was not stuck.
+    fn stick(&mut self, i: usize, time: f64) {
         let system = self.system;
         let it = &system.interactions[i];
         let d = system.dim;
@@ -180,23 +196,18 @@ impl Run<'_> {
             offset: -h_dot(&it.h, &self.y[..d]),
             shadowed: self.shadowed(i),
         };
-        let force = self.holding_force(i, time);
-        if force.abs() <= system.static_force(i) {
-            if !matches!(was, Mode::Stuck { .. }) || self.open[i].is_none() {
-                self.open[i] = Some(Open {
-                    kind: ContactKind::Sticking,
-                    onset: time,
-                    approach_speed: 0.0,
-                    max_indentation: 0.0,
-                    dissipated: 0.0,
-                    resting: true,
-                    balance: OnsetBalance::default(),
-                    energy: f64::NAN,
-                    power: 0.0,
-                });
-            }
-        } else {
-            self.slide(i, time, -force.signum());
+        if !matches!(was, Mode::Stuck { .. }) || self.open[i].is_none() {
+            self.open[i] = Some(Open {
+                kind: ContactKind::Sticking,
+                onset: time,
+                approach_speed: 0.0,
+                max_indentation: 0.0,
+                dissipated: 0.0,
+                resting: true,
+                balance: OnsetBalance::default(),
+                energy: f64::NAN,
+                power: 0.0,
+            });
         }
     }
 

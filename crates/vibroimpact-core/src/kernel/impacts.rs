@@ -64,13 +64,16 @@ impl Default for Squeeze {
 }
 
 impl Squeeze {
-    /// After an event (`rigid`: one the rigid pairs' problem resolved)
+    /// After an event at `time` (`rigid`: one the rigid pairs' problem resolved)
     /// `interval` s after the last, in a run of `resolution` s. Shorter than
     /// the longer of the two before it by a margin (equal flights, an
     /// elastic rattle, are no collapse), it closes in.
-    pub(crate) fn after(&mut self, rigid: bool, interval: f64, resolution: f64) {
+    pub(crate) fn after(&mut self, rigid: bool, (time, interval): (f64, f64), resolution: f64) {
         let before = self.intervals[0].max(self.intervals[1]);
-        let closing = rigid && interval < resolution && interval < 0.999 * before;
+        // Events at one instant to the time's round-off close in too (their
+        // intervals, zero or an ulp, can shrink no further).
+        let instant = interval <= 8.0 * f64::EPSILON * time.abs();
+        let closing = rigid && interval < resolution && (interval < 0.999 * before || instant);
         self.shrinking = if closing { self.shrinking + 1 } else { 0 };
         self.intervals = [self.intervals[1], interval];
     }

@@ -105,6 +105,9 @@ pub(super) struct Run<'a> {
     pub(super) last_poll: std::time::Instant,
     /// Fixed stepping's timing of contacts (None: stepping by events).
     pub(super) timing: Option<ContactTiming>,
+    /// The fixed step that must resolve each compliant contact (None for an
+    /// adaptive method or the exact flow), s.
+    pub(super) contact_step: Option<f64>,
     /// Whether the method creates energy at contacts by construction (see
     /// [`SystemStepper::creates_contact_energy`]).
     pub(super) creates_contact_energy: bool,

@@ -242,6 +242,7 @@ impl<'a> Run<'a> {
             stretches: !adaptive && stepper.takes_stretches(system, timing.is_some()),
             timing,
             creates_contact_energy: stepper.creates_contact_energy(),
+            contact_step: (!adaptive && !stepper.is_exact()).then_some(dt),
             changes: vec![None; count],
             closing: vec![None; count],
             all_compliant: all_compliant(system),

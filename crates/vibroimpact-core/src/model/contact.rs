@@ -572,6 +572,28 @@ impl AnyLaw {
         }
     }
 
+    /// How long (s) the law's elastic force holds two free bodies of
+    /// effective mass `effective_mass` (kg) that meet at `approach` (m/s):
+    /// `pi sqrt(m / k)` for the linear law, `2.9433 delta_max / approach`
+    /// for a Hertz law (Goldsmith's, `delta_max = (5 m v^2 / 4 k)^(2/5)`);
+    /// infinite for bodies that do not approach. A damped law's contact is
+    /// of the same scale: what a fixed step has to resolve.
+    pub fn impact_duration(&self, effective_mass: f64, approach: f64) -> f64 {
+        if approach.is_nan() || approach <= 0.0 {
+            return f64::INFINITY;
+        }
+        match self {
+            AnyLaw::Hertz(Hertz { stiffness })
+            | AnyLaw::HysterHertz(HysterHertz { stiffness, .. }) => {
+                let deepest = (1.25 * effective_mass * approach * approach / stiffness).powf(0.4);
+                crate::model::closed_forms::HERTZ_DURATION_CONSTANT * deepest / approach
+            }
+            AnyLaw::Linear(Linear { stiffness }) => {
+                std::f64::consts::PI * (effective_mass / stiffness).sqrt()
+            }
+        }
+    }
+
     /// The rate latched at the onset of a contact that approaches at
     /// `approach` (m/s) with `pressing` (m/s^2, > 0 pressing the bodies
     /// together) on the effective mass `effective_mass` (kg): the approach,

@@ -131,7 +131,7 @@ fn noise_grid(intensity: f64, cutoff_frequency: f64, duration: f64) -> Result<(f
     let count = (duration / interval).ceil() + 1.0;
     if count.is_nan() || count > MAX_SIGNAL_SAMPLES as f64 {
         return Err(Error::Inconsistent(format!(
-            "a random signal of duration {duration} s and cutoff_frequency {cutoff} Hz needs {count:.3e} samples; \
+            "a random signal of duration {duration} s and cutoff_frequency {cutoff} Hz needs {count:.0} samples; \
              at most {MAX_SIGNAL_SAMPLES} are allowed: lower the cutoff or the duration"
         )));
     }

@@ -273,13 +273,25 @@ pub(super) fn highest_frequency(structure: &Structure) -> f64 {
 /// 1.5 steps had run, grown by 1e63 and stopped on the energy check.)
 const EXPLICIT_STEPS_PER_PERIOD: f64 = std::f64::consts::PI / std::f64::consts::SQRT_2;
 
+/// The fewest steps a mode-stepped method takes in a period of the fastest
+/// natural mode: the exact flow an eighth of it at most (its cubic event
+/// search's step), an adaptive method at least one.
+fn steps_per_period(spec: &MethodSpec) -> f64 {
+    if spec.kind == Kind::Exact {
+        8.0
+    } else {
+        1.0
+    }
+}
+
 /// Whether a run of `spec` and `plan` resolves a fastest mode of `frequency`.
 fn resolves(spec: &MethodSpec, plan: &RunPlan, frequency: f64) -> bool {
     let explicit = spec.kind == Kind::Explicit;
     if explicit && frequency * EXPLICIT_STEPS_PER_PERIOD * plan.dt.unwrap_or(0.0) > 1.0 {
         return false;
     }
-    !(spec.kind.is_mode_stepped() && plan.t_end * frequency > plan.max_steps as f64)
+    let steps = plan.t_end * frequency * steps_per_period(spec);
+    !(spec.kind.is_mode_stepped() && steps > plan.max_steps as f64)
 }
 
 /// Refuse a run that cannot resolve the structure's fastest mode: an
@@ -322,18 +334,19 @@ fn check_natural_period(
             python_g3(period / 20.0)
         )));
     }
-    let steps = plan.t_end * frequency;
-    if spec.kind.is_mode_stepped() && steps > plan.max_steps as f64 {
+    let (periods, per_period) = (plan.t_end * frequency, steps_per_period(spec));
+    if spec.kind.is_mode_stepped() && periods * per_period > plan.max_steps as f64 {
         return Err(Error::Inconsistent(format!(
             "[solver] t_end = {} s spans {} periods of the fastest mode ({} Hz), and {} steps at \
-             least once in each: more than max_steps ({}); shorten t_end below {} s, raise \
+             least {} in each: more than max_steps ({}); shorten t_end below {} s, raise \
              max_steps, or check mass and stiffness",
             python_repr(plan.t_end),
-            python_g3(steps),
+            python_g3(periods),
             python_g3(frequency),
             spec.name,
+            times(per_period),
             plan.max_steps,
-            python_g3(plan.max_steps as f64 / frequency)
+            python_g3(plan.max_steps as f64 / (frequency * per_period))
         )));
     }
     Ok(())
@@ -370,6 +383,15 @@ fn check_forcing_steps(spec: &MethodSpec, plan: &RunPlan, forcing: &[(usize, f64
         }
     }
     Ok(())
+}
+
+/// "once", or "8 times".
+fn times(count: f64) -> String {
+    if count == 1.0 {
+        "once".to_string()
+    } else {
+        format!("{count} times")
+    }
 }
 
 /// Rust's exponent (`1e8`, `1e-5`) as Python writes it (`1e+08`, `1e-05`),

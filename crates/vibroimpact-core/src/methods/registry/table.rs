@@ -149,7 +149,8 @@ pub const MAX_STEPS: OptionSpec = OptionSpec {
     name: "max_steps",
     default: Some(1e9),
     low: 1.0,
-    high: u64::MAX as f64,
+    // 2^63 - 1, as the scenarios and Python take it (rounded to 2^63).
+    high: i64::MAX as f64,
     low_open: false,
     allowed: "a whole number >= 1",
 };

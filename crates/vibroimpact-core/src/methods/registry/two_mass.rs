@@ -8,7 +8,7 @@ pub use settings::*;
 
 use crate::error::Result;
 use crate::kernel::events::SystemSolution;
-use crate::methods::registry::{AnyStepper, Options};
+use crate::methods::registry::{check_steps_resolve, AnyStepper, Options};
 use crate::model::contact::Contact;
 use crate::model::impact_damper::{ImpactDamper, State};
 
@@ -54,6 +54,11 @@ pub fn simulate(
     )?;
     let settings = &settings.checked()?;
     start.check_apart(system.clearance)?;
+    // The system's own limits: an explicit step over the main mass's period
+    // (it had blown up, a NumericalBlowUp, where the same structure as a
+    // system was refused up front).
+    let run = settings.run_options();
+    check_steps_resolve(&system.spec(contact)?, settings.method.name(), run.dt)?;
     let assembly = system.assembly(contact)?;
     let y0 = start.vector(&assembly)?;
     let mut stepper = AnyStepper::new(
@@ -61,11 +66,5 @@ pub fn simulate(
         settings.method.name(),
         &options_of(&settings.method),
     )?;
-    stepper.integrate_stepped(
-        &assembly,
-        &y0,
-        &settings.run_options(),
-        settings.kernel_stepping(),
-        interrupt,
-    )
+    stepper.integrate_stepped(&assembly, &y0, &run, settings.kernel_stepping(), interrupt)
 }
