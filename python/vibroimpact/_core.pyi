@@ -334,6 +334,7 @@ class PreparedSystem:
         *,
         record_from: float | None = None,
         strobe_period: float | None = None,
+        carried: list[list[float] | None] | None = None,
     ) -> dict[str, Any]: ...
     def shoot(
         self,

@@ -19,17 +19,7 @@ use vibroimpact_core::model::signals::{Signal, SweepLaw};
 use vibroimpact_core::model::structure::Structure;
 
 fn spec(structure: Structure) -> SystemSpec {
-    SystemSpec {
-        structure,
-        dampers: vec![],
-        collisions: vec![],
-        frictions: vec![],
-        stops: vec![],
-        gravity: 0.0,
-        excitations: vec![],
-        points: vec![],
-        moments: vec![],
-    }
+    SystemSpec::of(structure, vec![])
 }
 
 fn exact(

@@ -49,18 +49,11 @@ fn exact_w(t: f64) -> f64 {
 fn max_error(method: Method, dt: f64) -> f64 {
     let structure = Structure::oscillator(MAIN_MASS, STIFFNESS, DAMPING).unwrap();
     let spec = SystemSpec {
-        structure,
-        dampers: vec![],
-        collisions: vec![],
-        frictions: vec![],
-        stops: vec![],
-        gravity: 0.0,
         excitations: vec![Excitation {
             load: Load::Force { at: 0.0 },
             signal: Signal::harmonic(FORCE.amplitude, FORCE.frequency / TAU, 0.0).unwrap(),
         }],
-        points: vec![],
-        moments: vec![],
+        ..SystemSpec::of(structure, vec![])
     };
     let system = Assembly::new(&spec).unwrap();
     let (q_re, q_im) = steady_amplitude();

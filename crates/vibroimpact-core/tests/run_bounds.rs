@@ -20,7 +20,6 @@ use vibroimpact_core::MAX_RECORD_BYTES;
 /// 1 + 2 (40 + 1) = 83 values.
 fn beam() -> (Assembly, Vec<f64>) {
     let spec = SystemSpec {
-        structure: Structure::cantilever(1.0, 2.0e5, 1e-8, 1.0, 40, 0.01).unwrap(),
         dampers: vec![Damper {
             mass: 0.01,
             at: 1.0,
@@ -28,13 +27,10 @@ fn beam() -> (Assembly, Vec<f64>) {
             upper_clearance: 1e-3,
             law: PairLaw::Compliant(Contact::new(LawKind::Hertz, 1e5, None, 0.0).unwrap()),
         }],
-        collisions: vec![],
-        frictions: vec![],
-        stops: vec![],
-        gravity: 0.0,
-        excitations: vec![],
-        points: vec![],
-        moments: vec![],
+        ..SystemSpec::of(
+            Structure::cantilever(1.0, 2.0e5, 1e-8, 1.0, 40, 0.01).unwrap(),
+            vec![],
+        )
     };
     let system = Assembly::new(&spec).unwrap();
     let mut v = vec![0.0; 40];

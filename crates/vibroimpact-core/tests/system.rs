@@ -30,17 +30,7 @@ fn options(dt: Option<f64>, t_end: f64) -> RunOptions {
 }
 
 fn spec(structure: Structure) -> SystemSpec {
-    SystemSpec {
-        structure,
-        dampers: vec![],
-        collisions: vec![],
-        frictions: vec![],
-        stops: vec![],
-        gravity: 0.0,
-        excitations: vec![],
-        points: vec![],
-        moments: vec![],
-    }
+    SystemSpec::of(structure, vec![])
 }
 
 fn run(spec: &SystemSpec, y0: &[Vec<f64>; 4], method: &str, dt: f64, t_end: f64) -> SystemSolution {

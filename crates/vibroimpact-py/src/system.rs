@@ -11,7 +11,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::kernel::events::{RunOptions, Stepping};
+use vibroimpact_core::kernel::events::{CarriedContact, RunOptions, Stepping};
 use vibroimpact_core::kernel::reductions::ReduceOptions;
 use vibroimpact_core::methods::registry::{
     check_settings, AnyStepper, Options, DEFAULT_MAX_ROWS, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE,
@@ -95,14 +95,14 @@ impl Ready {
     fn run(
         &mut self,
         py: Python<'_>,
-        y0: &[f64],
+        start: (&[f64], &[Option<CarriedContact>]),
         t_end: f64,
         history: (bool, u64),
         record_from: Option<f64>,
         strobe_period: Option<f64>,
     ) -> PyResult<core::kernel::events::SystemSolution> {
         released(py, |interrupt| {
-            self.integrate(y0, t_end, history, record_from, strobe_period, interrupt)
+            self.integrate(start, t_end, history, record_from, strobe_period, interrupt)
         })
     }
 
@@ -134,10 +134,11 @@ impl Ready {
         }
     }
 
-    /// Integrate from `y0` (the caller holds no GIL).
+    /// Integrate from `y0`, continuing the contacts `carried` (the caller
+    /// holds no GIL).
     fn integrate(
         &mut self,
-        y0: &[f64],
+        start: (&[f64], &[Option<CarriedContact>]),
         t_end: f64,
         history: (bool, u64),
         record_from: Option<f64>,
@@ -148,7 +149,7 @@ impl Ready {
         let (system, stepping) = (&self.system, self.limits.stepping);
         // The registry's run, which gives an energy error its method's advice.
         self.stepper
-            .integrate_stepped(system, y0, &options, stepping, interrupt)
+            .integrate_continued(system, start, &options, stepping, interrupt)
     }
 
     /// The full state of the flat state `z` (x then v).
@@ -190,7 +191,7 @@ impl Ready {
         let (n, d) = (self.system.n, self.system.dim);
         let y0 = resumed_state(&self.system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..]])?;
         Ok(self
-            .integrate(&y0, t_end, (false, 1), None, None, interrupt)?
+            .integrate((&y0, &[]), t_end, (false, 1), None, None, interrupt)?
             .final_state)
     }
 }
@@ -283,8 +284,13 @@ impl PreparedSystem {
 
     /// Run from the flat state `x` then `v` (the structure's coordinates, then
     /// the dampers') for `t_end` s, keeping no history: a dict as
-    /// `simulate_system` returns.
-    #[pyo3(signature = (state, t_end, *, record_from=None, strobe_period=None))]
+    /// `simulate_system` returns, with `open_contacts` (per interaction, None
+    /// or the compliant contact open at the end: `[approach_rate (m/s),
+    /// onset (s), approach_speed (m/s), max_indentation (m)]`). `carried`:
+    /// the `open_contacts` of the run this one continues from its final
+    /// state, onsets shifted by its `-final_time` (None: contacts in
+    /// progress at the start begin there).
+    #[pyo3(signature = (state, t_end, *, record_from=None, strobe_period=None, carried=None))]
     fn run<'py>(
         &self,
         py: Python<'py>,
@@ -292,6 +298,7 @@ impl PreparedSystem {
         #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
         #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
         #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
+        carried: Option<Vec<Option<[f64; 4]>>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let mut ready = self.locked(Some(&state))?;
         let system = &ready.system;
@@ -310,7 +317,13 @@ impl PreparedSystem {
             [&state[..n], &state[d..d + n], &state[n..d], &state[d + n..]],
         )
         .map_err(to_py)?;
-        let sol = ready.run(py, &y0, t_end, (false, 1), record_from, strobe_period)?;
+        let carried: Vec<Option<CarriedContact>> = carried
+            .unwrap_or_default()
+            .into_iter()
+            .map(|c| c.map(crate::convert::carried_contact))
+            .collect();
+        let start = (&y0[..], &carried[..]);
+        let sol = ready.run(py, start, t_end, (false, 1), record_from, strobe_period)?;
         solution_dict(py, &ready.system, sol)
     }
 
@@ -442,7 +455,15 @@ pub fn simulate_system<'py>(
     )?;
     let mut ready = Ready::new(spec, method, t_end, &options, limits)?;
     let y0 = start_of(&ready.system, &initial)?;
-    let sol = ready.run(py, &y0, t_end, (history, every), record_from, strobe_period)?;
+    let start = (&y0[..], &[][..]);
+    let sol = ready.run(
+        py,
+        start,
+        t_end,
+        (history, every),
+        record_from,
+        strobe_period,
+    )?;
     solution_dict(py, &ready.system, sol)
 }
 
@@ -515,6 +536,12 @@ fn solution_dict<'py>(
     out.set_item("recorded_time", r.recorded_time)?;
     out.set_item("strobe", r.strobe.into_pyarray(py))?;
     out.set_item("strobe_time", r.strobe_time.into_pyarray(py))?;
+    let open: Vec<Option<[f64; 4]>> = sol
+        .open_contacts
+        .iter()
+        .map(|c| c.map(crate::convert::carried_values))
+        .collect();
+    out.set_item("open_contacts", open)?;
     Ok(out)
 }
 

@@ -50,7 +50,7 @@ from vibroimpact.analysis.located import (
 )
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import shifted, with_parameter
-from vibroimpact.analysis.runs import Runner, runner, state_arrays
+from vibroimpact.analysis.runs import Runner, _impacts, runner, state_arrays
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
@@ -385,8 +385,7 @@ class _Arc:
         multipliers = self.multipliers_of(jac)
         run = self.run_at(p)
         recorded = run.periods(z, self.periods, record=True)
-        kinds = recorded["contacts"]["kind"]
-        impacts = sum(1 for kind in kinds if kind in ("impact", "compliant")) / self.periods
+        impacts = _impacts(recorded) / self.periods
         return BranchPoint(
             value=p,
             state=self.at_zero(run, z),

@@ -199,7 +199,8 @@ def struck(run: Runner, state: np.ndarray, periods: int) -> set[str]:
     hit: set[str] = set()
     for p, kind, onset in zip(contacts["pair"], contacts["kind"], contacts["onset"], strict=True):
         name = names[p]
-        if kind not in ("impact", "compliant"):
+        # A contact carried from the run before (onset < 0) strikes again later.
+        if kind not in ("impact", "compliant") or onset < 0.0:
             continue
         if _kind(name) != "damper":
             hit.add(name)

@@ -27,6 +27,7 @@ from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import (
     Runner,
     as_runner,
+    begun,
     check_kept,
     checked_run,
     failed_everywhere,
@@ -112,8 +113,10 @@ def _impact_samples(
     names = list(raw["pairs"])
     chosen = np.array(
         [
-            kind in ("impact", "compliant") and (pair is None or names[index] == pair)
-            for kind, index in zip(contacts["kind"], contacts["pair"], strict=True)
+            new and kind in ("impact", "compliant") and (pair is None or names[index] == pair)
+            for kind, index, new in zip(
+                contacts["kind"], contacts["pair"], begun(contacts), strict=True
+            )
         ],
         dtype=bool,
     )

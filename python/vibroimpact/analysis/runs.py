@@ -73,6 +73,11 @@ class Runner:
     k: int = 0
     runs: int = 0
     _prepared_system: PreparedSystem | None = field(default=None, repr=False)
+    #: The compliant contacts open at the end of the last runs, by the bytes of
+    #: their final states: a run continued from one of them continues them (its
+    #: onset and a damped law's latched approach rate, which (x, v) do not
+    #: hold) rather than beginning them afresh, counted twice.
+    _carried: dict[bytes, list[Any]] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         self.n = structure_coordinates(self.prepared.spec["structure"])
@@ -128,12 +133,14 @@ class Runner:
             raise AnalysisError(
                 f"state: must have {2 * (self.n + self.k)} values (x then v), got {len(z)}"
             )
+        z = np.asarray(z, dtype=float)
         try:
             raw = self.system().run(
-                np.asarray(z, dtype=float).tolist(),
+                z.tolist(),
                 t_end,
                 record_from=0.0 if record else None,
                 strobe_period=self.period if strobe else None,
+                carried=self._carried.get(z.tobytes()),
             )
         except SimulationError as err:
             if "max_rows" not in str(err):
@@ -146,7 +153,18 @@ class Runner:
                 "fewer periods, or raise max_rows"
             ) from None
         self.runs += 1
+        self._carry(raw)
         return raw
+
+    def _carry(self, raw: Mapping[str, Any]) -> None:
+        """Keep the contacts ``raw`` left open, for a run from its final state."""
+        open_contacts = raw["open_contacts"]
+        if len(self._carried) >= CARRIED_STATES:
+            del self._carried[next(iter(self._carried))]
+        end = float(raw["final_time"])
+        shifted = [None if c is None else [c[0], c[1] - end, c[2], c[3]] for c in open_contacts]
+        final = np.asarray(raw["final_state"], dtype=float)
+        self._carried[final.tobytes()] = shifted
 
     def system(self) -> PreparedSystem:
         """The core's checked system with its method (made once)."""
@@ -309,9 +327,24 @@ def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Ru
     return Runner(prepared, period)
 
 
+#: The final states whose open contacts a :class:`Runner` keeps.
+CARRIED_STATES = 8
+
+
+def begun(contacts: Mapping[str, Any]) -> np.ndarray:
+    """Which of a run's ``contacts`` began in it: not those it continued from the
+    run before (their onsets < 0)."""
+    return np.asarray(contacts["onset"], dtype=float) >= 0.0
+
+
 def _impacts(raw: Mapping[str, Any]) -> int:
-    kinds = raw["contacts"]["kind"]
-    return sum(1 for kind in kinds if kind in ("impact", "compliant"))
+    """The impacts and compliant contacts that began in the run ``raw``."""
+    contacts = raw["contacts"]
+    return sum(
+        1
+        for kind, new in zip(contacts["kind"], begun(contacts), strict=True)
+        if new and kind in ("impact", "compliant")
+    )
 
 
 #: The forcing periods a long recording's first stretch runs to estimate its contacts

@@ -33,6 +33,7 @@ def _recorded_by_period(
     squares: Any = 0.0
     time = 0.0
     kinds: list[str] = []
+    onsets: list[float] = []
     z = state
     for _ in range(count):
         raw = run._periods(z, 1, record=True)
@@ -40,6 +41,7 @@ def _recorded_by_period(
         squares = squares + np.asarray(raw["square_integrals"], dtype=float)
         time += float(raw["recorded_time"])
         kinds += list(raw["contacts"]["kind"])
+        onsets += list(raw["contacts"]["onset"])
         z = np.asarray(raw["final_state"], dtype=float)
     rows = np.array(peaks)
     with warnings.catch_warnings():
@@ -49,7 +51,7 @@ def _recorded_by_period(
         "peaks": largest,
         "square_integrals": squares,
         "recorded_time": time,
-        "contacts": {"kind": kinds},
+        "contacts": {"kind": kinds, "onset": onsets},
         "final_state": z,
     }
     return merged, least

@@ -8,7 +8,7 @@
 use crate::error::{Error, Result};
 use crate::kernel::clock::CHATTER_EVENTS;
 use crate::kernel::contact_balance::OnsetBalance;
-use crate::kernel::events::{ContactKind, Open};
+use crate::kernel::events::{CarriedContact, ContactKind, Open};
 use crate::kernel::impacts;
 use crate::kernel::locate::{any_compliant, crossed, event_value_from};
 use crate::kernel::observe::EventView;
@@ -492,6 +492,26 @@ impl Run<'_> {
             oc.max_indentation = oc.max_indentation.max(deepest);
         }
         Ok(used)
+    }
+
+    /// The compliant contacts open now, for a run continued from here
+    /// ([`crate::kernel::events::SystemSolution::open_contacts`]).
+    pub(super) fn open_contacts(&self) -> Vec<Option<CarriedContact>> {
+        let carried = |(record, mode): (&Option<Open>, &Mode)| match (record, mode) {
+            (Some(oc), Mode::Compliant { approach_rate, .. })
+                if oc.kind == ContactKind::Compliant =>
+            {
+                Some(CarriedContact {
+                    approach_rate: *approach_rate,
+                    onset: oc.onset,
+                    // A contact begun at rest had no approach to rebound from.
+                    approach_speed: if oc.resting { 0.0 } else { oc.approach_speed },
+                    max_indentation: oc.max_indentation,
+                })
+            }
+            _ => None,
+        };
+        self.open.iter().zip(&self.modes).map(carried).collect()
     }
 
     /// The records of the contacts still open at the end (NaN separation).

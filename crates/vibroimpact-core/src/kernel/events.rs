@@ -200,6 +200,60 @@ pub struct PairContact {
     pub energy_change: f64,
 }
 
+/// A compliant contact open at a run's end, carried into a run continued
+/// from its final state: what the state `(x, v)` alone does not hold (a
+/// damped law's latched approach rate, the contact's onset), without which
+/// the continued run would begin the contact afresh (counted twice, a
+/// Hunt-Crossley force latched at the indentation rate of mid-contact).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CarriedContact {
+    /// The law's latched approach rate, m/s (> 0).
+    pub approach_rate: f64,
+    /// The onset, s, in the continued run's time (<= 0).
+    pub onset: f64,
+    /// The approach speed at the onset, m/s.
+    pub approach_speed: f64,
+    /// The deepest indentation so far, m.
+    pub max_indentation: f64,
+}
+
+impl CarriedContact {
+    /// Refuses carried contacts no run of `count` interactions could have
+    /// left: one per interaction (or none), each as [`Self::check`].
+    pub fn check_all(carried: &[Option<Self>], count: usize) -> Result<()> {
+        if !carried.is_empty() && carried.len() != count {
+            return Err(Error::Inconsistent(format!(
+                "the carried contacts must be one per interaction ({count}), got {}",
+                carried.len()
+            )));
+        }
+        for (i, contact) in carried.iter().enumerate() {
+            contact.map(|c| c.check(i)).transpose()?;
+        }
+        Ok(())
+    }
+
+    /// Refuses a carried contact no run could have left, naming its
+    /// interaction `i`.
+    pub fn check(&self, i: usize) -> Result<()> {
+        let fine = self.approach_rate.is_finite()
+            && self.approach_rate > 0.0
+            && self.onset.is_finite()
+            && self.onset <= 0.0
+            && self.approach_speed.is_finite()
+            && self.approach_speed >= 0.0
+            && self.max_indentation.is_finite()
+            && self.max_indentation >= 0.0;
+        if fine {
+            return Ok(());
+        }
+        Err(Error::Inconsistent(format!(
+            "carried contact {i}: approach_rate must be finite and > 0, onset finite and <= 0 s, \
+             approach_speed and max_indentation finite and >= 0, got {self:?}"
+        )))
+    }
+}
+
 /// What a run returns.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemSolution {
@@ -232,6 +286,10 @@ pub struct SystemSolution {
     /// (its law's and its contact damper's, N, > 0 pushing it apart; 0
     /// apart), row after row.
     pub contact_forces: Vec<f64>,
+    /// Per interaction, its compliant contact still open at the end, onset
+    /// in this run's time (shift it by `-final_time` to continue a run from
+    /// `final_state`: [`integrate_system_continued`]); None where open.
+    pub open_contacts: Vec<Option<CarriedContact>>,
 }
 
 /// A contact being followed.
@@ -392,7 +450,32 @@ pub fn integrate_system_stepped<S: SystemStepper>(
     interrupt: &mut dyn FnMut() -> bool,
     record_limit: u64,
 ) -> Result<SystemSolution> {
-    let mut run = Run::new(system, stepper, initial, options, stepping, record_limit)?;
+    let carried = &[];
+    integrate_system_continued(
+        system,
+        stepper,
+        (initial, carried),
+        options,
+        stepping,
+        interrupt,
+        record_limit,
+    )
+}
+
+/// [`integrate_system_stepped`] continuing another run from its final
+/// state, the compliant contacts it left open `carried` (per interaction,
+/// or empty for none: see [`SystemSolution::open_contacts`]).
+pub fn integrate_system_continued<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    (initial, carried): (&[f64], &[Option<CarriedContact>]),
+    options: &RunOptions,
+    stepping: Stepping,
+    interrupt: &mut dyn FnMut() -> bool,
+    record_limit: u64,
+) -> Result<SystemSolution> {
+    let start = (initial, carried);
+    let mut run = Run::new(system, stepper, start, options, stepping, record_limit)?;
     if run.timing.is_some() {
         while run.clock.time < options.t_end {
             if run.stretches && run.clock.accepted > 0 && run.fast_steps(stepper, interrupt)? {
@@ -424,7 +507,8 @@ pub fn integrate_system_observed<S: SystemStepper>(
     observer: &mut dyn EventObserver,
 ) -> Result<SystemSolution> {
     let stepping = Stepping::Events;
-    let mut run = Run::new(system, stepper, initial, options, stepping, record_limit)?;
+    let start = (initial, &[][..]);
+    let mut run = Run::new(system, stepper, start, options, stepping, record_limit)?;
     let (dim, count) = (system.dim, system.interactions.len());
     observer.start(run.clock.time, &run.y[..2 * dim], &run.modes)?;
     let steps = observer.wants_steps();

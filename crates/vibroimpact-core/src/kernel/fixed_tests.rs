@@ -8,33 +8,15 @@ use crate::kernel::events::{
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::kernel::reductions::ReduceOptions;
 use crate::methods::steppers::{ExplicitRk, NewmarkFamily, SystemStepper};
-use crate::model::assembly::{initial_state, Assembly, Damper, PairLaw, SystemSpec};
+use crate::model::assembly::{initial_state, Assembly, PairLaw, SystemSpec};
 use crate::model::closed_forms::linear_contact_duration;
 use crate::model::contact::{Contact, LawKind};
 use crate::model::impact_damper::{ImpactDamper, State};
-use crate::model::structure::Structure;
 
 /// The two-mass impact damper written as a general system: an oscillator
 /// with one damper of equal clearances.
 fn spec(system: &ImpactDamper, contact: &Contact) -> SystemSpec {
-    SystemSpec {
-        structure: Structure::oscillator(system.main_mass, system.stiffness, system.damping)
-            .unwrap(),
-        dampers: vec![Damper {
-            mass: system.impact_mass,
-            at: 0.0,
-            lower_clearance: system.clearance,
-            upper_clearance: system.clearance,
-            law: PairLaw::Compliant(*contact),
-        }],
-        collisions: vec![],
-        frictions: vec![],
-        stops: vec![],
-        gravity: 0.0,
-        excitations: vec![],
-        points: vec![],
-        moments: vec![],
-    }
+    system.spec(contact).unwrap()
 }
 
 fn options(dt: f64, t_end: f64) -> RunOptions {

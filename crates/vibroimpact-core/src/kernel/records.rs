@@ -214,6 +214,7 @@ impl Run<'_> {
     /// The solution: the contacts still open closed at NaN, those before
     /// the kept ones dropped, all in order of onset.
     pub(super) fn finish<S: SystemStepper>(mut self, stepper: &S) -> SystemSolution {
+        let open_contacts = self.open_contacts();
         self.close_open();
         let from = self.options.reduce.contacts_from;
         if from > f64::NEG_INFINITY {
@@ -255,6 +256,7 @@ impl Run<'_> {
             reductions: self.reductions,
             contact_force_pairs: self.force_pairs,
             contact_forces: self.contact_forces,
+            open_contacts,
         }
     }
 }

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::kernel::balance::{EnergySampler, EnergyWatch, ENERGY_INTERVAL};
 use crate::kernel::clock::{Clock, Schedule};
 use crate::kernel::contact_balance::OnsetBalance;
-use crate::kernel::events::{ContactKind, Open, RunOptions, Stepping};
+use crate::kernel::events::{CarriedContact, ContactKind, Open, RunOptions, Stepping};
 use crate::kernel::fixed;
 use crate::kernel::impacts::Impacts;
 use crate::kernel::locate::{any_compliant, wall_round_off, Buffers, Gaps};
@@ -113,11 +113,13 @@ fn force_pairs(system: &Assembly) -> Vec<usize> {
 }
 
 impl<'a> Run<'a> {
-    /// A run of `system` from `initial`, its first history row kept.
+    /// A run of `system` from `initial`, the compliant contacts `carried`
+    /// from the run it continues (per interaction, or empty), its first
+    /// history row kept.
     pub(super) fn new<S: SystemStepper>(
         system: &'a Assembly,
         stepper: &mut S,
-        initial: &[f64],
+        (initial, carried): (&[f64], &[Option<CarriedContact>]),
         options: &'a RunOptions,
         stepping: Stepping,
         record_limit: u64,
@@ -131,6 +133,7 @@ impl<'a> Run<'a> {
             )));
         }
         options.check()?;
+        CarriedContact::check_all(carried, count)?;
         if let Some(at) = initial.iter().position(|v| !v.is_finite()) {
             return Err(Error::Inconsistent(format!(
                 "the initial state must be finite: value {at} (of x, v and the energy \
@@ -254,15 +257,19 @@ impl<'a> Run<'a> {
             last_poll: std::time::Instant::now(),
             watch: None,
         };
-        run.start(stepper)?;
+        run.start(stepper, carried)?;
         Ok(run)
     }
 
     /// The state at t = 0: contacts resumed, gaps and stored energy taken,
     /// the first history row kept and the first step chosen.
-    fn start<S: SystemStepper>(&mut self, stepper: &mut S) -> Result<()> {
+    fn start<S: SystemStepper>(
+        &mut self,
+        stepper: &mut S,
+        carried: &[Option<CarriedContact>],
+    ) -> Result<()> {
         let system = self.system;
-        self.resume_contacts();
+        self.resume_contacts(carried);
         if self.friction {
             self.settle_friction(0.0, 0.0);
         }
@@ -288,9 +295,11 @@ impl<'a> Run<'a> {
     }
 
     /// A compliant pair that starts in contact (a run continued from
-    /// another's end) resumes it, its approach rate taken as the indentation
-    /// rate now (a damped law's at least the pressing's, as at any onset).
-    fn resume_contacts(&mut self) {
+    /// another's end) resumes it: as `carried` (its latched approach rate,
+    /// onset and approach), or else its approach rate taken as the
+    /// indentation rate now (a damped law's at least the pressing's, as at
+    /// any onset) and its onset now.
+    fn resume_contacts(&mut self, carried: &[Option<CarriedContact>]) {
         let system = self.system;
         let scales = (
             self.schedule.chatter_interval(0.0),
@@ -303,17 +312,25 @@ impl<'a> Run<'a> {
                 // The law's rate > 0 (a damped law divides by it); the record
                 // keeps the approach there was: none for bodies at rest.
                 let approach = rate.abs();
-                let (approach_rate, resting) =
+                let (mut approach_rate, mut resting) =
                     self.compliant_onset(i, 0.0, approach.max(f64::MIN_POSITIVE), scales);
+                let (mut onset, mut approach_speed, mut deepest) = (0.0, approach, -gap);
+                if let Some(Some(c)) = carried.get(i) {
+                    approach_rate = c.approach_rate;
+                    (onset, approach_speed) = (c.onset, c.approach_speed);
+                    deepest = deepest.max(c.max_indentation);
+                    // A resting contact was carried with no approach.
+                    resting = false;
+                }
                 self.modes[i] = Mode::Compliant {
                     approach_rate,
                     indented_only: self.timing.is_some(),
                 };
                 self.open[i] = Some(Open {
                     kind: ContactKind::Compliant,
-                    onset: 0.0,
-                    approach_speed: approach,
-                    max_indentation: -gap,
+                    onset,
+                    approach_speed,
+                    max_indentation: deepest,
                     dissipated: self.y[loss_slot(system, i)],
                     resting,
                     balance: OnsetBalance::default(),

@@ -31,7 +31,7 @@ impl<'a> FixedRun<'a> {
         let run = Run::new(
             system,
             stepper,
-            initial,
+            (initial, &[]),
             options,
             stepping,
             MAX_RECORD_BYTES,

@@ -27,8 +27,8 @@ pub use table::{
 
 use crate::error::{EnergyAdvice, Error, Result};
 use crate::kernel::events::{
-    integrate_system, integrate_system_observed, integrate_system_stepped, RunOptions, Stepping,
-    SystemSolution,
+    integrate_system, integrate_system_continued, integrate_system_observed, CarriedContact,
+    RunOptions, Stepping, SystemSolution,
 };
 use crate::kernel::fixed;
 use crate::kernel::memory::MAX_RECORD_BYTES;
@@ -196,19 +196,33 @@ impl AnyStepper {
         stepping: Stepping,
         interrupt: &mut dyn FnMut() -> bool,
     ) -> Result<SystemSolution> {
+        self.integrate_continued(system, (y0, &[]), options, stepping, interrupt)
+    }
+
+    /// [`Self::integrate_stepped`] continuing a run from its final state
+    /// `y0`, with the compliant contacts it left open `carried` (see
+    /// [`crate::kernel::events::integrate_system_continued`]).
+    pub fn integrate_continued(
+        &mut self,
+        system: &Assembly,
+        start: (&[f64], &[Option<CarriedContact>]),
+        options: &RunOptions,
+        stepping: Stepping,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<SystemSolution> {
         let (limit, advice) = (MAX_RECORD_BYTES, self.energy_advice());
         match self {
             Self::Rk(s) => {
-                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+                integrate_system_continued(system, s, start, options, stepping, interrupt, limit)
             }
             Self::Newmark(s) => {
-                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+                integrate_system_continued(system, s, start, options, stepping, interrupt, limit)
             }
             Self::Paper(s) => {
-                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+                integrate_system_continued(system, s, start, options, stepping, interrupt, limit)
             }
             Self::Exact(s) => {
-                integrate_system_stepped(system, s, y0, options, stepping, interrupt, limit)
+                integrate_system_continued(system, s, start, options, stepping, interrupt, limit)
             }
         }
         .map_err(|e| e.advised(advice))

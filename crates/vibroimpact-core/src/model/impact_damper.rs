@@ -58,23 +58,15 @@ impl ImpactDamper {
     /// both clearances d and `contact`'s law and contact damper c1. Unforced,
     /// no gravity.
     pub fn spec(&self, contact: &Contact) -> Result<SystemSpec> {
-        Ok(SystemSpec {
-            structure: Structure::oscillator(self.main_mass, self.stiffness, self.damping)?,
-            dampers: vec![Damper {
-                mass: self.impact_mass,
-                at: 0.0,
-                lower_clearance: self.clearance,
-                upper_clearance: self.clearance,
-                law: PairLaw::Compliant(*contact),
-            }],
-            collisions: vec![],
-            frictions: vec![],
-            stops: vec![],
-            gravity: 0.0,
-            excitations: vec![],
-            points: vec![],
-            moments: vec![],
-        })
+        let damper = Damper {
+            mass: self.impact_mass,
+            at: 0.0,
+            lower_clearance: self.clearance,
+            upper_clearance: self.clearance,
+            law: PairLaw::Compliant(*contact),
+        };
+        let structure = Structure::oscillator(self.main_mass, self.stiffness, self.damping)?;
+        Ok(SystemSpec::of(structure, vec![damper]))
     }
 
     /// [`Self::spec`], assembled for the kernel.

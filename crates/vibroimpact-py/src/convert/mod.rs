@@ -182,3 +182,25 @@ pub(crate) fn derivative_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
         Err(err) => Err(err),
     }
 }
+
+/// A carried contact from its four values (see `PreparedSystem.run`).
+pub(crate) fn carried_contact(
+    [approach_rate, onset, approach_speed, max_indentation]: [f64; 4],
+) -> vibroimpact_core::kernel::events::CarriedContact {
+    vibroimpact_core::kernel::events::CarriedContact {
+        approach_rate,
+        onset,
+        approach_speed,
+        max_indentation,
+    }
+}
+
+/// A carried contact's four values (see `PreparedSystem.run`).
+pub(crate) fn carried_values(c: vibroimpact_core::kernel::events::CarriedContact) -> [f64; 4] {
+    [
+        c.approach_rate,
+        c.onset,
+        c.approach_speed,
+        c.max_indentation,
+    ]
+}

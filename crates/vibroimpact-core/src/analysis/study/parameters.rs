@@ -514,18 +514,11 @@ mod tests {
 
     fn noisy(structure: Structure, signal: Signal) -> SystemSpec {
         SystemSpec {
-            structure,
-            dampers: vec![],
-            collisions: vec![],
-            frictions: vec![],
-            stops: vec![],
-            gravity: 0.0,
             excitations: vec![Excitation {
                 load: Load::Base,
                 signal,
             }],
-            points: vec![],
-            moments: vec![],
+            ..SystemSpec::of(structure, vec![])
         }
     }
 

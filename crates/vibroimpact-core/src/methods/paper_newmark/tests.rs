@@ -15,15 +15,8 @@ use std::f64::consts::TAU;
 /// A structure alone (no pair), with `excitations`.
 fn bare(structure: Structure, excitations: Vec<Excitation>) -> Assembly {
     Assembly::new(&SystemSpec {
-        structure,
-        dampers: vec![],
-        collisions: vec![],
-        frictions: vec![],
-        stops: vec![],
-        gravity: 0.0,
         excitations,
-        points: vec![],
-        moments: vec![],
+        ..SystemSpec::of(structure, vec![])
     })
     .unwrap()
 }
