@@ -270,7 +270,7 @@ VALID: dict[str, tuple[Callable[..., Any], dict[str, Any]]] = {
             history=True,
             **kwargs,
         ),
-        {"dt": 1e-3, "t_end": 1e-2, "strobe_period": 5e-3},
+        {"dt": 1e-3, "t_end": 1e-2, "strobe_period": 5e-3, "beta": 0.25, "gamma": 0.5},
     ),
     "adequacy": (
         vi.adequacy,

@@ -148,6 +148,11 @@ def test_adaptive_methods_take_a_tiny_first_step_and_stop_clearly_at_a_huge_t_en
         ('method = "generalized-alpha"\ndt = 1e-4\nt_end = 1e20', 2, "t_end / dt"),
         ('method = "dop853"\ndt = 1e-4\nt_end = 1e20', 1, "t_end"),
         ('method = "rk4"\ndt = 1.0\nt_end = 0.3', 2, "dt must be at most t_end (0.3 s)"),
+        (
+            'method = "newmark-implicit"\ndt = 2.5\nbeta = 0.0\nt_end = 30.0',
+            2,
+            "beta = 0.0 < gamma / 2",
+        ),
     ],
 )
 def test_the_command_line_says_so_in_one_line(
@@ -164,6 +169,31 @@ def test_the_command_line_says_so_in_one_line(
     assert proc.returncode == code, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and named in lines[0] and "Traceback" not in proc.stderr
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("beta", [0.0, 0.2])
+def test_a_conditionally_stable_newmark_step_over_its_limit_is_refused(beta: float) -> None:
+    # Newmark with 2 beta < gamma is stable where w dt <= 1 / sqrt(gamma / 2 - beta); a
+    # probe's central differences on a 1e12 N/m mode (w dt = 100) ran to 2.7e56 m.
+    limit = 1.0 / math.sqrt(0.25 - beta) / 1e6
+    stiff = {"kind": "oscillator", "mass": 1.0, "stiffness": 1e12}
+    start = {"structure_displacement": [1e-9]}
+    for dt, refused in ((1.01 * limit, True), (0.99 * limit, False)):
+        settings = dict(method="newmark-implicit", dt=dt, beta=beta, t_end=200 * dt)
+        if refused:
+            with pytest.raises(ValueError, match=r"\[solver\] dt: newmark-implicit with beta"):
+                vi.simulate_system(stiff, initial=start, energy_tolerance=1.0, **settings)
+            with pytest.raises(ValueError, match="reduce dt below"):
+                vi.simulate(
+                    vi.ImpactDamper(**{**TABLE1, "stiffness": 1e12}), HERTZ, ONSET, **settings
+                )
+        else:
+            # Within the limit the undamped motion keeps its amplitude (beyond it, by
+            # 1.2 a step: 1e17 over these 200 steps). Its energy is the method's own
+            # (modified) energy, not the ledger's (hence the tolerance).
+            sol = vi.simulate_system(stiff, initial=start, energy_tolerance=1.0, **settings)
+            assert np.max(np.abs(sol.structure_displacement)) < 1.05e-9
 
 
 # ------------------------------------------------------------------------------ 2. memory

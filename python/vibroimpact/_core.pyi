@@ -400,6 +400,8 @@ def _check_run(
     every: int,
     history: bool,
     strobe_period: float | None,
+    beta: float | None = None,
+    gamma: float | None = None,
 ) -> None: ...
 def _check_forcing_period(
     spec: dict[str, Any],

@@ -6,7 +6,7 @@ tables label (here, outside the analyses, which import the model that the tables
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 _M = "m"
@@ -186,6 +186,19 @@ def contact_cell(value: Any, still_open: bool, width: int) -> str:
         return f"{'open' if still_open else '-':>{width}}"
     # + 0.0 turns a negative zero into a zero.
     return f"{value + 0.0:>{width}.7g}"
+
+
+def contact_table(
+    rows: Iterable[Mapping[str, Any]], columns: Sequence[str], width: int
+) -> list[str]:
+    """A printed table of contacts: its header (the ``CONTACT_HEADERS``), then a line of
+    ``columns`` per row (see :func:`contact_cell`; a row whose ``separation`` is not
+    finite is still open), each cell right-aligned in ``width``."""
+    lines = ["  ".join(f"{CONTACT_HEADERS.get(name, name):>{width}}" for name in columns)]
+    for row in rows:
+        still_open = not math.isfinite(row["separation"])
+        lines.append("  ".join(contact_cell(row[name], still_open, width) for name in columns))
+    return lines
 
 
 #: The SI unit of each column of a contact table (``to_pandas().attrs["units"]``; "1"

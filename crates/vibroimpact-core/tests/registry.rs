@@ -27,6 +27,7 @@ fn plan(method: &str, dt: Option<f64>, t_end: f64) -> RunPlan<'_> {
         every: 1,
         history: true,
         strobe_period: None,
+        options: Default::default(),
     }
 }
 
@@ -130,6 +131,41 @@ fn an_explicit_step_over_the_fastest_period_is_refused() {
                 "max_steps (1000000)",
             ],
         );
+    });
+}
+
+#[test]
+fn a_conditionally_stable_newmark_step_over_its_limit_is_refused() {
+    common::timeout(10, || {
+        // Table 1's structure: w = 1 rad/s. Newmark with 2 beta < gamma is stable
+        // where w dt <= 1 / sqrt(gamma / 2 - beta): 2 s for central differences
+        // (beta 0, gamma 1/2; it had run to 2.7e56 m), sqrt(5) s for (0.1, 0.6).
+        let system = table_1();
+        for method in ["newmark", "newmark-implicit"] {
+            for (beta, gamma, limit) in [(0.0, 0.5, 2.0), (0.1, 0.6, 5.0_f64.sqrt())] {
+                let mut run = plan(method, Some(1.01 * limit), 1000.0);
+                (run.options.beta, run.options.gamma) = (beta, gamma);
+                refused(
+                    &system,
+                    &run,
+                    &[
+                        "[solver] dt: ",
+                        method,
+                        "beta >= gamma / 2",
+                        "reduce dt below",
+                    ],
+                );
+                run.dt = Some(0.99 * limit);
+                assert_eq!(check_run(&system, &run), Ok(()), "{method} {beta}");
+                // At beta >= gamma / 2 any step is stable.
+                (run.options.beta, run.dt) = (0.5 * gamma, Some(100.0 * limit));
+                assert_eq!(check_run(&system, &run), Ok(()), "{method} {beta}");
+            }
+        }
+        // generalized-alpha's beta is its own (stable): the option is not read.
+        let mut run = plan("generalized-alpha", Some(100.0), 1000.0);
+        run.options.beta = 0.0;
+        assert_eq!(check_run(&system, &run), Ok(()));
     });
 }
 

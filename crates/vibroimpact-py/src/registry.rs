@@ -93,9 +93,10 @@ fn forcing(spec: &Bound<'_, PyDict>) -> PyResult<Vec<(usize, f64)>> {
 /// within its limits (the core's `registry::check_run`): too many steps, a
 /// step or a method that cannot resolve the fastest mode or a harmonic
 /// forcing, a history or strobe record beyond `max_rows` or the records'
-/// memory. Raises ``InvalidInputError`` naming the key and what is allowed.
+/// memory. `beta` and `gamma` (None: the registry's defaults): a Newmark
+/// step's. Raises ``InvalidInputError`` naming the key and what is allowed.
 #[pyfunction]
-#[pyo3(signature = (spec, *, method, dt, t_end, max_steps, max_rows, every, history, strobe_period))]
+#[pyo3(signature = (spec, *, method, dt, t_end, max_steps, max_rows, every, history, strobe_period, beta=None, gamma=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn check_run(
     spec: &Bound<'_, PyDict>,
@@ -107,6 +108,8 @@ pub(crate) fn check_run(
     #[pyo3(from_py_with = crate::convert::every_arg)] every: u64,
     history: bool,
     #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::beta)] beta: Option<f64>,
+    #[pyo3(from_py_with = crate::convert::optional::gamma)] gamma: Option<f64>,
 ) -> PyResult<()> {
     let structure_dict = spec
         .get_item("structure")?
@@ -131,6 +134,7 @@ pub(crate) fn check_run(
         every,
         history,
         strobe_period,
+        options: registry::Options::or_defaults(None, None, beta, gamma, None),
     };
     check_scales(&scales, &plan).map_err(to_py)
 }

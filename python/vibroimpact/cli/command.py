@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import csv
-import math
 import os
 import signal
 import sys
@@ -53,7 +52,7 @@ from vibroimpact.scenario.system import (
     write_system_history,
 )
 from vibroimpact.scenario.two_mass import Scenario, ScenarioError, load_scenario, paper_collision
-from vibroimpact.units import CONTACT_HEADERS, contact_cell
+from vibroimpact.units import contact_table
 
 HISTORY_COLUMNS = (
     ("t", "time, s"),
@@ -182,13 +181,9 @@ def contact_lines(sol: Solution) -> list[str]:
 
     Columns come from ``ContactTable.columns``; a value left undefined because the
     contact is still open at the end of the run (NaN in the table) reads ``open``, one a
-    closed contact has none of reads ``-`` (see ``units.contact_cell``).
+    closed contact has none of reads ``-`` (see ``units.contact_table``).
     """
-    columns = list(sol.contacts.columns)
-    lines = ["  ".join(f"{CONTACT_HEADERS.get(name, name):>15}" for name in columns)]
-    for row in sol.contacts.to_dicts():
-        still_open = not math.isfinite(row["separation"])
-        lines.append("  ".join(contact_cell(row[name], still_open, 15) for name in columns))
+    lines = contact_table(sol.contacts.to_dicts(), list(sol.contacts.columns), 15)
     return [*lines, f"  {ENERGY_DISSIPATED_TEXT}", f"  {ENERGY_CHANGE_TEXT}"]
 
 

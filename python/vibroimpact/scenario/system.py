@@ -10,7 +10,6 @@ wrong type or a bad value is an error naming the file, the section and the key.
 from __future__ import annotations
 
 import csv
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,7 +28,7 @@ from vibroimpact.system import (
     structure_coordinates,
 )
 from vibroimpact.system.parameter_keys import check_parameter_keys
-from vibroimpact.units import CONTACT_HEADERS, contact_cell
+from vibroimpact.units import contact_table
 
 SECTIONS = (*RUN_SECTIONS, *ANALYSIS_SECTIONS)
 
@@ -289,8 +288,5 @@ def system_lines(
             "restitution",
             "energy_dissipated",
         ]
-        lines.append("  ".join(f"{CONTACT_HEADERS.get(h, h):>17}" for h in head))
-        for row in sol.contacts.to_dicts():
-            still_open = not math.isfinite(row["separation"])
-            lines.append("  ".join(contact_cell(row[h], still_open, 17) for h in head))
+        lines += contact_table(sol.contacts.to_dicts(), head, 17)
     return lines

@@ -257,6 +257,8 @@ def prepare_system(
         check_run(
             spec,
             **{key: solver[key] for key in ("method", "dt", "t_end", "max_steps", "max_rows")},
+            beta=solver.get("beta"),
+            gamma=solver.get("gamma"),
             every=output["every"],
             history=output["history"],
             strobe_period=output["strobe_period"],

@@ -481,7 +481,7 @@ pub(super) fn row_system(
     for (p, v) in parameters.iter().zip(values) {
         p.apply(&mut spec, &mut initial, *v)?;
     }
-    check_steps_resolve(&spec, &settings.method, settings.dt)?;
+    check_steps_resolve(&spec, &settings.method, settings.dt, settings.options)?;
     Ok((spec, initial))
 }
 

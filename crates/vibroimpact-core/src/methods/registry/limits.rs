@@ -5,7 +5,7 @@
 //! the step). Each refusal is one line naming the field (as a scenario's
 //! `[solver]`, `[output]` or `[[excitation]]` key) and what is allowed.
 
-use super::table::{method, Kind, MethodSpec, DT, T_END};
+use super::table::{method, Kind, MethodSpec, Options, BETA, DT, T_END};
 use crate::error::{Error, Result};
 use crate::kernel::memory::MAX_RECORD_BYTES;
 use crate::model::assembly::SystemSpec;
@@ -35,6 +35,9 @@ pub struct RunPlan<'a> {
     pub history: bool,
     /// Stroboscopic sampling period, s (None: none).
     pub strobe_period: Option<f64>,
+    /// The method's options: a Newmark step (`beta`, `gamma`) with `2 beta <
+    /// gamma` is stable only below a step (see [`stable_steps_per_period`]).
+    pub options: Options,
 }
 
 /// What the limits read of a system: its structure, its coordinates (the
@@ -83,7 +86,12 @@ pub fn check_run(system: &SystemSpec, plan: &RunPlan) -> Result<()> {
 /// base system passed, its values changing the system but not the run's
 /// settings: an explicit step over the fastest mode, a harmonic sampled
 /// below two steps a period by the `method`'s fixed step `dt` (s).
-pub fn check_steps_resolve(system: &SystemSpec, method_name: &str, dt: Option<f64>) -> Result<()> {
+pub fn check_steps_resolve(
+    system: &SystemSpec,
+    method_name: &str,
+    dt: Option<f64>,
+    options: Options,
+) -> Result<()> {
     let spec = method(method_name)?;
     // No end, no rows: the run's settings, the study's own, were checked once.
     let plan = RunPlan {
@@ -95,6 +103,7 @@ pub fn check_steps_resolve(system: &SystemSpec, method_name: &str, dt: Option<f6
         every: 1,
         history: false,
         strobe_period: None,
+        options,
     };
     let scales = RunScales::of(system);
     check_natural_period(spec, &plan, scales.structure, None)?;
@@ -119,6 +128,7 @@ pub fn check_step_within(dt: f64, t_end: f64, method: &str, field: &str) -> Resu
 /// [`check_run`] on what it reads of the system.
 pub fn check_scales(system: &RunScales, plan: &RunPlan) -> Result<()> {
     let spec = method(plan.method)?;
+    plan.options.checked()?;
     if let Some(dt) = plan.dt {
         DT.check(dt)?;
     }
@@ -273,6 +283,43 @@ pub(super) fn highest_frequency(structure: &Structure) -> f64 {
 /// 1.5 steps had run, grown by 1e63 and stopped on the energy check.)
 const EXPLICIT_STEPS_PER_PERIOD: f64 = std::f64::consts::PI / std::f64::consts::SQRT_2;
 
+/// The error of a fixed step `dt` (s) over `steps` of the fastest mode's
+/// `period` (s; of `frequency`, Hz), where `spec`'s method is unstable.
+fn unstable_step(
+    spec: &MethodSpec,
+    options: &Options,
+    (period, frequency): (f64, f64),
+    steps: f64,
+    dt: f64,
+) -> Error {
+    if spec.kind == Kind::Explicit {
+        return Error::Inconsistent(format!(
+            "[solver] dt: the fastest mode's period, {} s ({} Hz), is below 2.22 steps of dt = \
+             {} s (pi / sqrt(2)), where {} is unstable: reduce dt to about {} s (20 steps a \
+             period; at the stability limit itself the run is stable but not accurate), use an \
+             implicit method (newmark-implicit, generalized-alpha), or check mass and stiffness",
+            python_g3(period),
+            python_g3(frequency),
+            python_repr(dt),
+            spec.name,
+            python_g3(period / 20.0)
+        ));
+    }
+    Error::Inconsistent(format!(
+        "[solver] dt: {} with beta = {} < gamma / 2 (gamma = {}) is stable only where \
+         2 pi f dt <= 1 / sqrt(gamma / 2 - beta) = {}, and the fastest mode ({} Hz) gives {}: \
+         reduce dt below {} s, or set beta >= gamma / 2 (beta = 0.25, gamma = 0.5: stable on \
+         any mode)",
+        spec.name,
+        python_repr(options.beta),
+        python_repr(options.gamma),
+        python_g3(std::f64::consts::TAU / steps),
+        python_g3(frequency),
+        python_g3(std::f64::consts::TAU * frequency * dt),
+        python_g3(period / steps)
+    ))
+}
+
 /// The fewest steps a mode-stepped method takes in a period of the fastest
 /// natural mode: the exact flow an eighth of it at most (its cubic event
 /// search's step), an adaptive method at least one.
@@ -284,30 +331,47 @@ fn steps_per_period(spec: &MethodSpec) -> f64 {
     }
 }
 
+/// The fewest fixed steps in an undamped mode's period at which `spec`'s
+/// method with `options` is stable, None where it is on any mode: an
+/// explicit one's [`EXPLICIT_STEPS_PER_PERIOD`], and a Newmark step (the
+/// methods reading `beta`) with `2 beta < gamma`, stable where `omega dt <=
+/// 1 / sqrt(gamma / 2 - beta)` (Hughes, The Finite Element Method, 9.1.2:
+/// beta = 0, gamma = 1/2, central differences, at `omega dt <= 2`).
+fn stable_steps_per_period(spec: &MethodSpec, options: &Options) -> Option<f64> {
+    if spec.kind == Kind::Explicit {
+        return Some(EXPLICIT_STEPS_PER_PERIOD);
+    }
+    let newmark = spec.options.iter().any(|o| o.name == BETA.name);
+    let margin = 0.5 * options.gamma - options.beta;
+    (newmark && margin > 0.0).then(|| std::f64::consts::TAU * margin.sqrt())
+}
+
 /// Whether a run of `spec` and `plan` resolves a fastest mode of `frequency`.
 fn resolves(spec: &MethodSpec, plan: &RunPlan, frequency: f64) -> bool {
-    let explicit = spec.kind == Kind::Explicit;
-    if explicit && frequency * EXPLICIT_STEPS_PER_PERIOD * plan.dt.unwrap_or(0.0) > 1.0 {
+    let stable = stable_steps_per_period(spec, &plan.options);
+    if stable.is_some_and(|steps| frequency * steps * plan.dt.unwrap_or(0.0) > 1.0) {
         return false;
     }
     let steps = plan.t_end * frequency * steps_per_period(spec);
     !(spec.kind.is_mode_stepped() && steps > plan.max_steps as f64)
 }
 
-/// Refuse a run that cannot resolve the structure's fastest mode: an
-/// explicit fixed step is unstable on a mode whose period is shorter than
-/// [`EXPLICIT_STEPS_PER_PERIOD`] of it; an adaptive method or the exact flow steps at least once in each
-/// period of that mode. The eigenvalues only where the bound does not
-/// settle it (they had cost a dropped ball's run a quarter of its time), and
-/// once: `known` is the highest frequency (Hz) where already computed.
+/// Refuse a run that cannot resolve the structure's fastest mode: a fixed
+/// step is unstable on a mode whose period is shorter than its
+/// [`stable_steps_per_period`] (an explicit method's, a Newmark step's with
+/// `2 beta < gamma`); an adaptive method or the exact flow steps at least
+/// once in each period of that mode. The eigenvalues only where the bound
+/// does not settle it (they had cost a dropped ball's run a quarter of its
+/// time), and once: `known` is the highest frequency (Hz) where already
+/// computed.
 fn check_natural_period(
     spec: &MethodSpec,
     plan: &RunPlan,
     structure: &Structure,
     known: Option<f64>,
 ) -> Result<()> {
-    let explicit = spec.kind == Kind::Explicit;
-    if !explicit && !spec.kind.is_mode_stepped() {
+    let stable = stable_steps_per_period(spec, &plan.options);
+    if stable.is_none() && !spec.kind.is_mode_stepped() {
         return Ok(());
     }
     if resolves(spec, plan, frequency_bound(structure)) {
@@ -318,21 +382,17 @@ fn check_natural_period(
         return Ok(());
     }
     let period = 1.0 / frequency;
-    if let Some(dt) = plan
-        .dt
-        .filter(|dt| explicit && period < EXPLICIT_STEPS_PER_PERIOD * dt)
-    {
-        return Err(Error::Inconsistent(format!(
-            "[solver] dt: the fastest mode's period, {} s ({} Hz), is below 2.22 steps of dt = \
-             {} s (pi / sqrt(2)), where {} is unstable: reduce dt to about {} s (20 steps a \
-             period; at the stability limit itself the run is stable but not accurate), use an \
-             implicit method (newmark-implicit, generalized-alpha), or check mass and stiffness",
-            python_g3(period),
-            python_g3(frequency),
-            python_repr(dt),
-            spec.name,
-            python_g3(period / 20.0)
-        )));
+    let unstable = stable
+        .zip(plan.dt)
+        .filter(|(steps, dt)| period < steps * dt);
+    if let Some((steps, dt)) = unstable {
+        return Err(unstable_step(
+            spec,
+            &plan.options,
+            (period, frequency),
+            steps,
+            dt,
+        ));
     }
     let (periods, per_period) = (plan.t_end * frequency, steps_per_period(spec));
     if spec.kind.is_mode_stepped() && periods * per_period > plan.max_steps as f64 {

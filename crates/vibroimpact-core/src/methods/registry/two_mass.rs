@@ -58,13 +58,15 @@ pub fn simulate(
     // (it had blown up, a NumericalBlowUp, where the same structure as a
     // system was refused up front).
     let run = settings.run_options();
-    check_steps_resolve(&system.spec(contact)?, settings.method.name(), run.dt)?;
+    let options = options_of(&settings.method);
+    check_steps_resolve(
+        &system.spec(contact)?,
+        settings.method.name(),
+        run.dt,
+        options,
+    )?;
     let assembly = system.assembly(contact)?;
     let y0 = start.vector(&assembly)?;
-    let mut stepper = AnyStepper::new(
-        &assembly,
-        settings.method.name(),
-        &options_of(&settings.method),
-    )?;
+    let mut stepper = AnyStepper::new(&assembly, settings.method.name(), &options)?;
     stepper.integrate_stepped(&assembly, &y0, &run, settings.kernel_stepping(), interrupt)
 }
