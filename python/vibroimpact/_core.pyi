@@ -354,7 +354,12 @@ def tangent_map(
     parameters: list[tuple[PreparedSystem, PreparedSystem, float]] = ...,
 ) -> dict[str, Any]: ...
 def lyapunov_spectrum(
-    prepared: PreparedSystem, state: list[float], block_time: float, blocks: int
+    prepared: PreparedSystem,
+    state: list[float],
+    block_time: float,
+    blocks: int,
+    *,
+    carried: list[list[float] | None] | None = None,
 ) -> dict[str, Any]: ...
 def interactions(prepared: PreparedSystem) -> list[dict[str, Any]]: ...
 def simulate(

@@ -72,29 +72,19 @@ fn run(
     )
 }
 
-/// The open contacts of `sol`, their onsets in the time of a run continued
-/// from its end.
-fn carried(sol: &SystemSolution) -> Vec<Option<CarriedContact>> {
-    let shift = |c: CarriedContact| CarriedContact {
-        onset: c.onset - sol.final_time,
-        ..c
-    };
-    sol.open_contacts.iter().map(|c| c.map(shift)).collect()
-}
-
 #[test]
 fn a_run_continued_with_its_open_contacts_is_the_run_in_two_pieces() {
     common::timeout(60, || {
         let system = system();
         let settled = run(&system, &[0.0; 4], &[], 300.0).unwrap();
-        let start = (&settled.final_state, carried(&settled));
+        let start = (&settled.final_state, settled.carried());
         assert!(
             start.1.iter().any(Option::is_some),
             "the strobe is in a contact"
         );
         let whole = run(&system, start.0, &start.1, 12.0).unwrap();
         let first = run(&system, start.0, &start.1, 7.0).unwrap();
-        let open = carried(&first);
+        let open = first.carried();
         let second = run(&system, &first.final_state, &open, 5.0).unwrap();
         let fresh = run(&system, &first.final_state, &[], 5.0).unwrap();
         // The contact continued: its onset the first run's, shifted.

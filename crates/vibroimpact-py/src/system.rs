@@ -317,11 +317,7 @@ impl PreparedSystem {
             [&state[..n], &state[d..d + n], &state[n..d], &state[d + n..]],
         )
         .map_err(to_py)?;
-        let carried: Vec<Option<CarriedContact>> = carried
-            .unwrap_or_default()
-            .into_iter()
-            .map(|c| c.map(crate::convert::carried_contact))
-            .collect();
+        let carried = crate::convert::carried_contacts(carried);
         let start = (&y0[..], &carried[..]);
         let sol = ready.run(py, start, t_end, (false, 1), record_from, strobe_period)?;
         solution_dict(py, &ready.system, sol)

@@ -109,16 +109,19 @@ pub fn tangent_map<'py>(
 
 /// The Lyapunov spectrum from the flat state `state` over `blocks` runs of
 /// `block_time` s each, each from the last one's end (see
-/// `core::analysis::tangent::lyapunov_blocks`): `exponents` (1/s,
-/// descending), `standard_error` (over the blocks), `time` (s), `impacts`,
-/// `grazings`.
+/// `core::analysis::tangent::lyapunov_blocks`), each continuing the
+/// compliant contacts the last left open, the first those `carried` (as
+/// `PreparedSystem.run`'s): `exponents` (1/s, descending), `standard_error`
+/// (over the blocks), `time` (s), `impacts`, `grazings`.
 #[pyfunction]
+#[pyo3(signature = (prepared, state, block_time, blocks, *, carried=None))]
 pub fn lyapunov_spectrum<'py>(
     py: Python<'py>,
     prepared: &PreparedSystem,
     state: Vec<f64>,
     #[pyo3(from_py_with = crate::convert::arg::block_time)] block_time: f64,
     #[pyo3(from_py_with = crate::convert::blocks_arg)] blocks: u64,
+    carried: Option<Vec<Option<[f64; 4]>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     if !(block_time.is_finite() && block_time > 0.0) {
         return Err(InvalidInputError::new_err(format!(
@@ -142,8 +145,12 @@ pub fn lyapunov_spectrum<'py>(
             system, stepper, ..
         } = ready;
         let system: &core::model::assembly::Assembly = system;
+        let mut carried = crate::convert::carried_contacts(carried);
         tangent::lyapunov_blocks(system, &y0, block_time, blocks, &mut |y, flow| {
-            let end = stepper.integrate_observed(system, y, &options, interrupt, flow)?;
+            let start = (y, &carried[..]);
+            let end =
+                stepper.integrate_observed_continued(system, start, &options, interrupt, flow)?;
+            carried = end.carried();
             full_state(system, &end.final_state[..2 * system.dim])
         })
     })?;

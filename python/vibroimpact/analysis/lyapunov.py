@@ -21,7 +21,7 @@ from vibroimpact.analysis.limits import (
     whole_count,
 )
 from vibroimpact.analysis.parameters import forcing_period
-from vibroimpact.analysis.runs import Runner, _prepare, as_runner, checked_run
+from vibroimpact.analysis.runs import Runner, _prepare, as_runner, carried_from, checked_run
 from vibroimpact.model.modes import structure_frequencies
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
@@ -115,7 +115,12 @@ def lyapunov(
             )
         blocks = BLOCKS
         block_time = run.period / BLOCKS
-    raw = lyapunov_spectrum(run.system(), [float(v) for v in z], block_time, blocks)
+    # A contact in progress at the settled state continues (carried_from), and each
+    # block continues the last one's.
+    carried = carried_from(z, run.interaction_count())
+    raw = lyapunov_spectrum(
+        run.system(), [float(v) for v in z], block_time, blocks, carried=carried
+    )
     run.runs += blocks
     exponents = np.asarray(raw["exponents"], dtype=float)
     return Lyapunov(

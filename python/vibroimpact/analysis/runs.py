@@ -16,6 +16,7 @@ from vibroimpact._core import (
     InvalidInputError,
     PreparedSystem,
     SimulationError,
+    interactions,
     tangent_map,
 )
 from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_periods, whole_count
@@ -73,11 +74,7 @@ class Runner:
     k: int = 0
     runs: int = 0
     _prepared_system: PreparedSystem | None = field(default=None, repr=False)
-    #: The compliant contacts open at the end of the last runs, by the bytes of
-    #: their final states: a run continued from one of them continues them (its
-    #: onset and a damped law's latched approach rate, which (x, v) do not
-    #: hold) rather than beginning them afresh, counted twice.
-    _carried: dict[bytes, list[Any]] = field(default_factory=dict, repr=False)
+    _interactions: int | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         self.n = structure_coordinates(self.prepared.spec["structure"])
@@ -140,7 +137,7 @@ class Runner:
                 t_end,
                 record_from=0.0 if record else None,
                 strobe_period=self.period if strobe else None,
-                carried=self._carried.get(z.tobytes()),
+                carried=carried_from(z, self.interaction_count()),
             )
         except SimulationError as err:
             if "max_rows" not in str(err):
@@ -158,13 +155,22 @@ class Runner:
 
     def _carry(self, raw: Mapping[str, Any]) -> None:
         """Keep the contacts ``raw`` left open, for a run from its final state."""
-        open_contacts = raw["open_contacts"]
-        if len(self._carried) >= CARRIED_STATES:
-            del self._carried[next(iter(self._carried))]
         end = float(raw["final_time"])
-        shifted = [None if c is None else [c[0], c[1] - end, c[2], c[3]] for c in open_contacts]
-        final = np.asarray(raw["final_state"], dtype=float)
-        self._carried[final.tobytes()] = shifted
+        shifted = [
+            None if c is None else [c[0], c[1] - end, c[2], c[3]] for c in raw["open_contacts"]
+        ]
+        if any(c is not None for c in shifted):
+            if len(_CARRIED) >= CARRIED_STATES:
+                del _CARRIED[next(iter(_CARRIED))]
+            final = np.asarray(raw["final_state"], dtype=float).tobytes()
+            _CARRIED[final, len(shifted)] = shifted
+
+    def interaction_count(self) -> int:
+        """The system's interactions (a damper's two walls, each stop, collision and
+        friction element): the length of its runs' ``open_contacts``."""
+        if self._interactions is None:
+            self._interactions = len(interactions(self.system()))
+        return self._interactions
 
     def system(self) -> PreparedSystem:
         """The core's checked system with its method (made once)."""
@@ -327,8 +333,22 @@ def runner(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Ru
     return Runner(prepared, period)
 
 
-#: The final states whose open contacts a :class:`Runner` keeps.
-CARRIED_STATES = 8
+#: The final states whose open contacts the runners keep (:func:`carried_from`).
+CARRIED_STATES = 64
+
+#: The compliant contacts open at the end of the runners' last runs, by the bytes of
+#: their final states: a run continued from one of them, by the same runner or by the
+#: next point's of a sweep, continues them (their onsets and a damped law's latched
+#: approach rate, which (x, v) do not hold) rather than beginning them afresh, counted
+#: twice. Only runs that ended inside a contact are kept.
+_CARRIED: dict[tuple[bytes, int], list[Any]] = {}
+
+
+def carried_from(state: np.ndarray, count: int) -> list[Any] | None:
+    """The contacts a run of a system of ``count`` interactions ending at ``state`` (x
+    then v) left open, onsets relative to its end (``PreparedSystem.run``'s
+    ``carried``); None where no run kept ended there inside a contact."""
+    return _CARRIED.get((np.asarray(state, dtype=float).tobytes(), count))
 
 
 def begun(contacts: Mapping[str, Any]) -> np.ndarray:

@@ -292,6 +292,18 @@ pub struct SystemSolution {
     pub open_contacts: Vec<Option<CarriedContact>>,
 }
 
+impl SystemSolution {
+    /// [`Self::open_contacts`], their onsets in the time of a run continued
+    /// from [`Self::final_state`] (shifted by `-final_time`).
+    pub fn carried(&self) -> Vec<Option<CarriedContact>> {
+        let shift = |c: CarriedContact| CarriedContact {
+            onset: c.onset - self.final_time,
+            ..c
+        };
+        self.open_contacts.iter().map(|c| c.map(shift)).collect()
+    }
+}
+
 /// A contact being followed.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Open {
@@ -493,21 +505,21 @@ pub fn integrate_system_continued<S: SystemStepper>(
     Ok(run.finish(stepper))
 }
 
-/// [`integrate_system_within`] with `observer` told of the run's start, of
-/// each event (the states and modes either side, the rigid pairs' jumps)
+/// [`integrate_system_within`] from `start` (the initial state and the
+/// contacts carried, as [`integrate_system_continued`]'s) with `observer`
+/// told of the run's start, of each event (the states and modes either side, the rigid pairs' jumps)
 /// and of its end: what the tangent flow is made of
 /// ([`crate::kernel::observe`]). Steps are cut at events.
 pub fn integrate_system_observed<S: SystemStepper>(
     system: &Assembly,
     stepper: &mut S,
-    initial: &[f64],
+    start: (&[f64], &[Option<CarriedContact>]),
     options: &RunOptions,
     interrupt: &mut dyn FnMut() -> bool,
     record_limit: u64,
     observer: &mut dyn EventObserver,
 ) -> Result<SystemSolution> {
     let stepping = Stepping::Events;
-    let start = (initial, &[][..]);
     let mut run = Run::new(system, stepper, start, options, stepping, record_limit)?;
     let (dim, count) = (system.dim, system.interactions.len());
     observer.start(run.clock.time, &run.y[..2 * dim], &run.modes)?;

@@ -168,19 +168,33 @@ impl AnyStepper {
         interrupt: &mut dyn FnMut() -> bool,
         observer: &mut dyn EventObserver,
     ) -> Result<SystemSolution> {
+        self.integrate_observed_continued(system, (y0, &[]), options, interrupt, observer)
+    }
+
+    /// [`Self::integrate_observed`] continuing a run from its final state,
+    /// with the compliant contacts it left open (see
+    /// [`Self::integrate_continued`]).
+    pub fn integrate_observed_continued(
+        &mut self,
+        system: &Assembly,
+        start: (&[f64], &[Option<CarriedContact>]),
+        options: &RunOptions,
+        interrupt: &mut dyn FnMut() -> bool,
+        observer: &mut dyn EventObserver,
+    ) -> Result<SystemSolution> {
         let (limit, advice) = (MAX_RECORD_BYTES, self.energy_advice());
         match self {
             Self::Rk(s) => {
-                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+                integrate_system_observed(system, s, start, options, interrupt, limit, observer)
             }
             Self::Newmark(s) => {
-                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+                integrate_system_observed(system, s, start, options, interrupt, limit, observer)
             }
             Self::Paper(s) => {
-                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+                integrate_system_observed(system, s, start, options, interrupt, limit, observer)
             }
             Self::Exact(s) => {
-                integrate_system_observed(system, s, y0, options, interrupt, limit, observer)
+                integrate_system_observed(system, s, start, options, interrupt, limit, observer)
             }
         }
         .map_err(|e| e.advised(advice))

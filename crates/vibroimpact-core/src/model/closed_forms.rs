@@ -44,9 +44,17 @@ pub fn goldsmith_max_indentation(
     representable(
         "maximum indentation",
         "m",
-        (5.0 * v * v / (4.0 * k_star * k)).powf(0.4),
+        hertz_deepest(k_star, k, v),
         INPUTS,
     )
+}
+
+/// Goldsmith's deepest indentation (m) of a Hertz contact of `stiffness`
+/// (N/m^1.5) between bodies of inverse effective mass `inverse_mass`
+/// (1/kg) approaching at `speed` (m/s), its inputs unchecked:
+/// `(5 v^2 / (4 K* K))^(2/5)`.
+pub(crate) fn hertz_deepest(inverse_mass: f64, stiffness: f64, speed: f64) -> f64 {
+    (5.0 * speed * speed / (4.0 * inverse_mass * stiffness)).powf(0.4)
 }
 
 /// Goldsmith's Hertz contact duration, s:

@@ -585,8 +585,9 @@ impl AnyLaw {
         match self {
             AnyLaw::Hertz(Hertz { stiffness })
             | AnyLaw::HysterHertz(HysterHertz { stiffness, .. }) => {
-                let deepest = (1.25 * effective_mass * approach * approach / stiffness).powf(0.4);
-                crate::model::closed_forms::HERTZ_DURATION_CONSTANT * deepest / approach
+                use crate::model::closed_forms::{hertz_deepest, HERTZ_DURATION_CONSTANT};
+                let deepest = hertz_deepest(1.0 / effective_mass, *stiffness, approach);
+                HERTZ_DURATION_CONSTANT * deepest / approach
             }
             AnyLaw::Linear(Linear { stiffness }) => {
                 std::f64::consts::PI * (effective_mass / stiffness).sqrt()

@@ -183,6 +183,17 @@ pub(crate) fn derivative_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
     }
 }
 
+/// The carried contacts of `PreparedSystem.run`'s `carried` (None: none).
+pub(crate) fn carried_contacts(
+    carried: Option<Vec<Option<[f64; 4]>>>,
+) -> Vec<Option<vibroimpact_core::kernel::events::CarriedContact>> {
+    carried
+        .unwrap_or_default()
+        .into_iter()
+        .map(|c| c.map(carried_contact))
+        .collect()
+}
+
 /// A carried contact from its four values (see `PreparedSystem.run`).
 pub(crate) fn carried_contact(
     [approach_rate, onset, approach_speed, max_indentation]: [f64; 4],

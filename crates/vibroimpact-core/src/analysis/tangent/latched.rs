@@ -80,13 +80,17 @@ impl Latched {
     }
 
     /// At the run's start: a contact resumed there latched the state's own
-    /// closing speed `|h . v|`, whose row is `sign(h . v) [0, h]`.
+    /// closing speed `|h . v|`, whose row is `sign(h . v) [0, h]`; one
+    /// carried from the run before (its rate not the state's) has none.
     pub(super) fn resume(&mut self, system: &Assembly, y: &[f64], modes: &[Mode]) {
         let (d, size) = (system.dim, 2 * system.dim);
         self.rows.iter_mut().for_each(|v| *v = 0.0);
         for (i, mode) in modes.iter().enumerate() {
-            if self.which[i] && matches!(mode, Mode::Compliant { .. }) {
+            if let (true, Mode::Compliant { approach_rate, .. }) = (self.which[i], mode) {
                 let (_, rate) = system.gap(i, y);
+                if (approach_rate - rate.abs()).abs() > 1e-12 * approach_rate {
+                    continue;
+                }
                 let h = &system.interactions()[i].h;
                 for (c, hc) in h.iter().enumerate() {
                     self.rows[i * size + d + c] = rate.signum() * hc;
