@@ -183,3 +183,28 @@ def test_lyapunov_exponents_of_a_periodic_orbit_through_a_contact_at_its_strobe(
     # strobe outside the contact: 0.08 and 0.28; the tangent of the latched rate is
     # not carried across the blocks).
     assert np.all(np.abs(inside.exponents - exact) < 0.3), (inside.exponents, exact)
+
+
+@pytest.mark.timeout(120)
+def test_an_orbit_whose_section_falls_inside_a_damped_contact_is_shot_on_a_clear_one() -> None:
+    # From the settled state at a phase whose strobe is inside a hertz-damped contact,
+    # Newton on the map of (x, v) (which begins the contact afresh) had converged to
+    # the non-impacting linear orbit: 0 impacts a period, 3.89e-3 m. The section is now
+    # moved out of the contact; the orbit is the settled one, its multipliers those of
+    # the same orbit shot with the strobe outside the contact.
+    inside = an.runner(_sections("hertz-damped", 0.0535))
+    settled = an.steady_state(inside, settle_periods=300, record_periods=1)
+    found = an.orbit(inside, settled.state)
+    assert found.converged and found.impacts_per_period == 2.0
+    assert found.amplitude[0] == pytest.approx(settled.amplitude[0], rel=1e-6)
+    scale = np.max(np.abs(settled.state))
+    # (The settled state is settled to 1e-6 of the motion: 4e-6 measured.)
+    assert np.allclose(found.state, settled.state, rtol=0, atol=1e-4 * scale)
+    outside = an.runner(_sections("hertz-damped", 0.2035))
+    reference = an.orbit(outside, an.steady_state(outside, settle_periods=300).state)
+    assert np.allclose(
+        np.sort_complex(found.floquet_multipliers),
+        np.sort_complex(reference.floquet_multipliers),
+        rtol=0,
+        atol=1e-6,
+    )

@@ -3,12 +3,14 @@ core), with their Floquet multipliers and stability."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from vibroimpact import arguments
+from vibroimpact._core import interactions
 from vibroimpact.analysis.limits import MAX_ITERATIONS, MAX_PERIODS, relative_tolerance, whole_count
+from vibroimpact.analysis.parameters import shifted
 from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run, state_arrays
 from vibroimpact.model.system import System
 from vibroimpact.summary import summarised
@@ -27,6 +29,10 @@ class Orbit:
     amplitude: np.ndarray
     iterations: int
     residual: float
+    #: The Jacobian of the map at the orbit: on the scenario's section, or on the one
+    #: :func:`orbit` moved out of a contact whose law latches its rate (the multipliers,
+    #: its eigenvalues, are the same on any section; ``grazings``' times are then from
+    #: the moved section).
     monodromy: np.ndarray = field(repr=False)
     #: How the monodromy was made: ``"tangent"`` (the tangent flow through the impacts,
     #: exact) or ``"differences"`` (central differences of whole runs).
@@ -44,6 +50,43 @@ class Orbit:
     def arrays(self, n: int, k: int) -> dict[str, list[float]]:
         """The state as the four arrays of ``[initial]``."""
         return state_arrays(self.state, n, k)
+
+
+#: The contact laws whose force depends on the approach rate latched at the onset, which
+#: a state (x, v) does not hold.
+LATCHING_LAWS = ("hertz-damped", "hyster-hertz")
+
+#: The fractions of the forcing period :func:`_clear_section` tries, in order.
+_SECTION_FRACTIONS = np.arange(1, 20) / 20
+
+
+def _in_latching_contact(run: Runner, z: np.ndarray) -> bool:
+    """Whether a pair whose law latches its approach rate is in contact at ``z``."""
+    spec, x = run.prepared.spec, z[: run.n + run.k]
+    for it in interactions(run.system()):
+        kind, _, index = str(it["pair"]).partition(" ")
+        parts = spec.get(kind, ())
+        law = parts[int(index)].get("law") if index.isdigit() and int(index) < len(parts) else None
+        if law in LATCHING_LAWS and it["offset"] + float(np.dot(it["h"], x)) < 0.0:
+            return True
+    return False
+
+
+def _clear_section(run: Runner, z: np.ndarray) -> tuple[Runner, np.ndarray, float]:
+    """``run``, ``z`` and 0 where no latching contact is open at ``z``; else the runner
+    of the system whose forcing starts ``fraction`` of a period later, the state there
+    on the run from ``z``, and that fraction: the first of :data:`_SECTION_FRACTIONS`
+    clear of such contacts (the Floquet multipliers do not depend on the section). As
+    the continuation's section moves away from impacts."""
+    if not _in_latching_contact(run, z):
+        return run, z, 0.0
+    for fraction in _SECTION_FRACTIONS:
+        end = run._run(z, fraction * run.period, record=False, strobe=False)["final_state"]
+        moved = np.asarray(end, dtype=float)
+        if not _in_latching_contact(run, moved):
+            spec = shifted(run.prepared.spec, float(fraction))
+            return Runner(replace(run.prepared, spec=spec), run.period), moved, float(fraction)
+    return run, z, 0.0
 
 
 @arguments.typed()
@@ -77,9 +120,17 @@ def orbit(
     if jacobian == "auto":
         jacobian = "tangent"
     z = run.initial_state() if state is None else np.asarray(state, dtype=float)
-    shot = run.shoot(z, periods, tolerance, max_iterations, jacobian)
+    # A section inside a contact whose law latches its approach rate is moved out of it:
+    # the map of (x, v) there would begin the contact afresh (see _clear_section).
+    shooting, z, moved = _clear_section(run, z)
+    shot = shooting.shoot(z, periods, tolerance, max_iterations, jacobian)
     size = len(z)
     z = np.asarray(shot["state"], dtype=float)
+    if moved:
+        # Back on the scenario's section: the rest of the period from the moved one (its
+        # run's open contact is carried to the recording below).
+        rest = (1.0 - moved) * run.period
+        z = np.asarray(shooting._run(z, rest, record=False, strobe=False)["final_state"])
     jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
     converged = bool(shot["converged"])
     iterations = int(shot["iterations"])
