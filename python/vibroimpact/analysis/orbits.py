@@ -8,7 +8,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact._core import interactions
 from vibroimpact.analysis.limits import MAX_ITERATIONS, MAX_PERIODS, relative_tolerance, whole_count
 from vibroimpact.analysis.parameters import shifted
 from vibroimpact.analysis.runs import Runner, _impacts, as_runner, checked_run, state_arrays
@@ -60,16 +59,22 @@ LATCHING_LAWS = ("hertz-damped", "hyster-hertz")
 _SECTION_FRACTIONS = np.arange(1, 20) / 20
 
 
-def _in_latching_contact(run: Runner, z: np.ndarray) -> bool:
-    """Whether a pair whose law latches its approach rate is in contact at ``z``."""
-    spec, x = run.prepared.spec, z[: run.n + run.k]
-    for it in interactions(run.system()):
+def _latching_walls(run: Runner) -> list[tuple[np.ndarray, float]]:
+    """The row ``h`` and offset (m) of each interaction whose law latches its approach
+    rate (its gap ``offset + h . x``)."""
+    spec, walls = run.prepared.spec, []
+    for it in run.walls():
         kind, _, index = str(it["pair"]).partition(" ")
         parts = spec.get(kind, ())
         law = parts[int(index)].get("law") if index.isdigit() and int(index) < len(parts) else None
-        if law in LATCHING_LAWS and it["offset"] + float(np.dot(it["h"], x)) < 0.0:
-            return True
-    return False
+        if law in LATCHING_LAWS:
+            walls.append((np.asarray(it["h"], dtype=float), float(it["offset"])))
+    return walls
+
+
+def _in_contact(walls: list[tuple[np.ndarray, float]], z: np.ndarray) -> bool:
+    """Whether any of ``walls`` is in contact at the state ``z`` (x then v)."""
+    return any(offset + float(np.dot(h, z[: len(h)])) < 0.0 for h, offset in walls)
 
 
 def _clear_section(run: Runner, z: np.ndarray) -> tuple[Runner, np.ndarray, float]:
@@ -78,12 +83,13 @@ def _clear_section(run: Runner, z: np.ndarray) -> tuple[Runner, np.ndarray, floa
     on the run from ``z``, and that fraction: the first of :data:`_SECTION_FRACTIONS`
     clear of such contacts (the Floquet multipliers do not depend on the section). As
     the continuation's section moves away from impacts."""
-    if not _in_latching_contact(run, z):
+    walls = _latching_walls(run)
+    if not _in_contact(walls, z):
         return run, z, 0.0
     for fraction in _SECTION_FRACTIONS:
         end = run._run(z, fraction * run.period, record=False, strobe=False)["final_state"]
         moved = np.asarray(end, dtype=float)
-        if not _in_latching_contact(run, moved):
+        if not _in_contact(walls, moved):
             spec = shifted(run.prepared.spec, float(fraction))
             return Runner(replace(run.prepared, spec=spec), run.period), moved, float(fraction)
     return run, z, 0.0

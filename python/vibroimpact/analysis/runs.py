@@ -74,7 +74,7 @@ class Runner:
     k: int = 0
     runs: int = 0
     _prepared_system: PreparedSystem | None = field(default=None, repr=False)
-    _interactions: int | None = field(default=None, repr=False)
+    _walls: list[dict[str, Any]] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         self.n = structure_coordinates(self.prepared.spec["structure"])
@@ -165,12 +165,17 @@ class Runner:
             final = np.asarray(raw["final_state"], dtype=float).tobytes()
             _CARRIED[final, len(shifted)] = shifted
 
-    def interaction_count(self) -> int:
+    def walls(self) -> list[dict[str, Any]]:
         """The system's interactions (a damper's two walls, each stop, collision and
-        friction element): the length of its runs' ``open_contacts``."""
-        if self._interactions is None:
-            self._interactions = len(interactions(self.system()))
-        return self._interactions
+        friction element), as the compiled core's ``interactions`` gives them (made
+        once)."""
+        if self._walls is None:
+            self._walls = interactions(self.system())
+        return self._walls
+
+    def interaction_count(self) -> int:
+        """The length of the system's runs' ``open_contacts``: one per interaction."""
+        return len(self.walls())
 
     def system(self) -> PreparedSystem:
         """The core's checked system with its method (made once)."""
