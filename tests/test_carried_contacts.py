@@ -18,6 +18,8 @@ import pytest
 
 import vibroimpact as vi
 from vibroimpact import analysis as an
+from vibroimpact.analysis.parameters import shifted
+from vibroimpact.analysis.runs import state_arrays
 
 FREQUENCY = 11.5
 PERIOD = 1.0 / FREQUENCY
@@ -208,3 +210,89 @@ def test_an_orbit_whose_section_falls_inside_a_damped_contact_is_shot_on_a_clear
         rtol=0,
         atol=1e-6,
     )
+
+
+@pytest.mark.timeout(120)
+def test_a_continuation_whose_section_falls_inside_a_damped_contact_follows_the_orbits() -> None:
+    # A softer contact (1e5 N/m^1.5) lasts 14 % of a period, from 4.7 % of a period
+    # before the scenario's section: the continuation shot from (x, v) there (the map
+    # begins the contact afresh), and its second point was another map's orbit, 3
+    # impacts a period and 0.107 from the orbit at its frequency (2 impacts). It now
+    # moves its section clear of the contacts, and every point is the orbit `orbit`
+    # finds at its frequency.
+    sections = _sections("hertz-damped", 0.0)
+    sections["damper"][0]["stiffness"] = 1e5
+    settled = an.steady_state(an.runner(sections), settle_periods=300, record_periods=1)
+    contacts = an.runner(sections).periods(settled.state, 1)["contacts"]
+    assert np.asarray(contacts["onset"])[0] < 0.0  # the section is inside a contact
+    sections["initial"] = state_arrays(settled.state, 1, 1)
+    branch = an.continue_orbit(sections, "excitation.0.frequency", stop=12.0, max_points=6)
+    assert len(branch.points) == 6
+    for point in branch.points:
+        at = dict(sections, excitation=[dict(sections["excitation"][0], frequency=point.value)])
+        found = an.orbit(an.runner(at), point.state)
+        assert found.converged and found.impacts_per_period == point.impacts_per_period == 2.0
+        scale = np.max(np.abs(found.state))
+        assert np.allclose(point.state, found.state, rtol=0, atol=1e-6 * scale)
+        assert point.amplitude[0] == pytest.approx(found.amplitude[0], rel=1e-6)
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize(("path", "step"), [("amplitude", 0.01), ("frequency", 1e-4)])
+def test_an_orbits_derivatives_through_a_section_inside_a_damped_contact(
+    path: str, step: float
+) -> None:
+    # The orbit's state at a section 4.7 % of a period into a hertz-damped contact: the
+    # implicit function theorem on the map of (x, v) there (which begins the contact
+    # afresh) had given the damper's velocity's derivative in the amplitude 3 times too
+    # large and the amplitude's 16 % small. Now equal to central differences of the
+    # orbits themselves.
+    sections = _sections("hertz-damped", 0.0)
+    sections["damper"][0]["stiffness"] = 1e5
+    run = an.runner(sections)
+    found = an.orbit(run, an.steady_state(run, settle_periods=300, record_periods=1).state)
+    key = f"excitation.0.{path}"
+    derivative = an.orbit_derivatives(sections, found, [key])[key]
+    value = sections["excitation"][0][path]
+    sides = []
+    for shift in (step, -step):
+        at = dict(sections, excitation=[dict(sections["excitation"][0], **{path: value + shift})])
+        sides.append(an.orbit(an.runner(at), found.state))
+    differences = (sides[0].state - sides[1].state) / (2 * step)
+    scale = np.max(np.abs(differences))
+    assert np.allclose(derivative.state, differences, rtol=0, atol=1e-4 * scale)
+    amplitude = (sides[0].amplitude - sides[1].amplitude) / (2 * step)
+    assert derivative.amplitude == pytest.approx(amplitude, rel=1e-4)
+
+
+@pytest.mark.timeout(120)
+def test_an_orbit_shot_on_a_moved_section_reports_the_monodromy_of_its_own() -> None:
+    # The orbit's state is on the scenario's section (inside a contact); its monodromy
+    # had been the moved section's (the same multipliers, another matrix). Now the
+    # scenario's section's: as differences of continuous runs from a clear instant
+    # through that section and one period on, M = D(two) D(one)^-1.
+    sections = _sections("hertz-damped", 0.0)
+    sections["damper"][0]["stiffness"] = 1e5
+    run = an.runner(sections)
+    found = an.orbit(run, an.steady_state(run, settle_periods=300, record_periods=1).state)
+    fraction = 0.3
+    clear = an.runner(shifted(sections, fraction))
+    start = np.asarray(
+        run._run(found.state, fraction * PERIOD, record=False, strobe=False)["final_state"]
+    )
+
+    def after(z: np.ndarray, periods: float) -> np.ndarray:
+        end = clear._run(z, (periods - fraction) * PERIOD, record=False, strobe=False)[
+            "final_state"
+        ]
+        return np.asarray(end, dtype=float)
+
+    one, two = np.zeros((4, 4)), np.zeros((4, 4))
+    for j in range(4):
+        e = np.zeros(4)
+        e[j] = 1e-7 * max(abs(start[j]), 1e-3)
+        one[:, j] = after(start + e, 1) - after(start - e, 1)
+        two[:, j] = after(start + e, 2) - after(start - e, 2)
+    expected = two @ np.linalg.inv(one)
+    scale = np.max(np.abs(expected))
+    assert np.allclose(found.monodromy, expected, rtol=0, atol=1e-5 * scale)

@@ -405,30 +405,35 @@ class _Arc:
 
     def clear_of_impacts(self, u: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``u`` and ``t`` on a section moved away from the impacts, if one is near."""
-        if not self.shiftable:
+        moved = self.cleared(u)
+        if moved is u:
             return u, t
+        new_t = self.tangent(self.jacobian(moved), None)
+        return moved, (new_t if new_t[self.size] * t[self.size] > 0 else -new_t)
+
+    def cleared(self, u: np.ndarray) -> np.ndarray:
+        """``u`` on a section moved to the middle of the widest stretch of the orbit
+        clear of contacts where an impact is near the section or a contact is open
+        across it (a contact's state (x, v) does not hold its onset, nor a damped law's
+        latched approach rate: the map would begin it afresh); ``u`` itself otherwise."""
+        if not self.shiftable:
+            return u
         p = float(u[self.size] * self.scale[self.size])
         z = u[: self.size] * self.scale[: self.size]
         run = self.run_at(p)
-        raw = run.periods(z, self.periods)
-        onsets = np.asarray(raw["contacts"]["onset"], dtype=float)
-        if onsets.size == 0:
-            return u, t
         span_t = self.periods * run.period
-        phases = np.sort(np.mod(onsets / span_t, 1.0))
-        near = min(float(phases[0]), float(1.0 - phases[-1]))
-        if near > 0.02:
-            return u, t
-        gaps = np.diff(np.concatenate([phases, [phases[0] + 1.0]]))
-        widest = int(np.argmax(gaps))
-        move = float(phases[widest] + gaps[widest] / 2) % 1.0
+        contacts = run.periods(z, self.periods)["contacts"]
+        move = _clear_phase(
+            np.asarray(contacts["onset"], dtype=float) / span_t,
+            np.asarray(contacts["separation"], dtype=float) / span_t,
+        )
+        if move is None:
+            return u
         moved = np.asarray(
             run._run(z, move * span_t, record=False, strobe=False)["final_state"], dtype=float
         )
         self.section = (self.section + move * self.periods) % 1.0
-        u = np.concatenate([moved / self.scale[: self.size], [u[self.size]]])
-        new_t = self.tangent(self.jacobian(u), None)
-        return u, (new_t if new_t[self.size] * t[self.size] > 0 else -new_t)
+        return np.concatenate([moved / self.scale[: self.size], [u[self.size]]])
 
     def correct(self, predicted: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """The orbit on the plane through ``predicted`` normal to ``t`` (Newton) and its
@@ -562,6 +567,8 @@ class _Arc:
         stopped."""
         dim = self.size // 2
         u = np.concatenate([state, [start_value]]) / self.scale
+        # The branch's Jacobian from a section clear of contacts (see `cleared`).
+        u = self.cleared(u)
         jac = self.jacobian(u)
         t = self.tangent(jac, None)
         points = [self.point(u, jac)]
@@ -673,6 +680,39 @@ class _Arc:
                 stopped = "reached stop"
                 break
         return points, stopped
+
+
+#: How near the section (a fraction of the orbit's periods) an impact moves it.
+SECTION_MARGIN = 0.02
+
+
+def _clear_phase(onsets: np.ndarray, separations: np.ndarray) -> float | None:
+    """Where to put the section (a fraction of the run from it) given the contacts of
+    one run over the orbit's periods from the section, their ``onsets`` and
+    ``separations`` as fractions of that run (an onset < 0: a contact carried across
+    the section; a separation NaN: one open at the run's end, across the section too):
+    None where no onset is within :data:`SECTION_MARGIN` of the section and no contact
+    spans it; else the middle of the widest stretch between the contacts."""
+    if onsets.size == 0:
+        return None
+    ends = np.where(np.isnan(separations), 1.0, np.maximum(separations, onsets))
+    phases = np.mod(onsets, 1.0)
+    across = bool(np.any(onsets < 0.0) or np.any(ends >= 1.0))
+    near = min(float(np.min(phases)), float(1.0 - np.max(phases)))
+    if near > SECTION_MARGIN and not across:
+        return None
+    # The contacts as arcs of the circle of phases, from each onset; the stretch after
+    # each arc to the next one's start, clear of them all.
+    starts = phases
+    stops = phases + (ends - onsets)
+    order = np.argsort(starts)
+    starts, stops = starts[order], np.maximum.accumulate(stops[order])
+    following = np.concatenate([starts[1:], [starts[0] + 1.0]])
+    clear = following - stops
+    widest = int(np.argmax(clear))
+    if clear[widest] <= 0.0:
+        return None
+    return float(stops[widest] + clear[widest] / 2) % 1.0
 
 
 def _value_of(

@@ -132,12 +132,15 @@ def orbit(
     shot = shooting.shoot(z, periods, tolerance, max_iterations, jacobian)
     size = len(z)
     z = np.asarray(shot["state"], dtype=float)
+    jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
     if moved:
         # Back on the scenario's section: the rest of the period from the moved one (its
-        # run's open contact is carried to the recording below).
+        # run's open contact is carried to the recording below), and the monodromy
+        # there, conjugated by the flow over that rest (the same multipliers).
         rest = (1.0 - moved) * run.period
+        flow = np.asarray(shooting.tangent(z, rest)["matrix"], dtype=float)
         z = np.asarray(shooting._run(z, rest, record=False, strobe=False)["final_state"])
-    jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
+        jac = flow @ jac @ np.linalg.inv(flow)
     converged = bool(shot["converged"])
     iterations = int(shot["iterations"])
     residual = float(shot["residual"])

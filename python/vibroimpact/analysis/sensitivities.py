@@ -13,7 +13,7 @@ settled state (:func:`settled_derivatives`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +23,8 @@ from vibroimpact import arguments
 from vibroimpact._core import SimulationError
 from vibroimpact.analysis.continuation import _value_of
 from vibroimpact.analysis.limits import AnalysisError
-from vibroimpact.analysis.orbits import Orbit, orbit
+from vibroimpact.analysis.orbits import Orbit, _clear_section, orbit
+from vibroimpact.analysis.parameters import shifted as shifted_data
 from vibroimpact.analysis.parameters import with_parameter, with_parameter_path_check
 from vibroimpact.analysis.runs import Runner, runner
 from vibroimpact.analysis.steady import SteadyState
@@ -118,6 +119,11 @@ def orbit_derivatives(
     out: dict[str, Derivative] = {}
     size = len(found.state)
     base = runner(data, base_dir)
+    _, moved, fraction = _clear_section(base, found.state)
+    if fraction:
+        # The section inside a contact whose law latches its approach rate: the map of
+        # (x, v) there begins the contact afresh. On a section clear of it, then back.
+        return _from_clear_section(data, found, paths, (moved, fraction), base_dir)
     sides = [_sides(data, path, base, base_dir) for path in paths]
     shifted = [(up, down, (s_up - s_down) / 2) for (up, s_up), (down, s_down) in sides]
     map_by = map_derivatives(base, found.state, periods, shifted)
@@ -133,6 +139,38 @@ def orbit_derivatives(
         out[path] = Derivative(
             state, *((up - down) / width for up, down in zip(*amplitudes, strict=True))
         )
+    return out
+
+
+def _from_clear_section(
+    data: Mapping[str, Any],
+    found: Orbit,
+    paths: list[str],
+    section: tuple[np.ndarray, float],
+    base_dir: Path | None,
+) -> dict[str, Derivative]:
+    """:func:`orbit_derivatives` of ``found`` through the state ``moved`` a ``fraction``
+    of a period after its own (``section``, clear of contacts): there by the implicit
+    function theorem, then carried to t = 0 along the rest of the period, ``z0 =
+    F(z, p)``: ``dz0/dp = (dF/dz) dz/dp + dF/dp`` (the tangent flow, and differences
+    of the runs in the parameter). The amplitudes are the whole orbit's, on any section."""
+    moved, fraction = section
+    clear = shifted_data(dict(data), fraction)
+    base = runner(clear, base_dir)
+    monodromy = base.tangent(moved, found.periods * base.period)["matrix"]
+    on_clear = orbit_derivatives(
+        clear, replace(found, state=moved, monodromy=monodromy), paths, base_dir=base_dir
+    )
+    rest = base.tangent(moved, (1.0 - fraction) * base.period)["matrix"]
+    out: dict[str, Derivative] = {}
+    for path in paths:
+        ends = []
+        for run, shift in _sides(clear, path, base, base_dir):
+            end = run._run(moved, (1.0 - fraction) * run.period, record=False, strobe=False)
+            ends.append((np.asarray(end["final_state"], dtype=float), shift))
+        (up, s_up), (down, s_down) = ends
+        state = rest @ on_clear[path].state + (up - down) / (s_up - s_down)
+        out[path] = replace(on_clear[path], state=state)
     return out
 
 
