@@ -18,6 +18,7 @@ import pytest
 
 import vibroimpact as vi
 from vibroimpact import analysis as an
+from vibroimpact import study as st
 from vibroimpact.analysis.parameters import shifted
 from vibroimpact.analysis.runs import state_arrays
 
@@ -213,28 +214,42 @@ def test_an_orbit_whose_section_falls_inside_a_damped_contact_is_shot_on_a_clear
 
 
 @pytest.mark.timeout(120)
-def test_a_continuation_whose_section_falls_inside_a_damped_contact_follows_the_orbits() -> None:
-    # A softer contact (1e5 N/m^1.5) lasts 14 % of a period, from 4.7 % of a period
-    # before the scenario's section: the continuation shot from (x, v) there (the map
-    # begins the contact afresh), and its second point was another map's orbit, 3
-    # impacts a period and 0.107 from the orbit at its frequency (2 impacts). It now
-    # moves its section clear of the contacts, and every point is the orbit `orbit`
-    # finds at its frequency.
+@pytest.mark.parametrize(
+    ("stiffness", "path", "stop"),
+    [(1e5, "frequency", 12.0), (1e6, "amplitude", 6.0)],
+)
+def test_a_continuation_whose_section_falls_inside_a_damped_contact_follows_the_orbits(
+    stiffness: float, path: str, stop: float
+) -> None:
+    # A soft contact (1e5 N/m^1.5) lasts 14 % of a period, from 4.7 % of a period before
+    # the scenario's section: the continuation shot from (x, v) there (the map begins
+    # the contact afresh), and its second point was another map's orbit, 3 impacts a
+    # period and 0.107 from the orbit at its frequency (2 impacts). It now moves its
+    # section clear of the contacts, and every point is the orbit `orbit` finds at its
+    # value. At 1e6 the first point had not been (0.5 % off in amplitude, |mu| 0.889 for
+    # 0.892): its state, scaled and back, lost an ulp, and the contact open at the
+    # section was begun afresh.
     sections = _sections("hertz-damped", 0.0)
-    sections["damper"][0]["stiffness"] = 1e5
+    sections["damper"][0]["stiffness"] = stiffness
     settled = an.steady_state(an.runner(sections), settle_periods=300, record_periods=1)
     contacts = an.runner(sections).periods(settled.state, 1)["contacts"]
     assert np.asarray(contacts["onset"])[0] < 0.0  # the section is inside a contact
     sections["initial"] = state_arrays(settled.state, 1, 1)
-    branch = an.continue_orbit(sections, "excitation.0.frequency", stop=12.0, max_points=6)
+    branch = an.continue_orbit(sections, f"excitation.0.{path}", stop=stop, max_points=6)
     assert len(branch.points) == 6
     for point in branch.points:
-        at = dict(sections, excitation=[dict(sections["excitation"][0], frequency=point.value)])
+        at = dict(sections, excitation=[dict(sections["excitation"][0], **{path: point.value})])
         found = an.orbit(an.runner(at), point.state)
         assert found.converged and found.impacts_per_period == point.impacts_per_period == 2.0
         scale = np.max(np.abs(found.state))
         assert np.allclose(point.state, found.state, rtol=0, atol=1e-6 * scale)
         assert point.amplitude[0] == pytest.approx(found.amplitude[0], rel=1e-6)
+        assert np.allclose(
+            np.sort(np.abs(point.floquet_multipliers)),
+            np.sort(np.abs(found.floquet_multipliers)),
+            rtol=0,
+            atol=1e-6,
+        )
 
 
 @pytest.mark.timeout(120)
@@ -296,3 +311,65 @@ def test_an_orbit_shot_on_a_moved_section_reports_the_monodromy_of_its_own() -> 
     expected = two @ np.linalg.inv(one)
     scale = np.max(np.abs(expected))
     assert np.allclose(found.monodromy, expected, rtol=0, atol=1e-5 * scale)
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("phase", [0.0, 2.0])
+def test_an_orbit_studys_section_inside_a_damped_contact_is_moved_clear(phase: float) -> None:
+    # At phase 0 the settled state is 4.7 % of a period into a hertz-damped contact: the
+    # core's orbit study shot from (x, v) there (the contact begun afresh) and reported 3
+    # impacts a period for 2, the largest multiplier 0.852 for 0.894 and an amplitude
+    # 13 % high. It now shoots on a section clear of the contact: the orbit `orbit`
+    # finds, as at phase 2 (strobe outside the contacts).
+    sections = _sections("hertz-damped", phase)
+    sections["damper"][0]["stiffness"] = 1e5
+    run = an.runner(sections)
+    found = an.orbit(run, an.steady_state(run, settle_periods=300, record_periods=1).state)
+    metrics = ["amplitude", "impacts_per_period", "stable", "largest_multiplier"]
+    study = st.study_of(
+        dict(
+            sections,
+            solver={"method": "dop853", "t_end": 1.0},
+            study={
+                "analysis": "orbit",
+                "settle_periods": 300,
+                "metrics": metrics,
+                "axes": {"excitation.0.amplitude": [5.0]},
+            },
+        )
+    )
+    point = study.run_chunk(range(1), threads=1)
+    assert int(np.asarray(point["status"])[0]) == 0
+    assert float(np.asarray(point["impacts_per_period"])[0]) == found.impacts_per_period == 2.0
+    largest = float(np.max(np.abs(found.floquet_multipliers)))
+    assert float(np.asarray(point["largest_multiplier"])[0]) == pytest.approx(largest, abs=1e-6)
+    amplitude = float(np.asarray(point["peak"]).ravel()[0])
+    assert amplitude == pytest.approx(found.amplitude[0], rel=1e-6)
+
+
+@pytest.mark.timeout(120)
+def test_a_two_period_orbit_through_damped_contacts_keeps_its_own_point() -> None:
+    # A period-2 orbit whose two points on the section are both inside hertz-damped
+    # contacts: orbit had returned the other point (one period on from the moved
+    # section), and orbit_derivatives carried the derivative there, 100 % off the
+    # derivative of the orbit's own point. Now the orbit's own point (the settled
+    # state's), and its derivative equal to central differences of the orbits.
+    sections = _sections("hertz-damped", 5.760)
+    sections["damper"][0]["stiffness"] = 1e6
+    sections["excitation"][0].update(frequency=10.5, amplitude=6.0)
+    run = an.runner(sections)
+    settled = an.steady_state(run, settle_periods=400, record_periods=8)
+    assert settled.period == 2
+    found = an.orbit(run, settled.state, periods=2)
+    assert found.converged
+    scale = np.max(np.abs(found.state))
+    assert np.allclose(found.state, settled.state, rtol=0, atol=1e-4 * scale)
+    key, step = "excitation.0.amplitude", 6e-4
+    derivative = an.orbit_derivatives(sections, found, [key])[key]
+    sides = []
+    for shift in (step, -step):
+        at = dict(sections, excitation=[dict(sections["excitation"][0], amplitude=6.0 + shift)])
+        sides.append(an.orbit(an.runner(at), found.state, periods=2, tolerance=1e-12).state)
+    differences = (sides[0] - sides[1]) / (2 * step)
+    size = np.max(np.abs(differences))
+    assert np.allclose(derivative.state, differences, rtol=0, atol=2e-3 * size)

@@ -166,7 +166,9 @@ pub fn lyapunov_spectrum<'py>(
 
 /// Each interaction (a wall of a pair) of the prepared system: `pair` (its
 /// pair's name, as the contact table gives it), `h` (over all coordinates,
-/// dense) and `offset` (m), its gap being `offset + h . x`.
+/// dense) and `offset` (m), its gap being `offset + h . x`; `latches`,
+/// whether its law's force depends on the approach rate latched at the
+/// contact's onset (which a state inside the contact does not hold).
 #[pyfunction]
 pub fn interactions<'py>(
     py: Python<'py>,
@@ -180,6 +182,7 @@ pub fn interactions<'py>(
         row.set_item("pair", system.pairs[it.pair].clone())?;
         row.set_item("h", it.h.clone().into_pyarray(py))?;
         row.set_item("offset", it.offset)?;
+        row.set_item("latches", it.law.latches())?;
         out.append(row)?;
     }
     Ok(out)

@@ -411,15 +411,18 @@ class _Arc:
         new_t = self.tangent(self.jacobian(moved), None)
         return moved, (new_t if new_t[self.size] * t[self.size] > 0 else -new_t)
 
-    def cleared(self, u: np.ndarray) -> np.ndarray:
+    def cleared(self, u: np.ndarray, state: np.ndarray | None = None) -> np.ndarray:
         """``u`` on a section moved to the middle of the widest stretch of the orbit
         clear of contacts where an impact is near the section or a contact is open
         across it (a contact's state (x, v) does not hold its onset, nor a damped law's
-        latched approach rate: the map would begin it afresh); ``u`` itself otherwise."""
+        latched approach rate: the map would begin it afresh); ``u`` itself otherwise.
+        ``state``: ``u``'s state unscaled, where known to the bit (a run's final state,
+        whose open contacts the runners keep: scaled and back it may differ by an ulp
+        and the contact would be begun afresh)."""
         if not self.shiftable:
             return u
         p = float(u[self.size] * self.scale[self.size])
-        z = u[: self.size] * self.scale[: self.size]
+        z = u[: self.size] * self.scale[: self.size] if state is None else state
         run = self.run_at(p)
         span_t = self.periods * run.period
         contacts = run.periods(z, self.periods)["contacts"]
@@ -568,7 +571,7 @@ class _Arc:
         dim = self.size // 2
         u = np.concatenate([state, [start_value]]) / self.scale
         # The branch's Jacobian from a section clear of contacts (see `cleared`).
-        u = self.cleared(u)
+        u = self.cleared(u, state)
         jac = self.jacobian(u)
         t = self.tangent(jac, None)
         points = [self.point(u, jac)]

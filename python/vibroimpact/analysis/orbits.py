@@ -51,25 +51,19 @@ class Orbit:
         return state_arrays(self.state, n, k)
 
 
-#: The contact laws whose force depends on the approach rate latched at the onset, which
-#: a state (x, v) does not hold.
-LATCHING_LAWS = ("hertz-damped", "hyster-hertz")
-
 #: The fractions of the forcing period :func:`_clear_section` tries, in order.
 _SECTION_FRACTIONS = np.arange(1, 20) / 20
 
 
 def _latching_walls(run: Runner) -> list[tuple[np.ndarray, float]]:
     """The row ``h`` and offset (m) of each interaction whose law latches its approach
-    rate (its gap ``offset + h . x``)."""
-    spec, walls = run.prepared.spec, []
-    for it in run.walls():
-        kind, _, index = str(it["pair"]).partition(" ")
-        parts = spec.get(kind, ())
-        law = parts[int(index)].get("law") if index.isdigit() and int(index) < len(parts) else None
-        if law in LATCHING_LAWS:
-            walls.append((np.asarray(it["h"], dtype=float), float(it["offset"])))
-    return walls
+    rate at the contact's onset, which a state (x, v) does not hold (its gap ``offset +
+    h . x``)."""
+    return [
+        (np.asarray(it["h"], dtype=float), float(it["offset"]))
+        for it in run.walls()
+        if it["latches"]
+    ]
 
 
 def _in_contact(walls: list[tuple[np.ndarray, float]], z: np.ndarray) -> bool:
@@ -134,10 +128,11 @@ def orbit(
     z = np.asarray(shot["state"], dtype=float)
     jac = np.asarray(shot["monodromy"], dtype=float).reshape(size, size)
     if moved:
-        # Back on the scenario's section: the rest of the period from the moved one (its
-        # run's open contact is carried to the recording below), and the monodromy
-        # there, conjugated by the flow over that rest (the same multipliers).
-        rest = (1.0 - moved) * run.period
+        # Back on the scenario's section at the orbit's own point: the rest of its
+        # periods from the moved section (its run's open contact is carried to the
+        # recording below), and the monodromy there, conjugated by the flow over that
+        # rest (the same multipliers).
+        rest = (periods - moved) * run.period
         flow = np.asarray(shooting.tangent(z, rest)["matrix"], dtype=float)
         z = np.asarray(shooting._run(z, rest, record=False, strobe=False)["final_state"])
         jac = flow @ jac @ np.linalg.inv(flow)

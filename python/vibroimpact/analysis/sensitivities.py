@@ -151,9 +151,10 @@ def _from_clear_section(
 ) -> dict[str, Derivative]:
     """:func:`orbit_derivatives` of ``found`` through the state ``moved`` a ``fraction``
     of a period after its own (``section``, clear of contacts): there by the implicit
-    function theorem, then carried to t = 0 along the rest of the period, ``z0 =
-    F(z, p)``: ``dz0/dp = (dF/dz) dz/dp + dF/dp`` (the tangent flow, and differences
-    of the runs in the parameter). The amplitudes are the whole orbit's, on any section."""
+    function theorem, then carried along the flow over the rest of the orbit's periods
+    to its own point, ``z0 = F(z, p)``: ``dz0/dp = (dF/dz) dz/dp + dF/dp`` (the tangent
+    flow, and differences of the runs in the parameter). The amplitudes are the whole
+    orbit's, on any section."""
     moved, fraction = section
     clear = shifted_data(dict(data), fraction)
     base = runner(clear, base_dir)
@@ -161,12 +162,14 @@ def _from_clear_section(
     on_clear = orbit_derivatives(
         clear, replace(found, state=moved, monodromy=monodromy), paths, base_dir=base_dir
     )
-    rest = base.tangent(moved, (1.0 - fraction) * base.period)["matrix"]
+    # To the orbit's own point: the rest of its periods.
+    rest = base.tangent(moved, (found.periods - fraction) * base.period)["matrix"]
     out: dict[str, Derivative] = {}
     for path in paths:
         ends = []
         for run, shift in _sides(clear, path, base, base_dir):
-            end = run._run(moved, (1.0 - fraction) * run.period, record=False, strobe=False)
+            length = (found.periods - fraction) * run.period
+            end = run._run(moved, length, record=False, strobe=False)
             ends.append((np.asarray(end["final_state"], dtype=float), shift))
         (up, s_up), (down, s_down) = ends
         state = rest @ on_clear[path].state + (up - down) / (s_up - s_down)

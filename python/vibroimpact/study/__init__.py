@@ -65,8 +65,10 @@ central differences, as :func:`vibroimpact.analysis.orbit`, in the core): ``stab
 is true when it converged and every Floquet multiplier is inside the unit circle,
 ``largest_multiplier`` the largest multiplier's modulus, ``amplitude`` and
 ``impacts_per_period`` those of the orbit, ``largest_lyapunov`` its largest multiplier's
-``ln |mu| / T``. A point whose shooting fails (no orbit near its
-settled state) is recorded with its reason. Both periodic analyses use the common period
+``ln |mu| / T``. A settled state inside a contact whose law latches its approach rate
+(``hertz-damped``, ``hyster-hertz``) is shot from on a section moved clear of it, as
+:func:`vibroimpact.analysis.orbit` moves its own. A point whose shooting fails (no orbit
+near its settled state) is recorded with its reason. Both periodic analyses use the common period
 of the excitations (see :func:`vibroimpact.analysis.forcing_period`): other forcing is
 refused, and a point an axis makes aperiodic fails with its reason.
 

@@ -2,6 +2,7 @@
 //! dissipated, settling and (orbit studies) the Floquet multipliers.
 
 use super::run::{run_options, stepper_of};
+use super::section::{clear_section, full_state};
 use super::settings::{Analysis, StudySettings};
 
 use crate::analysis::settling::{self, MAX_PERIOD};
@@ -10,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::kernel::events::{ContactKind, RunOptions, SystemSolution};
 use crate::kernel::reductions::ReduceOptions;
 use crate::methods::registry::AnyStepper;
-use crate::model::assembly::{resumed_state, Assembly};
+use crate::model::assembly::{Assembly, SystemSpec};
 use crate::{analysis::shooting, numerics::linalg};
 
 /// Newton's tolerance and iterations for an orbit study's shooting (as
@@ -46,9 +47,11 @@ pub struct RunMetrics {
     pub largest_lyapunov: f64,
 }
 
-/// An orbit study's run: settle, shoot, then one more orbit recorded.
+/// An orbit study's run of `system` (made of `spec`): settle, shoot, then
+/// one more orbit recorded. A settled state inside a contact whose law
+/// latches is shot from on a section clear of it ([`clear_section`]).
 pub(super) fn orbit_metrics(
-    system: &Assembly,
+    (spec, system): (&SystemSpec, &Assembly),
     stepper: &mut AnyStepper,
     y0: &[f64],
     settings: &StudySettings,
@@ -72,14 +75,26 @@ pub(super) fn orbit_metrics(
             reduce,
         )
     };
-    let (n, d) = (system.n, system.dim);
+    let d = system.dim;
     let settle_options = options(settle.max(1) as f64 * period, false);
     let span_options = options(span, false);
     let record_options = options(span, true);
     let mut z = if settle > 0 {
-        stepper
-            .integrate(system, y0, &settle_options, &mut || interrupt())?
-            .final_state
+        let settled = stepper.integrate(system, y0, &settle_options, &mut || interrupt())?;
+        let cleared = clear_section(
+            (spec, system),
+            stepper,
+            &settled,
+            (settings, period),
+            interrupt,
+        )?;
+        if let Some((spec, system, state)) = cleared {
+            let mut stepper = stepper_of(&system, settings)?;
+            let sizes = (period, 0, periods);
+            let metrics = (&spec, &system);
+            return orbit_metrics(metrics, &mut stepper, &state, settings, sizes, interrupt);
+        }
+        settled.final_state
     } else {
         y0[..2 * d].to_vec()
     };
@@ -89,7 +104,7 @@ pub(super) fn orbit_metrics(
                         options: &RunOptions,
                         flow: Option<&mut Tangent<'_>>|
      -> Result<SystemSolution> {
-        let y = resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..2 * d]])?;
+        let y = full_state(system, z)?;
         let run = match flow {
             Some(flow) => {
                 stepper.integrate_observed(system, &y, options, &mut || interrupt(), flow)

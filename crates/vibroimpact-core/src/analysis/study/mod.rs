@@ -18,6 +18,7 @@ mod lockstep;
 mod metrics;
 mod parameters;
 mod run;
+mod section;
 mod settings;
 
 pub use metrics::RunMetrics;

@@ -229,7 +229,7 @@ pub(super) fn measured_on(
         }
         Analysis::Orbit { settle, periods } => {
             return orbit_metrics(
-                system,
+                (spec, system),
                 stepper,
                 &y0,
                 settings,

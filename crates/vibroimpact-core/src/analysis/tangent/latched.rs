@@ -10,7 +10,6 @@
 //! `F`: `Phi <- F Phi + G L`.
 
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
-use crate::model::contact::AnyLaw;
 use crate::numerics::linalg;
 
 /// The latched rates' rows and the buffers their onsets need.
@@ -39,15 +38,7 @@ impl Latched {
         let which: Vec<bool> = system
             .interactions()
             .iter()
-            .map(|it| {
-                matches!(
-                    it.law,
-                    InteractionLaw::Compliant {
-                        law: AnyLaw::HysterHertz(_),
-                        ..
-                    }
-                )
-            })
+            .map(|it| it.law.latches())
             .collect();
         if !which.iter().any(|w| *w) {
             return None;
@@ -103,7 +94,7 @@ impl Latched {
     /// (`x` then `v`) in `modes_before`, its latched rate `latched`: its row
     /// is `c_i (stretch matrix)`, `stretch` the flow since the last factor
     /// (None: none). False where the rate latched is not the closing speed
-    /// (a landing slower than the pressing's rate, [`AnyLaw::latched_approach_rate`]):
+    /// (a landing slower than the pressing's rate, [`crate::model::contact::AnyLaw::latched_approach_rate`]):
     /// no derivative, its row zero.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn onset(

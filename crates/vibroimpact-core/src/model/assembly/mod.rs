@@ -55,6 +55,19 @@ pub enum InteractionLaw {
 }
 
 impl InteractionLaw {
+    /// Whether the law's force depends on the approach rate latched at its
+    /// contact's onset ([`AnyLaw::HysterHertz`]: `hertz-damped`,
+    /// `hyster-hertz`), which a state (x, v) inside the contact does not hold.
+    pub fn latches(&self) -> bool {
+        matches!(
+            self,
+            Self::Compliant {
+                law: AnyLaw::HysterHertz(_),
+                ..
+            }
+        )
+    }
+
     /// Whether this is a friction element (no wall: its row's rate is a
     /// sliding velocity).
     #[inline(always)]
