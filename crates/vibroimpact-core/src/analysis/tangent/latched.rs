@@ -10,7 +10,20 @@
 //! `F`: `Phi <- F Phi + G L`.
 
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
+use crate::model::contact::AnyLaw;
 use crate::numerics::linalg;
+
+/// What an onset's row is the derivative of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum OnsetRow {
+    /// The closing speed (the rate latched).
+    Closing,
+    /// The law's floor, latched where the landing is slower (the row is the
+    /// state's; a parameter's column does not take it).
+    Floor,
+    /// Neither: no derivative (a grazing).
+    Undefined,
+}
 
 /// The latched rates' rows and the buffers their onsets need.
 pub(super) struct Latched {
@@ -93,9 +106,10 @@ impl Latched {
     /// Interaction `i`'s contact starts at `time` from the state `before`
     /// (`x` then `v`) in `modes_before`, its latched rate `latched`: its row
     /// is `c_i (stretch matrix)`, `stretch` the flow since the last factor
-    /// (None: none). False where the rate latched is not the closing speed
-    /// (a landing slower than the pressing's rate, [`crate::model::contact::AnyLaw::latched_approach_rate`]):
-    /// no derivative, its row zero.
+    /// (None: none). Where the rate latched is the floor of a landing slower
+    /// than the pressing's rate ([`crate::model::contact::AnyLaw::latched_approach_rate`]),
+    /// `c_i` is the floor's derivative ([`Self::floor_row`]); where neither
+    /// (no closing speed), no derivative: its row zero.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn onset(
         &mut self,
@@ -105,44 +119,125 @@ impl Latched {
         latched: f64,
         stretch: Option<&[f64]>,
         matrix: &[f64],
-    ) -> bool {
+    ) -> OnsetRow {
         let (d, size) = (system.dim, 2 * system.dim);
         let h = &system.interactions()[i].h;
         let closing = -linalg::dot(h, &before[d..size]);
         let row = &mut self.rows[i * size..(i + 1) * size];
         row.iter_mut().for_each(|v| *v = 0.0);
-        if closing.is_nan() || closing <= 0.0 || latched > closing * (1.0 + 1e-12) {
-            return false;
+        if closing.is_nan() || closing <= 0.0 {
+            return OnsetRow::Undefined;
         }
         self.full[..size].copy_from_slice(before);
-        system.rates(
-            time,
-            &self.full,
-            modes_before,
-            &mut self.scratch,
-            &mut self.rates,
-        );
-        let shift = linalg::dot(h, &self.rates[d..size]) / -closing;
-        // c_i, then times the stretch.
-        self.row.iter_mut().for_each(|v| *v = 0.0);
-        for (c, hc) in h.iter().enumerate() {
-            self.row[c] = shift * hc;
-            self.row[d + c] = -hc;
-        }
-        self.onset_row.copy_from_slice(&self.row);
-        self.onset_shift = shift;
+        let kind = if latched > closing * (1.0 + 1e-12) {
+            if !self.floor_row(system, (time, modes_before), i, latched, closing) {
+                return OnsetRow::Undefined;
+            }
+            OnsetRow::Floor
+        } else {
+            system.rates(
+                time,
+                &self.full,
+                modes_before,
+                &mut self.scratch,
+                &mut self.rates,
+            );
+            let shift = linalg::dot(h, &self.rates[d..size]) / -closing;
+            // c_i, then times the stretch.
+            self.row.iter_mut().for_each(|v| *v = 0.0);
+            for (c, hc) in h.iter().enumerate() {
+                self.row[c] = shift * hc;
+                self.row[d + c] = -hc;
+            }
+            self.onset_row.copy_from_slice(&self.row);
+            self.onset_shift = shift;
+            OnsetRow::Closing
+        };
         if let Some(stretch) = stretch {
             let c_i = self.row.clone();
             for (col, out) in self.row.iter_mut().enumerate() {
                 *out = (0..size).map(|k| c_i[k] * stretch[k * size + col]).sum();
             }
         }
+        let row = &mut self.rows[i * size..(i + 1) * size];
         for (col, out) in row.iter_mut().enumerate() {
             *out = (0..size)
                 .map(|k| self.row[k] * matrix[k * size + col])
                 .sum();
         }
-        true
+        kind
+    }
+
+    /// `c_i` into `self.row` where interaction `i`'s latched rate is its
+    /// law's floor `r = sqrt(2 a delta_s)`, `a` the pressing (the gap's
+    /// acceleration `G` negated) at the onset state in `self.full`, which
+    /// `r` goes as `a^(5/6)`: `dr = -(5/6) (r / a) (dG/dy dy + G' dt)`, the
+    /// onset's time shift `dt = h . dx / closing` (`G'` along the flow).
+    /// `dG/dy` and `G'` by central differences (`G` is linear in the state
+    /// where no other contact is on). False where the latched rate is not
+    /// that floor.
+    fn floor_row(
+        &mut self,
+        system: &Assembly,
+        (time, modes): (f64, &[Mode]),
+        i: usize,
+        latched: f64,
+        closing: f64,
+    ) -> bool {
+        let it = &system.interactions()[i];
+        let InteractionLaw::Compliant {
+            law: AnyLaw::HysterHertz(law),
+            ..
+        } = it.law
+        else {
+            return false;
+        };
+        let (d, size) = (system.dim, 2 * system.dim);
+        let mut work = vec![0.0; system.state_len()];
+        let mut gap_acceleration = |y: &[f64], t: f64, scratch: &mut Scratch| {
+            system.gap_acceleration(i, t, y, modes, scratch, &mut work)
+        };
+        let pressing = -gap_acceleration(&self.full, time, &mut self.scratch);
+        let floor = law.resting_approach_rate(1.0 / it.inverse_mass, pressing);
+        if !(pressing > 0.0 && floor > 0.0) || (latched - floor).abs() > 1e-9 * floor {
+            return false;
+        }
+        let factor = -(5.0 / 6.0) * floor / pressing;
+        let mut moved = self.full.clone();
+        // dG/dy, a column at a time.
+        for k in 0..size {
+            let block = if k < d { 0..d } else { d..size };
+            let largest = self.full[block].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let step = 1e-6 * self.full[k].abs().max(1e-3 * largest).max(1e-300);
+            moved[k] = self.full[k] + step;
+            let up = gap_acceleration(&moved, time, &mut self.scratch);
+            moved[k] = self.full[k] - step;
+            let down = gap_acceleration(&moved, time, &mut self.scratch);
+            moved[k] = self.full[k];
+            self.row[k] = (up - down) / (2.0 * step);
+        }
+        // G' along the flow: the state moved by its rates over +-tau.
+        system.rates(time, &self.full, modes, &mut self.scratch, &mut self.rates);
+        let tau = 1e-6 * system.sticking_step.min(system.longest_period);
+        let mut along = |sign: f64, scratch: &mut Scratch| {
+            for (out, (y, r)) in moved
+                .iter_mut()
+                .zip(self.full.iter().zip(&self.rates))
+                .take(size)
+            {
+                *out = y + sign * tau * r;
+            }
+            gap_acceleration(&moved, time + sign * tau, scratch)
+        };
+        let up = along(1.0, &mut self.scratch);
+        let down = along(-1.0, &mut self.scratch);
+        let rate = (up - down) / (2.0 * tau);
+        let h = &it.h;
+        for (k, out) in self.row.iter_mut().enumerate().take(size) {
+            let shifted = if k < d { rate * h[k] / closing } else { 0.0 };
+            *out = factor * (*out + shifted);
+        }
+        self.row.iter().all(|v| v.is_finite())
     }
 
     /// Interaction `i`'s contact ends: its rate is read no more.

@@ -54,7 +54,7 @@ use crate::kernel::observe::{EventObserver, EventView};
 use crate::model::assembly::{Assembly, InteractionLaw, Mode, Scratch};
 use crate::numerics::linalg;
 use contact::{ContactSteps, Extra, Source};
-use latched::Latched;
+use latched::{Latched, OnsetRow};
 use parameters::Parameters;
 use saltation::Saltation;
 
@@ -400,10 +400,14 @@ impl<'s> Tangent<'s> {
                     let flow = stretch.then_some(&self.stretch[..]);
                     let found =
                         latched.onset(self.system, event, i, approach_rate, flow, &self.matrix);
+                    let closing = found == OnsetRow::Closing;
                     if let Some(p) = parameters.as_deref_mut() {
-                        p.onset(i, view.before, found.then_some(latched));
+                        p.onset(i, view.before, closing.then_some(latched));
                     }
-                    if !found {
+                    // A floor's row is the state's only: with parameters'
+                    // columns, still reported.
+                    let reported = found == OnsetRow::Floor && parameters.is_some();
+                    if found == OnsetRow::Undefined || reported {
                         self.grazings.push(Grazing {
                             time: view.time,
                             interaction: i,
