@@ -28,10 +28,10 @@ class Orbit:
     amplitude: np.ndarray
     iterations: int
     residual: float
-    #: The Jacobian of the map at the orbit: on the scenario's section, or on the one
-    #: :func:`orbit` moved out of a contact whose law latches its rate (the multipliers,
-    #: its eigenvalues, are the same on any section; ``grazings``' times are then from
-    #: the moved section).
+    #: The Jacobian of the map at the orbit, on the scenario's section (where :func:`orbit`
+    #: shot on a section moved out of a contact whose law latches its rate, carried back
+    #: by the flow; its eigenvalues, the multipliers, are the same on any section;
+    #: ``grazings``' times are then from the moved section).
     monodromy: np.ndarray = field(repr=False)
     #: How the monodromy was made: ``"tangent"`` (the tangent flow through the impacts,
     #: exact) or ``"differences"`` (central differences of whole runs).
