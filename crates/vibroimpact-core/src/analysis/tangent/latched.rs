@@ -18,8 +18,7 @@ use crate::numerics::linalg;
 pub(super) enum OnsetRow {
     /// The closing speed (the rate latched).
     Closing,
-    /// The law's floor, latched where the landing is slower (the row is the
-    /// state's; a parameter's column does not take it).
+    /// The law's floor, latched where the landing is slower.
     Floor,
     /// Neither: no derivative (a grazing).
     Undefined,
@@ -39,8 +38,9 @@ pub(super) struct Latched {
     rates: Vec<f64>,
     row: Vec<f64>,
     /// The last onset's `c_i` (the latched rate's derivative by the state
-    /// just before it) and its time shift's part, `h . a- / h . v-` (per
-    /// unit of the gap's change): a parameter's column reads them.
+    /// just before it) and its time shift's part: the latched rate's change
+    /// per unit of the gap's change at a fixed state (`h . a- / h . v-` for
+    /// a closing speed): a parameter's column reads them.
     pub(super) onset_row: Vec<f64>,
     pub(super) onset_shift: f64,
 }
@@ -184,22 +184,17 @@ impl Latched {
         latched: f64,
         closing: f64,
     ) -> bool {
-        let it = &system.interactions()[i];
-        let InteractionLaw::Compliant {
-            law: AnyLaw::HysterHertz(law),
-            ..
-        } = it.law
-        else {
-            return false;
-        };
         let (d, size) = (system.dim, 2 * system.dim);
         let mut work = vec![0.0; system.state_len()];
         let mut gap_acceleration = |y: &[f64], t: f64, scratch: &mut Scratch| {
             system.gap_acceleration(i, t, y, modes, scratch, &mut work)
         };
-        let pressing = -gap_acceleration(&self.full, time, &mut self.scratch);
-        let floor = law.resting_approach_rate(1.0 / it.inverse_mass, pressing);
-        if !(pressing > 0.0 && floor > 0.0) || (latched - floor).abs() > 1e-9 * floor {
+        let Some((floor, pressing)) =
+            floor_of(system, i, (time, &self.full, modes), &mut self.scratch)
+        else {
+            return false;
+        };
+        if (latched - floor).abs() > 1e-9 * floor {
             return false;
         }
         let factor = -(5.0 / 6.0) * floor / pressing;
@@ -232,12 +227,16 @@ impl Latched {
         let up = along(1.0, &mut self.scratch);
         let down = along(-1.0, &mut self.scratch);
         let rate = (up - down) / (2.0 * tau);
-        let h = &it.h;
+        let h = &system.interactions()[i].h;
         for (k, out) in self.row.iter_mut().enumerate().take(size) {
             let shifted = if k < d { rate * h[k] / closing } else { 0.0 };
             *out = factor * (*out + shifted);
         }
-        self.row.iter().all(|v| v.is_finite())
+        // A parameter that moves the gap moves the onset by `dg/dp /
+        // closing`, the floor with it along the flow.
+        self.onset_row.copy_from_slice(&self.row);
+        self.onset_shift = factor * rate / closing;
+        self.row.iter().all(|v| v.is_finite()) && self.onset_shift.is_finite()
     }
 
     /// Interaction `i`'s contact ends: its rate is read no more.
@@ -262,4 +261,28 @@ impl Latched {
             }
         }
     }
+}
+
+/// Interaction `i`'s floor `sqrt(2 a delta_s)` ([`crate::model::contact::HysterHertz::resting_approach_rate`])
+/// and the pressing `a` (m/s^2, the gap's acceleration negated) it is made
+/// from, at `time`, state `y` (its full length) in `modes`: None where the
+/// law has no floor there (not hysteretic, not pressed).
+pub(super) fn floor_of(
+    system: &Assembly,
+    i: usize,
+    (time, y, modes): (f64, &[f64], &[Mode]),
+    scratch: &mut Scratch,
+) -> Option<(f64, f64)> {
+    let it = &system.interactions()[i];
+    let InteractionLaw::Compliant {
+        law: AnyLaw::HysterHertz(law),
+        ..
+    } = it.law
+    else {
+        return None;
+    };
+    let mut work = vec![0.0; system.state_len()];
+    let pressing = -system.gap_acceleration(i, time, y, modes, scratch, &mut work);
+    let floor = law.resting_approach_rate(1.0 / it.inverse_mass, pressing);
+    (pressing > 0.0 && floor > 0.0).then_some((floor, pressing))
 }

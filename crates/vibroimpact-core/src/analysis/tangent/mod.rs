@@ -382,8 +382,8 @@ impl<'s> Tangent<'s> {
     /// The latched rates' rows at an event: set at a latching contact's
     /// onset (from the state's derivative just before it: the stretch's
     /// flow times the matrix), cleared at its separation. An onset whose
-    /// rate is not its closing speed has no derivative: counted with the
-    /// grazings.
+    /// rate is neither its closing speed nor its law's floor has no
+    /// derivative: counted with the grazings.
     fn latch(&mut self, view: &EventView<'_>, stretch: bool) {
         let Some(latched) = self.latched.as_mut() else {
             return;
@@ -400,14 +400,11 @@ impl<'s> Tangent<'s> {
                     let flow = stretch.then_some(&self.stretch[..]);
                     let found =
                         latched.onset(self.system, event, i, approach_rate, flow, &self.matrix);
-                    let closing = found == OnsetRow::Closing;
                     if let Some(p) = parameters.as_deref_mut() {
-                        p.onset(i, view.before, closing.then_some(latched));
+                        let defined = found != OnsetRow::Undefined;
+                        p.onset(i, event, defined.then_some((&*latched, found)));
                     }
-                    // A floor's row is the state's only: with parameters'
-                    // columns, still reported.
-                    let reported = found == OnsetRow::Floor && parameters.is_some();
-                    if found == OnsetRow::Undefined || reported {
+                    if found == OnsetRow::Undefined {
                         self.grazings.push(Grazing {
                             time: view.time,
                             interaction: i,
@@ -422,7 +419,7 @@ impl<'s> Tangent<'s> {
                 (Mode::Compliant { .. }, Mode::Open) => {
                     latched.separation(i, size);
                     if let Some(p) = parameters.as_deref_mut() {
-                        p.onset(i, view.before, None);
+                        p.onset(i, (view.time, view.before, view.modes_before), None);
                     }
                 }
                 _ => {}

@@ -19,6 +19,8 @@ use crate::model::assembly::{apart_damping, Assembly, Interaction, InteractionLa
 use crate::model::contact::ContactLaw;
 use crate::numerics::linalg;
 
+use super::latched::{floor_of, OnsetRow};
+
 /// A parameter's two assemblies: the system made at `p + delta` and at
 /// `p - delta`.
 #[derive(Debug, Clone)]
@@ -198,21 +200,44 @@ impl Parameters {
         )
     }
 
-    /// Interaction `i`'s latched approach rate at an onset from the state
-    /// `before`: its derivatives by the parameters, `c_i W- + shift dg/dp`
-    /// (`latched` the flow's rows, which hold `c_i` and the shift); zero
-    /// where none was latched (None: a separation, or no derivative).
-    pub(super) fn onset(&mut self, i: usize, before: &[f64], latched: Option<&super::Latched>) {
+    /// Interaction `i`'s latched approach rate at an onset at `time` from
+    /// the state `before` in `modes`: its derivatives by the parameters,
+    /// `c_i W- + shift dg/dp` (`latched` the flow's rows, which hold `c_i`
+    /// and the shift), and where the rate latched is the law's floor
+    /// ([`OnsetRow::Floor`]) the floor's own change at that state (its
+    /// law's, its mass's and the pressing's, between the shifted systems);
+    /// zero where none was latched (None: a separation, or no derivative).
+    pub(super) fn onset(
+        &mut self,
+        i: usize,
+        (time, before, modes): (f64, &[f64], &[Mode]),
+        latched: Option<(&super::Latched, OnsetRow)>,
+    ) {
         let m = self.count();
+        let size = before.len();
+        self.full[..size].copy_from_slice(before);
         for j in 0..m {
             self.latched[i * m + j] = match latched {
                 None => 0.0,
-                Some(l) => {
-                    let size = l.onset_row.len();
+                Some((l, kind)) => {
                     let along: f64 = (0..size)
                         .map(|k| l.onset_row[k] * self.columns[k * m + j])
                         .sum();
-                    along + l.onset_shift * self.gap_by(j, i, before).0
+                    let own = if kind == OnsetRow::Floor {
+                        let s = &self.shifted[j];
+                        let [up, down] = &mut self.scratches[j];
+                        let at = (time, &self.full[..], modes);
+                        match (
+                            floor_of(&s.plus, i, at, up),
+                            floor_of(&s.minus, i, at, down),
+                        ) {
+                            (Some((plus, _)), Some((minus, _))) => (plus - minus) / (2.0 * s.delta),
+                            _ => 0.0,
+                        }
+                    } else {
+                        0.0
+                    };
+                    along + l.onset_shift * self.gap_by(j, i, before).0 + own
                 }
             };
         }
