@@ -286,10 +286,10 @@ impl PreparedSystem {
     /// the dampers') for `t_end` s, keeping no history: a dict as
     /// `simulate_system` returns, with `open_contacts` (per interaction, None
     /// or the compliant contact open at the end: `[approach_rate (m/s),
-    /// onset (s), approach_speed (m/s), max_indentation (m)]`). `carried`:
-    /// the `open_contacts` of the run this one continues from its final
-    /// state, onsets shifted by its `-final_time` (None: contacts in
-    /// progress at the start begin there).
+    /// onset (s, before the run's end: < 0), approach_speed (m/s),
+    /// max_indentation (m)]`). `carried`: the `open_contacts` of the run
+    /// this one continues from its final state (None: contacts in progress
+    /// at the start begin there).
     #[pyo3(signature = (state, t_end, *, record_from=None, strobe_period=None, carried=None))]
     fn run<'py>(
         &self,
@@ -481,6 +481,13 @@ fn solution_dict<'py>(
     system: &Assembly,
     sol: core::kernel::events::SystemSolution,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // Onsets relative to the run's end: what a run continued from its final
+    // state takes as `carried` (made before the solution is taken apart).
+    let open: Vec<Option<[f64; 4]>> = sol
+        .carried()
+        .into_iter()
+        .map(|c| c.map(crate::convert::carried_values))
+        .collect();
     let out = PyDict::new(py);
     out.set_item("n", system.n)?;
     out.set_item("k", system.k)?;
@@ -532,11 +539,6 @@ fn solution_dict<'py>(
     out.set_item("recorded_time", r.recorded_time)?;
     out.set_item("strobe", r.strobe.into_pyarray(py))?;
     out.set_item("strobe_time", r.strobe_time.into_pyarray(py))?;
-    let open: Vec<Option<[f64; 4]>> = sol
-        .open_contacts
-        .iter()
-        .map(|c| c.map(crate::convert::carried_values))
-        .collect();
     out.set_item("open_contacts", open)?;
     Ok(out)
 }

@@ -154,16 +154,14 @@ class Runner:
         return raw
 
     def _carry(self, raw: Mapping[str, Any]) -> None:
-        """Keep the contacts ``raw`` left open, for a run from its final state."""
-        end = float(raw["final_time"])
-        shifted = [
-            None if c is None else [c[0], c[1] - end, c[2], c[3]] for c in raw["open_contacts"]
-        ]
-        if any(c is not None for c in shifted):
+        """Keep the contacts ``raw`` left open (onsets relative to its end), for a run
+        from its final state."""
+        carried = list(raw["open_contacts"])
+        if any(c is not None for c in carried):
             if len(_CARRIED) >= CARRIED_STATES:
                 del _CARRIED[next(iter(_CARRIED))]
             final = np.asarray(raw["final_state"], dtype=float).tobytes()
-            _CARRIED[final, len(shifted)] = shifted
+            _CARRIED[final, len(carried)] = carried
 
     def walls(self) -> list[dict[str, Any]]:
         """The system's interactions (a damper's two walls, each stop, collision and
