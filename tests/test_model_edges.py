@@ -44,14 +44,13 @@ def test_results_compare_by_identity_and_hash() -> None:
 def test_a_systems_analyses_are_its_own() -> None:
     """``to_dict()`` and the dict a System was given shared the analyses' tables: a
     change to either changed the System (and ``load(to_toml())`` then failed)."""
-    given = {"sweep": {"parameter": "excitation.0.frequency", "values": [8.0, 9.0]}}
+    table = {"parameter": "structure.stiffness", "start": 1000.0, "stop": 2000.0, "count": 5}
+    given = {"sweep": dict(table, derivatives=["structure.damping"])}
     system = _oscillator(analyses=given)
-    given["sweep"]["values"] = [-1.0]
+    given["sweep"]["derivatives"] = ["structure.mass"]
     sections = system.to_dict()
-    sections["sweep"]["values"].append(7.0)
-    assert system.analyses == {
-        "sweep": {"parameter": "excitation.0.frequency", "values": [8.0, 9.0]}
-    }
+    sections["sweep"]["derivatives"].append("structure.mass")
+    assert system.analyses == {"sweep": dict(table, derivatives=["structure.damping"])}
     assert vi.load(system.to_toml()) == system
 
 
@@ -273,3 +272,74 @@ def test_masses_beyond_the_exact_flow_s_resolution_are_told_so() -> None:
     said = str(err.value)
     assert "masses span 1.000e-15 kg to 1.000e0 kg" in said and '"dop853"' in said
     assert vi.simulate(system, method="dop853", t_end=0.1).final_time == 0.1
+
+
+def _damper(law: str, **keys: object) -> list[vi.Damper]:
+    return [vi.Damper(mass=0.05, at=0, clearance=0.005, law=law, **keys)]
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    ("keys", "words"),
+    [
+        # Analyses' and the study's tables, as vi.load checks them (the System had
+        # been built, and its to_toml() refused by vi.load).
+        (
+            {"analyses": {"sweep": {"parameter": "excitation.0.frequency", "count": 0}}},
+            "[sweep] count",
+        ),
+        ({"analyses": {"sweep": {"parameter": "excitation.0.frequency", "bogus": 1}}}, "bogus"),
+        (
+            {"analyses": {"study": {"analysis": "run", "metrics": ["bogus"], "axes": {}}}},
+            "[study] metrics",
+        ),
+        # The output and the method's fit to the model without the run's length
+        # (checked only when t_end was given).
+        ({"output": vi.Output(every=0)}, "[output] every"),
+        ({"output": vi.Output(points=[3])}, "[output] points[0]"),
+        ({"output": vi.Output(strobe_period=-1.0)}, "[output] strobe_period"),
+        ({"output": vi.Output(record_from=-1.0)}, "[output] record_from"),
+        ({"output": vi.Output(moments=[0.1])}, "[output] moments"),
+        (
+            {"dampers": _damper("rigid", restitution=0.6), "solver": vi.Solver(method="newmark")},
+            "compliant contact laws only",
+        ),
+        (
+            {"dampers": _damper("hertz", stiffness=1e7), "solver": vi.Solver(method="exact")},
+            "rigid and linear laws only",
+        ),
+        (
+            {
+                "dampers": _damper("rigid", restitution=0.6),
+                "solver": vi.Solver(method="rk4", dt=1e-4, stepping="fixed"),
+            },
+            "compliant contact laws only",
+        ),
+        ({"solver": vi.Solver(method="rk4", dt=1.0)}, "[solver] dt"),
+    ],
+)
+def test_a_system_without_its_runs_length_is_checked_as_a_run_of_it(
+    keys: dict[str, object], words: str
+) -> None:
+    analyses = keys.pop("analyses", None)
+    if analyses is not None:
+        base = _rattling()
+        with pytest.raises(ValueError) as refused:
+            base.replace(analyses=analyses)
+    else:
+        with pytest.raises(ValueError) as refused:
+            _oscillator(**keys)
+    assert words in str(refused.value) and "\n" not in str(refused.value)
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["rk4", "newmark", "generalized-alpha", "dop853", "exact"])
+def test_a_system_whose_runs_are_given_their_step_is_built_and_runs(method: str) -> None:
+    # A fixed step left to the run is checked then, not refused when the System is
+    # built; the window's start against the run's length then too.
+    system = _oscillator(solver=vi.Solver(method=method), output=vi.Output(record_from=0.05))
+    step = None if method in ("dop853", "exact") else 1e-4
+    solution = vi.simulate(system, t_end=0.1, dt=step)
+    assert solution.recorded_time == pytest.approx(0.05, abs=1e-4)
+    with pytest.raises(ValueError, match="record_from"):
+        vi.simulate(system, t_end=0.04, dt=step)

@@ -145,28 +145,30 @@ def test_a_system_whose_solver_has_no_t_end_loads_back_and_runs_as_given() -> No
 def test_a_systems_analyses_are_read_only() -> None:
     # Changed in place, they passed by the checks a System makes when built (an unknown
     # section, a misspelt key), and a hashed System's analyses changed under it.
-    system = vi.System(structure=OSCILLATOR, analyses={"sweep": {"count": 5, "values": [1, 2]}})
+    table = {"parameter": "structure.stiffness", "start": 1000.0, "stop": 2000.0, "count": 5}
+    keys = ["structure.damping"]
+    system = vi.System(structure=OSCILLATOR, analyses={"sweep": dict(table, derivatives=keys)})
     for change in (
         lambda a: a.__setitem__("swep", {}),
         lambda a: a.update(poincare={}),
         lambda a: a["sweep"].__setitem__("count", 6),
-        lambda a: a["sweep"]["values"].append(3),
+        lambda a: a["sweep"]["derivatives"].append("structure.mass"),
         lambda a: a.pop("sweep"),
     ):
         with pytest.raises(TypeError, match=r"read-only: make a changed System"):
             change(system.analyses)
-    assert system.analyses == {"sweep": {"count": 5, "values": [1, 2]}}
+    assert system.analyses == {"sweep": dict(table, derivatives=keys)}
     # A copy to change: to_dict's tables, and replace.
     tables = system.to_dict()
-    tables["sweep"]["values"].append(3)
-    assert type(tables["sweep"]) is dict and system.analyses["sweep"]["values"] == [1, 2]
+    tables["sweep"]["derivatives"].append("structure.mass")
+    assert type(tables["sweep"]) is dict and system.analyses["sweep"]["derivatives"] == keys
     changed = system.replace(analyses={"sweep": tables["sweep"]})
-    assert changed.analyses["sweep"]["values"] == [1, 2, 3]
+    assert changed.analyses["sweep"]["derivatives"] == [*keys, "structure.mass"]
     # Pickled (a Dask task) and copied, still read-only and equal.
     for other in (pickle.loads(pickle.dumps(system)), copy.deepcopy(system)):
         assert other == system
         with pytest.raises(TypeError):
-            other.analyses["sweep"]["values"].append(3)
+            other.analyses["sweep"]["derivatives"].append("structure.mass")
 
 
 @pytest.mark.timeout(60)

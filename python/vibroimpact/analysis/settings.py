@@ -16,6 +16,7 @@ from vibroimpact.analysis.limits import (
     relative_tolerance,
 )
 from vibroimpact.analysis.parameters import with_parameter_path_check
+from vibroimpact.model.system import ANALYSIS_CHECKS
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
 from vibroimpact.system.schema import _TEXTS
 
@@ -238,3 +239,4 @@ SETTINGS: dict[str, Callable[[Any], dict[str, Any]]] = {
     "curve": curve_settings,
     "basins": basins_settings,
 }
+ANALYSIS_CHECKS.update(SETTINGS)

@@ -8,14 +8,14 @@ import copy
 import math
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 
-from vibroimpact._core import InvalidInputError, PreparedSystem
+from vibroimpact._core import METHODS, InvalidInputError, PreparedSystem
 from vibroimpact.arguments import directory
 from vibroimpact.messages import shown, unknown_section
 from vibroimpact.model.modes import frequencies_summary
@@ -44,10 +44,12 @@ from vibroimpact.model.parts import (
 from vibroimpact.model.toml_text import toml_text
 from vibroimpact.notebook import system_html
 from vibroimpact.system import (
+    _FIXED_STEP,
     _OUTPUT,
     _SOLVER,
     RUN_SECTIONS,
     _fail,
+    _table,
     _unknown_key,
     initial_arrays,
     initial_table,
@@ -56,9 +58,16 @@ from vibroimpact.system import (
     system_spec,
 )
 from vibroimpact.system.parameter_keys import check_parameter_keys
+from vibroimpact.system.run import checked_output
 from vibroimpact.system.schema import MAX_SCENARIO_BYTES
 
 _P = TypeVar("_P", bound=Part)
+
+#: s: the step and length of the one-step run a System's solver and output are checked
+#: by where its runs are given their length (or their step) when run.
+PROBE_STEP = 1e-9
+#: The method an output without a solver is checked with: one that needs no step.
+ADAPTIVE_PROBE = next(name for name, m in METHODS.items() if m["kind"] == "adaptive")
 
 #: The sections of analyses and studies a System carries as read (see ``analyses``).
 ANALYSIS_SECTIONS = ("sweep", "continuation", "basins", "curve", "study")
@@ -196,6 +205,7 @@ class System:
         refused where it is written, not when it is first simulated."""
         sections = self.to_dict()
         check_parameter_keys(sections)
+        _check_analyses(sections)
         model = self.model_sections()
         if self.solver is not None and self.solver.t_end is not None:
             run = prepare_system(
@@ -214,10 +224,28 @@ class System:
             raise _fail("", "a value is nested too deeply (arrays within arrays)") from None
         table = initial_table(initial, spec)
         _core_check(spec, initial_arrays(table))
-        if self.solver is not None:
-            # Its runs are given their length: the rest is checked now (a misspelt
-            # method built, and was refused only when run).
-            solver_table(sections["solver"], length_given=False)
+        output = sections.get("output")
+        if output is not None:
+            checked_output(_table("[output] ", output, _OUTPUT), spec)
+        if self.solver is not None or output is not None:
+            # Its runs are given their length: the rest is checked now, as a run of one
+            # step checks it (a misspelt method, a law or stepping the method does not
+            # take, a step too long for the structure, a strobe period <= 0 built, and
+            # were refused only when run); the output alone with a method that needs no
+            # step. The window's start is checked against the length when it is given.
+            given = sections.get("solver", {"method": ADAPTIVE_PROBE})
+            solver = solver_table(given, length_given=False)
+            # A fixed step given at run time is checked then (a short one here).
+            step = solver["dt"] or (PROBE_STEP if solver["method"] in _FIXED_STEP else None)
+            probe = dict(given, t_end=step or PROBE_STEP) | ({} if step is None else {"dt": step})
+            window_left_out = {k: v for k, v in (output or {}).items() if k != "record_from"}
+            run = prepare_system(
+                **(model | {"initial": initial}),
+                solver=probe,
+                output=window_left_out,
+                base_dir=self.base_dir,
+            )
+            PreparedSystem(run.binding_spec(), **run.method_arguments())
 
     def model_sections(self) -> dict[str, Any]:
         """The model's sections as :func:`vibroimpact.system.prepare_system` takes them
@@ -519,3 +547,17 @@ def _brief_noise(excitation: dict[str, Any]) -> dict[str, Any]:
     ):
         return excitation
     return {**excitation, "duration": 1.0 / cutoff}
+
+
+#: The check of each analysis's table and the study's (section -> check), as a scenario
+#: file's are checked when it is read: registered by the analyses and the study when
+#: imported (``vibroimpact`` imports them), which are built on the model.
+ANALYSIS_CHECKS: dict[str, Callable[[Any], object]] = {}
+
+
+def _check_analyses(sections: Mapping[str, Any]) -> None:
+    """The analyses' and the study's tables among ``sections`` (a System built with a bad
+    one wrote a file that vi.load refused)."""
+    for name, check in ANALYSIS_CHECKS.items():
+        if name in sections:
+            check(sections[name])

@@ -13,6 +13,7 @@ import numpy as np
 
 from vibroimpact import arguments
 from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_total
+from vibroimpact.model.system import ANALYSIS_CHECKS
 from vibroimpact.study.axes import (
     _axis_count,
     _axis_values,
@@ -213,3 +214,6 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
     for path, spec in random.items():
         out["random"][str(path)] = _draws(str(path), spec, out["samples"], generator)
     return out
+
+
+ANALYSIS_CHECKS["study"] = checked_study_settings

@@ -265,9 +265,20 @@ def prepare_system(
         )
     except InvalidInputError as err:
         raise _fail("", short_numbers(str(err))) from None
+    check_record_window("[output] record_from: ", checked_output(output, spec), solver)
+    if (len(output["points"]) or len(output["moments"])) and output["record_from"] is None:
+        # Points ask for their peaks: of the whole run where no window is given
+        # (user trial: they were silently left out).
+        output["record_from"] = 0.0
+    return PreparedRun(spec, init, solver, output)
+
+
+def checked_output(output: Mapping[str, Any], spec: Mapping[str, Any]) -> float | None:
+    """The checks of an ``[output]`` table (filled by its schema) that do not need the
+    run's length: ``record_from`` >= 0 (returned), the points and moments on the
+    structure, each once and not too many."""
     if output["record_from"] is not None and not output["record_from"] >= 0:
         raise _fail("[output] record_from: ", f"must be >= 0 s, got {output['record_from']}")
-    check_record_window("[output] record_from: ", output["record_from"], solver)
     followed = len(output["points"]) + len(output["moments"])
     if followed > MAX_POINTS:
         raise _fail(
@@ -281,11 +292,7 @@ def prepare_system(
             _check_point(f"[output] {key}[{j}]", at, float(at), spec["structure"])
             if at in output[key][:j]:
                 raise _fail(f"[output] {key}: ", f"{shown(at)} is given twice")
-    if followed and output["record_from"] is None:
-        # Points ask for their peaks: of the whole run where no window is given
-        # (user trial: they were silently left out).
-        output["record_from"] = 0.0
-    return PreparedRun(spec, init, solver, output)
+    return output["record_from"]  # type: ignore[no-any-return]
 
 
 def _solution(
