@@ -213,14 +213,29 @@ pub struct PreparedSystem {
 
 impl PreparedSystem {
     /// The run state, locked (a run at a time), with `state`, where given,
-    /// checked to be the system's `2 dim` values.
+    /// checked to be the system's `2 dim` values. Where another thread's run
+    /// holds it, waited for with the GIL released (that run needs the GIL to
+    /// return: two threads on one system had hung, Ctrl-C unheard), and the
+    /// wait ended by an interrupt.
     pub(crate) fn locked(
         &self,
+        py: Python<'_>,
         state: Option<&[f64]>,
     ) -> PyResult<std::sync::MutexGuard<'_, Ready>> {
-        let ready = self.ready.lock().map_err(|_| {
-            InvalidInputError::new_err("a run of this system failed; make it again")
-        })?;
+        let ready = loop {
+            match self.ready.try_lock() {
+                Ok(ready) => break ready,
+                Err(std::sync::TryLockError::WouldBlock) => {
+                    py.detach(|| std::thread::sleep(std::time::Duration::from_micros(200)));
+                    py.check_signals()?;
+                }
+                Err(std::sync::TryLockError::Poisoned(_)) => {
+                    return Err(InvalidInputError::new_err(
+                        "a run of this system failed; make it again",
+                    ))
+                }
+            }
+        };
         let size = 2 * ready.system.dim;
         match state {
             Some(state) if state.len() != size => Err(InvalidInputError::new_err(format!(
@@ -300,7 +315,7 @@ impl PreparedSystem {
         #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
         carried: Option<Vec<Option<[f64; 4]>>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let mut ready = self.locked(Some(&state))?;
+        let mut ready = self.locked(py, Some(&state))?;
         let system = &ready.system;
         let (n, d) = (system.n, system.dim);
         T_END.check(t_end).map_err(to_py)?;
@@ -358,7 +373,7 @@ impl PreparedSystem {
         let forcing_period = FORCING_PERIOD
             .check(forcing_period.unwrap_or(t_end))
             .map_err(to_py)?;
-        let mut ready = self.locked(Some(&state))?;
+        let mut ready = self.locked(py, Some(&state))?;
         let ready: &mut Ready = &mut ready;
         let mut grazed = Vec::new();
         let shot = released(py, |interrupt| {

@@ -16,24 +16,26 @@ use crate::system::{full_state, PreparedSystem, Ready};
 /// The prepared system's run state, locked, with `state` checked to be `2 dim`
 /// values.
 fn ready_for<'a>(
+    py: Python<'_>,
     prepared: &'a PreparedSystem,
     state: &[f64],
 ) -> PyResult<std::sync::MutexGuard<'a, Ready>> {
-    prepared.locked(Some(state))
+    prepared.locked(py, Some(state))
 }
 
-/// Each parameter's two systems, made at `p + delta` and `p - delta`.
+/// Each parameter's two systems, made at `p + delta` and `p - delta`: each
+/// copied with its lock held alone (one system given as both, or as the run's
+/// own, had been locked twice at once: a hang).
 fn shifted_systems(
+    py: Python<'_>,
     parameters: Vec<(PyRef<'_, PreparedSystem>, PyRef<'_, PreparedSystem>, f64)>,
 ) -> PyResult<Vec<Shifted>> {
     parameters
         .into_iter()
         .map(|(plus, minus, delta)| {
-            Ok(Shifted {
-                plus: plus.locked(None)?.system.clone(),
-                minus: minus.locked(None)?.system.clone(),
-                delta,
-            })
+            let plus = plus.locked(py, None)?.system.clone();
+            let minus = minus.locked(py, None)?.system.clone();
+            Ok(Shifted { plus, minus, delta })
         })
         .collect()
 }
@@ -69,8 +71,8 @@ pub fn tangent_map<'py>(
     parameters: Vec<(PyRef<'py, PreparedSystem>, PyRef<'py, PreparedSystem>, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     T_END.check(t_end).map_err(to_py)?;
-    let shifted = shifted_systems(parameters)?;
-    let mut guard = ready_for(prepared, &state)?;
+    let shifted = shifted_systems(py, parameters)?;
+    let mut guard = ready_for(py, prepared, &state)?;
     let ready: &mut Ready = &mut guard;
     let (end, rate, matrix, impacts, found, columns) = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
@@ -134,7 +136,7 @@ pub fn lyapunov_spectrum<'py>(
         )));
     }
     let blocks = blocks as usize;
-    let mut guard = ready_for(prepared, &state)?;
+    let mut guard = ready_for(py, prepared, &state)?;
     let ready: &mut Ready = &mut guard;
     let spectrum = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
@@ -174,7 +176,7 @@ pub fn interactions<'py>(
     py: Python<'py>,
     prepared: &PreparedSystem,
 ) -> PyResult<Bound<'py, PyList>> {
-    let ready = prepared.locked(None)?;
+    let ready = prepared.locked(py, None)?;
     let system = &ready.system;
     let out = PyList::empty(py);
     for it in system.interactions() {

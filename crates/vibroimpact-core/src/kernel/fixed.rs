@@ -43,6 +43,12 @@ pub(crate) fn check<S: SystemStepper>(system: &Assembly, stepper: &S) -> Result<
             stepper.name()
         )));
     }
+    check_laws(system)
+}
+
+/// Whether fixed steps may take `system`'s laws: every pair compliant, no
+/// friction (the single run's check, and a lockstep study's).
+pub(crate) fn check_laws(system: &Assembly) -> Result<()> {
     if let Some(it) = system.interactions.iter().find(|it| it.law.is_friction()) {
         return Err(Error::Inconsistent(format!(
             "stepping = \"fixed\" cannot locate stick-slip ({} has friction): use stepping = \

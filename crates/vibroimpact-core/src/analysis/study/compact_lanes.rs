@@ -11,7 +11,7 @@ use super::settings::StudySettings;
 use crate::analysis::lanes::run_lanes;
 use crate::error::{Error, Result};
 use crate::kernel::reductions::ReduceOptions;
-use crate::model::assembly::{initial_state, Assembly, InteractionLaw, SystemSpec};
+use crate::model::assembly::{initial_state, Assembly, SystemSpec};
 
 /// A row's system and start, or why it has none.
 type Member = std::result::Result<(Assembly, Vec<f64>), String>;
@@ -22,16 +22,14 @@ pub(super) fn unfit_for_lanes(spec: &SystemSpec) -> Option<Error> {
     let why = match Assembly::new(spec) {
         Err(e) => return Some(e),
         Ok(system) => {
+            if let Err(e) = crate::kernel::fixed::check_laws(&system) {
+                // Friction or a rigid pair: the single fixed-step run's refusal.
+                return Some(e);
+            }
             if system.compact.is_none() {
                 "it is not a small modal system (at most 4 modes, 2 dampers, 6 walls, one \
                  force, no base excitation)"
                     .to_string()
-            } else if let Some(it) = system
-                .interactions
-                .iter()
-                .find(|it| matches!(it.law, InteractionLaw::Rigid { .. }))
-            {
-                format!("pair {} is rigid (give it a compliant law)", it.pair)
             } else {
                 return None;
             }

@@ -50,6 +50,8 @@ pub(super) fn run_lockstep(
     // specialised to the preset, the same bits as its single run, ten times
     // the compact lanes' speed on it); any other small modal system runs in
     // compact lanes.
+    // A damper with friction is no two-mass member (its lanes had run it
+    // without its friction): refused as the single fixed-step run refuses it.
     if member_of(spec, initial).is_err() {
         if let Some(unfit) = unfit_for_lanes(spec) {
             return Err(unfit);
@@ -136,6 +138,12 @@ pub(super) fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Me
     };
     if !spec.stops.is_empty() || spec.gravity != 0.0 || !spec.excitations.is_empty() {
         return Err(unfit("the scenario has stops, gravity or an excitation"));
+    }
+    if !spec.frictions.is_empty() || !spec.collisions.is_empty() {
+        // (A row's own: an axis may give a damper friction.)
+        return Err(unfit(
+            "stick-slip is located by event-driven runs only (friction)",
+        ));
     }
     if !spec.points.is_empty() || !spec.moments.is_empty() {
         // Its one coordinate is its one point: its peak and rms are already kept.

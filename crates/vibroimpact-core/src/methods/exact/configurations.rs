@@ -6,7 +6,7 @@ use super::flow::ExactFlow;
 use super::matrix_flow::MatrixFlow;
 use super::modal::Configuration;
 use super::oscillator::Oscillator;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::assembly::{Assembly, InteractionLaw, LinearParts, Mode};
 use crate::model::contact::AnyLaw;
 
@@ -281,6 +281,7 @@ impl ExactFlow {
                         index
                     }
                     None => {
+                        check_room(self.modes.len(), system.dim)?;
                         self.modes.push(made);
                         self.modes.len() - 1
                     }
@@ -289,4 +290,26 @@ impl ExactFlow {
         };
         Ok(self.selected)
     }
+}
+
+/// The most memory the configurations met may hold, bytes.
+const MAX_CONFIGURATION_BYTES: u64 = crate::kernel::memory::MAX_RECORD_BYTES / 2;
+
+/// Refuse a configuration past the `count` met for a system of `dim`
+/// coordinates where they would pass [`MAX_CONFIGURATION_BYTES`] (each
+/// counted as eight dense matrices of the state's size): pairs that stick
+/// in ever new combinations (twenty plastic dampers on a cantilever) had
+/// grown a run past 2 GiB, history off.
+fn check_room(count: usize, dim: usize) -> Result<()> {
+    let each = 8 * 8 * (2 * dim as u64).pow(2);
+    if (count as u64 + 1) * each <= MAX_CONFIGURATION_BYTES {
+        return Ok(());
+    }
+    Err(Error::Inconsistent(format!(
+        "the exact flow met {count} configurations of sticking pairs and touching linear \
+         contacts, about {} MiB, the most it keeps ({} MiB): its pairs stick in ever new \
+         combinations; use method = \"dop853\"",
+        (count as u64 * each) >> 20,
+        MAX_CONFIGURATION_BYTES >> 20
+    )))
 }
