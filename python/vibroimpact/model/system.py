@@ -237,7 +237,9 @@ class System:
             solver = solver_table(given, length_given=False)
             # A fixed step given at run time is checked then (a short one here).
             step = solver["dt"] or (PROBE_STEP if solver["method"] in _FIXED_STEP else None)
-            probe = dict(given, t_end=step or PROBE_STEP) | ({} if step is None else {"dt": step})
+            probe = dict(given, t_end=step or PROBE_STEP)
+            if step is not None:
+                probe["dt"] = step
             window_left_out = {k: v for k, v in (output or {}).items() if k != "record_from"}
             run = prepare_system(
                 **(model | {"initial": initial}),

@@ -49,9 +49,8 @@ pub(super) fn run_lockstep(
     // The two-mass damper runs in its own lanes (the compact fixed RK4
     // specialised to the preset, the same bits as its single run, ten times
     // the compact lanes' speed on it); any other small modal system runs in
-    // compact lanes.
-    // A damper with friction is no two-mass member (its lanes had run it
-    // without its friction): refused as the single fixed-step run refuses it.
+    // compact lanes, or is refused as its single fixed-step run is (a damper
+    // with friction is no two-mass member: its lanes had run it without it).
     if member_of(spec, initial).is_err() {
         if let Some(unfit) = unfit_for_lanes(spec) {
             return Err(unfit);
@@ -139,7 +138,7 @@ pub(super) fn member_of(spec: &SystemSpec, initial: &[Vec<f64>; 4]) -> Result<Me
     if !spec.stops.is_empty() || spec.gravity != 0.0 || !spec.excitations.is_empty() {
         return Err(unfit("the scenario has stops, gravity or an excitation"));
     }
-    if !spec.frictions.is_empty() || !spec.collisions.is_empty() {
+    if !spec.frictions.is_empty() {
         // (A row's own: an axis may give a damper friction.)
         return Err(unfit(
             "stick-slip is located by event-driven runs only (friction)",

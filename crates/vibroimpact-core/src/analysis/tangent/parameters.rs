@@ -213,9 +213,10 @@ impl Parameters {
         (time, before, modes): (f64, &[f64], &[Mode]),
         latched: Option<(&super::Latched, OnsetRow)>,
     ) {
-        let m = self.count();
-        let size = before.len();
-        self.full[..size].copy_from_slice(before);
+        let (m, size) = (self.count(), before.len());
+        if matches!(latched, Some((_, OnsetRow::Floor))) {
+            self.full[..size].copy_from_slice(before);
+        }
         for j in 0..m {
             self.latched[i * m + j] = match latched {
                 None => 0.0,
@@ -224,22 +225,29 @@ impl Parameters {
                         .map(|k| l.onset_row[k] * self.columns[k * m + j])
                         .sum();
                     let own = if kind == OnsetRow::Floor {
-                        let s = &self.shifted[j];
-                        let [up, down] = &mut self.scratches[j];
-                        let at = (time, &self.full[..], modes);
-                        match (
-                            floor_of(&s.plus, i, at, up),
-                            floor_of(&s.minus, i, at, down),
-                        ) {
-                            (Some((plus, _)), Some((minus, _))) => (plus - minus) / (2.0 * s.delta),
-                            _ => 0.0,
-                        }
+                        self.floor_by(j, i, (time, modes))
                     } else {
                         0.0
                     };
                     along + l.onset_shift * self.gap_by(j, i, before).0 + own
                 }
             };
+        }
+    }
+
+    /// Interaction `i`'s floor's change by parameter `j` at the state in
+    /// `self.full`, at `time` in `modes`: between the shifted systems (0
+    /// where either has none there).
+    fn floor_by(&mut self, j: usize, i: usize, (time, modes): (f64, &[Mode])) -> f64 {
+        let s = &self.shifted[j];
+        let [up, down] = &mut self.scratches[j];
+        let at = (time, &self.full[..], modes);
+        match (
+            floor_of(&s.plus, i, at, up),
+            floor_of(&s.minus, i, at, down),
+        ) {
+            (Some((plus, _)), Some((minus, _))) => (plus - minus) / (2.0 * s.delta),
+            _ => 0.0,
         }
     }
 
