@@ -2,6 +2,7 @@
 //! matrices, the walls of each pair with their pushes, the excitations'
 //! loads, the time scales and the followed points; every input checked.
 
+use super::scales::{gap_floor, TimeScales};
 use super::spec::{FrictionSite, Load, PairLaw, Side, SystemSpec, MAX_PAIRS, MAX_POINTS};
 use super::{
     same_row, Assembly, CompactParts, ForceLoad, Interaction, InteractionLaw, SPARSE_FROM,
@@ -49,7 +50,7 @@ impl Assembly {
             .collect();
         let point_rows = followed_rows(spec)?;
         let friction_hold = friction_holds(&interactions);
-        let gap_floor = gap_floor(&interactions);
+        let gap_floor = gap_floor(&interactions, scales.motion_length);
         let mut assembly = Self {
             gap_floor,
             compact: None,
@@ -99,21 +100,6 @@ impl Assembly {
             gravity: self.gravity,
             mirrors: &self.mirrors_previous,
         })
-    }
-}
-
-/// The system's `Assembly::gap_floor`, m.
-fn gap_floor(interactions: &[Interaction]) -> f64 {
-    let smallest = interactions
-        .iter()
-        .filter(|it| !it.law.is_friction())
-        .map(|it| it.offset.abs())
-        .filter(|o| *o > 0.0 && o.is_finite())
-        .fold(f64::INFINITY, f64::min);
-    if smallest.is_finite() {
-        1e-3 * smallest
-    } else {
-        0.0
     }
 }
 
@@ -590,84 +576,6 @@ fn excitation_loads(spec: &SystemSpec, minv: &[f64]) -> Result<(Vec<ForceLoad>, 
         }
     }
     Ok((forces, base))
-}
-
-/// The system's time scales (s) and the energy floor's mass times
-/// acceleration squared (see [`Assembly::energy_floor`]).
-struct TimeScales {
-    /// The shortest natural or forcing period (infinite for none).
-    shortest: f64,
-    longest_period: f64,
-    time_scale: f64,
-    floor_mass_acceleration: f64,
-    /// The finest interval over which a signal that is not a sum of
-    /// harmonics changes (s), with its signal's name.
-    finest_signal: Option<(f64, &'static str)>,
-}
-
-impl TimeScales {
-    fn of(
-        spec: &SystemSpec,
-        mass_influence: &[f64],
-        damper_mass: &[f64],
-        gravity: f64,
-        interactions: &[Interaction],
-    ) -> Self {
-        let s = &spec.structure;
-        let frequencies = s.natural_frequencies();
-        let fastest_natural = frequencies.iter().fold(0.0f64, |m, w| m.max(*w));
-        let mut shortest = if fastest_natural > 0.0 {
-            std::f64::consts::TAU / fastest_natural
-        } else {
-            f64::INFINITY
-        };
-        let total_mass: f64 =
-            linalg::dot(mass_influence, s.influence()) + damper_mass.iter().sum::<f64>();
-        let mut acceleration = gravity;
-        let mut finest_signal: Option<(f64, &'static str)> = None;
-        for excitation in &spec.excitations {
-            let (largest, period) = excitation.signal.extent();
-            shortest = shortest.min(period);
-            // A record's or random signal's shortest sample interval (half its
-            // extent's period), a sweep's half period at its highest frequency.
-            let interval = 0.5 * period;
-            if excitation.signal.has_breakpoints()
-                && finest_signal.is_none_or(|(f, _)| interval < f)
-            {
-                finest_signal = Some((interval, excitation.signal.harmonic_frequencies().0));
-            }
-            acceleration += match excitation.load {
-                Load::Base => largest,
-                Load::Force { .. } => largest / total_mass,
-            };
-        }
-        let longest_period = frequencies
-            .iter()
-            .find(|w| **w > 0.0)
-            .map_or(f64::INFINITY, |w| std::f64::consts::TAU / w);
-        // Without a period (a ball under gravity), the time to fall through
-        // the largest gap: a long run's length would make the floor of the
-        // energy check grow without bound.
-        let largest_gap = interactions
-            .iter()
-            .fold(0.0f64, |g, it| g.max(it.offset.abs()));
-        let fall_time = if acceleration > 0.0 && largest_gap > 0.0 {
-            (2.0 * largest_gap / acceleration).sqrt()
-        } else {
-            f64::INFINITY
-        };
-        let time_scale = match shortest.min(longest_period) {
-            period if period.is_finite() => period,
-            _ => fall_time,
-        };
-        Self {
-            shortest,
-            longest_period,
-            time_scale,
-            floor_mass_acceleration: total_mass * acceleration * acceleration,
-            finest_signal,
-        }
-    }
 }
 
 /// The rows of the points, then of the moments, the reductions follow
