@@ -20,6 +20,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import vibroimpact as vi
+from friction_reference import HorizontalDamper
+from friction_reference import simulate as stick_slip_reference
 from vibroimpact import study as st
 
 
@@ -212,3 +214,64 @@ def test_the_text_table_reads_a_closed_rows_undefined_value_as_undefined(
         duration, restitution = row[5], row[7]
         if duration != "open":
             assert restitution == "-", row
+
+
+def _brief_stick_on_a_carrier() -> tuple[vi.System, float, float]:
+    """A 10 g mass sliding at about 1 m/s on a free 1 kg, 50 Hz carrier moving at 1 m/s
+    (kinetic friction 1 mN, static 0.1 N): near t = 0.02 s their relative speed dips
+    through zero by about 1e-5 m/s where the force holding the mass together with the
+    carrier (some 4 mN) is far within static friction. The system, the mass's starting
+    speed and the run's length."""
+    stiffness = (2 * math.pi * 50.0) ** 2
+    start = 1.002 - 1e-5
+    system = vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=stiffness, damping=0.0),
+        dampers=[
+            vi.Damper(
+                mass=0.01,
+                at=0,
+                clearance=10.0,
+                law="rigid",
+                restitution=0.5,
+                friction=0.001,
+                static_friction=0.1,
+                normal_force=1.0,
+            )
+        ],
+        initial=vi.Initial(structure_velocity=[1.0], damper_velocity=[start]),
+    )
+    return system, start, 0.03
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["exact", "dop853", "dopri5"])
+def test_a_stop_inside_one_step_begins_the_stick_it_must(method: str) -> None:
+    # The dip and the stick it begins (0.12 ms) lie inside one of dop853's steps at its
+    # tolerances, and the ends of the step show a speed of one sign: dop853 passed over
+    # it at rtol 1e-10 as at its defaults (no stick, the mass 4.9e-4 m/s too fast at the
+    # end). Reference: the scipy stick-slip integration of the same equations, which
+    # steps at most 2e-5 s.
+    system, start, t_end = _brief_stick_on_a_carrier()
+    p = HorizontalDamper(
+        K=(2 * math.pi * 50.0) ** 2,
+        C=0.0,
+        m=0.01,
+        clearance=10.0,
+        restitution=0.5,
+        mu=0.001,
+        mu_static=0.1,
+        normal=1.0,
+        P=0.0,
+    )
+    reference, events = stick_slip_reference(
+        p, t_end, rtol=1e-12, atol=1e-15, y0=(0.0, 0.0, 1.0, start), max_step=2e-5
+    )
+    assert events == 2  # the stick and the slip
+    sol = vi.simulate(system, method=method, t_end=t_end, history=False)
+    table = sol.contacts.to_pandas()
+    sticks = table[table["kind"] == "sticking"]
+    assert len(sticks) == 1
+    assert 0.0199 < sticks["onset"].iloc[0] < sticks["separation"].iloc[0] < 0.0202
+    state = sol.final_state
+    assert state["damper_velocity"][0] == pytest.approx(reference[3], abs=1e-7)
+    assert state["structure_velocity"][0] == pytest.approx(reference[2], abs=1e-7)

@@ -332,8 +332,12 @@ fn sliding_crossing(
             root: guess,
         });
     }
+    // A dip that the quadratic takes below zero, or down to half of the
+    // ends' lower speed (it errs by far more than a shallow stop's depth
+    // over a long step), is checked on the method's solution.
     let lowest = -b / (2.0 * a);
-    if a > 0.0 && lowest > 0.0 && lowest < 1.0 && a * lowest * lowest + b * lowest + c < 0.0 {
+    let low = a * lowest * lowest + b * lowest + c;
+    if a > 0.0 && lowest > 0.0 && lowest < 1.0 && (low < 0.0 || low < 0.5 * d0.min(d1)) {
         return Some(Crossing {
             i,
             guess: lowest,
@@ -488,7 +492,15 @@ pub(super) fn locate<S: SystemStepper>(
     }
     let (mut hi, mut v_hi, mut best_error);
     if c.interior {
-        match dip_bottom(system, stepper, (time, y, h), modes, c, scratch, buffers)? {
+        match dip_bottom(
+            system,
+            stepper,
+            (time, y, h, full),
+            modes,
+            c,
+            scratch,
+            buffers,
+        )? {
             // Touching the wall by less than the tolerance, confirmed on the
             // method's solution: a graze (as the 0.1 kernel counted it).
             Ok((_, v, _)) if mode == Mode::Open && v >= -graze => return Ok(Location::Graze),
@@ -587,13 +599,24 @@ pub(super) fn locate<S: SystemStepper>(
 fn dip_bottom<S: SystemStepper>(
     system: &Assembly,
     stepper: &mut S,
-    (time, y, h): (f64, &[f64], f64),
+    (time, y, h, full): (f64, &[f64], f64, &[f64]),
     modes: &[Mode],
     c: Crossing,
     scratch: &mut Scratch,
     buffers: &mut Buffers,
 ) -> Result<std::result::Result<(f64, f64, f64), Location>> {
     let mode = modes[c.i];
+    if let Mode::Sliding { direction } = mode {
+        let at = (time, y, h, full);
+        return sliding_bottom(
+            system,
+            stepper,
+            at,
+            (modes, c.i, direction),
+            scratch,
+            buffers,
+        );
+    }
     let sign = side(mode);
     let value = |end: &[f64], at: f64, scratch: &mut Scratch, work: &mut [f64]| {
         event_value(system, c.i, mode, at, end, modes, scratch, work)
@@ -634,6 +657,57 @@ fn dip_bottom<S: SystemStepper>(
         return Ok(Err(Location::Unconfirmed));
     }
     Ok(Ok((hi, v_hi, best_error)))
+}
+
+/// [`dip_bottom`] of a sliding friction element `i`: the lowest sliding
+/// speed of a dip inside the step, where its rate (the row's relative
+/// acceleration, in `direction`) turns from falling to rising, bracketed
+/// from the step's ends (`y` and `full`) and narrowed by the secant on the
+/// method's solution, stopping at the first trial whose speed has passed
+/// zero. A speed has no curvature in the state (the gaps' Newton steps
+/// take the acceleration for it): a dip of 1e-5 m/s on a speed of 1 m/s,
+/// and the stick it begins, had gone unseen inside a step.
+#[allow(clippy::too_many_arguments)]
+fn sliding_bottom<S: SystemStepper>(
+    system: &Assembly,
+    stepper: &mut S,
+    (time, y, h, full): (f64, &[f64], f64, &[f64]),
+    (modes, i, direction): (&[Mode], usize, f64),
+    scratch: &mut Scratch,
+    buffers: &mut Buffers,
+) -> Result<std::result::Result<(f64, f64, f64), Location>> {
+    let rate = |state: &[f64], at: f64, scratch: &mut Scratch, work: &mut [f64]| {
+        direction * system.gap_acceleration(i, at, state, modes, scratch, work)
+    };
+    let (mut lo, mut rate_lo) = (0.0, rate(y, time, scratch, &mut buffers.work));
+    let (mut hi, mut rate_hi) = (h, rate(full, time + h, scratch, &mut buffers.work));
+    if !(rate_lo < 0.0 && rate_hi > 0.0) {
+        return Ok(Err(Location::Unconfirmed));
+    }
+    for _ in 0..16 {
+        let width = hi - lo;
+        let secant = lo - rate_lo * width / (rate_hi - rate_lo);
+        // Inside the bracket by a tenth of it, so that it narrows.
+        let trial = secant.clamp(lo + 0.1 * width, hi - 0.1 * width);
+        let error = stepper.attempt(system, time, y, trial, modes, scratch, &mut buffers.best)?;
+        if stepper.is_adaptive() && rejects(error) {
+            return Ok(Err(Location::Reject(trial)));
+        }
+        let speed = direction * system.gap(i, &buffers.best).1;
+        if speed <= 0.0 {
+            return Ok(Ok((trial, speed, error)));
+        }
+        let r = rate(&buffers.best, time + trial, scratch, &mut buffers.work);
+        if r < 0.0 {
+            (lo, rate_lo) = (trial, r);
+        } else {
+            (hi, rate_hi) = (trial, r);
+        }
+        if hi - lo <= 4.0 * f64::EPSILON * (time.abs() + h) {
+            break;
+        }
+    }
+    Ok(Err(Location::Unconfirmed))
 }
 
 #[cfg(test)]
