@@ -139,6 +139,10 @@ CURVE_BAD = [
     (("step = 0.003", "step = -0.01"), ["[curve] step", "> 0"]),
     (("stop = 17.0", "stop = 11.772"), ["[curve] stop", "start"]),
     (("stop = 17.0", "stop = 12.5"), ["no flip", "located", "12.5"]),
+    # Outside [1e-9, 1] of |second_stop - e| = 0.3: 1e-300 had ended in a ZeroDivisionError
+    # traceback, 1e9 in a curve of one point.
+    (("step = 0.003", "step = 1e-300"), ["step: must be in [", "got 1e-300"]),
+    (("step = 0.003", "step = 1e9"), ["step: must be in [", "got 1000000000.0"]),
 ]
 
 

@@ -276,8 +276,11 @@ BASINS_BAD = [
     (("stop = 0.03, count = 3", "stop = 0.03, count = 0"), ["[basins] x.count", ">= 1"]),
     (("stop = 0.4, count = 3", 'stop = 0.4, count = "3"'), ["[basins] y.count", "'3'"]),
     (("stop = 0.4, count = 3", "stop = 0.4, count = 3, stpo = 1"), ["[basins] y", "stpo"]),
-    (("start = -0.4, stop = 0.4, ", "start = -0.4, "), ["[basins] y", "stop"]),
+    # Said as "[basins] y: ... missing key 'stop'" (it had read "[basins] y.missing key").
+    (("start = -0.4, stop = 0.4, ", "start = -0.4, "), ["[basins] y: ", "missing key 'stop'"]),
     (("record_periods = 5", "record_periods = 0"), ["[basins] record_periods", "in [1, 10000000]"]),
+    # One value is start alone: stop had been dropped without a word.
+    (("stop = 0.03, count = 3", "stop = 0.03, count = 1"), ["[basins] x.count", ">= 2", "0.03"]),
 ]
 
 
@@ -294,6 +297,7 @@ BASINS_BAD = [
         "unknown axis key",
         "missing axis stop",
         "record_periods 0",
+        "count 1 dropping stop",
     ],
 )
 def test_bad_basins_sections_exit_2_naming_the_key(

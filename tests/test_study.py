@@ -322,6 +322,8 @@ def test_the_study_command_writes_the_file(tmp_path: Path) -> None:
         (('"damper.0.clearance"', '"structure.modes"'), ["structure.modes", "allowed"]),
         (('analysis = "steady-state"', 'analysis = "run"'), ["metrics", "steady-state"]),
         (("count = 4", "count = 0"), ["count", ">= 1"]),
+        # One value is start alone: stop had been dropped without a word.
+        (("count = 4", "count = 1"), ["count", ">= 2", "set stop = start"]),
         (('metrics = ["peak"', 'metrics = ["peek"'), ["metrics", "peek"]),
     ],
 )

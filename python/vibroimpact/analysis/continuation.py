@@ -115,6 +115,18 @@ class Branch:
 STEP_RANGE = (1e-9, 1.0)
 
 
+def check_step(name: str, step: float, span: float) -> None:
+    """Refuse a parameter ``step`` outside :data:`STEP_RANGE` of the range ``span`` it
+    steps over (a step beyond the whole range leaves at once; one of 1e-9 of it never
+    gets anywhere within max_points, and one of 1e-300 divided by zero)."""
+    if not STEP_RANGE[0] * abs(span) <= step <= STEP_RANGE[1] * abs(span):
+        raise AnalysisError(
+            f"{name}: must be in [{shown(STEP_RANGE[0] * abs(span))}, {shown(abs(span))}] "
+            f"(from 1e-9 of the range to the range |stop - start| = {shown(abs(span))}), "
+            f"got {shown(step)}"
+        )
+
+
 @arguments.typed()
 def continue_orbit(
     data: Mapping[str, Any] | System,
@@ -151,14 +163,7 @@ def continue_orbit(
     max_points = whole_count("max_points", max_points, 2, MAX_POINTS)
     span = stop - start_value
     ds = abs(span) / 50 if step is None else arguments.positive("step", step)
-    if not STEP_RANGE[0] * abs(span) <= ds <= STEP_RANGE[1] * abs(span):
-        # A step beyond the whole range leaves at once; one of 1e-9 of it never gets
-        # anywhere within max_points.
-        raise AnalysisError(
-            f"step: must be in [{shown(STEP_RANGE[0] * abs(span))}, {shown(abs(span))}] (from "
-            f"1e-9 of the range to the range |stop - start| = {shown(abs(span))}), got "
-            f"{shown(ds)}"
-        )
+    check_step("step", ds, span)
 
     # Harmonic forcing only: its section can move (see _Arc.section).
     shiftable = all(

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from vibroimpact import arguments
-from vibroimpact.analysis.continuation import _Arc, _value_of, continue_orbit
+from vibroimpact.analysis.continuation import _Arc, _value_of, check_step, continue_orbit
 from vibroimpact.analysis.grazing import away_from_zero, locate_grazing, struck
 from vibroimpact.analysis.limits import (
     MAX_PERIODS,
@@ -114,6 +114,9 @@ def curve(
         # curve, but the search reported one.
         raise AnalysisError(f"second: must be another parameter than {parameter!r}")
     s0 = _value_of(data, second)
+    if second_stop == s0:
+        raise AnalysisError(f"second_stop: must be a value other than {second} = {s0:g}")
+    check_step("step", step, second_stop - s0)
     at_start = with_parameter(data, parameter, start)
     try:
         # As continue_orbit's stop: a target the scenario cannot take is refused.

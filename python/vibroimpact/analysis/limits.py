@@ -43,6 +43,17 @@ arguments.WHOLE_RANGES["[sweep] count"] = (1, MAX_POINTS)
 MAX_ITERATIONS = 10_000
 
 
+def single_value_drops_stop(where: str, start: float, stop: float, count: int) -> str | None:
+    """The error (or None) of ``count`` values from ``start`` to ``stop`` where one value,
+    ``start`` alone, would drop ``stop`` without a word; ``where`` prefixes ``count``."""
+    if count == 1 and start != stop:
+        return (
+            f"{where}count: must be >= 2 to reach stop ({stop:g}) from start ({start:g}), "
+            "got 1 (one value: set stop = start)"
+        )
+    return None
+
+
 def whole_count(name: str, value: Any, low: int, high: int | None = None) -> int:
     """``value`` as a Python int when it is a whole number >= ``low`` (and at most
     ``high`` where given: an int or a NumPy integer, never a boolean); else

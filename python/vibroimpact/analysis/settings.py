@@ -14,8 +14,10 @@ from vibroimpact.analysis.limits import (
     check_periods,
     check_total,
     relative_tolerance,
+    single_value_drops_stop,
 )
 from vibroimpact.analysis.parameters import with_parameter_path_check
+from vibroimpact.messages import shown
 from vibroimpact.model.system import ANALYSIS_CHECKS
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
 from vibroimpact.system.schema import _TEXTS
@@ -59,12 +61,9 @@ def sweep_settings(table: Any) -> dict[str, Any]:
     _choice("[sweep] ", "spacing", out["spacing"], _SPACINGS)
     if out["count"] < 1:
         raise AnalysisError(f"[sweep] count: must be >= 1, got {out['count']}")
-    if out["count"] == 1 and out["start"] != out["stop"]:
-        # One value is start alone: stop would be dropped without a word.
-        raise AnalysisError(
-            f"[sweep] count: must be >= 2 to reach stop ({out['stop']:g}) from start "
-            f"({out['start']:g}), got 1 (one point: set stop = start)"
-        )
+    dropped = single_value_drops_stop("[sweep] ", out["start"], out["stop"], out["count"])
+    if dropped:
+        raise AnalysisError(dropped)
     for key, low in (("settle_periods", 0), ("record_periods", 1)):
         check_periods("[sweep] ", key, out[key], low)
     check_total(
@@ -155,7 +154,14 @@ def basins_settings(table: Any) -> dict[str, Any]:
     for axis in ("x", "y"):
         if axis not in table:
             raise AnalysisError(f"[basins] missing key {axis!r} ({{state, start, stop, count}})")
-        checked = _table(f"[basins] {axis}.", table[axis], _AXIS)
+        given = table[axis]
+        missing = [key for key in _AXIS if key not in given] if isinstance(given, Mapping) else []
+        if not isinstance(given, Mapping) or missing:
+            problem = f"missing key {missing[0]!r}" if missing else f"got {shown(given)}"
+            raise AnalysisError(
+                f"[basins] {axis}: must be a table {{state, start, stop, count}}, {problem}"
+            )
+        checked = _table(f"[basins] {axis}.", given, _AXIS)
         name, _, index = checked["state"].partition(".")
         if name not in _STATE_KEYS or not (index.isascii() and index.isdigit()):
             raise AnalysisError(
@@ -164,6 +170,10 @@ def basins_settings(table: Any) -> dict[str, Any]:
             )
         if checked["count"] < 1:
             raise AnalysisError(f"[basins] {axis}.count: must be >= 1, got {checked['count']}")
+        ends = (checked["start"], checked["stop"])
+        dropped = single_value_drops_stop(f"[basins] {axis}.", *ends, checked["count"])
+        if dropped:
+            raise AnalysisError(dropped)
         out[axis] = checked
     x, y = (out[a]["state"].partition(".") for a in ("x", "y"))
     if (x[0], int(x[2])) == (y[0], int(y[2])):

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from vibroimpact.analysis.limits import single_value_drops_stop
 from vibroimpact.arguments import real
 from vibroimpact.study.limits import MAX_STUDY_RUNS, StudyError
 from vibroimpact.system import _NUMBER, _REQ, _TEXT, _WHOLE, _choice, _table
@@ -55,6 +56,9 @@ def _axis_count(path: str, spec: Any) -> int:
         raise StudyError(f"{where}count: must be >= 1, got {count}")
     if count > MAX_STUDY_RUNS:
         raise StudyError(f"{where}count: must be at most {MAX_STUDY_RUNS:,}, got {count}")
+    dropped = single_value_drops_stop(where, axis["start"], axis["stop"], count)
+    if dropped:
+        raise StudyError(dropped)
     if axis["spacing"] == "log" and not (axis["start"] > 0 and axis["stop"] > 0):
         raise StudyError(f'{where}start, stop: must be > 0 for spacing = "log"')
     if _is_seed(path):
