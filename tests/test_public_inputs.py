@@ -393,3 +393,30 @@ def test_the_two_mass_damper_takes_its_values_by_name_only() -> None:
         main_mass=1.0, stiffness=1.0, damping=0.01, impact_mass=0.25, clearance=0.01
     )
     assert (damper.impact_mass, damper.clearance, damper.damping) == (0.25, 0.01, 0.01)
+
+
+@pytest.mark.parametrize("bad", [None, "abcd", [[0.01, 0.0]], [0.01, "x"]])
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda state: _core.tangent_map(_prepared_system(**PREPARED), state, 0.1),
+        lambda state: _core.lyapunov_spectrum(_prepared_system(**PREPARED), state, 0.1, 2),
+        lambda state: _prepared_system(**PREPARED).run(state, 0.1),
+        lambda state: _prepared_system(**PREPARED).shoot(
+            state, 0.1, tolerance=1e-8, max_iterations=2
+        ),
+    ],
+    ids=["tangent_map", "lyapunov_spectrum", "run", "shoot"],
+)
+def test_a_state_that_is_not_numbers_is_refused_by_name(call: Any, bad: Any) -> None:
+    # PyO3's own conversion had raised a TypeError ("'None' is not an instance of
+    # 'Sequence'", "Can't extract `str` to `Vec`"), which is no ValueError.
+    with pytest.raises(vi.InvalidInputError, match=r"^state must be a sequence of numbers"):
+        call(bad)
+
+
+@pytest.mark.parametrize("bad", [-1, 0, 2.0, True, 2**70])
+def test_max_iterations_not_a_whole_number_is_refused_by_name(bad: Any) -> None:
+    # -1 had raised an OverflowError.
+    with pytest.raises(vi.InvalidInputError, match=r"^max_iterations must be a whole number"):
+        _prepared_system(**PREPARED).shoot([0.01, 0.0], 0.1, tolerance=1e-8, max_iterations=bad)

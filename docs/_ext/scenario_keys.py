@@ -333,7 +333,11 @@ _SETTLED = (
 _VALUES_AXIS = {
     "start": ("the parameter's", 'finite; > 0 for spacing = "log"', "the first value"),
     "stop": ("the parameter's", 'finite; > 0 for spacing = "log"', "the last value"),
-    "count": ("1", ">= 1", "how many values, start and stop among them"),
+    "count": (
+        "1",
+        ">= 1; >= 2 where stop differs from start",
+        "how many values, start and stop among them",
+    ),
     "spacing": (None, '"linear" or "log"', "even steps, or an even ratio"),
 }
 
@@ -429,7 +433,11 @@ ANALYSES = {
         ),
         "start": ("m or m s-1", "finite", "its first value"),
         "stop": ("m or m s-1", "finite", "its last value"),
-        "count": ("1", ">= 1", "how many values (x count times y count at most 10^6)"),
+        "count": (
+            "1",
+            ">= 1; >= 2 where stop differs from start",
+            "how many values (x count times y count at most 10^6)",
+        ),
     },
     "study": {
         "analysis": (

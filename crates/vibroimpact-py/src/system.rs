@@ -309,7 +309,7 @@ impl PreparedSystem {
     fn run<'py>(
         &self,
         py: Python<'py>,
-        state: Vec<f64>,
+        #[pyo3(from_py_with = crate::convert::state_arg)] state: Vec<f64>,
         #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
         #[pyo3(from_py_with = crate::convert::optional::record_from)] record_from: Option<f64>,
         #[pyo3(from_py_with = crate::convert::optional::strobe_period)] strobe_period: Option<f64>,
@@ -350,10 +350,10 @@ impl PreparedSystem {
     fn shoot<'py>(
         &self,
         py: Python<'py>,
-        state: Vec<f64>,
+        #[pyo3(from_py_with = crate::convert::state_arg)] state: Vec<f64>,
         #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
         #[pyo3(from_py_with = crate::convert::arg::tolerance)] tolerance: f64,
-        max_iterations: usize,
+        #[pyo3(from_py_with = crate::convert::max_iterations_arg)] max_iterations: usize,
         #[pyo3(from_py_with = crate::convert::optional::forcing_period)] forcing_period: Option<
             f64,
         >,

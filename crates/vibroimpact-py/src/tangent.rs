@@ -66,7 +66,7 @@ pub(crate) fn grazings<'py>(
 pub fn tangent_map<'py>(
     py: Python<'py>,
     prepared: &PreparedSystem,
-    state: Vec<f64>,
+    #[pyo3(from_py_with = crate::convert::state_arg)] state: Vec<f64>,
     #[pyo3(from_py_with = crate::convert::arg::t_end)] t_end: f64,
     parameters: Vec<(PyRef<'py, PreparedSystem>, PyRef<'py, PreparedSystem>, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -120,7 +120,7 @@ pub fn tangent_map<'py>(
 pub fn lyapunov_spectrum<'py>(
     py: Python<'py>,
     prepared: &PreparedSystem,
-    state: Vec<f64>,
+    #[pyo3(from_py_with = crate::convert::state_arg)] state: Vec<f64>,
     #[pyo3(from_py_with = crate::convert::arg::block_time)] block_time: f64,
     #[pyo3(from_py_with = crate::convert::blocks_arg)] blocks: u64,
     carried: Option<Vec<Option<[f64; 4]>>>,

@@ -492,15 +492,8 @@ pub(super) fn locate<S: SystemStepper>(
     }
     let (mut hi, mut v_hi, mut best_error);
     if c.interior {
-        match dip_bottom(
-            system,
-            stepper,
-            (time, y, h, full),
-            modes,
-            c,
-            scratch,
-            buffers,
-        )? {
+        let step = (time, y, h, full);
+        match dip_bottom(system, stepper, step, modes, c, scratch, buffers)? {
             // Touching the wall by less than the tolerance, confirmed on the
             // method's solution: a graze (as the 0.1 kernel counted it).
             Ok((_, v, _)) if mode == Mode::Open && v >= -graze => return Ok(Location::Graze),

@@ -127,6 +127,24 @@ by_name!(arg, real -> f64: approach_rate, approach_speed, area, block_time, clea
 by_name!(optional, real_or_none -> Option<f64>: atol, beta, dt, energy_tolerance, forcing_period, gamma, other_radius, position, record_from, restitution, rtol, spectral_radius, strobe_period);
 by_name!(named_text, text -> String: law);
 
+/// A flat state (`state`): a sequence of numbers, invalid input naming the
+/// argument where it is not one (never a bare TypeError: None had said
+/// "'None' is not an instance of 'Sequence'", a string "Can't extract `str`
+/// to `Vec`").
+pub(crate) fn state_arg(value: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    value.extract::<Vec<f64>>().map_err(|_| {
+        InvalidInputError::new_err(format!(
+            "state must be a sequence of numbers (the flat state, m and m/s), got {}",
+            shown(value)
+        ))
+    })
+}
+
+/// `max_iterations`: a whole number >= 1 (-1 had raised an OverflowError).
+pub(crate) fn max_iterations_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    whole("max_iterations", value).map(|v| usize::try_from(v).unwrap_or(usize::MAX))
+}
+
 pub(crate) fn every_arg(value: &Bound<'_, PyAny>) -> PyResult<u64> {
     whole("every", value)
 }
