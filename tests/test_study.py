@@ -324,6 +324,11 @@ def test_the_study_command_writes_the_file(tmp_path: Path) -> None:
         (("count = 4", "count = 0"), ["count", ">= 1"]),
         # One value is start alone: stop had been dropped without a word.
         (("count = 4", "count = 1"), ["count", ">= 2", "set stop = start"]),
+        # Both varied: the runs took the lower wall's and the coordinate said clearance.
+        (
+            ("count = 4 }", 'count = 4 }\n"damper.0.lower_clearance" = [0.003]'),
+            ["damper.0.clearance", "damper.0.lower_clearance", "not both"],
+        ),
         (('metrics = ["peak"', 'metrics = ["peek"'), ["metrics", "peek"]),
     ],
 )

@@ -190,6 +190,7 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
         if path in counts:
             raise StudyError(f"[study.random] {path!r}: is also an axis")
         _distribution(path, spec, out["samples"])
+    _check_clearances([*counts, *map(str, random)])
     runs = math.prod(counts.values()) * max(out["samples"], 1)
     if runs > MAX_STUDY_RUNS:
         sizes = " x ".join(f"{path} {count}" for path, count in counts.items())
@@ -217,3 +218,19 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
 
 
 ANALYSIS_CHECKS["study"] = checked_study_settings
+
+
+def _check_clearances(paths: list[str]) -> None:
+    """Refuse a damper's ``clearance`` varied beside its ``lower_clearance`` or
+    ``upper_clearance``, as a scenario is refused for giving both: the runs took one
+    and the coordinates said the other."""
+    for path in paths:
+        parts = path.split(".")
+        if len(parts) == 3 and parts[0] == "damper" and parts[2] == "clearance":
+            for side in ("lower_clearance", "upper_clearance"):
+                other = f"damper.{parts[1]}.{side}"
+                if other in paths:
+                    raise StudyError(
+                        f"[study] {path!r} and {other!r}: vary clearance (each side) or "
+                        f"{side}, not both"
+                    )
