@@ -244,6 +244,7 @@ fn frequency_bound(structure: &Structure) -> f64 {
 /// eigenvalues only where the bound is not finite: then the highest natural
 /// frequency (Hz) they give, for [`check_natural_period`] to reuse.
 fn check_finite_modes(structure: &Structure) -> Result<Option<f64>> {
+    check_damping_rate(structure)?;
     if frequency_bound(structure).is_finite() {
         return Ok(None);
     }
@@ -256,6 +257,30 @@ fn check_finite_modes(structure: &Structure) -> Result<Option<f64>> {
          1.8e308 s^-2); check mass and stiffness, or write them in other units"
             .into(),
     ))
+}
+
+/// The most a coordinate's damping may be over its mass, `c / m` (1/s): its
+/// square, which the modes' and the flow's eigenvalues take, stays a double.
+/// A damping of 1e308 N s/m on 1 kg had been refused as "dt must be finite
+/// and > 0 s or None, got 0" (the exact flow's step underflowed).
+const MAX_DAMPING_RATE: f64 = 1e150;
+
+/// Refuse a structure whose damping over its mass (a diagonal term's
+/// `|c_ii| / m_ii`) is beyond [`MAX_DAMPING_RATE`].
+fn check_damping_rate(structure: &Structure) -> Result<()> {
+    let n = structure.dofs();
+    let (mass, damping) = (structure.mass(), structure.damping());
+    let rate = (0..n)
+        .map(|r| damping[r * n + r].abs() / mass[r * n + r])
+        .fold(0.0f64, f64::max);
+    if rate <= MAX_DAMPING_RATE {
+        return Ok(());
+    }
+    Err(Error::Inconsistent(format!(
+        "[structure] damping: its damping over its mass, {rate:.3e} 1/s, is beyond \
+         {MAX_DAMPING_RATE:e} 1/s (a decay time no double resolves); check damping and \
+         mass, or write them in other units"
+    )))
 }
 
 /// The largest of the structure's natural angular frequencies (rad/s; 0 for
@@ -597,6 +622,10 @@ mod tests {
             let damping = [vec![0.0; 2], vec![0.0; 2]];
             let matrices = Structure::matrices(&mass, &stiffness, &damping).unwrap();
             assert!(check_finite_modes(&matrices).is_err());
+            let overdamped = Structure::oscillator(1.0, 3947.8, 1e308).unwrap();
+            let error = check_finite_modes(&overdamped).unwrap_err().to_string();
+            assert!(error.contains("[structure] damping"), "{error}");
+            assert!(check_finite_modes(&Structure::oscillator(1.0, 1.0, 1e150).unwrap()).is_ok());
             // As large as a double holds: w = 1e150 rad/s, and a free body.
             for (m, k) in [(1e-150, 1e150), (1.0, 0.0), (1e-300, 1.0)] {
                 let fine = Structure::oscillator(m, k, 0.0).unwrap();
