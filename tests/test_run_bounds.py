@@ -254,5 +254,5 @@ def test_an_analysis_refuses_strobes_beyond_the_memory_limit(tmp_path: Path) -> 
         )
     )
     run = runner(data, tmp_path)
-    with pytest.raises(AnalysisError, match="settle fewer periods"):
+    with pytest.raises(AnalysisError, match="settle or record fewer periods"):
         run.periods(run.initial_state(), 10**7, strobe=True)
