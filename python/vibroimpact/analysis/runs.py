@@ -203,7 +203,8 @@ class Runner:
             raise AnalysisError(
                 f"periods: {count} stroboscopic states of {width} values, "
                 f"{count * width * 8 / 2**20:.0f} MiB, more than the "
-                f"{MAX_RECORD_BYTES >> 20} MiB a run's records may take: settle or record fewer periods"
+                f"{MAX_RECORD_BYTES >> 20} MiB a run's records may take: settle or record "
+                "fewer periods"
             )
         return self._run(state, count * self.period, record=record, strobe=strobe)
 
