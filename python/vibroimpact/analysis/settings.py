@@ -155,8 +155,11 @@ def basins_settings(table: Any) -> dict[str, Any]:
         if axis not in table:
             raise AnalysisError(f"[basins] missing key {axis!r} ({{state, start, stop, count}})")
         given = table[axis]
-        missing = [key for key in _AXIS if key not in given] if isinstance(given, Mapping) else []
-        if not isinstance(given, Mapping) or missing:
+        # Said here: _table's own "missing key" reads after "[basins] x." as one word.
+        required = [key for key, (_, default) in _AXIS.items() if default is _REQ]
+        mapping = isinstance(given, Mapping)
+        missing = [key for key in required if key not in given] if mapping else []
+        if not mapping or missing:
             problem = f"missing key {missing[0]!r}" if missing else f"got {shown(given)}"
             raise AnalysisError(
                 f"[basins] {axis}: must be a table {{state, start, stop, count}}, {problem}"

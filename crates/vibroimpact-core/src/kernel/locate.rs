@@ -600,15 +600,8 @@ fn dip_bottom<S: SystemStepper>(
 ) -> Result<std::result::Result<(f64, f64, f64), Location>> {
     let mode = modes[c.i];
     if let Mode::Sliding { direction } = mode {
-        let at = (time, y, h, full);
-        return sliding_bottom(
-            system,
-            stepper,
-            at,
-            (modes, c.i, direction),
-            scratch,
-            buffers,
-        );
+        let (step, sliding) = ((time, y, h, full), (modes, c.i, direction));
+        return sliding_bottom(system, stepper, step, sliding, scratch, buffers);
     }
     let sign = side(mode);
     let value = |end: &[f64], at: f64, scratch: &mut Scratch, work: &mut [f64]| {
@@ -660,7 +653,6 @@ fn dip_bottom<S: SystemStepper>(
 /// zero. A speed has no curvature in the state (the gaps' Newton steps
 /// take the acceleration for it): a dip of 1e-5 m/s on a speed of 1 m/s,
 /// and the stick it begins, had gone unseen inside a step.
-#[allow(clippy::too_many_arguments)]
 fn sliding_bottom<S: SystemStepper>(
     system: &Assembly,
     stepper: &mut S,
