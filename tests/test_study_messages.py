@@ -240,6 +240,38 @@ def test_the_heat_map_of_settled_draws_1_and_0_and_failed_runs_blank(
     np.testing.assert_array_equal(drawn[0], [[1.0, 1.0], [0.0, 1.0], [np.nan, np.nan]])
 
 
+def test_a_study_whose_every_run_fails_keeps_an_earlier_result(tmp_path: Path) -> None:
+    # A study whose every run failed had written its file of failures over an earlier
+    # result of the same name (an adversarial pass): the earlier file is kept, to the
+    # byte, the command says it did not write, and exits 1 with every reason in --json.
+    good = FORCED_DAMPER + (
+        '[study]\nanalysis = "run"\nmetrics = ["peak"]\n'
+        '[study.axes]\n"damper.0.restitution" = [0.5, 0.6]\n'
+    )
+    bad = good.replace("[0.5, 0.6]", "[1.1, 1.2]")
+    out = tmp_path / "r.nc"
+    done = cli("study", str(scenario(tmp_path, good)), "--out", str(out))
+    assert done.returncode == 0, done.stdout + done.stderr
+    earlier = out.read_bytes()
+    for extra in ([], ["--json"]):
+        done = cli("study", str(scenario(tmp_path, bad)), "--out", str(out), *extra)
+        assert done.returncode == 1, done.stdout + done.stderr
+        assert "is left as it was" in done.stderr and "Traceback" not in done.stderr
+        assert out.read_bytes() == earlier
+    summary = json.loads(done.stdout)
+    assert summary["written"] is False and len(summary["reasons"]) == 2
+    # With no earlier result the file of failures is written, as before.
+    fresh = tmp_path / "fresh.nc"
+    done = cli("study", str(scenario(tmp_path, bad)), "--out", str(fresh))
+    assert done.returncode == 1 and f"written to {fresh}" in done.stdout
+    with xr.open_dataset(fresh) as ds:
+        assert sorted(np.unique(ds["status"].values)) == [1, 2]
+    # The Python call keeps it too, and returns the failures.
+    dataset = st.run(load(scenario(tmp_path, bad)), out)
+    assert int(np.count_nonzero(dataset["status"].values)) == 2
+    assert out.read_bytes() == earlier
+
+
 def test_a_large_failed_region_lists_a_few_reasons_and_counts_the_rest(tmp_path: Path) -> None:
     # One line per distinct reason had printed one per refused value: a thousand lines
     # for a wide invalid region. The file keeps every reason.

@@ -145,6 +145,8 @@ def run_study_command(args: argparse.Namespace) -> int:
         if x == y:
             raise UsageError("--x and --y must be two different axes")
     start = time.perf_counter()
+    # `run` keeps an earlier output where every run fails (its notice says so).
+    earlier = args.out.exists() or args.out.is_symlink()
     dataset = run(
         study,
         args.out,
@@ -160,8 +162,13 @@ def run_study_command(args: argparse.Namespace) -> int:
         plot_study(args.plot, dataset, metric, x, str(y))
     elapsed = time.perf_counter() - start
     failed = int(np.count_nonzero(dataset["status"].values))
+    # Every run failed: the file is written (its reasons say why) unless it would
+    # replace an earlier result; nothing was computed, which the exit status says too.
+    status = 1 if failed == study.runs else 0
+    written = not (status and earlier)
     summary: dict[str, Any] = {
         "out": str(args.out),
+        "written": written,
         "runs": study.runs,
         "failed": failed,
         "reasons": json.loads(dataset.attrs["reasons"]),
@@ -169,16 +176,11 @@ def run_study_command(args: argparse.Namespace) -> int:
         "metrics": list(study.settings["metrics"]),
         "cpu_time": elapsed,
     }
-    # Every run failed: the file is written (its reasons say why), but nothing was
-    # computed, which the exit status says too.
-    status = 1 if failed == study.runs else 0
     if args.json:
         print(json_text(summary))
     else:
-        print(
-            f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, "
-            f"written to {args.out}"
-        )
+        where = f"written to {args.out}" if written else f"{args.out} not written"
+        print(f"{args.scenario}: {study.runs} runs ({failed} failed) in {elapsed:.3f} s, {where}")
         if args.plot:
             print(f"plot written to {args.plot}")
         # A few reasons; a large failed region has one per value (the file has all).
@@ -188,7 +190,11 @@ def run_study_command(args: argparse.Namespace) -> int:
         if len(reasons) > _REASONS_SHOWN:
             print(
                 f"  ... and {len(reasons) - _REASONS_SHOWN} more reasons (every one in the "
-                "file's attrs['reasons'], numbered by its status)"
+                + (
+                    "file's attrs['reasons'], numbered by its status)"
+                    if written
+                    else "--json output's reasons)"
+                )
             )
     if status:
         print(f"vibroimpact: error: every one of the {study.runs} runs failed", file=sys.stderr)

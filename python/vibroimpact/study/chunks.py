@@ -66,7 +66,9 @@ def run(
     0), the chunks its tasks; the results are the same. A run that resumes says so to
     ``notice`` (one line: the chunks kept before); a run that stops (interrupted, or
     failed) with chunks kept gets a note (:meth:`BaseException.add_note`) saying how
-    many and how to resume (``resume``). Returns the Dataset."""
+    many and how to resume (``resume``). Where every run failed, an earlier output of
+    the same name is kept, not replaced by a file of failures (``notice`` is told).
+    Returns the Dataset."""
     arguments.instance("study", study, Study, "vibroimpact.study.study_of(sections)")
     out = arguments.path("out", out)
     for name, function in (("progress", progress), ("notice", notice)):
@@ -82,6 +84,7 @@ def run(
         check_output(out, "out:")
     # What a killed write left: an earlier store moved aside is back before any run.
     remove_stale(out.resolve() if out.is_symlink() else out)
+    earlier = out.exists() or out.is_symlink()
     parts_dir = out.with_name(out.name + ".parts")
     fingerprint = study.fingerprint()
     manifest = parts_dir / "manifest.json"
@@ -140,7 +143,15 @@ def run(
         else:
             _run_on_dask(study, chunks, pending, dask, threads, finished)
         dataset = assemble(study, [parts[number] for number in range(len(path_of))])
-        if kind == ".zarr":
+        if earlier and every_run_failed(dataset):
+            # Nothing was computed: an earlier result of the same name is worth more
+            # than a file of failures (the dataset returned has every reason).
+            if notice is not None:
+                notice(
+                    f"every one of the {study.runs} runs failed: {out} is left as it was "
+                    "(an earlier result)"
+                )
+        elif kind == ".zarr":
             _write_zarr(dataset, out)
         else:
             write_netcdf(dataset, out)
@@ -159,6 +170,12 @@ def run(
         raise
     shutil.rmtree(parts_dir, ignore_errors=True)
     return dataset
+
+
+def every_run_failed(dataset: Any) -> bool:
+    """Whether a study's every run failed (``status`` non-zero everywhere)."""
+    status = np.asarray(dataset["status"].values)
+    return status.size > 0 and bool(np.all(status != 0))
 
 
 def _kept(study: Study, chunks: list[range], parts: Mapping[int, Any]) -> str:
