@@ -246,6 +246,8 @@ impl Impacts {
             out.push(Jump {
                 interaction: i,
                 restitution,
+                // As `resolve` records an impact: its role's, with an impulse.
+                struck: matches!(self.roles[s], Role::Impact { .. }) && self.lcp.z[s] != 0.0,
             });
         }
     }

@@ -15,6 +15,10 @@ use crate::model::assembly::Mode;
 pub struct Jump {
     pub interaction: usize,
     pub restitution: f64,
+    /// Whether it struck: it arrived at a speed of its own and its impulse
+    /// acted (the run records an impact), not a landing at rest, a pair
+    /// held or one that starts to stick without an approach.
+    pub struck: bool,
 }
 
 /// One event of a run.

@@ -497,7 +497,11 @@ impl EventObserver for Tangent<'_> {
             .iter()
             .zip(view.modes_after)
             .any(|(b, a)| *b == Mode::Open && matches!(a, Mode::Compliant { .. }));
-        self.impacts += u64::from(!view.jumps.is_empty() || onset);
+        // Impacts as the run records them: a pair that lands at rest (a
+        // stick carried across a block's cut, found again at its start) or
+        // is held by the others' impulses did not strike.
+        let struck = view.jumps.iter().any(|j| j.struck);
+        self.impacts += u64::from(struck || onset);
         self.latch(view, stretch);
         if let Some(p) = self.parameters.as_mut() {
             std::mem::swap(&mut p.columns, &mut self.moved);

@@ -161,6 +161,7 @@ impl Saltation {
                 .map(|interaction| Jump {
                     interaction,
                     restitution: 0.0,
+                    struck: false,
                 })
                 .collect()
         };
@@ -590,6 +591,7 @@ fn newly_stuck(view: &EventView<'_>) -> Vec<Jump> {
         .map(|interaction| Jump {
             interaction,
             restitution: 0.0,
+            struck: false,
         })
         .collect()
 }
@@ -603,6 +605,7 @@ fn sticking(view: &EventView<'_>) -> Vec<Jump> {
         .map(|j| Jump {
             interaction: j.interaction,
             restitution: 0.0,
+            struck: false,
         })
         .collect()
 }
