@@ -11,6 +11,8 @@ and the Poincare section of a period-1 orbit spread over 1e-3 m.
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -22,6 +24,7 @@ from vibroimpact import study as st
 from vibroimpact.analysis.parameters import shifted
 from vibroimpact.analysis.runs import state_arrays
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 FREQUENCY = 11.5
 PERIOD = 1.0 / FREQUENCY
 
@@ -435,3 +438,67 @@ def test_an_orbit_through_a_floor_onset_has_the_parameter_derivative_of_differen
     differences = (sides[0] - sides[1]) / (2 * step)
     size = np.max(np.abs(differences))
     assert np.allclose(derivative.state, differences, rtol=0, atol=1e-5 * size)
+
+
+def _one_contact_a_period(law: str, phase: float) -> dict[str, Any]:
+    """A 1 Hz oscillator (5 % damping) under a stop of ``law`` 10 mm above rest, forced
+    at 1.6 Hz: one contact a period; a ``phase`` of 0.482 rad puts t = 0 inside it."""
+    stop: dict[str, Any] = {"at": 0, "side": "upper", "gap": 0.01, "law": law}
+    stop.update({"stiffness": 1e5} if law == "hertz" else {"stiffness": 2000.0, "damping": 2.0})
+    force = {"kind": "force", "at": 0, "signal": "harmonic", "amplitude": 1.0}
+    return {
+        "structure": {
+            "kind": "oscillator",
+            "mass": 1.0,
+            "stiffness": 39.47841760435743,
+            "damping": 0.6283185307179586,
+        },
+        "stop": [stop],
+        "excitation": [{**force, "frequency": 1.6, "phase": phase}],
+        "solver": {"method": "dop853", "rtol": 1e-12, "atol": 1e-15},
+    }
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("law", ["hertz", "linear"])
+def test_an_orbit_through_a_contact_at_its_section_counts_each_contact_once(law: str) -> None:
+    # A law that latches no approach rate keeps its section inside the contact: its run
+    # from there had counted the contact in progress at t = 0 as one begun, 2 impacts a
+    # period for 1 (and 4 for 3 over 3 periods; a probe of the tangent analyses). The
+    # same orbit with its section outside the contact (phase 0) counts 1.
+    outside = an.runner(_one_contact_a_period(law, 0.0))
+    reference = an.orbit(outside, an.steady_state(outside, settle_periods=60).state)
+    assert reference.converged and reference.impacts_per_period == 1.0
+    inside = an.runner(_one_contact_a_period(law, 0.4819615307562894))
+    start = an.steady_state(inside, settle_periods=60).state
+    for periods in (1, 3):
+        found = an.orbit(inside, start, periods=periods)
+        assert found.converged and found.impacts_per_period == 1.0, (periods, found)
+    # Its multipliers are the phase-shifted orbit's (one orbit, another section).
+    np.testing.assert_allclose(
+        np.sort_complex(found.floquet_multipliers),
+        np.sort_complex(reference.floquet_multipliers**3),
+        rtol=1e-6,
+    )
+    # The run from a state inside a contact no run began says so: onset -0.0.
+    raw = inside.periods(found.state, 1)
+    assert np.signbit(raw["contacts"]["onset"][0]) and raw["contacts"]["onset"][0] == 0.0
+    assert list(an.runs.begun(raw["contacts"])) == [False, True]
+
+
+@pytest.mark.timeout(120)
+def test_lyapunov_counts_a_stick_across_its_blocks_cuts_once() -> None:
+    # A plastic damper (e = 0) sticks after each of its two impacts a period, and a stick
+    # spans each cut between the spectrum's blocks: the next block found it again at its
+    # start, a landing at 1e-8 m/s, and counted it as an impact (2,010 for 1,000 periods,
+    # 210 for 100). The independent count: the impacts one continuous run records over
+    # the same periods from the same settled state.
+    system = vi.load(EXAMPLES / "frf_impact_damper.toml")
+    damper = dataclasses.replace(system.dampers[0], restitution=0.0)
+    system = system.replace(dampers=[damper])
+    found = vi.lyapunov(system, settle=100, periods=100)
+    run = an.lyapunov_runner(system)
+    settled = run.map(run.initial_state(), 100)
+    whole = run.periods(settled, 100, record=True)
+    kinds = list(whole["contacts"]["kind"])
+    assert found.impacts == kinds.count("impact") == 200

@@ -199,8 +199,9 @@ def struck(run: Runner, state: np.ndarray, periods: int) -> set[str]:
     hit: set[str] = set()
     for p, kind, onset in zip(contacts["pair"], contacts["kind"], contacts["onset"], strict=True):
         name = names[p]
-        # A contact carried from the run before (onset < 0) strikes again later.
-        if kind not in ("impact", "compliant") or onset < 0.0:
+        # A contact carried from the run before (onset < 0, or -0.0 in progress at
+        # the start) strikes again later.
+        if kind not in ("impact", "compliant") or np.signbit(onset):
             continue
         if _kind(name) != "damper":
             hit.add(name)

@@ -21,7 +21,6 @@ from vibroimpact._core import (
 )
 from vibroimpact.analysis.limits import MAX_PERIODS, AnalysisError, check_periods, whole_count
 from vibroimpact.analysis.parameters import forcing_period
-from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.system import (
     PreparedRun,
@@ -29,6 +28,7 @@ from vibroimpact.system import (
     split_observed,
     structure_coordinates,
 )
+from vibroimpact.system.schema import not_a_table
 
 
 def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
@@ -39,7 +39,7 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
             "[structure] section, its dampers, stops and excitations)"
         )
     if not isinstance(data.get("solver", {}), Mapping):
-        raise InvalidInputError(f"[solver] must be a table, got {shown(data['solver'])}")
+        raise InvalidInputError(not_a_table("solver", data["solver"]))
     solver = dict(data.get("solver", {}))
     solver.setdefault("t_end", 1.0)
     output = data.get("output", {})
@@ -357,8 +357,11 @@ def carried_from(state: np.ndarray, count: int) -> list[Any] | None:
 
 def begun(contacts: Mapping[str, Any]) -> np.ndarray:
     """Which of a run's ``contacts`` began in it: not those it continued from the
-    run before (their onsets < 0)."""
-    return np.asarray(contacts["onset"], dtype=float) >= 0.0
+    run before (their onsets < 0), nor one in progress at its start that no run began
+    (onset -0.0: a state given inside a contact)."""
+    onsets = np.asarray(contacts["onset"], dtype=float)
+    began: np.ndarray = (onsets >= 0.0) & ~np.signbit(onsets)
+    return began
 
 
 def _impacts(raw: Mapping[str, Any]) -> int:

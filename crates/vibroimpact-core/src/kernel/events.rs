@@ -200,6 +200,15 @@ pub struct PairContact {
     pub energy_change: f64,
 }
 
+impl PairContact {
+    /// Whether the contact began in the run at or after `from` (s, >= 0):
+    /// not one carried from the run before (its onset < 0) nor one in
+    /// progress at the run's start whose onset no run gave (-0.0).
+    pub fn begun_from(&self, from: f64) -> bool {
+        self.onset >= from && self.onset.is_sign_positive()
+    }
+}
+
 /// A compliant contact open at a run's end, carried into a run continued
 /// from its final state: what the state `(x, v)` alone does not hold (a
 /// damped law's latched approach rate, the contact's onset), without which

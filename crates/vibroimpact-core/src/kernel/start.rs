@@ -314,7 +314,9 @@ impl<'a> Run<'a> {
                 let approach = rate.abs();
                 let (mut approach_rate, mut resting) =
                     self.compliant_onset(i, 0.0, approach.max(f64::MIN_POSITIVE), scales);
-                let (mut onset, mut approach_speed, mut deepest) = (0.0, approach, -gap);
+                // In progress at the start: -0.0, an onset at or before it that
+                // the run did not see begin (counted as no contact begun in it).
+                let (mut onset, mut approach_speed, mut deepest) = (-0.0, approach, -gap);
                 if let Some(Some(c)) = carried.get(i) {
                     approach_rate = c.approach_rate;
                     (onset, approach_speed) = (c.onset, c.approach_speed);

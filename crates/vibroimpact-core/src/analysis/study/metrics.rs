@@ -154,7 +154,7 @@ pub(super) fn orbit_metrics(
     let impacts = orbit
         .contacts
         .iter()
-        .filter(|c| c.kind != ContactKind::Sticking)
+        .filter(|c| c.kind != ContactKind::Sticking && c.begun_from(0.0))
         .count() as f64;
     let nan = f64::NAN;
     Ok(RunMetrics {
@@ -203,7 +203,7 @@ pub(super) fn metrics_of(
     let recorded: Vec<_> = sol
         .contacts
         .iter()
-        .filter(|c| c.onset >= record_from)
+        .filter(|c| c.begun_from(record_from))
         .collect();
     let impacts = recorded
         .iter()
