@@ -14,6 +14,9 @@ sticking contact from t = 0 that never ends, no impact, and the body's state sta
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 import pytest
 
 import vibroimpact as vi
@@ -68,3 +71,49 @@ def test_a_sprung_mass_pressed_by_gravity_onto_a_stop_stays_on_it(
         gravity=vi.Gravity(acceleration=G),
     )
     _stays_at_rest(_run(system, method))
+
+
+def _pressed_onto_a_stop(gap: float, damper: dict[str, Any], gravity: bool) -> vi.System:
+    """A 1 kg, 2000 N/m structure on a linear stop (12000 N/m) ``gap`` below it, carrying
+    a 50 g damper of no clearance, pressed onto the stop by a 20 Hz force of 8 N starting
+    at its trough (or by gravity)."""
+    force = vi.Force(at=0, signal=vi.Harmonic(amplitude=8.0, frequency=20.0, phase=math.pi))
+    return vi.System(
+        structure=vi.Oscillator(mass=1.0, stiffness=2000.0),
+        dampers=[vi.Damper(mass=0.05, at=0, clearance=0.0, **damper)],
+        stops=[vi.Stop(at=0, side="lower", gap=gap, law="linear", stiffness=12000.0)],
+        excitations=[] if gravity else [force],
+        gravity=vi.Gravity(acceleration=G) if gravity else None,
+    )
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    ("damper", "gravity", "method"),
+    [
+        ({"law": "hertz", "stiffness": 1e4}, False, "rk4"),
+        ({"law": "hertz", "stiffness": 1e4}, False, "dop853"),
+        ({"law": "hertz-damped", "stiffness": 1e4, "restitution": 0.5}, False, "dopri5"),
+        ({"law": "linear", "stiffness": 1e4}, False, "dop853"),
+        ({"law": "rigid", "restitution": 0.5}, True, "dop853"),
+        ({"law": "rigid", "restitution": 0.5}, True, "exact"),
+    ],
+)
+def test_pairs_set_touching_and_pressed_run_as_pairs_a_hair_apart(
+    damper: dict[str, Any], gravity: bool, method: str
+) -> None:
+    # Pairs touching at t = 0 with nothing moving (a contact beginning at 3e-162 m/s):
+    # rk4 had refused the contact as lasting 0 s ("reduce dt to about 0.0e0 s"), dop853
+    # had restarted at a step of 0 s after it and looped with no end (the square of the
+    # speed underflowed in both), and with gravity a contact's 7e-40 J had been refused
+    # as energy created (1.0 of nothing in play). The independent value: the same system
+    # with the stop 1e-12 m away, which every method ran.
+    step = {"dt": 1e-5} if method == "rk4" else {}
+    touching, apart = (
+        vi.simulate(_pressed_onto_a_stop(gap, damper, gravity), method=method, t_end=0.2, **step)
+        for gap in (0.0, 1e-12)
+    )
+    assert touching.final_time == apart.final_time == 0.2
+    assert touching.steps < 2 * apart.steps + 100
+    x0, x1 = (s.final_state["structure_displacement"][0] for s in (touching, apart))
+    assert x0 == pytest.approx(x1, rel=1e-6, abs=1e-11)

@@ -380,7 +380,10 @@ impl Run<'_> {
                     &self.y,
                     &self.modes,
                     (energy.stored_start, energy.impact_loss),
-                    energy.scale,
+                    // At least the round-off the run's own balance allows: a
+                    // pair set touching at rest has nothing in play (gravity
+                    // pressing a zero clearance: 7e-40 J had been refused).
+                    energy.scale.max(system.energy_floor(self.schedule.t_end)),
                     (energy.tolerance, self.creates_contact_energy),
                     record,
                 )?;
@@ -548,12 +551,28 @@ fn contact_time_scale(system: &Assembly, i: usize, speed: f64) -> f64 {
     };
     let speed = speed.abs();
     let energy = 0.5 * speed * speed / it.inverse_mass;
+    let stiffness = match law {
+        AnyLaw::Hertz(Hertz { stiffness })
+        | AnyLaw::HysterHertz(HysterHertz { stiffness, .. })
+        | AnyLaw::Linear(Linear { stiffness }) => stiffness,
+    };
+    let linear = matches!(law, AnyLaw::Linear(_));
+    if energy < f64::MIN_POSITIVE {
+        // The square underflowed (a pair set touching at rest, 3e-162 m/s: the
+        // scale had been 0 and the steps after the onset 0 s long, forever):
+        // the same in powers of the speed alone.
+        let compliance = 0.5 / (it.inverse_mass * stiffness);
+        return if linear {
+            (2.0 * compliance).sqrt()
+        } else {
+            (compliance / 0.4).powf(0.4) * speed.powf(-0.2)
+        };
+    }
     // The law's potential inverted: `0.4 k delta^2.5` (Hertz), `0.5 k delta^2`.
-    let indentation = match law {
-        AnyLaw::Hertz(Hertz { stiffness }) | AnyLaw::HysterHertz(HysterHertz { stiffness, .. }) => {
-            (energy / (0.4 * stiffness)).powf(0.4)
-        }
-        AnyLaw::Linear(Linear { stiffness }) => (2.0 * energy / stiffness).sqrt(),
+    let indentation = if linear {
+        (2.0 * energy / stiffness).sqrt()
+    } else {
+        (energy / (0.4 * stiffness)).powf(0.4)
     };
     indentation / speed
 }

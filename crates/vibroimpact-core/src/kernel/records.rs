@@ -178,13 +178,22 @@ impl Run<'_> {
         // progress: an event that recurs at once (a zero clearance, say)
         // would otherwise loop. (An adaptive method's own short steps, from
         // a tiny first step, grow.)
-        if taken <= self.schedule.chatter_interval(time) && (event || !self.schedule.adaptive) {
+        // A step that did not move the time at all, whatever ended it, makes
+        // none next either (a step size fallen to 0 had looped forever).
+        let frozen = taken <= 0.0 && !event;
+        if frozen
+            || taken <= self.schedule.chatter_interval(time) && (event || !self.schedule.adaptive)
+        {
             self.stalled += 1;
             if self.stalled >= STALLED_STEPS {
-                return Err(Error::Chattering {
-                    time,
-                    events: self.stalled,
-                    interval: taken,
+                return Err(if frozen {
+                    Error::StepSizeTooSmall { time, step: taken }
+                } else {
+                    Error::Chattering {
+                        time,
+                        events: self.stalled,
+                        interval: taken,
+                    }
                 });
             }
         } else {

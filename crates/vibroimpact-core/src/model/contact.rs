@@ -585,9 +585,12 @@ impl AnyLaw {
         match self {
             AnyLaw::Hertz(Hertz { stiffness })
             | AnyLaw::HysterHertz(HysterHertz { stiffness, .. }) => {
-                use crate::model::closed_forms::{hertz_deepest, HERTZ_DURATION_CONSTANT};
-                let deepest = hertz_deepest(1.0 / effective_mass, *stiffness, approach);
-                HERTZ_DURATION_CONSTANT * deepest / approach
+                use crate::model::closed_forms::HERTZ_DURATION_CONSTANT;
+                // The deepest indentation over the approach, (5 m v^2 / 4 k)^0.4
+                // / v, with no square to underflow: a pair set touching at rest
+                // (3e-162 m/s) had lasted 0 s and been refused as too short.
+                let scale = (5.0 * effective_mass / (4.0 * stiffness)).powf(0.4);
+                HERTZ_DURATION_CONSTANT * scale * approach.powf(-0.2)
             }
             AnyLaw::Linear(Linear { stiffness }) => {
                 std::f64::consts::PI * (effective_mass / stiffness).sqrt()
