@@ -26,7 +26,9 @@ def _record_error(tmp_path: Path, csv: str) -> str:
 
 
 @pytest.mark.parametrize(
-    "line", ["0,1_0", "1_0,5", "0x10,1", "0 1e", "\u0661,2", "0,100 # start of record"]
+    "line",
+    ["0,1_0", "1_0,5", "0x10,1", "0 1e", "\u0661,2", "0,100 # start of record"]
+    + ["0,", "0,e", "0,0,"],
 )
 def test_a_mistyped_first_sample_without_a_header_is_refused_not_dropped(
     tmp_path: Path, line: str

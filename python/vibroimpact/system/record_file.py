@@ -180,9 +180,18 @@ def _names_columns(line: str) -> bool:
     """Whether the first line names the columns: a cell before any comment that is not
     a number and not meant as one (``time``, ``El Centro 1940 NS``; ``0,1_0`` is a
     mistyped sample, ``0,100 # start`` a sample with a comment after it, which the rule
-    had read as a header and dropped without a word)."""
+    had read as a header and dropped without a word). An empty cell names nothing
+    (``0,`` is a sample missing its value), and two cells of which the first is a time
+    are a sample (``0,e``): both had been dropped as headers."""
     cells = _SEPARATOR.split(line.split("#", 1)[0].strip())
-    return any(not _NUMBER.fullmatch(c) and not _MEANT_AS_NUMBER.match(c) for c in cells)
+    if len(cells) == 2 and _meant_as_number(cells[0]):
+        return False
+    return any(c and not _meant_as_number(c) for c in cells)
+
+
+def _meant_as_number(cell: str) -> bool:
+    """Whether a cell is a number or meant as one (see :data:`_MEANT_AS_NUMBER`)."""
+    return bool(_NUMBER.fullmatch(cell) or _MEANT_AS_NUMBER.match(cell))
 
 
 def check_record(
