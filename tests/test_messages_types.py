@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+import vibroimpact as vi
 from test_hostile_inputs import RECORDED, refused
 from vibroimpact.scenario.two_mass import ScenarioError, parse_scenario
 from vibroimpact.system.record_file import MAX_RECORDED_FILE_BYTES
@@ -732,3 +733,19 @@ def test_too_many_periods_are_refused_naming_periods(name: str) -> None:
     system = vi.load(Path(__file__).resolve().parents[1] / "examples" / "frf_impact_damper.toml")
     with pytest.raises(ValueError, match=r"^periods: must be a whole number in \[1, 10000000\]"):
         getattr(vi, name)(system, periods=10**12)
+
+
+def test_a_section_written_as_a_list_of_tables_says_so() -> None:
+    # [[structure]]: dict() of the list had said "dictionary update sequence element #0
+    # has length 3; 2 is required", naming nothing (an adversarial pass).
+    oscillator = {"kind": "oscillator", "mass": 1.0, "stiffness": 1.0}
+    cases = [
+        ({"structure": [oscillator]}, "[structure] must be a table, got a list of 1 table"),
+        ({"structure": oscillator, "output": [{}]}, "[output] must be a table, got a list"),
+    ]
+    for sections, expected in cases:
+        with pytest.raises(vi.InvalidInputError) as caught:
+            vi.System.from_dict(sections)
+        assert str(caught.value).startswith(expected), caught.value
+    with pytest.raises(ValueError, match=r"\[\[structure\]\]\): write \[structure\], once$"):
+        vi.loads('[[structure]]\nkind = "oscillator"\nmass = 1.0\nstiffness = 1.0\n')

@@ -59,7 +59,7 @@ from vibroimpact.system import (
 )
 from vibroimpact.system.parameter_keys import check_parameter_keys
 from vibroimpact.system.run import checked_output
-from vibroimpact.system.schema import MAX_SCENARIO_BYTES
+from vibroimpact.system.schema import MAX_SCENARIO_BYTES, not_a_table
 
 _P = TypeVar("_P", bound=Part)
 
@@ -368,7 +368,7 @@ class System:
                 if table is None:
                     continue
                 if not isinstance(table, Mapping):
-                    raise _fail("", f"[{name}] must be a table, got {shown(table)}") from None
+                    raise _fail("", not_a_table(name, table)) from None
                 for key in table:
                     if key not in schema:
                         raise _unknown_key(f"[{name}] ", key, list(schema), "allowed:") from None
@@ -378,6 +378,9 @@ class System:
 
     @classmethod
     def _of_tables(cls, sections: Mapping[str, Any], base_dir: Path | None) -> System:
+        if not isinstance(sections["structure"], Mapping):
+            # ([[structure]]: a list, which dict() refused naming nothing.)
+            raise TypeError("[structure] is not a table: the schema's error names it")
         structure = dict(sections["structure"])
         kind = _STRUCTURES[str(structure.pop("kind"))]
         gravity = sections.get("gravity")

@@ -548,11 +548,20 @@ def _list(name: str, value: Any) -> list[Any]:
     return list(value)
 
 
+def not_a_table(name: str, value: Any) -> str:
+    """What is said of a section ``[name]`` that is not a table: a list of tables is
+    ``[[name]]`` written for ``[name]``."""
+    if isinstance(value, list) and value and all(isinstance(v, Mapping) for v in value):
+        count = f"{len(value)} table" + ("s" if len(value) > 1 else "")
+        return f"[{name}] must be a table, got a list of {count} ([[{name}]]): write [{name}], once"
+    return f"[{name}] must be a table, got {shown(value)}"
+
+
 def structure_spec(structure: Any) -> dict[str, Any]:
     """The ``[structure]`` table checked, its defaults filled and a cantilever's section
     and material resolved to what the core takes (see :func:`system_spec`)."""
     if not isinstance(structure, Mapping):
-        raise _fail("", f"[structure] must be a table, got {shown(structure)}")
+        raise _fail("", not_a_table("structure", structure))
     kind = structure.get("kind")
     _choice("[structure] ", "kind", kind, tuple(_STRUCTURE))
     schema = {"kind": (_TEXT, _REQ), **_STRUCTURE[str(kind)]}
