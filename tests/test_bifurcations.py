@@ -622,3 +622,47 @@ def test_a_bifurcation_leg_up_goes_up_whatever_the_order_of_the_values() -> None
         ("down", 11.0),
     ]
     assert [p.samples.tolist() for p in up] == [p.samples.tolist() for p in both[:3]]
+
+
+def test_a_branch_plot_marks_a_flip_where_it_was_located() -> None:
+    # The flip had been marked on the point after it (15.3 for one located at 14.978),
+    # and the whole segment before that point drawn dashed, unstable (a new user).
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from vibroimpact.analysis.continuation import Branch, BranchPoint
+    from vibroimpact.analysis.located import Bifurcation
+    from vibroimpact.analysis.plots import _draw_branch
+
+    def point(value: float, amplitude: float, stable: bool, **flagged: Any) -> BranchPoint:
+        state, multipliers = np.zeros(2), np.zeros(2, dtype=complex)
+        return BranchPoint(value, state, multipliers, stable, 1.0, np.array([amplitude]), **flagged)
+
+    points = [
+        point(14.0, 0.10, True),
+        point(14.5, 0.12, True),
+        point(15.3, 0.20, False, flags=["flip"], crossings={"flip": 14.9}),
+        point(16.0, 0.30, False, flags=["fold"], crossings={"fold": 15.6}),
+    ]
+    flip = Bifurcation("flip", 14.978, np.zeros(2), np.array([-1.0, 0.5]))
+    branch = Branch("p", 1, points, "end", 1, 0, bifurcations=[flip])
+    fig, ax = plt.subplots()
+    try:
+        _draw_branch(ax, branch, ("blue", "red"))
+        marks = [line for line in ax.lines if line.get_marker() == "o"]
+        at = {float(m.get_xdata()[0]): float(m.get_ydata()[0]) for m in marks}
+        # The located flip, and the fold (not located) where its multiplier crossed.
+        assert at.keys() == {14.978, 15.6}
+        assert at[14.978] == pytest.approx(0.12 + (14.978 - 14.5) / 0.8 * 0.08, rel=1e-12)
+        assert at[15.6] == pytest.approx(0.20 + 0.3 / 0.7 * 0.10, rel=1e-12)
+        texts = sorted(t.get_text() for t in ax.texts)
+        assert texts == ["flip", "fold"]
+        segments = [line for line in ax.lines if line.get_marker() != "o"]
+        solid = [tuple(s.get_xdata()) for s in segments if s.get_linestyle() == "-"]
+        dashed = [tuple(s.get_xdata()) for s in segments if s.get_linestyle() == "--"]
+        assert solid == [(14.0, 14.5), (14.5, 14.978)]
+        assert dashed == [(14.978, 15.3), (15.3, 16.0)]
+    finally:
+        plt.close(fig)

@@ -421,21 +421,7 @@ def plot_branch(path: Path, branch: Branch, data: Any = None) -> None:
         shades = (("tab:blue", "tab:red"), ("tab:cyan", "tab:orange"))
         shown = [branch] + ([branch.switched] if branch.switched is not None else [])
         for (steady, unsteady), part in zip(shades, shown, strict=False):
-            values = [p.value for p in part.points]
-            amplitude = [p.amplitude[0] for p in part.points]
-            for i in range(1, len(values)):
-                stable = part.points[i].stable and part.points[i - 1].stable
-                ax.plot(
-                    values[i - 1 : i + 1],
-                    amplitude[i - 1 : i + 1],
-                    "-" if stable else "--",
-                    color=steady if stable else unsteady,
-                    lw=1.2,
-                )
-            for p in part.points:
-                for flag in p.flags:
-                    ax.annotate(flag, (p.value, p.amplitude[0]), fontsize=7)
-                    ax.plot([p.value], [p.amplitude[0]], "ko", ms=3)
+            _draw_branch(ax, part, (steady, unsteady))
             ax.plot([], [], "-", color=steady, label=f"{part.periods}-period, stable")
             ax.plot([], [], "--", color=unsteady, label=f"{part.periods}-period, unstable")
         ax.set_xlabel(f"{branch.parameter}{_unit(branch.parameter, data)}")
@@ -444,6 +430,73 @@ def plot_branch(path: Path, branch: Branch, data: Any = None) -> None:
         ax.set_title(f"{branch.periods}-period orbits" + (f"; {located}" if located else ""))
         ax.legend()
         ax.grid(alpha=0.3)
+
+
+def _draw_branch(ax: Any, branch: Branch, colors: tuple[str, str]) -> None:
+    """One branch's amplitude, stable solid in ``colors[0]``, unstable dashed in
+    ``colors[1]``, each bifurcation marked where it lies (located exactly, else where
+    its multiplier crossed) and the line split there where the stability changed: the
+    whole segment had been drawn dashed and the flag put on the point after it."""
+    points = branch.points
+    marked = []
+    for before, after in zip(points, points[1:], strict=False):
+        flags = _flag_values(branch, before, after)
+        marked += [(kind, value, before, after) for kind, value in flags]
+        cuts, styles = [before.value, after.value], [before.stable and after.stable]
+        if flags and before.stable != after.stable:
+            cuts = [before.value, flags[0][1], after.value]
+            styles = [before.stable, after.stable]
+        for low, high, stable in zip(cuts, cuts[1:], styles, strict=False):
+            ax.plot(
+                [low, high],
+                [_amplitude_at(before, after, v) for v in (low, high)],
+                "-" if stable else "--",
+                color=colors[0] if stable else colors[1],
+                lw=1.2,
+            )
+    for found in branch.bifurcations:
+        near = _bracketing(points, found.value)
+        if near is not None and (found.kind, found.value) not in [m[:2] for m in marked]:
+            marked.append((found.kind, found.value, *near))
+    for kind, value, before, after in marked:
+        y = _amplitude_at(before, after, value)
+        ax.annotate(kind, (value, y), fontsize=7)
+        ax.plot([value], [y], "ko", ms=3)
+
+
+def _flag_values(branch: Branch, before: Any, point: Any) -> list[tuple[str, float]]:
+    """Each bifurcation ``point`` is flagged with since ``before``, and its parameter:
+    the located one between them, else where its multiplier crossed, else the point's."""
+    out = []
+    for flag in point.flags:
+        located = (
+            found.value
+            for found in branch.bifurcations
+            if found.kind == flag and _within(found.value, before.value, point.value)
+        )
+        out.append((flag, next(located, point.crossings.get(flag, point.value))))
+    return out
+
+
+def _within(value: float, a: float, b: float) -> bool:
+    """Whether ``value`` lies between ``a`` and ``b`` (either order), ends included."""
+    return min(a, b) <= value <= max(a, b)
+
+
+def _bracketing(points: list[Any], value: float) -> tuple[Any, Any] | None:
+    """The first two neighbouring points of a branch whose parameters bracket ``value``."""
+    for before, after in zip(points, points[1:], strict=False):
+        if _within(value, before.value, after.value):
+            return before, after
+    return None
+
+
+def _amplitude_at(before: Any, after: Any, value: float) -> float:
+    """Coordinate 0's amplitude between two branch points at parameter ``value``,
+    interpolated linearly (the located bifurcation's own orbit is not run again)."""
+    span = after.value - before.value
+    weight = 0.0 if span == 0 else (value - before.value) / span
+    return float(before.amplitude[0] + weight * (after.amplitude[0] - before.amplitude[0]))
 
 
 def plot_study(path: Path, dataset: Any, metric: str, x: str, y: str) -> None:
