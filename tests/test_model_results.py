@@ -114,3 +114,37 @@ def test_to_pandas_says_when_pandas_is_missing(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.setitem(sys.modules, "pandas", None)
     with pytest.raises(ImportError, match="to_pandas\\(\\) needs pandas"):
         sol.contacts.to_pandas()
+
+
+@pytest.mark.timeout(60)
+def test_a_sweep_of_a_system_takes_its_own_sweep_table() -> None:
+    # vi.sweep(vi.load(file)) had refused the file's own [sweep] ("missing a required
+    # argument: 'parameter'") where study_of and the command read it (a new user).
+    table = {
+        "parameter": "excitation.0.amplitude",
+        "start": 11.0,
+        "stop": 12.0,
+        "count": 3,
+        "direction": "both",
+        "settle_periods": 10,
+        "record_periods": 2,
+    }
+    system = ball_table().replace(analyses={"sweep": table})
+    explicit = vi.sweep(
+        system,
+        "excitation.0.amplitude",
+        [11.0, 11.5, 12.0],
+        direction="both",
+        settle_periods=10,
+        record_periods=2,
+    )
+    own = vi.sweep(system)
+    assert [(p.value, p.direction) for p in own] == [(p.value, p.direction) for p in explicit]
+    assert [p.amplitude.tolist() for p in own] == [p.amplitude.tolist() for p in explicit]
+    # A keyword given still wins over the table's.
+    up = vi.sweep(system, direction="up")
+    assert [p.direction for p in up] == ["up"] * 3
+    with pytest.raises(ValueError, match="parameter and values together"):
+        vi.sweep(system, "excitation.0.amplitude")
+    with pytest.raises(ValueError, match=r"a \[sweep\] table"):
+        vi.sweep(ball_table().replace(analyses={}))

@@ -19,7 +19,7 @@ from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner
 from vibroimpact.analysis.sensitivities import Derivative, derivative_paths, settled_derivatives
-from vibroimpact.analysis.settings import _DIRECTIONS
+from vibroimpact.analysis.settings import _DIRECTIONS, sweep_settings
 from vibroimpact.analysis.steady import SteadyState, linear_response, steady_state
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
@@ -185,6 +185,33 @@ def from_carried(attempt: Callable[[np.ndarray | None], _T], state: np.ndarray |
         return attempt(None)
 
 
+def _sweep_table(data: Mapping[str, Any], parameter: str | None, values: Any) -> dict[str, Any]:
+    """The settings :func:`sweep` takes where it is not given them: ``data``'s
+    ``[sweep]`` table checked, where ``parameter`` and ``values`` are both omitted;
+    else the defaults alone (the table is not read, nor need it be there)."""
+    if (parameter is None) != (values is None):
+        missing = "values" if values is None else "parameter"
+        raise AnalysisError(
+            f"{missing}: give parameter and values together, or neither (a [sweep] table "
+            "gives both)"
+        )
+    if parameter is None:
+        table = data.get("sweep")
+        if table is None:
+            raise AnalysisError(
+                "parameter and values: give them, or a System (or sections) with a [sweep] "
+                "table (parameter, start, stop, count)"
+            )
+        return sweep_settings(table)
+    return {
+        "direction": "up",
+        "settle_periods": 200,
+        "record_periods": 50,
+        "tolerance": 1e-6,
+        "derivatives": (),
+    }
+
+
 class _PointFailure(Exception):
     """A sweep point the method cannot take: recorded with its reason."""
 
@@ -192,16 +219,16 @@ class _PointFailure(Exception):
 @arguments.typed()
 def sweep(
     data: Mapping[str, Any] | System,
-    parameter: str,
-    values: Sequence[float] | np.ndarray,
+    parameter: str | None = None,
+    values: Sequence[float] | np.ndarray | None = None,
     *,
-    direction: str = "up",
-    settle_periods: int = 200,
-    record_periods: int = 50,
-    tolerance: float = 1e-6,
+    direction: str | None = None,
+    settle_periods: int | None = None,
+    record_periods: int | None = None,
+    tolerance: float | None = None,
     base_dir: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
-    derivatives: Sequence[str] = (),
+    derivatives: Sequence[str] | None = None,
 ) -> list[SweepPoint]:
     """A stepped sweep of ``parameter`` (a dotted path into the scenario's sections)
     over ``values`` (sorted: ``"up"`` is towards larger values whatever their order as
@@ -213,8 +240,39 @@ def sweep(
     :class:`~vibroimpact.System` or a scenario's sections. ``derivatives``: dotted
     paths such as ``"damper.0.clearance"``; at each point, the derivatives of the
     orbit through its settled state in each (:attr:`SweepPoint.derivatives`, per unit
-    of the parameter; see :func:`settled_derivatives`)."""
+    of the parameter; see :func:`settled_derivatives`). Without ``parameter`` and
+    ``values``, the ``[sweep]`` table of ``data`` (a System loaded from a scenario
+    keeps it) gives them, and every setting not given here (``direction`` ``"up"``,
+    ``settle_periods`` 200, ``record_periods`` 50, ``tolerance`` 1e-6 where neither
+    says)."""
     data, base_dir = sections_of(data, base_dir)
+    table = _sweep_table(data, parameter, values)
+    given = {
+        "direction": direction,
+        "settle_periods": settle_periods,
+        "record_periods": record_periods,
+        "tolerance": tolerance,
+        "derivatives": derivatives,
+    }
+    # The table's settings (its defaults filled) where given none here.
+    chosen = {key: table[key] if value is None else value for key, value in given.items()}
+    if parameter is None or values is None:
+        parameter, values = table["parameter"], sweep_values(table)
+    return _sweep(data, parameter, values, chosen, base_dir, progress)
+
+
+def _sweep(
+    data: Mapping[str, Any],
+    parameter: str,
+    values: Sequence[float] | np.ndarray,
+    settings: Mapping[str, Any],
+    base_dir: Path | None,
+    progress: Callable[[int, int], None] | None,
+) -> list[SweepPoint]:
+    """:func:`sweep` with every setting chosen (``settings``: its keywords')."""
+    direction, derivatives = settings["direction"], settings["derivatives"]
+    settle_periods, record_periods = settings["settle_periods"], settings["record_periods"]
+    tolerance = settings["tolerance"]
     arguments.text("parameter", parameter)
     paths = derivative_paths(data, derivatives)
     values = sorted(arguments.numbers("values", values).tolist())
