@@ -186,24 +186,31 @@ def test_orbit_prints_a_readable_summary(run_cli: RunCli) -> None:
 
 
 def test_an_orbit_not_found_says_its_figures_are_of_the_last_iterate(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
-    from vibroimpact.cli import analysis_commands
     from vibroimpact.cli import command as cli
 
-    real = analysis_commands.orbit
     # One Newton iteration from a start off the orbit cannot converge.
-    monkeypatch.setattr(
-        analysis_commands, "orbit", lambda run, **kw: real(run, **kw, max_iterations=1)
-    )
-    assert cli.main(["orbit", str(BALL_TABLE)]) == 0
+    assert cli.main(["orbit", str(BALL_TABLE), "--max-iterations", "1"]) == 0
     out = capsys.readouterr().out
     assert "did NOT converge" in out
-    assert "last Newton iterate, not of an orbit" in out
+    assert "last Newton iterate, not of an orbit; start nearer it with --settle N" in out
     # A converged one does not say so.
-    monkeypatch.setattr(analysis_commands, "orbit", real)
     assert cli.main(["orbit", str(BALL_TABLE)]) == 0
     assert "last Newton iterate" not in capsys.readouterr().out
+
+
+def test_orbit_settles_before_shooting_where_asked(capsys: pytest.CaptureFixture[str]) -> None:
+    # The command shot from [initial] alone, with no bound on its iterations: a new
+    # user's cantilever ran 86 s to no orbit, with no way to start nearer it.
+    from vibroimpact.cli import command as cli
+
+    assert cli.main(["orbit", str(BALL_TABLE), "--settle", "30", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    run = vi.runner(tomllib.loads(BALL_TABLE.read_text(encoding="utf-8")))
+    expected = vi.orbit(run, run.map(run.initial_state(), 30))
+    assert out["converged"] and out["iterations"] == expected.iterations
+    assert out["state"] == expected.arrays(run.n, run.k)
 
 
 # ------------------------------------------------------------------------- sweep
@@ -465,6 +472,8 @@ def test_orbit_needs_forcing_with_a_period(
         (("--periods", "0"), "--periods"),
         (("--periods", "-3"), "--periods"),
         (("--tolerance", "0"), "--tolerance"),
+        (("--settle", "-1"), "--settle"),
+        (("--max-iterations", "0"), "--max-iterations"),
     ],
 )
 def test_bad_orbit_arguments_exit_2(run_cli: RunCli, args: tuple[str, str], fragment: str) -> None:

@@ -36,7 +36,7 @@ from vibroimpact.analysis import (
     sweep,
     sweep_values,
 )
-from vibroimpact.analysis.limits import relative_tolerance
+from vibroimpact.analysis.limits import MAX_ITERATIONS, relative_tolerance, whole_count
 from vibroimpact.analysis.runs import failed_everywhere
 from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
@@ -55,10 +55,19 @@ def _system(path: Path, command: str) -> SystemScenario:
 def run_orbit(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario, args.command)
     check_periods("", "--periods", args.periods, 1)
+    check_periods("", "--settle", args.settle, 0)
+    whole_count("--max-iterations", args.max_iterations, 1, MAX_ITERATIONS)
     relative_tolerance("--tolerance", args.tolerance)
     run = runner(scenario.data, scenario.base_dir)
     start = time.perf_counter()
-    found = orbit(run, periods=args.periods, tolerance=args.tolerance)
+    guess = run.map(run.initial_state(), args.settle) if args.settle else None
+    found = orbit(
+        run,
+        guess,
+        periods=args.periods,
+        tolerance=args.tolerance,
+        max_iterations=args.max_iterations,
+    )
     derivatives = (
         orbit_derivatives(
             scenario.data,
@@ -119,7 +128,10 @@ def run_orbit(args: argparse.Namespace) -> int:
         *(
             []
             if found.converged
-            else ["(what follows is of the last Newton iterate, not of an orbit)"]
+            else [
+                "(what follows is of the last Newton iterate, not of an orbit; start nearer "
+                "it with --settle N, or allow more --max-iterations)"
+            ]
         ),
         f"stable: {found.stable}; impacts per forcing period: {found.impacts_per_period:g}",
         "Floquet multipliers: "

@@ -42,6 +42,21 @@ def add_commands(sub: Any) -> None:
         help="largest |P(z) - z| relative to the largest displacement and velocity (1e-10)",
     )
     orbit_parser.add_argument(
+        "--settle",
+        type=int,
+        default=0,
+        metavar="N",
+        help="forcing periods run from [initial] before shooting, the guess then the state "
+        "they end at (0: [initial] itself); a guess near the orbit is what Newton needs",
+    )
+    orbit_parser.add_argument(
+        "--max-iterations",
+        type=int,
+        default=40,
+        metavar="N",
+        help="Newton iterations at most (40); each is a run of K periods and its tangent flow",
+    )
+    orbit_parser.add_argument(
         "--derivative",
         action="append",
         metavar="PATH",
