@@ -382,8 +382,18 @@ def test_bad_sweep_sections_exit_2_naming_the_key(
             ("[sweep]", '[study.axes]\n"damper.0.mas" = [0.05]\n[sweep]'),
             ["[study.axes]", "[damper] has no key 'mas'", "did you mean 'mass'"],
         ),
+        # An entry the scenario does not have, a value that is no number (a new user:
+        # a plain run took the first; the sweep said 'law: must be a string, got 7.0').
+        (
+            ('parameter = "excitation.0.frequency"', 'parameter = "excitation.1.frequency"'),
+            ["[sweep] parameter", "the scenario has 1 [[excitation]] (index 0)"],
+        ),
+        (
+            ('parameter = "excitation.0.frequency"', 'parameter = "damper.0.law"'),
+            ["[sweep] parameter", "'damper.0.law' is 'rigid' in the scenario, not a number"],
+        ),
     ],
-    ids=["sweep", "continuation", "study axis"],
+    ids=["sweep", "continuation", "study axis", "missing entry", "not a number"],
 )
 def test_a_misspelt_parameter_key_is_refused_when_the_file_is_read(
     run_cli: RunCli, tmp_path: Path, change: tuple[str, str], fragments: list[str]
@@ -401,7 +411,7 @@ def test_a_misspelt_derivative_key_is_told_the_closest(run_cli: RunCli, tmp_path
     done = run_cli("orbit", str(path), "--derivative", "damper.0.clearence")
     assert_one_line_error(done, "[damper] has no key 'clearence'", "did you mean 'clearance'")
     done = run_cli("orbit", str(path), "--derivative", "damper.3.clearance")
-    assert_one_line_error(done, "'damper.3.clearance': not set in the scenario")
+    assert_one_line_error(done, "'damper.3.clearance': the scenario has 1 [[damper]] (index 0)")
 
 
 def test_sweep_without_a_sweep_section_exits_2(run_cli: RunCli, tmp_path: Path) -> None:

@@ -148,3 +148,6 @@ def test_a_sweep_of_a_system_takes_its_own_sweep_table() -> None:
         vi.sweep(system, "excitation.0.amplitude")
     with pytest.raises(ValueError, match=r"a \[sweep\] table"):
         vi.sweep(ball_table().replace(analyses={}))
+    # A key that is no number: said of the parameter, not as the value its schema refused.
+    with pytest.raises(ValueError, match="'rigid' in the scenario, not a number"):
+        vi.sweep(system, "stop.0.law", [1.0])

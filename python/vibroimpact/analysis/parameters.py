@@ -96,6 +96,13 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
             f"parameter {path!r}: is an array in the scenario, not one number; a sweep "
             f"varies one number{whose}"
         )
+    if isinstance(current, str | bool):
+        # A law's name, a flag: set to a number, its schema had refused the value
+        # ("law: must be a string, got 7.0"), not the parameter.
+        raise AnalysisError(
+            f"parameter {path!r}: is {current!r} in the scenario, not a number; a sweep "
+            "varies one number"
+        )
     if isinstance(current, int) and not isinstance(current, bool) and float(value).is_integer():
         # A whole-number key (a cantilever's modes, a seed) stays one: a sweep's
         # values are floats, which its check refused ("got 3.0", user trial).
