@@ -14,6 +14,12 @@ from vibroimpact.output import path_argument
 
 def add_commands(sub: Any) -> None:
     """Register ``orbit`` and ``sweep`` on the command line's subparsers."""
+    _add_orbit(sub)
+    _add_sweep(sub)
+
+
+def _add_orbit(sub: Any) -> None:
+    """The ``orbit`` command's parser."""
     orbit_parser = sub.add_parser(
         "orbit",
         help="shoot for a periodic orbit of a forced scenario with [structure], with its stability",
@@ -74,6 +80,9 @@ def add_commands(sub: Any) -> None:
         help="plot the orbit's time history and phase portrait with its impacts marked",
     )
 
+
+def _add_sweep(sub: Any) -> None:
+    """The ``sweep`` command's parser."""
     sweep_parser = sub.add_parser(
         "sweep",
         help="stepped sweep of a parameter (frequency response), from a [sweep] section",
