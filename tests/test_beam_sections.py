@@ -244,3 +244,33 @@ def test_a_bad_beam_in_a_scenario_exits_2_with_one_line(
     err = captured.err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("vibroimpact: error:")
     assert all(fragment in err[0] for fragment in fragments), err[0]
+
+
+@pytest.mark.parametrize("part", ["damper", "force"])
+def test_a_damper_or_a_force_at_the_clamp_is_refused(part: str) -> None:
+    # Every mode has a node at x = 0: a damper there had rattled in a box that never
+    # moves and a force there had done no work, both without a word (0 contacts, 8
+    # steps), where a stop or a friction element there is refused (a probe of the API).
+    beam = vi.Cantilever(
+        length=0.5, youngs_modulus=7e10, second_moment=1e-10, mass_per_length=0.27, modes=2
+    )
+    at = {"damper": 0.5, "force": 0.5, part: 0.0}
+    system = {
+        "structure": beam,
+        "dampers": [
+            vi.Damper(mass=0.01, at=at["damper"], clearance=1e-3, law="rigid", restitution=0.6)
+        ],
+        "excitations": [vi.Force(at=at["force"], signal=vi.Harmonic(amplitude=1.0, frequency=8.0))],
+    }
+    where = "damper 0" if part == "damper" else "excitation 0"
+    with pytest.raises(ValueError, match=f"{where} at = 0 m is a point that does not move"):
+        vi.System(**system)  # type: ignore[arg-type]
+    # Anywhere the modes move, it runs.
+    at[part] = 0.25
+    system["dampers"] = [
+        vi.Damper(mass=0.01, at=at["damper"], clearance=1e-3, law="rigid", restitution=0.6)
+    ]
+    system["excitations"] = [
+        vi.Force(at=at["force"], signal=vi.Harmonic(amplitude=1.0, frequency=8.0))
+    ]
+    assert len(vi.simulate(vi.System(**system), method="exact", t_end=0.5).contacts) > 0  # type: ignore[arg-type]

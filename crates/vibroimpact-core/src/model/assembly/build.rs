@@ -351,7 +351,7 @@ impl Walls {
                      clearance"
                 )));
             }
-            let point = s.point(&format!("{name} at"), d.at)?;
+            let point = moving(&name, d.at, s.point(&format!("{name} at"), d.at)?)?;
             let law = interaction_law(&name, &d.law)?;
             let pair = self.pair(name);
             // Relative displacement u = z_j - point . q; upper wall: g = upper - u,
@@ -563,7 +563,8 @@ fn excitation_loads(spec: &SystemSpec, minv: &[f64]) -> Result<(Vec<ForceLoad>, 
             .map_err(|e| Error::Inconsistent(format!("excitation {j} signal: {e}")))?;
         match excitation.load {
             Load::Force { at } => {
-                let row = s.point(&format!("excitation {j} at"), at)?;
+                let name = format!("excitation {j}");
+                let row = moving(&name, at, s.point(&format!("{name} at"), at)?)?;
                 let mut push = vec![0.0; n];
                 linalg::multiply(minv, &row, &mut push);
                 forces.push(ForceLoad {
@@ -576,6 +577,20 @@ fn excitation_loads(spec: &SystemSpec, minv: &[f64]) -> Result<(Vec<ForceLoad>, 
         }
     }
     Ok((forces, base))
+}
+
+/// The structure's `row` at `at` (m) of the part `name`, refused where no mode
+/// moves there (a cantilever's clamp): a damper there rattles in a box that
+/// never moves and a force there does no work, both silently (a stop or a
+/// friction element there is refused as acting at a point that does not move).
+fn moving(name: &str, at: f64, row: Vec<f64>) -> Result<Vec<f64>> {
+    if row.iter().all(|&v| v == 0.0) {
+        return Err(Error::Inconsistent(format!(
+            "{name} at = {at} m is a point that does not move (every mode has a node there, \
+             as at a cantilever's clamp): move it"
+        )));
+    }
+    Ok(row)
 }
 
 /// The rows of the points, then of the moments, the reductions follow
