@@ -290,7 +290,7 @@ def _calls() -> list[Any]:
             continuation.continue_orbit,
             continued,
             "tolerance",
-            NONE_FOR_NUMBER,
+            NONE_FOR_NUMBER[1:],  # None: the [continuation] table's, or the default
         ),
         (
             continuation.continue_orbit,

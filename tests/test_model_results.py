@@ -151,3 +151,21 @@ def test_a_sweep_of_a_system_takes_its_own_sweep_table() -> None:
     # A key that is no number: said of the parameter, not as the value its schema refused.
     with pytest.raises(ValueError, match="'rigid' in the scenario, not a number"):
         vi.sweep(system, "stop.0.law", [1.0])
+
+
+@pytest.mark.timeout(120)
+def test_a_continuation_of_a_system_takes_its_own_continuation_table() -> None:
+    # As vi.sweep takes [sweep]: vi.continue_orbit(vi.load(file)) had refused the file's
+    # own [continuation] ("missing a required argument: 'parameter'"; a new user).
+    system = vi.load(ROOT / "examples" / "ball_table_continuation.toml")
+    table = dict(system.analyses["continuation"])
+    table.update(stop=13.0, max_points=6)
+    system = system.replace(analyses={"continuation": table})
+    own = vi.continue_orbit(system)
+    explicit = vi.continue_orbit(
+        system, table["parameter"], stop=13.0, max_points=6, step=0.3, switch=True
+    )
+    assert [p.value for p in own.points] == [p.value for p in explicit.points]
+    assert len(own.points) >= 2
+    with pytest.raises(ValueError, match="parameter and stop together"):
+        vi.continue_orbit(system, table["parameter"])

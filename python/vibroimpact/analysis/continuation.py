@@ -51,6 +51,7 @@ from vibroimpact.analysis.located import (
 from vibroimpact.analysis.orbits import orbit
 from vibroimpact.analysis.parameters import shifted, with_parameter
 from vibroimpact.analysis.runs import Runner, _impacts, runner, state_arrays
+from vibroimpact.analysis.settings import chosen_settings
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
 from vibroimpact.summary import summarised
@@ -130,16 +131,16 @@ def check_step(name: str, step: float, span: float) -> None:
 @arguments.typed()
 def continue_orbit(
     data: Mapping[str, Any] | System,
-    parameter: str,
+    parameter: str | None = None,
     *,
-    stop: float,
-    periods: int = 1,
+    stop: float | None = None,
+    periods: int | None = None,
     step: float | None = None,
-    max_points: int = 200,
-    tolerance: float = 1e-9,
+    max_points: int | None = None,
+    tolerance: float | None = None,
     base_dir: Path | None = None,
     progress: Callable[[int, int], None] | None = None,
-    switch: bool = False,
+    switch: bool | None = None,
 ) -> Branch:
     """Continue the K-period orbit found from the scenario's ``[initial]`` (at the
     scenario's value of ``parameter``) towards ``stop``, with arclength steps of
@@ -148,8 +149,15 @@ def continue_orbit(
     corrector fails even with small steps. Bifurcations are located exactly where every
     pair is rigid (:attr:`Branch.bifurcations`); with ``switch``, the continuation goes
     on from the first flip along the period-doubled branch (:attr:`Branch.switched`).
-    ``data``: a :class:`~vibroimpact.System` or a scenario's sections."""
+    ``data``: a :class:`~vibroimpact.System` or a scenario's sections; without
+    ``parameter`` and ``stop``, its ``[continuation]`` table gives them and every setting
+    not given here (else ``periods`` 1, ``max_points`` 200, ``tolerance`` 1e-9)."""
     data, base_dir = sections_of(data, base_dir)
+    keys = ("parameter", "stop", "periods", "step", "max_points", "tolerance", "switch")
+    values = (parameter, stop, periods, step, max_points, tolerance, switch)
+    given = dict(zip(keys, values, strict=True))
+    chosen = chosen_settings(data, "continuation", given, ("parameter", "stop"))
+    parameter, stop, periods, step, max_points, tolerance, switch = (chosen[k] for k in keys)
     arguments.text("parameter", parameter)
     stop = arguments.number("stop", stop)
     periods = whole_count("periods", periods, 1, MAX_PERIODS)

@@ -245,6 +245,36 @@ def curve_settings(table: Any) -> dict[str, Any]:
     return out
 
 
+def chosen_settings(
+    data: Mapping[str, Any],
+    section: str,
+    given: Mapping[str, Any],
+    required: tuple[str, ...],
+) -> dict[str, Any]:
+    """An analysis's settings: each of ``given`` that is not None, the rest from
+    ``data``'s ``[section]`` table (checked, its defaults filled) where every one of
+    ``required`` is omitted (a System loaded from a file keeps its tables), else the
+    table's defaults."""
+    missing = [key for key in required if given[key] is None]
+    if missing and len(missing) < len(required):
+        raise AnalysisError(
+            f"{', '.join(missing)}: give {' and '.join(required)} together, or none (a "
+            f"[{section}] table gives them)"
+        )
+    if missing:
+        table = data.get(section)
+        if table is None:
+            raise AnalysisError(
+                f"{' and '.join(required)}: give them, or a System (or sections) with a "
+                f"[{section}] table"
+            )
+        base = SETTINGS[section](table)
+    else:
+        schema = {"sweep": _SWEEP, "continuation": _CONTINUATION}[section]
+        base = {key: default for key, (_, default) in schema.items() if default is not _REQ}
+    return {key: base.get(key) if value is None else value for key, value in given.items()}
+
+
 #: Sections of analyses, checked when a scenario is read.
 SETTINGS: dict[str, Callable[[Any], dict[str, Any]]] = {
     "sweep": sweep_settings,

@@ -19,7 +19,7 @@ from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner
 from vibroimpact.analysis.sensitivities import Derivative, derivative_paths, settled_derivatives
-from vibroimpact.analysis.settings import _DIRECTIONS, sweep_settings
+from vibroimpact.analysis.settings import _DIRECTIONS, SETTINGS, chosen_settings
 from vibroimpact.analysis.steady import SteadyState, linear_response, steady_state
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
@@ -185,33 +185,6 @@ def from_carried(attempt: Callable[[np.ndarray | None], _T], state: np.ndarray |
         return attempt(None)
 
 
-def _sweep_table(data: Mapping[str, Any], parameter: str | None, values: Any) -> dict[str, Any]:
-    """The settings :func:`sweep` takes where it is not given them: ``data``'s
-    ``[sweep]`` table checked, where ``parameter`` and ``values`` are both omitted;
-    else the defaults alone (the table is not read, nor need it be there)."""
-    if (parameter is None) != (values is None):
-        missing = "values" if values is None else "parameter"
-        raise AnalysisError(
-            f"{missing}: give parameter and values together, or neither (a [sweep] table "
-            "gives both)"
-        )
-    if parameter is None:
-        table = data.get("sweep")
-        if table is None:
-            raise AnalysisError(
-                "parameter and values: give them, or a System (or sections) with a [sweep] "
-                "table (parameter, start, stop, count)"
-            )
-        return sweep_settings(table)
-    return {
-        "direction": "up",
-        "settle_periods": 200,
-        "record_periods": 50,
-        "tolerance": 1e-6,
-        "derivatives": (),
-    }
-
-
 class _PointFailure(Exception):
     """A sweep point the method cannot take: recorded with its reason."""
 
@@ -246,19 +219,20 @@ def sweep(
     ``settle_periods`` 200, ``record_periods`` 50, ``tolerance`` 1e-6 where neither
     says)."""
     data, base_dir = sections_of(data, base_dir)
-    table = _sweep_table(data, parameter, values)
     given = {
+        "parameter": parameter,
+        "values": values,
         "direction": direction,
         "settle_periods": settle_periods,
         "record_periods": record_periods,
         "tolerance": tolerance,
         "derivatives": derivatives,
     }
-    # The table's settings (its defaults filled) where given none here.
-    chosen = {key: table[key] if value is None else value for key, value in given.items()}
-    if parameter is None or values is None:
-        parameter, values = table["parameter"], sweep_values(table)
-    return _sweep(data, parameter, values, chosen, base_dir, progress)
+    chosen = chosen_settings(data, "sweep", given, ("parameter", "values"))
+    if values is None:
+        # The table's values: its start, stop, count and spacing.
+        chosen["values"] = sweep_values(SETTINGS["sweep"](data["sweep"]))
+    return _sweep(data, chosen["parameter"], chosen["values"], chosen, base_dir, progress)
 
 
 def _sweep(
