@@ -27,7 +27,7 @@ import numpy as np
 from vibroimpact._core import interactions
 from vibroimpact.analysis.located import Bifurcation
 from vibroimpact.analysis.parameters import shifted, with_parameter
-from vibroimpact.analysis.runs import Runner, runner
+from vibroimpact.analysis.runs import Runner, begun, runner
 from vibroimpact.model.system import listed_tables
 
 if TYPE_CHECKING:
@@ -197,11 +197,12 @@ def struck(run: Runner, state: np.ndarray, periods: int) -> set[str]:
     names = raw["pairs"]
     contacts = raw["contacts"]
     hit: set[str] = set()
-    for p, kind, onset in zip(contacts["pair"], contacts["kind"], contacts["onset"], strict=True):
+    rows = zip(contacts["pair"], contacts["kind"], contacts["onset"], begun(contacts), strict=True)
+    for p, kind, onset, new in rows:
         name = names[p]
-        # A contact carried from the run before (onset < 0, or -0.0 in progress at
-        # the start) strikes again later.
-        if kind not in ("impact", "compliant") or np.signbit(onset):
+        # A contact carried from the run before (or in progress at its start) strikes
+        # again later.
+        if kind not in ("impact", "compliant") or not new:
             continue
         if _kind(name) != "damper":
             hit.add(name)

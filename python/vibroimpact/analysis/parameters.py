@@ -15,6 +15,7 @@ from vibroimpact._core import _forcing_period as _core_forcing_period
 from vibroimpact.analysis.limits import AnalysisError, whole_count
 from vibroimpact.messages import shown
 from vibroimpact.system import RUN_SECTIONS
+from vibroimpact.system.parameter_keys import check_entry
 
 
 def forcing_period(data: Mapping[str, Any]) -> float:
@@ -67,6 +68,9 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
             ' such as "excitation.0.frequency"'
         )
     with_parameter_path_check(path, "")
+    # An entry the scenario lacks, a value that is no number (a law's name): said of
+    # the parameter, as when a scenario's paths are read.
+    check_entry(out, "parameter", path, AnalysisError)
     node: Any = out
     for depth, key in enumerate(parts[:-1]):
         try:
@@ -95,13 +99,6 @@ def with_parameter(data: Mapping[str, Any], path: str, value: float) -> dict[str
         raise AnalysisError(
             f"parameter {path!r}: is an array in the scenario, not one number; a sweep "
             f"varies one number{whose}"
-        )
-    if isinstance(current, str | bool):
-        # A law's name, a flag: set to a number, its schema had refused the value
-        # ("law: must be a string, got 7.0"), not the parameter.
-        raise AnalysisError(
-            f"parameter {path!r}: is {current!r} in the scenario, not a number; a sweep "
-            "varies one number"
         )
     if isinstance(current, int) and not isinstance(current, bool) and float(value).is_integer():
         # A whole-number key (a cantilever's modes, a seed) stays one: a sweep's

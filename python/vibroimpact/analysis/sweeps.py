@@ -19,7 +19,7 @@ from vibroimpact.analysis.limits import MAX_POINTS, AnalysisError
 from vibroimpact.analysis.parameters import with_parameter
 from vibroimpact.analysis.runs import runner
 from vibroimpact.analysis.sensitivities import Derivative, derivative_paths, settled_derivatives
-from vibroimpact.analysis.settings import _DIRECTIONS, SETTINGS, chosen_settings
+from vibroimpact.analysis.settings import _DIRECTIONS, chosen_settings
 from vibroimpact.analysis.steady import SteadyState, linear_response, steady_state
 from vibroimpact.messages import shown
 from vibroimpact.model.system import System, sections_of
@@ -227,11 +227,12 @@ def sweep(
         "record_periods": record_periods,
         "tolerance": tolerance,
         "derivatives": derivatives,
+        # The table's (where it gives the values): what they are made of.
+        **dict.fromkeys(("start", "stop", "count", "spacing")),
     }
     chosen = chosen_settings(data, "sweep", given, ("parameter", "values"))
     if values is None:
-        # The table's values: its start, stop, count and spacing.
-        chosen["values"] = sweep_values(SETTINGS["sweep"](data["sweep"]))
+        chosen["values"] = sweep_values(chosen)
     return _sweep(data, chosen["parameter"], chosen["values"], chosen, base_dir, progress)
 
 

@@ -28,6 +28,7 @@ from vibroimpact.study import (
     PER_COORDINATE,
     base_metrics,
     check_threads,
+    every_run_failed,
     output_kind,
     run,
     study_of,
@@ -164,7 +165,7 @@ def run_study_command(args: argparse.Namespace) -> int:
     failed = int(np.count_nonzero(dataset["status"].values))
     # Every run failed: the file is written (its reasons say why) unless it would
     # replace an earlier result; nothing was computed, which the exit status says too.
-    status = 1 if failed == study.runs else 0
+    status = 1 if every_run_failed(dataset) else 0
     written = not (status and earlier)
     summary: dict[str, Any] = {
         "out": str(args.out),

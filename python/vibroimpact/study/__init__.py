@@ -97,7 +97,7 @@ take is refused naming ``stepping``.
 """
 
 from vibroimpact.study.assembly import assemble
-from vibroimpact.study.chunks import run, terminal_progress
+from vibroimpact.study.chunks import every_run_failed, run, terminal_progress
 from vibroimpact.study.grid import Study, check_axis_frequencies, chunk_part, study_of
 from vibroimpact.study.limits import MAX_STUDY_RUNS, MAX_WORKERS, StudyError, check_threads
 from vibroimpact.study.settings import (
@@ -123,6 +123,7 @@ __all__ = [
     "check_threads",
     "checked_study_settings",
     "chunk_part",
+    "every_run_failed",
     "output_kind",
     "run",
     "study_of",

@@ -76,7 +76,7 @@ def check_parameter_key(
     only where one is close)."""
     parts = path.split(".")
     if not typos_only:
-        _check_entry(data, where, path)
+        check_entry(data, where, path)
     known = _known_keys(data, parts[0])
     key = next((p for p in parts[1:] if not p.isdigit()), None)
     if known is None or key is None or key in known:
@@ -88,11 +88,18 @@ def check_parameter_key(
     raise InvalidInputError(f"{where}: {path!r}: [{parts[0]}] has no key {key!r}{hint}")
 
 
-def _check_entry(data: Mapping[str, Any], where: str, path: str) -> None:
-    """Refuse a path into an entry the scenario does not have (``excitation.1.frequency``
-    with one excitation) or onto a value that is no number (``damper.0.law``): a plain
-    run had taken the first, and the analysis refused either only as it ran, the
-    second as a value its schema refused ('law: must be a string, got 7.0')."""
+def check_entry(
+    data: Mapping[str, Any],
+    where: str,
+    path: str,
+    error: type[InvalidInputError] = InvalidInputError,
+) -> None:
+    """Refuse (as ``error``) a path into an entry the scenario does not have
+    (``excitation.1.frequency`` with one excitation) or onto a value that is no number
+    (``damper.0.law``): a plain run had taken the first, and the analysis refused either
+    only as it ran, the second as a value its schema refused ('law: must be a string,
+    got 7.0'). The check of a scenario's paths as it is read, and of an analysis's
+    parameter as it is set (``vibroimpact.analysis.with_parameter``)."""
     parts = path.split(".")
     node: Any = data.get(parts[0])
     for depth, key in enumerate(parts[1:], start=1):
@@ -100,16 +107,14 @@ def _check_entry(data: Mapping[str, Any], where: str, path: str) -> None:
             if int(key) >= len(node):
                 count = len(node)
                 have = {0: "none", 1: "index 0"}.get(count, f"index 0 to {count - 1}")
-                raise InvalidInputError(
-                    f"{where}: {path!r}: the scenario has {count} [[{parts[0]}]] ({have})"
-                )
+                raise error(f"{where}: {path!r}: the scenario has {count} [[{parts[0]}]] ({have})")
             node = node[int(key)]
         elif isinstance(node, Mapping) and key in node:
             node = node[key]
         else:
             return  # a key left to its default, or a path the analysis refuses itself
         if depth == len(parts) - 1 and (isinstance(node, str | bool)):
-            raise InvalidInputError(
+            raise error(
                 f"{where}: {path!r} is {node!r} in the scenario, not a number: an analysis "
                 "varies a number"
             )
