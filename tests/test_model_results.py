@@ -169,3 +169,32 @@ def test_a_continuation_of_a_system_takes_its_own_continuation_table() -> None:
     assert len(own.points) >= 2
     with pytest.raises(ValueError, match="parameter and stop together"):
         vi.continue_orbit(system, table["parameter"])
+
+
+@pytest.mark.timeout(120)
+def test_basins_of_a_system_take_its_own_basins_table() -> None:
+    # As vi.sweep takes [sweep]: vi.basins(vi.load(file)) had refused the file's own
+    # [basins] ("missing a required argument: 'first'").
+    system = vi.load(ROOT / "examples" / "ball_table_basins.toml")
+    table = dict(system.analyses["basins"])
+    table.update(
+        x={"state": "structure_displacement.0", "start": 0.005, "stop": 0.02, "count": 2},
+        y={"state": "structure_velocity.0", "start": -0.2, "stop": 0.2, "count": 2},
+        settle_periods=30,
+        record_periods=4,
+    )
+    system = system.replace(analyses={"basins": table})
+    own = vi.basins(system)
+    # The table's axes by hand: the state is (x, v) of the one coordinate.
+    first, second = (0, np.linspace(0.005, 0.02, 2)), (1, np.linspace(-0.2, 0.2, 2))
+    explicit = vi.basins(system, first, second, settle_periods=30, record_periods=4)
+    assert own.labels.tolist() == explicit.labels.tolist()
+    assert own.attractors == explicit.attractors
+    assert own.labels.shape == (2, 2) and (own.labels >= 0).any()
+    # A keyword given overrides the table (whose 4 is valid).
+    with pytest.raises(ValueError, match="record_periods"):
+        vi.basins(system, record_periods=0)
+    with pytest.raises(ValueError, match="first and second together"):
+        vi.basins(system, first)
+    with pytest.raises(ValueError, match=r"a \[basins\] table"):
+        vi.basins(system.replace(analyses={}))

@@ -23,7 +23,7 @@ from vibroimpact.analysis.limits import (
     check_total,
     whole_count,
 )
-from vibroimpact.analysis.parameters import with_parameter
+from vibroimpact.analysis.parameters import state_index, with_parameter
 from vibroimpact.analysis.runs import (
     Runner,
     as_runner,
@@ -33,7 +33,7 @@ from vibroimpact.analysis.runs import (
     failed_everywhere,
     runner,
 )
-from vibroimpact.analysis.settings import BIFURCATION_SAMPLES
+from vibroimpact.analysis.settings import BIFURCATION_SAMPLES, chosen_settings
 from vibroimpact.analysis.steady import steady_state
 from vibroimpact.analysis.sweeps import from_carried
 from vibroimpact.messages import shown
@@ -265,24 +265,59 @@ def _axis(name: str, value: Any) -> tuple[int, np.ndarray]:
     return index, arguments.numbers(f"{name}[1] (the values)", value[1])
 
 
+def table_axes(
+    settings: Mapping[str, Any], run: Runner
+) -> tuple[tuple[int, np.ndarray], tuple[int, np.ndarray]]:
+    """:func:`basins`'s ``first`` and ``second`` from a checked ``[basins]`` table's
+    ``x`` and ``y`` (``{state, start, stop, count}``) for ``run``'s state."""
+    axes = []
+    for axis in ("x", "y"):
+        a = settings[axis]
+        try:
+            index = state_index(a["state"], run.n, run.k)
+        except AnalysisError as err:
+            raise AnalysisError(f"[basins] {axis}.state: {err}") from None
+        axes.append((index, np.linspace(a["start"], a["stop"], a["count"])))
+    return axes[0], axes[1]
+
+
 @arguments.typed()
 def basins(
     run: Runner | System,
-    first: tuple[int, np.ndarray],
-    second: tuple[int, np.ndarray],
+    first: tuple[int, np.ndarray] | None = None,
+    second: tuple[int, np.ndarray] | None = None,
     *,
     state: np.ndarray | None = None,
-    settle_periods: int = 200,
-    record_periods: int = 20,
-    tolerance: float = 1e-6,
+    settle_periods: int | None = None,
+    record_periods: int | None = None,
+    tolerance: float | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Basins:
     """For each pair of values of two state components (``(index into the flat
     state (x, v), values)``), starting from ``state`` (default ``[initial]``) with
     those two set, find the steady state and group the results into attractors:
     same period, same impacts per period and amplitudes within 1e-3 relative.
-    ``run``: a :class:`Runner` or a :class:`~vibroimpact.System`."""
+    ``run``: a :class:`Runner` or a :class:`~vibroimpact.System`. Without ``first``
+    and ``second``, the ``[basins]`` table of a System (one loaded from a scenario
+    keeps it) gives them (its ``x`` and ``y``), and every setting not given here
+    (``settle_periods`` 200, ``record_periods`` 20, ``tolerance`` 1e-6 where neither
+    says)."""
+    data = sections_of(run)[0] if isinstance(run, System) else {}
+    given = {
+        "first": first,
+        "second": second,
+        "settle_periods": settle_periods,
+        "record_periods": record_periods,
+        "tolerance": tolerance,
+        # The table's axes (where it gives them): what first and second are made of.
+        **dict.fromkeys(("x", "y")),
+    }
+    chosen = chosen_settings(data, "basins", given, ("first", "second"))
     run = as_runner(run)
+    if first is None or second is None:
+        first, second = table_axes(chosen, run)
+    settle_periods, record_periods = chosen["settle_periods"], chosen["record_periods"]
+    tolerance = chosen["tolerance"]
     # Checked here: each start's steady state would take a bad count for a start
     # inside a wall (every label -3).
     state = checked_run(run, state)

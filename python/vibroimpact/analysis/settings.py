@@ -270,7 +270,7 @@ def chosen_settings(
             )
         base = SETTINGS[section](table)
     else:
-        schema = {"sweep": _SWEEP, "continuation": _CONTINUATION}[section]
+        schema = {"sweep": _SWEEP, "continuation": _CONTINUATION, "basins": _BASINS}[section]
         base = {key: default for key, (_, default) in schema.items() if default is not _REQ}
     return {key: base.get(key) if value is None else value for key, value in given.items()}
 

@@ -32,11 +32,11 @@ from vibroimpact.analysis import (
     shown_derivative,
     shown_label,
     shown_values,
-    state_index,
     sweep,
     sweep_values,
 )
 from vibroimpact.analysis.limits import MAX_ITERATIONS, relative_tolerance, whole_count
+from vibroimpact.analysis.maps import table_axes
 from vibroimpact.analysis.runs import failed_everywhere
 from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
@@ -418,14 +418,7 @@ def run_basins(args: argparse.Namespace) -> int:
     scenario = _system(args.scenario, args.command)
     settings = _section(scenario, "basins", args.scenario)
     run = runner(scenario.data, scenario.base_dir)
-    axes = []
-    for axis in ("x", "y"):
-        a = settings[axis]
-        try:
-            index = state_index(a["state"], run.n, run.k)
-        except AnalysisError as err:
-            raise AnalysisError(f"[basins] {axis}.state: {err}") from None
-        axes.append((index, np.linspace(a["start"], a["stop"], a["count"])))
+    axes = table_axes(settings, run)
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()
     result = basins(
