@@ -260,7 +260,7 @@ def _calls() -> list[Any]:
         (maps.basins, basins, "first", NOT_AN_AXIS),
         (maps.basins, basins, "second", NOT_AN_AXIS),
         (maps.basins, basins, "state", NOT_A_STATE),
-        (maps.basins, basins, "tolerance", NONE_FOR_NUMBER),
+        (maps.basins, basins, "tolerance", NONE_FOR_NUMBER[1:]),  # None: the table's
         (maps.basins, basins, "progress", NOT_A_FUNCTION),
         (
             continuation.continue_orbit,

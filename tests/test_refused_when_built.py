@@ -101,6 +101,39 @@ def test_a_start_inside_a_wall_is_refused_where_the_system_is_built(
 
 
 @pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["rk4", "dop853"])
+def test_a_damper_may_start_pressed_into_a_compliant_seat(method: str) -> None:
+    # A damper resting on its Hertz seat under gravity is inside its wall by the
+    # static indentation (m g / k)^(2/3): it had been refused as "starts ... inside its
+    # wall" by simulate and study, where orbit and sweep took it. At the closed-form
+    # equilibrium (the structure sagging by (M + m) g / K) nothing moves.
+    mass, stiffness, damper_mass, clearance, hertz, g = 1.0, 1e4, 0.1, 0.002, 1e8, 9.81
+    depth = (damper_mass * g / hertz) ** (2 / 3)
+    sag = -(mass + damper_mass) * g / stiffness
+    seat = sag - clearance - depth
+    system = vi.System(
+        structure=vi.Oscillator(mass=mass, stiffness=stiffness, damping=1.0),
+        dampers=[
+            vi.Damper(mass=damper_mass, at=0, clearance=clearance, law="hertz", stiffness=hertz)
+        ],
+        gravity=vi.Gravity(acceleration=g),
+        initial=vi.Initial(structure_displacement=[sag], damper_displacement=[seat]),
+    )
+    sol = vi.simulate(system, method=method, t_end=0.2, dt=1e-5 if method == "rk4" else None)
+    assert max(abs(x[0] - sag) for x in sol.structure_displacement) < 1e-12
+    assert max(abs(y[0] - seat) for y in sol.damper_displacement) < 1e-12
+    assert sol.contact_force[-1][0] == pytest.approx(damper_mass * g, rel=1e-9)
+    # One contact, in progress from the start (no onset, no approach), never ended.
+    assert len(sol.contacts) == 1
+    assert sol.contacts.onset[0] == 0.0 and math.isnan(sol.contacts.separation[0])
+    assert sol.contacts.max_indentation[0] == pytest.approx(depth, rel=1e-6)
+    # A rigid seat there is still refused: no rigid body is inside another.
+    rigid = vi.Damper(mass=damper_mass, at=0, clearance=clearance, law="rigid", restitution=0.5)
+    with pytest.raises(vi.InvalidInputError, match="damper 0 starts 4.58.*e-6 m inside its wall"):
+        system.replace(dampers=[rigid])
+
+
+@pytest.mark.timeout(60)
 @pytest.mark.parametrize(
     ("solver", "message"),
     [

@@ -51,7 +51,8 @@ impl Assembly {
 }
 
 /// The initial state vector from the four arrays of `[initial]` (zeros where
-/// empty), checked against the system's sizes and finite.
+/// empty), checked against the system's sizes and finite; no rigid pair
+/// inside its wall (a compliant one may be, pressed in).
 pub fn initial_state(
     assembly: &Assembly,
     structure_displacement: &[f64],
@@ -72,9 +73,8 @@ pub fn initial_state(
 }
 
 /// A state to continue from, as a run left it: the same as
-/// [`initial_state`] but a compliant pair may be in contact (the kernel
-/// resumes the contact, its approach rate taken as the indentation rate
-/// then); a rigid pair may not be inside its wall.
+/// [`initial_state`] but a rigid pair within the drift of a method's
+/// solution inside its wall is put back on it.
 pub fn resumed_state(assembly: &Assembly, arrays: [&[f64]; 4]) -> Result<Vec<f64>> {
     state_from(assembly, arrays, true)
 }
@@ -110,7 +110,10 @@ fn state_from(assembly: &Assembly, arrays: [&[f64]; 4], resumed: bool) -> Result
         let (gap, _) = assembly.gap(i, &y);
         let it = &assembly.interactions[i];
         // A friction element's row is no gap: it has no wall to be inside.
-        if (resumed && matches!(it.law, InteractionLaw::Compliant { .. })) || it.law.is_friction() {
+        // A compliant pair may start pressed into its wall (a damper resting
+        // on its seat under gravity): its force is the law's at that depth,
+        // and the kernel takes the contact as one in progress.
+        if matches!(it.law, InteractionLaw::Compliant { .. }) || it.law.is_friction() {
             continue;
         }
         // On the wall to round-off is at the wall.
