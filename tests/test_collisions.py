@@ -458,6 +458,11 @@ def test_a_damper_with_no_wall_needs_a_collision_or_friction_to_hold_it() -> Non
     for j in (2, 3):
         data["damper"][j] |= {"friction": 0.2, "normal_force": 0.1}
     an.runner(data)
+    # Static friction alone too (a kinetic coefficient of 0: it had been refused as held
+    # by nothing; a physicist's probe).
+    for j in (2, 3):
+        data["damper"][j] |= {"friction": 0.0, "static_friction": 2.0}
+    an.runner(data)
 
 
 def still_table(g: float) -> tuple[vi.Oscillator, float]:

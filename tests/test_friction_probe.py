@@ -14,6 +14,7 @@ import math
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -275,3 +276,58 @@ def test_a_stop_inside_one_step_begins_the_stick_it_must(method: str) -> None:
     state = sol.final_state
     assert state["damper_velocity"][0] == pytest.approx(reference[3], abs=1e-7)
     assert state["structure_velocity"][0] == pytest.approx(reference[2], abs=1e-7)
+
+
+def _stack(normal_force: float, force: float = 0.0) -> vi.System:
+    """A 0.1 kg block held on a vertical wall by friction (kinetic 0.4, static 0.5 of
+    ``normal_force``), a 0.2 kg ball resting on its floor at t = 0, under gravity;
+    ``force`` (N) a push down on the block from 0, rising as sin."""
+    forcing = [
+        vi.Force(at=0, signal=vi.Harmonic(amplitude=force, frequency=1.0, phase=math.pi / 2))
+    ]
+    return vi.System(
+        structure=vi.Oscillator(mass=0.1, stiffness=0.0, damping=0.0),
+        dampers=[
+            vi.Damper(
+                mass=0.2,
+                at=0,
+                lower_clearance=0.0,
+                upper_clearance=0.05,
+                law="rigid",
+                restitution=0.5,
+            )
+        ],
+        frictions=[
+            vi.Friction(at=0, coefficient=0.4, static_coefficient=0.5, normal_force=normal_force)
+        ],
+        gravity=vi.Gravity(acceleration=9.81),
+        excitations=forcing if force else [],
+    )
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk4"])
+def test_a_stack_that_static_friction_holds_at_the_start_stays(method: str) -> None:
+    # The ball resting on the held block at t = 0 had fallen for the first step's
+    # round-off; its landing (1.4e-10 m/s) set the block sliding, and kinetic friction
+    # (2.8 N) could not stop the stack's weight (2.943 N): it slid 0.238 m in 1 s,
+    # where static friction (3.5 N) holds it still (a physicist's probe).
+    settings: dict[str, Any] = {"method": method, "t_end": 1.0}
+    if method == "rk4":
+        settings["dt"] = 1e-4
+    held = vi.simulate(_stack(7.0), **settings)
+    assert np.max(np.abs(held.structure_displacement)) == 0.0
+    assert held.energy["friction"] == 0.0
+    resting = held.contacts.to_pandas()
+    assert (resting["approach_speed"] == 0.0).all()
+    # Pushed down by a force that the static force still holds (2.943 + 0.5 < 3.5 N):
+    # held from the start, as a scipy run with the block stuck from t = 0 has it.
+    pushed = vi.simulate(_stack(7.0, force=0.5), **settings)
+    assert np.max(np.abs(pushed.structure_displacement)) < 1e-12  # the constraint's drift
+    # Where the static force (0.5 * 5.5 = 2.75 N) cannot hold the weight (2.943 N), the
+    # stack slides from t = 0 as one body, at g less the kinetic force's 0.4 * 5.5 N.
+    slid = vi.simulate(_stack(5.5), **settings)
+    acceleration = 9.81 - 0.4 * 5.5 / 0.3
+    expected = -0.5 * acceleration * 1.0**2
+    assert slid.final_state["structure_displacement"][0] == pytest.approx(expected, rel=1e-6)
+    assert slid.final_state["damper_displacement"][0] == pytest.approx(expected, rel=1e-6)

@@ -634,7 +634,7 @@ def system_spec(
                     )
                 del d[key]
             del d["friction"]
-        rubs = bool(d.get("friction")) and bool(d.get("normal_force"))
+        rubs = bool(d.get("normal_force")) and bool(d.get("friction") or d.get("static_friction"))
         held = any(j in c["dampers"] for c in collisions) or rubs
         if d["lower_clearance"] == d["upper_clearance"] == math.inf and not held:
             raise _fail(

@@ -94,6 +94,48 @@ impl Run<'_> {
         self.release_overloaded(time);
     }
 
+    /// At the start of a run with friction: rigid pairs on their walls
+    /// resolved at once, as an event would resolve them there (one at rest
+    /// and pressed sticks, with no impulse), and the elements settled again
+    /// with them in place. Left to the first step, a body resting at t = 0 on
+    /// one that friction holds fell for that step's round-off, and its
+    /// landing, 1e-10 m/s, jolted the held body into a slide that kinetic
+    /// friction could not stop (a stack static friction holds slid away).
+    pub(super) fn rest_at_start(&mut self) {
+        let system = self.system;
+        let mut rigid = false;
+        for i in 0..self.modes.len() {
+            if self.on_wall_at_start[i] && !system.held_by_mirror(i, &self.modes) {
+                rigid |= self.impacts.mark(system, i, self.modes[i]);
+            }
+        }
+        if !rigid {
+            return;
+        }
+        self.just_switched.iter_mut().for_each(|s| *s = false);
+        let scales = (
+            self.resolution,
+            self.schedule.chatter_interval(0.0),
+            self.schedule.time_scale,
+        );
+        self.impacts.resolve(
+            system,
+            0.0,
+            &mut self.y,
+            &mut self.modes,
+            &mut self.open,
+            &mut self.contacts,
+            &mut self.energy.impact_loss,
+            &mut self.grazes,
+            scales,
+            false,
+            &mut self.scratch,
+            &mut self.buffers.work,
+            &mut self.just_switched,
+        );
+        self.settle_friction(0.0, self.impacts.speed_scale());
+    }
+
     /// Stuck elements whose holding force passes their static force once
     /// the event's switches are made (an element that stuck loads another
     /// on a coupled row) slide, the most overloaded first, until the rest

@@ -272,6 +272,7 @@ impl<'a> Run<'a> {
         self.resume_contacts(carried);
         if self.friction {
             self.settle_friction(0.0, 0.0);
+            self.rest_at_start();
         }
         if self.timing.is_some() {
             self.resume_fixed();
