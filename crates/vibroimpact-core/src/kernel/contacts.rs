@@ -522,8 +522,13 @@ impl Run<'_> {
         let system = self.system;
         for (i, record) in self.open.iter().enumerate() {
             if let Some(oc) = record {
+                // With events a compliant record holds its loss slot's value
+                // at the onset; fixed steps sum its dissipation themselves
+                // (`fixed::pressed`), as they do at a separation.
                 let dissipated = match oc.kind {
-                    ContactKind::Compliant => self.y[loss_slot(system, i)] - oc.dissipated,
+                    ContactKind::Compliant if self.timing.is_none() => {
+                        self.y[loss_slot(system, i)] - oc.dissipated
+                    }
                     _ => oc.dissipated,
                 };
                 let pair = system.interactions[i].pair;
