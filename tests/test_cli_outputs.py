@@ -62,6 +62,28 @@ def test_paper_out_is_a_folder_and_a_studys_out_a_name(tmp_path: Path, run_cli: 
     refused(run_cli("study", str(study), "--out", ".nc"), "--out .nc: needs a name before")
 
 
+@pytest.mark.timeout(60)
+def test_an_interrupted_paper_run_leaves_the_last_set_of_files_as_it_was(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Interrupted after its tables, a run had replaced table2.csv and table3.csv and
+    # left the last run's report.md and figures, whose figures then contradicted the
+    # tables (an adversarial probe's Ctrl-C).
+    from vibroimpact.paper import job, plots
+
+    earlier = {"table2.csv": "old table", "table3.csv": "old", "report.md": "old report"}
+    for name, text in earlier.items():
+        (tmp_path / name).write_text(text)
+
+    def interrupted(path: Path) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(plots, "fig4", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        job.run_paper(tmp_path)
+    assert {p.name: p.read_text() for p in tmp_path.iterdir()} == earlier
+
+
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
 def test_a_full_output_is_one_line(tmp_path: Path) -> None:
     # --json > /dev/full ended in a traceback (OSError: No space left on device).

@@ -11,7 +11,10 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 import platform
+import shutil
+import tempfile
 import time
 import warnings
 from collections.abc import Callable
@@ -288,21 +291,33 @@ def findings(
 
 
 def run_paper(out: Path) -> int:
-    """Compute everything, write the files into ``out`` and print the tables."""
-    # Here, not at the top: matplotlib loads for this job only, not for every command.
-    from vibroimpact.paper.plots import fig1, fig3, fig4, work_precision
-
-    started = time.perf_counter()
+    """Compute everything, write the files into ``out`` and print the tables. The
+    files are made in a folder of their own inside ``out`` and moved into it together
+    at the end: an interrupted or failed run leaves the last run's set as it was (its
+    report agreeing with its tables), not new tables beside an old report."""
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: is a file; --out is the folder the results go into")
     try:
         out.mkdir(parents=True, exist_ok=True)
-        probe = out / ".write-test"
-        probe.write_text("")
-        probe.unlink()
+        staging = Path(tempfile.mkdtemp(prefix=".paper-", dir=out))
     except OSError as err:
         raise UsageError(f"cannot write to {str(out)!r}: {err.strerror or err}") from None
+    try:
+        written = _paper_files(staging)
+        for name in written:
+            os.replace(staging / name, out / name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return 0
 
+
+def _paper_files(out: Path) -> list[str]:
+    """:func:`run_paper`'s work: every file written into ``out`` (their names, in
+    order), the tables printed."""
+    # Here, not at the top: matplotlib loads for this job only, not for every command.
+    from vibroimpact.paper.plots import fig1, fig3, fig4, work_precision
+
+    started = time.perf_counter()
     goldsmith = goldsmith_contact_duration(IMPACT_MASS, MAIN_MASS, HERTZ_STIFFNESS, APPROACH_SPEED)
     exact = exact_duration()
     rows = table2(goldsmith, exact)
@@ -348,8 +363,8 @@ def run_paper(out: Path) -> int:
             path, rows, blocks, found, elapsed, platform.platform(), [*written, path.name]
         ),
     )
-    print(f"\nwrote {', '.join(written)} to {out}/ in {elapsed:.1f} s")
+    print(f"\nwrote {', '.join(written)} to {out.parent}/ in {elapsed:.1f} s")
     missing = beyond.scipy_missing()
     if missing is not None:
         print(f"note: {missing}")
-    return 0
+    return written
