@@ -490,6 +490,13 @@ def test_lyapunov_of_an_unforced_ball(run_cli: RunCli, tmp_path: Path) -> None:
     assert out["impacts"] == impacts and all(math.isfinite(v) for v in out["exponents"])
     assert sum(out["exponents"]) * 3.0 == pytest.approx(2 * impacts * math.log(e), rel=1e-9)
     assert_one_line_error(run_cli("lyapunov", str(path), "--settle", "3"), "--settle")
+    # Its runs keep no history: with [output] history = false, a max_rows below t_end /
+    # dt rows is no limit (it had been refused, advised to set the history = false that
+    # it had, an adversarial probe).
+    few = source.replace("t_end = 6.0 ", "max_rows = 10\nt_end = 3.0 ", 1)
+    few += "\n[output]\nhistory = false\n"
+    held = lyapunov_json(run_cli, str(write(tmp_path, "few.toml", few)))
+    assert {**held, "cpu_time": 0} == {**out, "cpu_time": 0}
 
 
 def test_lyapunov_refusals_exit_2(run_cli: RunCli, tmp_path: Path) -> None:

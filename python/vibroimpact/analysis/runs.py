@@ -43,12 +43,14 @@ def _prepare(data: Mapping[str, Any], base_dir: Path | None) -> PreparedRun:
     solver = dict(data.get("solver", {}))
     solver.setdefault("t_end", 1.0)
     output = data.get("output", {})
-    # Of [output], the analyses keep only the points and moments they report.
+    # Of [output], the analyses keep only the points and moments they report; their
+    # runs keep no history, so t_end / dt rows are no limit of theirs (an unforced
+    # lyapunov over 1e5 s had been refused for a history it never keeps).
     followed = {
         key: output[key]
         for key in ("points", "moments")
         if isinstance(output, Mapping) and key in output
-    }
+    } | {"history": False}
     return prepare_system(
         data["structure"],
         damper=data.get("damper", ()),
