@@ -512,6 +512,10 @@ def test_lyapunov_refusals_exit_2(run_cli: RunCli, tmp_path: Path) -> None:
     assert out["impacts"] > 0 and all(math.isfinite(v) for v in out["exponents"])
     assert_one_line_error(run_cli("lyapunov", str(BALL_TABLE), "--settle", "-1"), "--settle")
     assert_one_line_error(run_cli("lyapunov", str(BALL_TABLE), "--periods", "0"), "--periods")
+    # The analysis's own refusals name the flags too (they had said "settle 9999999 and
+    # periods 2", a probe).
+    both = run_cli("lyapunov", str(BALL_TABLE), "--settle", "9999999", "--periods", "2")
+    assert_one_line_error(both, "--settle 9999999 and --periods 2: a run settles")
     assert_one_line_error(run_cli("lyapunov", str(TWO_MASS)), str(TWO_MASS), "[structure]")
 
 

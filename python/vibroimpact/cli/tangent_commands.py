@@ -4,10 +4,12 @@ runs, its output and plots."""
 from __future__ import annotations
 
 import argparse
+import re
 import time
 from typing import Any
 
 from vibroimpact.analysis import (
+    AnalysisError,
     check_periods,
     curve_of,
     curve_regions,
@@ -76,6 +78,11 @@ def add_tangent_parsers(sub: Any) -> None:
     )
 
 
+#: lyapunov's keywords where its messages name them ("settle 100 and periods 2: ...",
+#: "periods: ..., give periods >= 11"), not its words ("forcing periods span").
+_FLAGGED = re.compile(r"(?<![\w-])(settle|periods)(?=:| \d| >=)")
+
+
 def run_lyapunov(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if not isinstance(scenario, SystemScenario):
@@ -92,7 +99,11 @@ def run_lyapunov(args: argparse.Namespace) -> int:
             "over [solver] t_end"
         )
     start = time.perf_counter()
-    found = lyapunov(run, settle=args.settle, periods=args.periods)
+    try:
+        found = lyapunov(run, settle=args.settle, periods=args.periods)
+    except AnalysisError as err:
+        # The analysis names its keywords; here they are the flags.
+        raise AnalysisError(_FLAGGED.sub(r"--\1", str(err))) from None
     cpu_time = time.perf_counter() - start
     summary = {
         "exponents": [float(v) for v in found.exponents],
