@@ -203,7 +203,9 @@ def test_the_cli_json_has_each_points_derivatives(run_cli: RunCli, tmp_path: Pat
 
 
 def test_the_scenario_key_and_the_table(run_cli: RunCli, tmp_path: Path) -> None:
-    scenario = frf_scenario(tmp_path, 'derivatives = ["damper.0.clearance"]\n')
+    # Named twice: one column (it had been printed twice; a probe).
+    twice = 'derivatives = ["damper.0.clearance", "damper.0.clearance"]\n'
+    scenario = frf_scenario(tmp_path, twice)
     done = run_cli("sweep", str(scenario))
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()

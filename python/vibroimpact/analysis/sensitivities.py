@@ -85,7 +85,8 @@ def derivative_paths(data: Mapping[str, Any], paths: Sequence[str] | str) -> lis
         arguments.text("derivative", path)
         with_parameter_path_check(path, "")
         _value_of(data, path, "derivative", "the derivative is taken at its value")
-    return list(paths)
+    # Each once, as [study] metrics are (a path twice had made its column twice).
+    return list(dict.fromkeys(paths))
 
 
 def orbit_derivatives(

@@ -169,7 +169,8 @@ def run_sweep(args: argparse.Namespace) -> int:
             f"{args.scenario}: sweep needs a [sweep] section (parameter, start, stop, count)"
         )
     values = sweep_values(settings)
-    derivatives = args.derivative or settings["derivatives"]
+    # Each once, as the analysis takes them (derivative_paths).
+    derivatives = list(dict.fromkeys(args.derivative or settings["derivatives"] or ()))
     start = time.perf_counter()
     show = sys.stderr.isatty() and not args.json
 
