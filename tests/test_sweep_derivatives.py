@@ -212,6 +212,7 @@ def test_the_scenario_key_and_the_table(run_cli: RunCli, tmp_path: Path) -> None
     assert "(d amplitude_0 / d damper.0.clearance: m per m)" in lines
     (head,) = [line for line in lines if line.split()[:1] == ["value"]]
     assert head.split()[-5:] == ["d", "amplitude_0", "/", "d", "damper.0.clearance"]
+    assert head.count("damper.0.clearance") == 1
     rows = [line.split() for line in lines[lines.index(head) + 1 :]]
     table = json.loads(run_cli("sweep", str(scenario), "--json").stdout)["points"]
     for row, point in zip(rows, table, strict=True):
