@@ -141,8 +141,9 @@ CURVE_BAD = [
     (("stop = 17.0", "stop = 12.5"), ["no flip", "located", "12.5"]),
     # Outside [1e-9, 1] of |second_stop - e| = 0.3: 1e-300 had ended in a ZeroDivisionError
     # traceback, 1e9 in a curve of one point.
-    (("step = 0.003", "step = 1e-300"), ["step: must be in [", "got 1e-300"]),
-    (("step = 0.003", "step = 1e9"), ["step: must be in [", "got 1000000000.0"]),
+    # Named by the table (they had said "step:" alone, a probe).
+    (("step = 0.003", "step = 1e-300"), ["[curve] step: must be in [", "got 1e-300"]),
+    (("step = 0.003", "step = 1e9"), ["[curve] step: must be in [", "got 1000000000.0"]),
 ]
 
 

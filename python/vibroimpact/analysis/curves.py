@@ -218,26 +218,27 @@ def _locate(
 @arguments.typed()
 def curve_of(data: Mapping[str, Any] | System, base_dir: Path | None = None) -> Curve:
     """The curve a scenario's ``[curve]`` section asks for (see :func:`curve`)."""
-    from vibroimpact.analysis.settings import curve_settings
+    from vibroimpact.analysis.settings import curve_settings, named_in
 
     data, base_dir = sections_of(data, base_dir)
     if "curve" not in data:
         raise AnalysisError("data: a [curve] section is needed")
     settings = curve_settings(data["curve"])
-    return curve(
-        data,
-        settings["kind"],
-        settings["parameter"],
-        start=settings["start"],
-        stop=settings["stop"],
-        second=settings["second"],
-        second_stop=settings["second_stop"],
-        step=settings["step"],
-        periods=settings["periods"],
-        max_points=settings["max_points"],
-        tolerance=settings["tolerance"],
-        base_dir=base_dir,
-    )
+    with named_in("curve", settings):
+        return curve(
+            data,
+            settings["kind"],
+            settings["parameter"],
+            start=settings["start"],
+            stop=settings["stop"],
+            second=settings["second"],
+            second_stop=settings["second_stop"],
+            step=settings["step"],
+            periods=settings["periods"],
+            max_points=settings["max_points"],
+            tolerance=settings["tolerance"],
+            base_dir=base_dir,
+        )
 
 
 def curve_regions(

@@ -4,7 +4,8 @@ checked, with their defaults: what reading a scenario checks (:data:`SETTINGS`).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import contextmanager
 from typing import Any
 
 from vibroimpact.analysis.limits import (
@@ -273,6 +274,19 @@ def chosen_settings(
         schema = {"sweep": _SWEEP, "continuation": _CONTINUATION, "basins": _BASINS}[section]
         base = {key: default for key, (_, default) in schema.items() if default is not _REQ}
     return {key: base.get(key) if value is None else value for key, value in given.items()}
+
+
+@contextmanager
+def named_in(section: str, keys: Iterable[str]) -> Iterator[None]:
+    """An analysis's refusal of one of a table's ``keys`` (its message begins ``key:``,
+    the keyword's name) named as the scenario names it: ``[section] key: ...``."""
+    try:
+        yield
+    except AnalysisError as err:
+        key, colon, _ = str(err).partition(":")
+        if colon and key in set(keys):
+            raise AnalysisError(f"[{section}] {err}") from None
+        raise
 
 
 #: Sections of analyses, checked when a scenario is read.

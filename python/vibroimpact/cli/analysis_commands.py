@@ -38,6 +38,7 @@ from vibroimpact.analysis import (
 from vibroimpact.analysis.limits import MAX_ITERATIONS, relative_tolerance, whole_count
 from vibroimpact.analysis.maps import table_axes
 from vibroimpact.analysis.runs import failed_everywhere
+from vibroimpact.analysis.settings import named_in
 from vibroimpact.cli.tangent_commands import run_curve, run_lyapunov
 from vibroimpact.output import UsageError, check_plot, finite_or_none, json_text, structure_needed
 from vibroimpact.scenario.system import SystemScenario
@@ -472,7 +473,7 @@ def run_continue(args: argparse.Namespace) -> int:
     settings = _section(scenario, "continuation", args.scenario)
     show = sys.stderr.isatty() and not args.json
     start = time.perf_counter()
-    with _named_as("step: ", "[continuation] step: "):
+    with named_in("continuation", settings):
         branch = continue_orbit(
             scenario.data,
             settings["parameter"],
