@@ -133,6 +133,19 @@ fn fixed_step_counts_beyond_max_steps_or_2_pow_53_are_refused_up_front() {
             };
             assert!(make(100).is_ok());
             assert!(message(make(99)).contains("more than max_steps = 99"));
+            // Counted as the kernel counts them: 1e6 s of 1e-4 s are 1e10 steps
+            // (the message had said 9999999990).
+            let long = Settings::new(
+                method,
+                Some(1e-4),
+                1e6,
+                1,
+                ContactTiming::Located,
+                Some(stepping),
+                1_000_000_000,
+            );
+            let text = message(long);
+            assert!(text.contains("t_end / dt = 10000000000 steps"), "{text}");
         }
     });
 }

@@ -371,7 +371,10 @@ impl Settings {
     /// `t_end / dt` rounded up, as f64 (a relative 1e-9 of slack keeps
     /// `0.3 / 1e-4` at 3000 despite rounding); infinite when it overflows.
     fn step_count(&self, dt: f64) -> f64 {
-        ((self.t_end / dt) * (1.0 - 1e-9)).ceil().max(1.0)
+        // The kernel's count: its last step ends within 1e-9 of a step of
+        // t_end (`Schedule::at_end`). A slack relative to the count had
+        // dropped 10 of 1e10 steps from the message.
+        ((self.t_end / dt) - 1e-9).ceil().max(1.0)
     }
 
     /// The general kernel's options for this run of the two-mass preset
