@@ -62,6 +62,18 @@ def test_paper_out_is_a_folder_and_a_studys_out_a_name(tmp_path: Path, run_cli: 
     refused(run_cli("study", str(study), "--out", ".nc"), "--out .nc: needs a name before")
 
 
+def test_a_name_with_a_line_break_is_quoted_on_the_error_s_one_line(
+    tmp_path: Path, run_cli: Cli
+) -> None:
+    # A path holding a line break had split the error over two lines (a probe).
+    scenario = write(tmp_path, BASE)
+    done = run_cli("simulate", str(scenario), "--out", "no\nwhere/p.csv")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert "--out no\\nwhere/p.csv: the folder 'no\\nwhere' does not exist" in done.stderr
+    usage = run_cli("simulate", str(scenario), "--colour", "a\nb")
+    assert usage.returncode == 2 and usage.stderr.count("\n") == 1, usage.stderr
+
+
 @pytest.mark.timeout(60)
 def test_an_interrupted_paper_run_leaves_the_last_set_of_files_as_it_was(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch

@@ -83,7 +83,13 @@ class _Parser(argparse.ArgumentParser):
     commands' parsers are of this class too (``add_subparsers`` makes its own kind)."""
 
     def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        self.exit(2, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+
+
+def _one_line(text: str) -> str:
+    """An error's text on one line: the line breaks of a name it quotes (a path may
+    hold them) written as ``\\n``."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -352,12 +358,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             return run_study_command(args)
         return _simulate(args)
     except (InvalidInputError, UsageError) as err:
-        print(f"vibroimpact: error: {short_numbers(str(err))}", file=sys.stderr)
+        print(f"vibroimpact: error: {_one_line(short_numbers(str(err)))}", file=sys.stderr)
         _print_notes(err)
         return 2
     except (NumericalBlowUpError, SimulationError) as err:
         # The input was valid but the run could not be completed.
-        print(f"vibroimpact: error: {short_numbers(str(err))}", file=sys.stderr)
+        print(f"vibroimpact: error: {_one_line(short_numbers(str(err)))}", file=sys.stderr)
         _print_notes(err)
         return 1
     except KeyboardInterrupt as stop:
@@ -387,7 +393,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # What the system refused (the output full: `--json > /dev/full`, a file size
         # limit), said in one line as every error is; the run itself did not fail.
         where = f"{err.filename}: " if err.filename else "writing the output: "
-        print(f"vibroimpact: error: {where}{err.strerror or err}", file=sys.stderr)
+        print(f"vibroimpact: error: {_one_line(f'{where}{err.strerror or err}')}", file=sys.stderr)
         _print_notes(err)
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
