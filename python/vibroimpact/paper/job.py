@@ -306,6 +306,9 @@ def run_paper(out: Path) -> int:
         written = _paper_files(staging)
         for name in written:
             os.replace(staging / name, out / name)
+    except UsageError as err:
+        # Named where the user asked for it, not in the folder of the making.
+        raise UsageError(str(err).replace(str(staging), str(out))) from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return 0
