@@ -97,12 +97,15 @@ def test_an_interrupted_paper_run_leaves_the_last_set_of_files_as_it_was(
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
-def test_a_full_output_is_one_line(tmp_path: Path) -> None:
-    # --json > /dev/full ended in a traceback (OSError: No space left on device).
+@pytest.mark.parametrize("words", [["simulate", "{scenario}", "--json"], ["--help"], ["--version"]])
+def test_a_full_output_is_one_line(tmp_path: Path, words: list[str]) -> None:
+    # --json > /dev/full ended in a traceback (OSError: No space left on device); --help
+    # and --version ended with status 0 and nothing said (argparse drops a failed write).
     scenario = write(tmp_path, BASE)
+    command = [word.format(scenario=scenario) for word in words]
     with open("/dev/full", "w") as full:
         done = subprocess.run(
-            [sys.executable, "-m", "vibroimpact", "simulate", str(scenario), "--json"],
+            [sys.executable, "-m", "vibroimpact", *command],
             stdout=full,
             stderr=subprocess.PIPE,
             text=True,

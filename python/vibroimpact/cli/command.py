@@ -82,6 +82,14 @@ class _Parser(argparse.ArgumentParser):
     the usage lines first), pointing to the command's help; exit status 2. The
     commands' parsers are of this class too (``add_subparsers`` makes its own kind)."""
 
+    def _print_message(self, message: str, file: Any = None) -> None:
+        # argparse's own drops a failed write (help into a full output: exit 0, nothing
+        # said); here it reaches main, which says it.
+        if message:
+            stream = file or sys.stderr
+            stream.write(message)
+            stream.flush()
+
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
 
@@ -338,7 +346,18 @@ def _escape_unencodable() -> list[tuple[Any, str]]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
-    args = _parser().parse_args(argv)
+    try:
+        args = _parser().parse_args(argv)
+    except BrokenPipeError:
+        # The reader (`| head`) left early, as main takes it below.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except OSError as err:
+        # --help or --version into a full output (> /dev/full): said, as a run's is.
+        print(f"vibroimpact: error: writing the output: {err.strerror or err}", file=sys.stderr)
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     # A termination request or a closed terminal ends the run like Ctrl-C does, so
     # that a file being written is removed and an earlier result stays whole.
     main_thread = threading.current_thread() is threading.main_thread()
