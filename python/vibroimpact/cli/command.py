@@ -346,18 +346,6 @@ def _escape_unencodable() -> list[tuple[Any, str]]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
-    try:
-        args = _parser().parse_args(argv)
-    except BrokenPipeError:
-        # The reader (`| head`) left early, as main takes it below.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-    except OSError as err:
-        # --help or --version into a full output (> /dev/full): said, as a run's is.
-        print(f"vibroimpact: error: writing the output: {err.strerror or err}", file=sys.stderr)
-        with contextlib.suppress(OSError):
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 1
     # A termination request or a closed terminal ends the run like Ctrl-C does, so
     # that a file being written is removed and an earlier result stays whole.
     main_thread = threading.current_thread() is threading.main_thread()
@@ -369,6 +357,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     # PYTHONIOENCODING=ascii) gets it escaped, not a UnicodeEncodeError.
     encodings = _escape_unencodable()
     try:
+        # In here: --help or --version into a full output is said as a run's is.
+        args = _parser().parse_args(argv)
         if args.command == "paper":
             return run_paper(args.out)
         if args.command in COMMANDS:

@@ -201,21 +201,7 @@ impl Run<'_> {
             self.mark_touching(touch);
         }
         if rigid {
-            any |= self.impacts.resolve(
-                system,
-                event_time,
-                &mut self.y,
-                &mut self.modes,
-                &mut self.open,
-                &mut self.contacts,
-                &mut self.energy.impact_loss,
-                &mut self.grazes,
-                (resolution, instant, time_scale),
-                collapse,
-                &mut self.scratch,
-                &mut self.buffers.work,
-                &mut self.just_switched,
-            );
+            any |= self.resolve_marked(event_time, (resolution, instant, time_scale), collapse);
             if self.watch.is_some() {
                 self.watch_jumps();
             }
@@ -251,6 +237,33 @@ impl Run<'_> {
     /// The gaps that touch at an event whose time's round-off is `instant`
     /// (s): what the state's speeds close within it, or the round-off of
     /// the gap's scale that a touch's release leaves between two pairs.
+    /// The marked rigid pairs and the sticking ones resolved at `time` on
+    /// the run's state ([`impacts::Impacts::resolve`]; `scales`: the resolution, the
+    /// time's round-off and the system's time scale, s): whether any changed
+    /// or any impulse acted.
+    pub(super) fn resolve_marked(
+        &mut self,
+        time: f64,
+        scales: (f64, f64, f64),
+        collapse: bool,
+    ) -> bool {
+        self.impacts.resolve(
+            self.system,
+            time,
+            &mut self.y,
+            &mut self.modes,
+            &mut self.open,
+            &mut self.contacts,
+            &mut self.energy.impact_loss,
+            &mut self.grazes,
+            scales,
+            collapse,
+            &mut self.scratch,
+            &mut self.buffers.work,
+            &mut self.just_switched,
+        )
+    }
+
     fn touch_band(&self, instant: f64) -> TouchBand {
         let d = self.system.dim;
         let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, v| m.max(v.abs()));

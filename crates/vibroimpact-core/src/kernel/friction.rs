@@ -118,21 +118,7 @@ impl Run<'_> {
             self.schedule.chatter_interval(0.0),
             self.schedule.time_scale,
         );
-        self.impacts.resolve(
-            system,
-            0.0,
-            &mut self.y,
-            &mut self.modes,
-            &mut self.open,
-            &mut self.contacts,
-            &mut self.energy.impact_loss,
-            &mut self.grazes,
-            scales,
-            false,
-            &mut self.scratch,
-            &mut self.buffers.work,
-            &mut self.just_switched,
-        );
+        self.resolve_marked(0.0, scales, false);
         self.settle_friction(0.0, self.impacts.speed_scale());
     }
 
