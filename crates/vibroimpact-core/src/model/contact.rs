@@ -533,6 +533,20 @@ fn hertz_static_indentation(stiffness: f64, effective_mass: f64, pressing: f64) 
 }
 
 impl AnyLaw {
+    /// Whether the law acts on a pair at `indentation` (m) in its contact
+    /// mode: where the pair is indented, and the linear law also on its own
+    /// straight line past the wall while the mode is the contact (stepping
+    /// by events, not `indented_only`). A step located onto the separation
+    /// evaluates its last stages about the wall, some a hair past it: there
+    /// the clamped force's kink had cost a high-order method its order
+    /// (`dop853`'s rebound off by up to 30 times `rtol`). The straight line
+    /// is the same field, smooth, up to the separation the event ends it
+    /// at. The Hertz laws' power 1.5 has no such extension.
+    #[inline(always)]
+    pub fn acts(&self, indentation: f64, indented_only: bool) -> bool {
+        indentation > 0.0 || (!indented_only && matches!(self, AnyLaw::Linear(_)))
+    }
+
     /// The force's derivative by the approach rate latched at the onset
     /// (N per m/s) at `indentation` (m), its `rate` (m/s) and
     /// that `approach_rate` (m/s): `-K delta^1.5 alpha delta' / v0^2` for the

@@ -279,7 +279,7 @@ fn contact_force(it: &Interaction, mode: Mode, indentation: f64, rate: f64) -> f
     else {
         return 0.0;
     };
-    if indentation > 0.0 {
+    if law.acts(indentation, indented_only) {
         law.force_and_elastic(indentation, rate, approach_rate).0 + damping * rate
     } else {
         apart_damping(damping, indented_only) * rate

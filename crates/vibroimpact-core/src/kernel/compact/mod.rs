@@ -246,7 +246,7 @@ impl Compact {
                 };
                 products = Some((hx, hv));
                 let (indentation, rate) = (-(wall.offset + hx), -hv);
-                let (force, elastic, damping) = if indentation > 0.0 {
+                let (force, elastic, damping) = if law.acts(indentation, *indented_only) {
                     let (force, elastic) = match law {
                         AnyLaw::HysterHertz(l) => HysterHertz::force_of(
                             l.parts(),

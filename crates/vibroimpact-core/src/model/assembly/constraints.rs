@@ -133,7 +133,7 @@ impl Assembly {
                     }
                     let rate = -h_dot(&it.h, v);
                     let (_, by_indentation, by_rate, damping) =
-                        if indentation > 0.0 || (inside && indentation == 0.0) {
+                        if law.acts(indentation, indented_only) || (inside && indentation == 0.0) {
                             let (force, by_indentation, by_rate) =
                                 law.force_derivatives(indentation, rate, approach_rate);
                             (force, by_indentation, by_rate, damping)

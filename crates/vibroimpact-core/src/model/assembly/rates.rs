@@ -188,7 +188,7 @@ impl Assembly {
                     };
                     products = Some((hx, hv));
                     let (indentation, rate) = (-(it.offset + hx), -hv);
-                    let (force, elastic, damping) = if indentation > 0.0 {
+                    let (force, elastic, damping) = if law.acts(indentation, *indented_only) {
                         let (force, elastic) =
                             law.force_and_elastic(indentation, rate, approach_rate);
                         (force, elastic, damping)
