@@ -40,7 +40,7 @@ def test_the_periodic_analyses_take_a_system() -> None:
     basins = vi.basins(system, (0, [0.015]), (1, [0.16]), settle_periods=50, record_periods=2)
     assert basins.labels.shape == (1, 1) and basins.labels[0, 0] == 0
     with pytest.raises(vi.InvalidInputError, match="run"):
-        vi.orbit(sections)  # type: ignore[arg-type]  # a dict is not a run, as before
+        vi.orbit(5)  # type: ignore[arg-type]  # (sections are taken: see below)
 
 
 def test_the_parameter_analyses_and_studies_take_a_system() -> None:
@@ -198,3 +198,28 @@ def test_basins_of_a_system_take_its_own_basins_table() -> None:
         vi.basins(system, first)
     with pytest.raises(ValueError, match=r"a \[basins\] table"):
         vi.basins(system.replace(analyses={}))
+
+
+@pytest.mark.timeout(120)
+def test_the_runner_analyses_take_a_scenarios_sections_too() -> None:
+    # The getting-started page says so; orbit, steady_state, poincare, basins (and
+    # lyapunov) had refused a dict ("run: must be a Runner", a new user's trial) where
+    # sweep, bifurcation and continuation took it. Each gives what the System gives.
+    path = ROOT / "examples" / "ball_table_basins.toml"
+    sections = tomllib.loads(path.read_text())
+    system = vi.load(path)
+    orbit, expected = vi.orbit(sections), vi.orbit(system)
+    assert orbit.converged
+    assert np.array_equal(orbit.floquet_multipliers, expected.floquet_multipliers)
+    steady = vi.steady_state(sections, settle_periods=20, record_periods=4)
+    own = vi.steady_state(system, settle_periods=20, record_periods=4)
+    assert steady.settled and np.array_equal(steady.state, own.state)
+    section = vi.poincare(sections, settle_periods=5, periods=10)
+    own_section = vi.poincare(system, settle_periods=5, periods=10)
+    assert np.array_equal(section.strobe, own_section.strobe)
+    axes = (0, np.linspace(0.005, 0.02, 2)), (1, np.linspace(-0.2, 0.2, 2))
+    basins = vi.basins(sections, *axes, settle_periods=20, record_periods=4)
+    own_basins = vi.basins(system, *axes, settle_periods=20, record_periods=4)
+    assert basins.labels.tolist() == own_basins.labels.tolist()
+    spectrum = vi.lyapunov(sections, settle=5, periods=20)
+    assert np.array_equal(spectrum.exponents, vi.lyapunov(system, settle=5, periods=20).exponents)

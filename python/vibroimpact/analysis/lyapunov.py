@@ -77,7 +77,7 @@ def lyapunov_runner(data: Mapping[str, Any] | System, base_dir: Path | None = No
 
 @arguments.typed()
 def lyapunov(
-    run: Runner | System,
+    run: Runner | System | Mapping[str, Any],
     state: np.ndarray | None = None,
     *,
     settle: int | None = None,
@@ -90,7 +90,7 @@ def lyapunov(
     stretches over the time (1/s). A system without excitation is averaged over
     ``[solver] t_end`` from ``state``, without settling. ``run``: a
     :class:`Runner` (see :func:`lyapunov_runner`) or a :class:`~vibroimpact.System`."""
-    if isinstance(run, System):
+    if isinstance(run, (System, Mapping)):
         run = lyapunov_runner(run)
     run = as_runner(run)
     state = checked_run(run, state)

@@ -57,7 +57,7 @@ class Section:
 
 @arguments.typed()
 def poincare(
-    run: Runner | System,
+    run: Runner | System | Mapping[str, Any],
     state: np.ndarray | None = None,
     *,
     settle_periods: int = 200,
@@ -283,7 +283,7 @@ def table_axes(
 
 @arguments.typed()
 def basins(
-    run: Runner | System,
+    run: Runner | System | Mapping[str, Any],
     first: tuple[int, np.ndarray] | None = None,
     second: tuple[int, np.ndarray] | None = None,
     *,
@@ -302,7 +302,7 @@ def basins(
     keeps it) gives them (its ``x`` and ``y``), and every setting not given here
     (``settle_periods`` 200, ``record_periods`` 20, ``tolerance`` 1e-6 where neither
     says)."""
-    data = sections_of(run)[0] if isinstance(run, System) else {}
+    data = sections_of(run)[0] if isinstance(run, (System, Mapping)) else {}
     given = {
         "first": first,
         "second": second,

@@ -47,6 +47,14 @@ def forcing_period(data: Mapping[str, Any]) -> float:
                 f"excitation {len(parts)}: frequencies must be numbers (Hz) for a periodic "
                 f"analysis, got {given!r:.60}"
             )
+        bad = [f for f in frequencies if not 0.0 <= f < math.inf]
+        if bad:
+            # As the run names it (the core's period rule had said only that a periodic
+            # analysis needs a harmonic excitation, naming no key).
+            key = "frequency" if signal == "harmonic" else "frequencies"
+            raise AnalysisError(
+                f"excitation {len(parts)}.{key}: must be finite and >= 0 Hz, got {bad[0]!r}"
+            )
         parts.append((signal, [float(f) for f in frequencies]))
     try:
         return _core_forcing_period(parts)

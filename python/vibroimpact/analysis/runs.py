@@ -312,10 +312,12 @@ def failed_everywhere(
     )
 
 
-def as_runner(run: Runner | System) -> Runner:
-    """The analyses' entry: a :class:`~vibroimpact.System` as its :class:`Runner`
-    (anything else as it is, for :func:`checked_run` to check)."""
-    return runner(run) if isinstance(run, System) else run
+def as_runner(run: Runner | System | Mapping[str, Any]) -> Runner:
+    """The analyses' entry: a :class:`~vibroimpact.System` or a scenario's sections
+    as its :class:`Runner` (anything else as it is, for :func:`checked_run` to
+    check). Sections had been refused by the analyses that take a Runner, where the
+    others took them (a new user's trial of the getting-started page)."""
+    return runner(run) if isinstance(run, (System, Mapping)) else run
 
 
 def checked_run(run: Any, state: Any) -> np.ndarray | None:

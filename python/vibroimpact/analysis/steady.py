@@ -88,7 +88,7 @@ class SteadyState:
 
 @arguments.typed()
 def steady_state(
-    run: Runner | System,
+    run: Runner | System | Mapping[str, Any],
     state: np.ndarray | None = None,
     *,
     settle_periods: int = 200,
