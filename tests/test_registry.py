@@ -264,7 +264,7 @@ def test_no_default_is_written_outside_the_core_registry() -> None:
     ("name", "value", "allowed"),
     [
         ("t_end", -1.0, "finite and > 0 s"),
-        ("dt", 0.0, "finite and > 0 s or None"),
+        ("dt", 0.0, "finite and > 0 s, or left out"),
         ("energy_tolerance", 2.0, "in (0, 1]"),
         ("rtol", 0.5, "in [1e-15, 0.1]"),
     ],

@@ -291,3 +291,30 @@ def test_a_large_failed_region_lists_a_few_reasons_and_counts_the_rest(tmp_path:
         assert len(reasons) == 10 and sorted(np.unique(ds["status"].values)) == list(range(1, 11))
     done = cli("study", str(scenario(tmp_path, text)), "--out", str(out), "--json")
     assert len(json.loads(done.stdout)["reasons"]) == 10
+
+
+def test_a_study_begun_in_python_resumes_from_the_command_line(tmp_path: Path) -> None:
+    """``vi.study_of(vi.load(path))`` and ``vibroimpact study path`` are one study: the
+    command line resumes the chunks Python kept (an adversarial probe: its fingerprint
+    had hashed the [study] table with its defaults filled in, Python's as written, so
+    the resume was refused as "another study"), and the file equals a whole run's."""
+    import vibroimpact as vi
+
+    path = scenario(tmp_path, (BASE + STEADY).replace("chunk_size = 7", "chunk_size = 3"))
+    study = vi.study_of(vi.load(path))
+    whole = tmp_path / "whole.nc"
+    assert cli("study", str(path), "--out", str(whole)).returncode == 0
+    out = tmp_path / "out.nc"
+
+    def stop_after_two(done: int, total: int, rate: float) -> None:
+        if done >= 6:
+            raise Stop
+
+    with pytest.raises(Stop):
+        st.run(study, out, progress=stop_after_two)
+    assert (out.with_name("out.nc.parts") / "chunk-000000.npz").exists()
+    proc = cli("study", str(path), "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert "resum" in proc.stderr
+    assert xr.open_dataset(out).attrs["input_hash"] == xr.open_dataset(whole).attrs["input_hash"]
+    assert out.read_bytes() == whole.read_bytes()

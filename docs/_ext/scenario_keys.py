@@ -137,7 +137,7 @@ SYSTEM = {
         ),
         "density": ("kg m-3", "> 0", "the material's density (instead of mass_per_length)"),
         "modes": ("1", "[1, 200]", "the modes kept (modal coordinates)"),
-        "damping_ratio": ("1", ">= 0", "every mode's damping ratio"),
+        "damping_ratio": ("1", "[0, 1]", "every mode's damping ratio"),
     },
     "damper": {
         "mass": ("kg", "> 0", "the loose mass"),
@@ -308,7 +308,12 @@ SYSTEM = {
             "the located peaks and RMS (peak, rms, point_*, moment_*) from this time on; the "
             "history, contacts, strobe and energy balance still start at t = 0",
         ),
-        "strobe_period": ("s", "> 0", "keep the state once every period (Poincare section)"),
+        "strobe_period": (
+            "s",
+            "> 0",
+            "keep the state once every period (Poincare section); an adaptive method steps "
+            "onto each of its instants, so its steps differ (within rtol) from a run without",
+        ),
         "points": (None, _POINT, "structure points whose displacement every reduction follows"),
         "moments": (
             "m",

@@ -67,7 +67,8 @@ def real(value: Any) -> int | float | None:
     booleans (Python's or NumPy's) included."""
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
         value = value[()]
-    if isinstance(value, bool | np.bool_):
+    # NumPy's times are integers to it (int() of one fails): no number of seconds.
+    if isinstance(value, bool | np.bool_ | np.timedelta64 | np.datetime64):
         return None
     if isinstance(value, np.integer):
         return int(value)

@@ -100,6 +100,7 @@ def netcdf_bytes(dataset: Any) -> bytes:
     return buffer.getvalue()
 
 
+@arguments.typed()
 def write_netcdf(dataset: Any, path: str | Path) -> None:
     """Write the xarray Dataset ``dataset`` to ``path`` as a NetCDF 4 file (64-bit
     integers, strings as strings, numeric variables compressed: see

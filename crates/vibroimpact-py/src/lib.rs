@@ -10,6 +10,7 @@ mod convert;
 mod errors;
 mod helpers;
 mod inputs;
+mod ready;
 mod registry;
 mod run;
 mod system;

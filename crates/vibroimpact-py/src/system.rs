@@ -11,197 +11,16 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyDict, PyList};
 use vibroimpact_core as core;
-use vibroimpact_core::kernel::events::{CarriedContact, RunOptions, Stepping};
-use vibroimpact_core::kernel::reductions::ReduceOptions;
+use vibroimpact_core::kernel::events::Stepping;
 use vibroimpact_core::methods::registry::{
-    check_settings, AnyStepper, Options, DEFAULT_MAX_ROWS, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE,
-    FORCING_PERIOD, RECORD_FROM, STROBE_PERIOD, SYSTEM, TOLERANCE, T_END,
+    Options, DEFAULT_MAX_STEPS, ENERGY_TOLERANCE, FORCING_PERIOD, RECORD_FROM, STROBE_PERIOD,
+    SYSTEM, TOLERANCE, T_END,
 };
 use vibroimpact_core::model::assembly::{initial_state, resumed_state, Assembly};
 
 use crate::convert::system::system_spec;
 use crate::errors::{released, to_py, InvalidInputError};
-
-/// The numbers a run takes beside its system and method.
-#[derive(Debug, Clone, Copy)]
-struct Limits {
-    dt: Option<f64>,
-    max_steps: u64,
-    max_rows: u64,
-    energy_tolerance: f64,
-    /// Events, or fixed steps (see `core::kernel::fixed`).
-    stepping: Stepping,
-}
-
-impl Limits {
-    /// The limits as given, each left out (None) taking the core registry's
-    /// default for a system, checked with the method's `options` against the
-    /// registry's ranges.
-    fn new(
-        method: &str,
-        t_end: f64,
-        dt: Option<f64>,
-        options: &Options,
-        (max_steps, max_rows, energy_tolerance): (Option<u64>, Option<u64>, Option<f64>),
-        (stepping, contact_timing): (Option<&str>, Option<&str>),
-    ) -> PyResult<Self> {
-        let energy_tolerance = energy_tolerance.unwrap_or(ENERGY_TOLERANCE.default_value());
-        check_method(t_end, dt, options, energy_tolerance)?;
-        Ok(Self {
-            dt,
-            max_steps: max_steps.unwrap_or(DEFAULT_MAX_STEPS),
-            max_rows: max_rows.unwrap_or(DEFAULT_MAX_ROWS),
-            energy_tolerance,
-            stepping: stepping_of(
-                match stepping {
-                    Some(stepping) => stepping,
-                    None => SYSTEM.stepping(method).map_err(to_py)?,
-                },
-                contact_timing.unwrap_or(SYSTEM.contact_timing),
-            )?,
-        })
-    }
-}
-
-/// A checked system with its method, ready to run from any state.
-pub(crate) struct Ready {
-    pub(crate) system: Assembly,
-    pub(crate) stepper: AnyStepper,
-    limits: Limits,
-}
-
-impl Ready {
-    fn new(
-        spec: &Bound<'_, PyDict>,
-        method: &str,
-        t_end: f64,
-        options: &Options,
-        limits: Limits,
-    ) -> PyResult<Self> {
-        let system_spec = system_spec(spec, t_end)?;
-        let system = Assembly::new(&system_spec).map_err(to_py)?;
-        let stepper = AnyStepper::new(&system, method, options).map_err(to_py)?;
-        stepper
-            .check_stepping(&system, limits.stepping)
-            .map_err(to_py)?;
-        Ok(Self {
-            system,
-            stepper,
-            limits,
-        })
-    }
-
-    /// Integrate from `y0` with the GIL released (see [`crate::released`]).
-    fn run(
-        &mut self,
-        py: Python<'_>,
-        start: (&[f64], &[Option<CarriedContact>]),
-        t_end: f64,
-        history: (bool, u64),
-        record_from: Option<f64>,
-        strobe_period: Option<f64>,
-    ) -> PyResult<core::kernel::events::SystemSolution> {
-        released(py, |interrupt| {
-            self.integrate(start, t_end, history, record_from, strobe_period, interrupt)
-        })
-    }
-
-    /// The options of a run to `t_end` (see [`Self::integrate`]).
-    pub(crate) fn options(
-        &self,
-        t_end: f64,
-        history: (bool, u64),
-        record_from: Option<f64>,
-        strobe_period: Option<f64>,
-    ) -> RunOptions {
-        let strobe_period = strobe_period.unwrap_or(f64::INFINITY);
-        let limits = self.limits;
-        let dt = self.stepper.step(limits.dt, t_end, strobe_period);
-        RunOptions {
-            dt,
-            t_end,
-            every: history.1,
-            keep_history: history.0,
-            max_steps: limits.max_steps,
-            max_rows: limits.max_rows,
-            energy_tolerance: limits.energy_tolerance,
-            reduce: ReduceOptions {
-                record_from: record_from.unwrap_or(f64::INFINITY),
-                strobe_period,
-                mean_square: true,
-                contacts_from: f64::NEG_INFINITY,
-            },
-        }
-    }
-
-    /// Integrate from `y0`, continuing the contacts `carried` (the caller
-    /// holds no GIL).
-    fn integrate(
-        &mut self,
-        start: (&[f64], &[Option<CarriedContact>]),
-        t_end: f64,
-        history: (bool, u64),
-        record_from: Option<f64>,
-        strobe_period: Option<f64>,
-        interrupt: &mut dyn FnMut() -> bool,
-    ) -> core::Result<core::kernel::events::SystemSolution> {
-        let options = self.options(t_end, history, record_from, strobe_period);
-        let (system, stepping) = (&self.system, self.limits.stepping);
-        // The registry's run, which gives an energy error its method's advice.
-        self.stepper
-            .integrate_continued(system, start, &options, stepping, interrupt)
-    }
-
-    /// The full state of the flat state `z` (x then v).
-    pub(crate) fn full_state(&self, z: &[f64]) -> core::Result<Vec<f64>> {
-        full_state(&self.system, z)
-    }
-
-    /// The stroboscopic map over `t_end` from the flat state `z` with its
-    /// Jacobian from the tangent flow (row-major).
-    /// Its grazings into `grazed` (the last map's: the orbit's, once Newton's
-    /// method has converged, as `shoot` returns it).
-    fn map_tangent(
-        &mut self,
-        z: &[f64],
-        t_end: f64,
-        interrupt: &mut dyn FnMut() -> bool,
-        grazed: &mut Vec<core::analysis::tangent::Grazing>,
-    ) -> core::Result<(Vec<f64>, Vec<f64>)> {
-        let y0 = self.full_state(z)?;
-        let options = self.options(t_end, (false, 1), None, None);
-        let Self {
-            system, stepper, ..
-        } = self;
-        let mut flow = core::analysis::tangent::Tangent::product(system)?;
-        let end = stepper.integrate_observed(system, &y0, &options, interrupt, &mut flow)?;
-        let size = 2 * system.dim;
-        grazed.clear();
-        grazed.extend_from_slice(flow.grazings());
-        Ok((end.final_state[..size].to_vec(), flow.matrix().to_vec()))
-    }
-
-    /// The stroboscopic map over `t_end` from the flat state `z` (x then v).
-    fn map(
-        &mut self,
-        z: &[f64],
-        t_end: f64,
-        interrupt: &mut dyn FnMut() -> bool,
-    ) -> core::Result<Vec<f64>> {
-        let (n, d) = (self.system.n, self.system.dim);
-        let y0 = resumed_state(&self.system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..]])?;
-        Ok(self
-            .integrate((&y0, &[]), t_end, (false, 1), None, None, interrupt)?
-            .final_state)
-    }
-}
-
-/// The full state (with the energy accumulators) of `system`'s flat state `z`
-/// (x then v).
-pub(crate) fn full_state(system: &Assembly, z: &[f64]) -> core::Result<Vec<f64>> {
-    let (n, d) = (system.n, system.dim);
-    resumed_state(system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..]])
-}
+use crate::ready::{check_method, Limits, Ready};
 
 /// A 0.2 system checked once, with its method, to run many times from any
 /// state (the analyses' stroboscopic maps): see `vibroimpact.analysis`.
@@ -316,9 +135,9 @@ impl PreparedSystem {
         carried: Option<Vec<Option<[f64; 4]>>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let mut ready = self.locked(py, Some(&state))?;
+        T_END.check(t_end).map_err(to_py)?;
         let system = &ready.system;
         let (n, d) = (system.n, system.dim);
-        T_END.check(t_end).map_err(to_py)?;
         record_from
             .map(|v| RECORD_FROM.check(v))
             .transpose()
@@ -412,19 +231,6 @@ impl PreparedSystem {
     }
 }
 
-/// The settings a run takes, each finite and in its range: the core
-/// registry's check.
-fn check_method(
-    t_end: f64,
-    dt: Option<f64>,
-    options: &Options,
-    energy_tolerance: f64,
-) -> PyResult<()> {
-    check_settings(t_end, dt, *options, energy_tolerance)
-        .map(|_| ())
-        .map_err(to_py)
-}
-
 /// Integrate a 0.2 system (see `vibroimpact.simulate_system`). Returns a
 /// dict of flat arrays that the Python side shapes.
 #[pyfunction]
@@ -483,11 +289,6 @@ pub fn simulate_system<'py>(
 fn start_of(system: &Assembly, initial: &[Vec<f64>; 4]) -> PyResult<Vec<f64>> {
     let [x, v, z, w] = initial;
     initial_state(system, x, v, z, w).map_err(to_py)
-}
-
-/// The kernel's stepping from `[solver] stepping` and `contact_timing`.
-fn stepping_of(stepping: &str, contact_timing: &str) -> PyResult<Stepping> {
-    Stepping::parse(stepping, contact_timing).map_err(to_py)
 }
 
 /// A run's results as a dict of flat arrays.

@@ -11,7 +11,8 @@ use vibroimpact_core::methods::registry::T_END;
 use vibroimpact_core::model::assembly::Scratch;
 
 use crate::errors::{released, to_py, InvalidInputError};
-use crate::system::{full_state, PreparedSystem, Ready};
+use crate::ready::{full_state, Ready};
+use crate::system::PreparedSystem;
 
 /// The prepared system's run state, locked, with `state` checked to be `2 dim`
 /// values.
@@ -74,9 +75,13 @@ pub fn tangent_map<'py>(
     let shifted = shifted_systems(py, parameters)?;
     let mut guard = ready_for(py, prepared, &state)?;
     let ready: &mut Ready = &mut guard;
+    ready.check_length(t_end, "t_end")?;
     let (end, rate, matrix, impacts, found, columns) = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
-        let options = ready.options(t_end, (false, 1), None, None);
+        let mut options = ready.options(t_end, (false, 1), None, None);
+        // The map reads no contact: none kept (a long run's table had grown
+        // toward the records' limit for nothing).
+        options.reduce.contacts_from = f64::INFINITY;
         let Ready {
             system, stepper, ..
         } = ready;
@@ -135,9 +140,11 @@ pub fn lyapunov_spectrum<'py>(
             "blocks must be a whole number in [1, 1000000], got {blocks}"
         )));
     }
-    let blocks = blocks as usize;
     let mut guard = ready_for(py, prepared, &state)?;
     let ready: &mut Ready = &mut guard;
+    let total = block_time * blocks as f64;
+    ready.check_length(total, "block_time x blocks")?;
+    let blocks = blocks as usize;
     let spectrum = released(py, |interrupt| {
         let y0 = ready.full_state(&state)?;
         let mut options = ready.options(block_time, (false, 1), None, None);

@@ -10,11 +10,12 @@ import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
-from pathlib import Path
+from pathlib import Path, PurePath
 from typing import Any, TypeVar
 
 import numpy as np
 
+from vibroimpact import arguments
 from vibroimpact._core import METHODS, InvalidInputError, PreparedSystem
 from vibroimpact.arguments import directory
 from vibroimpact.messages import shown, unknown_section
@@ -179,7 +180,7 @@ class System:
         """Whether a recorded signal reads a ``file`` by a relative path."""
         return any(
             isinstance(e.signal, Recorded)
-            and e.signal.file is not None
+            and isinstance(e.signal.file, str | PurePath)
             and not Path(e.signal.file).is_absolute()
             for e in self.excitations
         )
@@ -290,6 +291,7 @@ class System:
         analyses: dict[str, Any] = _plain_values(self.analyses)
         return sections | analyses
 
+    @arguments.typed()
     def to_toml(self, *, solver: Solver | None = None, output: Output | None = None) -> str:
         """The system as a 0.2 scenario (TOML text, SI units) that
         :func:`vibroimpact.load` reads back into an equal System (a recorded signal's
@@ -303,6 +305,13 @@ class System:
                 solver=self.solver if solver is None else solver,
                 output=self.output if output is None else output,
             )
+        for index, excitation in enumerate(system.excitations):
+            name = getattr(excitation.signal, "file", None)
+            if isinstance(name, str) and _not_utf8(name):
+                raise InvalidInputError(
+                    f"System.to_toml: [[excitation]] {index} file: {name!r} is not UTF-8 "
+                    "text, which a TOML file holds; rename the file (it runs from Python)"
+                )
         text = toml_text(system.to_dict())
         size = len(text.encode("utf-8"))
         if size > MAX_SCENARIO_BYTES:
@@ -327,6 +336,7 @@ class System:
         return System(**(values | changes))
 
     @classmethod
+    @arguments.typed()
     def from_dict(cls, sections: Mapping[str, Any], base_dir: Path | None = None) -> System:
         """A System of a scenario's sections (as ``tomllib`` reads a 0.2 scenario, or
         :meth:`to_dict` gives); checked first as they are, so that a bad table gets the
@@ -436,11 +446,26 @@ def _parts(name: str, value: Any, kind: type | tuple[type, ...], wanted: str) ->
     return tuple(value)
 
 
+def _not_utf8(text: str) -> bool:
+    """Whether ``text`` holds what UTF-8 cannot write (a file name's undecodable bytes,
+    which Python keeps as lone surrogates)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
+
+
 def listed_tables(value: Any) -> list[Mapping[str, Any]]:
-    """An array of tables (or one table) as a list."""
+    """An array of tables (or one table) as a list; a TypeError where it is neither
+    (``excitation = "abc"`` had been taken letter by letter, a message naming nothing:
+    the schema's error names the section)."""
     if value is None:
         return []
-    return [value] if isinstance(value, Mapping) else list(value)
+    tables = [value] if isinstance(value, Mapping) else value
+    if not isinstance(tables, list | tuple) or not all(isinstance(t, Mapping) for t in tables):
+        raise TypeError("not an array of tables: the schema's error names it")
+    return list(tables)
 
 
 def _part(kind: type[_P], table: Any) -> _P | None:

@@ -45,6 +45,7 @@ def _load(path: Path) -> dict[str, Any]:
     return part
 
 
+@arguments.typed()
 def run(
     study: Study,
     out: Path,

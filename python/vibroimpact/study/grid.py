@@ -52,7 +52,15 @@ class Study:
         """A hash of everything that decides the results: the scenario, the version,
         and the contents of the files it reads (a recorded signal changed between an
         interrupted run and its resumption would otherwise mix two inputs)."""
-        content: dict[str, Any] = {"data": _plain(self.data), "version": __version__}
+        # The [study] table as checked, its defaults filled in: a scenario's own table
+        # (the command line's) and a System's (vi.load's) had hashed apart, and a study
+        # begun one way could not be resumed the other.
+        data = {key: value for key, value in self.data.items() if key != "study"}
+        content: dict[str, Any] = {
+            "data": _plain(data),
+            "study": _plain(self.settings),
+            "version": __version__,
+        }
         files: list[str | None] = []
         for e in self.data.get("excitation", None) or ():
             name = e.get("file") if isinstance(e, Mapping) else None

@@ -199,7 +199,8 @@ def study_settings(table: Any, build: bool = True) -> dict[str, Any]:
             sizes += f" x samples {out['samples']}"
             keys = "[study] samples, [study.axes] count"
         raise StudyError(
-            f"{keys}: the study would make {runs:.3g} runs ({sizes}), more than "
+            # Whole: 1e+07 of 10,010,001 had read as the limit itself.
+            f"{keys}: the study would make {runs:,} runs ({sizes}), more than "
             f"{MAX_STUDY_RUNS:,}; lower the counts or samples, or split the study"
         )
     if not build:

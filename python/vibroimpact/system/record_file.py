@@ -96,6 +96,9 @@ def _read_bytes(path: Path, where: str) -> bytes:
     """The file's bytes, checked as UTF-8: a regular file of at most
     :data:`MAX_RECORDED_FILE_BYTES`, refused before it is read."""
     name = str(path)
+    if "\0" in name:
+        # The system's calls refuse it with Python's "embedded null byte", naming nothing.
+        raise _fail(where, f"{name!r} holds a null character, which no file name can")
     too_large = (
         f"{name!r} is larger than {MAX_RECORDED_FILE_BYTES // 2**20} MiB, the limit of a "
         "recorded signal"

@@ -264,7 +264,7 @@ fn check_finite_modes(structure: &Structure) -> Result<Option<f64>> {
 /// The most a coordinate's damping may be over its mass, `c / m` (1/s): its
 /// square, which the modes' and the flow's eigenvalues take, stays a double.
 /// A damping of 1e308 N s/m on 1 kg had been refused as "dt must be finite
-/// and > 0 s or None, got 0" (the exact flow's step underflowed).
+/// and > 0 s, or left out, got 0" (the exact flow's step underflowed).
 const MAX_DAMPING_RATE: f64 = 1e150;
 
 /// Refuse a structure whose damping over its mass (a diagonal term's

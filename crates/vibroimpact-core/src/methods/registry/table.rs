@@ -94,7 +94,7 @@ pub const DT: OptionSpec = OptionSpec {
     low: 0.0,
     high: f64::MAX,
     low_open: true,
-    allowed: "finite and > 0 s or None",
+    allowed: "finite and > 0 s, or left out",
 };
 /// The relative tolerance of an error control: looser than a tenth controls
 /// nothing (the run would stop on its energy balance); tighter than 1e-15 is

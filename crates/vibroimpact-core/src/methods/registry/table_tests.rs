@@ -106,7 +106,7 @@ fn a_run_s_settings_are_checked_with_its_options() {
                 Some(-1.0),
                 good,
                 0.05,
-                "dt must be finite and > 0 s or None, got -1",
+                "dt must be finite and > 0 s, or left out, got -1",
             ),
             (
                 1.0,
