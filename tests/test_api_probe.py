@@ -132,3 +132,30 @@ def test_a_periodic_analysis_names_a_negative_forcing_frequency() -> None:
             ValueError, match=r"^excitation 0\.frequency: must be finite and >= 0 Hz"
         ):
             analysis(sections)
+
+
+@pytest.mark.parametrize("count", [-1, 0, 10_000_001])
+def test_a_study_axis_count_is_told_one_range(count: int) -> None:
+    # A studies probe: -1 was told [0, 2^63 - 1], and 0 then refused as ">= 1".
+    from vibroimpact.study.settings import study_settings
+
+    axes = {"damper.0.clearance": {"start": 1e-3, "stop": 2e-3, "count": count}}
+    with pytest.raises(
+        ValueError, match=rf"count: must be a whole number in \[1, 10,000,000\], got {count}$"
+    ):
+        study_settings({"axes": axes})
+
+
+def test_a_drawn_path_no_study_can_vary_is_named_as_drawn() -> None:
+    # It had been named "study axis" where [study.random] gave it.
+    sections = _forced().to_dict()
+    sections["solver"] = {"method": "exact", "t_end": 0.5}
+    sections["study"] = {
+        "axes": {"damper.0.clearance": [0.004, 0.005]},
+        "random": {"damper.0.colour": {"uniform": [0.01, 0.02]}},
+        "samples": 2,
+    }
+    with pytest.raises(
+        ValueError, match=r"\[study.random\] 'damper.0.colour': not a path a study can vary"
+    ):
+        vi.study_of(sections)

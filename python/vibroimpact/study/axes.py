@@ -49,13 +49,16 @@ def _axis_count(path: str, spec: Any) -> int:
     spec = _listed(spec)
     if not isinstance(spec, Mapping):
         return len(_axis_values(path, spec))
+    allowed = f"{where}count: must be a whole number in [1, {MAX_STUDY_RUNS:,}]"
+    given = spec.get("count")
+    if isinstance(given, int) and not isinstance(given, bool) and given < 1:
+        # One range for every count refused (a negative one had been told [0, 2^63 - 1]).
+        raise StudyError(f"{allowed}, got {given}")
     axis = _table(where, spec, _AXIS)
     _choice(where, "spacing", axis["spacing"], _SPACINGS)
     count: int = axis["count"]
-    if count < 1:
-        raise StudyError(f"{where}count: must be >= 1, got {count}")
     if count > MAX_STUDY_RUNS:
-        raise StudyError(f"{where}count: must be at most {MAX_STUDY_RUNS:,}, got {count}")
+        raise StudyError(f"{allowed}, got {count}")
     dropped = single_value_drops_stop(where, axis["start"], axis["stop"], count)
     if dropped:
         raise StudyError(dropped)

@@ -192,7 +192,18 @@ def study_of(
         except InvalidInputError as err:
             raise StudyError(f"{source}: {err}") from None
     # The base scenario and every axis path are checked by a run of none.
-    shape = study.run_chunk(range(0, 0))
+    try:
+        shape = study.run_chunk(range(0, 0))
+    except InvalidInputError as err:
+        # The core names each varied path a study axis: a drawn one is named where it is.
+        text = str(err)
+        for path in checked.get("random", {}):
+            text = text.replace(
+                f"study axis {json.dumps(str(path))}", f"[study.random] {str(path)!r}"
+            )
+        if text == str(err):
+            raise
+        raise type(err)(text) from None
     # Each structure coordinate, then each followed point and moment.
     followed = _count(output, "points") + _count(output, "moments")
     check_study_memory(study.runs, int(shape["n"]) + followed, len(shape["pairs"]), source)
