@@ -257,15 +257,17 @@ class Stop(Exception):
     pass
 
 
+def stop_after_two(done: int, total: int, rate: float) -> None:
+    """A study's progress that stops it once two chunks of 3 runs are kept."""
+    if done >= 6:
+        raise Stop
+
+
 def test_an_interrupted_study_resumes_into_the_same_file(tmp_path: Path) -> None:
     study = load(scenario(tmp_path, (BASE + STEADY).replace("chunk_size = 7", "chunk_size = 3")))
     whole = tmp_path / "whole.nc"
     st.run(study, whole)
     resumed = tmp_path / "resumed.nc"
-
-    def stop_after_two(done: int, total: int, rate: float) -> None:
-        if done >= 6:
-            raise Stop
 
     with pytest.raises(Stop):
         st.run(study, resumed, progress=stop_after_two)

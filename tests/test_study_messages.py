@@ -20,7 +20,7 @@ import xarray as xr
 
 from conftest import shell_signals
 from study_checks import FORCED_DAMPER  # noqa: E402
-from test_study import BASE, STEADY, Stop, cli, load, scenario
+from test_study import BASE, STEADY, Stop, cli, load, scenario, stop_after_two
 from test_study_orbit import LINEAR
 from vibroimpact import study as st
 from vibroimpact.analysis import runner, steady_state, with_parameter
@@ -305,10 +305,6 @@ def test_a_study_begun_in_python_resumes_from_the_command_line(tmp_path: Path) -
     whole = tmp_path / "whole.nc"
     assert cli("study", str(path), "--out", str(whole)).returncode == 0
     out = tmp_path / "out.nc"
-
-    def stop_after_two(done: int, total: int, rate: float) -> None:
-        if done >= 6:
-            raise Stop
 
     with pytest.raises(Stop):
         st.run(study, out, progress=stop_after_two)

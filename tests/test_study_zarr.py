@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 import xarray as xr
 
-from test_study import BASE, MONTE_CARLO, STEADY, Stop, cli, load, scenario
+from test_study import BASE, MONTE_CARLO, STEADY, Stop, cli, load, scenario, stop_after_two
 from test_user_experience import one_line_error, run_main
 from vibroimpact import output
 from vibroimpact import study as st
@@ -71,10 +71,6 @@ def test_an_interrupted_zarr_study_resumes_into_the_same_store(tmp_path: Path) -
     whole = tmp_path / "whole.zarr"
     st.run(study, whole)
     resumed = tmp_path / "resumed.zarr"
-
-    def stop_after_two(done: int, total: int, rate: float) -> None:
-        if done >= 6:
-            raise Stop
 
     with pytest.raises(Stop):
         st.run(study, resumed, progress=stop_after_two)

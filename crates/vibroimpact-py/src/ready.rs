@@ -233,8 +233,7 @@ impl Ready {
         t_end: f64,
         interrupt: &mut dyn FnMut() -> bool,
     ) -> core::Result<Vec<f64>> {
-        let (n, d) = (self.system.n, self.system.dim);
-        let y0 = resumed_state(&self.system, [&z[..n], &z[d..d + n], &z[n..d], &z[d + n..]])?;
+        let y0 = self.full_state(z)?;
         Ok(self
             .integrate((&y0, &[]), t_end, (false, 1), None, None, interrupt)?
             .final_state)

@@ -126,12 +126,13 @@ def orbit(
     # the map of (x, v) there would begin the contact afresh (see _clear_section).
     shooting, z, moved = _clear_section(run, z)
     shot = shooting.shoot(z, periods, tolerance, max_iterations, jacobian)
-    if not moved and _in_contact(_latching_walls(run), np.asarray(shot["state"], dtype=float)):
+    found = np.asarray(shot["state"], dtype=float)
+    if not moved and _in_contact(_latching_walls(run), found):
         # The guess was clear of those contacts, the point found is not: it solved the
         # map that begins the contact afresh at the section, not the motion's (a
         # physicist's probe: "converged" on a false orbit, its multipliers 0.7 % off).
         # Shot again from a section clear of the point's contact.
-        shooting, z, moved = _clear_section(run, np.asarray(shot["state"], dtype=float))
+        shooting, z, moved = _clear_section(run, found)
         if moved:
             shot = shooting.shoot(z, periods, tolerance, max_iterations, jacobian)
     size = len(z)
